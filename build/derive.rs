@@ -1,0 +1,665 @@
+//! The derivations, with Symbolica (build time only, one thread).
+//!
+//! From a validated [`Model`] this derives, symbolically and without any
+//! special case per model:
+//! - the Lagrangian with positions substituted and velocities taken as total
+//!   time derivatives; terms depending on time only are dropped (they are total
+//!   time derivatives and change no equation of motion);
+//! - the mass matrix A(q) = ∂²L/∂q'², the linear term b(q, θ) = ∂L/∂q'|_{q'=0},
+//!   the potential V(q, θ) = −L|_{q'=0}, the momenta p = A q' + b;
+//! - the velocities q' = A⁻¹(p − b) (A⁻¹ by cofactors) and the Hamiltonian
+//!   H = ½ (p − b)ᵀ A⁻¹ (p − b) + V;
+//! - Hamilton's equations with generalised forces: q' as above,
+//!   p' = ∂L/∂q + Q evaluated at that q' (equal to −∂H/∂q + Q);
+//! - with a fast phase θ: the means over θ of H (H̄), V, the vibrational
+//!   potential V_vibr = ½ mean(bᵀ A⁻¹ b), the forces P̄ = mean Q(q, q'(q, p, θ)),
+//!   the averaged equations q' = ∂H̄/∂p, p' = −∂H̄/∂q + P̄;
+//! - the Jacobians of both vector fields, ∂V/∂q, C = ∂²V/∂q² and the Hessian
+//!   of the effective potential V + V_vibr.
+//!
+//! Every result is kept as Symbolica's printed text (for snapshots and for
+//! code generation) and as LaTeX.
+
+use crate::model::{Expr, Model};
+use symbolica::prelude::*;
+
+/// One derived expression, printed.
+pub struct Derived {
+    /// Stable key, e.g. `hamiltonian` or `mass_matrix[0][1]`.
+    pub key: String,
+    pub description: String,
+    pub text: String,
+    pub latex: String,
+}
+
+/// The part of the derivation the code generator needs, as printed text.
+pub struct Derivation {
+    pub dof: usize,
+    /// Everything derived, in reading order, for snapshots and reports.
+    pub derived: Vec<Derived>,
+    /// Velocities q'(q, p, θ).
+    pub velocities: Vec<String>,
+    /// ∂L/∂q + Q, in terms of q, q', θ (evaluated after the velocities).
+    pub momentum_rates: Vec<String>,
+    /// p = A q' + b in terms of q, q', θ.
+    pub momenta: Vec<String>,
+    pub hamiltonian: String,
+    /// Jacobian of the exact field; entries may use the velocity symbols.
+    pub exact_jacobian: Vec<Vec<String>>,
+    pub mass_matrix: Vec<Vec<String>>,
+    /// Phase averaged quantities (empty without a fast phase).
+    pub averaged_rhs: Vec<String>,
+    pub averaged_jacobian: Vec<Vec<String>>,
+    pub averaged_hamiltonian: String,
+    /// Potential (its mean over the phase, if any).
+    pub potential: String,
+    pub vibrational_potential: String,
+    pub potential_gradient: Vec<String>,
+    pub potential_hessian: Vec<Vec<String>>,
+    pub effective_potential_hessian: Vec<Vec<String>>,
+    /// dθ/dt in terms of the parameters.
+    pub phase_rate: String,
+}
+
+/// A derivation failure, with the model quantity it concerns.
+pub struct DeriveError {
+    pub key: String,
+    pub reason: String,
+}
+
+fn atom(text: &str) -> Result<Atom, DeriveError> {
+    try_parse!(text).map_err(|e| DeriveError {
+        key: "(internal)".into(),
+        reason: format!("Symbolica cannot parse '{text}': {e}"),
+    })
+}
+
+fn var(name: &str) -> Atom {
+    Atom::var(symbol!(name))
+}
+
+fn num(n: i64) -> Atom {
+    Atom::num(n)
+}
+
+fn subst(e: &Atom, name: &str, by: &Atom) -> Atom {
+    e.replace(var(name).to_pattern()).with(by.to_pattern())
+}
+
+fn is_zero(e: &Atom) -> bool {
+    e.expand().to_string() == "0"
+}
+
+fn latex(e: &Atom) -> String {
+    let mut options = PrintOptions::latex();
+    options.hide_all_namespaces = true;
+    e.printer(options).to_string()
+}
+
+/// Momentum symbol of a coordinate.
+pub fn momentum_name(coordinate: &str) -> String {
+    format!("p_{coordinate}")
+}
+
+/// Mean over one period of the phase `phase`, for expressions that contain the
+/// phase only through sin(phase) and cos(phase), polynomially: with S = sin,
+/// C = cos, mean(S^a C^b) = (a−1)!!(b−1)!!/(a+b)!! for even a, b and 0 otherwise.
+/// Coefficients are read off as Taylor coefficients in S and C.
+fn phase_mean(e: &Atom, phase: &str) -> Result<Atom, DeriveError> {
+    let (s_name, c_name) = ("phase__sin", "phase__cos");
+    let s = var(s_name);
+    let c = var(c_name);
+    let replaced = e
+        .replace(atom(&format!("sin({phase})"))?.to_pattern())
+        .with(s.to_pattern())
+        .replace(atom(&format!("cos({phase})"))?.to_pattern())
+        .with(c.to_pattern());
+    if !is_zero(&replaced.derivative(symbol!(phase))) {
+        return Err(DeriveError {
+            key: "fast_phase".into(),
+            reason: format!(
+                "the phase '{phase}' enters other than through sin({phase}) and cos({phase}); rewrite multiple angles with addition formulas"
+            ),
+        });
+    }
+    fn double_factorial(n: i64) -> i64 {
+        if n <= 0 {
+            1
+        } else {
+            n * double_factorial(n - 2)
+        }
+    }
+    let mut mean = num(0);
+    let mut ds = replaced;
+    let mut a = 0i64;
+    let mut a_factorial = 1i64;
+    while !is_zero(&ds) {
+        let mut dsc = ds.clone();
+        let mut b = 0i64;
+        let mut b_factorial = 1i64;
+        while !is_zero(&dsc) {
+            if a % 2 == 0 && b % 2 == 0 {
+                let coefficient = subst(&subst(&dsc, s_name, &num(0)), c_name, &num(0));
+                let weight = Atom::num(double_factorial(a - 1) * double_factorial(b - 1))
+                    / Atom::num(double_factorial(a + b) * a_factorial * b_factorial);
+                mean = mean + coefficient * weight;
+            }
+            dsc = dsc.derivative(symbol!(c_name));
+            b += 1;
+            b_factorial *= b;
+        }
+        ds = ds.derivative(symbol!(s_name));
+        a += 1;
+        a_factorial *= a;
+    }
+    Ok(mean)
+}
+
+/// Determinant by cofactor expansion (the systems here have 1–3 degrees of freedom).
+fn determinant(m: &[Vec<Atom>]) -> Atom {
+    let n = m.len();
+    if n == 1 {
+        return m[0][0].clone();
+    }
+    let mut det = num(0);
+    for j in 0..n {
+        let minor: Vec<Vec<Atom>> = m[1..]
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != j)
+                    .map(|(_, a)| a.clone())
+                    .collect()
+            })
+            .collect();
+        let term = &m[0][j] * &determinant(&minor);
+        det = if j % 2 == 0 { det + term } else { det - term };
+    }
+    det
+}
+
+/// Inverse by cofactors over the expanded determinant.
+fn inverse(m: &[Vec<Atom>]) -> (Atom, Vec<Vec<Atom>>) {
+    let n = m.len();
+    let det = determinant(m).expand();
+    let inv = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    // (A⁻¹)_ij = cofactor_ji / det
+                    let cofactor = if n == 1 {
+                        num(1)
+                    } else {
+                        let minor: Vec<Vec<Atom>> = m
+                            .iter()
+                            .enumerate()
+                            .filter(|(r, _)| *r != j)
+                            .map(|(_, row)| {
+                                row.iter()
+                                    .enumerate()
+                                    .filter(|(k, _)| *k != i)
+                                    .map(|(_, a)| a.clone())
+                                    .collect()
+                            })
+                            .collect();
+                        let d = determinant(&minor).expand();
+                        if (i + j) % 2 == 0 {
+                            d
+                        } else {
+                            -d
+                        }
+                    };
+                    cofactor / &det
+                })
+                .collect()
+        })
+        .collect();
+    (det, inv)
+}
+
+/// Canonical form modulo sin²x + cos²x = 1 for the angle `x`: as a
+/// polynomial in S = sin x, every S^k becomes S^(k mod 2) (1 − C²)^(k div 2).
+/// Applied to the Lagrangian (a polynomial in these), so that everything
+/// derived from it is free of sin² + cos² leftovers.
+fn reduce_pythagorean(e: &Atom, angle: &str) -> Result<Atom, DeriveError> {
+    let (s_name, c_name) = ("angle__sin", "angle__cos");
+    let sin = atom(&format!("sin({angle})"))?;
+    let cos = atom(&format!("cos({angle})"))?;
+    let replaced = e
+        .replace(sin.to_pattern())
+        .with(var(s_name).to_pattern())
+        .replace(cos.to_pattern())
+        .with(var(c_name).to_pattern());
+    let one_minus_c2 = num(1) - var(c_name) * var(c_name);
+    let mut result = num(0);
+    let mut derivative = replaced;
+    let mut k = 0i64;
+    let mut factorial = 1i64;
+    while !is_zero(&derivative) {
+        let coefficient = subst(&derivative, s_name, &num(0)) / num(factorial);
+        let mut power = if k % 2 == 1 { var(s_name) } else { num(1) };
+        for _ in 0..k / 2 {
+            power = power * &one_minus_c2;
+        }
+        result = result + coefficient * power;
+        derivative = derivative.derivative(symbol!(s_name));
+        k += 1;
+        factorial *= k;
+    }
+    Ok(subst(&subst(&result, s_name, &sin), c_name, &cos).expand())
+}
+
+/// Drops the terms of an expanded sum that depend on none of `symbols`.
+fn drop_terms_without(e: &Atom, symbols: &[String]) -> Result<Atom, DeriveError> {
+    let text = e.expand().to_string();
+    let parsed = Expr::parse(&text).map_err(|err| DeriveError {
+        key: "lagrangian".into(),
+        reason: format!("cannot read back '{text}': {err}"),
+    })?;
+    let kept: Vec<Expr> = parsed
+        .terms()
+        .into_iter()
+        .filter(|t| t.symbols().iter().any(|s| symbols.contains(s)))
+        .collect();
+    atom(&Expr::sum(kept).to_string())
+}
+
+struct Recorder {
+    derived: Vec<Derived>,
+}
+
+impl Recorder {
+    fn record(
+        &mut self,
+        key: impl Into<String>,
+        description: impl Into<String>,
+        e: &Atom,
+    ) -> String {
+        let text = e.to_string();
+        self.derived.push(Derived {
+            key: key.into(),
+            description: description.into(),
+            text: text.clone(),
+            latex: latex(e),
+        });
+        text
+    }
+}
+
+fn matrix_text(m: &[Vec<Atom>]) -> Vec<Vec<String>> {
+    m.iter()
+        .map(|row| row.iter().map(|a| a.to_string()).collect())
+        .collect()
+}
+
+/// Runs every derivation for one model.
+pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
+    let n = model.dof();
+    let q: Vec<String> = model.coordinates.iter().map(|c| c.name.clone()).collect();
+    let qd: Vec<String> = model
+        .coordinates
+        .iter()
+        .map(|c| c.velocity.clone())
+        .collect();
+    let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
+    for name in &p {
+        let clash = model.parameters.iter().any(|x| &x.name == name)
+            || model.definitions.iter().any(|(d, _)| d == name);
+        if clash || q.contains(name) || qd.contains(name) {
+            return Err(DeriveError {
+                key: "coordinates".into(),
+                reason: format!("the momentum name '{name}' is already used"),
+            });
+        }
+    }
+    if n > 3 {
+        return Err(DeriveError {
+            key: "coordinates".into(),
+            reason: "more than 3 degrees of freedom: the symbolic inverse of the mass matrix is only emitted up to 3".into(),
+        });
+    }
+    let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
+    let rate = match &model.fast_phase {
+        Some(f) => atom(&f.rate.to_string())?,
+        None => num(1),
+    };
+    let mut rec = Recorder {
+        derived: Vec::new(),
+    };
+
+    // Positions, then their total time derivatives.
+    let mut positions: Vec<(String, Atom)> = Vec::new();
+    for (name, e) in &model.definitions {
+        let mut a = atom(&e.to_string())?;
+        for (prev, value) in &positions {
+            a = subst(&a, prev, value);
+        }
+        positions.push((name.clone(), a));
+    }
+    let total_derivative = |x: &Atom| -> Atom {
+        let mut d = num(0);
+        for (qi, qdi) in q.iter().zip(&qd) {
+            d = d + x.derivative(symbol!(qi.as_str())) * var(qdi);
+        }
+        match &phase {
+            Some(th) => d + &rate * x.derivative(symbol!(th.as_str())),
+            None => d + x.derivative(symbol!(model.time.as_str())),
+        }
+    };
+
+    // The Lagrangian: `dot(x)` becomes the symbol x__dot, replaced by its value.
+    let with_placeholders =
+        model
+            .lagrangian
+            .rewrite_calls(&mut |name, args| match (name, &args[0]) {
+                ("dot", Expr::Sym(s)) => Some(Expr::Sym(format!("{s}__dot"))),
+                _ => None,
+            });
+    let mut lagrangian = atom(&with_placeholders.to_string())?;
+    for (name, value) in &positions {
+        lagrangian = subst(
+            &lagrangian,
+            &format!("{name}__dot"),
+            &total_derivative(value),
+        );
+    }
+    for qi in &q {
+        lagrangian = subst(
+            &lagrangian,
+            &format!("{qi}__dot"),
+            &total_derivative(&var(qi)),
+        );
+    }
+    for (name, value) in &positions {
+        lagrangian = subst(&lagrangian, name, value);
+    }
+    let mut dynamic: Vec<String> = q.clone();
+    dynamic.extend(qd.iter().cloned());
+    let mut lagrangian = drop_terms_without(&lagrangian, &dynamic)?;
+    for (coordinate, c) in q.iter().zip(&model.coordinates) {
+        if c.periodic {
+            lagrangian = reduce_pythagorean(&lagrangian, coordinate)?;
+        }
+    }
+    rec.record(
+        "lagrangian",
+        "L(q, q', θ), terms depending on time only dropped",
+        &lagrangian,
+    );
+
+    // Mass matrix, linear term, potential.
+    let at_rest = |e: &Atom| qd.iter().fold(e.clone(), |acc, v| subst(&acc, v, &num(0)));
+    let mass: Vec<Vec<Atom>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    lagrangian
+                        .derivative(symbol!(qd[i].as_str()))
+                        .derivative(symbol!(qd[j].as_str()))
+                        .expand()
+                })
+                .collect()
+        })
+        .collect();
+    for i in 0..n {
+        for k in 0..n {
+            let third = mass[i][k].derivative(symbol!(qd[0].as_str()));
+            let mut nonzero = !is_zero(&third);
+            for v in &qd[1..] {
+                nonzero |= !is_zero(&mass[i][k].derivative(symbol!(v.as_str())));
+            }
+            if nonzero {
+                return Err(DeriveError {
+                    key: "lagrangian".into(),
+                    reason: "is not quadratic in the velocities".into(),
+                });
+            }
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            rec.record(
+                format!("mass_matrix[{i}][{j}]"),
+                "A = ∂²L/∂q'²",
+                &mass[i][j],
+            );
+        }
+    }
+    let linear: Vec<Atom> = (0..n)
+        .map(|i| at_rest(&lagrangian.derivative(symbol!(qd[i].as_str()))).expand())
+        .collect();
+    for (i, b) in linear.iter().enumerate() {
+        rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", b);
+    }
+    let potential = (-at_rest(&lagrangian)).expand();
+    rec.record("potential", "V = −L at q' = 0", &potential);
+
+    let momenta: Vec<Atom> = (0..n)
+        .map(|i| {
+            let mut m = linear[i].clone();
+            for j in 0..n {
+                m = m + &mass[i][j] * var(&qd[j]);
+            }
+            m.expand()
+        })
+        .collect();
+    for (i, m) in momenta.iter().enumerate() {
+        rec.record(
+            format!("momenta[{i}]"),
+            format!("{} = ∂L/∂{}", p[i], qd[i]),
+            m,
+        );
+    }
+
+    let (det, inv) = inverse(&mass);
+    if is_zero(&det) {
+        return Err(DeriveError {
+            key: "lagrangian".into(),
+            reason: "the mass matrix is singular".into(),
+        });
+    }
+    rec.record("mass_matrix_determinant", "det A", &det);
+    let shifted: Vec<Atom> = (0..n).map(|i| var(&p[i]) - &linear[i]).collect();
+    let velocities: Vec<Atom> = (0..n)
+        .map(|i| (0..n).fold(num(0), |acc, j| acc + &inv[i][j] * &shifted[j]))
+        .collect();
+    for (i, v) in velocities.iter().enumerate() {
+        rec.record(
+            format!("velocities[{i}]"),
+            format!("{} = A⁻¹(p − b)", qd[i]),
+            &v.together(),
+        );
+    }
+    let mut kinetic = num(0);
+    for i in 0..n {
+        for j in 0..n {
+            kinetic = kinetic + &shifted[i] * &inv[i][j] * &shifted[j];
+        }
+    }
+    let hamiltonian = kinetic / num(2) + &potential;
+    let hamiltonian_text = rec.record(
+        "hamiltonian",
+        "H = ½(p − b)ᵀA⁻¹(p − b) + V",
+        &hamiltonian.together(),
+    );
+
+    // Exact equations: q' = A⁻¹(p − b), p' = ∂L/∂q + Q at that q'.
+    let forces: Vec<Atom> = model
+        .forces
+        .iter()
+        .map(|f| atom(&f.to_string()))
+        .collect::<Result<_, _>>()?;
+    let rates: Vec<Atom> = (0..n)
+        .map(|i| (lagrangian.derivative(symbol!(q[i].as_str())) + &forces[i]).expand())
+        .collect();
+    let substitute_velocities = |e: &Atom| -> Atom {
+        qd.iter()
+            .zip(&velocities)
+            .fold(e.clone(), |acc, (name, value)| subst(&acc, name, value))
+    };
+    for i in 0..n {
+        rec.record(
+            format!("momentum_rates[{i}]"),
+            format!("d{}/dt = ∂L/∂{} + Q, at the velocities above", p[i], q[i]),
+            &rates[i],
+        );
+    }
+
+    // Jacobian of the exact field by the chain rule through q'(q, p).
+    let state: Vec<String> = q.iter().chain(&p).cloned().collect();
+    let mut exact_jacobian = vec![vec![String::new(); 2 * n]; 2 * n];
+    for (k, s) in state.iter().enumerate() {
+        let dv: Vec<Atom> = velocities
+            .iter()
+            .map(|v| v.derivative(symbol!(s.as_str())))
+            .collect();
+        for i in 0..n {
+            exact_jacobian[i][k] = dv[i].to_string();
+            let mut d = if k < n {
+                rates[i].derivative(symbol!(s.as_str()))
+            } else {
+                num(0)
+            };
+            for m in 0..n {
+                d = d + rates[i].derivative(symbol!(qd[m].as_str())) * &dv[m];
+            }
+            exact_jacobian[n + i][k] = d.to_string();
+        }
+    }
+
+    let mut derivation = Derivation {
+        dof: n,
+        derived: Vec::new(),
+        velocities: velocities.iter().map(|v| v.to_string()).collect(),
+        momentum_rates: rates.iter().map(|r| r.to_string()).collect(),
+        momenta: momenta.iter().map(|m| m.to_string()).collect(),
+        hamiltonian: hamiltonian_text,
+        exact_jacobian,
+        mass_matrix: matrix_text(&mass),
+        averaged_rhs: Vec::new(),
+        averaged_jacobian: Vec::new(),
+        averaged_hamiltonian: String::new(),
+        potential: String::new(),
+        vibrational_potential: String::new(),
+        potential_gradient: Vec::new(),
+        potential_hessian: Vec::new(),
+        effective_potential_hessian: Vec::new(),
+        phase_rate: rate.to_string(),
+    };
+
+    // Averaging over the fast phase.
+    let (mean_potential, vibrational) = match &phase {
+        Some(th) => {
+            let averaged_hamiltonian = phase_mean(&hamiltonian, th)?.together();
+            derivation.averaged_hamiltonian = rec.record(
+                "averaged_hamiltonian",
+                "H̄ = mean over the phase of H",
+                &averaged_hamiltonian,
+            );
+            let mean_potential = phase_mean(&potential, th)?.expand();
+            let mut quadratic = num(0);
+            for i in 0..n {
+                for j in 0..n {
+                    quadratic = quadratic + &linear[i] * &inv[i][j] * &linear[j];
+                }
+            }
+            let vibrational = phase_mean(&(quadratic / num(2)), th)?;
+            let vibrational = vibrational.together();
+            let averaged_forces: Vec<Atom> = forces
+                .iter()
+                .map(|f| phase_mean(&substitute_velocities(f), th).map(|a| a.together()))
+                .collect::<Result<_, _>>()?;
+            for (i, f) in averaged_forces.iter().enumerate() {
+                rec.record(
+                    format!("averaged_forces[{i}]"),
+                    "P̄ = mean Q(q, q'(q, p, θ))",
+                    f,
+                );
+            }
+            let mut rhs: Vec<Atom> = (0..n)
+                .map(|i| averaged_hamiltonian.derivative(symbol!(p[i].as_str())))
+                .collect();
+            for i in 0..n {
+                rhs.push(
+                    -averaged_hamiltonian.derivative(symbol!(q[i].as_str())) + &averaged_forces[i],
+                );
+            }
+            for (i, r) in rhs.iter().enumerate() {
+                rec.record(
+                    format!("averaged_rhs[{i}]"),
+                    format!("d{}/dt of the averaged system", state[i]),
+                    &r.together(),
+                );
+            }
+            derivation.averaged_rhs = rhs.iter().map(|r| r.to_string()).collect();
+            derivation.averaged_jacobian = rhs
+                .iter()
+                .map(|r| {
+                    state
+                        .iter()
+                        .map(|s| r.derivative(symbol!(s.as_str())).to_string())
+                        .collect()
+                })
+                .collect();
+            (mean_potential, vibrational)
+        }
+        None => (potential.clone(), num(0)),
+    };
+    if !is_zero(&mean_potential.derivative(symbol!(model.time.as_str()))) {
+        return Err(DeriveError {
+            key: "lagrangian".into(),
+            reason: "the potential depends on time other than through a fast phase".into(),
+        });
+    }
+    derivation.potential = rec.record(
+        "mean_potential",
+        "V averaged over the phase",
+        &mean_potential,
+    );
+    derivation.vibrational_potential = rec.record(
+        "vibrational_potential",
+        "V_vibr = ½ mean(bᵀ A⁻¹ b)",
+        &vibrational,
+    );
+    let effective = &mean_potential + &vibrational;
+    rec.record("effective_potential", "V + V_vibr", &effective.together());
+    derivation.potential_gradient = (0..n)
+        .map(|i| {
+            rec.record(
+                format!("potential_gradient[{i}]"),
+                "∂V/∂q",
+                &mean_potential.derivative(symbol!(q[i].as_str())),
+            )
+        })
+        .collect();
+    let hessian =
+        |e: &Atom, key: &str, description: &str, rec: &mut Recorder| -> Vec<Vec<String>> {
+            (0..n)
+                .map(|i| {
+                    (0..n)
+                        .map(|j| {
+                            let d = e
+                                .derivative(symbol!(q[i].as_str()))
+                                .derivative(symbol!(q[j].as_str()));
+                            rec.record(format!("{key}[{i}][{j}]"), description, &d.together())
+                        })
+                        .collect()
+                })
+                .collect()
+        };
+    derivation.potential_hessian = hessian(
+        &mean_potential,
+        "potential_hessian",
+        "C = ∂²V/∂q²",
+        &mut rec,
+    );
+    derivation.effective_potential_hessian = hessian(
+        &effective,
+        "effective_potential_hessian",
+        "∂²(V + V_vibr)/∂q²",
+        &mut rec,
+    );
+    derivation.derived = rec.derived;
+    Ok(derivation)
+}

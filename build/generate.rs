@@ -1,0 +1,437 @@
+//! Assembles the generated module of one model from its derivation and renders
+//! it through the tera templates in `templates/`.
+
+use crate::derive::{momentum_name, Derivation};
+use crate::emit::Emitter;
+use crate::model::Model;
+use serde::Serialize;
+
+#[derive(Serialize)]
+struct Function {
+    name: String,
+    doc: String,
+    args: String,
+    ret: String,
+    body: Vec<String>,
+    result: String,
+}
+
+#[derive(Serialize)]
+struct Param {
+    name: String,
+    default: String,
+    description: String,
+}
+
+#[derive(Serialize)]
+/// Rust string literals of one derived expression.
+struct DerivedEntry {
+    key: String,
+    description: String,
+    text: String,
+    latex: String,
+}
+
+/// What a function reads from its arguments.
+#[derive(Clone, Copy)]
+enum Inputs {
+    /// Parameters only.
+    Params,
+    /// Coordinates only (`q: &[f64; N]`).
+    Coordinates,
+    /// Coordinates and velocities, at time t.
+    CoordinatesVelocities,
+    /// The Hamiltonian state `y = [q, p]` at time t.
+    State,
+    /// The state of the autonomous averaged system.
+    AveragedState,
+}
+
+struct Context<'a> {
+    model: &'a Model,
+    derivation: &'a Derivation,
+}
+
+impl Context<'_> {
+    fn n(&self) -> usize {
+        self.derivation.dof
+    }
+    fn coordinates(&self) -> Vec<String> {
+        self.model
+            .coordinates
+            .iter()
+            .map(|c| c.name.clone())
+            .collect()
+    }
+    fn velocities(&self) -> Vec<String> {
+        self.model
+            .coordinates
+            .iter()
+            .map(|c| c.velocity.clone())
+            .collect()
+    }
+    fn momenta(&self) -> Vec<String> {
+        self.coordinates()
+            .iter()
+            .map(|c| momentum_name(c))
+            .collect()
+    }
+
+    fn signature_and_prelude(&self, inputs: Inputs) -> (String, Vec<String>) {
+        let n = self.n();
+        let params: Vec<String> = self
+            .model
+            .parameters
+            .iter()
+            .map(|p| p.name.clone())
+            .collect();
+        let mut prelude = vec![format!("let &Params {{ {} }} = params;", params.join(", "))];
+        let phase_line = self
+            .model
+            .fast_phase
+            .as_ref()
+            .map(|f| format!("let {} = t * phase_rate(params);", f.name));
+        let args = match inputs {
+            Inputs::Params => "params: &Params".to_string(),
+            Inputs::Coordinates => {
+                prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
+                format!("q: &[f64; {n}], params: &Params")
+            }
+            Inputs::CoordinatesVelocities => {
+                prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
+                prelude.push(format!("let [{}] = *qd;", self.velocities().join(", ")));
+                prelude.extend(phase_line);
+                format!("t: f64, q: &[f64; {n}], qd: &[f64; {n}], params: &Params")
+            }
+            Inputs::State | Inputs::AveragedState => {
+                let mut names = self.coordinates();
+                names.extend(self.momenta());
+                prelude.push(format!("let [{}] = *y;", names.join(", ")));
+                if matches!(inputs, Inputs::State) {
+                    prelude.extend(phase_line);
+                    format!("t: f64, y: &[f64; {}], params: &Params", 2 * n)
+                } else {
+                    format!("y: &[f64; {}], params: &Params", 2 * n)
+                }
+            }
+        };
+        (args, prelude)
+    }
+
+    /// A function evaluating `stages` of named outputs, returning `result`.
+    fn function(
+        &self,
+        name: &str,
+        doc: &str,
+        inputs: Inputs,
+        ret: String,
+        stages: &[Vec<(String, String)>],
+        result: String,
+    ) -> Result<Function, String> {
+        let (args, mut body) = self.signature_and_prelude(inputs);
+        let mut emitter = Emitter::default();
+        for stage in stages {
+            emitter.stage(stage).map_err(|e| format!("{name}: {e}"))?;
+        }
+        body.extend(emitter.finish());
+        Ok(Function {
+            name: name.into(),
+            doc: doc.into(),
+            args,
+            ret,
+            body,
+            result,
+        })
+    }
+}
+
+fn named(prefix: &str, values: &[String]) -> Vec<(String, String)> {
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (format!("{prefix}{i}"), v.clone()))
+        .collect()
+}
+
+fn matrix(prefix: &str, m: &[Vec<String>]) -> (Vec<(String, String)>, String) {
+    let mut outputs = Vec::new();
+    let mut rows = Vec::new();
+    for (i, row) in m.iter().enumerate() {
+        let mut cells = Vec::new();
+        for (j, v) in row.iter().enumerate() {
+            let name = format!("{prefix}_{i}_{j}");
+            outputs.push((name.clone(), v.clone()));
+            cells.push(name);
+        }
+        rows.push(format!("[{}]", cells.join(", ")));
+    }
+    (outputs, format!("[{}]", rows.join(", ")))
+}
+
+fn vector(prefix: &str, values: &[String]) -> (Vec<(String, String)>, String) {
+    let outputs = named(prefix, values);
+    let names: Vec<String> = outputs.iter().map(|(n, _)| n.clone()).collect();
+    (outputs, format!("[{}]", names.join(", ")))
+}
+
+/// Renders the generated module of one model.
+pub fn render(
+    tera: &tera::Tera,
+    model: &Model,
+    derivation: &Derivation,
+    source_file: &str,
+) -> Result<String, String> {
+    let cx = Context { model, derivation };
+    let n = cx.n();
+    let m = 2 * n;
+    let velocity_stage: Vec<(String, String)> = cx
+        .velocities()
+        .into_iter()
+        .zip(derivation.velocities.iter().cloned())
+        .collect();
+    let mut functions = Vec::new();
+
+    if model.fast_phase.is_some() {
+        functions.push(cx.function(
+            "phase_rate",
+            "dθ/dt of the fast phase θ.",
+            Inputs::Params,
+            "f64".into(),
+            &[vec![("rate".into(), derivation.phase_rate.clone())]],
+            "rate".into(),
+        )?);
+    }
+    let (outs, result) = vector("v", &derivation.velocities);
+    functions.push(cx.function(
+        "velocities",
+        "Velocities q' = A⁻¹(p − b) at state y = [q, p].",
+        Inputs::State,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = vector("p", &derivation.momenta);
+    functions.push(cx.function(
+        "momenta",
+        "Momenta p = A q' + b from coordinates and velocities.",
+        Inputs::CoordinatesVelocities,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (rates, _) = vector("dp", &derivation.momentum_rates);
+    let mut rhs_names = cx.velocities();
+    rhs_names.extend(rates.iter().map(|(name, _)| name.clone()));
+    functions.push(cx.function(
+        "exact_rhs",
+        "Hamilton's equations with forces: [q', p'] with q' = A⁻¹(p − b), p' = ∂L/∂q + Q.",
+        Inputs::State,
+        format!("[f64; {m}]"),
+        &[velocity_stage.clone(), rates],
+        format!("[{}]", rhs_names.join(", ")),
+    )?);
+    let (outs, result) = matrix("j", &derivation.exact_jacobian);
+    functions.push(cx.function(
+        "exact_jacobian",
+        "Jacobian ∂(q', p')/∂(q, p) of the exact field.",
+        Inputs::State,
+        format!("[[f64; {m}]; {m}]"),
+        &[velocity_stage.clone(), outs],
+        result,
+    )?);
+    functions.push(cx.function(
+        "hamiltonian",
+        "Hamiltonian H(q, p, t).",
+        Inputs::State,
+        "f64".into(),
+        &[vec![("h".into(), derivation.hamiltonian.clone())]],
+        "h".into(),
+    )?);
+    let (outs, result) = matrix("a", &derivation.mass_matrix);
+    functions.push(cx.function(
+        "mass_matrix",
+        "Mass matrix A(q) = ∂²L/∂q'².",
+        Inputs::Coordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &[outs],
+        result,
+    )?);
+    functions.push(cx.function(
+        "potential",
+        "Potential energy V(q) (averaged over the phase).",
+        Inputs::Coordinates,
+        "f64".into(),
+        &[vec![("v".into(), derivation.potential.clone())]],
+        "v".into(),
+    )?);
+    let (outs, result) = vector("g", &derivation.potential_gradient);
+    functions.push(cx.function(
+        "potential_gradient",
+        "∂V/∂q.",
+        Inputs::Coordinates,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = matrix("c", &derivation.potential_hessian);
+    functions.push(cx.function(
+        "potential_hessian",
+        "C = ∂²V/∂q².",
+        Inputs::Coordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &[outs],
+        result,
+    )?);
+
+    if model.fast_phase.is_some() {
+        functions.push(cx.function(
+            "vibrational_potential",
+            "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b).",
+            Inputs::Coordinates,
+            "f64".into(),
+            &[vec![("w".into(), derivation.vibrational_potential.clone())]],
+            "w".into(),
+        )?);
+        let effective = format!(
+            "({}) + ({})",
+            derivation.potential, derivation.vibrational_potential
+        );
+        functions.push(cx.function(
+            "effective_potential",
+            "Effective potential V + V_vibr of the averaged system.",
+            Inputs::Coordinates,
+            "f64".into(),
+            &[vec![("v".into(), effective)]],
+            "v".into(),
+        )?);
+        let (outs, result) = matrix("b", &derivation.effective_potential_hessian);
+        functions.push(cx.function(
+            "effective_potential_hessian",
+            "∂²(V + V_vibr)/∂q².",
+            Inputs::Coordinates,
+            format!("[[f64; {n}]; {n}]"),
+            &[outs],
+            result,
+        )?);
+        let (outs, result) = vector("f", &derivation.averaged_rhs);
+        functions.push(cx.function(
+            "averaged_rhs",
+            "Averaged equations: q' = ∂H̄/∂p, p' = −∂H̄/∂q + P̄.",
+            Inputs::AveragedState,
+            format!("[f64; {m}]"),
+            &[outs],
+            result,
+        )?);
+        let (outs, result) = matrix("j", &derivation.averaged_jacobian);
+        functions.push(cx.function(
+            "averaged_jacobian",
+            "Jacobian of the averaged field.",
+            Inputs::AveragedState,
+            format!("[[f64; {m}]; {m}]"),
+            &[outs],
+            result,
+        )?);
+        functions.push(cx.function(
+            "averaged_hamiltonian",
+            "Averaged Hamiltonian H̄(q, p).",
+            Inputs::AveragedState,
+            "f64".into(),
+            &[vec![("h".into(), derivation.averaged_hamiltonian.clone())]],
+            "h".into(),
+        )?);
+    }
+
+    // Functions of q alone must not depend on anything else.
+    let forbidden: Vec<String> = cx
+        .velocities()
+        .into_iter()
+        .chain(cx.momenta())
+        .chain(model.fast_phase.iter().map(|f| f.name.clone()))
+        .chain([model.time.clone()])
+        .collect();
+    for f in &functions {
+        if f.args.starts_with("q: ") {
+            for line in &f.body[2..] {
+                if let Some(bad) = forbidden.iter().find(|s| {
+                    line.split(|c: char| !c.is_alphanumeric() && c != '_')
+                        .any(|w| w == s.as_str())
+                }) {
+                    return Err(format!(
+                        "{}: depends on '{bad}', but should depend on the coordinates only",
+                        f.name
+                    ));
+                }
+            }
+        }
+    }
+
+    let params: Vec<Param> = model
+        .parameters
+        .iter()
+        .map(|p| Param {
+            name: p.name.clone(),
+            default: format!("{:?}", p.default),
+            description: format!("{:?}", p.description),
+        })
+        .collect();
+    let derived: Vec<DerivedEntry> = derivation
+        .derived
+        .iter()
+        .map(|d| DerivedEntry {
+            key: format!("{:?}", d.key),
+            description: format!("{:?}", d.description),
+            text: format!("{:?}", d.text),
+            latex: format!("{:?}", d.latex),
+        })
+        .collect();
+    let mut context = tera::Context::new();
+    context.insert("name", &model.name);
+    context.insert("description", &model.description);
+    context.insert("source_file", source_file);
+    context.insert("dof", &n);
+    context.insert("state_dim", &m);
+    context.insert("coordinates", &cx.coordinates());
+    context.insert(
+        "periodic",
+        &model
+            .coordinates
+            .iter()
+            .map(|c| c.periodic)
+            .collect::<Vec<_>>(),
+    );
+    context.insert("momenta", &cx.momenta());
+    context.insert("params", &params);
+    context.insert("has_phase", &model.fast_phase.is_some());
+    context.insert(
+        "phase",
+        &model
+            .fast_phase
+            .as_ref()
+            .map(|f| f.name.clone())
+            .unwrap_or_default(),
+    );
+    context.insert("functions", &functions);
+    context.insert("derived", &derived);
+    tera.render("model.rs.tera", &context)
+        .map_err(|e| format!("template model.rs.tera: {e:?}"))
+}
+
+/// Renders the registry module listing every model.
+pub fn render_registry(tera: &tera::Tera, models: &[Model]) -> Result<String, String> {
+    #[derive(Serialize)]
+    struct Entry {
+        name: String,
+        doc: String,
+    }
+    let entries: Vec<Entry> = models
+        .iter()
+        .map(|m| Entry {
+            name: m.name.clone(),
+            doc: format!("{:?}", m.description),
+        })
+        .collect();
+    let mut context = tera::Context::new();
+    context.insert("models", &entries);
+    tera.render("registry.rs.tera", &context)
+        .map_err(|e| format!("template registry.rs.tera: {e:?}"))
+}

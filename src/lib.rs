@@ -1,0 +1,11 @@
+//! mechlab: Lagrangians of small mechanical systems → symbolic derivations at
+//! build time → fast, verified simulations and figures.
+//!
+//! Pipeline: `models/*.toml` → `build.rs` (Symbolica, build time only) →
+//! generated modules in [`models`] → runtime: [`ode`] (integrators),
+//! analyses, plots → `examples/` (scenes).
+
+pub mod model;
+pub mod models;
+pub mod ode;
+pub mod registry;

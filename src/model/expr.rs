@@ -1,0 +1,518 @@
+//! The small expression language of model files.
+//!
+//! It is shared by `build.rs` and the library: the build script uses it to
+//! validate model files before any computer algebra runs, to split sums, and to
+//! turn Symbolica's printed results into Rust code; the library uses it so
+//! that the same validation (and its error messages) can be tested without
+//! Symbolica. It parses the usual infix syntax (`+ - * / ^`, calls such as
+//! `sin(q)`), evaluates numerically and differentiates symbolically (without
+//! simplification: enough for numerical checks).
+
+use std::collections::BTreeSet;
+use std::fmt;
+
+/// Functions an expression may call, with their arity.
+pub const FUNCTIONS: &[(&str, usize)] = &[
+    ("sin", 1),
+    ("cos", 1),
+    ("tan", 1),
+    ("exp", 1),
+    ("log", 1),
+    ("sqrt", 1),
+    ("dot", 1),
+];
+
+/// Binary operators, in the order of their precedence classes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+}
+
+/// An expression tree.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    /// A numeric literal, kept as written so that printing it back is exact.
+    Num(String),
+    Sym(String),
+    Neg(Box<Expr>),
+    Bin(BinOp, Box<Expr>, Box<Expr>),
+    Call(String, Vec<Expr>),
+}
+
+/// A parse error with the byte offset where it was found.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParseError {
+    pub offset: usize,
+    pub message: String,
+}
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} (at character {})", self.message, self.offset + 1)
+    }
+}
+
+impl std::error::Error for ParseError {}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Token {
+    Num(String),
+    Ident(String),
+    Op(char),
+    LParen,
+    RParen,
+    Comma,
+}
+
+fn tokenize(text: &str) -> Result<Vec<(usize, Token)>, ParseError> {
+    let bytes = text.as_bytes();
+    let mut tokens = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let c = bytes[i] as char;
+        if c.is_ascii_whitespace() {
+            i += 1;
+        } else if c.is_ascii_digit()
+            || (c == '.' && i + 1 < bytes.len() && bytes[i + 1].is_ascii_digit())
+        {
+            let start = i;
+            while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+                i += 1;
+            }
+            if i < bytes.len() && (bytes[i] == b'e' || bytes[i] == b'E') {
+                let mut j = i + 1;
+                if j < bytes.len() && (bytes[j] == b'+' || bytes[j] == b'-') {
+                    j += 1;
+                }
+                if j < bytes.len() && bytes[j].is_ascii_digit() {
+                    i = j;
+                    while i < bytes.len() && bytes[i].is_ascii_digit() {
+                        i += 1;
+                    }
+                }
+            }
+            let literal = &text[start..i];
+            if literal.parse::<f64>().is_err() {
+                return Err(ParseError {
+                    offset: start,
+                    message: format!("malformed number '{literal}'"),
+                });
+            }
+            tokens.push((start, Token::Num(literal.to_string())));
+        } else if c.is_ascii_alphabetic() || c == '_' {
+            let start = i;
+            while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                i += 1;
+            }
+            tokens.push((start, Token::Ident(text[start..i].to_string())));
+        } else {
+            let token = match c {
+                '+' | '-' | '*' | '/' | '^' => Token::Op(c),
+                '(' => Token::LParen,
+                ')' => Token::RParen,
+                ',' => Token::Comma,
+                _ => {
+                    return Err(ParseError {
+                        offset: i,
+                        message: format!("unexpected character '{c}'"),
+                    })
+                }
+            };
+            tokens.push((i, token));
+            i += c.len_utf8();
+        }
+    }
+    Ok(tokens)
+}
+
+struct Parser {
+    tokens: Vec<(usize, Token)>,
+    pos: usize,
+    end: usize,
+}
+
+impl Parser {
+    fn peek(&self) -> Option<&Token> {
+        self.tokens.get(self.pos).map(|(_, t)| t)
+    }
+    fn offset(&self) -> usize {
+        self.tokens.get(self.pos).map_or(self.end, |(o, _)| *o)
+    }
+    fn error<T>(&self, message: impl Into<String>) -> Result<T, ParseError> {
+        Err(ParseError {
+            offset: self.offset(),
+            message: message.into(),
+        })
+    }
+    fn expect(&mut self, token: Token, what: &str) -> Result<(), ParseError> {
+        if self.peek() == Some(&token) {
+            self.pos += 1;
+            Ok(())
+        } else {
+            self.error(format!("expected {what}"))
+        }
+    }
+
+    fn sum(&mut self) -> Result<Expr, ParseError> {
+        let mut lhs = self.product()?;
+        while let Some(Token::Op(op @ ('+' | '-'))) = self.peek().cloned() {
+            self.pos += 1;
+            let rhs = self.product()?;
+            let op = if op == '+' { BinOp::Add } else { BinOp::Sub };
+            lhs = Expr::Bin(op, Box::new(lhs), Box::new(rhs));
+        }
+        Ok(lhs)
+    }
+
+    fn product(&mut self) -> Result<Expr, ParseError> {
+        let mut lhs = self.unary()?;
+        while let Some(Token::Op(op @ ('*' | '/'))) = self.peek().cloned() {
+            self.pos += 1;
+            let rhs = self.unary()?;
+            let op = if op == '*' { BinOp::Mul } else { BinOp::Div };
+            lhs = Expr::Bin(op, Box::new(lhs), Box::new(rhs));
+        }
+        Ok(lhs)
+    }
+
+    fn unary(&mut self) -> Result<Expr, ParseError> {
+        match self.peek() {
+            Some(Token::Op('-')) => {
+                self.pos += 1;
+                Ok(Expr::Neg(Box::new(self.unary()?)))
+            }
+            Some(Token::Op('+')) => {
+                self.pos += 1;
+                self.unary()
+            }
+            _ => self.power(),
+        }
+    }
+
+    fn power(&mut self) -> Result<Expr, ParseError> {
+        let base = self.atom()?;
+        if self.peek() == Some(&Token::Op('^')) {
+            self.pos += 1;
+            let exponent = self.unary()?;
+            return Ok(Expr::Bin(BinOp::Pow, Box::new(base), Box::new(exponent)));
+        }
+        Ok(base)
+    }
+
+    fn atom(&mut self) -> Result<Expr, ParseError> {
+        match self.peek().cloned() {
+            Some(Token::Num(n)) => {
+                self.pos += 1;
+                Ok(Expr::Num(n))
+            }
+            Some(Token::Ident(name)) => {
+                self.pos += 1;
+                if self.peek() == Some(&Token::LParen) {
+                    self.pos += 1;
+                    let mut args = vec![self.sum()?];
+                    while self.peek() == Some(&Token::Comma) {
+                        self.pos += 1;
+                        args.push(self.sum()?);
+                    }
+                    self.expect(Token::RParen, "')' closing the arguments of a function")?;
+                    Ok(Expr::Call(name, args))
+                } else {
+                    Ok(Expr::Sym(name))
+                }
+            }
+            Some(Token::LParen) => {
+                self.pos += 1;
+                let inner = self.sum()?;
+                self.expect(Token::RParen, "')'")?;
+                Ok(inner)
+            }
+            Some(_) => self.error("expected a number, a name or '('"),
+            None => self.error("unexpected end of expression"),
+        }
+    }
+}
+
+impl Expr {
+    /// Parses infix text. Function names are not checked here (see [`Expr::check_calls`]).
+    pub fn parse(text: &str) -> Result<Expr, ParseError> {
+        let tokens = tokenize(text)?;
+        if tokens.is_empty() {
+            return Err(ParseError {
+                offset: 0,
+                message: "empty expression".into(),
+            });
+        }
+        let mut parser = Parser {
+            tokens,
+            pos: 0,
+            end: text.len(),
+        };
+        let expr = parser.sum()?;
+        if parser.pos != parser.tokens.len() {
+            return parser.error("unexpected text after the end of the expression");
+        }
+        Ok(expr)
+    }
+
+    pub fn num(value: i64) -> Expr {
+        Expr::Num(value.to_string())
+    }
+
+    /// Every symbol (not function name) used.
+    pub fn symbols(&self) -> BTreeSet<String> {
+        let mut out = BTreeSet::new();
+        self.visit(&mut |e| {
+            if let Expr::Sym(s) = e {
+                out.insert(s.clone());
+            }
+        });
+        out
+    }
+
+    /// Checks that every call names a known function with the right number of arguments.
+    pub fn check_calls(&self) -> Result<(), String> {
+        let mut problem = None;
+        self.visit(&mut |e| {
+            if let Expr::Call(name, args) = e {
+                match FUNCTIONS.iter().find(|(f, _)| f == name) {
+                    None if problem.is_none() => {
+                        problem = Some(format!("unknown function '{name}'"))
+                    }
+                    Some((_, arity)) if *arity != args.len() && problem.is_none() => {
+                        problem = Some(format!(
+                            "function '{name}' takes {arity} argument(s), got {}",
+                            args.len()
+                        ))
+                    }
+                    _ => {}
+                }
+            }
+        });
+        problem.map_or(Ok(()), Err)
+    }
+
+    fn visit(&self, f: &mut impl FnMut(&Expr)) {
+        f(self);
+        match self {
+            Expr::Num(_) | Expr::Sym(_) => {}
+            Expr::Neg(a) => a.visit(f),
+            Expr::Bin(_, a, b) => {
+                a.visit(f);
+                b.visit(f);
+            }
+            Expr::Call(_, args) => args.iter().for_each(|a| a.visit(f)),
+        }
+    }
+
+    /// Replaces every symbol for which `map` returns an expression.
+    pub fn substitute(&self, map: &dyn Fn(&str) -> Option<Expr>) -> Expr {
+        match self {
+            Expr::Num(_) => self.clone(),
+            Expr::Sym(s) => map(s).unwrap_or_else(|| self.clone()),
+            Expr::Neg(a) => Expr::Neg(Box::new(a.substitute(map))),
+            Expr::Bin(op, a, b) => Expr::Bin(
+                *op,
+                Box::new(a.substitute(map)),
+                Box::new(b.substitute(map)),
+            ),
+            Expr::Call(name, args) => Expr::Call(
+                name.clone(),
+                args.iter().map(|a| a.substitute(map)).collect(),
+            ),
+        }
+    }
+
+    /// Rewrites every call `name(args)` with `f`, innermost first.
+    pub fn rewrite_calls(&self, f: &mut dyn FnMut(&str, &[Expr]) -> Option<Expr>) -> Expr {
+        match self {
+            Expr::Num(_) | Expr::Sym(_) => self.clone(),
+            Expr::Neg(a) => Expr::Neg(Box::new(a.rewrite_calls(f))),
+            Expr::Bin(op, a, b) => Expr::Bin(
+                *op,
+                Box::new(a.rewrite_calls(f)),
+                Box::new(b.rewrite_calls(f)),
+            ),
+            Expr::Call(name, args) => {
+                let args: Vec<Expr> = args.iter().map(|a| a.rewrite_calls(f)).collect();
+                f(name, &args).unwrap_or_else(|| Expr::Call(name.clone(), args))
+            }
+        }
+    }
+
+    /// Numerical value; `env` gives the value of each symbol.
+    pub fn eval(&self, env: &dyn Fn(&str) -> Option<f64>) -> Result<f64, String> {
+        Ok(match self {
+            Expr::Num(n) => n
+                .parse::<f64>()
+                .map_err(|_| format!("malformed number '{n}'"))?,
+            Expr::Sym(s) => env(s).ok_or_else(|| format!("no value for '{s}'"))?,
+            Expr::Neg(a) => -a.eval(env)?,
+            Expr::Bin(op, a, b) => {
+                let (x, y) = (a.eval(env)?, b.eval(env)?);
+                match op {
+                    BinOp::Add => x + y,
+                    BinOp::Sub => x - y,
+                    BinOp::Mul => x * y,
+                    BinOp::Div => x / y,
+                    BinOp::Pow => x.powf(y),
+                }
+            }
+            Expr::Call(name, args) => {
+                let x = args[0].eval(env)?;
+                match name.as_str() {
+                    "sin" => x.sin(),
+                    "cos" => x.cos(),
+                    "tan" => x.tan(),
+                    "exp" => x.exp(),
+                    "log" => x.ln(),
+                    "sqrt" => x.sqrt(),
+                    _ => return Err(format!("cannot evaluate function '{name}'")),
+                }
+            }
+        })
+    }
+
+    /// Symbolic partial derivative (unsimplified, for numerical checks).
+    pub fn derivative(&self, var: &str) -> Expr {
+        use BinOp::*;
+        let zero = || Expr::num(0);
+        let bin = |op, a: Expr, b: Expr| Expr::Bin(op, Box::new(a), Box::new(b));
+        match self {
+            Expr::Num(_) => zero(),
+            Expr::Sym(s) => Expr::num(i64::from(s == var)),
+            Expr::Neg(a) => Expr::Neg(Box::new(a.derivative(var))),
+            Expr::Bin(op, a, b) => {
+                let (a, b) = (a.as_ref().clone(), b.as_ref().clone());
+                let (da, db) = (a.derivative(var), b.derivative(var));
+                match op {
+                    Add => bin(Add, da, db),
+                    Sub => bin(Sub, da, db),
+                    Mul => bin(Add, bin(Mul, da, b), bin(Mul, a, db)),
+                    Div => bin(
+                        Div,
+                        bin(Sub, bin(Mul, da, b.clone()), bin(Mul, a, db)),
+                        bin(Mul, b.clone(), b),
+                    ),
+                    // d(a^b) = a^b (b' ln a + b a'/a); for a constant exponent only the second term.
+                    Pow if b.symbols().is_empty() => bin(
+                        Mul,
+                        bin(Mul, b.clone(), bin(Pow, a, bin(Sub, b, Expr::num(1)))),
+                        da,
+                    ),
+                    Pow => bin(
+                        Mul,
+                        self.clone(),
+                        bin(
+                            Add,
+                            bin(Mul, db, Expr::Call("log".into(), vec![a.clone()])),
+                            bin(Div, bin(Mul, b, da), a),
+                        ),
+                    ),
+                }
+            }
+            Expr::Call(name, args) => {
+                let a = args[0].clone();
+                let da = a.derivative(var);
+                let outer = match name.as_str() {
+                    "sin" => Expr::Call("cos".into(), vec![a]),
+                    "cos" => Expr::Neg(Box::new(Expr::Call("sin".into(), vec![a]))),
+                    "tan" => bin(
+                        Div,
+                        Expr::num(1),
+                        bin(Pow, Expr::Call("cos".into(), vec![a]), Expr::num(2)),
+                    ),
+                    "exp" => self.clone(),
+                    "log" => bin(Div, Expr::num(1), a),
+                    "sqrt" => bin(Div, Expr::num(1), bin(Mul, Expr::num(2), self.clone())),
+                    // `dot` is expanded before anything is differentiated.
+                    _ => Expr::Call(format!("d_{name}"), vec![a]),
+                };
+                bin(Mul, outer, da)
+            }
+        }
+    }
+
+    /// The terms of a sum, each with its sign folded in (`a - b` gives `a`, `-b`).
+    pub fn terms(&self) -> Vec<Expr> {
+        match self {
+            Expr::Bin(BinOp::Add, a, b) => {
+                let mut t = a.terms();
+                t.extend(b.terms());
+                t
+            }
+            Expr::Bin(BinOp::Sub, a, b) => {
+                let mut t = a.terms();
+                t.extend(b.terms().into_iter().map(|x| Expr::Neg(Box::new(x))));
+                t
+            }
+            _ => vec![self.clone()],
+        }
+    }
+
+    /// Sum of terms (`0` for none).
+    pub fn sum(terms: Vec<Expr>) -> Expr {
+        terms
+            .into_iter()
+            .reduce(|a, b| match b {
+                Expr::Neg(b) => Expr::Bin(BinOp::Sub, Box::new(a), b),
+                b => Expr::Bin(BinOp::Add, Box::new(a), Box::new(b)),
+            })
+            .unwrap_or_else(|| Expr::num(0))
+    }
+
+    fn precedence(&self) -> u8 {
+        match self {
+            Expr::Bin(BinOp::Add | BinOp::Sub, ..) => 1,
+            Expr::Bin(BinOp::Mul | BinOp::Div, ..) | Expr::Neg(_) => 2,
+            Expr::Bin(BinOp::Pow, ..) => 3,
+            Expr::Num(_) | Expr::Sym(_) | Expr::Call(..) => 4,
+        }
+    }
+}
+
+impl fmt::Display for Expr {
+    /// Prints in the same infix syntax, with only the parentheses needed.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let wrap = |f: &mut fmt::Formatter<'_>, e: &Expr, min: u8| {
+            if e.precedence() < min {
+                write!(f, "({e})")
+            } else {
+                write!(f, "{e}")
+            }
+        };
+        match self {
+            Expr::Num(n) => write!(f, "{n}"),
+            Expr::Sym(s) => write!(f, "{s}"),
+            Expr::Neg(a) => {
+                write!(f, "-")?;
+                wrap(f, a, 3)
+            }
+            Expr::Bin(op, a, b) => {
+                let (sym, left_min, right_min) = match op {
+                    BinOp::Add => ("+", 1, 2),
+                    BinOp::Sub => ("-", 1, 2),
+                    BinOp::Mul => ("*", 2, 3),
+                    BinOp::Div => ("/", 2, 3),
+                    BinOp::Pow => ("^", 4, 4),
+                };
+                wrap(f, a, left_min)?;
+                write!(f, "{sym}")?;
+                wrap(f, b, right_min)
+            }
+            Expr::Call(name, args) => {
+                write!(f, "{name}(")?;
+                for (i, a) in args.iter().enumerate() {
+                    if i > 0 {
+                        write!(f, ", ")?;
+                    }
+                    write!(f, "{a}")?;
+                }
+                write!(f, ")")
+            }
+        }
+    }
+}

@@ -1,0 +1,599 @@
+//! The model file format (`models/<name>.toml`) and its validation.
+//!
+//! `build.rs` and the library compile this same file, so every message a user
+//! can get from a malformed model is also tested in `tests/model_errors.rs`.
+//! Validation is complete before any computer algebra runs: names, symbols,
+//! functions, the order of definitions, and, numerically at sample states,
+//! that the Lagrangian is quadratic in the velocities with a positive definite
+//! mass matrix.
+
+use super::expr::Expr;
+use serde::Deserialize;
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+
+/// What a model file says, as written (see `models/README.md` for the format).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    pub name: String,
+    pub description: String,
+    #[serde(default = "default_time")]
+    pub time: String,
+    pub coordinates: Vec<CoordinateSpec>,
+    #[serde(default)]
+    pub parameters: Vec<ParameterSpec>,
+    pub fast_phase: Option<FastPhaseSpec>,
+    /// Named positions (functions of coordinates, time and the fast phase).
+    #[serde(default)]
+    pub definitions: BTreeMap<String, String>,
+    pub lagrangian: String,
+    /// Non-potential generalised force per coordinate name.
+    #[serde(default)]
+    pub forces: BTreeMap<String, String>,
+}
+
+fn default_time() -> String {
+    "t".into()
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoordinateSpec {
+    pub name: String,
+    pub velocity: String,
+    #[serde(default)]
+    pub periodic: bool,
+    #[serde(default)]
+    pub description: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterSpec {
+    pub name: String,
+    pub default: f64,
+    pub description: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FastPhaseSpec {
+    pub name: String,
+    /// dθ/dt as an expression in the parameters.
+    pub rate: String,
+    #[serde(default)]
+    pub description: String,
+}
+
+/// A problem in a model file: which file, which key, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModelError {
+    pub file: String,
+    pub key: String,
+    pub reason: String,
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: key `{}`: {}", self.file, self.key, self.reason)
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// A generalised coordinate.
+#[derive(Clone, Debug)]
+pub struct Coordinate {
+    pub name: String,
+    pub velocity: String,
+    pub periodic: bool,
+    pub description: String,
+}
+
+#[derive(Clone, Debug)]
+pub struct Parameter {
+    pub name: String,
+    pub default: f64,
+    pub description: String,
+}
+
+/// The fast phase θ with dθ/dt = rate(parameters); the model is 2π-periodic in θ.
+#[derive(Clone, Debug)]
+pub struct FastPhase {
+    pub name: String,
+    pub rate: Expr,
+    pub description: String,
+}
+
+/// A validated model.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub description: String,
+    pub time: String,
+    pub coordinates: Vec<Coordinate>,
+    pub parameters: Vec<Parameter>,
+    pub fast_phase: Option<FastPhase>,
+    /// Definitions in an order in which each uses only earlier ones.
+    pub definitions: Vec<(String, Expr)>,
+    /// The Lagrangian as written; `dot(x)` is the total time derivative of `x`.
+    pub lagrangian: Expr,
+    /// One force per coordinate (zero where the file gives none).
+    pub forces: Vec<Expr>,
+}
+
+const RESERVED: &[&str] = &[
+    "pi", "e", "i", "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false",
+    "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref",
+    "return", "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe",
+    "use", "where", "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final",
+    "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
+];
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic())
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !name.contains("__")
+}
+
+impl Model {
+    /// Reads and validates a model file's text; `file` names it in errors.
+    pub fn parse(file: &str, text: &str) -> Result<Model, ModelError> {
+        let err = |key: &str, reason: String| ModelError {
+            file: file.to_string(),
+            key: key.to_string(),
+            reason,
+        };
+        let spec: ModelFile = toml::from_str(text).map_err(|e| {
+            let message = e.message().to_string();
+            let key = match e.span() {
+                Some(span) => key_at(text, span.start),
+                None => "(file)".to_string(),
+            };
+            err(&key, message)
+        })?;
+        spec.validate(file)
+    }
+}
+
+/// The dotted key whose line contains byte `offset` (best effort, for messages).
+fn key_at(text: &str, offset: usize) -> String {
+    let mut table = String::new();
+    let mut key = String::new();
+    for (start, line) in line_starts(text) {
+        if start > offset {
+            break;
+        }
+        let trimmed = line.trim();
+        if trimmed.starts_with('[') {
+            table = trimmed
+                .trim_matches(|c| c == '[' || c == ']')
+                .trim()
+                .to_string();
+            key.clear();
+        } else if let Some((k, _)) = trimmed.split_once('=') {
+            key = k.trim().to_string();
+        }
+    }
+    match (table.is_empty(), key.is_empty()) {
+        (true, true) => "(file)".into(),
+        (true, false) => key,
+        (false, true) => table,
+        (false, false) => format!("{table}.{key}"),
+    }
+}
+
+fn line_starts(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut start = 0;
+    text.split_inclusive('\n').map(move |line| {
+        let s = start;
+        start += line.len();
+        (s, line)
+    })
+}
+
+impl ModelFile {
+    fn validate(self, file: &str) -> Result<Model, ModelError> {
+        let err = |key: &str, reason: String| ModelError {
+            file: file.to_string(),
+            key: key.to_string(),
+            reason,
+        };
+
+        if !is_identifier(&self.name) || self.name.chars().any(|c| c.is_ascii_uppercase()) {
+            return Err(err(
+                "name",
+                format!(
+                    "'{}' is not a lowercase identifier (letters, digits, '_')",
+                    self.name
+                ),
+            ));
+        }
+        if self.coordinates.is_empty() {
+            return Err(err(
+                "coordinates",
+                "a model needs at least one coordinate".into(),
+            ));
+        }
+
+        // Every name, once, as an identifier.
+        let mut seen = BTreeSet::new();
+        let mut declare = |key: &str, name: &str| -> Result<(), ModelError> {
+            if !is_identifier(name) {
+                return Err(err(key, format!("'{name}' is not an identifier (a letter, then letters, digits or single '_')")));
+            }
+            if RESERVED.contains(&name) || super::expr::FUNCTIONS.iter().any(|(f, _)| *f == name) {
+                return Err(err(key, format!("'{name}' is a reserved name")));
+            }
+            if !seen.insert(name.to_string()) {
+                return Err(err(key, format!("'{name}' is declared twice")));
+            }
+            Ok(())
+        };
+        declare("time", &self.time)?;
+        for (i, c) in self.coordinates.iter().enumerate() {
+            declare(&format!("coordinates[{i}].name"), &c.name)?;
+            declare(&format!("coordinates[{i}].velocity"), &c.velocity)?;
+        }
+        for (i, p) in self.parameters.iter().enumerate() {
+            declare(&format!("parameters[{i}].name"), &p.name)?;
+            if !p.default.is_finite() {
+                return Err(err(
+                    &format!("parameters[{i}].default"),
+                    format!("default of '{}' is not finite", p.name),
+                ));
+            }
+        }
+        if let Some(phase) = &self.fast_phase {
+            declare("fast_phase.name", &phase.name)?;
+        }
+        for name in self.definitions.keys() {
+            declare(&format!("definitions.{name}"), name)?;
+        }
+
+        let coordinates: Vec<String> = self.coordinates.iter().map(|c| c.name.clone()).collect();
+        let velocities: Vec<String> = self
+            .coordinates
+            .iter()
+            .map(|c| c.velocity.clone())
+            .collect();
+        let parameters: Vec<String> = self.parameters.iter().map(|p| p.name.clone()).collect();
+        let phase: Vec<String> = self.fast_phase.iter().map(|p| p.name.clone()).collect();
+        let definitions: Vec<String> = self.definitions.keys().cloned().collect();
+        // With a fast phase, explicit time enters only through it (so averaging is well defined).
+        let time: Vec<String> = if self.fast_phase.is_some() {
+            vec![]
+        } else {
+            vec![self.time.clone()]
+        };
+
+        let parse = |key: &str,
+                     text: &str,
+                     allowed: &[&Vec<String>],
+                     dot_allowed: bool|
+         -> Result<Expr, ModelError> {
+            let expr =
+                Expr::parse(text).map_err(|e| err(key, format!("cannot parse '{text}': {e}")))?;
+            expr.check_calls().map_err(|reason| err(key, reason))?;
+            for symbol in expr.symbols() {
+                if !allowed.iter().any(|set| set.contains(&symbol)) {
+                    let hint = if self.fast_phase.is_some() && symbol == self.time {
+                        format!(" (time enters only through the fast phase '{}')", phase[0])
+                    } else {
+                        String::new()
+                    };
+                    return Err(err(key, format!("unknown symbol '{symbol}'{hint}")));
+                }
+            }
+            let mut dot_problem = None;
+            expr.rewrite_calls(&mut |name, args| {
+                if name == "dot" && dot_problem.is_none() {
+                    dot_problem = match (&args[0], dot_allowed) {
+                        (_, false) => Some("dot() is only allowed in the Lagrangian".to_string()),
+                        (Expr::Sym(s), true)
+                            if definitions.contains(s) || coordinates.contains(s) =>
+                        {
+                            None
+                        }
+                        (arg, true) => Some(format!(
+                            "dot() takes the name of a definition or coordinate, not '{arg}'"
+                        )),
+                    };
+                }
+                None
+            });
+            match dot_problem {
+                Some(reason) => Err(err(key, reason)),
+                None => Ok(expr),
+            }
+        };
+
+        let fast_phase = match &self.fast_phase {
+            Some(p) => Some(FastPhase {
+                name: p.name.clone(),
+                rate: parse("fast_phase.rate", &p.rate, &[&parameters], false)?,
+                description: p.description.clone(),
+            }),
+            None => None,
+        };
+
+        // Definitions are positions: no velocities, and no cycles.
+        let mut parsed_defs = BTreeMap::new();
+        for (name, text) in &self.definitions {
+            let key = format!("definitions.{name}");
+            let e = parse(
+                &key,
+                text,
+                &[&coordinates, &parameters, &phase, &time, &definitions],
+                false,
+            )?;
+            parsed_defs.insert(name.clone(), e);
+        }
+        let mut ordered: Vec<(String, Expr)> = Vec::new();
+        while ordered.len() < parsed_defs.len() {
+            let ready = parsed_defs.iter().find(|(name, e)| {
+                !ordered.iter().any(|(n, _)| n == *name)
+                    && e.symbols()
+                        .iter()
+                        .all(|s| !definitions.contains(s) || ordered.iter().any(|(n, _)| n == s))
+            });
+            match ready {
+                Some((name, e)) => ordered.push((name.clone(), e.clone())),
+                None => {
+                    let stuck: Vec<&String> = parsed_defs
+                        .keys()
+                        .filter(|n| !ordered.iter().any(|(m, _)| m == *n))
+                        .collect();
+                    return Err(err(
+                        "definitions",
+                        format!("definitions refer to each other in a cycle: {stuck:?}"),
+                    ));
+                }
+            }
+        }
+
+        let all = [
+            &coordinates,
+            &velocities,
+            &parameters,
+            &phase,
+            &time,
+            &definitions,
+        ];
+        let lagrangian = parse("lagrangian", &self.lagrangian, &all, true)?;
+        for name in self.forces.keys() {
+            if !coordinates.contains(name) {
+                return Err(err(
+                    &format!("forces.{name}"),
+                    format!("'{name}' is not a coordinate"),
+                ));
+            }
+        }
+        let forces = coordinates
+            .iter()
+            .map(|c| match self.forces.get(c) {
+                Some(text) => parse(&format!("forces.{c}"), text, &all, false),
+                None => Ok(Expr::num(0)),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+
+        let model = Model {
+            name: self.name,
+            description: self.description,
+            time: self.time,
+            coordinates: self
+                .coordinates
+                .into_iter()
+                .map(|c| Coordinate {
+                    name: c.name,
+                    velocity: c.velocity,
+                    periodic: c.periodic,
+                    description: c.description,
+                })
+                .collect(),
+            parameters: self
+                .parameters
+                .into_iter()
+                .map(|p| Parameter {
+                    name: p.name,
+                    default: p.default,
+                    description: p.description,
+                })
+                .collect(),
+            fast_phase,
+            definitions: ordered,
+            lagrangian,
+            forces,
+        };
+        model
+            .check_numerically()
+            .map_err(|(key, reason)| err(&key, reason))?;
+        Ok(model)
+    }
+}
+
+impl Model {
+    pub fn dof(&self) -> usize {
+        self.coordinates.len()
+    }
+
+    /// The Lagrangian with definitions substituted and `dot` expanded as a
+    /// total time derivative: Σ ∂x/∂q_i q'_i + rate ∂x/∂θ + ∂x/∂t.
+    /// Unsimplified; used for numerical checks (the build derives it again with Symbolica).
+    pub fn expanded_lagrangian(&self) -> Expr {
+        let resolved = self.resolved_definitions();
+        let lookup = |s: &str| {
+            resolved
+                .iter()
+                .find(|(n, _)| n == s)
+                .map(|(_, e)| e.clone())
+        };
+        let total_derivative = |x: &Expr| {
+            let mut terms: Vec<Expr> = self
+                .coordinates
+                .iter()
+                .map(|c| {
+                    Expr::Bin(
+                        super::expr::BinOp::Mul,
+                        Box::new(x.derivative(&c.name)),
+                        Box::new(Expr::Sym(c.velocity.clone())),
+                    )
+                })
+                .collect();
+            if let Some(p) = &self.fast_phase {
+                terms.push(Expr::Bin(
+                    super::expr::BinOp::Mul,
+                    Box::new(p.rate.clone()),
+                    Box::new(x.derivative(&p.name)),
+                ));
+            } else {
+                terms.push(x.derivative(&self.time));
+            }
+            Expr::sum(terms)
+        };
+        self.lagrangian
+            .rewrite_calls(&mut |name, args| match (name, &args[0]) {
+                ("dot", Expr::Sym(s)) => Some(total_derivative(
+                    &lookup(s).unwrap_or_else(|| Expr::Sym(s.clone())),
+                )),
+                _ => None,
+            })
+            .substitute(&lookup)
+    }
+
+    /// Definitions with every other definition substituted.
+    pub fn resolved_definitions(&self) -> Vec<(String, Expr)> {
+        let mut resolved: Vec<(String, Expr)> = Vec::new();
+        for (name, e) in &self.definitions {
+            let r = e.substitute(&|s| {
+                resolved
+                    .iter()
+                    .find(|(n, _)| n == s)
+                    .map(|(_, e)| e.clone())
+            });
+            resolved.push((name.clone(), r));
+        }
+        resolved
+    }
+
+    /// Checks at sample states that L is finite, quadratic in the velocities,
+    /// with a positive definite mass matrix; and that the phase rate is finite and non-zero.
+    fn check_numerically(&self) -> Result<(), (String, String)> {
+        let n = self.dof();
+        let lagrangian = self.expanded_lagrangian();
+        let mut seed = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut random = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let params = |s: &str| {
+            self.parameters
+                .iter()
+                .find(|p| p.name == s)
+                .map(|p| p.default)
+        };
+        if let Some(p) = &self.fast_phase {
+            let rate = p
+                .rate
+                .eval(&params)
+                .map_err(|e| ("fast_phase.rate".to_string(), e))?;
+            if !rate.is_finite() || rate == 0.0 {
+                return Err((
+                    "fast_phase.rate".into(),
+                    format!(
+                        "rate is {rate} at the default parameters; it must be finite and non-zero"
+                    ),
+                ));
+            }
+        }
+        for _sample in 0..5 {
+            let q: Vec<f64> = (0..n).map(|_| 3.0 * random()).collect();
+            let v: Vec<f64> = (0..n).map(|_| random()).collect();
+            let phase = 3.0 * random();
+            let time = random();
+            let at = |velocity: &[f64]| -> Result<f64, String> {
+                let env = |s: &str| -> Option<f64> {
+                    if let Some(i) = self.coordinates.iter().position(|c| c.name == s) {
+                        return Some(q[i]);
+                    }
+                    if let Some(i) = self.coordinates.iter().position(|c| c.velocity == s) {
+                        return Some(velocity[i]);
+                    }
+                    if self.fast_phase.as_ref().is_some_and(|p| p.name == s) {
+                        return Some(phase);
+                    }
+                    if s == self.time {
+                        return Some(time);
+                    }
+                    params(s)
+                };
+                lagrangian.eval(&env)
+            };
+            let scaled = |s: f64| v.iter().map(|x| s * x).collect::<Vec<_>>();
+            let l: Vec<f64> = [-1.0, 0.0, 1.0, 2.0]
+                .iter()
+                .map(|&s| at(&scaled(s)))
+                .collect::<Result<_, _>>()
+                .map_err(|e| ("lagrangian".to_string(), e))?;
+            if l.iter().any(|x| !x.is_finite()) {
+                return Err((
+                    "lagrangian".into(),
+                    format!("not finite at q = {q:?}, q' = {v:?}"),
+                ));
+            }
+            let third_difference = l[3] - 3.0 * l[2] + 3.0 * l[1] - l[0];
+            let scale = l.iter().map(|x| x.abs()).fold(1.0, f64::max);
+            if third_difference.abs() > 1e-8 * scale {
+                return Err(("lagrangian".into(), "is not quadratic in the velocities (its third derivative along a velocity direction is non-zero)".into()));
+            }
+            // Mass matrix by polarisation (exact for a quadratic).
+            let unit = |i: usize, j: usize, si: f64, sj: f64| {
+                let mut w = vec![0.0; n];
+                w[i] += si;
+                w[j] += sj;
+                at(&w).unwrap_or(f64::NAN)
+            };
+            let mut mass = vec![vec![0.0; n]; n];
+            for i in 0..n {
+                for j in 0..n {
+                    mass[i][j] = if i == j {
+                        unit(i, i, 1.0, 0.0) + unit(i, i, -1.0, 0.0) - 2.0 * unit(i, i, 0.0, 0.0)
+                    } else {
+                        (unit(i, j, 1.0, 1.0) - unit(i, j, 1.0, -1.0) - unit(i, j, -1.0, 1.0)
+                            + unit(i, j, -1.0, -1.0))
+                            / 4.0
+                    };
+                }
+            }
+            if !cholesky_ok(&mass) {
+                return Err(("lagrangian".into(), format!("mass matrix ∂²L/∂q'² = {mass:?} at q = {q:?} is singular or not positive definite")));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn cholesky_ok(a: &[Vec<f64>]) -> bool {
+    let n = a.len();
+    let scale = (0..n).map(|i| a[i][i].abs()).fold(0.0, f64::max);
+    let mut l = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        for j in 0..=i {
+            let s: f64 = (0..j).map(|k| l[i][k] * l[j][k]).sum();
+            if i == j {
+                let d = a[i][i] - s;
+                if !(d > 1e-10 * scale) {
+                    return false;
+                }
+                l[i][i] = d.sqrt();
+            } else {
+                l[i][j] = (a[i][j] - s) / l[j][j];
+            }
+        }
+    }
+    true
+}

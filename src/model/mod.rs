@@ -1,0 +1,8 @@
+//! Model files: the expression language and the validated model description.
+//! Compiled both into the library and into `build.rs` (via `#[path]`).
+
+pub mod expr;
+pub mod file;
+
+pub use expr::Expr;
+pub use file::{Model, ModelError};
