@@ -1,4 +1,16 @@
 //! Integrators over fixed-size states.
+//!
+//! The split follows diffsol: a *problem* is a [`System`] (f and optionally
+//! its Jacobian), a *method* is a [`Method`] chosen at run time by name and
+//! tolerance or step, and an [`Integrator`] holds the solver state (the last
+//! accepted step size) and the run's [`Stats`], reported like Hairer's codes.
+//! States are `[f64; N]`: no allocation per step.
+
+mod dop853;
+mod gauss;
+mod rk4;
+
+use std::fmt;
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
 pub trait System<const N: usize> {
@@ -7,4 +19,305 @@ pub trait System<const N: usize> {
     fn jacobian(&self, _t: f64, _y: &[f64; N]) -> Option<[[f64; N]; N]> {
         None
     }
+}
+
+/// An integration method with its accuracy knob.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    /// Classical Runge–Kutta, order 4, fixed step (at most `step`).
+    Rk4 { step: f64 },
+    /// Dormand–Prince 8(5,3) with Hairer's step control.
+    Dop853 { rtol: f64, atol: f64 },
+    /// Implicit Gauss–Legendre with 2 (order 4) or 3 (order 6) stages,
+    /// symplectic, fixed step, stage equations solved to round-off.
+    Gauss { stages: usize, step: f64 },
+}
+
+/// Method names accepted by [`Method::parse`].
+pub const METHOD_NAMES: [&str; 4] = ["rk4", "dop853", "gauss4", "gauss6"];
+
+impl Method {
+    /// A method by name: `rk4`, `gauss4`, `gauss6` take a step size, `dop853`
+    /// a tolerance (used as both relative and absolute tolerance).
+    pub fn parse(name: &str, tol_or_step: f64) -> Result<Method, OdeError> {
+        let method = match name {
+            "rk4" => Method::Rk4 { step: tol_or_step },
+            "dop853" => Method::Dop853 {
+                rtol: tol_or_step,
+                atol: tol_or_step,
+            },
+            "gauss4" => Method::Gauss {
+                stages: 2,
+                step: tol_or_step,
+            },
+            "gauss6" => Method::Gauss {
+                stages: 3,
+                step: tol_or_step,
+            },
+            _ => return Err(OdeError::UnknownMethod(name.to_string())),
+        };
+        method.validate()?;
+        Ok(method)
+    }
+
+    /// The name [`Method::parse`] accepts.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Rk4 { .. } => "rk4",
+            Method::Dop853 { .. } => "dop853",
+            Method::Gauss { stages: 2, .. } => "gauss4",
+            Method::Gauss { .. } => "gauss6",
+        }
+    }
+
+    /// Classical order of the method.
+    pub fn order(&self) -> usize {
+        match self {
+            Method::Rk4 { .. } => 4,
+            Method::Dop853 { .. } => 8,
+            Method::Gauss { stages, .. } => 2 * stages,
+        }
+    }
+
+    fn validate(&self) -> Result<(), OdeError> {
+        let positive = |what: &'static str, x: f64| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err(OdeError::InvalidSetting { what, value: x })
+            }
+        };
+        match *self {
+            Method::Rk4 { step } => positive("step", step),
+            Method::Dop853 { rtol, atol } => {
+                positive("relative tolerance", rtol)?;
+                positive("absolute tolerance", atol)
+            }
+            Method::Gauss { stages, step } => {
+                if stages != 2 && stages != 3 {
+                    return Err(OdeError::InvalidSetting {
+                        what: "Gauss–Legendre stages",
+                        value: stages as f64,
+                    });
+                }
+                positive("step", step)
+            }
+        }
+    }
+}
+
+/// Work statistics of a run, as Hairer's codes report them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected steps (adaptive methods).
+    pub rejected: u64,
+    /// Right-hand side evaluations.
+    pub f_evals: u64,
+    /// Jacobian evaluations.
+    pub jac_evals: u64,
+    /// Fixed-point iterations of implicit methods.
+    pub iterations: u64,
+}
+
+impl std::ops::AddAssign for Stats {
+    fn add_assign(&mut self, o: Stats) {
+        self.steps += o.steps;
+        self.rejected += o.rejected;
+        self.f_evals += o.f_evals;
+        self.jac_evals += o.jac_evals;
+        self.iterations += o.iterations;
+    }
+}
+
+/// Why an integration stopped.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OdeError {
+    UnknownMethod(String),
+    InvalidSetting {
+        what: &'static str,
+        value: f64,
+    },
+    /// The initial state or time is NaN or infinite.
+    NonFiniteInitialState {
+        t: f64,
+        y: Vec<f64>,
+    },
+    /// The solution became NaN or infinite (the run diverged).
+    NonFinite {
+        t: f64,
+        y: Vec<f64>,
+    },
+    StepSizeUnderflow {
+        t: f64,
+        h: f64,
+    },
+    TooManySteps {
+        t: f64,
+        max_steps: u64,
+    },
+    /// The implicit stage equations did not converge.
+    NoConvergence {
+        t: f64,
+        h: f64,
+        y: Vec<f64>,
+    },
+}
+
+impl fmt::Display for OdeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            OdeError::UnknownMethod(name) => write!(
+                f,
+                "unknown method '{name}' (known: {})",
+                METHOD_NAMES.join(", ")
+            ),
+            OdeError::InvalidSetting { what, value } => {
+                write!(f, "invalid {what}: {value} (must be finite and positive)")
+            }
+            OdeError::NonFiniteInitialState { t, y } => {
+                write!(f, "initial state is not finite: t = {t}, y = {y:?}")
+            }
+            OdeError::NonFinite { t, y } => write!(
+                f,
+                "solution diverged (non-finite state) at t = {t}: y = {y:?}"
+            ),
+            OdeError::StepSizeUnderflow { t, h } => {
+                write!(f, "step size underflow at t = {t} (h = {h:e})")
+            }
+            OdeError::TooManySteps { t, max_steps } => {
+                write!(f, "more than {max_steps} steps, stopped at t = {t}")
+            }
+            OdeError::NoConvergence { t, h, y } => {
+                write!(f, "implicit stage equations did not converge at t = {t} with h = {h:e}, y = {y:?}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for OdeError {}
+
+/// Solver state: the method, the last step size, statistics.
+#[derive(Clone, Debug)]
+pub struct Integrator {
+    method: Method,
+    /// Step size to try next (adaptive methods), carried across calls.
+    next_step: Option<f64>,
+    pub stats: Stats,
+    /// Upper bound on steps per call of [`Integrator::advance`].
+    pub max_steps: u64,
+}
+
+impl Integrator {
+    pub fn new(method: Method) -> Result<Integrator, OdeError> {
+        method.validate()?;
+        Ok(Integrator {
+            method,
+            next_step: None,
+            stats: Stats::default(),
+            max_steps: 10_000_000,
+        })
+    }
+
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// Advances `y0` at `t0` to `t1` (t1 > t0 or t1 < t0).
+    pub fn advance<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+    ) -> Result<[f64; N], OdeError> {
+        self.advance_observed(system, t0, y0, t1, &mut |_, _| {})
+    }
+
+    /// Like [`Integrator::advance`], calling `observe(t, y)` after every accepted step.
+    pub fn advance_observed<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+        observe: &mut dyn FnMut(f64, &[f64; N]),
+    ) -> Result<[f64; N], OdeError> {
+        if !t0.is_finite() || !t1.is_finite() || y0.iter().any(|x| !x.is_finite()) {
+            return Err(OdeError::NonFiniteInitialState {
+                t: t0,
+                y: y0.to_vec(),
+            });
+        }
+        if t1 == t0 {
+            return Ok(*y0);
+        }
+        match self.method {
+            Method::Rk4 { step } => rk4::integrate(
+                system,
+                t0,
+                y0,
+                t1,
+                step,
+                self.max_steps,
+                &mut self.stats,
+                observe,
+            ),
+            Method::Gauss { stages, step } => gauss::integrate(
+                system,
+                stages,
+                t0,
+                y0,
+                t1,
+                step,
+                self.max_steps,
+                &mut self.stats,
+                observe,
+            ),
+            Method::Dop853 { rtol, atol } => {
+                let mut solver = dop853::Dop853 {
+                    rtol,
+                    atol,
+                    max_steps: self.max_steps,
+                    next_step: self.next_step,
+                };
+                let y = solver.integrate(system, t0, y0, t1, &mut self.stats, observe);
+                self.next_step = solver.next_step;
+                y
+            }
+        }
+    }
+}
+
+/// Number of equal fixed steps of at most `step` covering `t0..t1`.
+fn fixed_steps(t0: f64, t1: f64, step: f64, max_steps: u64) -> Result<(u64, f64), OdeError> {
+    let n = ((t1 - t0).abs() / step).ceil().max(1.0);
+    if n > max_steps as f64 {
+        return Err(OdeError::TooManySteps { t: t0, max_steps });
+    }
+    let n = n as u64;
+    Ok((n, (t1 - t0) / n as f64))
+}
+
+fn check_finite<const N: usize>(t: f64, y: &[f64; N]) -> Result<(), OdeError> {
+    if y.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(OdeError::NonFinite { t, y: y.to_vec() })
+    }
+}
+
+/// y + h Σ coefficients[j] k[j], the Runge–Kutta stage combination.
+#[inline(always)]
+fn combine<const N: usize>(y: &[f64; N], h: f64, coefficients: &[f64], k: &[[f64; N]]) -> [f64; N] {
+    let mut out = *y;
+    for i in 0..N {
+        let mut s = 0.0;
+        for (c, kj) in coefficients.iter().zip(k) {
+            s += c * kj[i];
+        }
+        out[i] += h * s;
+    }
+    out
 }

@@ -1,0 +1,370 @@
+//! DOP853: the explicit Runge–Kutta pair of order 8 with error estimators of
+//! orders 5 and 3 (Dormand–Prince), with the step control of Hairer's
+//! `dop853.f` (Hairer, Nørsett & Wanner, Solving ODE I, §II.10). The
+//! coefficients are those published with `dop853.f`.
+
+use super::{check_finite, combine, OdeError, Stats, System};
+
+const C: [f64; 12] = [
+    0.0,
+    0.526001519587677318785587544488e-01,
+    0.789002279381515978178381316732e-01,
+    0.118350341907227396726757197510,
+    0.281649658092772603273242802490,
+    0.333333333333333333333333333333,
+    0.25,
+    0.307692307692307692307692307692,
+    0.651282051282051282051282051282,
+    0.6,
+    0.857142857142857142857142857142,
+    1.0,
+];
+
+/// Rows i = 1..11 of the Butcher matrix (a[i][j] for j < i).
+const A: [[f64; 11]; 12] = [
+    [0.0; 11],
+    [
+        5.26001519587677318785587544488e-2,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        1.97250569845378994544595329183e-2,
+        5.91751709536136983633785987549e-2,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        2.95875854768068491816892993775e-2,
+        0.,
+        8.87627564304205475450678981324e-2,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        2.41365134159266685502369798665e-1,
+        0.,
+        -8.84549479328286085344864962717e-1,
+        9.24834003261792003115737966543e-1,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        3.7037037037037037037037037037e-2,
+        0.,
+        0.,
+        1.70828608729473871279604482173e-1,
+        1.25467687566822425016691814123e-1,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        3.7109375e-2,
+        0.,
+        0.,
+        1.70252211019544039314978060272e-1,
+        6.02165389804559606850219397283e-2,
+        -1.7578125e-2,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        3.70920001185047927108779319836e-2,
+        0.,
+        0.,
+        1.70383925712239993810214054705e-1,
+        1.07262030446373284651809199168e-1,
+        -1.53194377486244017527936158236e-2,
+        8.27378916381402288758473766002e-3,
+        0.,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        6.24110958716075717114429577812e-1,
+        0.,
+        0.,
+        -3.36089262944694129406857109825,
+        -8.68219346841726006818189891453e-1,
+        2.75920996994467083049415600797e1,
+        2.01540675504778934086186788979e1,
+        -4.34898841810699588477366255144e1,
+        0.,
+        0.,
+        0.,
+    ],
+    [
+        4.77662536438264365890433908527e-1,
+        0.,
+        0.,
+        -2.48811461997166764192642586468,
+        -5.90290826836842996371446475743e-1,
+        2.12300514481811942347288949897e1,
+        1.52792336328824235832596922938e1,
+        -3.32882109689848629194453265587e1,
+        -2.03312017085086261358222928593e-2,
+        0.,
+        0.,
+    ],
+    [
+        -9.3714243008598732571704021658e-1,
+        0.,
+        0.,
+        5.18637242884406370830023853209,
+        1.09143734899672957818500254654,
+        -8.14978701074692612513997267357,
+        -1.85200656599969598641566180701e1,
+        2.27394870993505042818970056734e1,
+        2.49360555267965238987089396762,
+        -3.0467644718982195003823669022,
+        0.,
+    ],
+    [
+        2.27331014751653820792359768449,
+        0.,
+        0.,
+        -1.05344954667372501984066689879e1,
+        -2.00087205822486249909675718444,
+        -1.79589318631187989172765950534e1,
+        2.79488845294199600508499808837e1,
+        -2.85899827713502369474065508674,
+        -8.87285693353062954433549289258,
+        1.23605671757943030647266201528e1,
+        6.43392746015763530355970484046e-1,
+    ],
+];
+
+/// Weights of the order-8 solution.
+const B: [f64; 12] = [
+    5.42937341165687622380535766363e-2,
+    0.,
+    0.,
+    0.,
+    0.,
+    4.45031289275240888144113950566,
+    1.89151789931450038304281599044,
+    -5.8012039600105847814672114227,
+    3.1116436695781989440891606237e-1,
+    -1.52160949662516078556178806805e-1,
+    2.01365400804030348374776537501e-1,
+    4.47106157277725905176885569043e-2,
+];
+
+const BHH: [f64; 3] = [
+    0.244094488188976377952755905512,
+    0.733846688281611857341361741547,
+    0.220588235294117647058823529412e-1,
+];
+
+/// Order-5 error estimator.
+const ER: [f64; 12] = [
+    0.1312004499419488073250102996e-1,
+    0.,
+    0.,
+    0.,
+    0.,
+    -0.1225156446376204440720569753e1,
+    -0.4957589496572501915214079952,
+    0.1664377182454986536961530415e1,
+    -0.3503288487499736816886487290,
+    0.3341791187130174790297318841,
+    0.8192320648511571246570742613e-1,
+    -0.2235530786388629525884427845e-1,
+];
+
+const SAFETY: f64 = 0.9;
+/// Bounds on h_new / h (Hairer's fac1 = 0.333, fac2 = 6).
+const MIN_FACTOR: f64 = 0.333;
+const MAX_FACTOR: f64 = 6.0;
+
+pub(super) struct Dop853 {
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_steps: u64,
+    /// Step size to try first; updated to the last proposal on return.
+    pub next_step: Option<f64>,
+}
+
+impl Dop853 {
+    fn scale(&self, a: f64, b: f64) -> f64 {
+        self.atol + self.rtol * a.abs().max(b.abs())
+    }
+
+    /// Hairer's initial step size guess.
+    fn initial_step<S: System<N>, const N: usize>(
+        &self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        f0: &[f64; N],
+        direction: f64,
+        stats: &mut Stats,
+    ) -> f64 {
+        let norm = |v: &[f64; N]| {
+            (v.iter()
+                .zip(y)
+                .map(|(x, yi)| (x / self.scale(*yi, *yi)).powi(2))
+                .sum::<f64>()
+                / N as f64)
+                .sqrt()
+        };
+        let (d0, d1) = (norm(y), norm(f0));
+        let h0 = if d0 < 1e-10 || d1 < 1e-10 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
+        let y1: [f64; N] = std::array::from_fn(|i| y[i] + direction * h0 * f0[i]);
+        let f1 = system.rhs(t + direction * h0, &y1);
+        stats.f_evals += 1;
+        let diff: [f64; N] = std::array::from_fn(|i| f1[i] - f0[i]);
+        let d2 = norm(&diff) / h0;
+        let h1 = if d1.max(d2) <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / 8.0)
+        };
+        (100.0 * h0).min(h1)
+    }
+
+    pub(super) fn integrate<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+        stats: &mut Stats,
+        observe: &mut dyn FnMut(f64, &[f64; N]),
+    ) -> Result<[f64; N], OdeError> {
+        let direction = (t1 - t0).signum();
+        let span = (t1 - t0).abs();
+        let mut t = t0;
+        let mut y = *y0;
+        let mut k = [[0.0; N]; 12];
+        k[0] = system.rhs(t, &y);
+        stats.f_evals += 1;
+        let mut h = match self.next_step {
+            Some(h) => h,
+            None => self.initial_step(system, t, &y, &k[0], direction, stats),
+        }
+        .min(span);
+        let mut steps = 0u64;
+        let mut last_rejected = false;
+        loop {
+            if steps >= self.max_steps {
+                return Err(OdeError::TooManySteps {
+                    t,
+                    max_steps: self.max_steps,
+                });
+            }
+            let remaining = (t1 - t).abs();
+            let last = h >= remaining * (1.0 - 1e-12);
+            let h_try = if last { remaining } else { h };
+            if h_try < 1e-14 * t.abs().max(1.0) {
+                return Err(OdeError::StepSizeUnderflow { t, h: h_try });
+            }
+            let hs = direction * h_try;
+            for i in 1..12 {
+                let yi = combine(&y, hs, &A[i][..i], &k[..i]);
+                k[i] = system.rhs(t + C[i] * hs, &yi);
+            }
+            let y_new = combine(&y, hs, &B, &k);
+            stats.f_evals += 11;
+            steps += 1;
+            // Error estimate (Hairer's combination of the 5th and 3rd order estimators).
+            let (mut err5, mut err3) = (0.0, 0.0);
+            for i in 0..N {
+                let sk = self.scale(y[i], y_new[i]);
+                let mut e5 = 0.0;
+                for (e, kj) in ER.iter().zip(&k) {
+                    e5 += e * kj[i];
+                }
+                let mut bs = 0.0;
+                for (b, kj) in B.iter().zip(&k) {
+                    bs += b * kj[i];
+                }
+                let e3 = bs - BHH[0] * k[0][i] - BHH[1] * k[8][i] - BHH[2] * k[11][i];
+                err5 += (e5 / sk).powi(2);
+                err3 += (e3 / sk).powi(2);
+            }
+            let denominator = err5 + 0.01 * err3;
+            let err = if denominator > 0.0 {
+                h_try * err5 / (denominator * N as f64).sqrt()
+            } else {
+                0.0
+            };
+            if !err.is_finite() {
+                // A non-finite stage: retry smaller, unless the step is already tiny.
+                if !y_new.iter().all(|x| x.is_finite()) && h_try < 1e-10 * span {
+                    return Err(OdeError::NonFinite {
+                        t,
+                        y: y_new.to_vec(),
+                    });
+                }
+                stats.rejected += 1;
+                h = h_try * 0.1;
+                last_rejected = true;
+                continue;
+            }
+            let factor = (err.powf(1.0 / 8.0) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
+            if err <= 1.0 {
+                check_finite(t + hs, &y_new)?;
+                t = if last { t1 } else { t + hs };
+                y = y_new;
+                stats.steps += 1;
+                k[0] = system.rhs(t, &y);
+                stats.f_evals += 1;
+                observe(t, &y);
+                let mut h_new = h_try / factor;
+                if last_rejected {
+                    h_new = h_new.min(h_try);
+                }
+                last_rejected = false;
+                if last {
+                    // Keep the proposal for the next call, not the truncated last step.
+                    self.next_step = Some(if h_try < h { h } else { h_new });
+                    return Ok(y);
+                }
+                h = h_new;
+            } else {
+                stats.rejected += 1;
+                last_rejected = true;
+                h = h_try / (err.powf(1.0 / 8.0) / SAFETY).min(1.0 / MIN_FACTOR);
+            }
+        }
+    }
+}

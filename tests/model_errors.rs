@@ -1,0 +1,196 @@
+//! Malformed model files give errors naming the file, the key and the reason.
+//! The library compiles the same reader as `build.rs`.
+
+use mechlab::model::{Model, ModelError};
+
+const GOOD: &str = r#"
+name = "toy"
+description = "a pendulum"
+lagrangian = "qd^2/2 + k*cos(q)"
+
+[[coordinates]]
+name = "q"
+velocity = "qd"
+periodic = true
+
+[[parameters]]
+name = "k"
+default = 1.0
+description = "stiffness"
+"#;
+
+fn error(text: &str) -> ModelError {
+    Model::parse("models/toy.toml", text).expect_err("the model should be rejected")
+}
+
+fn assert_error(text: &str, key: &str, reason_part: &str) {
+    let e = error(text);
+    assert_eq!(e.file, "models/toy.toml");
+    assert_eq!(e.key, key, "wrong key in: {e}");
+    assert!(
+        e.reason.contains(reason_part),
+        "reason '{}' lacks '{reason_part}'",
+        e.reason
+    );
+    let shown = e.to_string();
+    assert!(shown.starts_with("models/toy.toml: key `"), "{shown}");
+}
+
+#[test]
+fn the_reference_model_is_accepted() {
+    let model = Model::parse("models/toy.toml", GOOD).unwrap();
+    assert_eq!(model.dof(), 1);
+    assert_eq!(model.parameters[0].default, 1.0);
+}
+
+#[test]
+fn the_shipped_models_are_accepted() {
+    for info in mechlab::models::ALL {
+        Model::parse(info.source_file, info.source).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn unknown_key() {
+    assert_error(
+        &GOOD.replace("[[parameters]]", "colour = \"red\"\n[[parameters]]"),
+        "coordinates.colour",
+        "unknown field `colour`",
+    );
+}
+
+#[test]
+fn non_numeric_default() {
+    assert_error(
+        &GOOD.replace("default = 1.0", "default = \"one\""),
+        "parameters.default",
+        "invalid type",
+    );
+}
+
+#[test]
+fn unknown_symbol() {
+    assert_error(
+        &GOOD.replace("k*cos(q)", "k*cos(q) + g*q"),
+        "lagrangian",
+        "unknown symbol 'g'",
+    );
+}
+
+#[test]
+fn unknown_function() {
+    assert_error(
+        &GOOD.replace("k*cos(q)", "k*cosh(q)"),
+        "lagrangian",
+        "unknown function 'cosh'",
+    );
+}
+
+#[test]
+fn malformed_expression() {
+    assert_error(
+        &GOOD.replace("k*cos(q)", "k*cos(q"),
+        "lagrangian",
+        "cannot parse",
+    );
+}
+
+#[test]
+fn not_quadratic_in_velocities() {
+    assert_error(
+        &GOOD.replace("qd^2/2", "qd^4/4"),
+        "lagrangian",
+        "not quadratic in the velocities",
+    );
+}
+
+#[test]
+fn singular_mass_matrix() {
+    let two = GOOD
+        .replace("qd^2/2 + k*cos(q)", "(qd + sd)^2/2 + k*cos(q)")
+        .replace(
+            "[[parameters]]",
+            "[[coordinates]]\nname = \"s\"\nvelocity = \"sd\"\n\n[[parameters]]",
+        );
+    assert_error(&two, "lagrangian", "singular or not positive definite");
+}
+
+#[test]
+fn negative_kinetic_energy() {
+    assert_error(
+        &GOOD.replace("qd^2/2", "-qd^2/2"),
+        "lagrangian",
+        "not positive definite",
+    );
+}
+
+#[test]
+fn duplicate_name() {
+    assert_error(
+        &GOOD.replace("name = \"k\"", "name = \"q\""),
+        "parameters[0].name",
+        "declared twice",
+    );
+}
+
+#[test]
+fn reserved_name() {
+    assert_error(
+        &GOOD.replace("name = \"k\"", "name = \"pi\""),
+        "parameters[0].name",
+        "reserved",
+    );
+}
+
+#[test]
+fn force_on_unknown_coordinate() {
+    assert_error(
+        &format!("{GOOD}\n[forces]\nx = \"-qd\"\n"),
+        "forces.x",
+        "not a coordinate",
+    );
+}
+
+#[test]
+fn cyclic_definitions() {
+    let text = GOOD.replace("k*cos(q)", "k*a") + "\n[definitions]\na = \"b + q\"\nb = \"a\"\n";
+    assert_error(&text, "definitions", "cycle");
+}
+
+#[test]
+fn dot_of_an_expression() {
+    assert_error(
+        &GOOD.replace("qd^2/2", "dot(sin(q))^2/2"),
+        "lagrangian",
+        "dot() takes the name",
+    );
+}
+
+#[test]
+fn velocities_in_a_definition() {
+    let text = GOOD.replace("k*cos(q)", "k*x") + "\n[definitions]\nx = \"qd\"\n";
+    assert_error(&text, "definitions.x", "unknown symbol 'qd'");
+}
+
+#[test]
+fn explicit_time_with_a_fast_phase() {
+    let text = GOOD.replace("k*cos(q)", "k*cos(q)*t")
+        + "\n[fast_phase]\nname = \"theta\"\nrate = \"1/k\"\n";
+    assert_error(
+        &text,
+        "lagrangian",
+        "time enters only through the fast phase",
+    );
+}
+
+#[test]
+fn zero_phase_rate() {
+    let text = GOOD.to_string() + "\n[fast_phase]\nname = \"theta\"\nrate = \"0*k\"\n";
+    assert_error(&text, "fast_phase.rate", "non-zero");
+}
+
+#[test]
+fn missing_lagrangian() {
+    let e = error(&GOOD.replace("lagrangian = \"qd^2/2 + k*cos(q)\"", ""));
+    assert!(e.reason.contains("missing field `lagrangian`"), "{e}");
+}

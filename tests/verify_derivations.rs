@@ -1,0 +1,353 @@
+//! The generated code against independent closed forms and hand derivations.
+
+use mechlab::models::{double_pendulum as dp, kapitza};
+use mechlab::ode::{Integrator, Method, System};
+
+/// Deterministic pseudo-random numbers in [-1, 1).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
+}
+
+/// SPEC.md §1 with our phase convention y = A ε cos θ, which gives the cross
+/// term with a minus sign: H = p²/2 − A p sin q sin θ + (A²/2) sin²q sin²θ + cos q.
+fn kapitza_h_closed_form(q: f64, p: f64, t: f64, a: f64, eps: f64) -> f64 {
+    let th = t / eps;
+    p * p / 2.0 - a * p * q.sin() * th.sin()
+        + a * a / 2.0 * q.sin().powi(2) * th.sin().powi(2)
+        + q.cos()
+}
+
+#[test]
+fn kapitza_hamiltonian_matches_the_closed_form() {
+    let mut rng = Rng(7);
+    for _ in 0..200 {
+        let params = kapitza::Params {
+            A: 3.0 * rng.next(),
+            eps: 0.05 + rng.next().abs(),
+            mu: rng.next().abs(),
+        };
+        let (q, p, t) = (4.0 * rng.next(), 3.0 * rng.next(), 10.0 * rng.next());
+        let h = kapitza::hamiltonian(t, &[q, p], &params);
+        assert!(close(
+            h,
+            kapitza_h_closed_form(q, p, t, params.A, params.eps),
+            1e-13
+        ));
+        let hbar = kapitza::averaged_hamiltonian(&[q, p], &params);
+        let expected = p * p / 2.0 + q.cos() + params.A * params.A / 4.0 * q.sin().powi(2);
+        assert!(
+            close(hbar, expected, 1e-13),
+            "H̄ = {hbar}, expected {expected}"
+        );
+        let v = kapitza::effective_potential(&[q], &params);
+        assert!(close(
+            v,
+            q.cos() + params.A * params.A / 4.0 * q.sin().powi(2),
+            1e-13
+        ));
+    }
+}
+
+#[test]
+fn kapitza_equations_are_hamiltons_with_friction() {
+    // q' = ∂H/∂p, p' = −∂H/∂q − μ ∂H/∂p, with H the closed form (central differences).
+    let mut rng = Rng(11);
+    let d = 1e-6;
+    for _ in 0..100 {
+        let params = kapitza::Params {
+            A: 2.0 * rng.next(),
+            eps: 0.1 + rng.next().abs(),
+            mu: rng.next().abs(),
+        };
+        let (q, p, t) = (4.0 * rng.next(), 2.0 * rng.next(), 5.0 * rng.next());
+        let h = |q: f64, p: f64| kapitza_h_closed_form(q, p, t, params.A, params.eps);
+        let dh_dp = (h(q, p + d) - h(q, p - d)) / (2.0 * d);
+        let dh_dq = (h(q + d, p) - h(q - d, p)) / (2.0 * d);
+        let [qd, pd] = kapitza::exact_rhs(t, &[q, p], &params);
+        assert!(close(qd, dh_dp, 1e-8));
+        assert!(close(pd, -dh_dq - params.mu * dh_dp, 1e-8));
+    }
+}
+
+fn check_jacobian<const N: usize>(
+    f: &dyn Fn(&[f64; N]) -> [f64; N],
+    jac: &[[f64; N]; N],
+    y: &[f64; N],
+) {
+    let d = 1e-6;
+    for k in 0..N {
+        let mut plus = *y;
+        let mut minus = *y;
+        plus[k] += d;
+        minus[k] -= d;
+        let (fp, fm) = (f(&plus), f(&minus));
+        for i in 0..N {
+            let numeric = (fp[i] - fm[i]) / (2.0 * d);
+            assert!(
+                close(jac[i][k], numeric, 1e-6),
+                "J[{i}][{k}] = {} vs {numeric}",
+                jac[i][k]
+            );
+        }
+    }
+}
+
+#[test]
+fn jacobians_match_finite_differences() {
+    let mut rng = Rng(3);
+    for _ in 0..50 {
+        let kp = kapitza::Params {
+            A: 2.0 * rng.next(),
+            eps: 0.2,
+            mu: rng.next().abs(),
+        };
+        let t = rng.next();
+        let y = [3.0 * rng.next(), rng.next()];
+        check_jacobian(
+            &|y| kapitza::exact_rhs(t, y, &kp),
+            &kapitza::exact_jacobian(t, y.as_ref().try_into().unwrap(), &kp),
+            &y,
+        );
+        check_jacobian(
+            &|y| kapitza::averaged_rhs(y, &kp),
+            &kapitza::averaged_jacobian(&y, &kp),
+            &y,
+        );
+        let pp = dp::Params {
+            a: 3.0,
+            nu: 10.0,
+            mu: 0.3,
+            m1: 1.3,
+            m2: 0.7,
+            l1: 0.9,
+            l2: 1.2,
+            ..Default::default()
+        };
+        let y = [3.0 * rng.next(), 3.0 * rng.next(), rng.next(), rng.next()];
+        check_jacobian(
+            &|y| dp::exact_rhs(t, y, &pp),
+            &dp::exact_jacobian(t, &y, &pp),
+            &y,
+        );
+        check_jacobian(
+            &|y| dp::averaged_rhs(y, &pp),
+            &dp::averaged_jacobian(&y, &pp),
+            &y,
+        );
+    }
+}
+
+/// Accelerations of the double pendulum on a base with vertical acceleration
+/// ẅ, derived by hand in the base frame (effective gravity g + ẅ, angles from
+/// the upward vertical, friction Q1 = −μ φ1', Q2 = −μ(φ2' − φ1')).
+fn double_pendulum_accelerations(phi: [f64; 2], w: [f64; 2], t: f64, p: &dp::Params) -> [f64; 2] {
+    let wdd = -p.a * p.nu * (p.nu * t).cos();
+    let g = p.g + wdd;
+    let (s12, c12) = (phi[0] - phi[1]).sin_cos();
+    let m11 = (p.m1 + p.m2) * p.l1 * p.l1;
+    let m12 = p.m2 * p.l1 * p.l2 * c12;
+    let m22 = p.m2 * p.l2 * p.l2;
+    let q1 = -p.mu * w[0];
+    let q2 = -p.mu * (w[1] - w[0]);
+    let r1 = q1 - p.m2 * p.l1 * p.l2 * s12 * w[1] * w[1] + g * (p.m1 + p.m2) * p.l1 * phi[0].sin();
+    let r2 = q2 + p.m2 * p.l1 * p.l2 * s12 * w[0] * w[0] + g * p.m2 * p.l2 * phi[1].sin();
+    let det = m11 * m22 - m12 * m12;
+    [(m22 * r1 - m12 * r2) / det, (m11 * r2 - m12 * r1) / det]
+}
+
+#[test]
+fn double_pendulum_equations_match_a_hand_derivation() {
+    let mut rng = Rng(5);
+    for _ in 0..100 {
+        let params = dp::Params {
+            m1: 1.0 + rng.next().abs(),
+            m2: 0.5 + rng.next().abs(),
+            l1: 0.5 + rng.next().abs(),
+            l2: 0.5 + rng.next().abs(),
+            g: 9.81,
+            a: 2.0 * rng.next().abs(),
+            nu: 5.0 + 20.0 * rng.next().abs(),
+            mu: rng.next().abs(),
+        };
+        let t = 3.0 * rng.next();
+        let phi = [3.0 * rng.next(), 3.0 * rng.next()];
+        let w = [2.0 * rng.next(), 2.0 * rng.next()];
+        // State from the generated momenta, then accelerations by the chain rule:
+        // q'' = ∂v/∂t + ∂v/∂q q' + ∂v/∂p p'.
+        let p = dp::momenta(t, &phi, &w, &params);
+        let y = [phi[0], phi[1], p[0], p[1]];
+        let v = dp::velocities(t, &y, &params);
+        assert!(close(v[0], w[0], 1e-12) && close(v[1], w[1], 1e-12));
+        let f = dp::exact_rhs(t, &y, &params);
+        let j = dp::exact_jacobian(t, &y, &params);
+        let d = 1e-6;
+        let (vp, vm) = (
+            dp::velocities(t + d, &y, &params),
+            dp::velocities(t - d, &y, &params),
+        );
+        let expected = double_pendulum_accelerations(phi, w, t, &params);
+        for i in 0..2 {
+            let dv_dt = (vp[i] - vm[i]) / (2.0 * d);
+            let acceleration = dv_dt + (0..4).map(|k| j[i][k] * f[k]).sum::<f64>();
+            assert!(
+                close(acceleration, expected[i], 1e-6),
+                "φ{}'' = {acceleration}, by hand {}",
+                i + 1,
+                expected[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn double_pendulum_vibrational_potential_matches_the_closed_form() {
+    // V_vibr = (a²/4) sᵀ A⁻¹ s, s = ((m1 + m2) l1 sin φ1, m2 l2 sin φ2).
+    let mut rng = Rng(9);
+    for _ in 0..100 {
+        let p = dp::Params {
+            m1: 1.0 + rng.next().abs(),
+            m2: 0.5 + rng.next().abs(),
+            l1: 0.5 + rng.next().abs(),
+            l2: 0.5 + rng.next().abs(),
+            a: 3.0 * rng.next(),
+            ..Default::default()
+        };
+        let phi = [3.0 * rng.next(), 3.0 * rng.next()];
+        let s = [
+            (p.m1 + p.m2) * p.l1 * phi[0].sin(),
+            p.m2 * p.l2 * phi[1].sin(),
+        ];
+        let m11 = (p.m1 + p.m2) * p.l1 * p.l1;
+        let m12 = p.m2 * p.l1 * p.l2 * (phi[0] - phi[1]).cos();
+        let m22 = p.m2 * p.l2 * p.l2;
+        let det = m11 * m22 - m12 * m12;
+        let quadratic = (m22 * s[0] * s[0] - 2.0 * m12 * s[0] * s[1] + m11 * s[1] * s[1]) / det;
+        let expected = p.a * p.a / 4.0 * quadratic;
+        assert!(close(dp::vibrational_potential(&phi, &p), expected, 1e-12));
+        let mass = dp::mass_matrix(&phi, &p);
+        assert!(
+            close(mass[0][0], m11, 1e-13)
+                && close(mass[0][1], m12, 1e-13)
+                && close(mass[1][1], m22, 1e-13)
+        );
+        let v = p.g * ((p.m1 + p.m2) * p.l1 * phi[0].cos() + p.m2 * p.l2 * phi[1].cos());
+        assert!(close(dp::potential(&phi, &p), v, 1e-13));
+    }
+}
+
+#[test]
+fn averaged_double_pendulum_conserves_its_hamiltonian() {
+    let params = dp::Params {
+        a: 3.0,
+        mu: 0.0,
+        ..Default::default()
+    };
+    let system = dp::Averaged { params };
+    let y0 = [0.3, -0.4, 0.2, 0.1];
+    let h0 = dp::averaged_hamiltonian(&y0, &params);
+    let mut integrator = Integrator::new(Method::Dop853 {
+        rtol: 1e-12,
+        atol: 1e-12,
+    })
+    .unwrap();
+    let mut worst = 0.0f64;
+    let y = integrator
+        .advance_observed(&system, 0.0, &y0, 200.0, &mut |_, y| {
+            worst = worst.max((dp::averaged_hamiltonian(y, &params) - h0).abs());
+        })
+        .unwrap();
+    assert!(worst < 1e-9, "H̄ drifted by {worst}");
+    assert!(y != y0);
+}
+
+/// Max over t ∈ [0, t_end] of |φ_exact − φ_averaged| from the same (q, p).
+fn averaging_deviation(nu: f64) -> f64 {
+    let params = dp::Params {
+        a: 2.0,
+        nu,
+        ..Default::default()
+    };
+    let exact = dp::Exact { params };
+    let averaged = dp::Averaged { params };
+    let y0 = [2.8, 3.3, 0.0, 0.0];
+    let method = Method::Dop853 {
+        rtol: 1e-11,
+        atol: 1e-11,
+    };
+    let (mut a, mut b) = (
+        Integrator::new(method).unwrap(),
+        Integrator::new(method).unwrap(),
+    );
+    let (mut ya, mut yb) = (y0, y0);
+    let mut deviation = 0.0f64;
+    let samples = 400;
+    let t_end = 3.0;
+    for i in 0..samples {
+        let (t0, t1) = (
+            t_end * i as f64 / samples as f64,
+            t_end * (i + 1) as f64 / samples as f64,
+        );
+        ya = a.advance(&exact, t0, &ya, t1).unwrap();
+        yb = b.advance(&averaged, t0, &yb, t1).unwrap();
+        deviation = deviation
+            .max((ya[0] - yb[0]).abs())
+            .max((ya[1] - yb[1]).abs());
+    }
+    deviation
+}
+
+#[test]
+fn exact_solution_approaches_the_averaged_one_like_one_over_nu() {
+    let nus = [100.0, 200.0, 400.0, 800.0];
+    let deviations: Vec<f64> = nus.iter().map(|&nu| averaging_deviation(nu)).collect();
+    for w in deviations.windows(2) {
+        let ratio = w[0] / w[1];
+        assert!(
+            (1.6..2.5).contains(&ratio),
+            "deviation ratio per doubling of ν = {ratio} ({deviations:?})"
+        );
+    }
+    assert!(deviations[3] < 0.05, "{deviations:?}");
+}
+
+#[test]
+fn exact_system_trait_matches_the_free_functions() {
+    let params = kapitza::Params::default();
+    let y = [0.3, -0.2];
+    assert_eq!(
+        kapitza::Exact { params }.rhs(0.7, &y),
+        kapitza::exact_rhs(0.7, &y, &params)
+    );
+    assert_eq!(
+        kapitza::Averaged { params }.jacobian(0.0, &y),
+        Some(kapitza::averaged_jacobian(&y, &params))
+    );
+}
+
+#[test]
+fn parameters_by_name() {
+    let mut p = kapitza::Params::default();
+    p.set("A", 2.5).unwrap();
+    assert_eq!(p.A, 2.5);
+    assert_eq!(p.get("eps"), Some(0.1));
+    let e = p.set("B", 1.0).unwrap_err().to_string();
+    assert!(
+        e.contains("no parameter 'B'") && e.contains("A, eps, mu"),
+        "{e}"
+    );
+    assert!(p
+        .set("mu", f64::NAN)
+        .unwrap_err()
+        .to_string()
+        .contains("must be finite"));
+}
