@@ -5,7 +5,10 @@
 //! generated modules in [`models`] → runtime: [`ode`] (integrators),
 //! analyses, plots → `examples/` (scenes).
 
+pub mod analysis;
 pub mod model;
 pub mod models;
 pub mod ode;
+pub mod plot;
 pub mod registry;
+pub mod scene;

@@ -1,0 +1,189 @@
+//! Scene `kapitza_period_map` (deliverables 1.2–1.4): orbits of the period map
+//! of the pendulum with a vibrating pivot on the unrolled cylinder
+//! (q mod 2π, p). Without q0/p0 it draws the portraits of three presets
+//! (A = 0: the ordinary pendulum; small A: chaos near the separatrices;
+//! larger A: a wide chaotic sea) or of the given A; with q0 and p0 it
+//! computes one orbit and reports its final state and cost.
+
+use mechlab::analysis::period_map::{orbit, orbits};
+use mechlab::models::kapitza;
+use mechlab::ode::{Integrator, Method};
+use mechlab::plot::{palette, Figure, PanelSpec};
+use mechlab::scene::{knob, run, Scene, SceneError};
+use std::f64::consts::PI;
+
+const KNOBS: &[mechlab::scene::Knob] = &[
+    knob(
+        "A",
+        "presets",
+        "pivot amplitude; 'presets' draws A = 0, 0.2 and 1.0",
+    ),
+    knob("eps", "0.1", "ε: forcing period / 2π"),
+    knob("mu", "0", "viscous friction"),
+    knob(
+        "orbits",
+        "24",
+        "number of initial conditions (portrait mode)",
+    ),
+    knob("periods", "3000", "periods per orbit"),
+    knob(
+        "method",
+        "dop853",
+        "integrator: dop853, rk4, gauss4, gauss6",
+    ),
+    knob(
+        "tol",
+        "1e-10",
+        "tolerance (dop853) or step size (rk4, gauss*)",
+    ),
+    knob("q0", "", "single-orbit mode: initial q"),
+    knob("p0", "", "single-orbit mode: initial p"),
+];
+
+/// Initial conditions: a spread through the lower position q = π, plus points near the separatrix.
+fn initial_conditions(count: usize) -> Vec<[f64; 2]> {
+    let near = [[PI, 1.98], [PI, 2.02], [0.05, 0.0], [PI, -1.98]];
+    let spread = count.saturating_sub(near.len()).max(1);
+    let mut points: Vec<[f64; 2]> = (0..spread)
+        .map(|i| [PI - 1e-9, 0.1 + 2.9 * i as f64 / (spread - 1).max(1) as f64])
+        .collect();
+    points.extend(near.iter().take(count.saturating_sub(spread)));
+    points
+}
+
+fn main() {
+    run(|| {
+        let scene = Scene::from_args(
+            "kapitza_period_map",
+            "orbits of the period map of the Kapitza pendulum",
+            KNOBS,
+        )?;
+        let eps = scene.positive("eps")?;
+        let mu = scene.non_negative("mu")?;
+        let periods = scene.count("periods")?;
+        let method = Method::parse(scene.text("method"), scene.number("tol")?)?;
+        let amplitudes: Vec<f64> = match scene.text("A") {
+            "presets" => vec![0.0, 0.2, 1.0],
+            _ => vec![scene.number("A")?],
+        };
+        let period = 2.0 * PI * eps;
+
+        if !scene.text("q0").is_empty() || !scene.text("p0").is_empty() {
+            // Single-orbit mode.
+            let y0 = [scene.number("q0")?, scene.number("p0")?];
+            let params = kapitza::Params {
+                A: amplitudes[0],
+                eps,
+                mu,
+            };
+            let mut integrator = Integrator::new(method)?;
+            let start = std::time::Instant::now();
+            let points = orbit(
+                &mut integrator,
+                &kapitza::Exact { params },
+                period,
+                &y0,
+                periods,
+                &kapitza::PERIODIC_STATE,
+            )?;
+            let seconds = start.elapsed().as_secs_f64();
+            let last = points[points.len() - 1];
+            scene.write_csv(
+                "orbit.csv",
+                "period,q,p",
+                points
+                    .iter()
+                    .enumerate()
+                    .map(|(k, y)| format!("{k},{:.17e},{:.17e}", y[0], y[1])),
+            )?;
+            let mut figure = Figure::single(
+                800,
+                600,
+                PanelSpec::new(
+                    &format!("A={} EPS={eps} MU={mu}", params.A),
+                    "Q",
+                    "P",
+                    (-PI, PI),
+                    range_p(&points),
+                ),
+            );
+            figure.points(0, points.iter().map(|y| (y[0], y[1])), palette(0), 1);
+            scene.save_figure(&figure, "orbit.png")?;
+            scene.write_summary(serde_json::json!({
+                "final_state": last, "periods": periods, "method": method.name(),
+                "tol": scene.number("tol")?, "seconds": seconds, "f_evals": integrator.stats.f_evals,
+                "steps": integrator.stats.steps, "rejected": integrator.stats.rejected,
+            }))?;
+            return Ok(());
+        }
+
+        let initial = initial_conditions(scene.count("orbits")?);
+        let mut summary = Vec::new();
+        for &a in &amplitudes {
+            let params = kapitza::Params { A: a, eps, mu };
+            eprintln!("A = {a}: {} orbits × {periods} periods", initial.len());
+            let start = std::time::Instant::now();
+            let results = orbits(
+                method,
+                &kapitza::Exact { params },
+                period,
+                &initial,
+                periods,
+                &kapitza::PERIODIC_STATE,
+            );
+            let seconds = start.elapsed().as_secs_f64();
+            let mut figure = Figure::single(
+                900,
+                700,
+                PanelSpec::new(
+                    &format!("KAPITZA PERIOD MAP  A={a}  EPS={eps}  MU={mu}  ({periods} PERIODS)"),
+                    "Q (0 = UPWARD)",
+                    "P",
+                    (-PI, PI),
+                    (-3.6, 3.6),
+                ),
+            );
+            let mut rows = Vec::new();
+            let mut f_evals = 0;
+            for (k, result) in results.into_iter().enumerate() {
+                let (points, stats) = result.map_err(|e| {
+                    SceneError::Numerical(format!("orbit {k} from {:?}: {e}", initial[k]))
+                })?;
+                f_evals += stats.f_evals;
+                figure.points(0, points.iter().map(|y| (y[0], y[1])), palette(k), 1);
+                rows.extend(
+                    points
+                        .iter()
+                        .enumerate()
+                        .map(|(n, y)| format!("{k},{n},{:.12e},{:.12e}", y[0], y[1])),
+                );
+            }
+            figure.legend(
+                0,
+                &[
+                    (format!("A={a} EPS={eps} MU={mu}"), palette(0)),
+                    (
+                        format!("{} ORBITS, {}", initial.len(), method.name()),
+                        palette(1),
+                    ),
+                ],
+            );
+            let tag = format!("A{a}");
+            scene.save_figure(&figure, &format!("portrait_{tag}.png"))?;
+            scene.write_csv(&format!("orbits_{tag}.csv"), "orbit,period,q,p", rows)?;
+            summary.push(serde_json::json!({"A": a, "orbits": initial.len(), "periods": periods, "seconds": seconds, "f_evals": f_evals}));
+        }
+        scene.write_summary(serde_json::json!({"eps": eps, "mu": mu, "method": method.name(), "portraits": summary}))?;
+        Ok(())
+    });
+}
+
+fn range_p(points: &[[f64; 2]]) -> (f64, f64) {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+            (lo.min(y[1]), hi.max(y[1]))
+        });
+    let pad = 0.05 * (hi - lo).max(1e-3);
+    (lo - pad, hi + pad)
+}

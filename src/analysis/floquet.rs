@@ -1,0 +1,85 @@
+//! Monodromy matrices and Floquet multipliers of periodic motions.
+
+use super::variational::Variational;
+use crate::ode::{Integrator, OdeError, System};
+use nalgebra::DMatrix;
+
+/// The state after one period and the monodromy matrix ∂y(T)/∂y(0)
+/// (row i, column k), from the variational equations. M = N + N².
+pub fn monodromy<S: System<N>, const N: usize, const M: usize>(
+    integrator: &mut Integrator,
+    system: &S,
+    period: f64,
+    y0: &[f64; N],
+) -> Result<([f64; N], [[f64; N]; N]), OdeError> {
+    assert_eq!(M, N + N * N, "monodromy needs M = N + N²");
+    let identity: Vec<[f64; N]> = (0..N)
+        .map(|k| std::array::from_fn(|i| f64::from(u8::from(i == k))))
+        .collect();
+    let variational = Variational::<S, N, M>::new(system);
+    let z0 = Variational::<S, N, M>::pack(y0, &identity);
+    let z = integrator.advance(&variational, 0.0, &z0, period)?;
+    let mut m = [[0.0; N]; N];
+    for (k, column) in (0..N)
+        .map(|k| Variational::<S, N, M>::tangent(&z, k))
+        .enumerate()
+    {
+        for i in 0..N {
+            m[i][k] = column[i];
+        }
+    }
+    Ok((Variational::<S, N, M>::state(&z), m))
+}
+
+/// Eigenvalues of a monodromy matrix, as (re, im), sorted by decreasing modulus.
+pub fn floquet_multipliers<const N: usize>(monodromy: &[[f64; N]; N]) -> Vec<(f64, f64)> {
+    let m = DMatrix::from_fn(N, N, |i, k| monodromy[i][k]);
+    let mut values: Vec<(f64, f64)> = m
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| (z.re, z.im))
+        .collect();
+    values.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
+    values
+}
+
+/// Spectral radius: the largest modulus of the multipliers.
+pub fn spectral_radius(multipliers: &[(f64, f64)]) -> f64 {
+    multipliers
+        .iter()
+        .map(|(re, im)| re.hypot(*im))
+        .fold(0.0, f64::max)
+}
+
+/// Stability of a periodic motion from its multipliers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Some multiplier outside the unit circle.
+    Unstable,
+    /// All on the unit circle (linearly stable; conservative case).
+    Stable,
+    /// All strictly inside: asymptotically stable.
+    AsymptoticallyStable,
+}
+
+impl Verdict {
+    /// `tolerance` absorbs the integration error on |λ| = 1.
+    pub fn from_multipliers(multipliers: &[(f64, f64)], tolerance: f64) -> Verdict {
+        let radius = spectral_radius(multipliers);
+        if radius > 1.0 + tolerance {
+            Verdict::Unstable
+        } else if radius < 1.0 - tolerance {
+            Verdict::AsymptoticallyStable
+        } else {
+            Verdict::Stable
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Verdict::Unstable => "unstable",
+            Verdict::Stable => "stable",
+            Verdict::AsymptoticallyStable => "asymptotically stable",
+        }
+    }
+}

@@ -1,0 +1,87 @@
+//! Lyapunov exponents of a period map (per iteration) and the fast Lyapunov
+//! indicator (FLI) used to shade chaos maps.
+
+use super::period_map::wrap_angle;
+use super::variational::Variational;
+use crate::ode::{Integrator, OdeError, System};
+use nalgebra::DMatrix;
+
+/// The full Lyapunov spectrum of the period map (exponents per period, in
+/// decreasing order), by QR re-orthonormalisation after every period.
+/// M = N + N². Starts from `y0`; the first `transient` periods are skipped.
+pub fn lyapunov_spectrum<S: System<N>, const N: usize, const M: usize>(
+    integrator: &mut Integrator,
+    system: &S,
+    period: f64,
+    y0: &[f64; N],
+    transient: usize,
+    periods: usize,
+    wrap: &[bool],
+) -> Result<(Vec<f64>, [f64; N]), OdeError> {
+    assert_eq!(M, N + N * N, "the spectrum needs M = N + N²");
+    let variational = Variational::<S, N, M>::new(system);
+    let mut y = *y0;
+    for _ in 0..transient {
+        y = integrator.advance(system, 0.0, &y, period)?;
+    }
+    let mut basis: Vec<[f64; N]> = (0..N)
+        .map(|k| std::array::from_fn(|i| f64::from(u8::from(i == k))))
+        .collect();
+    let mut sums = vec![0.0; N];
+    for _ in 0..periods {
+        let z = integrator.advance(
+            &variational,
+            0.0,
+            &Variational::<S, N, M>::pack(&y, &basis),
+            period,
+        )?;
+        y = Variational::<S, N, M>::state(&z);
+        for (x, w) in y.iter_mut().zip(wrap) {
+            if *w {
+                *x = wrap_angle(*x);
+            }
+        }
+        let m = DMatrix::from_fn(N, N, |i, k| Variational::<S, N, M>::tangent(&z, k)[i]);
+        let qr = m.qr();
+        let (q, r) = (qr.q(), qr.r());
+        for k in 0..N {
+            sums[k] += r[(k, k)].abs().ln();
+            basis[k] = std::array::from_fn(|i| q[(i, k)] * r[(k, k)].signum());
+        }
+    }
+    let mut exponents: Vec<f64> = sums.iter().map(|s| s / periods as f64).collect();
+    exponents.sort_by(|a, b| b.total_cmp(a));
+    Ok((exponents, y))
+}
+
+/// Fast Lyapunov indicator of the period map: max over iterations of
+/// ln‖w‖ for one tangent vector w started at `w0`, renormalised when large
+/// (the logarithms are accumulated). M = 2N.
+pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
+    integrator: &mut Integrator,
+    system: &S,
+    period: f64,
+    y0: &[f64; N],
+    w0: &[f64; N],
+    periods: usize,
+) -> Result<f64, OdeError> {
+    assert_eq!(M, 2 * N, "the FLI needs M = 2N");
+    let variational = Variational::<S, N, M>::new(system);
+    let mut z = Variational::<S, N, M>::pack(y0, &[*w0]);
+    let norm0 = w0.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let mut log_scale = 0.0;
+    let mut fli = f64::NEG_INFINITY;
+    for _ in 0..periods {
+        z = integrator.advance(&variational, 0.0, &z, period)?;
+        let w = Variational::<S, N, M>::tangent(&z, 0);
+        let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+        fli = fli.max(log_scale + (norm / norm0).ln());
+        if norm > 1e100 {
+            log_scale += norm.ln();
+            for x in &mut z[N..] {
+                *x /= norm;
+            }
+        }
+    }
+    Ok(fli)
+}

@@ -1,0 +1,349 @@
+//! The scenes contract: `cargo run --release --example <scene> -- [--set
+//! name=value]... [--out DIR]`. Output goes to `out/<scene>/` by default:
+//! PNG figures, CSV data and `summary.json`. Every file is written to a
+//! temporary name first and renamed, so results are never half-written.
+
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A knob of a scene: name, default (as text) and help.
+#[derive(Clone, Debug)]
+pub struct Knob {
+    pub name: &'static str,
+    pub default: &'static str,
+    pub help: &'static str,
+}
+
+pub const fn knob(name: &'static str, default: &'static str, help: &'static str) -> Knob {
+    Knob {
+        name,
+        default,
+        help,
+    }
+}
+
+/// Why a scene could not run.
+#[derive(Debug)]
+pub enum SceneError {
+    /// Bad command line.
+    Usage(String),
+    /// A `--set` value that does not parse or is out of range.
+    BadValue {
+        name: String,
+        value: String,
+        reason: String,
+    },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// A numerical failure (divergence, ...), with context.
+    Numerical(String),
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SceneError::Usage(m) => write!(f, "{m}"),
+            SceneError::BadValue {
+                name,
+                value,
+                reason,
+            } => write!(f, "--set {name}={value}: {reason}"),
+            SceneError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            SceneError::Numerical(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+impl From<crate::ode::OdeError> for SceneError {
+    fn from(e: crate::ode::OdeError) -> Self {
+        SceneError::Numerical(e.to_string())
+    }
+}
+
+impl From<crate::registry::ParameterError> for SceneError {
+    fn from(e: crate::registry::ParameterError) -> Self {
+        SceneError::Usage(e.to_string())
+    }
+}
+
+/// A parsed command line of a scene.
+#[derive(Debug)]
+pub struct Scene {
+    pub name: &'static str,
+    knobs: Vec<Knob>,
+    values: Vec<(String, String)>,
+    pub out: PathBuf,
+}
+
+impl Scene {
+    /// Parses `std::env::args`; prints help and exits on `--help`.
+    pub fn from_args(name: &'static str, about: &str, knobs: &[Knob]) -> Result<Scene, SceneError> {
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        if args.iter().any(|a| a == "--help" || a == "-h") {
+            println!("{}", Self::help(name, about, knobs));
+            std::process::exit(0);
+        }
+        Self::parse(name, knobs, &args)
+    }
+
+    pub fn help(name: &str, about: &str, knobs: &[Knob]) -> String {
+        let mut s = format!(
+            "{name}: {about}\n\nusage: cargo run --release --example {name} -- [--set name=value]... [--out DIR]\n\nknobs (default):\n"
+        );
+        for k in knobs {
+            s += &format!("  {:<12} ({}) {}\n", k.name, k.default, k.help);
+        }
+        s += &format!(
+            "\noutput: out/{name}/ unless --out is given: PNG figures, CSV data, summary.json\n"
+        );
+        s
+    }
+
+    /// Parses arguments (without the program name).
+    pub fn parse(name: &'static str, knobs: &[Knob], args: &[String]) -> Result<Scene, SceneError> {
+        let mut values: Vec<(String, String)> = knobs
+            .iter()
+            .map(|k| (k.name.to_string(), k.default.to_string()))
+            .collect();
+        let mut out = PathBuf::from("out").join(name);
+        let mut i = 0;
+        while i < args.len() {
+            let next = || {
+                args.get(i + 1)
+                    .cloned()
+                    .ok_or_else(|| SceneError::Usage(format!("{} needs a value", args[i])))
+            };
+            match args[i].as_str() {
+                "--set" => {
+                    let pair = next()?;
+                    let (key, value) = pair.split_once('=').ok_or_else(|| {
+                        SceneError::Usage(format!("--set {pair}: expected name=value"))
+                    })?;
+                    match values.iter_mut().find(|(k, _)| k == key) {
+                        Some(slot) => slot.1 = value.to_string(),
+                        None => {
+                            let known: Vec<&str> = knobs.iter().map(|k| k.name).collect();
+                            return Err(SceneError::Usage(format!(
+                                "--set {key}: unknown knob for scene {name} (known: {})",
+                                known.join(", ")
+                            )));
+                        }
+                    }
+                    i += 2;
+                }
+                "--out" => {
+                    out = PathBuf::from(next()?);
+                    i += 2;
+                }
+                other => {
+                    return Err(SceneError::Usage(format!(
+                        "unexpected argument '{other}' (see --help)"
+                    )))
+                }
+            }
+        }
+        Ok(Scene {
+            name,
+            knobs: knobs.to_vec(),
+            values,
+            out,
+        })
+    }
+
+    /// The text value of a knob.
+    pub fn text(&self, name: &str) -> &str {
+        &self
+            .values
+            .iter()
+            .find(|(k, _)| k == name)
+            .unwrap_or_else(|| panic!("scene {} has no knob {name}", self.name))
+            .1
+    }
+
+    /// A finite number.
+    pub fn number(&self, name: &str) -> Result<f64, SceneError> {
+        let text = self.text(name);
+        match text.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(SceneError::BadValue {
+                name: name.into(),
+                value: text.into(),
+                reason: "not a finite number".into(),
+            }),
+        }
+    }
+
+    /// A number that must be positive.
+    pub fn positive(&self, name: &str) -> Result<f64, SceneError> {
+        let v = self.number(name)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(SceneError::BadValue {
+                name: name.into(),
+                value: self.text(name).into(),
+                reason: "must be positive".into(),
+            })
+        }
+    }
+
+    /// A non-negative number.
+    pub fn non_negative(&self, name: &str) -> Result<f64, SceneError> {
+        let v = self.number(name)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(SceneError::BadValue {
+                name: name.into(),
+                value: self.text(name).into(),
+                reason: "must not be negative".into(),
+            })
+        }
+    }
+
+    /// A positive whole number.
+    pub fn count(&self, name: &str) -> Result<usize, SceneError> {
+        let text = self.text(name);
+        match text.trim().parse::<usize>() {
+            Ok(v) if v > 0 => Ok(v),
+            _ => Err(SceneError::BadValue {
+                name: name.into(),
+                value: text.into(),
+                reason: "not a positive whole number".into(),
+            }),
+        }
+    }
+
+    /// The knobs and their values, for summaries.
+    pub fn settings(&self) -> serde_json::Value {
+        let map: serde_json::Map<String, serde_json::Value> = self
+            .values
+            .iter()
+            .map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone())))
+            .collect();
+        serde_json::Value::Object(map)
+    }
+
+    pub fn knobs(&self) -> &[Knob] {
+        &self.knobs
+    }
+
+    /// Path of an output file, creating the output directory.
+    pub fn path(&self, file: &str) -> Result<PathBuf, SceneError> {
+        std::fs::create_dir_all(&self.out).map_err(|source| SceneError::Io {
+            path: self.out.clone(),
+            source,
+        })?;
+        Ok(self.out.join(file))
+    }
+
+    pub fn save_figure(
+        &self,
+        figure: &crate::plot::Figure,
+        file: &str,
+    ) -> Result<PathBuf, SceneError> {
+        let path = self.path(file)?;
+        figure.save(&path).map_err(|source| SceneError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        eprintln!("wrote {}", path.display());
+        Ok(path)
+    }
+
+    /// Writes CSV with a header line.
+    pub fn write_csv(
+        &self,
+        file: &str,
+        header: &str,
+        rows: impl IntoIterator<Item = String>,
+    ) -> Result<PathBuf, SceneError> {
+        let path = self.path(file)?;
+        let mut text = String::from(header);
+        text.push('\n');
+        for row in rows {
+            text += &row;
+            text.push('\n');
+        }
+        write_atomic(&path, text.as_bytes()).map_err(|source| SceneError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        eprintln!("wrote {}", path.display());
+        Ok(path)
+    }
+
+    pub fn write_text(&self, file: &str, text: &str) -> Result<PathBuf, SceneError> {
+        let path = self.path(file)?;
+        write_atomic(&path, text.as_bytes()).map_err(|source| SceneError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        eprintln!("wrote {}", path.display());
+        Ok(path)
+    }
+
+    /// Writes `summary.json` (with the scene's settings added).
+    pub fn write_summary(&self, mut summary: serde_json::Value) -> Result<PathBuf, SceneError> {
+        if let serde_json::Value::Object(map) = &mut summary {
+            map.insert("scene".into(), self.name.into());
+            map.insert("settings".into(), self.settings());
+        }
+        let text = serde_json::to_string_pretty(&summary).expect("JSON values serialise");
+        self.write_text("summary.json", &text)
+    }
+}
+
+/// Writes a file atomically: a temporary file in the same directory, then rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let temporary = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
+    {
+        let mut f = std::fs::File::create(&temporary)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+    }
+    std::fs::rename(&temporary, path)
+}
+
+/// Progress on stderr for long runs: "label: done/total (percent)".
+pub struct Progress {
+    label: String,
+    total: usize,
+    last_percent: usize,
+}
+
+impl Progress {
+    pub fn new(label: &str, total: usize) -> Progress {
+        Progress {
+            label: label.to_string(),
+            total: total.max(1),
+            last_percent: usize::MAX,
+        }
+    }
+    pub fn update(&mut self, done: usize) {
+        let percent = done * 100 / self.total;
+        if percent / 10 != self.last_percent / 10 || done == self.total {
+            if percent != self.last_percent {
+                eprintln!("{}: {done}/{} ({percent}%)", self.label, self.total);
+            }
+            self.last_percent = percent;
+        }
+    }
+}
+
+/// Runs a scene's body and turns an error into a message and exit code 2.
+pub fn run(body: impl FnOnce() -> Result<(), SceneError>) {
+    if let Err(e) = body() {
+        eprintln!("error: {e}");
+        std::process::exit(2);
+    }
+}
