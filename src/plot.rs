@@ -419,6 +419,50 @@ impl Figure {
         self.canvas.line((r, t), (r, b), frame);
     }
 
+    /// Level sets of `f` with spacing `step` (and the level `special`, drawn in
+    /// `special_color`): a pixel is marked where f crosses a level towards its neighbours.
+    pub fn contours(
+        &mut self,
+        k: usize,
+        f: &dyn Fn(f64, f64) -> f64,
+        step: f64,
+        color: Rgb,
+        special: f64,
+        special_color: Rgb,
+    ) {
+        let panel = self.panels[k];
+        let (w, h) = (panel.width as usize, panel.height as usize);
+        let (x0, x1, y0, y1) = (
+            panel.x_range.0,
+            panel.x_range.1,
+            panel.y_range.0,
+            panel.y_range.1,
+        );
+        let value = |i: usize, j: usize| {
+            f(
+                x0 + (x1 - x0) * i as f64 / (w - 1) as f64,
+                y1 - (y1 - y0) * j as f64 / (h - 1) as f64,
+            )
+        };
+        let grid: Vec<f64> = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .map(|(i, j)| value(i, j))
+            .collect();
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let a = grid[j * w + i];
+                for b in [grid[j * w + i + 1], grid[(j + 1) * w + i]] {
+                    let (x, y) = (panel.left + i as i64, panel.top + j as i64);
+                    if (a - special).signum() != (b - special).signum() {
+                        self.canvas.fill_rect(x, y, x + 1, y + 1, special_color);
+                    } else if (a / step).floor() != (b / step).floor() {
+                        self.canvas.set(x, y, color);
+                    }
+                }
+            }
+        }
+    }
+
     /// Legend lines in the panel's top-left corner, each with a colour swatch.
     pub fn legend(&mut self, k: usize, entries: &[(String, Rgb)]) {
         let panel = self.panels[k];

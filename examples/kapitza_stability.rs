@@ -1,0 +1,297 @@
+//! Scene `kapitza_stability` (deliverables 1.5, 1.6): is the upper position
+//! q = 0 of the pendulum with a vibrating pivot stable?
+//!
+//! q = 0, p = 0 is a T-periodic solution of the exact system for every A.
+//! Its stability follows from the Floquet multipliers of the linearised
+//! period map (the monodromy matrix M, from the generated Jacobian). For this
+//! 2×2 map the multipliers lie in the closed unit disc iff |tr M| ≤ 1 + det M
+//! (det M = exp(−μT) by Liouville); the critical amplitude A* is the root of
+//! |tr M| − 1 − det M, bracketed on a scan and bisected to 1e-10. The
+//! averaged system predicts A* = √2 (V = cos q + A²/4 sin²q has V''(0) = A²/2 − 1).
+
+use mechlab::analysis::floquet::{floquet_multipliers, monodromy, Verdict};
+use mechlab::analysis::period_map::orbit;
+use mechlab::models::kapitza;
+use mechlab::ode::{Integrator, Method};
+use mechlab::plot::{palette, Figure, PanelSpec, BLUE, GREY, RED};
+use mechlab::scene::{knob, run, Progress, Scene, SceneError};
+use rayon::prelude::*;
+use std::f64::consts::{PI, SQRT_2};
+
+const KNOBS: &[mechlab::scene::Knob] = &[
+    knob("A", "1.6", "pivot amplitude to judge"),
+    knob("eps", "0.1", "ε: forcing period / 2π"),
+    knob("mu", "0", "viscous friction"),
+    knob(
+        "tol",
+        "1e-12",
+        "DOP853 tolerance for the monodromy matrices",
+    ),
+    knob("periods", "2000", "periods per orbit near q = 0"),
+    knob("chart_eps", "40", "chart resolution in ε (0.02..0.5)"),
+    knob("chart_a", "120", "chart resolution in A (0..A_max)"),
+    knob("chart_a_max", "12", "largest A of the chart"),
+];
+
+/// |tr M| − 1 − det M: negative inside the stability region.
+fn stability_margin(
+    a: f64,
+    eps: f64,
+    mu: f64,
+    method: Method,
+) -> Result<(f64, [[f64; 2]; 2]), SceneError> {
+    let params = kapitza::Params { A: a, eps, mu };
+    let mut integrator = Integrator::new(method)?;
+    let (_, m) = monodromy::<_, 2, 6>(
+        &mut integrator,
+        &kapitza::Exact { params },
+        2.0 * PI * eps,
+        &[0.0, 0.0],
+    )?;
+    let trace = m[0][0] + m[1][1];
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    Ok((trace.abs() - 1.0 - det, m))
+}
+
+/// The smallest A in (0, a_max) where q = 0 becomes stable, or None.
+fn critical_amplitude(
+    eps: f64,
+    mu: f64,
+    method: Method,
+    a_max: f64,
+) -> Result<Option<f64>, SceneError> {
+    let steps = 400;
+    let mut previous = (0.0, stability_margin(0.0, eps, mu, method)?.0);
+    for i in 1..=steps {
+        let a = a_max * i as f64 / steps as f64;
+        let g = stability_margin(a, eps, mu, method)?.0;
+        if previous.1 > 0.0 && g <= 0.0 {
+            let (mut lo, mut hi) = (previous.0, a);
+            while hi - lo > 1e-10 {
+                let mid = 0.5 * (lo + hi);
+                if stability_margin(mid, eps, mu, method)?.0 > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return Ok(Some(0.5 * (lo + hi)));
+        }
+        previous = (a, g);
+    }
+    Ok(None)
+}
+
+fn main() {
+    run(|| {
+        let scene = Scene::from_args(
+            "kapitza_stability",
+            "stability of the upper position; critical amplitude A*; stability chart",
+            KNOBS,
+        )?;
+        let (a, eps, mu) = (
+            scene.non_negative("A")?,
+            scene.positive("eps")?,
+            scene.non_negative("mu")?,
+        );
+        let method = Method::parse("dop853", scene.positive("tol")?)?;
+        let period = 2.0 * PI * eps;
+
+        let a_star = critical_amplitude(eps, mu, method, 4.0)?;
+        let (_, m) = stability_margin(a, eps, mu, method)?;
+        let multipliers = floquet_multipliers(&m);
+        let verdict = Verdict::from_multipliers(&multipliers, 1e-7);
+        let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+        println!("ε = {eps}, μ = {mu}: A* = {a_star:?} (averaged: √2 = {SQRT_2})");
+        println!(
+            "A = {a}: multipliers {multipliers:?}, det M = {det} (exp(−μT) = {}): {}",
+            (-mu * period).exp(),
+            verdict.name()
+        );
+
+        // Orbits near q = 0 below and above A*, and with friction above A*.
+        let a_ref = a_star.unwrap_or(SQRT_2);
+        let cases = [
+            (a_ref - 0.15, mu, "BELOW A*"),
+            (a_ref + 0.15, mu, "ABOVE A*"),
+            (a_ref + 0.15, mu.max(0.1), "ABOVE A*, WITH FRICTION"),
+        ];
+        let periods = scene.count("periods")?;
+        let starts = [[0.05, 0.0], [0.15, 0.0], [0.3, 0.0], [0.0, 0.25]];
+        let specs: Vec<PanelSpec> = cases
+            .iter()
+            .map(|(ca, cmu, label)| {
+                PanelSpec::new(
+                    Box::leak(format!("{label}: A={ca:.3} MU={cmu}").into_boxed_str()),
+                    "Q",
+                    "P",
+                    (-1.0, 1.0),
+                    (-1.0, 1.0),
+                )
+            })
+            .collect();
+        let mut figure = Figure::grid(3, 1, 460, 460, &specs);
+        let mut rows = Vec::new();
+        for (k, (ca, cmu, _)) in cases.iter().enumerate() {
+            let system = kapitza::Exact {
+                params: kapitza::Params {
+                    A: *ca,
+                    eps,
+                    mu: *cmu,
+                },
+            };
+            for (s, y0) in starts.iter().enumerate() {
+                let mut integrator = Integrator::new(Method::Dop853 {
+                    rtol: 1e-10,
+                    atol: 1e-10,
+                })?;
+                let points = orbit(
+                    &mut integrator,
+                    &system,
+                    period,
+                    y0,
+                    periods,
+                    &kapitza::PERIODIC_STATE,
+                )?;
+                figure.points(
+                    k,
+                    points.iter().map(|y| (y[0], y[1])),
+                    palette(s),
+                    if *cmu > 0.0 { 2 } else { 1 },
+                );
+                rows.extend(
+                    points
+                        .iter()
+                        .enumerate()
+                        .map(|(n, y)| format!("{ca},{cmu},{s},{n},{:.12e},{:.12e}", y[0], y[1])),
+                );
+            }
+        }
+        scene.save_figure(&figure, "orbits_near_upper_position.png")?;
+        scene.write_csv(
+            "orbits_near_upper_position.csv",
+            "A,mu,orbit,period,q,p",
+            rows,
+        )?;
+
+        // Averaged phase portraits just below and above √2: level sets of H̄.
+        let averaged_cases = [SQRT_2 - 0.3, SQRT_2 + 0.3];
+        let specs: Vec<PanelSpec> = averaged_cases
+            .iter()
+            .map(|ca| {
+                PanelSpec::new(
+                    Box::leak(format!("AVERAGED H LEVELS, A={ca:.3}").into_boxed_str()),
+                    "Q",
+                    "P",
+                    (-PI, PI),
+                    (-2.5, 2.5),
+                )
+            })
+            .collect();
+        let mut figure = Figure::grid(2, 1, 560, 460, &specs);
+        for (k, ca) in averaged_cases.iter().enumerate() {
+            let params = kapitza::Params {
+                A: *ca,
+                eps,
+                mu: 0.0,
+            };
+            let h_top = kapitza::averaged_hamiltonian(&[0.0, 0.0], &params);
+            figure.contours(
+                k,
+                &|q, p| kapitza::averaged_hamiltonian(&[q, p], &params),
+                0.15,
+                BLUE,
+                h_top,
+                RED,
+            );
+        }
+        scene.save_figure(&figure, "averaged_portraits.png")?;
+
+        // Stability chart in the (ε, A) plane.
+        let (ne, na, a_max) = (
+            scene.count("chart_eps")?,
+            scene.count("chart_a")?,
+            scene.positive("chart_a_max")?,
+        );
+        let eps_values: Vec<f64> = (0..ne)
+            .map(|i| 0.02 + 0.48 * i as f64 / (ne - 1).max(1) as f64)
+            .collect();
+        let a_values: Vec<f64> = (0..na)
+            .map(|j| a_max * (j as f64 + 0.5) / na as f64)
+            .collect();
+        let mut progress = Progress::new("stability chart (ε rows)", ne);
+        let mut chart = vec![0.0; ne * na];
+        for (i, &e) in eps_values.iter().enumerate() {
+            let column: Vec<Result<f64, SceneError>> = a_values
+                .par_iter()
+                .map(|&ca| {
+                    stability_margin(
+                        ca,
+                        e,
+                        mu,
+                        Method::Dop853 {
+                            rtol: 1e-10,
+                            atol: 1e-10,
+                        },
+                    )
+                    .map(|r| r.0)
+                })
+                .collect();
+            for (j, g) in column.into_iter().enumerate() {
+                chart[j * ne + i] = if g? <= 0.0 { 0.75 } else { 0.0 };
+            }
+            progress.update(i + 1);
+        }
+        let mut figure = Figure::single(
+            800,
+            600,
+            PanelSpec::new(
+                &format!("UPPER POSITION STABLE (GREY), MU={mu}"),
+                "EPS",
+                "A",
+                (0.02, 0.5),
+                (0.0, a_max),
+            ),
+        );
+        figure.grey_map(0, ne, na, &chart);
+        figure.line(0, &[(0.02, SQRT_2), (0.5, SQRT_2)], RED);
+        figure.legend(
+            0,
+            &[("AVERAGED A*=SQRT(2)".into(), RED), ("STABLE".into(), GREY)],
+        );
+        scene.save_figure(&figure, "stability_chart.png")?;
+        scene.write_csv(
+            "stability_chart.csv",
+            "eps,A,stable",
+            (0..ne)
+                .flat_map(|i| (0..na).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    format!(
+                        "{},{},{}",
+                        eps_values[i],
+                        a_values[j],
+                        u8::from(chart[j * ne + i] > 0.0)
+                    )
+                }),
+        )?;
+
+        // A*(ε) against √2.
+        let eps_list = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
+        let a_star_by_eps: Vec<(f64, Option<f64>)> = eps_list
+            .par_iter()
+            .map(|&e| (e, critical_amplitude(e, 0.0, method, 4.0).ok().flatten()))
+            .collect();
+        for (e, s) in &a_star_by_eps {
+            println!("ε = {e}: A* = {s:?}, A* − √2 = {:?}", s.map(|x| x - SQRT_2));
+        }
+        scene.write_summary(serde_json::json!({
+            "eps": eps, "mu": mu, "A": a,
+            "a_star": a_star, "a_star_averaged": SQRT_2,
+            "multipliers": multipliers.iter().map(|(re, im)| [re, im]).collect::<Vec<_>>(),
+            "determinant": det, "determinant_expected": (-mu * period).exp(),
+            "verdict": verdict.name(),
+            "a_star_by_eps": a_star_by_eps.iter().map(|(e, s)| serde_json::json!({"eps": e, "a_star": s})).collect::<Vec<_>>(),
+        }))?;
+        Ok(())
+    });
+}
