@@ -28,9 +28,18 @@ impl System<1> for Forced {
 }
 
 fn observed_order(name: &str) -> f64 {
-    let reference = Integrator::new(Method::Gauss { stages: 3, step: 1e-3 }).unwrap().advance(&Forced, 0.0, &[1.0], 4.0).unwrap()[0];
+    let reference = Integrator::new(Method::Gauss {
+        stages: 3,
+        step: 1e-3,
+    })
+    .unwrap()
+    .advance(&Forced, 0.0, &[1.0], 4.0)
+    .unwrap()[0];
     let error = |h: f64| {
-        let y = Integrator::new(Method::parse(name, h).unwrap()).unwrap().advance(&Forced, 0.0, &[1.0], 4.0).unwrap()[0];
+        let y = Integrator::new(Method::parse(name, h).unwrap())
+            .unwrap()
+            .advance(&Forced, 0.0, &[1.0], 4.0)
+            .unwrap()[0];
         (y - reference).abs()
     };
     let (e1, e2) = (error(0.1), error(0.05));
@@ -41,7 +50,10 @@ fn observed_order(name: &str) -> f64 {
 fn fixed_step_methods_converge_with_their_order() {
     for (name, order) in [("rk4", 4.0), ("gauss4", 4.0), ("gauss6", 6.0)] {
         let observed = observed_order(name);
-        assert!((observed - order).abs() < 0.35, "{name}: observed order {observed}, expected {order}");
+        assert!(
+            (observed - order).abs() < 0.35,
+            "{name}: observed order {observed}, expected {order}"
+        );
     }
 }
 
@@ -49,8 +61,14 @@ fn fixed_step_methods_converge_with_their_order() {
 fn dop853_error_follows_its_tolerance() {
     let mut previous = f64::INFINITY;
     for tol in [1e-6, 1e-8, 1e-10, 1e-12] {
-        let mut integrator = Integrator::new(Method::Dop853 { rtol: tol, atol: tol }).unwrap();
-        let y = integrator.advance(&Oscillator, 0.0, &[1.0, 0.0], 20.0).unwrap();
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: tol,
+            atol: tol,
+        })
+        .unwrap();
+        let y = integrator
+            .advance(&Oscillator, 0.0, &[1.0, 0.0], 20.0)
+            .unwrap();
         let error = (y[0] - 20f64.cos()).abs().max((y[1] + 20f64.sin()).abs());
         assert!(error < 1e3 * tol, "tol {tol}: error {error}");
         assert!(error < previous, "error must shrink with the tolerance");
@@ -63,20 +81,36 @@ fn dop853_error_follows_its_tolerance() {
 fn dop853_is_eighth_order_in_its_step_count() {
     // Error ∝ steps^-8: halving the tolerance by 2^8 should roughly double the steps.
     let run = |tol: f64| {
-        let mut integrator = Integrator::new(Method::Dop853 { rtol: tol, atol: tol }).unwrap();
-        let y = integrator.advance(&Oscillator, 0.0, &[1.0, 0.0], 50.0).unwrap();
-        ((y[0] - 50f64.cos()).abs().max((y[1] + 50f64.sin()).abs()), integrator.stats.steps as f64)
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: tol,
+            atol: tol,
+        })
+        .unwrap();
+        let y = integrator
+            .advance(&Oscillator, 0.0, &[1.0, 0.0], 50.0)
+            .unwrap();
+        (
+            (y[0] - 50f64.cos()).abs().max((y[1] + 50f64.sin()).abs()),
+            integrator.stats.steps as f64,
+        )
     };
     let (e1, n1) = run(1e-7);
     let (e2, n2) = run(1e-11);
     let order = (e1 / e2).ln() / (n2 / n1).ln();
-    assert!((6.5..10.5).contains(&order), "observed order {order} ({e1:e} in {n1} steps, {e2:e} in {n2})");
+    assert!(
+        (6.5..10.5).contains(&order),
+        "observed order {order} ({e1:e} in {n1} steps, {e2:e} in {n2})"
+    );
 }
 
 #[test]
 fn gauss_legendre_keeps_the_energy_bounded_where_rk4_drifts() {
     // 10⁶ steps of the averaged Kapitza system (autonomous, Hamiltonian).
-    let params = kapitza::Params { A: 1.0, eps: 0.1, mu: 0.0 };
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
     let system = kapitza::Averaged { params };
     let y0 = [2.0, 0.5];
     let h0 = kapitza::averaged_hamiltonian(&y0, &params);
@@ -101,22 +135,47 @@ fn gauss_legendre_keeps_the_energy_bounded_where_rk4_drifts() {
     let (gauss_early, gauss_all) = energy_error(Method::Gauss { stages: 2, step: h });
     let (rk4_early, rk4_all) = energy_error(Method::Rk4 { step: h });
     // Symplectic: the error over the whole run is that of the first tenth (no secular growth).
-    assert!(gauss_all < 1.5 * gauss_early + 1e-14, "Gauss: {gauss_early:e} then {gauss_all:e}");
+    assert!(
+        gauss_all < 1.5 * gauss_early + 1e-14,
+        "Gauss: {gauss_early:e} then {gauss_all:e}"
+    );
     assert!(gauss_all < 1e-3, "Gauss energy error {gauss_all:e}");
     // RK4 dissipates: its error keeps growing.
-    assert!(rk4_all > 5.0 * rk4_early, "RK4: {rk4_early:e} then {rk4_all:e}");
+    assert!(
+        rk4_all > 5.0 * rk4_early,
+        "RK4: {rk4_early:e} then {rk4_all:e}"
+    );
 }
 
 #[test]
 fn pendulum_period_map_preserves_energy() {
     // A = 0, μ = 0: the period map is the time-T flow of the pendulum.
-    let params = kapitza::Params { A: 0.0, eps: 0.1, mu: 0.0 };
+    let params = kapitza::Params {
+        A: 0.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
     let system = kapitza::Exact { params };
     for y0 in [[3.0, 0.1], [PI - 0.01, 1.9], [0.5, 2.5]] {
         let e0 = kapitza::hamiltonian(0.0, &y0, &params);
-        let mut integrator = Integrator::new(Method::Dop853 { rtol: 1e-11, atol: 1e-11 }).unwrap();
-        let points = orbit(&mut integrator, &system, 2.0 * PI * 0.1, &y0, 2000, &kapitza::PERIODIC_STATE).unwrap();
-        let worst = points.iter().map(|y| (kapitza::hamiltonian(0.0, y, &params) - e0).abs()).fold(0.0, f64::max);
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: 1e-11,
+            atol: 1e-11,
+        })
+        .unwrap();
+        let points = orbit(
+            &mut integrator,
+            &system,
+            2.0 * PI * 0.1,
+            &y0,
+            2000,
+            &kapitza::PERIODIC_STATE,
+        )
+        .unwrap();
+        let worst = points
+            .iter()
+            .map(|y| (kapitza::hamiltonian(0.0, y, &params) - e0).abs())
+            .fold(0.0, f64::max);
         assert!(worst < 1e-8, "energy drift {worst:e} from {y0:?}");
     }
 }
@@ -126,19 +185,46 @@ fn monodromy_determinant_is_liouvilles() {
     for (a, mu) in [(0.5, 0.0), (1.6, 0.0), (1.6, 0.3), (3.0, 1.0)] {
         let params = kapitza::Params { A: a, eps: 0.1, mu };
         let period = 2.0 * PI * params.eps;
-        let mut integrator = Integrator::new(Method::Dop853 { rtol: 1e-12, atol: 1e-12 }).unwrap();
-        let (_, m) = monodromy::<_, 2, 6>(&mut integrator, &kapitza::Exact { params }, period, &[0.3, 0.2]).unwrap();
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+        })
+        .unwrap();
+        let (_, m) = monodromy::<_, 2, 6>(
+            &mut integrator,
+            &kapitza::Exact { params },
+            period,
+            &[0.3, 0.2],
+        )
+        .unwrap();
         let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-        assert!((det - (-mu * period).exp()).abs() < 1e-9, "A = {a}, μ = {mu}: det = {det}");
+        assert!(
+            (det - (-mu * period).exp()).abs() < 1e-9,
+            "A = {a}, μ = {mu}: det = {det}"
+        );
     }
 }
 
 #[test]
 fn upper_position_verdict_flips_at_the_averaged_threshold_for_small_eps() {
     let verdict = |a: f64, mu: f64| {
-        let params = kapitza::Params { A: a, eps: 0.05, mu };
-        let mut integrator = Integrator::new(Method::Dop853 { rtol: 1e-12, atol: 1e-12 }).unwrap();
-        let (_, m) = monodromy::<_, 2, 6>(&mut integrator, &kapitza::Exact { params }, 2.0 * PI * 0.05, &[0.0, 0.0]).unwrap();
+        let params = kapitza::Params {
+            A: a,
+            eps: 0.05,
+            mu,
+        };
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+        })
+        .unwrap();
+        let (_, m) = monodromy::<_, 2, 6>(
+            &mut integrator,
+            &kapitza::Exact { params },
+            2.0 * PI * 0.05,
+            &[0.0, 0.0],
+        )
+        .unwrap();
         Verdict::from_multipliers(&floquet_multipliers(&m), 1e-8)
     };
     assert_eq!(verdict(1.35, 0.0), Verdict::Unstable);
@@ -150,24 +236,78 @@ fn upper_position_verdict_flips_at_the_averaged_threshold_for_small_eps() {
 #[test]
 fn lyapunov_exponents_of_a_regular_orbit_vanish_and_sum_to_minus_mu_t() {
     let period = 2.0 * PI * 0.1;
-    let regular = kapitza::Exact { params: kapitza::Params { A: 0.2, eps: 0.1, mu: 0.0 } };
-    let mut integrator = Integrator::new(Method::Dop853 { rtol: 1e-11, atol: 1e-11 }).unwrap();
-    let (exponents, _) = lyapunov_spectrum::<_, 2, 6>(&mut integrator, &regular, period, &[PI, 1.0], 0, 4000, &[true, false]).unwrap();
-    assert!(exponents[0].abs() < 5e-3 && exponents[1].abs() < 5e-3, "{exponents:?}");
+    let regular = kapitza::Exact {
+        params: kapitza::Params {
+            A: 0.2,
+            eps: 0.1,
+            mu: 0.0,
+        },
+    };
+    let mut integrator = Integrator::new(Method::Dop853 {
+        rtol: 1e-11,
+        atol: 1e-11,
+    })
+    .unwrap();
+    let (exponents, _) = lyapunov_spectrum::<_, 2, 6>(
+        &mut integrator,
+        &regular,
+        period,
+        &[PI, 1.0],
+        0,
+        4000,
+        &[true, false],
+    )
+    .unwrap();
+    assert!(
+        exponents[0].abs() < 5e-3 && exponents[1].abs() < 5e-3,
+        "{exponents:?}"
+    );
     let mu = 0.3;
-    let damped = kapitza::Exact { params: kapitza::Params { A: 0.8, eps: 0.1, mu } };
-    let (exponents, _) = lyapunov_spectrum::<_, 2, 6>(&mut integrator, &damped, period, &[1.0, 0.5], 0, 500, &[true, false]).unwrap();
+    let damped = kapitza::Exact {
+        params: kapitza::Params {
+            A: 0.8,
+            eps: 0.1,
+            mu,
+        },
+    };
+    let (exponents, _) = lyapunov_spectrum::<_, 2, 6>(
+        &mut integrator,
+        &damped,
+        period,
+        &[1.0, 0.5],
+        0,
+        500,
+        &[true, false],
+    )
+    .unwrap();
     let sum: f64 = exponents.iter().sum();
-    assert!((sum + mu * period).abs() < 1e-8, "sum {sum}, expected {}", -mu * period);
+    assert!(
+        (sum + mu * period).abs() < 1e-8,
+        "sum {sum}, expected {}",
+        -mu * period
+    );
 }
 
 #[test]
 fn states_on_the_wrap_of_the_cylinder_are_equivalent() {
-    let params = kapitza::Params { A: 1.0, eps: 0.1, mu: 0.1 };
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.1,
+    };
     let system = kapitza::Exact { params };
-    let method = Method::Dop853 { rtol: 1e-12, atol: 1e-12 };
-    let a = Integrator::new(method).unwrap().advance(&system, 0.0, &[PI - 1e-12, 0.3], 5.0).unwrap();
-    let b = Integrator::new(method).unwrap().advance(&system, 0.0, &[-PI - 1e-12, 0.3], 5.0).unwrap();
+    let method = Method::Dop853 {
+        rtol: 1e-12,
+        atol: 1e-12,
+    };
+    let a = Integrator::new(method)
+        .unwrap()
+        .advance(&system, 0.0, &[PI - 1e-12, 0.3], 5.0)
+        .unwrap();
+    let b = Integrator::new(method)
+        .unwrap()
+        .advance(&system, 0.0, &[-PI - 1e-12, 0.3], 5.0)
+        .unwrap();
     assert!((wrap_angle(a[0]) - wrap_angle(b[0])).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9);
     assert!((-PI..PI).contains(&wrap_angle(PI)) && (-PI..PI).contains(&wrap_angle(-PI)));
 }
@@ -175,18 +315,33 @@ fn states_on_the_wrap_of_the_cylinder_are_equivalent() {
 #[test]
 fn zero_parameters_give_the_free_pendulum() {
     // A = 0 and μ = 0 with the forcing still defined: the equations reduce to q'' = sin q.
-    let params = kapitza::Params { A: 0.0, eps: 0.1, mu: 0.0 };
+    let params = kapitza::Params {
+        A: 0.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
     let f = kapitza::exact_rhs(1.3, &[0.7, -0.2], &params);
     assert_eq!(f, [-0.2, 0.7f64.sin()]);
 }
 
 #[test]
 fn bad_settings_and_states_are_errors() {
-    assert!(matches!(Method::parse("dop853", 0.0), Err(OdeError::InvalidSetting { .. })));
-    assert!(matches!(Method::parse("rk4", f64::NAN), Err(OdeError::InvalidSetting { .. })));
-    assert!(matches!(Method::parse("euler", 0.1), Err(OdeError::UnknownMethod(_))));
+    assert!(matches!(
+        Method::parse("dop853", 0.0),
+        Err(OdeError::InvalidSetting { .. })
+    ));
+    assert!(matches!(
+        Method::parse("rk4", f64::NAN),
+        Err(OdeError::InvalidSetting { .. })
+    ));
+    assert!(matches!(
+        Method::parse("euler", 0.1),
+        Err(OdeError::UnknownMethod(_))
+    ));
     let mut integrator = Integrator::new(Method::Rk4 { step: 0.1 }).unwrap();
-    let e = integrator.advance(&Oscillator, 0.0, &[f64::NAN, 0.0], 1.0).unwrap_err();
+    let e = integrator
+        .advance(&Oscillator, 0.0, &[f64::NAN, 0.0], 1.0)
+        .unwrap_err();
     assert!(matches!(e, OdeError::NonFiniteInitialState { .. }));
     assert!(e.to_string().contains("not finite"));
 }
@@ -201,10 +356,27 @@ impl System<1> for BlowUp {
 
 #[test]
 fn a_diverging_run_stops_with_an_error() {
-    for method in [Method::Rk4 { step: 0.01 }, Method::Dop853 { rtol: 1e-8, atol: 1e-8 }, Method::Gauss { stages: 2, step: 0.01 }] {
-        let result = Integrator::new(method).unwrap().advance(&BlowUp, 0.0, &[1.0], 2.0);
+    for method in [
+        Method::Rk4 { step: 0.01 },
+        Method::Dop853 {
+            rtol: 1e-8,
+            atol: 1e-8,
+        },
+        Method::Gauss {
+            stages: 2,
+            step: 0.01,
+        },
+    ] {
+        let result = Integrator::new(method)
+            .unwrap()
+            .advance(&BlowUp, 0.0, &[1.0], 2.0);
         match result {
-            Err(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. } | OdeError::NoConvergence { .. } | OdeError::TooManySteps { .. }) => {}
+            Err(
+                OdeError::NonFinite { .. }
+                | OdeError::StepSizeUnderflow { .. }
+                | OdeError::NoConvergence { .. }
+                | OdeError::TooManySteps { .. },
+            ) => {}
             other => panic!("{}: expected an error, got {other:?}", method.name()),
         }
     }
@@ -213,10 +385,29 @@ fn a_diverging_run_stops_with_an_error() {
 #[test]
 fn very_fast_forcing_is_integrated_accurately() {
     // ε = 1e-3: 10 periods with DOP853 against gauss6 with a fine step.
-    let params = kapitza::Params { A: 1.6, eps: 1e-3, mu: 0.0 };
+    let params = kapitza::Params {
+        A: 1.6,
+        eps: 1e-3,
+        mu: 0.0,
+    };
     let system = kapitza::Exact { params };
     let t = 10.0 * 2.0 * PI * params.eps;
-    let a = Integrator::new(Method::Dop853 { rtol: 1e-12, atol: 1e-12 }).unwrap().advance(&system, 0.0, &[0.1, 0.0], t).unwrap();
-    let b = Integrator::new(Method::Gauss { stages: 3, step: 2.0 * PI * params.eps / 200.0 }).unwrap().advance(&system, 0.0, &[0.1, 0.0], t).unwrap();
-    assert!((a[0] - b[0]).abs() < 1e-10 && (a[1] - b[1]).abs() < 1e-9, "{a:?} vs {b:?}");
+    let a = Integrator::new(Method::Dop853 {
+        rtol: 1e-12,
+        atol: 1e-12,
+    })
+    .unwrap()
+    .advance(&system, 0.0, &[0.1, 0.0], t)
+    .unwrap();
+    let b = Integrator::new(Method::Gauss {
+        stages: 3,
+        step: 2.0 * PI * params.eps / 200.0,
+    })
+    .unwrap()
+    .advance(&system, 0.0, &[0.1, 0.0], t)
+    .unwrap();
+    assert!(
+        (a[0] - b[0]).abs() < 1e-10 && (a[1] - b[1]).abs() < 1e-9,
+        "{a:?} vs {b:?}"
+    );
 }

@@ -1,0 +1,129 @@
+//! Scene `rhs_benchmark`: speed of the generated right-hand sides against
+//! careful hand-written ones (issue: ratio generated / hand-written ≤ 1.1).
+//! Both are evaluated on the same pseudo-random states in one run.
+
+use mechlab::models::{double_pendulum as dp, kapitza};
+use mechlab::scene::{knob, run, Scene};
+use std::hint::black_box;
+use std::time::Instant;
+
+fn kapitza_by_hand(t: f64, y: &[f64; 2], p: &kapitza::Params) -> [f64; 2] {
+    let (s, c) = y[0].sin_cos();
+    let st = (t / p.eps).sin();
+    let qd = y[1] - p.A * st * s;
+    [qd, s + p.A * st * c * qd - p.mu * qd]
+}
+
+fn double_pendulum_by_hand(t: f64, y: &[f64; 4], p: &dp::Params) -> [f64; 4] {
+    let (s1, c1) = y[0].sin_cos();
+    let (s2, c2) = y[1].sin_cos();
+    let wd = -p.a * (p.nu * t).sin();
+    let (b1, b2) = (-(p.m1 + p.m2) * p.l1 * s1 * wd, -p.m2 * p.l2 * s2 * wd);
+    let c12 = c1 * c2 + s1 * s2;
+    let s12 = s1 * c2 - c1 * s2;
+    let a11 = (p.m1 + p.m2) * p.l1 * p.l1;
+    let a12 = p.m2 * p.l1 * p.l2 * c12;
+    let a22 = p.m2 * p.l2 * p.l2;
+    let det = a11 * a22 - a12 * a12;
+    let (r1, r2) = (y[2] - b1, y[3] - b2);
+    let v1 = (a22 * r1 - a12 * r2) / det;
+    let v2 = (a11 * r2 - a12 * r1) / det;
+    let k = p.m2 * p.l1 * p.l2 * s12 * v1 * v2;
+    let dp1 = -k + (p.m1 + p.m2) * p.l1 * (p.g * s1 - wd * c1 * v1) - p.mu * v1;
+    let dp2 = k + p.m2 * p.l2 * (p.g * s2 - wd * c2 * v2) - p.mu * (v2 - v1);
+    [v1, v2, dp1, dp2]
+}
+
+fn time<const N: usize>(states: &[[f64; N]], f: impl Fn(f64, &[f64; N]) -> [f64; N]) -> (f64, f64) {
+    let start = Instant::now();
+    let mut sum = 0.0;
+    for (i, y) in states.iter().enumerate() {
+        let r = f(black_box(i as f64 * 1e-3), black_box(y));
+        sum += r[N - 1];
+    }
+    (start.elapsed().as_secs_f64(), black_box(sum))
+}
+
+fn main() {
+    run(|| {
+        let scene = Scene::from_args(
+            "rhs_benchmark",
+            "generated vs hand-written right-hand sides",
+            &[knob(
+                "evaluations",
+                "4000000",
+                "evaluations per variant and round",
+            )],
+        )?;
+        let n = scene.count("evaluations")?;
+        let mut seed = 1u64;
+        let mut random = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0
+        };
+        let k_states: Vec<[f64; 2]> = (0..n).map(|_| [random(), random()]).collect();
+        let d_states: Vec<[f64; 4]> = (0..n)
+            .map(|_| [random(), random(), random(), random()])
+            .collect();
+        let kp = kapitza::Params {
+            mu: 0.1,
+            ..Default::default()
+        };
+        let pp = dp::Params {
+            mu: 0.1,
+            ..Default::default()
+        };
+        // Same results first (the benchmark compares equal work).
+        for y in k_states.iter().take(1000) {
+            let (a, b) = (
+                kapitza::exact_rhs(0.3, y, &kp),
+                kapitza_by_hand(0.3, y, &kp),
+            );
+            assert!(
+                a.iter()
+                    .zip(&b)
+                    .all(|(x, z)| (x - z).abs() < 1e-9 * (1.0 + z.abs())),
+                "{a:?} vs {b:?}"
+            );
+        }
+        for y in d_states.iter().take(1000) {
+            let (a, b) = (
+                dp::exact_rhs(0.3, y, &pp),
+                double_pendulum_by_hand(0.3, y, &pp),
+            );
+            assert!(
+                a.iter()
+                    .zip(&b)
+                    .all(|(x, z)| (x - z).abs() < 1e-8 * (1.0 + z.abs())),
+                "{a:?} vs {b:?}"
+            );
+        }
+        // Best of five alternating rounds each.
+        let mut best = [f64::INFINITY; 4];
+        for _ in 0..5 {
+            best[0] = best[0].min(time(&k_states, |t, y| kapitza::exact_rhs(t, y, &kp)).0);
+            best[1] = best[1].min(time(&k_states, |t, y| kapitza_by_hand(t, y, &kp)).0);
+            best[2] = best[2].min(time(&d_states, |t, y| dp::exact_rhs(t, y, &pp)).0);
+            best[3] = best[3].min(time(&d_states, |t, y| double_pendulum_by_hand(t, y, &pp)).0);
+        }
+        let per = |s: f64| s / n as f64 * 1e9;
+        let (rk, rd) = (best[0] / best[1], best[2] / best[3]);
+        println!(
+            "kapitza exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {rk:.3}",
+            per(best[0]),
+            per(best[1])
+        );
+        println!(
+            "double_pendulum exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {rd:.3}",
+            per(best[2]),
+            per(best[3])
+        );
+        scene.write_summary(serde_json::json!({
+            "kapitza": {"generated_ns": per(best[0]), "hand_written_ns": per(best[1]), "ratio": rk},
+            "double_pendulum": {"generated_ns": per(best[2]), "hand_written_ns": per(best[3]), "ratio": rd},
+        }))?;
+        Ok(())
+    });
+}
