@@ -3,7 +3,22 @@
 //!
 //! Pipeline: `models/*.toml` → `build.rs` (Symbolica, build time only) →
 //! generated modules in [`models`] → runtime: [`ode`] (integrators),
-//! analyses, plots → `examples/` (scenes).
+//! [`analysis`] (period map, Floquet, Lyapunov), [`plot`] → `examples/` (scenes).
+//!
+//! ```
+//! use mechlab::models::kapitza;
+//! use mechlab::ode::{Integrator, Method};
+//!
+//! // The averaged Kapitza pendulum conserves its Hamiltonian H̄.
+//! let params = kapitza::Params { A: 2.0, ..Default::default() };
+//! let system = kapitza::Averaged { params };
+//! let mut integrator = Integrator::new(Method::parse("gauss6", 0.05).unwrap()).unwrap();
+//! let y0 = [0.4, 0.0];
+//! let y = integrator.advance(&system, 0.0, &y0, 100.0).unwrap();
+//! let drift = kapitza::averaged_hamiltonian(&y, &params) - kapitza::averaged_hamiltonian(&y0, &params);
+//! assert!(drift.abs() < 1e-9);
+//! assert_eq!(integrator.stats.steps, 2000);
+//! ```
 
 pub mod analysis;
 pub mod model;

@@ -263,19 +263,13 @@ impl Scene {
         header: &str,
         rows: impl IntoIterator<Item = String>,
     ) -> Result<PathBuf, SceneError> {
-        let path = self.path(file)?;
         let mut text = String::from(header);
         text.push('\n');
         for row in rows {
             text += &row;
             text.push('\n');
         }
-        write_atomic(&path, text.as_bytes()).map_err(|source| SceneError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        eprintln!("wrote {}", path.display());
-        Ok(path)
+        self.write_text(file, &text)
     }
 
     pub fn write_text(&self, file: &str, text: &str) -> Result<PathBuf, SceneError> {

@@ -3,6 +3,9 @@
 //! `dop853.f` (Hairer, Nørsett & Wanner, Solving ODE I, §II.10). The
 //! coefficients are those published with `dop853.f`.
 
+// The constants are kept exactly as published with dop853.f.
+#![allow(clippy::excessive_precision)]
+
 use super::{check_finite, combine, OdeError, Stats, System};
 
 const C: [f64; 12] = [
