@@ -9,7 +9,9 @@
 //! |tr M| − 1 − det M, bracketed on a scan and bisected to 1e-10. The
 //! averaged system predicts A* = √2 (V = cos q + A²/4 sin²q has V''(0) = A²/2 − 1).
 
-use mechlab::analysis::floquet::{floquet_multipliers, monodromy, Verdict};
+use mechlab::analysis::floquet::{
+    first_stability_onset, floquet_multipliers, jury_margin, monodromy, Verdict,
+};
 use mechlab::analysis::period_map::orbit;
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
@@ -33,7 +35,7 @@ const KNOBS: &[mechlab::scene::Knob] = &[
     knob("chart_a_max", "12", "largest A of the chart"),
 ];
 
-/// |tr M| − 1 − det M: negative inside the stability region.
+/// |tr M| − 1 − det M of the upper position: negative inside the stability region.
 fn stability_margin(
     a: f64,
     eps: f64,
@@ -48,9 +50,7 @@ fn stability_margin(
         2.0 * PI * eps,
         &[0.0, 0.0],
     )?;
-    let trace = m[0][0] + m[1][1];
-    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-    Ok((trace.abs() - 1.0 - det, m))
+    Ok((jury_margin(&m), m))
 }
 
 /// The smallest A in (0, a_max) where q = 0 becomes stable, or None.
@@ -60,26 +60,13 @@ fn critical_amplitude(
     method: Method,
     a_max: f64,
 ) -> Result<Option<f64>, SceneError> {
-    let steps = 400;
-    let mut previous = (0.0, stability_margin(0.0, eps, mu, method)?.0);
-    for i in 1..=steps {
-        let a = a_max * i as f64 / steps as f64;
-        let g = stability_margin(a, eps, mu, method)?.0;
-        if previous.1 > 0.0 && g <= 0.0 {
-            let (mut lo, mut hi) = (previous.0, a);
-            while hi - lo > 1e-10 {
-                let mid = 0.5 * (lo + hi);
-                if stability_margin(mid, eps, mu, method)?.0 > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            return Ok(Some(0.5 * (lo + hi)));
-        }
-        previous = (a, g);
-    }
-    Ok(None)
+    first_stability_onset(
+        &|a| stability_margin(a, eps, mu, method).map(|r| r.0),
+        0.0,
+        a_max,
+        400,
+        1e-10,
+    )
 }
 
 fn main() {

@@ -411,3 +411,37 @@ fn very_fast_forcing_is_integrated_accurately() {
         "{a:?} vs {b:?}"
     );
 }
+
+/// A* of the exact system: first A where the upper position becomes stable.
+fn critical_amplitude(eps: f64) -> f64 {
+    use mechlab::analysis::floquet::{first_stability_onset, jury_margin};
+    let margin = |a: f64| -> Result<f64, OdeError> {
+        let params = kapitza::Params { A: a, eps, mu: 0.0 };
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+        })?;
+        let (_, m) = monodromy::<_, 2, 6>(
+            &mut integrator,
+            &kapitza::Exact { params },
+            2.0 * PI * eps,
+            &[0.0, 0.0],
+        )?;
+        Ok(jury_margin(&m))
+    };
+    first_stability_onset(&margin, 1.0, 2.0, 50, 1e-10)
+        .unwrap()
+        .expect("A* lies in (1, 2)")
+}
+
+#[test]
+fn critical_amplitude_approaches_sqrt_2_with_an_eps_squared_correction() {
+    let (a1, a2) = (critical_amplitude(0.1), critical_amplitude(0.05));
+    let (d1, d2) = (a1 - 2f64.sqrt(), a2 - 2f64.sqrt());
+    assert!(d1 > 0.0 && d2 > 0.0, "A* above √2: {a1}, {a2}");
+    let ratio = d1 / d2;
+    assert!(
+        (3.5..4.5).contains(&ratio),
+        "halving ε should divide A* − √2 by 4, got {ratio}"
+    );
+}

@@ -83,3 +83,41 @@ impl Verdict {
         }
     }
 }
+
+/// For a 2×2 monodromy matrix: |tr M| − 1 − det M. Both multipliers lie in the
+/// closed unit disc iff this is ≤ 0 (and det M ≤ 1), the Jury criterion.
+pub fn jury_margin(m: &[[f64; 2]; 2]) -> f64 {
+    let trace = m[0][0] + m[1][1];
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    trace.abs() - 1.0 - det
+}
+
+/// The first parameter value in (lo, hi] where `margin` changes from positive
+/// to ≤ 0: bracketed on `samples` equal steps, then bisected to `tolerance`.
+pub fn first_stability_onset<E>(
+    margin: &dyn Fn(f64) -> Result<f64, E>,
+    lo: f64,
+    hi: f64,
+    samples: usize,
+    tolerance: f64,
+) -> Result<Option<f64>, E> {
+    let mut previous = (lo, margin(lo)?);
+    for i in 1..=samples {
+        let a = lo + (hi - lo) * i as f64 / samples as f64;
+        let g = margin(a)?;
+        if previous.1 > 0.0 && g <= 0.0 {
+            let (mut left, mut right) = (previous.0, a);
+            while right - left > tolerance {
+                let mid = 0.5 * (left + right);
+                if margin(mid)? > 0.0 {
+                    left = mid;
+                } else {
+                    right = mid;
+                }
+            }
+            return Ok(Some(0.5 * (left + right)));
+        }
+        previous = (a, g);
+    }
+    Ok(None)
+}
