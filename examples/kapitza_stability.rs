@@ -105,17 +105,13 @@ fn main() {
         ];
         let periods = scene.count("periods")?;
         let starts = [[0.05, 0.0], [0.15, 0.0], [0.3, 0.0], [0.0, 0.25]];
-        let specs: Vec<PanelSpec> = cases
+        let titles: Vec<String> = cases
             .iter()
-            .map(|(ca, cmu, label)| {
-                PanelSpec::new(
-                    Box::leak(format!("{label}: A={ca:.3} MU={cmu}").into_boxed_str()),
-                    "Q",
-                    "P",
-                    (-1.0, 1.0),
-                    (-1.0, 1.0),
-                )
-            })
+            .map(|(ca, cmu, label)| format!("{label}: A={ca:.3} MU={cmu}"))
+            .collect();
+        let specs: Vec<PanelSpec> = titles
+            .iter()
+            .map(|t| PanelSpec::new(t, "Q", "P", (-1.0, 1.0), (-1.0, 1.0)))
             .collect();
         let mut figure = Figure::grid(3, 1, 460, 460, &specs);
         let mut rows = Vec::new();
@@ -163,17 +159,13 @@ fn main() {
 
         // Averaged phase portraits just below and above √2: level sets of H̄.
         let averaged_cases = [SQRT_2 - 0.3, SQRT_2 + 0.3];
-        let specs: Vec<PanelSpec> = averaged_cases
+        let titles: Vec<String> = averaged_cases
             .iter()
-            .map(|ca| {
-                PanelSpec::new(
-                    Box::leak(format!("AVERAGED H LEVELS, A={ca:.3}").into_boxed_str()),
-                    "Q",
-                    "P",
-                    (-PI, PI),
-                    (-2.5, 2.5),
-                )
-            })
+            .map(|ca| format!("AVERAGED H LEVELS, A={ca:.3}"))
+            .collect();
+        let specs: Vec<PanelSpec> = titles
+            .iter()
+            .map(|t| PanelSpec::new(t, "Q", "P", (-PI, PI), (-2.5, 2.5)))
             .collect();
         let mut figure = Figure::grid(2, 1, 560, 460, &specs);
         for (k, ca) in averaged_cases.iter().enumerate() {
