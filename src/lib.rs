@@ -21,6 +21,7 @@
 //! ```
 
 pub mod analysis;
+pub mod handwritten;
 pub mod model;
 pub mod models;
 pub mod ode;

@@ -445,3 +445,79 @@ fn critical_amplitude_approaches_sqrt_2_with_an_eps_squared_correction() {
         "halving ε should divide A* − √2 by 4, got {ratio}"
     );
 }
+
+#[test]
+fn radau5_converges_with_its_order_on_a_smooth_problem() {
+    // Error against step count: order 5 (global), seen as a slope between 3.5 and 7.
+    let exact = |t: f64| [t.cos(), -t.sin()];
+    let run = |tol: f64| {
+        let mut integrator = Integrator::new(Method::parse("radau5", tol).unwrap()).unwrap();
+        let y = integrator
+            .advance(&Oscillator, 0.0, &[1.0, 0.0], 20.0)
+            .unwrap();
+        let e = exact(20.0);
+        (
+            (y[0] - e[0]).abs().max((y[1] - e[1]).abs()),
+            integrator.stats.steps as f64,
+        )
+    };
+    let (e1, n1) = run(1e-6);
+    let (e2, n2) = run(1e-10);
+    assert!(e2 < 1e-7 && e1 < 1e-3, "errors {e1:e}, {e2:e}");
+    let order = (e1 / e2).ln() / (n2 / n1).ln();
+    assert!((3.5..7.0).contains(&order), "observed order {order}");
+}
+
+/// The rigid-rod acceleration of the worked example (SPEC.md §3): the stable
+/// root R* of Φ(R) = X* on its middle segment, then x₁'' from the rigid equations.
+fn rigid_rod_acceleration() -> f64 {
+    let (cos0, sin0) = (0.6f64, 0.8f64);
+    let r_star: f64 = 18.1 / 6.5;
+    3.6 - r_star * cos0 - 0.525 * (r_star * sin0 - 0.8).abs()
+}
+
+#[test]
+fn stiff_rod_finishes_with_radau5_in_few_steps_and_follows_the_rigid_limit() {
+    use mechlab::handwritten::sliding_rod::SlidingRod;
+    let velocity_deviation = |eps: f64| {
+        let rod = SlidingRod::worked_example(eps);
+        // R(0) = 3 lies in the basin of the stable root R* ≈ 2.78.
+        let y0 = rod.state_with_deformation(3.0 * eps * eps, 10.0);
+        let mut integrator = Integrator::new(Method::parse("radau5", 1e-8).unwrap()).unwrap();
+        let y = integrator.advance(&rod, 0.0, &y0, 2.0).unwrap();
+        let (_, _, r) = rod.deformation(&y);
+        (
+            y[2] - (10.0 + 2.0 * rigid_rod_acceleration()),
+            r,
+            integrator.stats,
+        )
+    };
+    let (dev_2, r_2, _) = velocity_deviation(1e-2);
+    let (dev_3, r_3, stats) = velocity_deviation(1e-3);
+    // Bounded work although the eigenvalues are of order 1/ε.
+    assert!(stats.steps < 400, "{stats:?}");
+    // The reaction settles to R*, and the velocity follows the rigid rod with an O(ε) lag.
+    assert!(
+        (r_2 - 18.1 / 6.5).abs() < 1e-3 && (r_3 - 18.1 / 6.5).abs() < 1e-3,
+        "R = {r_2}, {r_3}"
+    );
+    assert!(
+        dev_3.abs() < 0.2 * dev_2.abs() && dev_2.abs() < 0.1,
+        "{dev_2:e}, {dev_3:e}"
+    );
+    // Against an explicit reference at ε = 1e-3.
+    let rod = SlidingRod::worked_example(1e-3);
+    let y0 = rod.state_with_deformation(3e-6, 10.0);
+    let reference = Integrator::new(Method::parse("dop853", 1e-13).unwrap())
+        .unwrap()
+        .advance(&rod, 0.0, &y0, 2.0)
+        .unwrap();
+    let y = Integrator::new(Method::parse("radau5", 1e-9).unwrap())
+        .unwrap()
+        .advance(&rod, 0.0, &y0, 2.0)
+        .unwrap();
+    let error = (0..4)
+        .map(|i| (y[i] - reference[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(error < 1e-6, "radau5 vs dop853 reference: {error:e}");
+}

@@ -1,12 +1,14 @@
 //! DOP853: the explicit Runge–Kutta pair of order 8 with error estimators of
 //! orders 5 and 3 (Dormand–Prince), with the step control of Hairer's
 //! `dop853.f` (Hairer, Nørsett & Wanner, Solving ODE I, §II.10). The
-//! coefficients are those published with `dop853.f`.
+//! coefficients are those published with `dop853.f`, including its dense
+//! output of order 7 (three extra stages, computed only for the steps in which
+//! a state between the step's ends is asked for).
 
 // The constants are kept exactly as published with dop853.f.
 #![allow(clippy::excessive_precision)]
 
-use super::{check_finite, combine, OdeError, Stats, System};
+use super::{check_finite, combine, Flow, Observer, OdeError, Stats, Step, System};
 
 const C: [f64; 12] = [
     0.0,
@@ -209,6 +211,219 @@ const ER: [f64; 12] = [
     -0.2235530786388629525884427845e-1,
 ];
 
+/// Nodes of the three extra stages of the dense output (stages 14–16).
+const C_DENSE: [f64; 3] = [0.1, 0.2, 0.777777777777777777777777777778];
+
+/// Rows 14–16 of the Butcher matrix (a[i][j], j = 1..15, stage 13 being f at the step end).
+const A_DENSE: [[f64; 15]; 3] = [
+    [
+        5.61675022830479523392909219681e-2,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.,
+        2.53500210216624811088794765333e-1,
+        -2.46239037470802489917441475441e-1,
+        -1.24191423263816360469010140626e-1,
+        1.5329179827876569731206322685e-1,
+        8.20105229563468988491666602057e-3,
+        7.56789766054569976138603589584e-3,
+        -8.298e-3,
+        0.,
+        0.,
+    ],
+    [
+        3.18346481635021405060768473261e-2,
+        0.,
+        0.,
+        0.,
+        0.,
+        2.83009096723667755288322961402e-2,
+        5.35419883074385676223797384372e-2,
+        -5.49237485713909884646569340306e-2,
+        0.,
+        0.,
+        -1.08347328697249322858509316994e-4,
+        3.82571090835658412954920192323e-4,
+        -3.40465008687404560802977114492e-4,
+        1.41312443674632500278074618366e-1,
+        0.,
+    ],
+    [
+        -4.28896301583791923408573538692e-1,
+        0.,
+        0.,
+        0.,
+        0.,
+        -4.69762141536116384314449447206,
+        7.68342119606259904184240953878,
+        4.06898981839711007970213554331,
+        3.56727187455281109270669543021e-1,
+        0.,
+        0.,
+        0.,
+        -1.39902416515901462129418009734e-3,
+        2.9475147891527723389556272149,
+        -9.15095847217987001081870187138,
+    ],
+];
+
+/// Coefficients d[i][j] of the dense output polynomial, i = 4..7, stage j = 1..16.
+const D: [[f64; 16]; 4] = [
+    [
+        -0.84289382761090128651353491142e+01,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.56671495351937776962531783590e+00,
+        -0.30689499459498916912797304727e+01,
+        0.23846676565120698287728149680e+01,
+        0.21170345824450282767155149946e+01,
+        -0.87139158377797299206789907490e+00,
+        0.22404374302607882758541771650e+01,
+        0.63157877876946881815570249290e+00,
+        -0.88990336451333310820698117400e-01,
+        0.18148505520854727256656404962e+02,
+        -0.91946323924783554000451984436e+01,
+        -0.44360363875948939664310572000e+01,
+    ],
+    [
+        0.10427508642579134603413151009e+02,
+        0.,
+        0.,
+        0.,
+        0.,
+        0.24228349177525818288430175319e+03,
+        0.16520045171727028198505394887e+03,
+        -0.37454675472269020279518312152e+03,
+        -0.22113666853125306036270938578e+02,
+        0.77334326684722638389603898808e+01,
+        -0.30674084731089398182061213626e+02,
+        -0.93321305264302278729567221706e+01,
+        0.15697238121770843886131091075e+02,
+        -0.31139403219565177677282850411e+02,
+        -0.93529243588444783865713862664e+01,
+        0.35816841486394083752465898540e+02,
+    ],
+    [
+        0.19985053242002433820987653617e+02,
+        0.,
+        0.,
+        0.,
+        0.,
+        -0.38703730874935176555105901742e+03,
+        -0.18917813819516756882830838328e+03,
+        0.52780815920542364900561016686e+03,
+        -0.11573902539959630126141871134e+02,
+        0.68812326946963000169666922661e+01,
+        -0.10006050966910838403183860980e+01,
+        0.77771377980534432092869265740e+00,
+        -0.27782057523535084065932004339e+01,
+        -0.60196695231264120758267380846e+02,
+        0.84320405506677161018159903784e+02,
+        0.11992291136182789328035130030e+02,
+    ],
+    [
+        -0.25693933462703749003312586129e+02,
+        0.,
+        0.,
+        0.,
+        0.,
+        -0.15418974869023643374053993627e+03,
+        -0.23152937917604549567536039109e+03,
+        0.35763911791061412378285349910e+03,
+        0.93405324183624310003907691704e+02,
+        -0.37458323136451633156875139351e+02,
+        0.10409964950896230045147246184e+03,
+        0.29840293426660503123344363579e+02,
+        -0.43533456590011143754432175058e+02,
+        0.96324553959188282948394950600e+02,
+        -0.39177261675615439165231486172e+02,
+        -0.14972683625798562581422125276e+03,
+    ],
+];
+
+/// An accepted DOP853 step with Hairer's dense output of order 7.
+struct Dop853Step<'a, S, const N: usize> {
+    system: &'a S,
+    t0: f64,
+    y0: [f64; N],
+    h: f64,
+    t1: f64,
+    y1: [f64; N],
+    /// Stages 1–16: 1–12 of the step, 13 = f(t1, y1), 14–16 built on demand.
+    k: &'a mut [[f64; N]; 16],
+    /// The coefficients r0..r7 of the interpolating polynomial, once built.
+    dense: Option<[[f64; N]; 8]>,
+    stats: &'a mut Stats,
+}
+
+impl<S: System<N>, const N: usize> Dop853Step<'_, S, N> {
+    fn build_dense(&mut self) -> [[f64; N]; 8] {
+        let h = self.h;
+        for s in 0..3 {
+            let stage = 13 + s;
+            let y = combine(&self.y0, h, &A_DENSE[s][..stage], &self.k[..stage]);
+            self.k[stage] = self.system.rhs(self.t0 + C_DENSE[s] * h, &y);
+        }
+        self.stats.f_evals += 3;
+        let mut r = [[0.0; N]; 8];
+        for i in 0..N {
+            let diff = self.y1[i] - self.y0[i];
+            let bspl = h * self.k[0][i] - diff;
+            r[0][i] = self.y0[i];
+            r[1][i] = diff;
+            r[2][i] = bspl;
+            r[3][i] = diff - h * self.k[12][i] - bspl;
+            for (row, d) in D.iter().enumerate() {
+                let mut acc = 0.0;
+                for (dj, kj) in d.iter().zip(self.k.iter()) {
+                    acc += dj * kj[i];
+                }
+                r[4 + row][i] = h * acc;
+            }
+        }
+        r
+    }
+}
+
+impl<S: System<N>, const N: usize> Step<N> for Dop853Step<'_, S, N> {
+    fn start(&self) -> (f64, &[f64; N]) {
+        (self.t0, &self.y0)
+    }
+    fn end(&self) -> (f64, &[f64; N]) {
+        (self.t1, &self.y1)
+    }
+    fn state_at(&mut self, t: f64) -> Result<[f64; N], OdeError> {
+        let r = match self.dense {
+            Some(r) => r,
+            None => {
+                let r = self.build_dense();
+                self.dense = Some(r);
+                r
+            }
+        };
+        let theta = (t - self.t0) / self.h;
+        let theta1 = 1.0 - theta;
+        Ok(std::array::from_fn(|i| {
+            r[0][i]
+                + theta
+                    * (r[1][i]
+                        + theta1
+                            * (r[2][i]
+                                + theta
+                                    * (r[3][i]
+                                        + theta1
+                                            * (r[4][i]
+                                                + theta
+                                                    * (r[5][i]
+                                                        + theta1 * (r[6][i] + theta * r[7][i]))))))
+        }))
+    }
+}
+
 const SAFETY: f64 = 0.9;
 /// Bounds on h_new / h (Hairer's fac1 = 0.333, fac2 = 6).
 const MIN_FACTOR: f64 = 0.333;
@@ -271,13 +486,13 @@ impl Dop853 {
         y0: &[f64; N],
         t1: f64,
         stats: &mut Stats,
-        observe: &mut dyn FnMut(f64, &[f64; N]),
-    ) -> Result<[f64; N], OdeError> {
+        observe: Observer<'_, N>,
+    ) -> Result<(f64, [f64; N]), OdeError> {
         let direction = (t1 - t0).signum();
         let span = (t1 - t0).abs();
         let mut t = t0;
         let mut y = *y0;
-        let mut k = [[0.0; N]; 12];
+        let mut k = [[0.0; N]; 16];
         k[0] = system.rhs(t, &y);
         stats.f_evals += 1;
         let mut h = match self.next_step {
@@ -346,21 +561,38 @@ impl Dop853 {
             let factor = (err.powf(1.0 / 8.0) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
             if err <= 1.0 {
                 check_finite(t + hs, &y_new)?;
-                t = if last { t1 } else { t + hs };
-                y = y_new;
+                let t_new = if last { t1 } else { t + hs };
                 stats.steps += 1;
-                k[0] = system.rhs(t, &y);
+                k[12] = system.rhs(t_new, &y_new);
                 stats.f_evals += 1;
-                observe(t, &y);
+                let mut view = Dop853Step {
+                    system,
+                    t0: t,
+                    y0: y,
+                    h: hs,
+                    t1: t_new,
+                    y1: y_new,
+                    k: &mut k,
+                    dense: None,
+                    stats,
+                };
+                let flow = observe(&mut view)?;
+                t = t_new;
+                y = y_new;
+                k[0] = k[12];
                 let mut h_new = h_try / factor;
                 if last_rejected {
                     h_new = h_new.min(h_try);
                 }
                 last_rejected = false;
+                if let Flow::Stop { t, y } = flow {
+                    self.next_step = Some(h_new);
+                    return Ok((t, y));
+                }
                 if last {
                     // Keep the proposal for the next call, not the truncated last step.
                     self.next_step = Some(if h_try < h { h } else { h_new });
-                    return Ok(y);
+                    return Ok((t, y));
                 }
                 h = h_new;
             } else {

@@ -7,9 +7,12 @@
 //! States are `[f64; N]`: no allocation per step.
 
 mod dop853;
+mod events;
 mod gauss;
+mod radau5;
 mod rk4;
 
+pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
 use std::fmt;
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
@@ -21,6 +24,32 @@ pub trait System<const N: usize> {
     }
 }
 
+/// One accepted step, as an integrator hands it to observers and to event
+/// location: its two ends, and the state anywhere in between.
+pub trait Step<const N: usize> {
+    fn start(&self) -> (f64, &[f64; N]);
+    fn end(&self) -> (f64, &[f64; N]);
+    /// The state at `t` inside the step, to the method's accuracy: DOP853's
+    /// dense output of order 7 (built on the first call, 3 more f-evaluations),
+    /// or for the other methods a fresh step of length t − start.
+    fn state_at(&mut self, t: f64) -> Result<[f64; N], OdeError>;
+}
+
+/// What an observer tells the integrator after a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Flow<const N: usize> {
+    Continue,
+    /// End the run at (t, y), a point of the step just taken.
+    Stop {
+        t: f64,
+        y: [f64; N],
+    },
+}
+
+/// Called after every accepted step.
+pub type Observer<'a, const N: usize> =
+    &'a mut dyn FnMut(&mut dyn Step<N>) -> Result<Flow<N>, OdeError>;
+
 /// An integration method with its accuracy knob.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
@@ -31,14 +60,17 @@ pub enum Method {
     /// Implicit Gauss–Legendre with 2 (order 4) or 3 (order 6) stages,
     /// symplectic, fixed step, stage equations solved to round-off.
     Gauss { stages: usize, step: f64 },
+    /// Radau IIA of order 5 (Hairer's RADAU5 scheme): implicit, L-stable, for
+    /// stiff systems; Newton iterations with the system's Jacobian.
+    Radau5 { rtol: f64, atol: f64 },
 }
 
 /// Method names accepted by [`Method::parse`].
-pub const METHOD_NAMES: [&str; 4] = ["rk4", "dop853", "gauss4", "gauss6"];
+pub const METHOD_NAMES: [&str; 5] = ["rk4", "dop853", "gauss4", "gauss6", "radau5"];
 
 impl Method {
     /// A method by name: `rk4`, `gauss4`, `gauss6` take a step size, `dop853`
-    /// a tolerance (used as both relative and absolute tolerance).
+    /// and `radau5` a tolerance (used as both relative and absolute tolerance).
     pub fn parse(name: &str, tol_or_step: f64) -> Result<Method, OdeError> {
         let method = match name {
             "rk4" => Method::Rk4 { step: tol_or_step },
@@ -54,6 +86,10 @@ impl Method {
                 stages: 3,
                 step: tol_or_step,
             },
+            "radau5" => Method::Radau5 {
+                rtol: tol_or_step,
+                atol: tol_or_step,
+            },
             _ => return Err(OdeError::UnknownMethod(name.to_string())),
         };
         method.validate()?;
@@ -67,6 +103,7 @@ impl Method {
             Method::Dop853 { .. } => "dop853",
             Method::Gauss { stages: 2, .. } => "gauss4",
             Method::Gauss { .. } => "gauss6",
+            Method::Radau5 { .. } => "radau5",
         }
     }
 
@@ -76,6 +113,7 @@ impl Method {
             Method::Rk4 { .. } => 4,
             Method::Dop853 { .. } => 8,
             Method::Gauss { stages, .. } => 2 * stages,
+            Method::Radau5 { .. } => 5,
         }
     }
 
@@ -89,7 +127,7 @@ impl Method {
         };
         match *self {
             Method::Rk4 { step } => positive("step", step),
-            Method::Dop853 { rtol, atol } => {
+            Method::Dop853 { rtol, atol } | Method::Radau5 { rtol, atol } => {
                 positive("relative tolerance", rtol)?;
                 positive("absolute tolerance", atol)
             }
@@ -232,7 +270,7 @@ impl Integrator {
         y0: &[f64; N],
         t1: f64,
     ) -> Result<[f64; N], OdeError> {
-        self.advance_observed(system, t0, y0, t1, &mut |_, _| {})
+        Ok(self.run(system, t0, y0, t1, &mut |_| Ok(Flow::Continue))?.1)
     }
 
     /// Like [`Integrator::advance`], calling `observe(t, y)` after every accepted step.
@@ -244,14 +282,105 @@ impl Integrator {
         t1: f64,
         observe: &mut dyn FnMut(f64, &[f64; N]),
     ) -> Result<[f64; N], OdeError> {
-        if !t0.is_finite() || !t1.is_finite() || y0.iter().any(|x| !x.is_finite()) {
-            return Err(OdeError::NonFiniteInitialState {
-                t: t0,
-                y: y0.to_vec(),
+        let mut each_step = |step: &mut dyn Step<N>| {
+            let (t, y) = step.end();
+            observe(t, y);
+            Ok(Flow::Continue)
+        };
+        Ok(self.run(system, t0, y0, t1, &mut each_step)?.1)
+    }
+
+    /// Advances `y0` from `t0` to the last of `times` (increasing, or decreasing
+    /// for a backward run), returning the state at each of them from the
+    /// method's interpolant: the step sizes stay those the accuracy needs.
+    pub fn advance_sampled<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        times: &[f64],
+    ) -> Result<Vec<[f64; N]>, OdeError> {
+        let Some(&t1) = times.last() else {
+            return Ok(Vec::new());
+        };
+        let forward = t1 >= t0;
+        let ordered = times
+            .windows(2)
+            .all(|w| if forward { w[1] >= w[0] } else { w[1] <= w[0] });
+        let inside = times
+            .iter()
+            .all(|&t| if forward { t >= t0 } else { t <= t0 });
+        if !ordered || !inside || times.iter().any(|t| !t.is_finite()) {
+            return Err(OdeError::InvalidSetting {
+                what: "sample times (must be finite, ordered and on one side of t0)",
+                value: t1,
             });
         }
+        let mut states = Vec::with_capacity(times.len());
+        let mut next = 0;
+        while next < times.len() && times[next] == t0 {
+            states.push(*y0);
+            next += 1;
+        }
+        self.run(system, t0, y0, t1, &mut |step| {
+            let (t_end, y_end) = step.end();
+            let y_end = *y_end;
+            while next < times.len()
+                && (if forward {
+                    times[next] <= t_end
+                } else {
+                    times[next] >= t_end
+                })
+            {
+                let y = if times[next] == t_end {
+                    y_end
+                } else {
+                    step.state_at(times[next])?
+                };
+                states.push(y);
+                next += 1;
+            }
+            Ok(Flow::Continue)
+        })?;
+        Ok(states)
+    }
+
+    /// Advances `y0` from `t0` towards `t1`, locating the zero crossings of
+    /// the events; stops at the first terminal one. A later call from the
+    /// returned state restarts cleanly (the reported state is past the root).
+    pub fn advance_with_events<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+        events: &[Event<'_, N>],
+        settings: EventSettings,
+    ) -> Result<EventRun<N>, OdeError> {
+        check_initial(t0, y0, t1)?;
+        let mut locator = events::Locator::new(events, settings, t0, y0)?;
+        let (t, y) = self.run(system, t0, y0, t1, &mut |step| locator.scan(step))?;
+        let terminated = t != t1;
+        Ok(EventRun {
+            t,
+            y,
+            hits: locator.hits,
+            terminated,
+        })
+    }
+
+    /// The one driver every entry point goes through.
+    fn run<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+        observe: Observer<'_, N>,
+    ) -> Result<(f64, [f64; N]), OdeError> {
+        check_initial(t0, y0, t1)?;
         if t1 == t0 {
-            return Ok(*y0);
+            return Ok((t0, *y0));
         }
         match self.method {
             Method::Rk4 { step } => rk4::integrate(
@@ -282,12 +411,33 @@ impl Integrator {
                     max_steps: self.max_steps,
                     next_step: self.next_step,
                 };
-                let y = solver.integrate(system, t0, y0, t1, &mut self.stats, observe);
+                let end = solver.integrate(system, t0, y0, t1, &mut self.stats, observe);
                 self.next_step = solver.next_step;
-                y
+                end
+            }
+            Method::Radau5 { rtol, atol } => {
+                let mut solver = radau5::Radau5 {
+                    rtol,
+                    atol,
+                    max_steps: self.max_steps,
+                    next_step: self.next_step,
+                };
+                let end = solver.integrate(system, t0, y0, t1, &mut self.stats, observe);
+                self.next_step = solver.next_step;
+                end
             }
         }
     }
+}
+
+fn check_initial<const N: usize>(t0: f64, y0: &[f64; N], t1: f64) -> Result<(), OdeError> {
+    if !t0.is_finite() || !t1.is_finite() || y0.iter().any(|x| !x.is_finite()) {
+        return Err(OdeError::NonFiniteInitialState {
+            t: t0,
+            y: y0.to_vec(),
+        });
+    }
+    Ok(())
 }
 
 /// Number of equal fixed steps of at most `step` covering `t0..t1`.
