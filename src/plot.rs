@@ -465,6 +465,11 @@ impl Figure {
 
     /// Legend lines in the panel's top-left corner, each with a colour swatch.
     pub fn legend(&mut self, k: usize, entries: &[(String, Rgb)]) {
+        self.legend_at(k, entries, false);
+    }
+
+    /// Legend lines in the top-left or (`bottom`) bottom-left corner.
+    pub fn legend_at(&mut self, k: usize, entries: &[(String, Rgb)], bottom: bool) {
         let panel = self.panels[k];
         let width = entries
             .iter()
@@ -473,7 +478,12 @@ impl Figure {
             .unwrap_or(0)
             + 22;
         let height = entries.len() as i64 * 10 + 6;
-        let (x, y) = (panel.left + 6, panel.top + 6);
+        let y = if bottom {
+            panel.top + panel.height - height - 6
+        } else {
+            panel.top + 6
+        };
+        let x = panel.left + 6;
         self.canvas.fill_rect(x, y, x + width, y + height, WHITE);
         for (i, (text, color)) in entries.iter().enumerate() {
             let ty = y + 4 + i as i64 * 10;
