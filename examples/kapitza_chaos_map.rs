@@ -21,10 +21,14 @@ fn main() {
                 knob("A", "1", "pivot amplitude"),
                 knob("eps", "0.1", "ε: forcing period / 2π"),
                 knob("mu", "0", "viscous friction"),
-                knob("pixels", "240", "resolution (pixels per side)"),
-                knob("periods", "120", "periods per pixel for the FLI"),
+                knob("pixels", "300", "resolution (pixels per side)"),
+                knob("periods", "180", "periods per pixel for the FLI"),
                 knob("p_max", "3", "the map covers p in [-p_max, p_max]"),
-                knob("method", "dop853", "integrator (rk4, dop853, gauss4, gauss6, radau5)"),
+                knob(
+                    "method",
+                    "dop853",
+                    "integrator (rk4, dop853, gauss4, gauss6, radau5)",
+                ),
                 knob("tol", "1e-8", "tolerance (dop853, radau5) or step size"),
             ],
         )?;

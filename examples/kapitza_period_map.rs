@@ -29,7 +29,7 @@ const KNOBS: &[mechlab::scene::Knob] = &[
     knob(
         "method",
         "dop853",
-        "integrator: dop853, rk4, gauss4, gauss6",
+        "integrator: dop853, rk4, gauss4, gauss6, radau5",
     ),
     knob(
         "tol",

@@ -62,9 +62,8 @@ impl Solver {
     fn setting(&self) -> f64 {
         match *self {
             Solver::Ours(Method::Rk4 { step }) | Solver::Ours(Method::Gauss { step, .. }) => step,
-            Solver::Ours(Method::Dop853 { rtol, .. }) | Solver::Ours(Method::Radau5 { rtol, .. }) => {
-                rtol
-            }
+            Solver::Ours(Method::Dop853 { rtol, .. })
+            | Solver::Ours(Method::Radau5 { rtol, .. }) => rtol,
             Solver::Peer(tol) => tol,
         }
     }
@@ -137,12 +136,18 @@ struct Row {
 }
 
 fn max_difference<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Runs `work` once, then repeats it until `min_seconds` have passed; returns
 /// its result and the mean time of one run.
-fn timed<T>(min_seconds: f64, mut work: impl FnMut() -> Result<T, String>) -> Result<(T, f64), String> {
+fn timed<T>(
+    min_seconds: f64,
+    mut work: impl FnMut() -> Result<T, String>,
+) -> Result<(T, f64), String> {
     let start = Instant::now();
     let result = work()?;
     let mut runs = 1u32;
@@ -203,7 +208,8 @@ fn measure<S: System<N>, const N: usize, const M: usize>(
             let mut integrator = None;
             let (mut worst, mut evals) = (0.0f64, 0u64);
             for w in orbit.windows(2) {
-                let (y, e) = solver.advance::<S, N, M>(&mut integrator, system, 0.0, &w[0], *period)?;
+                let (y, e) =
+                    solver.advance::<S, N, M>(&mut integrator, system, 0.0, &w[0], *period)?;
                 worst = worst.max(max_difference(&y, &w[1]));
                 evals += e;
             }
@@ -222,9 +228,10 @@ fn reference_end<S: System<N>, const N: usize, const M: usize>(
     check: Method,
 ) -> Result<(Measure<N>, f64), SceneError> {
     let best = Solver::Ours(Method::parse("dop853", 1e-14)?);
-    let (reference, _) = end_state::<S, N, M>(best, system, y0, period, periods).map_err(SceneError::Numerical)?;
-    let (other, _) =
-        end_state::<S, N, M>(Solver::Ours(check), system, y0, period, periods).map_err(SceneError::Numerical)?;
+    let (reference, _) =
+        end_state::<S, N, M>(best, system, y0, period, periods).map_err(SceneError::Numerical)?;
+    let (other, _) = end_state::<S, N, M>(Solver::Ours(check), system, y0, period, periods)
+        .map_err(SceneError::Numerical)?;
     let agreement = max_difference(&reference, &other);
     Ok((
         Measure::EndState {
@@ -251,7 +258,10 @@ fn reference_orbit<S: System<N>, const N: usize>(
     for _ in 0..periods {
         let y = orbit.last().unwrap();
         let next = best.advance(system, 0.0, y, period)?;
-        worst = worst.max(max_difference(&next, &other.advance(system, 0.0, y, period)?));
+        worst = worst.max(max_difference(
+            &next,
+            &other.advance(system, 0.0, y, period)?,
+        ));
         orbit.push(next);
     }
     Ok((Measure::PeriodMap { period, orbit }, worst))
@@ -260,11 +270,15 @@ fn reference_orbit<S: System<N>, const N: usize>(
 fn solvers(fixed_steps: &[f64], stiff: bool) -> Vec<Solver> {
     let mut list = Vec::new();
     for k in 3..=13 {
-        list.push(Solver::Ours(Method::parse("dop853", 10f64.powi(-k)).unwrap()));
+        list.push(Solver::Ours(
+            Method::parse("dop853", 10f64.powi(-k)).unwrap(),
+        ));
         list.push(Solver::Peer(10f64.powi(-k)));
     }
     for k in 3..=12 {
-        list.push(Solver::Ours(Method::parse("radau5", 10f64.powi(-k)).unwrap()));
+        list.push(Solver::Ours(
+            Method::parse("radau5", 10f64.powi(-k)).unwrap(),
+        ));
     }
     for &h in fixed_steps {
         list.push(Solver::Ours(Method::Rk4 { step: h }));
@@ -324,11 +338,14 @@ fn sweep<S: System<N>, const N: usize, const M: usize>(
     eprintln!("{problem}: {:.1} s", start.elapsed().as_secs_f64());
 }
 
-/// Least-squares slope of log(error) against log(cost) where errors are above round-off.
+/// Least-squares slope of log(error) against log(cost), over the points
+/// above the method's round-off floor (10× its smallest error) and below 1e-2;
+/// none if they do not lie on a line (r² < 0.9).
 fn slope(points: &[(f64, f64)]) -> Option<f64> {
+    let floor = points.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     let pts: Vec<(f64, f64)> = points
         .iter()
-        .filter(|(c, e)| *e > 1e-12 && *e < 1e-2 && *c > 0.0)
+        .filter(|(c, e)| *e > 10.0 * floor && *e < 1e-2 && *c > 0.0)
         .map(|(c, e)| (c.ln(), e.ln()))
         .collect();
     if pts.len() < 3 {
@@ -341,7 +358,9 @@ fn slope(points: &[(f64, f64)]) -> Option<f64> {
     );
     let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
     let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    Some(sxy / sxx)
+    let syy: f64 = pts.iter().map(|p| (p.1 - my).powi(2)).sum();
+    // No slope where the points do not lie on a line (stability-limited runs).
+    (sxy * sxy / (sxx * syy) > 0.9).then_some(sxy / sxx)
 }
 
 /// Seconds needed to reach `target` error, interpolated log-log along a method's runs.
@@ -359,10 +378,17 @@ fn seconds_at(rows: &[&Row], target: f64) -> Option<f64> {
 
 const METHODS: [&str; 6] = ["rk4", "gauss4", "gauss6", "dop853", "radau5", PEER];
 
-fn plot_problem(scene: &Scene, problem: &str, rows: &[&Row]) -> Result<serde_json::Value, SceneError> {
+fn plot_problem(
+    scene: &Scene,
+    problem: &str,
+    rows: &[&Row],
+) -> Result<serde_json::Value, SceneError> {
     let floor = 1e-16;
     let range = |f: &dyn Fn(&Row) -> f64| {
-        let (lo, hi) = rows.iter().map(|r| f(r)).fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+        let (lo, hi) = rows
+            .iter()
+            .map(|r| f(r))
+            .fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
         (lo / 2.0, hi * 2.0)
     };
     let errors = range(&|r| r.error.max(floor));
@@ -374,22 +400,45 @@ fn plot_problem(scene: &Scene, problem: &str, rows: &[&Row]) -> Result<serde_jso
         640,
         480,
         &[
-            PanelSpec::new(&title_time, "seconds", "max error", range(&|r| r.seconds), errors).log_log(),
-            PanelSpec::new(&title_evals, "f evaluations", "max error", range(&|r| r.f_evals as f64), errors)
-                .log_log(),
+            PanelSpec::new(
+                &title_time,
+                "seconds",
+                "max error",
+                range(&|r| r.seconds),
+                errors,
+            )
+            .log_log(),
+            PanelSpec::new(
+                &title_evals,
+                "f evaluations",
+                "max error",
+                range(&|r| r.f_evals as f64),
+                errors,
+            )
+            .log_log(),
         ],
     );
     let mut legend = Vec::new();
     let mut slopes = serde_json::Map::new();
     for (k, method) in METHODS.iter().enumerate() {
-        let mut mine: Vec<&Row> = rows.iter().copied().filter(|r| r.method == *method).collect();
+        let mut mine: Vec<&Row> = rows
+            .iter()
+            .copied()
+            .filter(|r| r.method == *method)
+            .collect();
         if mine.is_empty() {
             continue;
         }
         mine.sort_by(|a, b| a.f_evals.cmp(&b.f_evals));
         let color = palette(k);
-        let by_time: Vec<(f64, f64)> = mine.iter().map(|r| (r.seconds, r.error.max(floor))).collect();
-        let by_evals: Vec<(f64, f64)> = mine.iter().map(|r| (r.f_evals as f64, r.error.max(floor))).collect();
+        let by_time: Vec<(f64, f64)> = mine
+            .iter()
+            .map(|r| (r.seconds, r.error.max(floor)))
+            .collect();
+        let by_evals: Vec<(f64, f64)> = mine
+            .iter()
+            .map(|r| (r.f_evals as f64, r.error.max(floor)))
+            .collect();
         for (panel, pts) in [(0, &by_time), (1, &by_evals)] {
             figure.line(panel, pts, color);
             figure.points(panel, pts.iter().copied(), color, 5);
@@ -414,9 +463,17 @@ fn main() {
             "work_precision",
             "error against cost for every method on the Kapitza, double-pendulum and rod problems",
             &[
-                knob("min_seconds", "0.02", "each run is repeated until it has taken this long"),
+                knob(
+                    "min_seconds",
+                    "0.02",
+                    "each run is repeated until it has taken this long",
+                ),
                 knob("periods", "1000", "periods of the Kapitza map"),
-                knob("budget", "1", "seconds: a method slower than this is not run at tighter settings"),
+                knob(
+                    "budget",
+                    "1",
+                    "seconds: a method slower than this is not run at tighter settings",
+                ),
             ],
         )?;
         let min_seconds = scene.non_negative("min_seconds")?;
@@ -430,48 +487,132 @@ fn main() {
         };
 
         // (a) The Kapitza period map.
-        let kp = kapitza::Params { A: 1.5, eps: 0.1, mu: 0.0 };
+        let kp = kapitza::Params {
+            A: 1.5,
+            eps: 0.1,
+            mu: 0.0,
+        };
         let kapitza_system = kapitza::Exact { params: kp };
         let period = TAU * kp.eps;
-        let per_period = |n: &[usize], span: f64| n.iter().map(|&k| span / k as f64).collect::<Vec<_>>();
-        let check = Method::Gauss { stages: 3, step: period / 512.0 };
-        let list = solvers(&per_period(&[8, 16, 32, 64, 128, 256, 512, 1024], period), false);
+        let per_period =
+            |n: &[usize], span: f64| n.iter().map(|&k| span / k as f64).collect::<Vec<_>>();
+        let check = Method::Gauss {
+            stages: 3,
+            step: period / 512.0,
+        };
+        let list = solvers(
+            &per_period(&[8, 16, 32, 64, 128, 256, 512, 1024], period),
+            false,
+        );
         let regular = [0.3, 0.0];
         let (how, agreement) = reference_orbit(&kapitza_system, &regular, period, periods, check)?;
         record("kapitza_regular", agreement);
-         sweep::<_, 2, 3>("kapitza_regular", &kapitza_system, &regular, &how, &list, min_seconds, budget, &mut rows, &mut failures);
-        let (how, agreement) = reference_end::<_, 2, 3>(&kapitza_system, &regular, period, periods, check)?;
+        sweep::<_, 2, 3>(
+            "kapitza_regular",
+            &kapitza_system,
+            &regular,
+            &how,
+            &list,
+            min_seconds,
+            budget,
+            &mut rows,
+            &mut failures,
+        );
+        let (how, agreement) =
+            reference_end::<_, 2, 3>(&kapitza_system, &regular, period, periods, check)?;
         record("kapitza_regular_global", agreement);
-        sweep::<_, 2, 3>("kapitza_regular_global", &kapitza_system, &regular, &how, &list, min_seconds, budget, &mut rows, &mut failures);
+        sweep::<_, 2, 3>(
+            "kapitza_regular_global",
+            &kapitza_system,
+            &regular,
+            &how,
+            &list,
+            min_seconds,
+            budget,
+            &mut rows,
+            &mut failures,
+        );
         let chaotic = [1.0, 0.0];
         let (how, agreement) = reference_orbit(&kapitza_system, &chaotic, period, periods, check)?;
         record("kapitza_chaotic", agreement);
-        sweep::<_, 2, 3>("kapitza_chaotic", &kapitza_system, &chaotic, &how, &list, min_seconds, budget, &mut rows, &mut failures);
+        sweep::<_, 2, 3>(
+            "kapitza_chaotic",
+            &kapitza_system,
+            &chaotic,
+            &how,
+            &list,
+            min_seconds,
+            budget,
+            &mut rows,
+            &mut failures,
+        );
 
         // (b) The double pendulum on the vibrating base, ν = 100, t ∈ [0, 10].
-        let pp = dp::Params { nu: 100.0, ..Default::default() };
+        let pp = dp::Params {
+            nu: 100.0,
+            ..Default::default()
+        };
         let pendulum = dp::Exact { params: pp };
         let y0 = [0.3, -0.2, 0.0, 0.0];
         let forcing = TAU / pp.nu;
         let list = solvers(&per_period(&[4, 8, 16, 32, 64, 128, 256], forcing), false);
-        let (how, agreement) =
-            reference_end::<_, 4, 5>(&pendulum, &y0, 10.0, 1, Method::Gauss { stages: 3, step: forcing / 256.0 })?;
+        let (how, agreement) = reference_end::<_, 4, 5>(
+            &pendulum,
+            &y0,
+            10.0,
+            1,
+            Method::Gauss {
+                stages: 3,
+                step: forcing / 256.0,
+            },
+        )?;
         record("double_pendulum", agreement);
-        sweep::<_, 4, 5>("double_pendulum", &pendulum, &y0, &how, &list, min_seconds, budget, &mut rows, &mut failures);
+        sweep::<_, 4, 5>(
+            "double_pendulum",
+            &pendulum,
+            &y0,
+            &how,
+            &list,
+            min_seconds,
+            budget,
+            &mut rows,
+            &mut failures,
+        );
 
         // (c) The sliding deformable rod, ε = 0.01 and 0.001, t ∈ [0, 2], from R(0) = 3.
         for (problem, eps) in [("rod_eps_0.01", 1e-2), ("rod_eps_0.001", 1e-3)] {
             let rod = SlidingRod::worked_example(eps);
             let y0 = rod.state_with_deformation(3.0 * eps * eps, 10.0);
-            let list = solvers(&per_period(&[64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384], 2.0), true);
-            let (how, agreement) = reference_end::<_, 4, 5>(&rod, &y0, 2.0, 1, Method::parse("radau5", 1e-13)?)?;
+            let list = solvers(
+                &per_period(&[64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384], 2.0),
+                true,
+            );
+            let (how, agreement) =
+                reference_end::<_, 4, 5>(&rod, &y0, 2.0, 1, Method::parse("radau5", 1e-13)?)?;
             record(problem, agreement);
-            sweep::<_, 4, 5>(problem, &rod, &y0, &how, &list, min_seconds, budget, &mut rows, &mut failures);
+            sweep::<_, 4, 5>(
+                problem,
+                &rod,
+                &y0,
+                &how,
+                &list,
+                min_seconds,
+                budget,
+                &mut rows,
+                &mut failures,
+            );
         }
 
         // Figures and slopes.
         let mut slopes = serde_json::Map::new();
-        for problem in ["kapitza_regular", "kapitza_regular_global", "kapitza_chaotic", "double_pendulum", "rod_eps_0.01", "rod_eps_0.001"] {
+        for problem in [
+            "kapitza_regular",
+            "kapitza_regular_global",
+            "kapitza_chaotic",
+            "double_pendulum",
+            "rod_eps_0.01",
+            "rod_eps_0.001",
+        ] {
             let mine: Vec<&Row> = rows.iter().filter(|r| r.problem == problem).collect();
             slopes.insert(problem.to_string(), plot_problem(&scene, problem, &mine)?);
         }
@@ -484,7 +625,10 @@ fn main() {
             "runs.csv",
             "problem,method,tol_or_step,error,seconds,f_evals",
             rows.iter().map(|r| {
-                format!("{},{},{:e},{:e},{:e},{}", r.problem, r.method, r.tol_or_step, r.error, r.seconds, r.f_evals)
+                format!(
+                    "{},{},{:e},{:e},{:e},{}",
+                    r.problem, r.method, r.tol_or_step, r.error, r.seconds, r.f_evals
+                )
             }),
         )?;
         let runs: Vec<serde_json::Value> = rows
@@ -529,13 +673,17 @@ fn performance(
     // Overhead: integration time / (f-evaluations × time of one bare f), the
     // bare f timed on exactly the (t, y) at which the integrator called it.
     let overhead = |method: Method| -> Result<(f64, f64), SceneError> {
-        let recording = Recording { inner: system, calls: RefCell::new(Vec::new()) };
+        let recording = Recording {
+            inner: system,
+            calls: RefCell::new(Vec::new()),
+        };
         end_state::<_, 2, 3>(Solver::Ours(method), &recording, y0, period, periods)
             .map_err(SceneError::Numerical)?;
         let calls = recording.calls.into_inner();
-        let ((_, evals), seconds) =
-            timed(0.3, || end_state::<_, 2, 3>(Solver::Ours(method), system, y0, period, periods))
-                .map_err(SceneError::Numerical)?;
+        let ((_, evals), seconds) = timed(0.3, || {
+            end_state::<_, 2, 3>(Solver::Ours(method), system, y0, period, periods)
+        })
+        .map_err(SceneError::Numerical)?;
         let (_, bare_total) = timed(0.3, || {
             let mut sum = 0.0;
             for (t, y) in &calls {
@@ -548,10 +696,19 @@ fn performance(
         Ok((seconds / (evals as f64 * bare), bare))
     };
     let (dop853_overhead, bare) = overhead(Method::parse("dop853", 1e-10)?)?;
-    let (rk4_overhead, _) = overhead(Method::Rk4 { step: period / 64.0 })?;
-    let regular: Vec<&Row> = rows.iter().filter(|r| r.problem == "kapitza_regular").collect();
+    let (rk4_overhead, _) = overhead(Method::Rk4 {
+        step: period / 64.0,
+    })?;
+    let regular: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.problem == "kapitza_regular")
+        .collect();
     let at = |method: &str| {
-        let mine: Vec<&Row> = regular.iter().copied().filter(|r| r.method == method).collect();
+        let mine: Vec<&Row> = regular
+            .iter()
+            .copied()
+            .filter(|r| r.method == method)
+            .collect();
         seconds_at(&mine, 1e-10)
     };
     let ours: Vec<(&str, f64)> = ["rk4", "gauss4", "gauss6", "dop853", "radau5"]
