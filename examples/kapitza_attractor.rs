@@ -7,58 +7,14 @@
 //! transients, a zoom on its layers, the box-counting plot, and reports the
 //! Lyapunov exponents (their sum is −μT) and the box-counting dimension.
 
+use mechlab::analysis::dimension::{bounds, box_counting, kaplan_yorke_dimension};
 use mechlab::analysis::lyapunov::lyapunov_spectrum;
 use mechlab::analysis::period_map::orbit;
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, RED};
 use mechlab::scene::{knob, run, Scene, SceneError};
-use std::collections::HashSet;
 use std::f64::consts::PI;
-
-/// Occupied boxes of side `size` (in units of the bounding box) for each size.
-fn box_counts(points: &[[f64; 2]], sizes: &[f64]) -> Vec<usize> {
-    let (lo, hi) = bounds(points);
-    let span = [hi[0] - lo[0], hi[1] - lo[1]];
-    sizes
-        .iter()
-        .map(|&size| {
-            let boxes: HashSet<(i64, i64)> = points
-                .iter()
-                .map(|p| {
-                    (
-                        ((p[0] - lo[0]) / (span[0] * size)).floor() as i64,
-                        ((p[1] - lo[1]) / (span[1] * size)).floor() as i64,
-                    )
-                })
-                .collect();
-            boxes.len()
-        })
-        .collect()
-}
-
-fn bounds(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
-    points.iter().fold(
-        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-        |(lo, hi), p| {
-            (
-                [lo[0].min(p[0]), lo[1].min(p[1])],
-                [hi[0].max(p[0]), hi[1].max(p[1])],
-            )
-        },
-    )
-}
-
-/// Least-squares line through (x, y): (slope, intercept).
-fn fit(points: &[(f64, f64)]) -> (f64, f64) {
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let slope = sxy / sxx;
-    (slope, my - slope * mx)
-}
 
 /// The centre of the most populated cell of a coarse grid: where the zoom
 /// shows the most layers.
@@ -142,22 +98,18 @@ fn main() {
             &wrap,
         )?;
         let expected_sum = -params.mu * period;
-        let kaplan_yorke = if lyapunov[0] > 0.0 {
-            1.0 + lyapunov[0] / lyapunov[1].abs()
-        } else {
-            0.0
-        };
+        let kaplan_yorke = kaplan_yorke_dimension(&lyapunov);
 
         // Box counting over box sides 1/4 … 1/256 of the extent; the fit
         // leaves out the coarsest and the finest, which 10⁵ points cannot fill.
-        let sizes: Vec<f64> = (2..=8).map(|k| 0.5f64.powi(k)).collect();
-        let counts = box_counts(&points, &sizes);
-        let log_points: Vec<(f64, f64)> = sizes
+        let sides: Vec<f64> = (2..=8).map(|k| 0.5f64.powi(k)).collect();
+        let counted = box_counting(&points, &sides, 1..sides.len() - 1);
+        let (dimension, intercept) = (counted.dimension, counted.intercept);
+        let log_points: Vec<(f64, f64)> = sides
             .iter()
-            .zip(&counts)
+            .zip(&counted.boxes)
             .map(|(s, n)| ((1.0 / s).ln(), (*n as f64).ln()))
             .collect();
-        let (dimension, intercept) = fit(&log_points[1..log_points.len() - 1]);
 
         // Pictures: the attractor with the zoom window, the zoom, the box counts.
         let (lo, hi) = bounds(&points);
@@ -231,7 +183,10 @@ fn main() {
         scene.write_csv(
             "box_counting.csv",
             "box_side,boxes",
-            sizes.iter().zip(&counts).map(|(s, n)| format!("{s:e},{n}")),
+            sides
+                .iter()
+                .zip(&counted.boxes)
+                .map(|(s, n)| format!("{s:e},{n}")),
         )?;
         println!(
             "lyapunov exponents per period {:.4} {:.4}, sum {:.4} (expected -mu T = {expected_sum:.4}), box-counting dimension {dimension:.3}, Kaplan-Yorke {kaplan_yorke:.3}",

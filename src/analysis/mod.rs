@@ -2,6 +2,7 @@
 //! variational equations (monodromy, Floquet multipliers, Lyapunov exponents,
 //! the fast Lyapunov indicator) and the Chirikov standard map.
 
+pub mod dimension;
 pub mod floquet;
 pub mod lyapunov;
 pub mod period_map;
