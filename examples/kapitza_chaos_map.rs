@@ -3,7 +3,7 @@
 //! computed from the variational equations with the generated Jacobian:
 //! dark = chaotic, light = regular (islands, invariant curves).
 
-use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
+use mechlab::analysis::lyapunov::{fast_lyapunov_indicator, fli_shading};
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{Figure, PanelSpec};
@@ -87,16 +87,12 @@ fn main() {
             f_evals += evals;
         }
 
-        // Regular orbits grow like ln(n); shade from there to the 99th percentile.
-        let mut sorted: Vec<f64> = fli.iter().copied().filter(|x| x.is_finite()).collect();
-        sorted.sort_by(f64::total_cmp);
-        let low = (periods as f64).ln();
-        let high = sorted[(sorted.len() as f64 * 0.99) as usize].max(low + 1.0);
-        let shades: Vec<f64> = fli
-            .iter()
-            .map(|x| ((x - low) / (high - low)).clamp(0.0, 1.0))
-            .collect();
-        let chaotic = fli.iter().filter(|x| **x > 2.0 * low).count() as f64 / fli.len() as f64;
+        let shading = fli_shading(&fli, periods);
+        let (shades, low, chaotic) = (
+            &shading.shades,
+            shading.regular_level,
+            shading.chaotic_fraction,
+        );
         let title = format!(
             "KAPITZA FLI MAP, A={}, EPS={}, MU={}, {periods} PERIODS",
             params.A, params.eps, params.mu
@@ -106,7 +102,7 @@ fn main() {
             pixels.max(360) + 75,
             PanelSpec::new(&title, "Q", "P", (-PI, PI), (-p_max, p_max)),
         );
-        figure.grey_map(0, pixels, pixels, &shades);
+        figure.grey_map(0, pixels, pixels, shades);
         scene.save_figure(&figure, "chaos_map.png")?;
         scene.write_csv(
             "chaos_map.csv",

@@ -3,6 +3,7 @@
 //! chaos map in which every pixel is shaded by the fast Lyapunov indicator of
 //! its orbit (dark = chaotic): the stochastic web of SPEC.md §1.
 
+use mechlab::analysis::lyapunov::fli_shading;
 use mechlab::analysis::standard_map::{standard_map, standard_map_fli};
 use mechlab::plot::{palette, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Scene};
@@ -68,16 +69,12 @@ fn main() {
             })
             .collect();
         let seconds = start.elapsed().as_secs_f64();
-        // Regular orbits grow like ln(n); shade from there up to the 99th percentile.
-        let mut sorted: Vec<f64> = fli.iter().copied().filter(|x| x.is_finite()).collect();
-        sorted.sort_by(f64::total_cmp);
-        let low = (iterations as f64).ln();
-        let high = sorted[(sorted.len() as f64 * 0.99) as usize].max(low + 1.0);
-        let shades: Vec<f64> = fli
-            .iter()
-            .map(|x| ((x - low) / (high - low)).clamp(0.0, 1.0))
-            .collect();
-        let chaotic = fli.iter().filter(|x| **x > 2.0 * low).count() as f64 / fli.len() as f64;
+        let shading = fli_shading(&fli, iterations);
+        let (shades, low, chaotic) = (
+            &shading.shades,
+            shading.regular_level,
+            shading.chaotic_fraction,
+        );
         let mut figure = Figure::single(
             pixels + 90,
             pixels + 75,
@@ -89,7 +86,7 @@ fn main() {
                 (-PI, PI),
             ),
         );
-        figure.grey_map(0, pixels, pixels, &shades);
+        figure.grey_map(0, pixels, pixels, shades);
         scene.save_figure(&figure, "chaos_map.png")?;
         scene.write_csv(
             "chaos_map.csv",

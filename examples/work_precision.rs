@@ -504,48 +504,38 @@ fn main() {
             &per_period(&[8, 16, 32, 64, 128, 256, 512, 1024], period),
             false,
         );
-        let regular = [0.3, 0.0];
-        let (how, agreement) = reference_orbit(&kapitza_system, &regular, period, periods, check)?;
-        record("kapitza_regular", agreement);
-        sweep::<_, 2, 3>(
-            "kapitza_regular",
-            &kapitza_system,
-            &regular,
-            &how,
-            &list,
-            min_seconds,
-            budget,
-            &mut rows,
-            &mut failures,
-        );
-        let (how, agreement) =
-            reference_end::<_, 2, 3>(&kapitza_system, &regular, period, periods, check)?;
-        record("kapitza_regular_global", agreement);
-        sweep::<_, 2, 3>(
-            "kapitza_regular_global",
-            &kapitza_system,
-            &regular,
-            &how,
-            &list,
-            min_seconds,
-            budget,
-            &mut rows,
-            &mut failures,
-        );
-        let chaotic = [1.0, 0.0];
-        let (how, agreement) = reference_orbit(&kapitza_system, &chaotic, period, periods, check)?;
-        record("kapitza_chaotic", agreement);
-        sweep::<_, 2, 3>(
-            "kapitza_chaotic",
-            &kapitza_system,
-            &chaotic,
-            &how,
-            &list,
-            min_seconds,
-            budget,
-            &mut rows,
-            &mut failures,
-        );
+        let (regular, chaotic) = ([0.3, 0.0], [1.0, 0.0]);
+        let kapitza_problems = [
+            (
+                "kapitza_regular",
+                regular,
+                reference_orbit(&kapitza_system, &regular, period, periods, check)?,
+            ),
+            (
+                "kapitza_regular_global",
+                regular,
+                reference_end::<_, 2, 3>(&kapitza_system, &regular, period, periods, check)?,
+            ),
+            (
+                "kapitza_chaotic",
+                chaotic,
+                reference_orbit(&kapitza_system, &chaotic, period, periods, check)?,
+            ),
+        ];
+        for (problem, y0, (how, agreement)) in &kapitza_problems {
+            record(problem, *agreement);
+            sweep::<_, 2, 3>(
+                problem,
+                &kapitza_system,
+                y0,
+                how,
+                &list,
+                min_seconds,
+                budget,
+                &mut rows,
+                &mut failures,
+            );
+        }
 
         // (b) The double pendulum on the vibrating base, ν = 100, t ∈ [0, 10].
         let pp = dp::Params {

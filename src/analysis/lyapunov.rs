@@ -85,3 +85,36 @@ pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
     }
     Ok(fli)
 }
+
+/// Grey levels for a chaos map from FLI values after `iterations` periods.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FliShading {
+    /// One value in [0, 1] per input (1 = most chaotic).
+    pub shades: Vec<f64>,
+    /// ln(iterations): the FLI of a regular orbit, whose tangent vectors grow linearly.
+    pub regular_level: f64,
+    /// Share of values above twice the regular level.
+    pub chaotic_fraction: f64,
+}
+
+/// Shades FLI values from the regular level (white) to the 99th percentile
+/// (black), so that a few extreme orbits do not wash out the map.
+pub fn fli_shading(fli: &[f64], iterations: usize) -> FliShading {
+    let mut sorted: Vec<f64> = fli.iter().copied().filter(|x| x.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let low = (iterations as f64).ln();
+    let high = sorted
+        .get((sorted.len() as f64 * 0.99) as usize)
+        .copied()
+        .unwrap_or(low)
+        .max(low + 1.0);
+    FliShading {
+        shades: fli
+            .iter()
+            .map(|x| ((x - low) / (high - low)).clamp(0.0, 1.0))
+            .collect(),
+        regular_level: low,
+        chaotic_fraction: fli.iter().filter(|x| **x > 2.0 * low).count() as f64
+            / fli.len().max(1) as f64,
+    }
+}
