@@ -429,7 +429,7 @@ fn plot_problem(
         if mine.is_empty() {
             continue;
         }
-        mine.sort_by(|a, b| a.f_evals.cmp(&b.f_evals));
+        mine.sort_by_key(|r| r.f_evals);
         let color = palette(k);
         let by_time: Vec<(f64, f64)> = mine
             .iter()

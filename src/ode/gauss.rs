@@ -60,10 +60,11 @@ fn solve_stages<S: System<N>, const N: usize>(
         for i in 0..stages {
             let mut z = *y;
             for k in 0..N {
-                let mut acc = 0.0;
-                for j in 0..stages {
-                    acc += tab.a[i][j] * f[j][k];
-                }
+                let acc: f64 = tab.a[i][..stages]
+                    .iter()
+                    .zip(f.iter())
+                    .map(|(a, fj)| a * fj[k])
+                    .sum();
                 z[k] += h * acc;
             }
             next[i] = system.rhs(t + tab.c[i] * h, &z);
@@ -101,10 +102,7 @@ fn increment<const N: usize>(
     f: &[[f64; N]; 3],
     k: usize,
 ) -> f64 {
-    let mut acc = 0.0;
-    for j in 0..stages {
-        acc += tab.b[j] * f[j][k];
-    }
+    let acc: f64 = tab.b[..stages].iter().zip(f).map(|(b, fj)| b * fj[k]).sum();
     h * acc
 }
 

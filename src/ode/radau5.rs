@@ -71,8 +71,8 @@ fn lu_factor(a: &mut [f64], n: usize, pivots: &mut [usize]) -> bool {
 /// Solves with the factors of [`lu_factor`] (whole rows were swapped, so all
 /// row exchanges are applied to b before the forward substitution).
 fn lu_solve(a: &[f64], n: usize, pivots: &[usize], b: &mut [f64]) {
-    for k in 0..n {
-        b.swap(k, pivots[k]);
+    for (k, &p) in pivots.iter().enumerate().take(n) {
+        b.swap(k, p);
     }
     for k in 0..n {
         for i in k + 1..n {
@@ -110,9 +110,9 @@ impl<const N: usize> Step<N> for Radau5Step<N> {
         // Lagrange basis on the nodes 0, c1, c2, c3, for the nodes cᵢ.
         let weights: [f64; 3] = std::array::from_fn(|i| {
             let mut w = s / C[i];
-            for j in 0..3 {
+            for (j, cj) in C.iter().enumerate() {
                 if j != i {
-                    w *= (s - C[j]) / (C[i] - C[j]);
+                    w *= (s - cj) / (C[i] - cj);
                 }
             }
             w
