@@ -8,7 +8,7 @@
 // The constants are kept exactly as published with dop853.f.
 #![allow(clippy::excessive_precision)]
 
-use super::{check_finite, combine, Flow, Observer, OdeError, Stats, Step, System};
+use super::{check_finite, combine, Observer, OdeError, Stats, Step, StepControl, System};
 
 const C: [f64; 12] = [
     0.0,
@@ -436,96 +436,88 @@ fn eighth_root(x: f64) -> f64 {
     x.sqrt().sqrt().sqrt()
 }
 
-pub(super) struct Dop853 {
-    pub rtol: f64,
-    pub atol: f64,
-    pub max_steps: u64,
-    /// Step size to try first; updated to the last proposal on return.
-    pub next_step: Option<f64>,
+fn scale(control: &StepControl, a: f64, b: f64) -> f64 {
+    control.atol + control.rtol * a.abs().max(b.abs())
 }
 
-impl Dop853 {
-    fn scale(&self, a: f64, b: f64) -> f64 {
-        self.atol + self.rtol * a.abs().max(b.abs())
-    }
+/// Hairer's initial step size guess.
+fn initial_step<S: System<N>, const N: usize>(
+    control: &StepControl,
+    system: &S,
+    t: f64,
+    y: &[f64; N],
+    f0: &[f64; N],
+    direction: f64,
+    stats: &mut Stats,
+) -> f64 {
+    let norm = |v: &[f64; N]| {
+        (v.iter()
+            .zip(y)
+            .map(|(x, yi)| (x / scale(control, *yi, *yi)).powi(2))
+            .sum::<f64>()
+            / N as f64)
+            .sqrt()
+    };
+    let (d0, d1) = (norm(y), norm(f0));
+    let h0 = if d0 < 1e-10 || d1 < 1e-10 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    let y1: [f64; N] = std::array::from_fn(|i| y[i] + direction * h0 * f0[i]);
+    let f1 = system.rhs(t + direction * h0, &y1);
+    stats.f_evals += 1;
+    let diff: [f64; N] = std::array::from_fn(|i| f1[i] - f0[i]);
+    let d2 = norm(&diff) / h0;
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / 8.0)
+    };
+    (100.0 * h0).min(h1)
+}
 
-    /// Hairer's initial step size guess.
-    fn initial_step<S: System<N>, const N: usize>(
-        &self,
-        system: &S,
-        t: f64,
-        y: &[f64; N],
-        f0: &[f64; N],
-        direction: f64,
-        stats: &mut Stats,
-    ) -> f64 {
-        let norm = |v: &[f64; N]| {
-            (v.iter()
-                .zip(y)
-                .map(|(x, yi)| (x / self.scale(*yi, *yi)).powi(2))
-                .sum::<f64>()
-                / N as f64)
-                .sqrt()
-        };
-        let (d0, d1) = (norm(y), norm(f0));
-        let h0 = if d0 < 1e-10 || d1 < 1e-10 {
-            1e-6
-        } else {
-            0.01 * d0 / d1
-        };
-        let y1: [f64; N] = std::array::from_fn(|i| y[i] + direction * h0 * f0[i]);
-        let f1 = system.rhs(t + direction * h0, &y1);
-        stats.f_evals += 1;
-        let diff: [f64; N] = std::array::from_fn(|i| f1[i] - f0[i]);
-        let d2 = norm(&diff) / h0;
-        let h1 = if d1.max(d2) <= 1e-15 {
-            (h0 * 1e-3).max(1e-6)
-        } else {
-            (0.01 / d1.max(d2)).powf(1.0 / 8.0)
-        };
-        (100.0 * h0).min(h1)
+/// Integrates from t0 to t1, starting with (and leaving in) the control's step size.
+pub(super) fn integrate<S: System<N>, const N: usize>(
+    control: &mut StepControl,
+    system: &S,
+    t0: f64,
+    y0: &[f64; N],
+    t1: f64,
+    stats: &mut Stats,
+    observe: Observer<'_, N>,
+) -> Result<(f64, [f64; N]), OdeError> {
+    let direction = (t1 - t0).signum();
+    let span = (t1 - t0).abs();
+    let mut t = t0;
+    let mut y = *y0;
+    let mut k = [[0.0; N]; 16];
+    k[0] = system.rhs(t, &y);
+    stats.f_evals += 1;
+    let mut h = match *control.next_step {
+        Some(h) => h,
+        None => initial_step(control, system, t, &y, &k[0], direction, stats),
     }
-
-    pub(super) fn integrate<S: System<N>, const N: usize>(
-        &mut self,
-        system: &S,
-        t0: f64,
-        y0: &[f64; N],
-        t1: f64,
-        stats: &mut Stats,
-        observe: Observer<'_, N>,
-    ) -> Result<(f64, [f64; N]), OdeError> {
-        let direction = (t1 - t0).signum();
-        let span = (t1 - t0).abs();
-        let mut t = t0;
-        let mut y = *y0;
-        let mut k = [[0.0; N]; 16];
-        k[0] = system.rhs(t, &y);
-        stats.f_evals += 1;
-        let mut h = match self.next_step {
-            Some(h) => h,
-            None => self.initial_step(system, t, &y, &k[0], direction, stats),
+    .min(span);
+    let mut steps = 0u64;
+    let mut last_rejected = false;
+    loop {
+        if steps >= control.max_steps {
+            return Err(OdeError::TooManySteps {
+                t,
+                max_steps: control.max_steps,
+            });
         }
-        .min(span);
-        let mut steps = 0u64;
-        let mut last_rejected = false;
-        loop {
-            if steps >= self.max_steps {
-                return Err(OdeError::TooManySteps {
-                    t,
-                    max_steps: self.max_steps,
-                });
-            }
-            let remaining = (t1 - t).abs();
-            let last = h >= remaining * (1.0 - 1e-12);
-            let h_try = if last { remaining } else { h };
-            if h_try < 1e-14 * t.abs().max(1.0) {
-                return Err(OdeError::StepSizeUnderflow { t, h: h_try });
-            }
-            let hs = direction * h_try;
-            // The stages, written out over the nonzero entries of A only, for
-            // the compiler to unroll.
-            macro_rules! stage {
+        let remaining = (t1 - t).abs();
+        let last = h >= remaining * (1.0 - 1e-12);
+        let h_try = if last { remaining } else { h };
+        if h_try < 1e-14 * t.abs().max(1.0) {
+            return Err(OdeError::StepSizeUnderflow { t, h: h_try });
+        }
+        let hs = direction * h_try;
+        // The stages, written out over the nonzero entries of A only, for
+        // the compiler to unroll.
+        macro_rules! stage {
                 ($i:literal: $first:literal $(, $j:literal)*) => {{
                     let mut yi = y;
                     for n in 0..N {
@@ -534,97 +526,90 @@ impl Dop853 {
                     k[$i] = system.rhs(t + C[$i] * hs, &yi);
                 }};
             }
-            stage!(1: 0);
-            stage!(2: 0, 1);
-            stage!(3: 0, 2);
-            stage!(4: 0, 2, 3);
-            stage!(5: 0, 3, 4);
-            stage!(6: 0, 3, 4, 5);
-            stage!(7: 0, 3, 4, 5, 6);
-            stage!(8: 0, 3, 4, 5, 6, 7);
-            stage!(9: 0, 3, 4, 5, 6, 7, 8);
-            stage!(10: 0, 3, 4, 5, 6, 7, 8, 9);
-            stage!(11: 0, 3, 4, 5, 6, 7, 8, 9, 10);
-            stats.f_evals += 11;
-            steps += 1;
-            // The solution and Hairer's error estimate (5th and 3rd order
-            // estimators combined); B and ER vanish on stages 2 to 5.
-            let mut y_new = y;
-            let (mut err5, mut err3) = (0.0, 0.0);
-            for i in 0..N {
-                let mut bs = B[0] * k[0][i];
-                let mut e5 = ER[0] * k[0][i];
-                for j in 5..12 {
-                    bs += B[j] * k[j][i];
-                    e5 += ER[j] * k[j][i];
-                }
-                y_new[i] += hs * bs;
-                let inverse_scale = 1.0 / self.scale(y[i], y_new[i]);
-                let e3 = bs - BHH[0] * k[0][i] - BHH[1] * k[8][i] - BHH[2] * k[11][i];
-                err5 += (e5 * inverse_scale).powi(2);
-                err3 += (e3 * inverse_scale).powi(2);
+        stage!(1: 0);
+        stage!(2: 0, 1);
+        stage!(3: 0, 2);
+        stage!(4: 0, 2, 3);
+        stage!(5: 0, 3, 4);
+        stage!(6: 0, 3, 4, 5);
+        stage!(7: 0, 3, 4, 5, 6);
+        stage!(8: 0, 3, 4, 5, 6, 7);
+        stage!(9: 0, 3, 4, 5, 6, 7, 8);
+        stage!(10: 0, 3, 4, 5, 6, 7, 8, 9);
+        stage!(11: 0, 3, 4, 5, 6, 7, 8, 9, 10);
+        stats.f_evals += 11;
+        steps += 1;
+        // The solution and Hairer's error estimate (5th and 3rd order
+        // estimators combined); B and ER vanish on stages 2 to 5.
+        let mut y_new = y;
+        let (mut err5, mut err3) = (0.0, 0.0);
+        for i in 0..N {
+            let mut bs = B[0] * k[0][i];
+            let mut e5 = ER[0] * k[0][i];
+            for j in 5..12 {
+                bs += B[j] * k[j][i];
+                e5 += ER[j] * k[j][i];
             }
-            let denominator = err5 + 0.01 * err3;
-            let err = if denominator > 0.0 {
-                h_try * err5 / (denominator * N as f64).sqrt()
-            } else {
-                0.0
+            y_new[i] += hs * bs;
+            let inverse_scale = 1.0 / scale(control, y[i], y_new[i]);
+            let e3 = bs - BHH[0] * k[0][i] - BHH[1] * k[8][i] - BHH[2] * k[11][i];
+            err5 += (e5 * inverse_scale).powi(2);
+            err3 += (e3 * inverse_scale).powi(2);
+        }
+        let denominator = err5 + 0.01 * err3;
+        let err = if denominator > 0.0 {
+            h_try * err5 / (denominator * N as f64).sqrt()
+        } else {
+            0.0
+        };
+        if !err.is_finite() {
+            // A non-finite stage: retry smaller, unless the step is already tiny.
+            if !y_new.iter().all(|x| x.is_finite()) && h_try < 1e-10 * span {
+                return Err(OdeError::NonFinite {
+                    t,
+                    y: y_new.to_vec(),
+                });
+            }
+            stats.rejected += 1;
+            h = h_try * 0.1;
+            last_rejected = true;
+            continue;
+        }
+        let factor = (eighth_root(err) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
+        if err <= 1.0 {
+            check_finite(t + hs, &y_new)?;
+            let t_new = if last { t1 } else { t + hs };
+            stats.steps += 1;
+            k[12] = system.rhs(t_new, &y_new);
+            stats.f_evals += 1;
+            let mut view = Dop853Step {
+                system,
+                t0: t,
+                y0: y,
+                h: hs,
+                t1: t_new,
+                y1: y_new,
+                k: &mut k,
+                dense: None,
+                stats,
             };
-            if !err.is_finite() {
-                // A non-finite stage: retry smaller, unless the step is already tiny.
-                if !y_new.iter().all(|x| x.is_finite()) && h_try < 1e-10 * span {
-                    return Err(OdeError::NonFinite {
-                        t,
-                        y: y_new.to_vec(),
-                    });
-                }
-                stats.rejected += 1;
-                h = h_try * 0.1;
-                last_rejected = true;
-                continue;
+            let flow = observe(&mut view)?;
+            t = t_new;
+            y = y_new;
+            k[0] = k[12];
+            let mut h_new = h_try / factor;
+            if last_rejected {
+                h_new = h_new.min(h_try);
             }
-            let factor = (eighth_root(err) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
-            if err <= 1.0 {
-                check_finite(t + hs, &y_new)?;
-                let t_new = if last { t1 } else { t + hs };
-                stats.steps += 1;
-                k[12] = system.rhs(t_new, &y_new);
-                stats.f_evals += 1;
-                let mut view = Dop853Step {
-                    system,
-                    t0: t,
-                    y0: y,
-                    h: hs,
-                    t1: t_new,
-                    y1: y_new,
-                    k: &mut k,
-                    dense: None,
-                    stats,
-                };
-                let flow = observe(&mut view)?;
-                t = t_new;
-                y = y_new;
-                k[0] = k[12];
-                let mut h_new = h_try / factor;
-                if last_rejected {
-                    h_new = h_new.min(h_try);
-                }
-                last_rejected = false;
-                if let Flow::Stop { t, y } = flow {
-                    self.next_step = Some(h_new);
-                    return Ok((t, y));
-                }
-                if last {
-                    // Keep the proposal for the next call, not the truncated last step.
-                    self.next_step = Some(if h_try < h { h } else { h_new });
-                    return Ok((t, y));
-                }
-                h = h_new;
-            } else {
-                stats.rejected += 1;
-                last_rejected = true;
-                h = h_try / (eighth_root(err) / SAFETY).min(1.0 / MIN_FACTOR);
+            last_rejected = false;
+            if let Some(end) = control.end_of_run(flow, last, (t, y), h, h_try, h_new) {
+                return Ok(end);
             }
+            h = h_new;
+        } else {
+            stats.rejected += 1;
+            last_rejected = true;
+            h = h_try / (eighth_root(err) / SAFETY).min(1.0 / MIN_FACTOR);
         }
     }
 }

@@ -174,25 +174,23 @@ impl<'e, 'a, const N: usize> Locator<'e, 'a, N> {
                 ta + (tb - ta) * j as f64 / (m + 1) as f64
             };
             let ys = if j == m + 1 { yb } else { step.state_at(ts)? };
+            // The conditions at the sample, evaluated once; after each located
+            // crossing the memory moves on and the same signs are compared again.
+            let signs = self.signs_at(ts, &ys);
             loop {
-                let crossings: Vec<Crossing> = (0..self.events.len())
-                    .filter_map(|i| {
-                        let g = (self.events[i].condition)(ts, &ys);
-                        let s = sign(g);
-                        let tracker = self.trackers[i];
-                        (tracker.sign != 0.0 && s != 0.0 && s != tracker.sign).then_some(Crossing {
-                            event: i,
-                            new_sign: s,
-                        })
-                    })
-                    .collect();
                 // Sign changes in directions nobody watches only update the memory.
-                let reported: Vec<_> = crossings
-                    .into_iter()
+                let reported: Vec<Crossing> = signs
+                    .iter()
+                    .zip(&self.trackers)
+                    .enumerate()
+                    .filter(|(_, (&s, tracker))| {
+                        tracker.sign != 0.0 && s != 0.0 && s != tracker.sign
+                    })
+                    .map(|(event, (&new_sign, _))| Crossing { event, new_sign })
                     .filter(|c| self.wanted(c.event, c.new_sign))
                     .collect();
                 if reported.is_empty() {
-                    self.remember(ts, &ys);
+                    self.remember(ts, &signs);
                     break;
                 }
                 let mut located = Vec::with_capacity(reported.len());
@@ -232,7 +230,8 @@ impl<'e, 'a, const N: usize> Locator<'e, 'a, N> {
                     });
                     terminal |= self.events[c.event].terminal;
                 }
-                self.remember(t_far, &y_far);
+                let far_signs = self.signs_at(t_far, &y_far);
+                self.remember(t_far, &far_signs);
                 if terminal {
                     return Ok(Flow::Stop { t: t_far, y: y_far });
                 }
@@ -243,10 +242,17 @@ impl<'e, 'a, const N: usize> Locator<'e, 'a, N> {
         Ok(Flow::Continue)
     }
 
-    /// Updates every event's last nonzero sign at (t, y).
-    fn remember(&mut self, t: f64, y: &[f64; N]) {
-        for (event, tracker) in self.events.iter().zip(&mut self.trackers) {
-            let s = sign((event.condition)(t, y));
+    /// The signs of all conditions at (t, y).
+    fn signs_at(&self, t: f64, y: &[f64; N]) -> Vec<f64> {
+        self.events
+            .iter()
+            .map(|e| sign((e.condition)(t, y)))
+            .collect()
+    }
+
+    /// Records every nonzero sign seen at t as that event's last sign.
+    fn remember(&mut self, t: f64, signs: &[f64]) {
+        for (&s, tracker) in signs.iter().zip(&mut self.trackers) {
             if s != 0.0 {
                 *tracker = Tracker { sign: s, t };
             }

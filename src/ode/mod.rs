@@ -404,29 +404,56 @@ impl Integrator {
                 &mut self.stats,
                 observe,
             ),
-            Method::Dop853 { rtol, atol } => {
-                let mut solver = dop853::Dop853 {
+            Method::Dop853 { rtol, atol } | Method::Radau5 { rtol, atol } => {
+                let mut control = StepControl {
                     rtol,
                     atol,
                     max_steps: self.max_steps,
-                    next_step: self.next_step,
+                    next_step: &mut self.next_step,
                 };
-                let end = solver.integrate(system, t0, y0, t1, &mut self.stats, observe);
-                self.next_step = solver.next_step;
-                end
-            }
-            Method::Radau5 { rtol, atol } => {
-                let mut solver = radau5::Radau5 {
-                    rtol,
-                    atol,
-                    max_steps: self.max_steps,
-                    next_step: self.next_step,
-                };
-                let end = solver.integrate(system, t0, y0, t1, &mut self.stats, observe);
-                self.next_step = solver.next_step;
-                end
+                if let Method::Dop853 { .. } = self.method {
+                    dop853::integrate(&mut control, system, t0, y0, t1, &mut self.stats, observe)
+                } else {
+                    radau5::integrate(&mut control, system, t0, y0, t1, &mut self.stats, observe)
+                }
             }
         }
+    }
+}
+
+/// Tolerances, step limit and the step size carried between calls: what the
+/// adaptive methods (DOP853, Radau 5) share.
+struct StepControl<'a> {
+    rtol: f64,
+    atol: f64,
+    max_steps: u64,
+    /// Step size to try first; on return, the one to try next.
+    next_step: &'a mut Option<f64>,
+}
+
+impl StepControl<'_> {
+    /// After an accepted step of size `h_try` (h proposed, `h_new` proposed
+    /// next): the end of the run, if the observer stopped it or the step was
+    /// the last. The step size kept for the next call is the proposal, not a
+    /// last step truncated to reach t1.
+    fn end_of_run<const N: usize>(
+        &mut self,
+        flow: Flow<N>,
+        last: bool,
+        (t, y): (f64, [f64; N]),
+        h: f64,
+        h_try: f64,
+        h_new: f64,
+    ) -> Option<(f64, [f64; N])> {
+        if let Flow::Stop { t, y } = flow {
+            *self.next_step = Some(h_new);
+            return Some((t, y));
+        }
+        if last {
+            *self.next_step = Some(if h_try < h { h } else { h_new });
+            return Some((t, y));
+        }
+        None
     }
 }
 
