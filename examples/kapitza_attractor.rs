@@ -13,7 +13,7 @@ use mechlab::analysis::period_map::orbit;
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, RED};
-use mechlab::scene::{knob, run, Scene, SceneError};
+use mechlab::scene::{knob, run, Scene};
 use std::f64::consts::PI;
 
 /// The centre of the most populated cell of a coarse grid: where the zoom
@@ -195,18 +195,16 @@ fn main() {
         if lyapunov[0] <= 0.0 {
             eprintln!("note: the largest exponent is not positive: at these parameters the attractor is not chaotic");
         }
-        scene
-            .write_summary(serde_json::json!({
-                "A": params.A, "eps": params.eps, "mu": params.mu,
-                "lyapunov": lyapunov,
-                "lyapunov_sum_expected": expected_sum,
-                "lyapunov_sum": lyapunov[0] + lyapunov[1],
-                "dimension": dimension,
-                "kaplan_yorke_dimension": kaplan_yorke,
-                "points": count,
-                "zoom_window": {"q": [q0, q1], "p": [p0, p1]},
-            }))
-            .map(|_| ())
-            .map_err(|e: SceneError| e)
+        scene.write_summary(serde_json::json!({
+            "A": params.A, "eps": params.eps, "mu": params.mu,
+            "lyapunov": lyapunov,
+            "lyapunov_sum_expected": expected_sum,
+            "lyapunov_sum": lyapunov[0] + lyapunov[1],
+            "dimension": dimension,
+            "kaplan_yorke_dimension": kaplan_yorke,
+            "points": count,
+            "zoom_window": {"q": [q0, q1], "p": [p0, p1]},
+        }))?;
+        Ok(())
     });
 }
