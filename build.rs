@@ -1,7 +1,8 @@
 //! Build script: model files → derivations (Symbolica) → generated Rust.
 //!
 //! Thin on purpose: reading and validation live in `src/model/` (shared with
-//! the library), derivations in `build/derive.rs`, common subexpression
+//! the library), derivations in `build/derive.rs`, readable forms in
+//! `build/simplify.rs` and `build/latex.rs`, common subexpression
 //! elimination in `build/emit.rs`, module assembly in `build/generate.rs`,
 //! layout in `templates/`. Symbolica runs here only, on this one thread.
 
@@ -15,6 +16,10 @@ mod derive;
 mod emit;
 #[path = "build/generate.rs"]
 mod generate;
+#[path = "build/latex.rs"]
+mod latex;
+#[path = "build/simplify.rs"]
+mod simplify;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

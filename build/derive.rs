@@ -17,10 +17,13 @@
 //! - the Jacobians of both vector fields, ∂V/∂q, C = ∂²V/∂q² and the Hessian
 //!   of the effective potential V + V_vibr.
 //!
-//! Every result is kept as Symbolica's printed text (for snapshots and for
-//! code generation) and as LaTeX.
+//! Every recorded result goes through `build/simplify.rs` (readable forms,
+//! checked against Symbolica's result at random points) and is kept as text
+//! (for snapshots and code generation) and as LaTeX (`build/latex.rs`).
 
+use crate::latex::Names;
 use crate::model::{Expr, Model};
+use crate::simplify;
 use symbolica::prelude::*;
 
 /// One derived expression, printed.
@@ -59,6 +62,9 @@ pub struct Derivation {
     pub effective_potential_hessian: Vec<Vec<String>>,
     /// dθ/dt in terms of the parameters.
     pub phase_rate: String,
+    /// Arithmetic operations of the right-hand sides after CSE, as derived
+    /// and in the readable form: (function, derived, readable, chosen).
+    pub operation_counts: Vec<(String, usize, usize, usize)>,
 }
 
 /// A derivation failure, with the model quantity it concerns.
@@ -88,12 +94,6 @@ fn subst(e: &Atom, name: &str, by: &Atom) -> Atom {
 
 fn is_zero(e: &Atom) -> bool {
     e.expand().to_string() == "0"
-}
-
-fn latex(e: &Atom) -> String {
-    let mut options = PrintOptions::latex();
-    options.hide_all_namespaces = true;
-    e.printer(options).to_string()
 }
 
 /// Momentum symbol of a coordinate.
@@ -267,24 +267,82 @@ fn drop_terms_without(e: &Atom, symbols: &[String]) -> Result<Atom, DeriveError>
 
 struct Recorder {
     derived: Vec<Derived>,
+    vocabulary: simplify::Vocabulary,
+    names: Names,
 }
 
 impl Recorder {
+    /// Records the readable form of `e`; returns its text.
     fn record(
         &mut self,
         key: impl Into<String>,
         description: impl Into<String>,
         e: &Atom,
-    ) -> String {
-        let text = e.to_string();
+    ) -> Result<String, DeriveError> {
+        self.record_sum(key, description, std::slice::from_ref(e))
+    }
+
+    /// Records the sum of `parts`, each simplified on its own (so that, e.g.,
+    /// H reads as its kinetic part plus V rather than one long fraction).
+    fn record_sum(
+        &mut self,
+        key: impl Into<String>,
+        description: impl Into<String>,
+        parts: &[Atom],
+    ) -> Result<String, DeriveError> {
+        let key = key.into();
+        let failure = |reason: String| DeriveError {
+            key: "lagrangian".into(),
+            reason: format!("derived `{key}`: {reason}"),
+        };
+        let mut derived = Vec::new();
+        let mut readable = Vec::new();
+        for part in parts {
+            let text = part.together().to_string();
+            readable.push(simplify::simplify(&text, &self.vocabulary).map_err(&failure)?);
+            derived.push(format!("({text})"));
+        }
+        let readable = simplify::sum(readable);
+        let seed = key.bytes().fold(self.derived.len() as u64, |h, b| {
+            h.wrapping_mul(31).wrapping_add(u64::from(b))
+        });
+        simplify::verify(&derived.join("+"), &readable, seed).map_err(&failure)?;
+        let text = readable.to_string();
         self.derived.push(Derived {
-            key: key.into(),
+            key,
             description: description.into(),
             text: text.clone(),
-            latex: latex(e),
+            latex: self.names.latex(&readable),
         });
-        text
+        Ok(text)
     }
+}
+
+/// Of two equivalent sets of right-hand sides, the readable one unless it
+/// costs more than 10 % more operations after CSE than the derived one (the
+/// emitted code should be what the snapshots show; the count is only a rough
+/// model of time, e.g. it cannot see latency chains). Returns the last
+/// stage's texts, both counts and the chosen one.
+fn cheaper(
+    derived: Vec<Vec<(String, String)>>,
+    readable: Vec<Vec<(String, String)>>,
+) -> Result<(Vec<String>, usize, usize, usize), DeriveError> {
+    let count = |stages: &[Vec<(String, String)>]| {
+        crate::emit::operation_count(stages).map_err(|reason| DeriveError {
+            key: "(internal)".into(),
+            reason,
+        })
+    };
+    let (before, after) = (count(&derived)?, count(&readable)?);
+    let readable_chosen = 10 * after <= 11 * before;
+    let chosen = if readable_chosen { readable } else { derived };
+    let last = chosen.last().cloned().unwrap_or_default();
+    Ok((
+        last.into_iter().map(|(_, t)| t).collect(),
+        before,
+        after,
+        if readable_chosen { after } else { before },
+    ))
 }
 
 fn matrix_text(m: &[Vec<Atom>]) -> Vec<Vec<String>> {
@@ -324,8 +382,34 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         Some(f) => atom(&f.rate.to_string())?,
         None => num(1),
     };
+    let names = Names::new(
+        &model
+            .coordinates
+            .iter()
+            .map(|c| {
+                (
+                    c.name.clone(),
+                    c.velocity.clone(),
+                    momentum_name(&c.name),
+                    c.latex.clone(),
+                )
+            })
+            .collect::<Vec<_>>(),
+        &model
+            .parameters
+            .iter()
+            .map(|x| (x.name.clone(), x.latex.clone()))
+            .chain(phase.iter().map(|th| (th.clone(), None)))
+            .collect::<Vec<_>>(),
+    );
     let mut rec = Recorder {
         derived: Vec::new(),
+        vocabulary: simplify::Vocabulary {
+            keys: p.iter().chain(&qd).cloned().collect(),
+            phase: phase.clone(),
+            coordinates: q.clone(),
+        },
+        names,
     };
 
     // Positions, then their total time derivatives.
@@ -386,7 +470,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         "lagrangian",
         "L(q, q', θ), terms depending on time only dropped",
         &lagrangian,
-    );
+    )?;
 
     // Mass matrix, linear term, potential.
     let at_rest = |e: &Atom| qd.iter().fold(e.clone(), |acc, v| subst(&acc, v, &num(0)));
@@ -423,17 +507,17 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                 format!("mass_matrix[{i}][{j}]"),
                 "A = ∂²L/∂q'²",
                 &mass[i][j],
-            );
+            )?;
         }
     }
     let linear: Vec<Atom> = (0..n)
         .map(|i| at_rest(&lagrangian.derivative(symbol!(qd[i].as_str()))).expand())
         .collect();
     for (i, b) in linear.iter().enumerate() {
-        rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", b);
+        rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", b)?;
     }
     let potential = (-at_rest(&lagrangian)).expand();
-    rec.record("potential", "V = −L at q' = 0", &potential);
+    rec.record("potential", "V = −L at q' = 0", &potential)?;
 
     let momenta: Vec<Atom> = (0..n)
         .map(|i| {
@@ -449,7 +533,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             format!("momenta[{i}]"),
             format!("{} = ∂L/∂{}", p[i], qd[i]),
             m,
-        );
+        )?;
     }
 
     let (det, inv) = inverse(&mass);
@@ -459,17 +543,18 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             reason: "the mass matrix is singular".into(),
         });
     }
-    rec.record("mass_matrix_determinant", "det A", &det);
+    rec.record("mass_matrix_determinant", "det A", &det)?;
     let shifted: Vec<Atom> = (0..n).map(|i| var(&p[i]) - &linear[i]).collect();
     let velocities: Vec<Atom> = (0..n)
         .map(|i| (0..n).fold(num(0), |acc, j| acc + &inv[i][j] * &shifted[j]))
         .collect();
+    let mut readable_velocities = Vec::new();
     for (i, v) in velocities.iter().enumerate() {
-        rec.record(
+        readable_velocities.push(rec.record(
             format!("velocities[{i}]"),
             format!("{} = A⁻¹(p − b)", qd[i]),
-            &v.together(),
-        );
+            v,
+        )?);
     }
     let mut kinetic = num(0);
     for i in 0..n {
@@ -477,12 +562,13 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             kinetic = kinetic + &shifted[i] * &inv[i][j] * &shifted[j];
         }
     }
-    let hamiltonian = kinetic / num(2) + &potential;
-    let hamiltonian_text = rec.record(
+    let kinetic = kinetic / num(2);
+    let hamiltonian = &kinetic + &potential;
+    let hamiltonian_text = rec.record_sum(
         "hamiltonian",
-        "H = ½(p − b)ᵀA⁻¹(p − b) + V",
-        &hamiltonian.together(),
-    );
+        "H = ½(p − b)ᵀA⁻¹(p − b) + V, by powers of the momenta",
+        &[kinetic.clone(), potential.clone()],
+    )?;
 
     // Exact equations: q' = A⁻¹(p − b), p' = ∂L/∂q + Q at that q'.
     let forces: Vec<Atom> = model
@@ -498,13 +584,40 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             .zip(&velocities)
             .fold(e.clone(), |acc, (name, value)| subst(&acc, name, value))
     };
+    let mut readable_rates = Vec::new();
     for i in 0..n {
-        rec.record(
+        readable_rates.push(rec.record(
             format!("momentum_rates[{i}]"),
             format!("d{}/dt = ∂L/∂{} + Q, at the velocities above", p[i], q[i]),
             &rates[i],
-        );
+        )?);
     }
+    let velocity_names: Vec<(String, String)> =
+        qd.iter().map(|v| (v.clone(), String::new())).collect();
+    let staged = |velocities: Vec<String>, rates: Vec<String>| {
+        let with = |values: Vec<String>, prefix: &str| -> Vec<(String, String)> {
+            values
+                .into_iter()
+                .enumerate()
+                .map(|(i, t)| (format!("{prefix}{i}"), t))
+                .collect()
+        };
+        let first: Vec<(String, String)> = velocity_names
+            .iter()
+            .zip(velocities)
+            .map(|((n, _), t)| (n.clone(), t))
+            .collect();
+        vec![first, with(rates, "dp")]
+    };
+    let (_, before, after, used) = cheaper(
+        staged(
+            velocities.iter().map(|v| v.to_string()).collect(),
+            rates.iter().map(|r| r.to_string()).collect(),
+        ),
+        staged(readable_velocities.clone(), readable_rates.clone()),
+    )?;
+    let use_readable = used == after;
+    let exact_counts = ("exact_rhs".to_string(), before, after, used);
 
     // Jacobian of the exact field by the chain rule through q'(q, p).
     let state: Vec<String> = q.iter().chain(&p).cloned().collect();
@@ -531,8 +644,16 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
     let mut derivation = Derivation {
         dof: n,
         derived: Vec::new(),
-        velocities: velocities.iter().map(|v| v.to_string()).collect(),
-        momentum_rates: rates.iter().map(|r| r.to_string()).collect(),
+        velocities: if use_readable {
+            readable_velocities
+        } else {
+            velocities.iter().map(|v| v.to_string()).collect()
+        },
+        momentum_rates: if use_readable {
+            readable_rates
+        } else {
+            rates.iter().map(|r| r.to_string()).collect()
+        },
         momenta: momenta.iter().map(|m| m.to_string()).collect(),
         hamiltonian: hamiltonian_text,
         exact_jacobian,
@@ -546,18 +667,19 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         potential_hessian: Vec::new(),
         effective_potential_hessian: Vec::new(),
         phase_rate: rate.to_string(),
+        operation_counts: vec![exact_counts],
     };
 
     // Averaging over the fast phase.
     let (mean_potential, vibrational) = match &phase {
         Some(th) => {
             let averaged_hamiltonian = phase_mean(&hamiltonian, th)?.together();
-            derivation.averaged_hamiltonian = rec.record(
-                "averaged_hamiltonian",
-                "H̄ = mean over the phase of H",
-                &averaged_hamiltonian,
-            );
             let mean_potential = phase_mean(&potential, th)?.expand();
+            derivation.averaged_hamiltonian = rec.record_sum(
+                "averaged_hamiltonian",
+                "H̄ = mean over the phase of H, by powers of the momenta",
+                &[phase_mean(&kinetic, th)?, mean_potential.clone()],
+            )?;
             let mut quadratic = num(0);
             for i in 0..n {
                 for j in 0..n {
@@ -575,7 +697,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                     format!("averaged_forces[{i}]"),
                     "P̄ = mean Q(q, q'(q, p, θ))",
                     f,
-                );
+                )?;
             }
             let mut rhs: Vec<Atom> = (0..n)
                 .map(|i| averaged_hamiltonian.derivative(symbol!(p[i].as_str())))
@@ -585,14 +707,29 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                     -averaged_hamiltonian.derivative(symbol!(q[i].as_str())) + &averaged_forces[i],
                 );
             }
+            let mut readable_rhs = Vec::new();
             for (i, r) in rhs.iter().enumerate() {
-                rec.record(
+                readable_rhs.push(rec.record(
                     format!("averaged_rhs[{i}]"),
                     format!("d{}/dt of the averaged system", state[i]),
-                    &r.together(),
-                );
+                    r,
+                )?);
             }
-            derivation.averaged_rhs = rhs.iter().map(|r| r.to_string()).collect();
+            let outputs = |texts: Vec<String>| -> Vec<Vec<(String, String)>> {
+                vec![texts
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, t)| (format!("f{i}"), t))
+                    .collect()]
+            };
+            let (chosen, before, after, used) = cheaper(
+                outputs(rhs.iter().map(|r| r.to_string()).collect()),
+                outputs(readable_rhs),
+            )?;
+            derivation
+                .operation_counts
+                .push(("averaged_rhs".into(), before, after, used));
+            derivation.averaged_rhs = chosen;
             derivation.averaged_jacobian = rhs
                 .iter()
                 .map(|r| {
@@ -616,14 +753,18 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         "mean_potential",
         "V averaged over the phase",
         &mean_potential,
-    );
+    )?;
     derivation.vibrational_potential = rec.record(
         "vibrational_potential",
         "V_vibr = ½ mean(bᵀ A⁻¹ b)",
         &vibrational,
-    );
+    )?;
     let effective = &mean_potential + &vibrational;
-    rec.record("effective_potential", "V + V_vibr", &effective.together());
+    rec.record_sum(
+        "effective_potential",
+        "V + V_vibr",
+        &[mean_potential.clone(), vibrational.clone()],
+    )?;
     derivation.potential_gradient = (0..n)
         .map(|i| {
             rec.record(
@@ -632,34 +773,37 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                 &mean_potential.derivative(symbol!(q[i].as_str())),
             )
         })
-        .collect();
-    let hessian =
-        |e: &Atom, key: &str, description: &str, rec: &mut Recorder| -> Vec<Vec<String>> {
-            (0..n)
-                .map(|i| {
-                    (0..n)
-                        .map(|j| {
-                            let d = e
-                                .derivative(symbol!(q[i].as_str()))
-                                .derivative(symbol!(q[j].as_str()));
-                            rec.record(format!("{key}[{i}][{j}]"), description, &d.together())
-                        })
-                        .collect()
-                })
-                .collect()
-        };
+        .collect::<Result<_, _>>()?;
+    let hessian = |e: &Atom,
+                   key: &str,
+                   description: &str,
+                   rec: &mut Recorder|
+     -> Result<Vec<Vec<String>>, DeriveError> {
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        let d = e
+                            .derivative(symbol!(q[i].as_str()))
+                            .derivative(symbol!(q[j].as_str()));
+                        rec.record(format!("{key}[{i}][{j}]"), description, &d)
+                    })
+                    .collect()
+            })
+            .collect()
+    };
     derivation.potential_hessian = hessian(
         &mean_potential,
         "potential_hessian",
         "C = ∂²V/∂q²",
         &mut rec,
-    );
+    )?;
     derivation.effective_potential_hessian = hessian(
         &effective,
         "effective_potential_hessian",
         "∂²(V + V_vibr)/∂q²",
         &mut rec,
-    );
+    )?;
     derivation.derived = rec.derived;
     Ok(derivation)
 }

@@ -59,6 +59,45 @@ fn as_number(e: &Expr) -> Option<f64> {
     }
 }
 
+/// The angles and integer coefficients of a linear combination such as
+/// `2*phi1-phi2`, if `e` is one.
+fn angle_combination(e: &Expr) -> Option<Vec<(String, i64)>> {
+    fn collect(e: &Expr, sign: i64, out: &mut Vec<(String, i64)>) -> Option<()> {
+        match e {
+            Expr::Sym(s) => {
+                match out.iter_mut().find(|(a, _)| a == s) {
+                    Some(entry) => entry.1 += sign,
+                    None => out.push((s.clone(), sign)),
+                }
+                Some(())
+            }
+            Expr::Neg(a) => collect(a, -sign, out),
+            Expr::Bin(BinOp::Add, a, b) => {
+                collect(a, sign, out)?;
+                collect(b, sign, out)
+            }
+            Expr::Bin(BinOp::Sub, a, b) => {
+                collect(a, sign, out)?;
+                collect(b, -sign, out)
+            }
+            Expr::Bin(BinOp::Mul, a, b) => match (as_number(a), as_number(b)) {
+                (Some(k), _) if k == k.round() && k.abs() <= 8.0 => {
+                    collect(b, sign * k as i64, out)
+                }
+                (_, Some(k)) if k == k.round() && k.abs() <= 8.0 => {
+                    collect(a, sign * k as i64, out)
+                }
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+    let mut out = Vec::new();
+    collect(e, 1, &mut out)?;
+    out.retain(|(_, k)| *k != 0);
+    (!out.is_empty()).then_some(out)
+}
+
 impl Emitter {
     fn intern(&mut self, node: Node) -> usize {
         if let Some(&i) = self.index.get(&node) {
@@ -108,6 +147,22 @@ impl Emitter {
                     BinOp::Pow => unreachable!(),
                 })
             }
+            Expr::Call(name, args) if matches!(name.as_str(), "sin" | "cos") => {
+                match angle_combination(&args[0]) {
+                    Some(k) if k.len() > 1 || k[0].1.abs() > 1 => {
+                        let (c, s) = self.sin_cos_of_combination(&k);
+                        if name == "sin" {
+                            s
+                        } else {
+                            c
+                        }
+                    }
+                    _ => {
+                        let a = self.build(&args[0])?;
+                        self.intern(Node::Call(if name == "sin" { "sin" } else { "cos" }, a))
+                    }
+                }
+            }
             Expr::Call(name, args) => {
                 let f: &'static str = match name.as_str() {
                     "sin" => "sin",
@@ -122,6 +177,42 @@ impl Emitter {
                 self.intern(Node::Call(f, a))
             }
         })
+    }
+
+    /// cos and sin of Σ k_j φ_j from the sin_cos of each φ_j by complex
+    /// multiplication: one transcendental pair per angle, shared by every
+    /// combination (sin(φ1 − φ2), cos(2φ1 − φ2), ...) in the function.
+    fn sin_cos_of_combination(&mut self, k: &[(String, i64)]) -> (usize, usize) {
+        let mut acc: Option<(usize, usize)> = None;
+        for (angle, coefficient) in k {
+            let v = self.intern(Node::Var(angle.clone()));
+            let c1 = self.intern(Node::Call("cos", v));
+            let s1 = self.intern(Node::Call("sin", v));
+            let mut power = (c1, s1);
+            for _ in 1..coefficient.unsigned_abs() {
+                power = self.complex_product(power, (c1, s1));
+            }
+            if *coefficient < 0 {
+                power = (power.0, self.intern(Node::Neg(power.1)));
+            }
+            acc = Some(match acc {
+                None => power,
+                Some(a) => self.complex_product(a, power),
+            });
+        }
+        acc.expect("a combination has at least one angle")
+    }
+
+    /// (cos a, sin a)·(cos b, sin b) = (cos(a + b), sin(a + b)).
+    fn complex_product(&mut self, a: (usize, usize), b: (usize, usize)) -> (usize, usize) {
+        let cc = self.intern(Node::Mul(a.0, b.0));
+        let ss = self.intern(Node::Mul(a.1, b.1));
+        let sc = self.intern(Node::Mul(a.1, b.0));
+        let cs = self.intern(Node::Mul(a.0, b.1));
+        (
+            self.intern(Node::Sub(cc, ss)),
+            self.intern(Node::Add(sc, cs)),
+        )
     }
 
     fn children(node: &Node) -> Vec<usize> {
@@ -318,4 +409,36 @@ impl Emitter {
         self.lines.push(format!("let {name} = {value};"));
         self.bound.insert(i, name);
     }
+}
+
+/// Cost of the DAG of `stages` in arithmetic operations (every node but
+/// literals and variables; transcendental calls weighted): the measure by
+/// which a readable form and a derived form of the same right-hand side are
+/// compared.
+pub fn operation_count(stages: &[Vec<(String, String)>]) -> Result<usize, String> {
+    let mut emitter = Emitter::default();
+    for stage in stages {
+        emitter.stage(stage)?;
+    }
+    Ok(emitter
+        .nodes
+        .iter()
+        .map(|node| match node {
+            Node::Lit(_) | Node::Var(_) => 0,
+            // A transcendental call costs about as much as 20 arithmetic
+            // operations; a sin and cos of one argument share one `sin_cos`.
+            Node::Call("cos", a) if emitter.index.contains_key(&Node::Call("sin", *a)) => 0,
+            Node::Call(..) | Node::Sqrt(_) | Node::Powf(..) => 20,
+            // A division takes several multiplications' time; a negation is
+            // folded into the neighbouring addition.
+            Node::Div(..) => 4,
+            Node::Neg(_) => 0,
+            // x^k by repeated squaring.
+            Node::Powi(_, k) => {
+                let k = k.unsigned_abs();
+                (32 - k.leading_zeros() + k.count_ones()).saturating_sub(2) as usize + 1
+            }
+            _ => 1,
+        })
+        .sum())
 }

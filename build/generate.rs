@@ -411,6 +411,14 @@ pub fn render(
             .unwrap_or_default(),
     );
     context.insert("functions", &functions);
+    context.insert(
+        "operation_counts",
+        &derivation
+            .operation_counts
+            .iter()
+            .map(|(f, before, after, used)| format!("(\"{f}\", {before}, {after}, {used})"))
+            .collect::<Vec<_>>(),
+    );
     context.insert("derived", &derived);
     tera.render("model.rs.tera", &context)
         .map_err(|e| format!("template model.rs.tera: {e:?}"))

@@ -28,3 +28,56 @@ fn every_derived_expression_is_pinned() {
         }
     }
 }
+
+fn derived(model: &str, key: &str) -> &'static mechlab::registry::DerivedExpression {
+    let info = mechlab::registry::find(model).expect("model exists");
+    info.derivations
+        .iter()
+        .find(|d| d.key == key)
+        .unwrap_or_else(|| panic!("{model} has no derived `{key}`"))
+}
+
+/// Pins the size of the key expressions, so that a regression to expanded
+/// products of sines and cosines fails here and not only in review.
+#[test]
+fn key_expressions_stay_readable() {
+    let kapitza_h = derived("kapitza", "hamiltonian").text;
+    assert!(kapitza_h.len() <= 80, "{kapitza_h}");
+    let v_vibr = derived("double_pendulum", "vibrational_potential").text;
+    assert!(v_vibr.len() <= 120, "{v_vibr}");
+    assert!(v_vibr.contains("(m1+m2*sin(phi1-phi2)^2)"), "{v_vibr}");
+    let h = derived("double_pendulum", "hamiltonian").text;
+    assert!(h.len() <= 400, "{} characters: {h}", h.len());
+    assert_eq!(
+        derived("inclined_pendulum", "vibrational_potential").text,
+        "A^2*sin(q-alpha)^2/4"
+    );
+    assert_eq!(
+        derived("elastic_pendulum", "vibrational_potential").text,
+        "a^2*m/4"
+    );
+}
+
+/// LaTeX follows a mechanics text: Greek letters, subscripts, dotted
+/// velocities, momenta p_{φ₁}; no ASCII names of Greek letters are left.
+#[test]
+fn latex_uses_greek_letters_and_subscripts() {
+    for model in mechlab::models::ALL {
+        for d in model.derivations {
+            for word in ["phi", "alpha", "theta", "tau", "eps", "mu", "nu"] {
+                let bare = d
+                    .latex
+                    .match_indices(word)
+                    .any(|(i, _)| i == 0 || !d.latex[..i].ends_with(['\\', 'r', 'a']));
+                assert!(!bare, "{} {}: '{word}' in {}", model.name, d.key, d.latex);
+            }
+        }
+    }
+    let p = derived("double_pendulum", "velocities[0]").latex;
+    assert!(p.contains("p_{\\varphi_2}") && p.contains("\\frac{"), "{p}");
+    let rates = derived("double_pendulum", "momentum_rates[0]").latex;
+    assert!(
+        rates.contains("\\dot{\\varphi_1}") && rates.contains("\\sin \\varphi_1"),
+        "{rates}"
+    );
+}

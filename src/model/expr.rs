@@ -489,7 +489,7 @@ impl fmt::Display for Expr {
             Expr::Sym(s) => write!(f, "{s}"),
             Expr::Neg(a) => {
                 write!(f, "-")?;
-                wrap(f, a, 3)
+                wrap(f, a, 2)
             }
             Expr::Bin(op, a, b) => {
                 let (sym, left_min, right_min) = match op {

@@ -12,7 +12,7 @@ use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
-/// What a model file says, as written (see `models/README.md` for the format).
+/// What a model file says, as written (the format is described in the README, section "Model files").
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelFile {
@@ -46,6 +46,9 @@ pub struct CoordinateSpec {
     pub periodic: bool,
     #[serde(default)]
     pub description: String,
+    /// LaTeX of the name, when the default (Greek names, digits as
+    /// subscripts) does not fit.
+    pub latex: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -54,6 +57,8 @@ pub struct ParameterSpec {
     pub name: String,
     pub default: f64,
     pub description: String,
+    /// LaTeX of the name, when the default does not fit.
+    pub latex: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -89,6 +94,8 @@ pub struct Coordinate {
     pub velocity: String,
     pub periodic: bool,
     pub description: String,
+    /// Explicit LaTeX name, if the model file gives one.
+    pub latex: Option<String>,
 }
 
 #[derive(Clone, Debug)]
@@ -96,6 +103,8 @@ pub struct Parameter {
     pub name: String,
     pub default: f64,
     pub description: String,
+    /// Explicit LaTeX name, if the model file gives one.
+    pub latex: Option<String>,
 }
 
 /// The fast phase θ with dθ/dt = rate(parameters); the model is 2π-periodic in θ.
@@ -391,6 +400,7 @@ impl ModelFile {
                     velocity: c.velocity,
                     periodic: c.periodic,
                     description: c.description,
+                    latex: c.latex,
                 })
                 .collect(),
             parameters: self
@@ -400,6 +410,7 @@ impl ModelFile {
                     name: p.name,
                     default: p.default,
                     description: p.description,
+                    latex: p.latex,
                 })
                 .collect(),
             fast_phase,
