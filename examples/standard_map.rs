@@ -1,7 +1,7 @@
 //! Scene `standard_map`: the Chirikov standard map
 //! (q, p) ↦ (q + p + ε sin q, p + ε sin q) on the cylinder — orbits, and a
 //! chaos map in which every pixel is shaded by the fast Lyapunov indicator of
-//! its orbit (dark = chaotic): the stochastic web of SPEC.md §1.
+//! its orbit (dark = chaotic): the stochastic web of Study 1 (docs/studies.md).
 
 use mechlab::analysis::lyapunov::fli_shading;
 use mechlab::analysis::standard_map::{standard_map, standard_map_fli};

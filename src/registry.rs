@@ -3,7 +3,8 @@
 
 use std::fmt;
 
-/// One derived expression as printed by Symbolica at build time.
+/// One derived expression in its readable form (checked at build time
+/// against Symbolica's result), as text and LaTeX.
 #[derive(Clone, Copy, Debug)]
 pub struct DerivedExpression {
     /// Stable key, e.g. `hamiltonian` or `mass_matrix[0][1]`.
@@ -25,6 +26,10 @@ pub struct ModelInfo {
     pub parameter_names: &'static [&'static str],
     pub parameter_descriptions: &'static [&'static str],
     pub derivations: &'static [DerivedExpression],
+    /// Cost of the right-hand sides after CSE (arithmetic operations,
+    /// transcendental calls weighted 20, divisions 4): (function, as derived
+    /// by Symbolica, in the readable form, emitted).
+    pub operation_counts: &'static [(&'static str, usize, usize, usize)],
     /// The generated Rust module.
     pub generated_code: &'static str,
 }

@@ -468,7 +468,7 @@ fn radau5_converges_with_its_order_on_a_smooth_problem() {
     assert!((3.5..7.0).contains(&order), "observed order {order}");
 }
 
-/// The rigid-rod acceleration of the worked example (SPEC.md §3): the stable
+/// The rigid-rod acceleration of the worked example (docs/studies.md, Study 3): the stable
 /// root R* of Φ(R) = X* on its middle segment, then x₁'' from the rigid equations.
 fn rigid_rod_acceleration() -> f64 {
     let (cos0, sin0) = (0.6f64, 0.8f64);

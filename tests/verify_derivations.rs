@@ -18,7 +18,7 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
 }
 
-/// SPEC.md §1 with our phase convention y = A ε cos θ, which gives the cross
+/// Study 1 (docs/studies.md) with our phase convention y = A ε cos θ, which gives the cross
 /// term with a minus sign: H = p²/2 − A p sin q sin θ + (A²/2) sin²q sin²θ + cos q.
 fn kapitza_h_closed_form(q: f64, p: f64, t: f64, a: f64, eps: f64) -> f64 {
     let th = t / eps;

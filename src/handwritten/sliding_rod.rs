@@ -1,4 +1,4 @@
-//! The deformable Painlevé–Klein rod of Study 3 (SPEC.md §3) in its sliding
+//! The deformable Painlevé–Klein rod of Study 3 (docs/studies.md, Study 3) in its sliding
 //! phase: both points move right (σ₁ = σ₂ = +1), no switching. State
 //! (x₁, x₂, x₁', x₂'). The rod is a visco-elastic element with reaction
 //! R = k δ/ε² + ν δ'/ε, which makes the system stiff as ε → 0 (eigenvalues of
@@ -23,7 +23,7 @@ pub struct SlidingRod {
 }
 
 impl SlidingRod {
-    /// The worked example of SPEC.md §3 at the given ε.
+    /// The worked example of Study 3 (docs/studies.md) at the given ε.
     pub fn worked_example(eps: f64) -> SlidingRod {
         SlidingRod {
             d: 0.8,
