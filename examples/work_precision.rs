@@ -351,16 +351,9 @@ fn slope(points: &[(f64, f64)]) -> Option<f64> {
     if pts.len() < 3 {
         return None;
     }
-    let n = pts.len() as f64;
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / n,
-        pts.iter().map(|p| p.1).sum::<f64>() / n,
-    );
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let syy: f64 = pts.iter().map(|p| (p.1 - my).powi(2)).sum();
+    let fit = mechlab::analysis::fit::least_squares(&pts);
     // No slope where the points do not lie on a line (stability-limited runs).
-    (sxy * sxy / (sxx * syy) > 0.9).then_some(sxy / sxx)
+    (fit.r_squared > 0.9).then_some(fit.slope)
 }
 
 /// Seconds needed to reach `target` error, interpolated log-log along a method's runs.

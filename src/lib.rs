@@ -3,7 +3,9 @@
 //!
 //! Pipeline: `models/*.toml` → `build.rs` (Symbolica, build time only) →
 //! generated modules in [`models`] → runtime: [`ode`] (integrators),
-//! [`analysis`] (period map, Floquet, Lyapunov), [`plot`] → `examples/` (scenes).
+//! [`analysis`] (period map, Floquet, Lyapunov, averaging), [`studies`]
+//! (closed forms and runs shared by the scenes of a study), [`plot`] →
+//! `examples/` (scenes).
 //!
 //! ```
 //! use mechlab::models::kapitza;
@@ -28,3 +30,4 @@ pub mod ode;
 pub mod plot;
 pub mod registry;
 pub mod scene;
+pub mod studies;

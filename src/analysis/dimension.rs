@@ -45,7 +45,8 @@ pub fn box_counting(
     let line: Vec<(f64, f64)> = fit
         .map(|k| ((1.0 / sides[k]).ln(), (boxes[k] as f64).ln()))
         .collect();
-    let (dimension, intercept) = least_squares(&line);
+    let fit = super::fit::least_squares(&line);
+    let (dimension, intercept) = (fit.slope, fit.intercept);
     BoxCounting {
         sides: sides.to_vec(),
         boxes,
@@ -78,15 +79,4 @@ pub fn bounds(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
             )
         },
     )
-}
-
-/// Least-squares line through (x, y): (slope, intercept).
-fn least_squares(points: &[(f64, f64)]) -> (f64, f64) {
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let slope = sxy / sxx;
-    (slope, my - slope * mx)
 }

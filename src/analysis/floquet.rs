@@ -121,3 +121,23 @@ pub fn first_stability_onset<E>(
     }
     Ok(None)
 }
+
+/// The first interval of a parameter in (lo, hi] on which `margin` ≤ 0
+/// (e.g. spectral radius − 1 − tolerance: stable), as (lower edge, upper
+/// edge); the upper edge is None if the interval reaches `hi`. Edges are
+/// bracketed on `samples` equal steps over (lo, hi] and bisected to `tolerance`.
+pub fn stability_window<E>(
+    margin: &dyn Fn(f64) -> Result<f64, E>,
+    lo: f64,
+    hi: f64,
+    samples: usize,
+    tolerance: f64,
+) -> Result<Option<(f64, Option<f64>)>, E> {
+    let Some(low) = first_stability_onset(margin, lo, hi, samples, tolerance)? else {
+        return Ok(None);
+    };
+    let rest = ((hi - low) / (hi - lo) * samples as f64).ceil().max(1.0) as usize;
+    let flipped = |a: f64| margin(a).map(|m| -m);
+    let high = first_stability_onset(&flipped, low + tolerance, hi, rest, tolerance)?;
+    Ok(Some((low, high)))
+}

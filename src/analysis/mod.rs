@@ -1,10 +1,14 @@
 //! Analyses built on the integrators: the period map and its orbits,
 //! variational equations (monodromy, Floquet multipliers, Lyapunov exponents,
-//! the fast Lyapunov indicator) and the Chirikov standard map.
+//! the fast Lyapunov indicator), the Chirikov standard map, the comparison
+//! of exact and averaged systems, and stabilisation by vibration.
 
+pub mod averaging;
 pub mod dimension;
+pub mod fit;
 pub mod floquet;
 pub mod lyapunov;
 pub mod period_map;
 pub mod standard_map;
 pub mod variational;
+pub mod vibrational_stability;
