@@ -219,6 +219,23 @@ impl Scene {
         }
     }
 
+    /// A comma-separated list of finite numbers (at least one).
+    pub fn numbers(&self, name: &str) -> Result<Vec<f64>, SceneError> {
+        let text = self.text(name);
+        let values: Option<Vec<f64>> = text
+            .split(',')
+            .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        match values {
+            Some(v) if !v.is_empty() => Ok(v),
+            _ => Err(SceneError::BadValue {
+                name: name.into(),
+                value: text.into(),
+                reason: "not a comma-separated list of finite numbers".into(),
+            }),
+        }
+    }
+
     /// The knobs and their values, for summaries.
     pub fn settings(&self) -> serde_json::Value {
         let map: serde_json::Map<String, serde_json::Value> = self

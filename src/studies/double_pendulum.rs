@@ -18,6 +18,7 @@ use crate::analysis::vibrational_stability::{
 };
 use crate::models::double_pendulum::{self as model, Exact, Params};
 use crate::ode::{Integrator, Method, OdeError};
+use crate::scene::{knob, Knob, Scene, SceneError};
 use std::f64::consts::PI;
 
 /// mean(h²) of the base velocity profile h = −sin.
@@ -127,4 +128,35 @@ pub fn exact_stability_window(
         exact_multipliers(&p, phi, tol).map(|(r, _)| r - 1.0 - 1e-6)
     };
     stability_window(&margin, 0.0, a_max, samples, 1e-6 * a_max)
+}
+
+/// Knobs for every parameter of the model, with the model file's defaults
+/// except the ones a scene overrides.
+pub fn parameter_knobs(overrides: &[(&'static str, &'static str)]) -> Vec<Knob> {
+    Params::NAMES
+        .iter()
+        .zip(Params::DEFAULT_TEXTS)
+        .zip(Params::DESCRIPTIONS)
+        .map(|((&name, default), help)| {
+            let default = overrides
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map_or(default, |(_, v)| v);
+            knob(name, default, help)
+        })
+        .collect()
+}
+
+/// The parameters set by the knobs of [`parameter_knobs`]: masses, lengths,
+/// g and ν positive, a and μ not negative.
+pub fn params_from_scene(scene: &Scene) -> Result<Params, SceneError> {
+    let mut params = Params::default();
+    for name in Params::NAMES {
+        let value = match name {
+            "a" | "mu" => scene.non_negative(name)?,
+            _ => scene.positive(name)?,
+        };
+        params.set(name, value)?;
+    }
+    Ok(params)
 }
