@@ -302,6 +302,10 @@ impl<'a> PanelSpec<'a> {
             log_y: false,
         }
     }
+    pub fn log_x(mut self) -> Self {
+        self.log_x = true;
+        self
+    }
     pub fn log_log(mut self) -> Self {
         self.log_x = true;
         self.log_y = true;
