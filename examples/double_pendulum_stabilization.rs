@@ -1,0 +1,236 @@
+//! Scene `double_pendulum_stabilization` (deliverable 2.4): which equilibria
+//! of the double pendulum does vertical vibration stabilise, and from which
+//! amplitude on?
+//!
+//! For every equilibrium (φ1, φ2 ∈ {0, π}): the roots λ of det(C − λA) = 0
+//! (from the generated mass matrix and potential Hessian), stability without
+//! vibration, and for the unstable ones the threshold a* of the criterion
+//! a² > g²/(mean(h²)|λ*|), as a closed formula and as a number. Then long
+//! runs of the limiting system from a small neighbourhood slightly above a*
+//! (stays near) and slightly below (leaves), and the exact system's
+//! stability window in a at the given ν from its Floquet multipliers: its
+//! lower edge is close to a*; its upper edge, where parametric resonance
+//! destabilises the equilibrium again, the averaged system does not have.
+
+use mechlab::analysis::vibrational_stability::Stabilization;
+use mechlab::models::double_pendulum::{Averaged, Params};
+use mechlab::ode::{Integrator, Method};
+use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
+use mechlab::scene::{knob, run, Progress, Scene};
+use mechlab::studies::double_pendulum::{
+    analyse_equilibrium, exact_multipliers, exact_stability_window, parameter_knobs,
+    params_from_scene, threshold_formula, EQUILIBRIA,
+};
+use rayon::prelude::*;
+
+fn main() {
+    run(|| {
+        let mut knobs = parameter_knobs(&[]);
+        knobs.extend([
+            knob(
+                "offset",
+                "0.05",
+                "initial distance of the long runs from the equilibrium (both angles)",
+            ),
+            knob(
+                "t_long",
+                "300",
+                "length of the long runs of the limiting system",
+            ),
+            knob("margin", "0.1", "the long runs use a = (1 ± margin) a*"),
+            knob(
+                "a_max_factor",
+                "30",
+                "the exact window is searched for a up to this × a*",
+            ),
+            knob(
+                "chart_points",
+                "150",
+                "amplitudes sampled for the exact spectral-radius chart",
+            ),
+            knob("method", "dop853", "integration method of the long runs"),
+            knob(
+                "tol",
+                "1e-10",
+                "tolerance (long runs and monodromy matrices)",
+            ),
+        ]);
+        let scene = Scene::from_args(
+            "double_pendulum_stabilization",
+            "equilibria, criterion (11), a*, long runs of the limiting system, the exact stability window",
+            &knobs,
+        )?;
+        let params = params_from_scene(&scene)?;
+        let offset = scene.number("offset")?;
+        let t_long = scene.positive("t_long")?;
+        let margin = scene.positive("margin")?;
+        let factor = scene.positive("a_max_factor")?;
+        let chart_points = scene.count("chart_points")?;
+        let tol = scene.positive("tol")?;
+        let method = Method::parse(scene.text("method"), tol)?;
+
+        let mut entries = Vec::new();
+        let mut titles = Vec::new();
+        let mut panels: Vec<(
+            Vec<Vec<(f64, f64)>>,
+            Vec<Vec<(f64, f64)>>,
+            Vec<(f64, f64)>,
+            f64,
+        )> = Vec::new();
+        let mut progress = Progress::new("equilibria", EQUILIBRIA.len());
+        for (k, phi) in EQUILIBRIA.iter().enumerate() {
+            let analysis = analyse_equilibrium(&params, *phi);
+            let formula = threshold_formula(*phi);
+            let name = format!(
+                "({}, {})",
+                if phi.0 == 0.0 { "0" } else { "PI" },
+                if phi.1 == 0.0 { "0" } else { "PI" }
+            );
+            println!(
+                "equilibrium {name}: λ = {:?}, stable without vibration: {}",
+                analysis.lambdas, analysis.stable_without_vibration
+            );
+            let mut entry = serde_json::json!({
+                "phi1": phi.0, "phi2": phi.1,
+                "lambdas": analysis.lambdas,
+                "stable_without_vibration": analysis.stable_without_vibration,
+                "a_star": null, "a_star_formula": null, "a_star_formula_latex": null, "exact_window": null,
+            });
+            match analysis.stabilization {
+                Stabilization::AlreadyStable => println!("  stable for every a (all λ > 0)"),
+                Stabilization::Degenerate => {
+                    println!("  not decided: a root λ is zero (degenerate equilibrium)");
+                    entry["reason"] =
+                        "a root of det(C − λA) is zero: the criterion does not apply".into();
+                }
+                Stabilization::Threshold {
+                    lambda_star,
+                    a_star,
+                } => {
+                    let (text, latex) = formula.expect("unstable equilibria have a formula");
+                    let a_max = factor * a_star;
+                    let window = exact_stability_window(&params, *phi, a_max, 240, tol)?;
+                    println!("  λ* = {lambda_star:.6}, a* = {a_star:.6}: {text}");
+                    println!(
+                        "  exact system at ν = {}: stable for a in {window:?}",
+                        params.nu
+                    );
+                    entry["a_star"] = a_star.into();
+                    entry["a_star_formula"] = text.into();
+                    entry["a_star_formula_latex"] = latex.into();
+                    entry["exact_window"] =
+                        window.map(|(lo, hi)| serde_json::json!([lo, hi])).into();
+                    // Long runs of the limiting system above and below a*.
+                    let y0 = [phi.0 + offset, phi.1 - offset, 0.0, 0.0];
+                    let grid: Vec<f64> = (0..=3000).map(|i| t_long * i as f64 / 3000.0).collect();
+                    let runs = [1.0 + margin, 1.0 - margin]
+                        .iter()
+                        .map(|f| {
+                            let system = Averaged {
+                                params: Params {
+                                    a: f * a_star,
+                                    ..params
+                                },
+                            };
+                            // A run that leaves stops being meaningful once it is far away.
+                            let states = Integrator::new(method)?
+                                .advance_sampled(&system, 0.0, &y0, &grid)?;
+                            Ok((0..2)
+                                .map(|i| {
+                                    states
+                                        .iter()
+                                        .zip(&grid)
+                                        .map(|(y, t)| (*t, y[i] - [phi.0, phi.1][i]))
+                                        .collect()
+                                })
+                                .collect::<Vec<Vec<(f64, f64)>>>())
+                        })
+                        .collect::<Result<Vec<_>, mechlab::ode::OdeError>>()?;
+                    let chart: Vec<(f64, f64)> = (1..=chart_points)
+                        .into_par_iter()
+                        .map(|i| {
+                            let a = a_max * i as f64 / chart_points as f64;
+                            exact_multipliers(&Params { a, ..params }, *phi, tol)
+                                .map(|(r, _)| (a, r))
+                        })
+                        .collect::<Result<_, _>>()?;
+                    let (above, below) = (runs[0].clone(), runs[1].clone());
+                    titles.push(format!(
+                        "{name} LIMIT A=(1+{margin})A*={:.3}: STAYS",
+                        (1.0 + margin) * a_star
+                    ));
+                    titles.push(format!(
+                        "{name} LIMIT A=(1-{margin})A*={:.3}: LEAVES",
+                        (1.0 - margin) * a_star
+                    ));
+                    titles.push(format!("{name} EXACT NU={}: SPECTRAL RADIUS", params.nu));
+                    panels.push((above, below, chart, a_star));
+                    let _ = k;
+                }
+            }
+            entries.push(entry);
+            progress.update(k + 1);
+        }
+
+        let mut specs = Vec::new();
+        for (p, (above, below, chart, _)) in panels.iter().enumerate() {
+            let extent = |runs: &Vec<Vec<(f64, f64)>>| {
+                runs.iter()
+                    .flatten()
+                    .fold(offset.abs(), |m, (_, y)| m.max(y.abs()))
+                    .min(3.5)
+                    * 1.1
+            };
+            let (ea, eb) = (extent(above), extent(below));
+            let r_max = chart.iter().fold(1.0f64, |m, (_, r)| m.max(*r)).min(3.0);
+            specs.push(PanelSpec::new(
+                &titles[3 * p],
+                "T",
+                "ANGLE - EQUILIBRIUM",
+                (0.0, t_long),
+                (-ea, ea),
+            ));
+            specs.push(PanelSpec::new(
+                &titles[3 * p + 1],
+                "T",
+                "ANGLE - EQUILIBRIUM",
+                (0.0, t_long),
+                (-eb, eb),
+            ));
+            specs.push(PanelSpec::new(
+                &titles[3 * p + 2],
+                "A",
+                "SPECTRAL RADIUS",
+                (0.0, chart.last().map_or(1.0, |c| c.0)),
+                (0.95, r_max * 1.02),
+            ));
+        }
+        let mut figure = Figure::grid(3, panels.len(), 520, 340, &specs);
+        let mut rows = Vec::new();
+        for (p, (above, below, chart, a_star)) in panels.iter().enumerate() {
+            for (i, color) in [(0, BLUE), (1, RED)] {
+                figure.line(3 * p, &above[i], color);
+                figure.line(3 * p + 1, &below[i], color);
+            }
+            let top = figure.panel(3 * p + 2).y_range.1;
+            figure.line(3 * p + 2, &[(*a_star, 0.95), (*a_star, top)], GREY);
+            figure.line(3 * p + 2, chart, BLACK);
+            figure.points(3 * p + 2, chart.iter().copied(), BLACK, 3);
+            figure.legend(3 * p, &[("PHI1".into(), BLUE), ("PHI2".into(), RED)]);
+            figure.legend(
+                3 * p + 2,
+                &[("EXACT".into(), BLACK), ("A* (LIMIT)".into(), GREY)],
+            );
+            rows.extend(chart.iter().map(|(a, r)| format!("{p},{a},{r}")));
+        }
+        scene.save_figure(&figure, "stabilization.png")?;
+        scene.write_csv("exact_spectral_radius.csv", "panel,a,spectral_radius", rows)?;
+        scene.write_summary(serde_json::json!({
+            "params": {"m1": params.m1, "m2": params.m2, "l1": params.l1, "l2": params.l2, "g": params.g, "mu": params.mu},
+            "nu": params.nu,
+            "mean_h2": mechlab::studies::double_pendulum::MEAN_H2,
+            "equilibria": entries,
+        }))?;
+        Ok(())
+    });
+}
