@@ -759,6 +759,23 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         "V_vibr = ½ mean(bᵀ A⁻¹ b)",
         &vibrational,
     )?;
+    if phase.is_some() {
+        let mut relative_kinetic = num(0);
+        for i in 0..n {
+            for j in 0..n {
+                relative_kinetic = relative_kinetic + &mass[i][j] * var(&qd[i]) * var(&qd[j]);
+            }
+        }
+        rec.record_sum(
+            "limiting_lagrangian",
+            "L̄ = ½ q'ᵀA q' − (V + V_vibr): the Lagrangian of the averaged system",
+            &[
+                relative_kinetic / num(2),
+                -mean_potential.clone(),
+                -vibrational.clone(),
+            ],
+        )?;
+    }
     let effective = &mean_potential + &vibrational;
     rec.record_sum(
         "effective_potential",

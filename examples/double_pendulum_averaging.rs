@@ -167,8 +167,14 @@ fn main() {
                     if i == 0 { BLUE } else { RED },
                 );
             }
-            for i in 0..2 {
-                figure.line(base_panel + 2, &curve(&|k| av[k][i]), BLACK);
+            for component in 0..2 {
+                let limit: Vec<(f64, f64)> = c
+                    .times
+                    .iter()
+                    .zip(av)
+                    .map(|(t, v)| (*t, v[component]))
+                    .collect();
+                figure.line(base_panel + 2, &limit, BLACK);
             }
             figure.legend(
                 base_panel,

@@ -16,12 +16,68 @@ use mechlab::analysis::vibrational_stability::Stabilization;
 use mechlab::models::double_pendulum::{Averaged, Params};
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
-use mechlab::scene::{knob, run, Progress, Scene};
+use mechlab::scene::{knob, run, Progress, Scene, SceneError};
 use mechlab::studies::double_pendulum::{
     analyse_equilibrium, exact_multipliers, exact_stability_window, parameter_knobs,
     params_from_scene, threshold_formula, EQUILIBRIA,
 };
 use rayon::prelude::*;
+
+/// What the figure shows of one unstable equilibrium.
+struct Panels {
+    /// φ − φ_eq against t, per coordinate, slightly above and below a*.
+    above: Vec<Vec<(f64, f64)>>,
+    below: Vec<Vec<(f64, f64)>>,
+    /// (a, spectral radius of the exact monodromy matrix).
+    chart: Vec<(f64, f64)>,
+    a_star: f64,
+}
+
+/// A long run of the limiting system at amplitude `a` from `y0`: the
+/// coordinates' distances from the equilibrium against t.
+fn limiting_run(
+    method: Method,
+    params: &Params,
+    a: f64,
+    phi: (f64, f64),
+    y0: &[f64; 4],
+    t_long: f64,
+) -> Result<Vec<Vec<(f64, f64)>>, SceneError> {
+    let system = Averaged {
+        params: Params { a, ..*params },
+    };
+    let grid: Vec<f64> = (0..=3000).map(|i| t_long * i as f64 / 3000.0).collect();
+    let states = Integrator::new(method)?.advance_sampled(&system, 0.0, y0, &grid)?;
+    Ok([phi.0, phi.1]
+        .iter()
+        .enumerate()
+        .map(|(i, eq)| {
+            states
+                .iter()
+                .zip(&grid)
+                .map(|(y, t)| (*t, y[i] - eq))
+                .collect()
+        })
+        .collect())
+}
+
+/// The exact system's spectral radius at the equilibrium for `points`
+/// amplitudes in (0, a_max], in parallel.
+fn spectral_radius_chart(
+    params: &Params,
+    phi: (f64, f64),
+    a_max: f64,
+    points: usize,
+    tol: f64,
+) -> Result<Vec<(f64, f64)>, SceneError> {
+    Ok((1..=points)
+        .into_par_iter()
+        .map(|i| {
+            let a = a_max * i as f64 / points as f64;
+            exact_multipliers(&Params { a, ..*params }, phi, tol).map(|(r, _)| (a, r))
+        })
+        .collect::<Result<_, _>>()?)
+}
 
 fn main() {
     run(|| {
@@ -71,12 +127,7 @@ fn main() {
 
         let mut entries = Vec::new();
         let mut titles = Vec::new();
-        let mut panels: Vec<(
-            Vec<Vec<(f64, f64)>>,
-            Vec<Vec<(f64, f64)>>,
-            Vec<(f64, f64)>,
-            f64,
-        )> = Vec::new();
+        let mut panels: Vec<Panels> = Vec::new();
         let mut progress = Progress::new("equilibria", EQUILIBRIA.len());
         for (k, phi) in EQUILIBRIA.iter().enumerate() {
             let analysis = analyse_equilibrium(&params, *phi);
@@ -120,41 +171,12 @@ fn main() {
                     entry["a_star_formula_latex"] = latex.into();
                     entry["exact_window"] =
                         window.map(|(lo, hi)| serde_json::json!([lo, hi])).into();
-                    // Long runs of the limiting system above and below a*.
                     let y0 = [phi.0 + offset, phi.1 - offset, 0.0, 0.0];
-                    let grid: Vec<f64> = (0..=3000).map(|i| t_long * i as f64 / 3000.0).collect();
-                    let runs = [1.0 + margin, 1.0 - margin]
-                        .iter()
-                        .map(|f| {
-                            let system = Averaged {
-                                params: Params {
-                                    a: f * a_star,
-                                    ..params
-                                },
-                            };
-                            // A run that leaves stops being meaningful once it is far away.
-                            let states = Integrator::new(method)?
-                                .advance_sampled(&system, 0.0, &y0, &grid)?;
-                            Ok((0..2)
-                                .map(|i| {
-                                    states
-                                        .iter()
-                                        .zip(&grid)
-                                        .map(|(y, t)| (*t, y[i] - [phi.0, phi.1][i]))
-                                        .collect()
-                                })
-                                .collect::<Vec<Vec<(f64, f64)>>>())
-                        })
-                        .collect::<Result<Vec<_>, mechlab::ode::OdeError>>()?;
-                    let chart: Vec<(f64, f64)> = (1..=chart_points)
-                        .into_par_iter()
-                        .map(|i| {
-                            let a = a_max * i as f64 / chart_points as f64;
-                            exact_multipliers(&Params { a, ..params }, *phi, tol)
-                                .map(|(r, _)| (a, r))
-                        })
-                        .collect::<Result<_, _>>()?;
-                    let (above, below) = (runs[0].clone(), runs[1].clone());
+                    let above =
+                        limiting_run(method, &params, (1.0 + margin) * a_star, *phi, &y0, t_long)?;
+                    let below =
+                        limiting_run(method, &params, (1.0 - margin) * a_star, *phi, &y0, t_long)?;
+                    let chart = spectral_radius_chart(&params, *phi, a_max, chart_points, tol)?;
                     titles.push(format!(
                         "{name} LIMIT A=(1+{margin})A*={:.3}: STAYS",
                         (1.0 + margin) * a_star
@@ -164,8 +186,12 @@ fn main() {
                         (1.0 - margin) * a_star
                     ));
                     titles.push(format!("{name} EXACT NU={}: SPECTRAL RADIUS", params.nu));
-                    panels.push((above, below, chart, a_star));
-                    let _ = k;
+                    panels.push(Panels {
+                        above,
+                        below,
+                        chart,
+                        a_star,
+                    });
                 }
             }
             entries.push(entry);
@@ -173,7 +199,16 @@ fn main() {
         }
 
         let mut specs = Vec::new();
-        for (p, (above, below, chart, _)) in panels.iter().enumerate() {
+        for (
+            p,
+            Panels {
+                above,
+                below,
+                chart,
+                ..
+            },
+        ) in panels.iter().enumerate()
+        {
             let extent = |runs: &Vec<Vec<(f64, f64)>>| {
                 runs.iter()
                     .flatten()
@@ -207,7 +242,16 @@ fn main() {
         }
         let mut figure = Figure::grid(3, panels.len(), 520, 340, &specs);
         let mut rows = Vec::new();
-        for (p, (above, below, chart, a_star)) in panels.iter().enumerate() {
+        for (
+            p,
+            Panels {
+                above,
+                below,
+                chart,
+                a_star,
+            },
+        ) in panels.iter().enumerate()
+        {
             for (i, color) in [(0, BLUE), (1, RED)] {
                 figure.line(3 * p, &above[i], color);
                 figure.line(3 * p + 1, &below[i], color);
