@@ -10,6 +10,8 @@
 #[path = "src/model/mod.rs"]
 mod model;
 
+#[path = "build/contacts.rs"]
+mod contacts;
 #[path = "build/derive.rs"]
 mod derive;
 #[path = "build/emit.rs"]
@@ -62,10 +64,17 @@ fn main() {
                 model.name
             ));
         }
-        let derivation = derive::derive(&model)
-            .unwrap_or_else(|e| fail(format!("{file}: key `{}`: {}", e.key, e.reason)));
-        let code = generate::render(&tera, &model, &derivation, &file)
-            .unwrap_or_else(|e| fail(format!("{file}: {e}")));
+        let derive_failure = |e: derive::DeriveError| -> ! {
+            fail(format!("{file}: key `{}`: {}", e.key, e.reason))
+        };
+        let code = if model.contacts.is_empty() {
+            let derivation = derive::derive(&model).unwrap_or_else(|e| derive_failure(e));
+            generate::render(&tera, &model, &derivation, &file)
+        } else {
+            let derivation = contacts::derive(&model).unwrap_or_else(|e| derive_failure(e));
+            generate::render_contacts(&tera, &model, &derivation, &file)
+        }
+        .unwrap_or_else(|e| fail(format!("{file}: {e}")));
         write_formatted(&generated.join(format!("{}.rs", model.name)), &code);
         models.push(model);
     }

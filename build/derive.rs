@@ -73,26 +73,26 @@ pub struct DeriveError {
     pub reason: String,
 }
 
-fn atom(text: &str) -> Result<Atom, DeriveError> {
+pub fn atom(text: &str) -> Result<Atom, DeriveError> {
     try_parse!(text).map_err(|e| DeriveError {
         key: "(internal)".into(),
         reason: format!("Symbolica cannot parse '{text}': {e}"),
     })
 }
 
-fn var(name: &str) -> Atom {
+pub fn var(name: &str) -> Atom {
     Atom::var(symbol!(name))
 }
 
-fn num(n: i64) -> Atom {
+pub fn num(n: i64) -> Atom {
     Atom::num(n)
 }
 
-fn subst(e: &Atom, name: &str, by: &Atom) -> Atom {
+pub fn subst(e: &Atom, name: &str, by: &Atom) -> Atom {
     e.replace(var(name).to_pattern()).with(by.to_pattern())
 }
 
-fn is_zero(e: &Atom) -> bool {
+pub fn is_zero(e: &Atom) -> bool {
     e.expand().to_string() == "0"
 }
 
@@ -265,15 +265,55 @@ fn drop_terms_without(e: &Atom, symbols: &[String]) -> Result<Atom, DeriveError>
     atom(&Expr::sum(kept).to_string())
 }
 
-struct Recorder {
+pub struct Recorder {
     derived: Vec<Derived>,
     vocabulary: simplify::Vocabulary,
     names: Names,
 }
 
 impl Recorder {
+    /// A recorder with the model's LaTeX names; readable forms are grouped
+    /// by `keys` (momenta, velocities).
+    pub fn for_model(model: &Model, keys: Vec<String>) -> Recorder {
+        let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
+        let names = Names::new(
+            &model
+                .coordinates
+                .iter()
+                .map(|c| {
+                    (
+                        c.name.clone(),
+                        c.velocity.clone(),
+                        momentum_name(&c.name),
+                        c.latex.clone(),
+                    )
+                })
+                .collect::<Vec<_>>(),
+            &model
+                .parameters
+                .iter()
+                .map(|x| (x.name.clone(), x.latex.clone()))
+                .chain(phase.iter().map(|th| (th.clone(), None)))
+                .collect::<Vec<_>>(),
+        );
+        Recorder {
+            derived: Vec::new(),
+            vocabulary: simplify::Vocabulary {
+                keys,
+                phase,
+                coordinates: model.coordinates.iter().map(|c| c.name.clone()).collect(),
+            },
+            names,
+        }
+    }
+
+    /// Everything recorded, in order.
+    pub fn finish(self) -> Vec<Derived> {
+        self.derived
+    }
+
     /// Records the readable form of `e`; returns its text.
-    fn record(
+    pub fn record(
         &mut self,
         key: impl Into<String>,
         description: impl Into<String>,
@@ -284,7 +324,7 @@ impl Recorder {
 
     /// Records the sum of `parts`, each simplified on its own (so that, e.g.,
     /// H reads as its kinetic part plus V rather than one long fraction).
-    fn record_sum(
+    pub fn record_sum(
         &mut self,
         key: impl Into<String>,
         description: impl Into<String>,
@@ -351,6 +391,57 @@ fn matrix_text(m: &[Vec<Atom>]) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// An expression of the model (the Lagrangian, a dissipation function) with
+/// the definitions substituted and `dot(x)` replaced by the total time
+/// derivative of x (through the coordinates, and the fast phase or time).
+pub fn kinematic(model: &Model, e: &Expr) -> Result<Atom, DeriveError> {
+    let q: Vec<&str> = model.coordinates.iter().map(|c| c.name.as_str()).collect();
+    let qd: Vec<&str> = model
+        .coordinates
+        .iter()
+        .map(|c| c.velocity.as_str())
+        .collect();
+    let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
+    let rate = match &model.fast_phase {
+        Some(f) => atom(&f.rate.to_string())?,
+        None => num(1),
+    };
+    let mut positions: Vec<(String, Atom)> = Vec::new();
+    for (name, e) in &model.definitions {
+        let mut a = atom(&e.to_string())?;
+        for (prev, value) in &positions {
+            a = subst(&a, prev, value);
+        }
+        positions.push((name.clone(), a));
+    }
+    let total_derivative = |x: &Atom| -> Atom {
+        let mut d = num(0);
+        for (qi, qdi) in q.iter().zip(&qd) {
+            d = d + x.derivative(symbol!(qi)) * var(qdi);
+        }
+        match &phase {
+            Some(th) => d + &rate * x.derivative(symbol!(th.as_str())),
+            None => d + x.derivative(symbol!(model.time.as_str())),
+        }
+    };
+    // `dot(x)` becomes the symbol x__dot, replaced by its value.
+    let with_placeholders = e.rewrite_calls(&mut |name, args| match (name, &args[0]) {
+        ("dot", Expr::Sym(s)) => Some(Expr::Sym(format!("{s}__dot"))),
+        _ => None,
+    });
+    let mut result = atom(&with_placeholders.to_string())?;
+    for (name, value) in &positions {
+        result = subst(&result, &format!("{name}__dot"), &total_derivative(value));
+    }
+    for qi in &q {
+        result = subst(&result, &format!("{qi}__dot"), &total_derivative(&var(qi)));
+    }
+    for (name, value) in &positions {
+        result = subst(&result, name, value);
+    }
+    Ok(result)
+}
+
 /// Runs every derivation for one model.
 pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
     let n = model.dof();
@@ -382,82 +473,9 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         Some(f) => atom(&f.rate.to_string())?,
         None => num(1),
     };
-    let names = Names::new(
-        &model
-            .coordinates
-            .iter()
-            .map(|c| {
-                (
-                    c.name.clone(),
-                    c.velocity.clone(),
-                    momentum_name(&c.name),
-                    c.latex.clone(),
-                )
-            })
-            .collect::<Vec<_>>(),
-        &model
-            .parameters
-            .iter()
-            .map(|x| (x.name.clone(), x.latex.clone()))
-            .chain(phase.iter().map(|th| (th.clone(), None)))
-            .collect::<Vec<_>>(),
-    );
-    let mut rec = Recorder {
-        derived: Vec::new(),
-        vocabulary: simplify::Vocabulary {
-            keys: p.iter().chain(&qd).cloned().collect(),
-            phase: phase.clone(),
-            coordinates: q.clone(),
-        },
-        names,
-    };
+    let mut rec = Recorder::for_model(model, p.iter().chain(&qd).cloned().collect());
 
-    // Positions, then their total time derivatives.
-    let mut positions: Vec<(String, Atom)> = Vec::new();
-    for (name, e) in &model.definitions {
-        let mut a = atom(&e.to_string())?;
-        for (prev, value) in &positions {
-            a = subst(&a, prev, value);
-        }
-        positions.push((name.clone(), a));
-    }
-    let total_derivative = |x: &Atom| -> Atom {
-        let mut d = num(0);
-        for (qi, qdi) in q.iter().zip(&qd) {
-            d = d + x.derivative(symbol!(qi.as_str())) * var(qdi);
-        }
-        match &phase {
-            Some(th) => d + &rate * x.derivative(symbol!(th.as_str())),
-            None => d + x.derivative(symbol!(model.time.as_str())),
-        }
-    };
-
-    // The Lagrangian: `dot(x)` becomes the symbol x__dot, replaced by its value.
-    let with_placeholders =
-        model
-            .lagrangian
-            .rewrite_calls(&mut |name, args| match (name, &args[0]) {
-                ("dot", Expr::Sym(s)) => Some(Expr::Sym(format!("{s}__dot"))),
-                _ => None,
-            });
-    let mut lagrangian = atom(&with_placeholders.to_string())?;
-    for (name, value) in &positions {
-        lagrangian = subst(
-            &lagrangian,
-            &format!("{name}__dot"),
-            &total_derivative(value),
-        );
-    }
-    for qi in &q {
-        lagrangian = subst(
-            &lagrangian,
-            &format!("{qi}__dot"),
-            &total_derivative(&var(qi)),
-        );
-    }
-    for (name, value) in &positions {
-        lagrangian = subst(&lagrangian, name, value);
-    }
+    let lagrangian = kinematic(model, &model.lagrangian)?;
     let mut dynamic: Vec<String> = q.clone();
     dynamic.extend(qd.iter().cloned());
     let mut lagrangian = drop_terms_without(&lagrangian, &dynamic)?;
@@ -821,6 +839,6 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         "∂²(V + V_vibr)/∂q²",
         &mut rec,
     )?;
-    derivation.derived = rec.derived;
+    derivation.derived = rec.finish();
     Ok(derivation)
 }

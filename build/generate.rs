@@ -1,7 +1,8 @@
 //! Assembles the generated module of one model from its derivation and renders
 //! it through the tera templates in `templates/`.
 
-use crate::derive::{momentum_name, Derivation};
+use crate::contacts::ContactDerivation;
+use crate::derive::{momentum_name, Derivation, Derived};
 use crate::emit::Emitter;
 use crate::model::Model;
 use serde::Serialize;
@@ -45,16 +46,21 @@ enum Inputs {
     State,
     /// The state of the autonomous averaged system.
     AveragedState,
+    /// `y = [s, s']` of a contact model (sliding coordinates, velocities).
+    ContactState,
 }
 
 struct Context<'a> {
     model: &'a Model,
-    derivation: &'a Derivation,
+    /// Degrees of freedom (contacts, for a contact model).
+    n: usize,
+    /// For a contact model: the sliding coordinates and their velocities.
+    contact_state: Vec<String>,
 }
 
 impl Context<'_> {
     fn n(&self) -> usize {
-        self.derivation.dof
+        self.n
     }
     fn coordinates(&self) -> Vec<String> {
         self.model
@@ -102,6 +108,10 @@ impl Context<'_> {
                 prelude.push(format!("let [{}] = *qd;", self.velocities().join(", ")));
                 prelude.extend(phase_line);
                 format!("t: f64, q: &[f64; {n}], qd: &[f64; {n}], params: &Params")
+            }
+            Inputs::ContactState => {
+                prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
+                format!("y: &[f64; {}], params: &Params", 2 * n)
             }
             Inputs::State | Inputs::AveragedState => {
                 let mut names = self.coordinates();
@@ -181,7 +191,11 @@ pub fn render(
     derivation: &Derivation,
     source_file: &str,
 ) -> Result<String, String> {
-    let cx = Context { model, derivation };
+    let cx = Context {
+        model,
+        n: derivation.dof,
+        contact_state: Vec::new(),
+    };
     let n = cx.n();
     let m = 2 * n;
     let velocity_stage: Vec<(String, String)> = cx
@@ -365,29 +379,7 @@ pub fn render(
         }
     }
 
-    let params: Vec<Param> = model
-        .parameters
-        .iter()
-        .map(|p| Param {
-            name: p.name.clone(),
-            default: format!("{:?}", p.default),
-            description: format!("{:?}", p.description),
-        })
-        .collect();
-    let derived: Vec<DerivedEntry> = derivation
-        .derived
-        .iter()
-        .map(|d| DerivedEntry {
-            key: format!("{:?}", d.key),
-            description: format!("{:?}", d.description),
-            text: format!("{:?}", d.text),
-            latex: format!("{:?}", d.latex),
-        })
-        .collect();
-    let mut context = tera::Context::new();
-    context.insert("name", &model.name);
-    context.insert("description", &model.description);
-    context.insert("source_file", source_file);
+    let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);
     context.insert("state_dim", &m);
     context.insert("coordinates", &cx.coordinates());
@@ -400,7 +392,6 @@ pub fn render(
             .collect::<Vec<_>>(),
     );
     context.insert("momenta", &cx.momenta());
-    context.insert("params", &params);
     context.insert("has_phase", &model.fast_phase.is_some());
     context.insert(
         "phase",
@@ -419,9 +410,114 @@ pub fn render(
             .map(|(f, before, after, used)| format!("(\"{f}\", {before}, {after}, {used})"))
             .collect::<Vec<_>>(),
     );
-    context.insert("derived", &derived);
     tera.render("model.rs.tera", &context)
         .map_err(|e| format!("template model.rs.tera: {e:?}"))
+}
+
+/// What every model template shows: names, parameters, derived expressions.
+fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::Context {
+    let params: Vec<Param> = model
+        .parameters
+        .iter()
+        .map(|p| Param {
+            name: p.name.clone(),
+            default: format!("{:?}", p.default),
+            description: format!("{:?}", p.description),
+        })
+        .collect();
+    let derived: Vec<DerivedEntry> = derived
+        .iter()
+        .map(|d| DerivedEntry {
+            key: format!("{:?}", d.key),
+            description: format!("{:?}", d.description),
+            text: format!("{:?}", d.text),
+            latex: format!("{:?}", d.latex),
+        })
+        .collect();
+    let mut context = tera::Context::new();
+    context.insert("name", &model.name);
+    context.insert("description", &model.description);
+    context.insert("source_file", source_file);
+    context.insert("params", &params);
+    context.insert("derived", &derived);
+    context
+}
+
+/// Renders the generated module of a model with Coulomb contacts.
+pub fn render_contacts(
+    tera: &tera::Tera,
+    model: &Model,
+    derivation: &ContactDerivation,
+    source_file: &str,
+) -> Result<String, String> {
+    let n = derivation.slides.len();
+    let cx = Context {
+        model,
+        n,
+        contact_state: derivation
+            .slides
+            .iter()
+            .chain(&derivation.velocities)
+            .cloned()
+            .collect(),
+    };
+    let functions = vec![
+        cx.function(
+            "free_forces",
+            "Force along each guide, all but friction: G = ∂L/∂s − ∂D/∂s' − (velocity terms).",
+            Inputs::ContactState,
+            format!("[f64; {n}]"),
+            &[named("g", &derivation.free_forces)],
+            vector("g", &derivation.free_forces).1,
+        )?,
+        cx.function(
+            "normal_forces",
+            "Normal reaction of each guide (the multiplier of its constraint).",
+            Inputs::ContactState,
+            format!("[f64; {n}]"),
+            &[named("n", &derivation.normal_forces)],
+            vector("n", &derivation.normal_forces).1,
+        )?,
+        cx.function(
+            "masses",
+            "Mass of each sliding point.",
+            Inputs::Params,
+            format!("[f64; {n}]"),
+            &[named("m", &derivation.masses)],
+            vector("m", &derivation.masses).1,
+        )?,
+        cx.function(
+            "friction",
+            "Friction coefficient of each contact.",
+            Inputs::Params,
+            format!("[f64; {n}]"),
+            &[named("mu", &derivation.friction)],
+            vector("mu", &derivation.friction).1,
+        )?,
+        cx.function(
+            "energy",
+            "Energy function E = Σ q'∂L/∂q' − L on the guides.",
+            Inputs::ContactState,
+            "f64".into(),
+            &[vec![("e".into(), derivation.energy.clone())]],
+            "e".into(),
+        )?,
+        cx.function(
+            "dissipation_power",
+            "P_D = Σ q'∂D/∂q': the rate at which the Rayleigh function dissipates energy.",
+            Inputs::ContactState,
+            "f64".into(),
+            &[vec![("p".into(), derivation.dissipation_power.clone())]],
+            "p".into(),
+        )?,
+    ];
+    let mut context = base_context(model, source_file, &derivation.derived);
+    context.insert("dof", &n);
+    context.insert("state_dim", &(2 * n));
+    context.insert("coordinates", &derivation.slides);
+    context.insert("functions", &functions);
+    tera.render("contact_model.rs.tera", &context)
+        .map_err(|e| format!("template contact_model.rs.tera: {e:?}"))
 }
 
 /// Renders the registry module listing every model.

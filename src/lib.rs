@@ -23,6 +23,7 @@
 //! ```
 
 pub mod analysis;
+pub mod contact;
 pub mod handwritten;
 pub mod model;
 pub mod models;

@@ -31,6 +31,28 @@ pub struct ModelFile {
     /// Non-potential generalised force per coordinate name.
     #[serde(default)]
     pub forces: BTreeMap<String, String>,
+    /// Rayleigh dissipation function D(q, q'): generalised forces −∂D/∂q'.
+    pub rayleigh: Option<String>,
+    /// Coulomb contacts: points sliding along rough guides.
+    #[serde(default)]
+    pub contacts: Vec<ContactSpec>,
+}
+
+/// A point held on a rough straight guide (Coulomb friction).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// The coordinate along the guide.
+    pub slides: String,
+    /// The coordinate the guide holds fixed; its Lagrange multiplier is the
+    /// normal reaction.
+    pub held: String,
+    /// The value the guide holds it at (an expression in the parameters).
+    pub at: String,
+    /// The friction coefficient (an expression in the parameters).
+    pub friction: String,
+    #[serde(default)]
+    pub description: String,
 }
 
 fn default_time() -> String {
@@ -130,6 +152,19 @@ pub struct Model {
     pub lagrangian: Expr,
     /// One force per coordinate (zero where the file gives none).
     pub forces: Vec<Expr>,
+    /// The Rayleigh dissipation function (zero if none); `dot()` as in L.
+    pub rayleigh: Expr,
+    pub contacts: Vec<Contact>,
+}
+
+/// A validated Coulomb contact.
+#[derive(Clone, Debug)]
+pub struct Contact {
+    pub slides: String,
+    pub held: String,
+    pub at: Expr,
+    pub friction: Expr,
+    pub description: String,
 }
 
 const RESERVED: &[&str] = &[
@@ -387,6 +422,11 @@ impl ModelFile {
                 None => Ok(Expr::num(0)),
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let rayleigh = match &self.rayleigh {
+            Some(text) => parse("rayleigh", text, &all, true)?,
+            None => Expr::num(0),
+        };
+        let contacts = self.validate_contacts(file, &coordinates, &parameters, &parse)?;
 
         let model = Model {
             name: self.name,
@@ -417,11 +457,77 @@ impl ModelFile {
             definitions: ordered,
             lagrangian,
             forces,
+            rayleigh,
+            contacts,
         };
         model
             .check_numerically()
             .map_err(|(key, reason)| err(&key, reason))?;
         Ok(model)
+    }
+}
+
+impl ModelFile {
+    /// Contacts: each slides along one coordinate and holds another, every
+    /// coordinate takes part in exactly one contact (the contact runtime
+    /// integrates the sliding coordinates only), no fast phase.
+    fn validate_contacts(
+        &self,
+        file: &str,
+        coordinates: &[String],
+        parameters: &Vec<String>,
+        parse: &dyn Fn(&str, &str, &[&Vec<String>], bool) -> Result<Expr, ModelError>,
+    ) -> Result<Vec<Contact>, ModelError> {
+        let err = |key: String, reason: String| ModelError {
+            file: file.to_string(),
+            key,
+            reason,
+        };
+        if self.contacts.is_empty() {
+            return Ok(Vec::new());
+        }
+        if self.fast_phase.is_some() {
+            return Err(err(
+                "contacts".into(),
+                "contacts and a fast phase cannot be combined".into(),
+            ));
+        }
+        let mut used: Vec<&str> = Vec::new();
+        let mut contacts = Vec::new();
+        for (i, c) in self.contacts.iter().enumerate() {
+            for (field, name) in [("slides", &c.slides), ("held", &c.held)] {
+                let key = format!("contacts[{i}].{field}");
+                if !coordinates.contains(name) {
+                    return Err(err(key, format!("'{name}' is not a coordinate")));
+                }
+                if used.contains(&name.as_str()) {
+                    return Err(err(
+                        key,
+                        format!("'{name}' already takes part in a contact"),
+                    ));
+                }
+                used.push(name);
+            }
+            contacts.push(Contact {
+                slides: c.slides.clone(),
+                held: c.held.clone(),
+                at: parse(&format!("contacts[{i}].at"), &c.at, &[parameters], false)?,
+                friction: parse(
+                    &format!("contacts[{i}].friction"),
+                    &c.friction,
+                    &[parameters],
+                    false,
+                )?,
+                description: c.description.clone(),
+            });
+        }
+        if let Some(free) = coordinates.iter().find(|c| !used.contains(&c.as_str())) {
+            return Err(err(
+                "contacts".into(),
+                format!("coordinate '{free}' takes part in no contact; a model with contacts needs every coordinate to slide or be held"),
+            ));
+        }
+        Ok(contacts)
     }
 }
 

@@ -5,4 +5,4 @@ pub mod expr;
 pub mod file;
 
 pub use expr::Expr;
-pub use file::{Model, ModelError};
+pub use file::{Contact, Model, ModelError};

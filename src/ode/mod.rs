@@ -369,6 +369,48 @@ impl Integrator {
         })
     }
 
+    /// Like [`Integrator::advance_with_events`], and also returns the states
+    /// at those of `times` (increasing, after t0) that the run reaches
+    /// before it stops, from the method's interpolant.
+    #[allow(clippy::too_many_arguments)]
+    pub fn advance_with_events_sampled<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+        events: &[Event<'_, N>],
+        settings: EventSettings,
+        times: &[f64],
+    ) -> Result<(EventRun<N>, Vec<(f64, [f64; N])>), OdeError> {
+        check_initial(t0, y0, t1)?;
+        let mut locator = events::Locator::new(events, settings, t0, y0)?;
+        let mut samples = Vec::new();
+        let mut next = times.partition_point(|&t| t <= t0);
+        let (t, y) = self.run(system, t0, y0, t1, &mut |step| {
+            let flow = locator.scan(step)?;
+            let limit = match flow {
+                Flow::Stop { t, .. } => t,
+                Flow::Continue => step.end().0,
+            };
+            while next < times.len() && times[next] <= limit {
+                samples.push((times[next], step.state_at(times[next])?));
+                next += 1;
+            }
+            Ok(flow)
+        })?;
+        let terminated = t != t1;
+        Ok((
+            EventRun {
+                t,
+                y,
+                hits: locator.hits,
+                terminated,
+            },
+            samples,
+        ))
+    }
+
     /// The one driver every entry point goes through.
     fn run<S: System<N>, const N: usize>(
         &mut self,

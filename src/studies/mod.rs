@@ -3,3 +3,4 @@
 //! more than one scene makes.
 
 pub mod double_pendulum;
+pub mod painleve;

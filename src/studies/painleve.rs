@@ -1,0 +1,100 @@
+//! Study 3: the Painlevé–Klein example, closed forms of the rod geometry and
+//! of the rigid-rod equation X* = Φ(R) (docs/studies.md).
+//!
+//! Coordinates: x1, x2 along the guides (point 1 on the guide at distance d);
+//! δ = √((x1 − x2)² + d²) − l, δ' = (x1' − x2')(x1 − x2)/(l + δ),
+//! cos φ = (x1 − x2)/(l + δ), sin φ = d/(l + δ), R = k ε⁻² δ + ν ε⁻¹ δ'.
+
+use crate::models::painleve_klein::Params;
+
+/// δ, δ', R, cos φ, sin φ at the state [x1, x2, v1, v2].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rod {
+    pub delta: f64,
+    pub delta_rate: f64,
+    pub reaction: f64,
+    pub cos_phi: f64,
+    pub sin_phi: f64,
+}
+
+pub fn rod(y: &[f64; 4], p: &Params) -> Rod {
+    let dx = y[0] - y[1];
+    let length = dx.hypot(p.d);
+    let delta = length - p.l;
+    let delta_rate = (y[2] - y[3]) * dx / length;
+    Rod {
+        delta,
+        delta_rate,
+        reaction: p.k / (p.eps * p.eps) * delta + p.nu / p.eps * delta_rate,
+        cos_phi: dx / length,
+        sin_phi: p.d / length,
+    }
+}
+
+/// The worked example's initial state for x2(0): x1 = 0, x1' = x2' = 10.
+pub fn worked_example_start(x2: f64) -> [f64; 4] {
+    [0.0, x2, 10.0, 10.0]
+}
+
+/// The reduced quantities of the rigid rod: X* = (X1 − X2)/cos φ0,
+/// μi* = μi tan φ0, Y1* = Y1/sin φ0, Y2* = Y2/sin φ0, φ0 = arcsin(d/l).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reduced {
+    pub x_star: f64,
+    pub mu1: f64,
+    pub mu2: f64,
+    pub y1: f64,
+    pub y2: f64,
+    pub cos_phi0: f64,
+}
+
+pub fn reduced(p: &Params) -> Reduced {
+    let sin0 = p.d / p.l;
+    let cos0 = (1.0 - sin0 * sin0).sqrt();
+    let tan0 = sin0 / cos0;
+    Reduced {
+        x_star: (p.X1 - p.X2) / cos0,
+        mu1: p.mu1 * tan0,
+        mu2: p.mu2 * tan0,
+        y1: p.Y1 / sin0,
+        y2: p.Y2 / sin0,
+        cos_phi0: cos0,
+    }
+}
+
+/// Φ(R) = 2R + σ(μ1*|R − Y1*| − μ2*|R + Y2*|).
+pub fn phi(r: f64, sigma: f64, q: &Reduced) -> f64 {
+    2.0 * r + sigma * (q.mu1 * (r - q.y1).abs() - q.mu2 * (r + q.y2).abs())
+}
+
+/// Every root R of X* = Φ(R) for the sign σ: Φ is linear between its kinks
+/// Y1* and −Y2*, so each of the (at most three) pieces is solved exactly.
+pub fn rigid_rod_roots(sigma: f64, q: &Reduced) -> Vec<f64> {
+    let mut kinks = [q.y1, -q.y2];
+    kinks.sort_by(f64::total_cmp);
+    let bounds = [f64::NEG_INFINITY, kinks[0], kinks[1], f64::INFINITY];
+    let mut roots: Vec<f64> = Vec::new();
+    for w in bounds.windows(2) {
+        let (lo, hi) = (w[0], w[1]);
+        // A point inside the piece fixes the signs of R − Y1* and R + Y2*.
+        let inside = match (lo.is_finite(), hi.is_finite()) {
+            (true, true) => 0.5 * (lo + hi),
+            (true, false) => lo + 1.0,
+            (false, true) => hi - 1.0,
+            (false, false) => 0.0,
+        };
+        let s1 = (inside - q.y1).signum();
+        let s2 = (inside + q.y2).signum();
+        // Φ = a R + b on this piece.
+        let a = 2.0 + sigma * (q.mu1 * s1 - q.mu2 * s2);
+        let b = sigma * (-q.mu1 * s1 * q.y1 - q.mu2 * s2 * q.y2);
+        if a == 0.0 {
+            continue;
+        }
+        let r = (q.x_star - b) / a;
+        if r >= lo && r <= hi && !roots.iter().any(|x| (x - r).abs() < 1e-12) {
+            roots.push(r);
+        }
+    }
+    roots
+}
