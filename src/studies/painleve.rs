@@ -98,3 +98,16 @@ pub fn rigid_rod_roots(sigma: f64, q: &Reduced) -> Vec<f64> {
     }
     roots
 }
+
+/// Φ'(R) away from the kinks.
+pub fn phi_slope(r: f64, sigma: f64, q: &Reduced) -> f64 {
+    2.0 + sigma * (q.mu1 * (r - q.y1).signum() - q.mu2 * (r + q.y2).signum())
+}
+
+/// The constant acceleration of the rigid rod sliding with σ at the rod
+/// force R: x1'' = X1 − R cos φ0 − σ μ1 |Y1 − R sin φ0| (= x2'' at a root).
+pub fn rigid_acceleration(r: f64, sigma: f64, p: &Params) -> f64 {
+    let sin0 = p.d / p.l;
+    let cos0 = (1.0 - sin0 * sin0).sqrt();
+    p.X1 - r * cos0 - sigma * p.mu1 * (p.Y1 - r * sin0).abs()
+}
