@@ -194,3 +194,85 @@ fn missing_lagrangian() {
     let e = error(&GOOD.replace("lagrangian = \"qd^2/2 + k*cos(q)\"", ""));
     assert!(e.reason.contains("missing field `lagrangian`"), "{e}");
 }
+
+const CONTACTS: &str = r#"
+name = "toy"
+description = "a point on a rough guide"
+lagrangian = "(xd^2 + yd^2)/2 + F*x - y"
+rayleigh = "c*xd^2/2"
+
+[[coordinates]]
+name = "x"
+velocity = "xd"
+
+[[coordinates]]
+name = "y"
+velocity = "yd"
+
+[[contacts]]
+slides = "x"
+held = "y"
+at = "0"
+friction = "mu"
+
+[[parameters]]
+name = "F"
+default = 1.0
+description = "pull"
+
+[[parameters]]
+name = "mu"
+default = 0.5
+description = "friction"
+
+[[parameters]]
+name = "c"
+default = 0.1
+description = "damping"
+"#;
+
+#[test]
+fn a_contact_model_is_accepted() {
+    let model = Model::parse("models/toy.toml", CONTACTS).unwrap();
+    assert_eq!(model.contacts.len(), 1);
+    assert_eq!(model.contacts[0].slides, "x");
+}
+
+#[test]
+fn malformed_contacts_name_the_problem() {
+    assert_error(
+        &CONTACTS.replace("slides = \"x\"", "slides = \"z\""),
+        "contacts[0].slides",
+        "'z' is not a coordinate",
+    );
+    assert_error(
+        &CONTACTS.replace("held = \"y\"", "held = \"x\""),
+        "contacts[0].held",
+        "already takes part in a contact",
+    );
+    assert_error(
+        &CONTACTS.replace("friction = \"mu\"", "friction = \"mu*x\""),
+        "contacts[0].friction",
+        "unknown symbol 'x'",
+    );
+    assert_error(
+        &CONTACTS.replace("at = \"0\"", "at = \"y0\""),
+        "contacts[0].at",
+        "unknown symbol 'y0'",
+    );
+    assert_error(
+        &CONTACTS.replace("friction = \"mu\"", "friction = \"mu\"\nnormal = \"y\""),
+        "contacts.normal",
+        "unknown field",
+    );
+    let extra = CONTACTS.replace(
+        "[[contacts]]",
+        "[[coordinates]]\nname = \"z\"\nvelocity = \"zd\"\n\n[[contacts]]",
+    );
+    assert_error(&extra, "contacts", "'z' takes part in no contact");
+    assert_error(
+        &CONTACTS.replace("rayleigh = \"c*xd^2/2\"", "rayleigh = \"c*xd^2/2 + w\""),
+        "rayleigh",
+        "unknown symbol 'w'",
+    );
+}
