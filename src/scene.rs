@@ -65,6 +65,12 @@ impl From<crate::ode::OdeError> for SceneError {
     }
 }
 
+impl From<crate::contact::ContactError> for SceneError {
+    fn from(e: crate::contact::ContactError) -> Self {
+        SceneError::Numerical(e.to_string())
+    }
+}
+
 impl From<crate::registry::ParameterError> for SceneError {
     fn from(e: crate::registry::ParameterError) -> Self {
         SceneError::Usage(e.to_string())
