@@ -318,3 +318,53 @@ fn energy_balance_holds_through_stops_and_sticks() {
         "ΔE = {change}, work = {work}"
     );
 }
+
+/// Deliverable 3.1: the slope signs of Φ agree with Φ itself on each piece,
+/// every graph falls in one of the listed classes, all of them occur, and
+/// a class whose slopes are all positive always has exactly one root.
+#[test]
+fn graph_classes_cover_every_phi() {
+    use mechlab::studies::painleve::{phi, segment_slopes, slope_signs, Reduced, GRAPH_CLASSES};
+    let mut s = 0x0dd_ba11_cafe_f00du64;
+    let mut seen = std::collections::BTreeSet::new();
+    for _ in 0..20000 {
+        let q = Reduced {
+            x_star: 20.0 * random(&mut s) - 10.0,
+            mu1: 5.0 * random(&mut s),
+            mu2: 5.0 * random(&mut s),
+            y1: 6.0 * random(&mut s) - 3.0,
+            y2: 6.0 * random(&mut s) - 3.0,
+            cos_phi0: 0.6,
+        };
+        for sigma in [1.0, -1.0] {
+            let (a, b) = (q.y1.min(-q.y2), q.y1.max(-q.y2));
+            let slopes = segment_slopes(sigma, &q);
+            let numeric = [
+                phi(a - 1.0, sigma, &q) - phi(a - 2.0, sigma, &q),
+                (phi(b, sigma, &q) - phi(a, sigma, &q)) / (b - a),
+                phi(b + 2.0, sigma, &q) - phi(b + 1.0, sigma, &q),
+            ];
+            for i in 0..3 {
+                if b - a > 1e-6 || i != 1 {
+                    assert!(
+                        (slopes[i] - numeric[i]).abs() < 1e-6,
+                        "{q:?} σ = {sigma}: {slopes:?} vs {numeric:?}"
+                    );
+                }
+            }
+            let signs = slope_signs(sigma, &q);
+            if signs.contains('0') {
+                continue;
+            }
+            assert!(
+                GRAPH_CLASSES.iter().any(|c| c.signs == signs),
+                "{signs} is not listed"
+            );
+            if signs == "+++" {
+                assert_eq!(rigid_rod_roots(sigma, &q).len(), 1);
+            }
+            seen.insert(signs);
+        }
+    }
+    assert_eq!(seen.len(), GRAPH_CLASSES.len(), "{seen:?}");
+}

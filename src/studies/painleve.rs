@@ -111,3 +111,88 @@ pub fn rigid_acceleration(r: f64, sigma: f64, p: &Params) -> f64 {
     let cos0 = (1.0 - sin0 * sin0).sqrt();
     p.X1 - r * cos0 - sigma * p.mu1 * (p.Y1 - r * sin0).abs()
 }
+
+/// The slopes of Φ on its three pieces, left to right (the middle piece lies
+/// between the kinks Y1* and −Y2*, whichever comes first).
+pub fn segment_slopes(sigma: f64, q: &Reduced) -> [f64; 3] {
+    let delta = q.mu2 - q.mu1;
+    let sum = q.mu1 + q.mu2;
+    let order = if q.y1 < -q.y2 { 1.0 } else { -1.0 };
+    [
+        2.0 + sigma * delta,
+        2.0 + sigma * order * sum,
+        2.0 - sigma * delta,
+    ]
+}
+
+/// The qualitative class of the graph of Φ: the signs of its slopes, e.g. "+-+".
+pub fn slope_signs(sigma: f64, q: &Reduced) -> String {
+    segment_slopes(sigma, q)
+        .iter()
+        .map(|s| {
+            if *s > 0.0 {
+                '+'
+            } else if *s < 0.0 {
+                '-'
+            } else {
+                '0'
+            }
+        })
+        .collect()
+}
+
+/// One qualitatively different graph of Φ: its slope signs, the region of
+/// the parameters where it occurs (Δ = μ2* − μ1*, S = μ1* + μ2*, o = +1 if
+/// Y1* < −Y2* else −1), and what X* = Φ(R) can have as roots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GraphClass {
+    pub signs: &'static str,
+    pub region: &'static str,
+    pub roots: &'static str,
+}
+
+/// Every class that occurs (the boundaries, where a slope is zero, are
+/// degenerate and left out). Derived from the slopes 2 + σΔ, 2 + σoS, 2 − σΔ:
+/// with σo = +1 the middle slope is positive; with σo = −1 it is negative
+/// iff S > 2, and |Δ| > 2 forces S > 2.
+pub const GRAPH_CLASSES: [GraphClass; 6] = [
+    GraphClass {
+        signs: "+++",
+        region: "|Δ| < 2 and (σo = +1 or S < 2)",
+        roots: "exactly one root for every X*",
+    },
+    GraphClass {
+        signs: "-++",
+        region: "σo = +1 and σΔ < −2",
+        roots: "no root below the minimum of Φ, two above it (Painlevé: non-existence or non-uniqueness)",
+    },
+    GraphClass {
+        signs: "++-",
+        region: "σo = +1 and σΔ > 2",
+        roots: "two roots below the maximum of Φ, none above it",
+    },
+    GraphClass {
+        signs: "+-+",
+        region: "σo = −1, |Δ| < 2 and S > 2",
+        roots: "three roots between the local extremes, one elsewhere (non-uniqueness)",
+    },
+    GraphClass {
+        signs: "--+",
+        region: "σo = −1 and σΔ < −2 (so S > 2)",
+        roots: "no root below the minimum, two above it",
+    },
+    GraphClass {
+        signs: "+--",
+        region: "σo = −1 and σΔ > 2 (so S > 2)",
+        roots: "two roots below the maximum, none above it",
+    },
+];
+
+/// The name of the Painlevé case of a root count.
+pub fn painleve_case(roots: usize) -> &'static str {
+    match roots {
+        0 => "no root: no solution with both points sliding (Painlevé non-existence)",
+        1 => "one root: regular, constant acceleration",
+        _ => "several roots: the motion is not determined (Painlevé non-uniqueness)",
+    }
+}
