@@ -12,28 +12,9 @@ use mechlab::models::painleve_klein::Params;
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
 use mechlab::scene::{knob, run, Knob, Scene};
 use mechlab::studies::painleve::{
-    painleve_case, phi, phi_slope, reduced, rigid_rod_roots, slope_signs, Reduced, GRAPH_CLASSES,
+    class_example, painleve_case, phi, phi_slope, reduced, rigid_rod_roots, slope_signs, Reduced,
+    GRAPH_CLASSES,
 };
-
-/// An example of each class (σ = +1), in the order of `GRAPH_CLASSES`.
-fn example(k: usize) -> Reduced {
-    let (mu1, mu2, y2) = [
-        (0.5, 0.5, -3.0),
-        (3.0, 0.3, -3.0),
-        (0.3, 3.0, -3.0),
-        (1.5, 1.5, 0.0),
-        (3.5, 0.5, 0.0),
-        (0.5, 3.5, 0.0),
-    ][k];
-    Reduced {
-        x_star: 0.0,
-        mu1,
-        mu2,
-        y1: 1.0,
-        y2,
-        cos_phi0: 0.6,
-    }
-}
 
 fn graph(q: &Reduced, sigma: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
     (0..=400)
@@ -76,17 +57,7 @@ fn main() {
         let mut titles: Vec<String> = Vec::new();
         let mut examples = Vec::new();
         for (k, class) in GRAPH_CLASSES.iter().enumerate() {
-            let mut e = example(k);
-            let kinks = [e.y1, -e.y2];
-            // X* near the kink where Φ turns, so that every root is in view.
-            let kinks = [kinks[0].min(kinks[1]), kinks[0].max(kinks[1])];
-            let b = class.signs.as_bytes();
-            let weight = match (b[0] != b[1], b[1] != b[2]) {
-                (true, false) => 0.95,
-                (false, true) => 0.05,
-                _ => 0.5,
-            };
-            e.x_star = weight * phi(kinks[0], 1.0, &e) + (1.0 - weight) * phi(kinks[1], 1.0, &e);
+            let e = class_example(k);
             assert_eq!(
                 slope_signs(1.0, &e),
                 class.signs,

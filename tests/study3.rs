@@ -368,3 +368,36 @@ fn graph_classes_cover_every_phi() {
     }
     assert_eq!(seen.len(), GRAPH_CLASSES.len(), "{seen:?}");
 }
+
+/// Deliverable 3.3: the eigenvalues of (25) at each equilibrium are those of
+/// its Jacobian by finite differences, and stability follows Φ'(R*) > 0.
+#[test]
+fn deformation_equilibria_and_their_eigenvalues() {
+    use mechlab::studies::painleve::DeformationEquation;
+    let params = Params::default();
+    for sigma in [1.0, -1.0] {
+        let eq = DeformationEquation {
+            reduced: reduced(&params),
+            sigma,
+            k: params.k,
+            nu: params.nu,
+            eps: params.eps,
+        };
+        let equilibria = eq.equilibria();
+        assert_eq!(equilibria.len(), 2);
+        for e in equilibria {
+            assert!(eq.acceleration(e.delta, 0.0).abs() < 1e-9);
+            let h = 1e-7;
+            let a =
+                (eq.acceleration(e.delta + h, 0.0) - eq.acceleration(e.delta - h, 0.0)) / (2.0 * h);
+            let b = (eq.acceleration(e.delta, h) - eq.acceleration(e.delta, -h)) / (2.0 * h);
+            // λ² − b λ − a = 0 from the Jacobian [[0, 1], [a, b]].
+            for (re, im) in e.eigenvalues {
+                let (r2, i2) = (re * re - im * im, 2.0 * re * im);
+                let residual = ((r2 - b * re - a).powi(2) + (i2 - b * im).powi(2)).sqrt();
+                assert!(residual < 1e-5 * (1.0 + a.abs() + b.abs()), "{residual}");
+            }
+            assert_eq!(e.asymptotically_stable, e.slope > 0.0);
+        }
+    }
+}

@@ -188,11 +188,118 @@ pub const GRAPH_CLASSES: [GraphClass; 6] = [
     },
 ];
 
+/// An example of the class `GRAPH_CLASSES[k]` for σ = +1 (reduced
+/// quantities, Y1* = 1, cos φ0 = 0.6), with X* near the kink where Φ turns
+/// so that every root of X* = Φ(R) lies close to the kinks.
+pub fn class_example(k: usize) -> Reduced {
+    let (mu1, mu2, y2) = [
+        (0.5, 0.5, -3.0),
+        (3.0, 0.3, -3.0),
+        (0.3, 3.0, -3.0),
+        (1.5, 1.5, 0.0),
+        (3.5, 0.5, 0.0),
+        (0.5, 3.5, 0.0),
+    ][k];
+    let mut e = Reduced {
+        x_star: 0.0,
+        mu1,
+        mu2,
+        y1: 1.0,
+        y2,
+        cos_phi0: 0.6,
+    };
+    let kinks = [e.y1.min(-e.y2), e.y1.max(-e.y2)];
+    let b = GRAPH_CLASSES[k].signs.as_bytes();
+    let weight = match (b[0] != b[1], b[1] != b[2]) {
+        (true, false) => 0.95,
+        (false, true) => 0.05,
+        _ => 0.5,
+    };
+    e.x_star = weight * phi(kinks[0], 1.0, &e) + (1.0 - weight) * phi(kinks[1], 1.0, &e);
+    e
+}
+
 /// The name of the Painlevé case of a root count.
 pub fn painleve_case(roots: usize) -> &'static str {
     match roots {
         0 => "no root: no solution with both points sliding (Painlevé non-existence)",
         1 => "one root: regular, constant acceleration",
         _ => "several roots: the motion is not determined (Painlevé non-uniqueness)",
+    }
+}
+
+/// The deformation equation (25) of the rod sliding with σ:
+/// δ'' = cos²φ0 (X* − Φ(R)), R = k ε⁻² δ + ν ε⁻¹ δ'.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeformationEquation {
+    pub reduced: Reduced,
+    pub sigma: f64,
+    pub k: f64,
+    pub nu: f64,
+    pub eps: f64,
+}
+
+/// An equilibrium of (25): δ* = ε² R*/k, δ' = 0, and its linearisation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeformationEquilibrium {
+    pub root: f64,
+    pub delta: f64,
+    /// Φ'(R*).
+    pub slope: f64,
+    /// Roots of λ² + c Φ' ν/ε λ + c Φ' k/ε² = 0, c = cos²φ0, as (re, im).
+    pub eigenvalues: [(f64, f64); 2],
+    /// Both eigenvalues in the open left half-plane.
+    pub asymptotically_stable: bool,
+}
+
+impl DeformationEquation {
+    pub fn reaction(&self, delta: f64, rate: f64) -> f64 {
+        self.k / (self.eps * self.eps) * delta + self.nu / self.eps * rate
+    }
+
+    /// δ'' at (δ, δ').
+    pub fn acceleration(&self, delta: f64, rate: f64) -> f64 {
+        let c = self.reduced.cos_phi0 * self.reduced.cos_phi0;
+        c * (self.reduced.x_star - phi(self.reaction(delta, rate), self.sigma, &self.reduced))
+    }
+
+    /// Every equilibrium (one per root of X* = Φ(R)) with its eigenvalues.
+    pub fn equilibria(&self) -> Vec<DeformationEquilibrium> {
+        let c = self.reduced.cos_phi0 * self.reduced.cos_phi0;
+        rigid_rod_roots(self.sigma, &self.reduced)
+            .into_iter()
+            .map(|root| {
+                let slope = phi_slope(root, self.sigma, &self.reduced);
+                let (b, k) = (
+                    c * slope * self.nu / self.eps,
+                    c * slope * self.k / (self.eps * self.eps),
+                );
+                let disc = b * b - 4.0 * k;
+                let eigenvalues = if disc >= 0.0 {
+                    [
+                        (0.5 * (-b + disc.sqrt()), 0.0),
+                        (0.5 * (-b - disc.sqrt()), 0.0),
+                    ]
+                } else {
+                    [
+                        (-0.5 * b, 0.5 * (-disc).sqrt()),
+                        (-0.5 * b, -0.5 * (-disc).sqrt()),
+                    ]
+                };
+                DeformationEquilibrium {
+                    root,
+                    delta: self.eps * self.eps * root / self.k,
+                    slope,
+                    eigenvalues,
+                    asymptotically_stable: eigenvalues.iter().all(|(re, _)| *re < 0.0),
+                }
+            })
+            .collect()
+    }
+}
+
+impl crate::ode::System<2> for DeformationEquation {
+    fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
+        [y[1], self.acceleration(y[0], y[1])]
     }
 }
