@@ -14,11 +14,13 @@
 //! with the fitted slopes), runs.csv, and summary.json with the runs and the
 //! performance ratios of the issue.
 
-use mechlab::handwritten::sliding_rod::SlidingRod;
+use mechlab::contact::{Mode, Smooth};
+use mechlab::models::painleve_klein::{self as painleve, Contacts};
 use mechlab::models::{double_pendulum as dp, kapitza};
 use mechlab::ode::{Integrator, Method, OdeError, System};
 use mechlab::plot::{palette, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Progress, Scene, SceneError};
+use mechlab::studies::painleve::state_with_deformation;
 use ode_solvers::{OutputType, SVector};
 use serde_json::json;
 use std::cell::RefCell;
@@ -564,8 +566,18 @@ fn main() {
 
         // (c) The sliding deformable rod, ε = 0.01 and 0.001, t ∈ [0, 2], from R(0) = 3.
         for (problem, eps) in [("rod_eps_0.01", 1e-2), ("rod_eps_0.001", 1e-3)] {
-            let rod = SlidingRod::worked_example(eps);
-            let y0 = rod.state_with_deformation(3.0 * eps * eps, 10.0);
+            let model = Contacts {
+                params: painleve::Params {
+                    eps,
+                    ..Default::default()
+                },
+            };
+            // Both points sliding right: the smooth phase of the contact model.
+            let rod = Smooth {
+                model: &model,
+                modes: [Mode::Slide(1); 2],
+            };
+            let y0 = state_with_deformation(&model.params, 3.0 * eps * eps, 10.0);
             let list = solvers(
                 &per_period(&[64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384], 2.0),
                 true,

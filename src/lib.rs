@@ -24,7 +24,6 @@
 
 pub mod analysis;
 pub mod contact;
-pub mod handwritten;
 pub mod model;
 pub mod models;
 pub mod ode;

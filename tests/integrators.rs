@@ -478,14 +478,27 @@ fn rigid_rod_acceleration() -> f64 {
 
 #[test]
 fn stiff_rod_finishes_with_radau5_in_few_steps_and_follows_the_rigid_limit() {
-    use mechlab::handwritten::sliding_rod::SlidingRod;
+    use mechlab::contact::{Mode, Smooth};
+    use mechlab::models::painleve_klein::{Contacts, Params};
+    use mechlab::studies::painleve::{rod, state_with_deformation};
+    // Both points sliding right: the smooth phase of the generated contact model.
+    let sliding = |eps: f64| Contacts {
+        params: Params {
+            eps,
+            ..Params::default()
+        },
+    };
     let velocity_deviation = |eps: f64| {
-        let rod = SlidingRod::worked_example(eps);
+        let model = sliding(eps);
+        let system = Smooth {
+            model: &model,
+            modes: [Mode::Slide(1); 2],
+        };
         // R(0) = 3 lies in the basin of the stable root R* ≈ 2.78.
-        let y0 = rod.state_with_deformation(3.0 * eps * eps, 10.0);
+        let y0 = state_with_deformation(&model.params, 3.0 * eps * eps, 10.0);
         let mut integrator = Integrator::new(Method::parse("radau5", 1e-8).unwrap()).unwrap();
-        let y = integrator.advance(&rod, 0.0, &y0, 2.0).unwrap();
-        let (_, _, r) = rod.deformation(&y);
+        let y = integrator.advance(&system, 0.0, &y0, 2.0).unwrap();
+        let r = rod(&y, &model.params).reaction;
         (
             y[2] - (10.0 + 2.0 * rigid_rod_acceleration()),
             r,
@@ -506,15 +519,19 @@ fn stiff_rod_finishes_with_radau5_in_few_steps_and_follows_the_rigid_limit() {
         "{dev_2:e}, {dev_3:e}"
     );
     // Against an explicit reference at ε = 1e-3.
-    let rod = SlidingRod::worked_example(1e-3);
-    let y0 = rod.state_with_deformation(3e-6, 10.0);
+    let model = sliding(1e-3);
+    let system = Smooth {
+        model: &model,
+        modes: [Mode::Slide(1); 2],
+    };
+    let y0 = state_with_deformation(&model.params, 3e-6, 10.0);
     let reference = Integrator::new(Method::parse("dop853", 1e-13).unwrap())
         .unwrap()
-        .advance(&rod, 0.0, &y0, 2.0)
+        .advance(&system, 0.0, &y0, 2.0)
         .unwrap();
     let y = Integrator::new(Method::parse("radau5", 1e-9).unwrap())
         .unwrap()
-        .advance(&rod, 0.0, &y0, 2.0)
+        .advance(&system, 0.0, &y0, 2.0)
         .unwrap();
     let error = (0..4)
         .map(|i| (y[i] - reference[i]).abs())

@@ -303,3 +303,9 @@ impl crate::ode::System<2> for DeformationEquation {
         [y[1], self.acceleration(y[0], y[1])]
     }
 }
+
+/// A state with both points at speed `v` and the rod deformed by δ; x1 = 0.
+pub fn state_with_deformation(p: &Params, delta: f64, v: f64) -> [f64; 4] {
+    let dx = ((p.l + delta).powi(2) - p.d * p.d).sqrt();
+    [0.0, -dx, v, v]
+}
