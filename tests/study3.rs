@@ -401,3 +401,47 @@ fn deformation_equilibria_and_their_eigenvalues() {
         }
     }
 }
+
+/// The generated sliding accelerations give δ'' of equation (23):
+/// δ'' = tan²φ δ'²/(l + δ) + cos φ (X1 − X2 − 2R cos φ − (σ1μ1|Y1 − R sin φ| − σ2μ2|Y2 + R sin φ|)).
+#[test]
+fn sliding_accelerations_satisfy_the_deformation_equation() {
+    let mut s = 0x5eed_5eed_5eed_5eedu64;
+    let p = Params::default();
+    let model = Contacts { params: p };
+    for _ in 0..500 {
+        let y = [
+            random(&mut s),
+            random(&mut s) - 1.5,
+            4.0 * random(&mut s) - 2.0,
+            4.0 * random(&mut s) - 2.0,
+        ];
+        let sig = [
+            if random(&mut s) < 0.5 { 1i8 } else { -1 },
+            if random(&mut s) < 0.5 { 1i8 } else { -1 },
+        ];
+        let f = Smooth {
+            model: &model,
+            modes: [Mode::Slide(sig[0]), Mode::Slide(sig[1])],
+        }
+        .rhs(0.0, &y);
+        let r = rod(&y, &p);
+        let length = p.l + r.delta;
+        // δ'' from the accelerations: d/dt[(v1 − v2) cos φ].
+        let from_model =
+            (f[2] - f[3]) * r.cos_phi + (y[2] - y[3]).powi(2) * r.sin_phi.powi(2) / length;
+        let (s1, s2) = (f64::from(sig[0]), f64::from(sig[1]));
+        let tan = r.sin_phi / r.cos_phi;
+        let eq23 = tan * tan * r.delta_rate.powi(2) / length
+            + r.cos_phi
+                * (p.X1
+                    - p.X2
+                    - 2.0 * r.reaction * r.cos_phi
+                    - (s1 * p.mu1 * (p.Y1 - r.reaction * r.sin_phi).abs()
+                        - s2 * p.mu2 * (p.Y2 + r.reaction * r.sin_phi).abs()));
+        assert!(
+            (from_model - eq23).abs() < 1e-9 * (1.0 + eq23.abs()),
+            "{from_model} vs {eq23}"
+        );
+    }
+}
