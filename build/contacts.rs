@@ -128,16 +128,23 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
         let v = velocity_of(&contact.slides);
         let mass = lagrangian.derivative(symbol!(v)).derivative(symbol!(v));
         masses.push(rec.record(format!("mass[{i}]"), format!("m = ∂²L/∂{v}²"), &mass)?);
-        free_forces.push(rec.record(
+        // The code keeps Symbolica's form: it is written in the differences
+        // of positions (x1 − x2), while the readable form expands them and
+        // would cancel catastrophically far from the origin.
+        let free = on_guides(&lagrange(&contact.slides))?;
+        rec.record(
             format!("free_force[{i}]"),
             format!("G along {}: all forces but friction", contact.slides),
-            &on_guides(&lagrange(&contact.slides))?,
-        )?);
-        normal_forces.push(rec.record(
+            &free,
+        )?;
+        free_forces.push(free.to_string());
+        let normal = on_guides(&(-lagrange(&contact.held)))?;
+        rec.record(
             format!("normal_force[{i}]"),
             format!("N: the guide's reaction holding {}", contact.held),
-            &on_guides(&(-lagrange(&contact.held)))?,
-        )?);
+            &normal,
+        )?;
+        normal_forces.push(normal.to_string());
         friction.push(rec.record(
             format!("friction[{i}]"),
             "μ, the friction coefficient",
@@ -150,16 +157,15 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
         energy = energy + lagrangian.derivative(symbol!(*vk)) * var(vk);
         power = power + rayleigh.derivative(symbol!(*vk)) * var(vk);
     }
-    let energy = rec.record(
-        "energy",
-        "E = Σ q'∂L/∂q' − L on the guides",
-        &on_guides(&energy)?,
-    )?;
-    let dissipation_power = rec.record(
+    let energy = on_guides(&energy)?;
+    rec.record("energy", "E = Σ q'∂L/∂q' − L on the guides", &energy)?;
+    let power = on_guides(&power)?;
+    rec.record(
         "dissipation_power",
         "P_D = Σ q'∂D/∂q' on the guides (dE/dt = Σ F_i s_i' − P_D)",
-        &on_guides(&power)?,
+        &power,
     )?;
+    let (energy, dissipation_power) = (energy.to_string(), power.to_string());
     Ok(ContactDerivation {
         derived: rec.finish(),
         slides,

@@ -66,10 +66,10 @@ fn main() {
             .collect();
         let mut titles = Vec::new();
         for (a, y0) in &cases {
-            let case = format!("A={a} PHI(0)=({},{}) SAME (Q,P)", y0[0], y0[1]);
-            titles.push(format!("{case}: PHI1 PHI2"));
-            titles.push(format!("{case}: |EXACT-LIMIT|"));
-            titles.push(format!("{case}: VELOCITIES"));
+            let case = format!("a = {a}, φ(0) = ({}, {}), same (q, p)", y0[0], y0[1]);
+            titles.push(format!("{case}: φ₁, φ₂"));
+            titles.push(format!("{case}: |exact − limit|"));
+            titles.push(format!("{case}: velocities"));
         }
         let mut rows = Vec::new();
         let mut summary_cases = Vec::new();
@@ -139,8 +139,8 @@ fn main() {
                     ),
                     _ => Box::new(ev.iter().chain(av.iter()).flat_map(|v| [v[0], v[1]])),
                 };
-                let y_label = ["ANGLE", "DEVIATION", "VELOCITY"][k % 3];
-                PanelSpec::new(title, "T", y_label, (0.0, t_end), range(values))
+                let y_label = ["angle", "deviation", "velocity"][k % 3];
+                PanelSpec::new(title, "t", y_label, (0.0, t_end), range(values))
             })
             .collect();
         let mut figure = Figure::grid(3, cases.len(), 560, 300, &specs);
@@ -179,21 +179,18 @@ fn main() {
             figure.legend(
                 base_panel,
                 &[
-                    ("EXACT PHI1".into(), BLUE),
-                    ("EXACT PHI2".into(), RED),
-                    ("LIMIT".into(), BLACK),
+                    ("exact φ₁".into(), BLUE),
+                    ("exact φ₂".into(), RED),
+                    ("limit".into(), BLACK),
                 ],
             );
-            figure.legend(
-                base_panel + 1,
-                &[("PHI1".into(), BLUE), ("PHI2".into(), RED)],
-            );
+            figure.legend(base_panel + 1, &[("φ₁".into(), BLUE), ("φ₂".into(), RED)]);
             figure.legend(
                 base_panel + 2,
                 &[
-                    ("EXACT V1".into(), BLUE),
-                    ("EXACT V2".into(), RED),
-                    ("LIMIT".into(), BLACK),
+                    ("exact φ₁′".into(), BLUE),
+                    ("exact φ₂′".into(), RED),
+                    ("limit".into(), BLACK),
                 ],
             );
         }

@@ -71,22 +71,22 @@ fn main() {
         let all_dev: Vec<f64> = result.max_deviation.concat();
         let all_scaled: Vec<f64> = scaled.concat();
         let title = format!(
-            "MAX DEVIATION OVER T={t_obs}: SLOPES {:.3}, {:.3}",
+            "max deviation over t ≤ {t_obs}: slopes {:.3}, {:.3}",
             slopes[0], slopes[1]
         );
         let specs = [
             PanelSpec::new(
                 &title,
-                "NU",
-                "MAX |EXACT-LIMIT|",
+                "ν",
+                "max |exact − limit|",
                 nu_range,
                 log_range(&all_dev),
             )
             .log_log(),
             PanelSpec::new(
-                "NU X MAX DEVIATION",
-                "NU",
-                "NU X DEVIATION",
+                "ν × max deviation",
+                "ν",
+                "ν × deviation",
                 nu_range,
                 (0.0, 1.1 * all_scaled.iter().fold(0.0f64, |m, v| m.max(*v))),
             )
@@ -116,9 +116,9 @@ fn main() {
             figure.points(1, points.iter().copied(), color, 7);
         }
         let legend = [
-            ("PHI1".to_string(), BLUE),
-            ("PHI2".to_string(), RED),
-            ("FITTED POWER LAW".to_string(), GREY),
+            ("φ₁".to_string(), BLUE),
+            ("φ₂".to_string(), RED),
+            ("fitted power law".to_string(), GREY),
         ];
         figure.legend(0, &legend);
         figure.legend(1, &legend[..2]);

@@ -114,11 +114,14 @@ fn main() {
             .filter(|d| *d > 0.0)
             .fold(f64::MAX, f64::min)
             .max(1e-12);
-        let decay_title = format!("DECAY, MU={}, A={}, NU={}", params.mu, params.a, params.nu);
+        let decay_title = format!(
+            "decay, μ = {}, a = {}, ν = {}",
+            params.mu, params.a, params.nu
+        );
         let mut decay = PanelSpec::new(
             &decay_title,
-            "T",
-            "DISTANCE TO EQUILIBRIUM",
+            "t",
+            "distance to the equilibrium",
             (0.0, t_end),
             (floor / 2.0, 2.0 * offset.abs().max(1e-9) * 1.5),
         );
@@ -135,9 +138,9 @@ fn main() {
             nus.iter().fold(0.0f64, |m, v| m.max(*v)) * 1.3,
         );
         let multiplier_spec = PanelSpec::new(
-            "EXACT: 1 - SPECTRAL RADIUS",
-            "NU",
-            "1 - RHO",
+            "exact system: 1 − spectral radius ρ",
+            "ν",
+            "1 − ρ",
             nu_range,
             (gap_min / 2.0, gap_max * 2.0),
         )
@@ -149,9 +152,9 @@ fn main() {
         figure.legend(
             0,
             &[
-                ("EXACT".into(), BLUE),
-                ("LIMIT".into(), BLACK),
-                ("EXP(MAX RE L T)".into(), GREY),
+                ("exact".into(), BLUE),
+                ("limit".into(), BLACK),
+                ("exp(max Re λ · t)".into(), GREY),
             ],
         );
         let exact_gap: Vec<(f64, f64)> = nus.iter().copied().zip(gaps.iter().copied()).collect();
@@ -165,8 +168,8 @@ fn main() {
         figure.legend(
             1,
             &[
-                ("EXACT FLOQUET".into(), BLUE),
-                ("FROM AVERAGED EIGENVALUES".into(), GREY),
+                ("exact (Floquet)".into(), BLUE),
+                ("from the averaged eigenvalues".into(), GREY),
             ],
         );
         scene.save_figure(&figure, "friction.png")?;

@@ -134,8 +134,8 @@ fn main() {
             let formula = threshold_formula(*phi);
             let name = format!(
                 "({}, {})",
-                if phi.0 == 0.0 { "0" } else { "PI" },
-                if phi.1 == 0.0 { "0" } else { "PI" }
+                if phi.0 == 0.0 { "0" } else { "π" },
+                if phi.1 == 0.0 { "0" } else { "π" }
             );
             println!(
                 "equilibrium {name}: λ = {:?}, stable without vibration: {}",
@@ -178,14 +178,14 @@ fn main() {
                         limiting_run(method, &params, (1.0 - margin) * a_star, *phi, &y0, t_long)?;
                     let chart = spectral_radius_chart(&params, *phi, a_max, chart_points, tol)?;
                     titles.push(format!(
-                        "{name} LIMIT A=(1+{margin})A*={:.3}: STAYS",
+                        "{name} limit, a = (1 + {margin}) a* = {:.3}: stays",
                         (1.0 + margin) * a_star
                     ));
                     titles.push(format!(
-                        "{name} LIMIT A=(1-{margin})A*={:.3}: LEAVES",
+                        "{name} limit, a = (1 − {margin}) a* = {:.3}: leaves",
                         (1.0 - margin) * a_star
                     ));
-                    titles.push(format!("{name} EXACT NU={}: SPECTRAL RADIUS", params.nu));
+                    titles.push(format!("{name} exact, ν = {}: spectral radius", params.nu));
                     panels.push(Panels {
                         above,
                         below,
@@ -220,22 +220,22 @@ fn main() {
             let r_max = chart.iter().fold(1.0f64, |m, (_, r)| m.max(*r)).min(3.0);
             specs.push(PanelSpec::new(
                 &titles[3 * p],
-                "T",
-                "ANGLE - EQUILIBRIUM",
+                "t",
+                "angle − equilibrium",
                 (0.0, t_long),
                 (-ea, ea),
             ));
             specs.push(PanelSpec::new(
                 &titles[3 * p + 1],
-                "T",
-                "ANGLE - EQUILIBRIUM",
+                "t",
+                "angle − equilibrium",
                 (0.0, t_long),
                 (-eb, eb),
             ));
             specs.push(PanelSpec::new(
                 &titles[3 * p + 2],
                 "A",
-                "SPECTRAL RADIUS",
+                "spectral radius ρ",
                 (0.0, chart.last().map_or(1.0, |c| c.0)),
                 (0.95, r_max * 1.02),
             ));
@@ -260,10 +260,10 @@ fn main() {
             figure.line(3 * p + 2, &[(*a_star, 0.95), (*a_star, top)], GREY);
             figure.line(3 * p + 2, chart, BLACK);
             figure.points(3 * p + 2, chart.iter().copied(), BLACK, 3);
-            figure.legend(3 * p, &[("PHI1".into(), BLUE), ("PHI2".into(), RED)]);
+            figure.legend(3 * p, &[("φ₁".into(), BLUE), ("φ₂".into(), RED)]);
             figure.legend(
                 3 * p + 2,
-                &[("EXACT".into(), BLACK), ("A* (LIMIT)".into(), GREY)],
+                &[("exact".into(), BLACK), ("a* (limit)".into(), GREY)],
             );
             rows.extend(chart.iter().map(|(a, r)| format!("{p},{a},{r}")));
         }

@@ -120,10 +120,10 @@ fn main() {
             (centre[1] - half[1], centre[1] + half[1]),
         );
         let title = format!(
-            "ATTRACTOR A={} EPS={} MU={}, {count} POINTS",
+            "attractor, A = {}, ε = {}, μ = {}, {count} points",
             params.A, params.eps, params.mu
         );
-        let zoom_title = format!("ZOOM X{zoom}: LAYERS");
+        let zoom_title = format!("zoom ×{zoom}: layers");
         let pad = 0.05 * (hi[1] - lo[1]);
         let mut figure = Figure::grid(
             2,
@@ -131,8 +131,8 @@ fn main() {
             700,
             700,
             &[
-                PanelSpec::new(&title, "Q", "P", (-PI, PI), (lo[1] - pad, hi[1] + pad)),
-                PanelSpec::new(&zoom_title, "Q", "P", window.0, window.1),
+                PanelSpec::new(&title, "q", "p", (-PI, PI), (lo[1] - pad, hi[1] + pad)),
+                PanelSpec::new(&zoom_title, "q", "p", window.0, window.1),
             ],
         );
         let xy: Vec<(f64, f64)> = points.iter().map(|p| (p[0], p[1])).collect();
@@ -143,7 +143,7 @@ fn main() {
         figure.line(0, &[(q0, p0), (q1, p0), (q1, p1), (q0, p1), (q0, p0)], RED);
         scene.save_figure(&figure, "attractor.png")?;
 
-        let fit_title = format!("BOX COUNTING: DIMENSION {dimension:.3}");
+        let fit_title = format!("box counting: dimension {dimension:.3}");
         let (x_lo, x_hi) = (log_points[0].0 - 0.3, log_points.last().unwrap().0 + 0.3);
         let y_lo = log_points.iter().map(|p| p.1).fold(f64::INFINITY, f64::min) - 0.5;
         let y_hi = log_points
@@ -156,8 +156,8 @@ fn main() {
             480,
             PanelSpec::new(
                 &fit_title,
-                "LN(1/BOX SIDE)",
-                "LN(BOXES)",
+                "ln(1/box side)",
+                "ln(boxes)",
                 (x_lo, x_hi),
                 (y_lo, y_hi),
             ),

@@ -6,7 +6,7 @@
 use mechlab::analysis::lyapunov::{fast_lyapunov_indicator, fli_shading};
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
-use mechlab::plot::{Figure, PanelSpec};
+use mechlab::plot::{ColorMap, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Progress, Scene, SceneError};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -94,16 +94,20 @@ fn main() {
             shading.chaotic_fraction,
         );
         let title = format!(
-            "KAPITZA FLI MAP, A={}, EPS={}, MU={}, {periods} PERIODS",
+            "Kapitza FLI map, A = {}, ε = {}, μ = {}, {periods} periods",
             params.A, params.eps, params.mu
         );
         let mut figure = Figure::single(
             pixels.max(360) + 90,
             pixels.max(360) + 75,
-            PanelSpec::new(&title, "Q", "P", (-PI, PI), (-p_max, p_max)),
+            PanelSpec::new(&title, "q", "p", (-PI, PI), (-p_max, p_max)),
         );
-        figure.grey_map(0, pixels, pixels, shades);
+        let label = "FLI: regular level (0) to the 99th percentile (1)";
+        let mut viridis = figure.clone();
+        figure.shaded_map(0, pixels, pixels, shades, ColorMap::Grey, label);
         scene.save_figure(&figure, "chaos_map.png")?;
+        viridis.shaded_map(0, pixels, pixels, shades, ColorMap::Viridis, label);
+        scene.save_figure(&viridis, "chaos_map_viridis.png")?;
         scene.write_csv(
             "chaos_map.csv",
             "q,p,fli",

@@ -100,9 +100,9 @@ fn main() {
                 800,
                 600,
                 PanelSpec::new(
-                    &format!("A={} EPS={eps} MU={mu}", params.A),
-                    "Q",
-                    "P",
+                    &format!("A = {}, ε = {eps}, μ = {mu}", params.A),
+                    "q",
+                    "p",
                     (-PI, PI),
                     range_p(&points),
                 ),
@@ -136,9 +136,11 @@ fn main() {
                 900,
                 700,
                 PanelSpec::new(
-                    &format!("KAPITZA PERIOD MAP  A={a}  EPS={eps}  MU={mu}  ({periods} PERIODS)"),
-                    "Q (0 = UPWARD)",
-                    "P",
+                    &format!(
+                        "Kapitza period map, A = {a}, ε = {eps}, μ = {mu} ({periods} periods)"
+                    ),
+                    "q (0 = upward)",
+                    "p",
                     (-PI, PI),
                     (-3.6, 3.6),
                 ),
@@ -161,9 +163,9 @@ fn main() {
             figure.legend(
                 0,
                 &[
-                    (format!("A={a} EPS={eps} MU={mu}"), palette(0)),
+                    (format!("A = {a}, ε = {eps}, μ = {mu}"), palette(0)),
                     (
-                        format!("{} ORBITS, {}", initial.len(), method.name()),
+                        format!("{} orbits, {}", initial.len(), method.name()),
                         palette(1),
                     ),
                 ],

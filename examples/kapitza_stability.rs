@@ -15,10 +15,13 @@ use mechlab::analysis::floquet::{
 use mechlab::analysis::period_map::orbit;
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
-use mechlab::plot::{palette, Figure, PanelSpec, BLUE, GREY, RED};
+use mechlab::plot::{palette, ColorMap, Figure, PanelSpec, BLUE, GREY, RED};
 use mechlab::scene::{knob, run, Progress, Scene, SceneError};
 use rayon::prelude::*;
 use std::f64::consts::{PI, SQRT_2};
+
+/// The shade of the stable region: the legend's grey.
+const STABLE_SHADE: f64 = 1.0 - 150.0 / 255.0;
 
 const KNOBS: &[mechlab::scene::Knob] = &[
     knob("A", "1.6", "pivot amplitude to judge"),
@@ -99,19 +102,19 @@ fn main() {
         // Orbits near q = 0 below and above A*, and with friction above A*.
         let a_ref = a_star.unwrap_or(SQRT_2);
         let cases = [
-            (a_ref - 0.15, mu, "BELOW A*"),
-            (a_ref + 0.15, mu, "ABOVE A*"),
-            (a_ref + 0.15, mu.max(0.1), "ABOVE A*, WITH FRICTION"),
+            (a_ref - 0.15, mu, "below A*"),
+            (a_ref + 0.15, mu, "above A*"),
+            (a_ref + 0.15, mu.max(0.1), "above A*, with friction"),
         ];
         let periods = scene.count("periods")?;
         let starts = [[0.05, 0.0], [0.15, 0.0], [0.3, 0.0], [0.0, 0.25]];
         let titles: Vec<String> = cases
             .iter()
-            .map(|(ca, cmu, label)| format!("{label}: A={ca:.3} MU={cmu}"))
+            .map(|(ca, cmu, label)| format!("{label}: A = {ca:.3}, μ = {cmu}"))
             .collect();
         let specs: Vec<PanelSpec> = titles
             .iter()
-            .map(|t| PanelSpec::new(t, "Q", "P", (-1.0, 1.0), (-1.0, 1.0)))
+            .map(|t| PanelSpec::new(t, "q", "p", (-1.0, 1.0), (-1.0, 1.0)))
             .collect();
         let mut figure = Figure::grid(3, 1, 460, 460, &specs);
         let mut rows = Vec::new();
@@ -161,11 +164,11 @@ fn main() {
         let averaged_cases = [SQRT_2 - 0.3, SQRT_2 + 0.3];
         let titles: Vec<String> = averaged_cases
             .iter()
-            .map(|ca| format!("AVERAGED H LEVELS, A={ca:.3}"))
+            .map(|ca| format!("levels of the averaged H̄, A = {ca:.3}"))
             .collect();
         let specs: Vec<PanelSpec> = titles
             .iter()
-            .map(|t| PanelSpec::new(t, "Q", "P", (-PI, PI), (-2.5, 2.5)))
+            .map(|t| PanelSpec::new(t, "q", "p", (-PI, PI), (-2.5, 2.5)))
             .collect();
         let mut figure = Figure::grid(2, 1, 560, 460, &specs);
         for (k, ca) in averaged_cases.iter().enumerate() {
@@ -217,7 +220,7 @@ fn main() {
                 })
                 .collect();
             for (j, g) in column.into_iter().enumerate() {
-                chart[j * ne + i] = if g? <= 0.0 { 0.75 } else { 0.0 };
+                chart[j * ne + i] = if g? <= 0.0 { STABLE_SHADE } else { 0.0 };
             }
             progress.update(i + 1);
         }
@@ -225,18 +228,25 @@ fn main() {
             800,
             600,
             PanelSpec::new(
-                &format!("UPPER POSITION STABLE (GREY), MU={mu}"),
-                "EPS",
+                &format!("upper position stable (grey), μ = {mu}"),
+                "ε",
                 "A",
                 (0.02, 0.5),
                 (0.0, a_max),
             ),
         );
-        figure.grey_map(0, ne, na, &chart);
+        figure.shaded_map(
+            0,
+            ne,
+            na,
+            &chart,
+            ColorMap::Grey,
+            "stable (grey) or not (white)",
+        );
         figure.line(0, &[(0.02, SQRT_2), (0.5, SQRT_2)], RED);
         figure.legend(
             0,
-            &[("AVERAGED A*=SQRT(2)".into(), RED), ("STABLE".into(), GREY)],
+            &[("averaged A* = √2".into(), RED), ("stable".into(), GREY)],
         );
         scene.save_figure(&figure, "stability_chart.png")?;
         scene.write_csv(

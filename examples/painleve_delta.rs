@@ -103,11 +103,11 @@ fn main() {
                     nu: params.nu,
                     eps: params.eps,
                 };
-                (format!("CLASS {}", c.signs), eq)
+                (format!("class {}", c.signs), eq)
             })
             .collect();
         cases.push((
-            format!("GIVEN, SIGMA={sigma:+}"),
+            format!("given parameters, σ = {sigma:+}"),
             DeformationEquation {
                 reduced: reduced(&params),
                 sigma,
@@ -151,7 +151,7 @@ fn main() {
                 let system = DeformationEquation { nu, ..*eq };
                 let stable: Vec<bool> = system.equilibria().iter().map(|e| e.slope > 0.0).collect();
                 let curves = portrait(&system, (window_x, (-rate, rate)), starts, t_end)?;
-                specs_titles.push(format!("{name}, NU={nu}"));
+                specs_titles.push(format!("{name}, ν = {nu}"));
                 panels.push((window_x, rate, curves, system.equilibria(), stable));
             }
             summary.push(serde_json::json!({
@@ -166,9 +166,7 @@ fn main() {
         let specs: Vec<PanelSpec> = panels
             .iter()
             .zip(&specs_titles)
-            .map(|((wx, rate, ..), title)| {
-                PanelSpec::new(title, "DELTA", "DELTA'", *wx, (-rate, *rate))
-            })
+            .map(|((wx, rate, ..), title)| PanelSpec::new(title, "δ", "δ′", *wx, (-rate, *rate)))
             .collect();
         let mut figure = Figure::grid(4, panels.len().div_ceil(4), 400, 330, &specs);
         for (k, (_, _, curves, equilibria, stable)) in panels.iter().enumerate() {

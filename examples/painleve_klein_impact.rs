@@ -133,13 +133,8 @@ fn main() {
         let titles: Vec<String> = figures_data
             .iter()
             .flat_map(|(x2, _)| {
-                [
-                    "PHASE CURVE (DELTA, DELTA')",
-                    "ROD FORCE R(T)",
-                    "V1(T)",
-                    "V2(T)",
-                ]
-                .map(|what| format!("X2(0)={x2}: {what}"))
+                ["phase curve (δ, δ′)", "rod force R(t)", "v₁(t)", "v₂(t)"]
+                    .map(|what| format!("x₂(0) = {x2}: {what}"))
             })
             .collect();
         let mut specs = Vec::new();
@@ -148,29 +143,29 @@ fn main() {
             let t_range = (0.0, run.t.max(1e-9));
             specs.push(PanelSpec::new(
                 &titles[4 * k],
-                "DELTA",
-                "DELTA'",
+                "δ",
+                "δ′",
                 range(rods.iter().map(|r| r.delta)),
                 range(rods.iter().map(|r| r.delta_rate)),
             ));
             specs.push(PanelSpec::new(
                 &titles[4 * k + 1],
-                "T",
+                "t",
                 "R",
                 t_range,
                 range(rods.iter().map(|r| r.reaction)),
             ));
             specs.push(PanelSpec::new(
                 &titles[4 * k + 2],
-                "T",
-                "V1",
+                "t",
+                "v₁",
                 t_range,
                 range(run.samples.iter().map(|(_, y)| y[2]).chain([0.0])),
             ));
             specs.push(PanelSpec::new(
                 &titles[4 * k + 3],
-                "T",
-                "V2",
+                "t",
+                "v₂",
                 t_range,
                 range(run.samples.iter().map(|(_, y)| y[3]).chain([0.0])),
             ));

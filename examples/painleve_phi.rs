@@ -73,7 +73,7 @@ fn main() {
                 roots.len()
             );
             titles.push(format!(
-                "SLOPES {}: {} ROOTS OF X*=PHI",
+                "slopes {}: {} roots of X* = Φ(R)",
                 class.signs,
                 roots.len()
             ));
@@ -96,10 +96,10 @@ fn main() {
                 "rising": stable, "case": painleve_case(roots.len())}),
             );
         }
-        titles.push("REGIONS, SIGMA*O=+1 (MU1*, MU2*)".into());
-        titles.push("REGIONS, SIGMA*O=-1 (MU1*, MU2*)".into());
+        titles.push("regions, σo = +1".into());
+        titles.push("regions, σo = −1".into());
         titles.push(format!(
-            "GIVEN: X*={:.3}, SIGMA=+1 (BLUE) -1 (RED)",
+            "given: X* = {:.3}, σ = +1 (blue), −1 (red)",
             q.x_star
         ));
 
@@ -115,22 +115,22 @@ fn main() {
             specs.push(PanelSpec::new(
                 &titles[specs.len()],
                 "R",
-                "PHI",
+                "Φ",
                 (lo, hi),
                 (a - 0.5, b + 0.5),
             ));
         }
         specs.push(PanelSpec::new(
             &titles[6],
-            "MU1*",
-            "MU2*",
+            "μ₁*",
+            "μ₂*",
             (0.0, 5.0),
             (0.0, 5.0),
         ));
         specs.push(PanelSpec::new(
             &titles[7],
-            "MU1*",
-            "MU2*",
+            "μ₁*",
+            "μ₂*",
             (0.0, 5.0),
             (0.0, 5.0),
         ));
@@ -147,7 +147,7 @@ fn main() {
         specs.push(PanelSpec::new(
             &titles[8],
             "R",
-            "PHI",
+            "Φ",
             (glo, ghi),
             (ga - 0.5, gb + 0.5),
         ));

@@ -115,23 +115,23 @@ fn main() {
         let eps_hi = eps_values.iter().fold(0.0f64, |m, e| m.max(*e));
         let specs = [
             PanelSpec::new(
-                "REGULAR: R AGAINST T/EPS",
-                "T/EPS",
+                "regular: R against t/ε",
+                "t/ε",
                 "R",
                 (0.0, tau_regular),
                 (lo_r.min(hi_r - 0.1), hi_r),
             ),
             PanelSpec::new(
-                "IMPACT: EPS*R AGAINST T/EPS",
-                "T/EPS",
-                "EPS*R",
+                "impact: εR against t/ε",
+                "t/ε",
+                "εR",
                 (0.0, tau_impact),
                 (lo_i, hi_i * 1.05),
             ),
             PanelSpec::new(
-                "IMPACT: SWITCH TIMES AGAINST EPS",
-                "EPS",
-                "T",
+                "impact: switch times against ε",
+                "ε",
+                "t",
                 (eps_lo / 1.5, eps_hi * 1.5),
                 (t_lo / 1.5, t_hi * 1.5),
             )
@@ -162,12 +162,12 @@ fn main() {
                 }
             }
             if !impact {
-                legend.push((format!("EPS={eps}"), color));
+                legend.push((format!("ε = {eps}"), color));
             }
         }
         if let Some(r) = r_star {
             figure.line(0, &[(0.0, r), (tau_regular, r)], GREY);
-            legend.push(("RIGID R*".into(), GREY));
+            legend.push(("rigid rod R*".into(), GREY));
         }
         figure.legend(0, &legend);
         figure.legend(1, &legend[..eps_values.len()]);

@@ -5,7 +5,7 @@
 
 use mechlab::analysis::lyapunov::fli_shading;
 use mechlab::analysis::standard_map::{standard_map, standard_map_fli};
-use mechlab::plot::{palette, Figure, PanelSpec};
+use mechlab::plot::{palette, ColorMap, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Scene};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -31,9 +31,9 @@ fn main() {
             800,
             800,
             PanelSpec::new(
-                &format!("STANDARD MAP ORBITS, EPS={eps}"),
-                "Q",
-                "P",
+                &format!("standard map orbits, ε = {eps}"),
+                "q",
+                "p",
                 (-PI, PI),
                 (-PI, PI),
             ),
@@ -79,15 +79,19 @@ fn main() {
             pixels + 90,
             pixels + 75,
             PanelSpec::new(
-                &format!("FLI CHAOS MAP, EPS={eps}, {iterations} ITERATIONS"),
-                "Q",
-                "P",
+                &format!("FLI chaos map, ε = {eps}, {iterations} iterations"),
+                "q",
+                "p",
                 (-PI, PI),
                 (-PI, PI),
             ),
         );
-        figure.grey_map(0, pixels, pixels, shades);
+        let label = "FLI: regular level (0) to the 99th percentile (1)";
+        let mut viridis = figure.clone();
+        figure.shaded_map(0, pixels, pixels, shades, ColorMap::Grey, label);
         scene.save_figure(&figure, "chaos_map.png")?;
+        viridis.shaded_map(0, pixels, pixels, shades, ColorMap::Viridis, label);
+        scene.save_figure(&viridis, "chaos_map_viridis.png")?;
         scene.write_csv(
             "chaos_map.csv",
             "q,p,fli",

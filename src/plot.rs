@@ -1,8 +1,18 @@
-//! Minimal raster figures written as PNG: panels with axes, ticks, labels,
-//! points, lines, grey-level maps and a legend. Self-contained (a 5×7 bitmap
-//! font, text shown in capitals) so that scenes need no system fonts.
+//! Figures on `plotters`: grids of panels with axes (linear or logarithmic),
+//! points, lines, shaded maps with a colour bar, level sets and legends,
+//! written as PNG and SVG. The text uses DejaVu Sans, embedded (the `dejavu`
+//! crate) and registered at run time, so Greek letters and subscripts
+//! (φ₁, ε, A*) render without system fonts.
+//!
+//! A figure records what its panels show and draws everything on `save`,
+//! so one description serves both backends.
 
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle, RGBColor};
 use std::path::Path;
+use std::sync::Once;
 
 /// An RGB colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,249 +41,33 @@ pub fn palette(i: usize) -> Rgb {
     P[i % P.len()]
 }
 
-/// Column-major 5×7 glyphs for ' '..='Z', bit 0 at the top.
-const FONT: [[u8; 5]; 59] = [
-    [0x00, 0x00, 0x00, 0x00, 0x00],
-    [0x00, 0x00, 0x5F, 0x00, 0x00],
-    [0x00, 0x07, 0x00, 0x07, 0x00],
-    [0x14, 0x7F, 0x14, 0x7F, 0x14],
-    [0x24, 0x2A, 0x7F, 0x2A, 0x12],
-    [0x23, 0x13, 0x08, 0x64, 0x62],
-    [0x36, 0x49, 0x55, 0x22, 0x50],
-    [0x00, 0x05, 0x03, 0x00, 0x00],
-    [0x00, 0x1C, 0x22, 0x41, 0x00],
-    [0x00, 0x41, 0x22, 0x1C, 0x00],
-    [0x08, 0x2A, 0x1C, 0x2A, 0x08],
-    [0x08, 0x08, 0x3E, 0x08, 0x08],
-    [0x00, 0x50, 0x30, 0x00, 0x00],
-    [0x08, 0x08, 0x08, 0x08, 0x08],
-    [0x00, 0x60, 0x60, 0x00, 0x00],
-    [0x20, 0x10, 0x08, 0x04, 0x02],
-    [0x3E, 0x51, 0x49, 0x45, 0x3E],
-    [0x00, 0x42, 0x7F, 0x40, 0x00],
-    [0x42, 0x61, 0x51, 0x49, 0x46],
-    [0x21, 0x41, 0x45, 0x4B, 0x31],
-    [0x18, 0x14, 0x12, 0x7F, 0x10],
-    [0x27, 0x45, 0x45, 0x45, 0x39],
-    [0x3C, 0x4A, 0x49, 0x49, 0x30],
-    [0x01, 0x71, 0x09, 0x05, 0x03],
-    [0x36, 0x49, 0x49, 0x49, 0x36],
-    [0x06, 0x49, 0x49, 0x29, 0x1E],
-    [0x00, 0x36, 0x36, 0x00, 0x00],
-    [0x00, 0x56, 0x36, 0x00, 0x00],
-    [0x00, 0x08, 0x14, 0x22, 0x41],
-    [0x14, 0x14, 0x14, 0x14, 0x14],
-    [0x41, 0x22, 0x14, 0x08, 0x00],
-    [0x02, 0x01, 0x51, 0x09, 0x06],
-    [0x32, 0x49, 0x79, 0x41, 0x3E],
-    [0x7E, 0x11, 0x11, 0x11, 0x7E],
-    [0x7F, 0x49, 0x49, 0x49, 0x36],
-    [0x3E, 0x41, 0x41, 0x41, 0x22],
-    [0x7F, 0x41, 0x41, 0x22, 0x1C],
-    [0x7F, 0x49, 0x49, 0x49, 0x41],
-    [0x7F, 0x09, 0x09, 0x01, 0x01],
-    [0x3E, 0x41, 0x41, 0x51, 0x32],
-    [0x7F, 0x08, 0x08, 0x08, 0x7F],
-    [0x00, 0x41, 0x7F, 0x41, 0x00],
-    [0x20, 0x40, 0x41, 0x3F, 0x01],
-    [0x7F, 0x08, 0x14, 0x22, 0x41],
-    [0x7F, 0x40, 0x40, 0x40, 0x40],
-    [0x7F, 0x02, 0x04, 0x02, 0x7F],
-    [0x7F, 0x04, 0x08, 0x10, 0x7F],
-    [0x3E, 0x41, 0x41, 0x41, 0x3E],
-    [0x7F, 0x09, 0x09, 0x09, 0x06],
-    [0x3E, 0x41, 0x51, 0x21, 0x5E],
-    [0x7F, 0x09, 0x19, 0x29, 0x46],
-    [0x46, 0x49, 0x49, 0x49, 0x31],
-    [0x01, 0x01, 0x7F, 0x01, 0x01],
-    [0x3F, 0x40, 0x40, 0x40, 0x3F],
-    [0x1F, 0x20, 0x40, 0x20, 0x1F],
-    [0x7F, 0x20, 0x18, 0x20, 0x7F],
-    [0x63, 0x14, 0x08, 0x14, 0x63],
-    [0x03, 0x04, 0x78, 0x04, 0x03],
-    [0x61, 0x51, 0x49, 0x45, 0x43],
-];
-
-/// An RGB raster image.
-pub struct Canvas {
-    pub width: usize,
-    pub height: usize,
-    pixels: Vec<Rgb>,
+fn rgb(c: Rgb) -> RGBColor {
+    RGBColor(c.0, c.1, c.2)
 }
 
-impl Canvas {
-    pub fn new(width: usize, height: usize) -> Canvas {
-        Canvas {
-            width,
-            height,
-            pixels: vec![WHITE; width * height],
-        }
-    }
+/// How a shaded map turns values in [0, 1] into colours.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorMap {
+    /// White (0) to black (1).
+    Grey,
+    /// Viridis, perceptually uniform: dark (0) to yellow (1).
+    Viridis,
+}
 
-    pub fn set(&mut self, x: i64, y: i64, c: Rgb) {
-        if x >= 0 && y >= 0 && (x as usize) < self.width && (y as usize) < self.height {
-            self.pixels[y as usize * self.width + x as usize] = c;
-        }
-    }
-
-    pub fn fill_rect(&mut self, x0: i64, y0: i64, x1: i64, y1: i64, c: Rgb) {
-        for y in y0.min(y1)..=y0.max(y1) {
-            for x in x0.min(x1)..=x0.max(x1) {
-                self.set(x, y, c);
+impl ColorMap {
+    fn color(self, v: f64) -> RGBColor {
+        let v = v.clamp(0.0, 1.0);
+        match self {
+            ColorMap::Grey => {
+                let g = (255.0 * (1.0 - v)) as u8;
+                RGBColor(g, g, g)
             }
+            ColorMap::Viridis => ViridisRGB::get_color(v),
         }
-    }
-
-    pub fn line(&mut self, (x0, y0): (i64, i64), (x1, y1): (i64, i64), c: Rgb) {
-        let (dx, dy) = ((x1 - x0).abs(), -(y1 - y0).abs());
-        let (sx, sy) = (if x0 < x1 { 1 } else { -1 }, if y0 < y1 { 1 } else { -1 });
-        let (mut x, mut y, mut err) = (x0, y0, dx + dy);
-        for _ in 0..=(dx - dy).min(100_000) {
-            self.set(x, y, c);
-            if x == x1 && y == y1 {
-                break;
-            }
-            let e2 = 2 * err;
-            if e2 >= dy {
-                err += dy;
-                x += sx;
-            }
-            if e2 <= dx {
-                err += dx;
-                y += sy;
-            }
-        }
-    }
-
-    /// Text in capitals with its top-left corner at (x, y); returns the width in pixels.
-    pub fn text(&mut self, x: i64, y: i64, text: &str, scale: i64, c: Rgb) -> i64 {
-        let mut cx = x;
-        for ch in text.chars() {
-            let ch = match ch.to_ascii_uppercase() {
-                '[' | '{' => '(',
-                ']' | '}' => ')',
-                '_' => '-',
-                '|' => '!',
-                ch => ch,
-            };
-            let index = if (' '..='Z').contains(&ch) {
-                ch as usize - 0x20
-            } else {
-                '?' as usize - 0x20
-            };
-            for (col, bits) in FONT[index].iter().enumerate() {
-                for row in 0..7 {
-                    if bits & (1 << row) != 0 {
-                        let (px, py) = (cx + col as i64 * scale, y + row * scale);
-                        self.fill_rect(px, py, px + scale - 1, py + scale - 1, c);
-                    }
-                }
-            }
-            cx += 6 * scale;
-        }
-        cx - x
-    }
-
-    pub fn text_width(text: &str, scale: i64) -> i64 {
-        text.chars().count() as i64 * 6 * scale
-    }
-
-    /// Writes the image as PNG, atomically (temporary file, then rename).
-    pub fn save_png(&self, path: &Path) -> std::io::Result<()> {
-        let mut bytes = Vec::new();
-        {
-            let mut encoder = png::Encoder::new(&mut bytes, self.width as u32, self.height as u32);
-            encoder.set_color(png::ColorType::Rgb);
-            encoder.set_depth(png::BitDepth::Eight);
-            let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-            let data: Vec<u8> = self.pixels.iter().flat_map(|p| [p.0, p.1, p.2]).collect();
-            writer
-                .write_image_data(&data)
-                .map_err(std::io::Error::other)?;
-        }
-        crate::scene::write_atomic(path, &bytes)
     }
 }
 
-/// "Nice" tick positions covering [lo, hi].
-pub fn ticks(lo: f64, hi: f64, target: usize) -> Vec<f64> {
-    let span = (hi - lo).abs().max(1e-300);
-    let raw = span / target.max(1) as f64;
-    let magnitude = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * magnitude)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * magnitude);
-    let first = (lo.min(hi) / step).ceil() as i64;
-    let last = (lo.max(hi) / step).floor() as i64;
-    (first..=last).map(|k| k as f64 * step).collect()
-}
-
-fn tick_label(v: f64) -> String {
-    if v == 0.0 {
-        return "0".into();
-    }
-    let a = v.abs();
-    if !(1e-3..1e4).contains(&a) {
-        format!("{v:.0e}")
-    } else {
-        let s = format!("{v:.4}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    }
-}
-
-/// One panel: a data rectangle mapped onto a pixel rectangle of a canvas.
-#[derive(Clone, Copy, Debug)]
-pub struct Panel {
-    pub x_range: (f64, f64),
-    pub y_range: (f64, f64),
-    /// Pixel box of the data area: left, top, width, height.
-    pub left: i64,
-    pub top: i64,
-    pub width: i64,
-    pub height: i64,
-    pub log_x: bool,
-    pub log_y: bool,
-}
-
-impl Panel {
-    fn tx(&self, v: f64) -> f64 {
-        if self.log_x {
-            v.log10()
-        } else {
-            v
-        }
-    }
-    fn ty(&self, v: f64) -> f64 {
-        if self.log_y {
-            v.log10()
-        } else {
-            v
-        }
-    }
-    /// Pixel of a data point (may lie outside the box).
-    pub fn pixel(&self, x: f64, y: f64) -> (i64, i64) {
-        let (x0, x1) = (self.tx(self.x_range.0), self.tx(self.x_range.1));
-        let (y0, y1) = (self.ty(self.y_range.0), self.ty(self.y_range.1));
-        let px = self.left as f64 + (self.tx(x) - x0) / (x1 - x0) * (self.width - 1) as f64;
-        let py = self.top as f64 + (y1 - self.ty(y)) / (y1 - y0) * (self.height - 1) as f64;
-        (px.round() as i64, py.round() as i64)
-    }
-    fn inside(&self, (px, py): (i64, i64)) -> bool {
-        px >= self.left
-            && px < self.left + self.width
-            && py >= self.top
-            && py < self.top + self.height
-    }
-}
-
-/// A figure of one or more panels in a grid.
-pub struct Figure {
-    pub canvas: Canvas,
-    panels: Vec<Panel>,
-}
-
+/// What a panel shows: its title, axis labels, ranges and scales.
 pub struct PanelSpec<'a> {
     pub title: &'a str,
     pub x_label: &'a str,
@@ -313,13 +107,56 @@ impl<'a> PanelSpec<'a> {
     }
 }
 
-const MARGIN_LEFT: i64 = 70;
-const MARGIN_BOTTOM: i64 = 45;
-const MARGIN_TOP: i64 = 30;
-const MARGIN_RIGHT: i64 = 20;
+/// A panel's data ranges and scales, as a scene may read them back.
+#[derive(Clone, Debug)]
+pub struct Panel {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x_range: (f64, f64),
+    pub y_range: (f64, f64),
+    pub log_x: bool,
+    pub log_y: bool,
+}
+
+#[derive(Clone)]
+enum Layer {
+    Points(Vec<(f64, f64)>, Rgb, i64),
+    Line(Vec<(f64, f64)>, Rgb),
+    Map {
+        columns: usize,
+        rows: usize,
+        values: Vec<f64>,
+        map: ColorMap,
+        label: String,
+    },
+    Contours(Vec<(f64, f64)>, Rgb, u32),
+    Legend(Vec<(String, Rgb)>, bool),
+}
+
+/// A figure of one or more panels in a grid.
+#[derive(Clone)]
+pub struct Figure {
+    columns: usize,
+    rows: usize,
+    panel_size: (u32, u32),
+    panels: Vec<Panel>,
+    layers: Vec<Vec<Layer>>,
+}
+
+const FONT: &str = "sans-serif";
+
+fn register_fonts() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are valid TrueType (a fixed asset of the dejavu crate).
+        let _ = register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
+        let _ = register_font(FONT, FontStyle::Bold, dejavu::sans::bold());
+    });
+}
 
 impl Figure {
-    /// A grid of `columns` × `rows` panels, each `panel_w` × `panel_h` pixels overall.
+    /// A grid of `columns` × `rows` panels, each `panel_w` × `panel_h` pixels.
     pub fn grid(
         columns: usize,
         rows: usize,
@@ -327,25 +164,25 @@ impl Figure {
         panel_h: usize,
         specs: &[PanelSpec],
     ) -> Figure {
-        let mut canvas = Canvas::new(columns * panel_w, rows * panel_h);
-        let mut panels = Vec::new();
-        for (k, spec) in specs.iter().enumerate() {
-            let (col, row) = ((k % columns) as i64, (k / columns) as i64);
-            let (ox, oy) = (col * panel_w as i64, row * panel_h as i64);
-            let panel = Panel {
-                x_range: spec.x_range,
-                y_range: spec.y_range,
-                left: ox + MARGIN_LEFT,
-                top: oy + MARGIN_TOP,
-                width: panel_w as i64 - MARGIN_LEFT - MARGIN_RIGHT,
-                height: panel_h as i64 - MARGIN_TOP - MARGIN_BOTTOM,
-                log_x: spec.log_x,
-                log_y: spec.log_y,
-            };
-            draw_frame(&mut canvas, &panel, spec);
-            panels.push(panel);
+        let panels: Vec<Panel> = specs
+            .iter()
+            .map(|s| Panel {
+                title: s.title.to_string(),
+                x_label: s.x_label.to_string(),
+                y_label: s.y_label.to_string(),
+                x_range: sane_range(s.x_range, s.log_x),
+                y_range: sane_range(s.y_range, s.log_y),
+                log_x: s.log_x,
+                log_y: s.log_y,
+            })
+            .collect();
+        Figure {
+            columns: columns.max(1),
+            rows: rows.max(1),
+            panel_size: (panel_w as u32, panel_h as u32),
+            layers: panels.iter().map(|_| Vec::new()).collect(),
+            panels,
         }
-        Figure { canvas, panels }
     }
 
     pub fn single(width: usize, height: usize, spec: PanelSpec) -> Figure {
@@ -353,7 +190,7 @@ impl Figure {
     }
 
     pub fn panel(&self, k: usize) -> Panel {
-        self.panels[k]
+        self.panels[k].clone()
     }
 
     /// Dots at data points (1 pixel, or a small square for `size` > 1).
@@ -364,67 +201,50 @@ impl Figure {
         color: Rgb,
         size: i64,
     ) {
-        let panel = self.panels[k];
-        for (x, y) in points {
-            if !x.is_finite() || !y.is_finite() {
-                continue;
-            }
-            let p = panel.pixel(x, y);
-            if panel.inside(p) {
-                if size <= 1 {
-                    self.canvas.set(p.0, p.1, color);
-                } else {
-                    let r = size / 2;
-                    self.canvas
-                        .fill_rect(p.0 - r, p.1 - r, p.0 + r, p.1 + r, color);
-                }
-            }
-        }
+        let pts: Vec<(f64, f64)> = points
+            .into_iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .collect();
+        self.layers[k].push(Layer::Points(pts, color, size));
     }
 
-    /// A polyline; segments leaving the box are skipped.
+    /// A polyline; it is broken where a point is not finite.
     pub fn line(&mut self, k: usize, points: &[(f64, f64)], color: Rgb) {
-        let panel = self.panels[k];
-        for w in points.windows(2) {
-            let (a, b) = (panel.pixel(w[0].0, w[0].1), panel.pixel(w[1].0, w[1].1));
-            if panel.inside(a) && panel.inside(b) {
-                self.canvas.line(a, b, color);
-            }
-        }
+        self.layers[k].push(Layer::Line(points.to_vec(), color));
     }
 
-    /// Fills the panel with a map: `value(x, y)` in [0, 1] → grey (1 = black).
+    /// Fills the panel with a map of values in [0, 1] (row 0 at the bottom;
+    /// non-finite values stay white) in grey, with a colour bar.
     pub fn grey_map(&mut self, k: usize, columns: usize, rows: usize, values: &[f64]) {
-        let panel = self.panels[k];
-        for py in 0..panel.height {
-            for px in 0..panel.width {
-                let i = (px as usize * columns / panel.width as usize).min(columns - 1);
-                let j = rows - 1 - (py as usize * rows / panel.height as usize).min(rows - 1);
-                let v = values[j * columns + i];
-                let g = if v.is_finite() {
-                    (255.0 * (1.0 - v.clamp(0.0, 1.0))) as u8
-                } else {
-                    255
-                };
-                self.canvas
-                    .set(panel.left + px, panel.top + py, Rgb(g, g, g));
-            }
-        }
-        let frame = Rgb(0, 0, 0);
-        let (l, t, r, b) = (
-            panel.left - 1,
-            panel.top - 1,
-            panel.left + panel.width,
-            panel.top + panel.height,
-        );
-        self.canvas.line((l, t), (r, t), frame);
-        self.canvas.line((l, b), (r, b), frame);
-        self.canvas.line((l, t), (l, b), frame);
-        self.canvas.line((r, t), (r, b), frame);
+        self.shaded_map(k, columns, rows, values, ColorMap::Grey, "");
     }
 
-    /// Level sets of `f` with spacing `step` (and the level `special`, drawn in
-    /// `special_color`): a pixel is marked where f crosses a level towards its neighbours.
+    /// Fills the panel with a map of values in [0, 1] in the colour map
+    /// `map`, with a colour bar labelled `label`.
+    pub fn shaded_map(
+        &mut self,
+        k: usize,
+        columns: usize,
+        rows: usize,
+        values: &[f64],
+        map: ColorMap,
+        label: &str,
+    ) {
+        self.layers[k].insert(
+            0,
+            Layer::Map {
+                columns,
+                rows,
+                values: values.to_vec(),
+                map,
+                label: label.to_string(),
+            },
+        );
+    }
+
+    /// Level sets of `f` with spacing `step` (and the level `special`, drawn
+    /// in `special_color`): marked where f crosses a level between
+    /// neighbouring points of a 400 × 400 grid over the panel.
     pub fn contours(
         &mut self,
         k: usize,
@@ -434,37 +254,35 @@ impl Figure {
         special: f64,
         special_color: Rgb,
     ) {
-        let panel = self.panels[k];
-        let (w, h) = (panel.width as usize, panel.height as usize);
-        let (x0, x1, y0, y1) = (
-            panel.x_range.0,
-            panel.x_range.1,
-            panel.y_range.0,
-            panel.y_range.1,
-        );
-        let value = |i: usize, j: usize| {
-            f(
-                x0 + (x1 - x0) * i as f64 / (w - 1) as f64,
-                y1 - (y1 - y0) * j as f64 / (h - 1) as f64,
-            )
+        let p = &self.panels[k];
+        let n = 400;
+        let (x0, x1, y0, y1) = (p.x_range.0, p.x_range.1, p.y_range.0, p.y_range.1);
+        let at = |i: usize, j: usize| {
+            let (x, y) = (
+                x0 + (x1 - x0) * i as f64 / (n - 1) as f64,
+                y0 + (y1 - y0) * j as f64 / (n - 1) as f64,
+            );
+            ((x, y), f(x, y))
         };
-        let grid: Vec<f64> = (0..h)
-            .flat_map(|j| (0..w).map(move |i| (i, j)))
-            .map(|(i, j)| value(i, j))
+        let grid: Vec<((f64, f64), f64)> = (0..n)
+            .flat_map(|j| (0..n).map(move |i| (i, j)))
+            .map(|(i, j)| at(i, j))
             .collect();
-        for j in 0..h - 1 {
-            for i in 0..w - 1 {
-                let a = grid[j * w + i];
-                for b in [grid[j * w + i + 1], grid[(j + 1) * w + i]] {
-                    let (x, y) = (panel.left + i as i64, panel.top + j as i64);
+        let (mut levels, mut specials) = (Vec::new(), Vec::new());
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let (xy, a) = grid[j * n + i];
+                for (_, b) in [grid[j * n + i + 1], grid[(j + 1) * n + i]] {
                     if (a - special).signum() != (b - special).signum() {
-                        self.canvas.fill_rect(x, y, x + 1, y + 1, special_color);
+                        specials.push(xy);
                     } else if (a / step).floor() != (b / step).floor() {
-                        self.canvas.set(x, y, color);
+                        levels.push(xy);
                     }
                 }
             }
         }
+        self.layers[k].push(Layer::Contours(levels, color, 1));
+        self.layers[k].push(Layer::Contours(specials, special_color, 2));
     }
 
     /// Legend lines in the panel's top-left corner, each with a colour swatch.
@@ -474,84 +292,286 @@ impl Figure {
 
     /// Legend lines in the top-left or (`bottom`) bottom-left corner.
     pub fn legend_at(&mut self, k: usize, entries: &[(String, Rgb)], bottom: bool) {
-        let panel = self.panels[k];
-        let width = entries
-            .iter()
-            .map(|(s, _)| Canvas::text_width(s, 1))
-            .max()
-            .unwrap_or(0)
-            + 22;
-        let height = entries.len() as i64 * 10 + 6;
-        let y = if bottom {
-            panel.top + panel.height - height - 6
-        } else {
-            panel.top + 6
-        };
-        let x = panel.left + 6;
-        self.canvas.fill_rect(x, y, x + width, y + height, WHITE);
-        for (i, (text, color)) in entries.iter().enumerate() {
-            let ty = y + 4 + i as i64 * 10;
-            self.canvas.fill_rect(x + 4, ty + 1, x + 10, ty + 5, *color);
-            self.canvas.text(x + 16, ty, text, 1, BLACK);
-        }
+        self.layers[k].push(Layer::Legend(entries.to_vec(), bottom));
     }
 
+    /// Whether an SVG of this figure stays small: no shaded map and at most
+    /// 50 000 drawn points (orbit clouds belong in PNG).
+    pub fn svg_is_cheap(&self) -> bool {
+        let mut points = 0;
+        for layer in self.layers.iter().flatten() {
+            points += match layer {
+                Layer::Map { .. } => return false,
+                Layer::Points(p, ..) | Layer::Line(p, _) | Layer::Contours(p, ..) => p.len(),
+                Layer::Legend(..) => 0,
+            };
+        }
+        points <= 50_000
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (
+            self.panel_size.0 * self.columns as u32,
+            self.panel_size.1 * self.rows as u32,
+        )
+    }
+
+    /// Writes the figure as PNG.
     pub fn save(&self, path: &Path) -> std::io::Result<()> {
-        self.canvas.save_png(path)
+        register_fonts();
+        let root = BitMapBackend::new(path, self.size()).into_drawing_area();
+        self.draw(&root).map_err(std::io::Error::other)?;
+        root.present()
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    }
+
+    /// Writes the figure as SVG.
+    pub fn save_svg(&self, path: &Path) -> std::io::Result<()> {
+        register_fonts();
+        let root = SVGBackend::new(path, self.size()).into_drawing_area();
+        self.draw(&root).map_err(std::io::Error::other)?;
+        root.present()
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE_COLOR).map_err(|e| e.to_string())?;
+        let areas = root.split_evenly((self.rows, self.columns));
+        for ((panel, layers), area) in self.panels.iter().zip(&self.layers).zip(&areas) {
+            draw_panel(area, panel, layers).map_err(|e| format!("{}: {e}", panel.title))?;
+        }
+        Ok(())
     }
 }
 
-fn draw_frame(canvas: &mut Canvas, panel: &Panel, spec: &PanelSpec) {
-    let (l, t) = (panel.left - 1, panel.top - 1);
-    let (r, b) = (panel.left + panel.width, panel.top + panel.height);
-    canvas.line((l, t), (r, t), BLACK);
-    canvas.line((l, b), (r, b), BLACK);
-    canvas.line((l, t), (l, b), BLACK);
-    canvas.line((r, t), (r, b), BLACK);
-    let axis_ticks = |lo: f64, hi: f64, log: bool| -> Vec<(f64, String)> {
-        if log {
-            let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
-            (a..=b).map(|e| (10f64.powi(e), format!("1E{e}"))).collect()
-        } else {
-            ticks(lo, hi, 5)
-                .into_iter()
-                .map(|v| (v, tick_label(v)))
-                .collect()
+const WHITE_COLOR: RGBColor = RGBColor(255, 255, 255);
+
+/// A usable axis range: ordered, not empty, positive on a log axis.
+fn sane_range((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
+    if !lo.is_finite() || !hi.is_finite() {
+        return if log { (0.1, 10.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        lo = lo.max(1e-300);
+        hi = hi.max(lo * 10.0);
+    } else if hi - lo <= 1e-300 {
+        let pad = lo.abs().max(1.0) * 1e-3;
+        lo -= pad;
+        hi += pad;
+    }
+    (lo, hi)
+}
+
+type Chart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    layers: &[Layer],
+) -> Result<(), String> {
+    let map_label = layers.iter().find_map(|l| match l {
+        Layer::Map { map, label, .. } => Some((*map, label.clone())),
+        _ => None,
+    });
+    // A shaded map gets a colour bar on the right.
+    let (plot_area, bar_area) = match &map_label {
+        Some(_) => {
+            let (w, _) = area.dim_in_pixel();
+            let (a, b) = area.split_horizontally(w.saturating_sub(70));
+            (a, Some(b))
         }
+        None => (area.clone(), None),
     };
-    for (v, label) in axis_ticks(spec.x_range.0, spec.x_range.1, spec.log_x) {
-        let (px, _) = panel.pixel(v, spec.y_range.0);
-        canvas.line((px, b), (px, b + 4), BLACK);
-        let w = Canvas::text_width(&label, 1);
-        canvas.text(px - w / 2, b + 8, &label, 1, BLACK);
+    let mut builder = ChartBuilder::on(&plot_area);
+    builder
+        .caption(&panel.title, (FONT, 15))
+        .margin(8)
+        .x_label_area_size(40)
+        .y_label_area_size(62);
+    let (x, y) = (
+        panel.x_range.0..panel.x_range.1,
+        panel.y_range.0..panel.y_range.1,
+    );
+    match (panel.log_x, panel.log_y) {
+        (false, false) => {
+            let mut c = builder
+                .build_cartesian_2d(x, y)
+                .map_err(|e| e.to_string())?;
+            fill(&mut c, panel, layers)
+        }
+        (true, false) => {
+            let mut c = builder
+                .build_cartesian_2d(x.log_scale(), y)
+                .map_err(|e| e.to_string())?;
+            fill(&mut c, panel, layers)
+        }
+        (false, true) => {
+            let mut c = builder
+                .build_cartesian_2d(x, y.log_scale())
+                .map_err(|e| e.to_string())?;
+            fill(&mut c, panel, layers)
+        }
+        (true, true) => {
+            let mut c = builder
+                .build_cartesian_2d(x.log_scale(), y.log_scale())
+                .map_err(|e| e.to_string())?;
+            fill(&mut c, panel, layers)
+        }
+    }?;
+    if let (Some(bar), Some((map, label))) = (bar_area, map_label) {
+        color_bar(&bar, map, &label)?;
     }
-    for (v, label) in axis_ticks(spec.y_range.0, spec.y_range.1, spec.log_y) {
-        let (_, py) = panel.pixel(spec.x_range.0, v);
-        canvas.line((l - 4, py), (l, py), BLACK);
-        let w = Canvas::text_width(&label, 1);
-        canvas.text(l - 8 - w, py - 3, &label, 1, BLACK);
+    Ok(())
+}
+
+/// A vertical colour bar for values 0..1.
+fn color_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    map: ColorMap,
+    label: &str,
+) -> Result<(), String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(30)
+        .margin_bottom(48)
+        .margin_right(30)
+        .y_label_area_size(0)
+        .right_y_label_area_size(30)
+        .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+        .map_err(|e| e.to_string())?;
+    let n = 100;
+    chart
+        .draw_series((0..n).map(|i| {
+            let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+            Rectangle::new([(0.0, a), (1.0, b)], map.color(0.5 * (a + b)).filled())
+        }))
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .disable_y_mesh()
+        .disable_x_axis()
+        .y_labels(6)
+        .y_desc(label)
+        .label_style((FONT, 12))
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
+fn fill<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    panel: &Panel,
+    layers: &[Layer],
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let visible = |&(x, y): &(f64, f64)| {
+        x.is_finite() && y.is_finite() && (!panel.log_x || x > 0.0) && (!panel.log_y || y > 0.0)
+    };
+    chart
+        .configure_mesh()
+        .x_desc(&panel.x_label)
+        .y_desc(&panel.y_label)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .x_labels(6)
+        .y_labels(6)
+        .draw()
+        .map_err(err)?;
+    for layer in layers {
+        match layer {
+            Layer::Map {
+                columns,
+                rows,
+                values,
+                map,
+                ..
+            } => {
+                let (x0, x1) = panel.x_range;
+                let (y0, y1) = panel.y_range;
+                let (dx, dy) = ((x1 - x0) / *columns as f64, (y1 - y0) / *rows as f64);
+                chart
+                    .draw_series(
+                        (0..*rows)
+                            .flat_map(|j| (0..*columns).map(move |i| (i, j)))
+                            .filter_map(|(i, j)| {
+                                let v = values[j * columns + i];
+                                v.is_finite().then(|| {
+                                    let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
+                                    Rectangle::new(
+                                        [(x, y), (x + dx, y + dy)],
+                                        map.color(v).filled(),
+                                    )
+                                })
+                            }),
+                    )
+                    .map_err(err)?;
+            }
+            Layer::Points(pts, color, size) => {
+                let c = rgb(*color);
+                if *size <= 1 {
+                    chart
+                        .draw_series(pts.iter().filter(|p| visible(p)).map(|p| Pixel::new(*p, c)))
+                        .map_err(err)?;
+                } else {
+                    let r = (*size / 2).max(1) as i32;
+                    chart
+                        .draw_series(pts.iter().filter(|p| visible(p)).map(|p| {
+                            EmptyElement::at(*p) + Rectangle::new([(-r, -r), (r, r)], c.filled())
+                        }))
+                        .map_err(err)?;
+                }
+            }
+            Layer::Contours(pts, color, size) => {
+                let (c, r) = (rgb(*color), *size as i32);
+                chart
+                    .draw_series(pts.iter().filter(|p| visible(p)).map(|p| {
+                        EmptyElement::at(*p) + Rectangle::new([(0, 0), (r, r)], c.filled())
+                    }))
+                    .map_err(err)?;
+            }
+            Layer::Line(pts, color) => {
+                let c = rgb(*color);
+                // Broken where a point cannot be drawn.
+                for piece in pts.split(|p| !visible(p)) {
+                    if piece.len() > 1 {
+                        chart
+                            .draw_series(LineSeries::new(piece.iter().copied(), c.stroke_width(1)))
+                            .map_err(err)?;
+                    }
+                }
+            }
+            Layer::Legend(entries, bottom) => {
+                for (text, color) in entries {
+                    let c = rgb(*color);
+                    chart
+                        .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                        .map_err(err)?
+                        .label(text.as_str())
+                        .legend(move |(x, y)| {
+                            Rectangle::new([(x, y - 4), (x + 12, y + 4)], c.filled())
+                        });
+                }
+                chart
+                    .configure_series_labels()
+                    .position(if *bottom {
+                        SeriesLabelPosition::LowerLeft
+                    } else {
+                        SeriesLabelPosition::UpperLeft
+                    })
+                    .label_font((FONT, 12))
+                    .background_style(WHITE_COLOR.mix(0.85))
+                    .border_style(RGBColor(180, 180, 180))
+                    .draw()
+                    .map_err(err)?;
+            }
+        }
     }
-    let w = Canvas::text_width(spec.title, 1);
-    canvas.text(
-        panel.left + panel.width / 2 - w / 2,
-        panel.top - 18,
-        spec.title,
-        1,
-        BLACK,
-    );
-    let w = Canvas::text_width(spec.x_label, 1);
-    canvas.text(
-        panel.left + panel.width / 2 - w / 2,
-        b + 24,
-        spec.x_label,
-        1,
-        BLACK,
-    );
-    canvas.text(
-        panel.left - MARGIN_LEFT + 4,
-        panel.top - 18,
-        spec.y_label,
-        1,
-        BLACK,
-    );
+    Ok(())
 }

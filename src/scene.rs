@@ -265,17 +265,34 @@ impl Scene {
         Ok(self.out.join(file))
     }
 
+    /// Writes `file` (a `.png` name) and, where it stays small (no shaded
+    /// map), the same figure as SVG beside it; each through a temporary file
+    /// renamed into place.
     pub fn save_figure(
         &self,
         figure: &crate::plot::Figure,
         file: &str,
     ) -> Result<PathBuf, SceneError> {
         let path = self.path(file)?;
-        figure.save(&path).map_err(|source| SceneError::Io {
-            path: path.clone(),
+        let io = |path: &Path, source: std::io::Error| SceneError::Io {
+            path: path.to_path_buf(),
             source,
-        })?;
+        };
+        let temporary = temporary_beside(&path);
+        figure
+            .save(&temporary)
+            .and_then(|_| std::fs::rename(&temporary, &path))
+            .map_err(|e| io(&path, e))?;
         eprintln!("wrote {}", path.display());
+        if figure.svg_is_cheap() {
+            let svg = path.with_extension("svg");
+            let temporary = temporary_beside(&svg);
+            figure
+                .save_svg(&temporary)
+                .and_then(|_| std::fs::rename(&temporary, &svg))
+                .map_err(|e| io(&svg, e))?;
+            eprintln!("wrote {}", svg.display());
+        }
         Ok(path)
     }
 
@@ -314,6 +331,16 @@ impl Scene {
         let text = serde_json::to_string_pretty(&summary).expect("JSON values serialise");
         self.write_text("summary.json", &text)
     }
+}
+
+/// A temporary name in the same directory with the same extension (the
+/// image encoders choose the format by extension).
+fn temporary_beside(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    path.with_file_name(format!(".tmp{}.{name}", std::process::id()))
 }
 
 /// Writes a file atomically: a temporary file in the same directory, then rename.

@@ -81,6 +81,36 @@ fn run(x2: f64, params: Params, tol: f64, t_end: f64, times: &[f64]) -> HybridRu
 
 /// x2(0) = −0.78: point 2 stops and stays (3a), point 1 stops at once but
 /// cannot stick and reverses (4b), then stops for good (4a): rest.
+/// The forces depend on the positions only through x1 − x2: the generated
+/// code must not cancel catastrophically far from the origin.
+#[test]
+fn generated_forces_are_translation_invariant() {
+    let p = Params {
+        eps: 1e-3,
+        ..Params::default()
+    };
+    let y = [0.3, -0.3, 1.0, 2.0];
+    for shift in [1e2, 1e4, 1e6] {
+        let moved = [y[0] + shift, y[1] + shift, y[2], y[3]];
+        for (a, b) in [
+            (model::free_forces(&y, &p), model::free_forces(&moved, &p)),
+            (
+                model::normal_forces(&y, &p),
+                model::normal_forces(&moved, &p),
+            ),
+        ] {
+            for i in 0..2 {
+                assert!(
+                    (a[i] - b[i]).abs() < 1e-6 * a[i].abs().max(1.0),
+                    "shift {shift}: {} vs {}",
+                    a[i],
+                    b[i]
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn worked_example_friction_impact_stops_reverses_and_rests() {
     let r = run(-0.78, Params::default(), 1e-10, 6.0, &[]);
