@@ -346,6 +346,33 @@ impl Figure {
 
 const WHITE_COLOR: RGBColor = RGBColor(255, 255, 255);
 
+/// A short tick label: round-off hidden (12 significant digits), powers of
+/// ten as 1e-4, no trailing zeros.
+fn tick_label(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let v: f64 = format!("{v:.11e}").parse().unwrap_or(v);
+    let a = v.abs();
+    if !(1e-3..1e5).contains(&a) {
+        let s = format!("{v:e}");
+        match s.split_once('e') {
+            Some((mantissa, exponent)) => {
+                let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+                if mantissa == "1" {
+                    format!("1e{exponent}")
+                } else {
+                    format!("{mantissa}e{exponent}")
+                }
+            }
+            None => s,
+        }
+    } else {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
 /// A usable axis range: ordered, not empty, positive on a log axis.
 fn sane_range((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
@@ -482,6 +509,8 @@ where
         .bold_line_style(RGBColor(215, 215, 215))
         .x_labels(6)
         .y_labels(6)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
         .draw()
         .map_err(err)?;
     for layer in layers {
