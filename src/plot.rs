@@ -496,8 +496,17 @@ where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    // Only what lies in the panel is drawn (plotters would pile the rest
+    // up on the frame); lines are broken where they leave it.
+    let inside = |v: f64, (lo, hi): (f64, f64)| {
+        let pad = 1e-9 * (hi - lo).abs();
+        v >= lo - pad && v <= hi + pad
+    };
     let visible = |&(x, y): &(f64, f64)| {
-        x.is_finite() && y.is_finite() && (!panel.log_x || x > 0.0) && (!panel.log_y || y > 0.0)
+        x.is_finite()
+            && y.is_finite()
+            && inside(x, panel.x_range)
+            && inside(y, panel.y_range)
     };
     chart
         .configure_mesh()
