@@ -349,8 +349,9 @@ const WHITE_COLOR: RGBColor = RGBColor(255, 255, 255);
 /// A short tick label: round-off hidden (12 significant digits), powers of
 /// ten as 1e-4, no trailing zeros.
 fn tick_label(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
+    // Ticks at zero come out of the tick arithmetic as ±1e-17 or so.
+    if v.abs() < 1e-15 || !v.is_finite() {
+        return if v.is_finite() { "0".into() } else { format!("{v}") };
     }
     let v: f64 = format!("{v:.11e}").parse().unwrap_or(v);
     let a = v.abs();
