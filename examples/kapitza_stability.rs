@@ -30,7 +30,7 @@ const KNOBS: &[mechlab::scene::Knob] = &[
     knob(
         "tol",
         "1e-12",
-        "DOP853 tolerance for the monodromy matrices",
+        "DOP853 tolerance of every run (monodromy matrices, orbits, chart)",
     ),
     knob("periods", "2000", "periods per orbit near q = 0"),
     knob("chart_eps", "40", "chart resolution in ε (0.02..0.5)"),
@@ -127,10 +127,7 @@ fn main() {
                 },
             };
             for (s, y0) in starts.iter().enumerate() {
-                let mut integrator = Integrator::new(Method::Dop853 {
-                    rtol: 1e-10,
-                    atol: 1e-10,
-                })?;
+                let mut integrator = Integrator::new(method)?;
                 let points = orbit(
                     &mut integrator,
                     &system,
@@ -206,18 +203,7 @@ fn main() {
         for (i, &e) in eps_values.iter().enumerate() {
             let column: Vec<Result<f64, SceneError>> = a_values
                 .par_iter()
-                .map(|&ca| {
-                    stability_margin(
-                        ca,
-                        e,
-                        mu,
-                        Method::Dop853 {
-                            rtol: 1e-10,
-                            atol: 1e-10,
-                        },
-                    )
-                    .map(|r| r.0)
-                })
+                .map(|&ca| stability_margin(ca, e, mu, method).map(|r| r.0))
                 .collect();
             for (j, g) in column.into_iter().enumerate() {
                 chart[j * ne + i] = if g? <= 0.0 { STABLE_SHADE } else { 0.0 };
@@ -268,8 +254,8 @@ fn main() {
         let eps_list = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
         let a_star_by_eps: Vec<(f64, Option<f64>)> = eps_list
             .par_iter()
-            .map(|&e| (e, critical_amplitude(e, 0.0, method, 4.0).ok().flatten()))
-            .collect();
+            .map(|&e| critical_amplitude(e, 0.0, method, 4.0).map(|s| (e, s)))
+            .collect::<Result<_, _>>()?;
         for (e, s) in &a_star_by_eps {
             println!("ε = {e}: A* = {s:?}, A* − √2 = {:?}", s.map(|x| x - SQRT_2));
         }

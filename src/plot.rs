@@ -351,7 +351,11 @@ const WHITE_COLOR: RGBColor = RGBColor(255, 255, 255);
 fn tick_label(v: f64) -> String {
     // Ticks at zero come out of the tick arithmetic as ±1e-17 or so.
     if v.abs() < 1e-15 || !v.is_finite() {
-        return if v.is_finite() { "0".into() } else { format!("{v}") };
+        return if v.is_finite() {
+            "0".into()
+        } else {
+            format!("{v}")
+        };
     }
     let v: f64 = format!("{v:.11e}").parse().unwrap_or(v);
     let a = v.abs();
@@ -504,10 +508,7 @@ where
         v >= lo - pad && v <= hi + pad
     };
     let visible = |&(x, y): &(f64, f64)| {
-        x.is_finite()
-            && y.is_finite()
-            && inside(x, panel.x_range)
-            && inside(y, panel.y_range)
+        x.is_finite() && y.is_finite() && inside(x, panel.x_range) && inside(y, panel.y_range)
     };
     chart
         .configure_mesh()

@@ -111,6 +111,8 @@ pub(super) struct Locator<'e, 'a, const N: usize> {
     events: &'e [Event<'a, N>],
     settings: EventSettings,
     trackers: Vec<Tracker>,
+    /// The conditions' signs at the current sample (reused: no allocation per step).
+    signs: Vec<f64>,
     pub hits: Vec<EventHit<N>>,
 }
 
@@ -148,6 +150,7 @@ impl<'e, 'a, const N: usize> Locator<'e, 'a, N> {
             events,
             settings,
             trackers,
+            signs: vec![0.0; events.len()],
             hits: Vec::new(),
         })
     }
@@ -176,9 +179,25 @@ impl<'e, 'a, const N: usize> Locator<'e, 'a, N> {
             let ys = if j == m + 1 { yb } else { step.state_at(ts)? };
             // The conditions at the sample, evaluated once; after each located
             // crossing the memory moves on and the same signs are compared again.
-            let signs = self.signs_at(ts, &ys);
+            let mut signs = std::mem::take(&mut self.signs);
+            self.signs_at(ts, &ys, &mut signs);
             loop {
                 // Sign changes in directions nobody watches only update the memory.
+                let changed =
+                    signs
+                        .iter()
+                        .zip(&self.trackers)
+                        .enumerate()
+                        .any(|(event, (&s, tracker))| {
+                            tracker.sign != 0.0
+                                && s != 0.0
+                                && s != tracker.sign
+                                && self.wanted(event, s)
+                        });
+                if !changed {
+                    self.remember(ts, &signs);
+                    break;
+                }
                 let reported: Vec<Crossing> = signs
                     .iter()
                     .zip(&self.trackers)
@@ -230,24 +249,26 @@ impl<'e, 'a, const N: usize> Locator<'e, 'a, N> {
                     });
                     terminal |= self.events[c.event].terminal;
                 }
-                let far_signs = self.signs_at(t_far, &y_far);
+                let mut far_signs = vec![0.0; self.events.len()];
+                self.signs_at(t_far, &y_far, &mut far_signs);
                 self.remember(t_far, &far_signs);
                 if terminal {
+                    self.signs = signs;
                     return Ok(Flow::Stop { t: t_far, y: y_far });
                 }
                 t_from = t_far;
             }
+            self.signs = signs;
             t_from = ts;
         }
         Ok(Flow::Continue)
     }
 
     /// The signs of all conditions at (t, y).
-    fn signs_at(&self, t: f64, y: &[f64; N]) -> Vec<f64> {
-        self.events
-            .iter()
-            .map(|e| sign((e.condition)(t, y)))
-            .collect()
+    fn signs_at(&self, t: f64, y: &[f64; N], out: &mut [f64]) {
+        for (o, e) in out.iter_mut().zip(self.events) {
+            *o = sign((e.condition)(t, y));
+        }
     }
 
     /// Records every nonzero sign seen at t as that event's last sign.

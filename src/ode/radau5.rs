@@ -278,7 +278,7 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
                 let sum: f64 = (0..N).map(|k| (e[k] / scale[k]).powi(2)).sum();
                 (sum / N as f64).sqrt().max(1e-10)
             };
-            let mut e: Vec<f64> = (0..N).map(|k| f0[k] + f2[k]).collect();
+            let mut e: [f64; N] = std::array::from_fn(|k| f0[k] + f2[k]);
             lu_solve(&filter, N, &filter_pivots, &mut e);
             let mut err = error_norm(&e);
             if err >= 1.0 && (first || rejected) {
