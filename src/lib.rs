@@ -24,6 +24,7 @@
 
 pub mod analysis;
 pub mod contact;
+pub mod explore;
 pub mod model;
 pub mod models;
 pub mod ode;

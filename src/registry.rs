@@ -24,6 +24,8 @@ pub struct ModelInfo {
     pub coordinates: &'static [&'static str],
     pub momenta: &'static [&'static str],
     pub parameter_names: &'static [&'static str],
+    /// Defaults of the model file, as text.
+    pub parameter_defaults: &'static [&'static str],
     pub parameter_descriptions: &'static [&'static str],
     pub derivations: &'static [DerivedExpression],
     /// Cost of the right-hand sides after CSE (arithmetic operations,
@@ -37,6 +39,58 @@ pub struct ModelInfo {
 /// Finds a model by name.
 pub fn find(name: &str) -> Option<&'static ModelInfo> {
     crate::models::ALL.iter().find(|m| m.name == name)
+}
+
+/// How a model moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Hamilton's equations in [q; p], with or without a fast phase.
+    Hamiltonian { dof: usize, fast_phase: bool },
+    /// Points on rough guides, state [s; s'], integrated with stick–slip switching.
+    Contacts { count: usize },
+}
+
+/// Any generated model with dynamically sized states and parameters in
+/// declaration order, so that one scene can run a model chosen by name.
+/// Methods that do not apply to a model's kind return `None`.
+pub trait DynamicModel: Sync {
+    fn info(&self) -> &'static ModelInfo;
+    fn kind(&self) -> Kind;
+    fn defaults(&self) -> Vec<f64>;
+    /// Which coordinates are angles.
+    fn periodic(&self) -> Vec<bool>;
+    /// The exact right-hand side (Hamiltonian models).
+    fn exact_rhs(&self, _params: &[f64], _t: f64, _y: &[f64]) -> Vec<f64> {
+        unimplemented!("a contact model has no smooth right-hand side")
+    }
+    fn averaged_rhs(&self, _params: &[f64], _y: &[f64]) -> Option<Vec<f64>> {
+        None
+    }
+    /// H (Hamiltonian models) or the energy function (contact models).
+    fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> f64;
+    fn averaged_energy(&self, _params: &[f64], _y: &[f64]) -> Option<f64> {
+        None
+    }
+    /// V + V_vibr (V without a fast phase).
+    fn effective_potential(&self, _params: &[f64], _q: &[f64]) -> Option<f64> {
+        None
+    }
+    /// Its Hessian, row-major.
+    fn effective_potential_hessian(&self, _params: &[f64], _q: &[f64]) -> Option<Vec<f64>> {
+        None
+    }
+    /// The period of the fast phase.
+    fn phase_period(&self, _params: &[f64]) -> Option<f64> {
+        None
+    }
+    /// Free forces and normal reactions (contact models).
+    fn contact_forces(&self, _params: &[f64], _y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        None
+    }
+    /// Masses and friction coefficients (contact models).
+    fn contact_constants(&self, _params: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        None
+    }
 }
 
 /// A parameter that cannot be set.

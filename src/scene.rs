@@ -161,6 +161,18 @@ impl Scene {
         })
     }
 
+    /// The value given on the command line for `--set name=…`, before the
+    /// knobs are known (a scene whose knobs depend on it, like `explore`).
+    pub fn peek(name: &str) -> Option<String> {
+        let args: Vec<String> = std::env::args().collect();
+        args.windows(2)
+            .filter(|w| w[0] == "--set")
+            .filter_map(|w| w[1].split_once('='))
+            .filter(|(k, _)| *k == name)
+            .map(|(_, v)| v.to_string())
+            .last()
+    }
+
     /// The text value of a knob.
     pub fn text(&self, name: &str) -> &str {
         &self

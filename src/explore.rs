@@ -1,0 +1,389 @@
+//! Exploring any model by name: one run of the exact system (and of the
+//! averaged one when the model has a fast phase, or the stick–slip
+//! integrator for a contact model), the period map, the equilibria of the
+//! effective potential with their stability, and the energy change.
+//!
+//! The models are reached through [`DynamicModel`] (slices, any size); the
+//! integrators are fixed-size, so the state length is dispatched once to a
+//! const-generic instance (2, 4 or 6: up to three degrees of freedom or
+//! three contacts). The slice conversions cost an allocation per call: the
+//! explorer is for looking, the study scenes for measuring.
+
+use crate::contact::{ContactError, ContactModel, StickSlip};
+use crate::ode::{Integrator, Method, OdeError, System};
+use crate::registry::{DynamicModel, Kind};
+use std::fmt;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    pub method: Method,
+    pub t_end: f64,
+    /// Samples of the time series.
+    pub samples: usize,
+    /// Periods of the period map (models with a fast phase).
+    pub periods: usize,
+}
+
+/// An equilibrium of the effective potential (V + V_vibr, or V).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Equilibrium {
+    pub q: Vec<f64>,
+    /// Eigenvalues of the Hessian, ascending.
+    pub hessian_eigenvalues: Vec<f64>,
+    /// A strict minimum: stable.
+    pub stable: bool,
+}
+
+/// Everything the explorer computed.
+#[derive(Clone, Debug, Default)]
+pub struct Exploration {
+    pub times: Vec<f64>,
+    pub exact: Vec<Vec<f64>>,
+    /// The averaged system from the same state (fast phase only).
+    pub averaged: Option<Vec<Vec<f64>>>,
+    /// Exact states at multiples of the phase period (fast phase only).
+    pub period_map: Option<Vec<Vec<f64>>>,
+    /// H(t) − H(0) along the exact run for an autonomous model, H̄ along the
+    /// averaged run for a model with a fast phase, E for contacts.
+    pub energy_change: Vec<f64>,
+    pub energy_label: &'static str,
+    pub equilibria: Vec<Equilibrium>,
+    /// Switches of a contact model, as text.
+    pub switches: Vec<String>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExploreError {
+    Ode(OdeError),
+    Contact(ContactError),
+    /// A state of the wrong length or an unsupported size.
+    Shape(String),
+}
+
+impl fmt::Display for ExploreError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ExploreError::Ode(e) => write!(f, "{e}"),
+            ExploreError::Contact(e) => write!(f, "{e}"),
+            ExploreError::Shape(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for ExploreError {}
+
+impl From<OdeError> for ExploreError {
+    fn from(e: OdeError) -> Self {
+        ExploreError::Ode(e)
+    }
+}
+
+impl From<ContactError> for ExploreError {
+    fn from(e: ContactError) -> Self {
+        ExploreError::Contact(e)
+    }
+}
+
+struct Exact<'a, const M: usize> {
+    model: &'a dyn DynamicModel,
+    params: &'a [f64],
+}
+
+impl<const M: usize> System<M> for Exact<'_, M> {
+    fn rhs(&self, t: f64, y: &[f64; M]) -> [f64; M] {
+        to_array(&self.model.exact_rhs(self.params, t, y))
+    }
+}
+
+struct Averaged<'a, const M: usize> {
+    model: &'a dyn DynamicModel,
+    params: &'a [f64],
+}
+
+impl<const M: usize> System<M> for Averaged<'_, M> {
+    fn rhs(&self, _t: f64, y: &[f64; M]) -> [f64; M] {
+        to_array(&self.model.averaged_rhs(self.params, y).unwrap_or_default())
+    }
+}
+
+struct Contacts<'a> {
+    model: &'a dyn DynamicModel,
+    params: &'a [f64],
+}
+
+impl<const C: usize, const M: usize> ContactModel<C, M> for Contacts<'_> {
+    fn free_forces(&self, y: &[f64; M]) -> [f64; C] {
+        to_array(
+            &self
+                .model
+                .contact_forces(self.params, y)
+                .unwrap_or_default()
+                .0,
+        )
+    }
+    fn normal_forces(&self, y: &[f64; M]) -> [f64; C] {
+        to_array(
+            &self
+                .model
+                .contact_forces(self.params, y)
+                .unwrap_or_default()
+                .1,
+        )
+    }
+    fn masses(&self) -> [f64; C] {
+        to_array(
+            &self
+                .model
+                .contact_constants(self.params)
+                .unwrap_or_default()
+                .0,
+        )
+    }
+    fn friction(&self) -> [f64; C] {
+        to_array(
+            &self
+                .model
+                .contact_constants(self.params)
+                .unwrap_or_default()
+                .1,
+        )
+    }
+}
+
+fn to_array<const N: usize>(v: &[f64]) -> [f64; N] {
+    std::array::from_fn(|i| v.get(i).copied().unwrap_or(f64::NAN))
+}
+
+/// Runs everything the explorer shows for `model` from `y0`.
+pub fn explore(
+    model: &dyn DynamicModel,
+    params: &[f64],
+    y0: &[f64],
+    settings: &Settings,
+) -> Result<Exploration, ExploreError> {
+    let expected = match model.kind() {
+        Kind::Hamiltonian { dof, .. } => 2 * dof,
+        Kind::Contacts { count } => 2 * count,
+    };
+    if y0.len() != expected {
+        return Err(ExploreError::Shape(format!(
+            "the state of '{}' has {expected} components, got {}",
+            model.info().name,
+            y0.len()
+        )));
+    }
+    match (model.kind(), expected) {
+        (Kind::Hamiltonian { .. }, 2) => hamiltonian::<2>(model, params, y0, settings),
+        (Kind::Hamiltonian { .. }, 4) => hamiltonian::<4>(model, params, y0, settings),
+        (Kind::Hamiltonian { .. }, 6) => hamiltonian::<6>(model, params, y0, settings),
+        (Kind::Contacts { .. }, 2) => contacts::<1, 2>(model, params, y0, settings),
+        (Kind::Contacts { .. }, 4) => contacts::<2, 4>(model, params, y0, settings),
+        (Kind::Contacts { .. }, 6) => contacts::<3, 6>(model, params, y0, settings),
+        _ => Err(ExploreError::Shape(format!(
+            "states of length {expected} are not supported"
+        ))),
+    }
+}
+
+fn grid(t_end: f64, samples: usize) -> Vec<f64> {
+    (0..=samples.max(1))
+        .map(|i| t_end * i as f64 / samples.max(1) as f64)
+        .collect()
+}
+
+fn hamiltonian<const M: usize>(
+    model: &dyn DynamicModel,
+    params: &[f64],
+    y0: &[f64],
+    settings: &Settings,
+) -> Result<Exploration, ExploreError> {
+    let y0: [f64; M] = to_array(y0);
+    let times = grid(settings.t_end, settings.samples);
+    let exact_system = Exact::<M> { model, params };
+    let exact =
+        Integrator::new(settings.method)?.advance_sampled(&exact_system, 0.0, &y0, &times)?;
+    let mut out = Exploration {
+        exact: exact.iter().map(|y| y.to_vec()).collect(),
+        equilibria: equilibria(model, params),
+        ..Default::default()
+    };
+    match model.phase_period(params) {
+        Some(period) => {
+            let averaged_system = Averaged::<M> { model, params };
+            let averaged = Integrator::new(settings.method)?.advance_sampled(
+                &averaged_system,
+                0.0,
+                &y0,
+                &times,
+            )?;
+            let h0 = model.averaged_energy(params, &y0).unwrap_or(0.0);
+            out.energy_change = averaged
+                .iter()
+                .map(|y| model.averaged_energy(params, y).unwrap_or(0.0) - h0)
+                .collect();
+            out.energy_label = "H̄(t) − H̄(0) along the averaged run";
+            out.averaged = Some(averaged.iter().map(|y| y.to_vec()).collect());
+            let map_times: Vec<f64> = (0..=settings.periods).map(|k| k as f64 * period).collect();
+            let map = Integrator::new(settings.method)?.advance_sampled(
+                &exact_system,
+                0.0,
+                &y0,
+                &map_times,
+            )?;
+            out.period_map = Some(map.iter().map(|y| y.to_vec()).collect());
+        }
+        None => {
+            let h0 = model.energy(params, 0.0, &y0);
+            out.energy_change = times
+                .iter()
+                .zip(&exact)
+                .map(|(t, y)| model.energy(params, *t, y) - h0)
+                .collect();
+            out.energy_label = "H(t) − H(0) along the exact run";
+        }
+    }
+    out.times = times;
+    Ok(out)
+}
+
+fn contacts<const C: usize, const M: usize>(
+    model: &dyn DynamicModel,
+    params: &[f64],
+    y0: &[f64],
+    settings: &Settings,
+) -> Result<Exploration, ExploreError> {
+    let y0: [f64; M] = to_array(y0);
+    let times = grid(settings.t_end, settings.samples);
+    let system = Contacts { model, params };
+    let run = StickSlip::new(settings.method).run::<_, C, M>(
+        &system,
+        0.0,
+        &y0,
+        settings.t_end,
+        &times,
+    )?;
+    let e0 = model.energy(params, 0.0, &y0);
+    Ok(Exploration {
+        times: run.samples.iter().map(|(t, _)| *t).collect(),
+        exact: run.samples.iter().map(|(_, y)| y.to_vec()).collect(),
+        energy_change: run
+            .samples
+            .iter()
+            .map(|(t, y)| model.energy(params, *t, y) - e0)
+            .collect(),
+        energy_label: "E(t) − E(0): friction and dissipation work",
+        switches: run
+            .switches
+            .iter()
+            .map(|s| {
+                format!(
+                    "t = {:.6}: contact {} {} → {} (case {})",
+                    s.t,
+                    s.contact + 1,
+                    s.from,
+                    s.to,
+                    s.case
+                )
+            })
+            .collect(),
+        ..Default::default()
+    })
+}
+
+/// Equilibria of the effective potential: Newton's method on its gradient
+/// (central differences) with the generated Hessian, from a grid of starts
+/// (12 per coordinate: angles over [−π, π), others over [−2, 2)); duplicates
+/// (angles modulo 2π) merged.
+pub fn equilibria(model: &dyn DynamicModel, params: &[f64]) -> Vec<Equilibrium> {
+    let periodic = model.periodic();
+    let n = periodic.len();
+    if model.effective_potential(params, &vec![0.0; n]).is_none() || n > 3 {
+        return Vec::new();
+    }
+    let v = |q: &[f64]| model.effective_potential(params, q).unwrap_or(f64::NAN);
+    let gradient = |q: &[f64]| -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let h = 1e-6 * (1.0 + q[i].abs());
+                let (mut a, mut b) = (q.to_vec(), q.to_vec());
+                a[i] += h;
+                b[i] -= h;
+                (v(&a) - v(&b)) / (2.0 * h)
+            })
+            .collect()
+    };
+    let per_axis: usize = 12;
+    let starts: Vec<Vec<f64>> = (0..per_axis.pow(n as u32))
+        .map(|mut k| {
+            (0..n)
+                .map(|i| {
+                    let j = k % per_axis;
+                    k /= per_axis;
+                    // The grid includes 0 and −π, where symmetric models have equilibria.
+                    let u = j as f64 / per_axis as f64;
+                    if periodic[i] {
+                        -std::f64::consts::PI + 2.0 * std::f64::consts::PI * u
+                    } else {
+                        -2.0 + 4.0 * u
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let mut found: Vec<Equilibrium> = Vec::new();
+    for start in starts {
+        let mut q = start;
+        for _ in 0..50 {
+            let g = gradient(&q);
+            let h = model
+                .effective_potential_hessian(params, &q)
+                .unwrap_or_default();
+            let hm = nalgebra::DMatrix::from_row_slice(n, n, &h);
+            let Some(step) = hm.lu().solve(&nalgebra::DVector::from_vec(g.clone())) else {
+                break;
+            };
+            for i in 0..n {
+                q[i] -= step[i];
+            }
+            if step.norm() < 1e-12 {
+                break;
+            }
+        }
+        let g = gradient(&q);
+        if !q.iter().all(|x| x.is_finite()) || g.iter().map(|x| x * x).sum::<f64>().sqrt() > 1e-7 {
+            continue;
+        }
+        for (x, p) in q.iter_mut().zip(&periodic) {
+            if *p {
+                *x = crate::analysis::period_map::wrap_angle(*x);
+            }
+        }
+        if found.iter().any(|e| {
+            e.q.iter().zip(&q).zip(&periodic).all(|((a, b), p)| {
+                let d = if *p {
+                    crate::analysis::period_map::wrap_angle(a - b)
+                } else {
+                    a - b
+                };
+                d.abs() < 1e-6
+            })
+        }) {
+            continue;
+        }
+        let h = model
+            .effective_potential_hessian(params, &q)
+            .unwrap_or_default();
+        let hm = nalgebra::DMatrix::from_row_slice(n, n, &h);
+        let sym = (&hm + hm.transpose()) * 0.5;
+        let mut eigenvalues: Vec<f64> = sym.symmetric_eigenvalues().iter().copied().collect();
+        eigenvalues.sort_by(f64::total_cmp);
+        let stable = eigenvalues.iter().all(|l| *l > 1e-9);
+        found.push(Equilibrium {
+            q,
+            hessian_eigenvalues: eigenvalues,
+            stable,
+        });
+    }
+    found
+}

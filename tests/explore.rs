@@ -1,0 +1,69 @@
+//! The explorer runs on every model of `models/`, including those added as
+//! files only, and finds the equilibria the closed forms predict.
+
+use mechlab::explore::{explore, Settings};
+use mechlab::models;
+use mechlab::ode::Method;
+use mechlab::registry::Kind;
+
+fn settings() -> Settings {
+    Settings {
+        method: Method::parse("dop853", 1e-8).unwrap(),
+        t_end: 1.0,
+        samples: 50,
+        periods: 5,
+    }
+}
+
+#[test]
+fn every_model_can_be_explored() {
+    for info in models::ALL {
+        let model = models::dynamic(info.name).expect("every model is listed");
+        let (n, phase) = match model.kind() {
+            Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
+            Kind::Contacts { count } => (count, false),
+        };
+        let y0: Vec<f64> = (0..n)
+            .map(|i| 0.3 - 0.5 * i as f64)
+            .chain((0..n).map(|_| 0.5))
+            .collect();
+        let result = explore(model, &model.defaults(), &y0, &settings())
+            .unwrap_or_else(|e| panic!("{}: {e}", info.name));
+        assert!(
+            result.exact.iter().flatten().all(|x| x.is_finite()),
+            "{}",
+            info.name
+        );
+        assert_eq!(result.averaged.is_some(), phase, "{}", info.name);
+        assert_eq!(result.period_map.is_some(), phase, "{}", info.name);
+        assert_eq!(result.energy_change.len(), result.times.len());
+    }
+}
+
+#[test]
+fn a_state_of_the_wrong_length_is_an_error() {
+    let model = models::dynamic("kapitza").unwrap();
+    assert!(explore(model, &model.defaults(), &[0.1, 0.0, 0.0], &settings()).is_err());
+}
+
+/// Kapitza at A = 1.5: V + V_vibr = cos q + (A²/4) sin²q has minima at 0
+/// (V'' = A²/2 − 1) and π (V'' = 1 + A²/2) and maxima at cos q = 2/A².
+#[test]
+fn kapitza_equilibria_match_the_closed_form() {
+    let model = models::dynamic("kapitza").unwrap();
+    let a: f64 = 1.5;
+    let mut params = model.defaults();
+    params[0] = a;
+    let found = mechlab::explore::equilibria(model, &params);
+    assert_eq!(found.len(), 4, "{found:?}");
+    let at = |q: f64| {
+        found
+            .iter()
+            .find(|e| mechlab::analysis::period_map::wrap_angle(e.q[0] - q).abs() < 1e-6)
+            .unwrap_or_else(|| panic!("no equilibrium at {q}: {found:?}"))
+    };
+    assert!(at(0.0).stable && (at(0.0).hessian_eigenvalues[0] - (a * a / 2.0 - 1.0)).abs() < 1e-9);
+    assert!(at(std::f64::consts::PI).stable);
+    let saddle = (2.0 / (a * a)).acos();
+    assert!(!at(saddle).stable && !at(-saddle).stable);
+}
