@@ -128,7 +128,7 @@ fn main() {
         let mut entries = Vec::new();
         let mut titles = Vec::new();
         let mut panels: Vec<Panels> = Vec::new();
-        let mut progress = Progress::new("equilibria", EQUILIBRIA.len());
+        let progress = Progress::new("equilibria", EQUILIBRIA.len());
         for (k, phi) in EQUILIBRIA.iter().enumerate() {
             let analysis = analyse_equilibrium(&params, *phi);
             let formula = threshold_formula(*phi);

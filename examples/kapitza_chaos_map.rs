@@ -10,7 +10,6 @@ use mechlab::plot::{ColorMap, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Progress, Scene, SceneError};
 use rayon::prelude::*;
 use std::f64::consts::PI;
-use std::sync::Mutex;
 
 fn main() {
     run(|| {
@@ -51,7 +50,7 @@ fn main() {
         };
 
         // Rows in parallel, in deterministic order; progress by rows.
-        let progress = Mutex::new((0usize, Progress::new("kapitza_chaos_map rows", pixels)));
+        let progress = Progress::new("kapitza_chaos_map rows", pixels);
         let start = std::time::Instant::now();
         let rows: Vec<Result<(Vec<f64>, u64), SceneError>> = (0..pixels)
             .into_par_iter()
@@ -71,10 +70,7 @@ fn main() {
                         )
                     })
                     .collect::<Result<Vec<f64>, _>>()?;
-                let mut guard = progress.lock().unwrap();
-                guard.0 += 1;
-                let done = guard.0;
-                guard.1.update(done);
+                progress.inc();
                 Ok((row, integrator.stats.f_evals))
             })
             .collect();

@@ -198,7 +198,7 @@ fn main() {
         let a_values: Vec<f64> = (0..na)
             .map(|j| a_max * (j as f64 + 0.5) / na as f64)
             .collect();
-        let mut progress = Progress::new("stability chart (ε rows)", ne);
+        let progress = Progress::new("stability chart (ε rows)", ne);
         let mut chart = vec![0.0; ne * na];
         for (i, &e) in eps_values.iter().enumerate() {
             let column: Vec<Result<f64, SceneError>> = a_values

@@ -304,7 +304,7 @@ fn sweep<S: System<N>, const N: usize, const M: usize>(
     rows: &mut Vec<Row>,
     failures: &mut Vec<serde_json::Value>,
 ) {
-    let mut progress = Progress::new(problem, list.len());
+    let progress = Progress::new(problem, list.len());
     let start = Instant::now();
     // A method whose run took longer than the budget is not run at tighter settings.
     let mut over_budget: Vec<&'static str> = Vec::new();

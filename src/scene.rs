@@ -370,28 +370,38 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     std::fs::rename(&temporary, path)
 }
 
-/// Progress on stderr for long runs: "label: done/total (percent)".
+/// A progress bar on stderr with rate and ETA (indicatif); it can be
+/// advanced from rayon workers (`inc`) or set from the main thread
+/// (`update`), and stays silent when stderr is not a terminal.
 pub struct Progress {
-    label: String,
-    total: usize,
-    last_percent: usize,
+    bar: indicatif::ProgressBar,
 }
 
 impl Progress {
     pub fn new(label: &str, total: usize) -> Progress {
-        Progress {
-            label: label.to_string(),
-            total: total.max(1),
-            last_percent: usize::MAX,
+        let bar = indicatif::ProgressBar::new(total.max(1) as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} [{bar:30}] {pos}/{len} ({per_sec}, eta {eta})",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
+        );
+        bar.set_message(label.to_string());
+        Progress { bar }
+    }
+    /// Sets the number of finished items.
+    pub fn update(&self, done: usize) {
+        self.bar.set_position(done as u64);
+        if done as u64 >= self.bar.length().unwrap_or(0) {
+            self.bar.finish();
         }
     }
-    pub fn update(&mut self, done: usize) {
-        let percent = done * 100 / self.total;
-        if percent / 10 != self.last_percent / 10 || done == self.total {
-            if percent != self.last_percent {
-                eprintln!("{}: {done}/{} ({percent}%)", self.label, self.total);
-            }
-            self.last_percent = percent;
+    /// One more item finished (from any thread).
+    pub fn inc(&self) {
+        self.bar.inc(1);
+        if self.bar.position() >= self.bar.length().unwrap_or(0) {
+            self.bar.finish();
         }
     }
 }
