@@ -96,38 +96,16 @@ pub struct HybridRun<const C: usize, const M: usize> {
 }
 
 /// Why a run stopped with an error.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ContactError {
-    Ode(OdeError),
+    #[error(transparent)]
+    Ode(#[from] OdeError),
     /// More than `limit` switches within `window` of time: chattering.
-    Chattering {
-        t: f64,
-        limit: usize,
-        window: f64,
-    },
+    #[error("chattering at t = {t}: more than {limit} switches within {window} time units")]
+    Chattering { t: f64, limit: usize, window: f64 },
     /// A bad initial state or setting.
+    #[error("{0}")]
     Invalid(String),
-}
-
-impl fmt::Display for ContactError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ContactError::Ode(e) => write!(f, "{e}"),
-            ContactError::Chattering { t, limit, window } => write!(
-                f,
-                "chattering at t = {t}: more than {limit} switches within {window} time units"
-            ),
-            ContactError::Invalid(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for ContactError {}
-
-impl From<OdeError> for ContactError {
-    fn from(e: OdeError) -> Self {
-        ContactError::Ode(e)
-    }
 }
 
 /// The smooth motion in fixed modes.

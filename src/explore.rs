@@ -12,7 +12,6 @@
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Integrator, Method, OdeError, System};
 use crate::registry::{DynamicModel, Kind};
-use std::fmt;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -53,36 +52,16 @@ pub struct Exploration {
     pub switches: Vec<String>,
 }
 
-#[derive(Clone, Debug, PartialEq)]
+/// Why an exploration failed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ExploreError {
-    Ode(OdeError),
-    Contact(ContactError),
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+    #[error(transparent)]
+    Contact(#[from] ContactError),
     /// A state of the wrong length or an unsupported size.
+    #[error("{0}")]
     Shape(String),
-}
-
-impl fmt::Display for ExploreError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ExploreError::Ode(e) => write!(f, "{e}"),
-            ExploreError::Contact(e) => write!(f, "{e}"),
-            ExploreError::Shape(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for ExploreError {}
-
-impl From<OdeError> for ExploreError {
-    fn from(e: OdeError) -> Self {
-        ExploreError::Ode(e)
-    }
-}
-
-impl From<ContactError> for ExploreError {
-    fn from(e: ContactError) -> Self {
-        ExploreError::Contact(e)
-    }
 }
 
 struct Exact<'a, const M: usize> {

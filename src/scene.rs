@@ -3,7 +3,6 @@
 //! PNG figures, CSV data and `summary.json`. Every file is written to a
 //! temporary name first and renamed, so results are never half-written.
 
-use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -24,40 +23,27 @@ pub const fn knob(name: &'static str, default: &'static str, help: &'static str)
 }
 
 /// Why a scene could not run.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// Bad command line.
+    #[error("{0}")]
     Usage(String),
     /// A `--set` value that does not parse or is out of range.
+    #[error("--set {name}={value}: {reason}")]
     BadValue {
         name: String,
         value: String,
         reason: String,
     },
+    #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
         source: std::io::Error,
     },
     /// A numerical failure (divergence, ...), with context.
+    #[error("{0}")]
     Numerical(String),
 }
-
-impl fmt::Display for SceneError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            SceneError::Usage(m) => write!(f, "{m}"),
-            SceneError::BadValue {
-                name,
-                value,
-                reason,
-            } => write!(f, "--set {name}={value}: {reason}"),
-            SceneError::Io { path, source } => write!(f, "{}: {source}", path.display()),
-            SceneError::Numerical(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for SceneError {}
 
 impl From<crate::ode::OdeError> for SceneError {
     fn from(e: crate::ode::OdeError) -> Self {

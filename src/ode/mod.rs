@@ -13,7 +13,6 @@ mod radau5;
 mod rk4;
 
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
-use std::fmt;
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
 pub trait System<const N: usize> {
@@ -170,71 +169,26 @@ impl std::ops::AddAssign for Stats {
 }
 
 /// Why an integration stopped.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum OdeError {
+    #[error("unknown method '{0}' (known: {known})", known = METHOD_NAMES.join(", "))]
     UnknownMethod(String),
-    InvalidSetting {
-        what: &'static str,
-        value: f64,
-    },
+    #[error("invalid {what}: {value} (must be finite and positive)")]
+    InvalidSetting { what: &'static str, value: f64 },
     /// The initial state or time is NaN or infinite.
-    NonFiniteInitialState {
-        t: f64,
-        y: Vec<f64>,
-    },
+    #[error("initial state is not finite: t = {t}, y = {y:?}")]
+    NonFiniteInitialState { t: f64, y: Vec<f64> },
     /// The solution became NaN or infinite (the run diverged).
-    NonFinite {
-        t: f64,
-        y: Vec<f64>,
-    },
-    StepSizeUnderflow {
-        t: f64,
-        h: f64,
-    },
-    TooManySteps {
-        t: f64,
-        max_steps: u64,
-    },
+    #[error("solution diverged (non-finite state) at t = {t}: y = {y:?}")]
+    NonFinite { t: f64, y: Vec<f64> },
+    #[error("step size underflow at t = {t} (h = {h:e})")]
+    StepSizeUnderflow { t: f64, h: f64 },
+    #[error("more than {max_steps} steps, stopped at t = {t}")]
+    TooManySteps { t: f64, max_steps: u64 },
     /// The implicit stage equations did not converge.
-    NoConvergence {
-        t: f64,
-        h: f64,
-        y: Vec<f64>,
-    },
+    #[error("implicit stage equations did not converge at t = {t} with h = {h:e}, y = {y:?}")]
+    NoConvergence { t: f64, h: f64, y: Vec<f64> },
 }
-
-impl fmt::Display for OdeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            OdeError::UnknownMethod(name) => write!(
-                f,
-                "unknown method '{name}' (known: {})",
-                METHOD_NAMES.join(", ")
-            ),
-            OdeError::InvalidSetting { what, value } => {
-                write!(f, "invalid {what}: {value} (must be finite and positive)")
-            }
-            OdeError::NonFiniteInitialState { t, y } => {
-                write!(f, "initial state is not finite: t = {t}, y = {y:?}")
-            }
-            OdeError::NonFinite { t, y } => write!(
-                f,
-                "solution diverged (non-finite state) at t = {t}: y = {y:?}"
-            ),
-            OdeError::StepSizeUnderflow { t, h } => {
-                write!(f, "step size underflow at t = {t} (h = {h:e})")
-            }
-            OdeError::TooManySteps { t, max_steps } => {
-                write!(f, "more than {max_steps} steps, stopped at t = {t}")
-            }
-            OdeError::NoConvergence { t, h, y } => {
-                write!(f, "implicit stage equations did not converge at t = {t} with h = {h:e}, y = {y:?}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for OdeError {}
 
 /// Solver state: the method, the last step size, statistics.
 #[derive(Clone, Debug)]
