@@ -30,5 +30,6 @@ pub mod models;
 pub mod ode;
 pub mod plot;
 pub mod registry;
+pub mod report;
 pub mod scene;
 pub mod studies;

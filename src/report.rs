@@ -1,0 +1,154 @@
+//! The browsable report: one static `index.html` over the scenes' outputs,
+//! a section per deliverable with its figure, the key numbers read from the
+//! scene's `summary.json` and a line saying what it shows. No network: the
+//! figures are linked files, formulas are shown as the LaTeX of the
+//! derivations.
+
+use serde_json::Value;
+use std::path::Path;
+
+/// One deliverable: where its figure and numbers come from.
+pub struct Section {
+    pub id: &'static str,
+    pub title: &'static str,
+    pub scene: &'static str,
+    pub figure: &'static str,
+    pub shows: &'static str,
+    /// (label, JSON pointer into summary.json).
+    pub numbers: &'static [(&'static str, &'static str)],
+}
+
+/// Every deliverable, in study order.
+pub const SECTIONS: &[Section] = &[
+    Section { id: "1.2-1.4", title: "Kapitza pendulum: period map", scene: "kapitza_period_map", figure: "portrait_A1.png",
+        shows: "Orbits of the period map on the cylinder; at A = 1 a chaotic sea around islands of regular motion (portrait_A0.png: the ordinary pendulum; portrait_A0.2.png: chaos only near the separatrices).",
+        numbers: &[("ε", "/eps"), ("μ", "/mu")] },
+    Section { id: "1.5-1.6", title: "Kapitza pendulum: the upper position", scene: "kapitza_stability", figure: "orbits_near_upper_position.png",
+        shows: "Orbits near q = 0 below and above the critical amplitude A*, and the spiral into q = 0 with friction.",
+        numbers: &[("A* (exact)", "/a_star"), ("A* (averaged, √2)", "/a_star_averaged"), ("verdict at the given A", "/verdict")] },
+    Section { id: "1.6", title: "Kapitza pendulum: stability chart", scene: "kapitza_stability", figure: "stability_chart.png",
+        shows: "Where q = 0 is stable in the (ε, A) plane: above √2 for small ε, and bounded above by parametric resonance.",
+        numbers: &[] },
+    Section { id: "1.4", title: "Kapitza pendulum: FLI chaos map", scene: "kapitza_chaos_map", figure: "chaos_map_viridis.png",
+        shows: "Every point shaded by the fast Lyapunov indicator of its orbit: the chaotic layer along the separatrices.",
+        numbers: &[("chaotic fraction", "/chaotic_fraction"), ("seconds", "/seconds")] },
+    Section { id: "1-web", title: "Illustration: the standard map", scene: "standard_map", figure: "chaos_map.png",
+        shows: "The stochastic web of the Chirikov standard map at ε = 0.16.",
+        numbers: &[("ε", "/eps"), ("chaotic fraction", "/chaotic_fraction")] },
+    Section { id: "1.7", title: "Kapitza pendulum: strange attractor", scene: "kapitza_attractor", figure: "attractor.png",
+        shows: "With friction the period map settles on a Hénon-like strange attractor.",
+        numbers: &[("Lyapunov exponents", "/lyapunov"), ("box-counting dimension", "/dimension"), ("Kaplan–Yorke dimension", "/kaplan_yorke_dimension")] },
+    Section { id: "2.2", title: "Double pendulum: Theorem 2", scene: "double_pendulum_averaging", figure: "averaging.png",
+        shows: "Exact (large ν) and limiting systems from the same (q, p): coordinates coincide to O(1/ν), velocities differ by O(1).",
+        numbers: &[("ν", "/nu"), ("max deviation, first case", "/cases/0/max_deviation")] },
+    Section { id: "2.3", title: "Double pendulum: deviation of order 1/ν", scene: "double_pendulum_convergence", figure: "convergence.png",
+        shows: "Max deviation against ν on log-log axes (slope −1) and ν × max deviation levelling off.",
+        numbers: &[("slopes", "/slope"), ("observation time", "/t_obs")] },
+    Section { id: "2.4", title: "Double pendulum: stabilisation", scene: "double_pendulum_stabilization", figure: "stabilization.png",
+        shows: "Limiting runs above and below a*, and the exact system's spectral radius against a: stable from a* up to a parametric resonance.",
+        numbers: &[("a* at (0, 0)", "/equilibria/0/a_star"), ("a* at (0, π)", "/equilibria/1/a_star"), ("exact window at (0, 0)", "/equilibria/0/exact_window"), ("formula at (0, 0)", "/equilibria/0/a_star_formula")] },
+    Section { id: "2.5", title: "Double pendulum: Theorem 3 with friction", scene: "double_pendulum_friction", figure: "friction.png",
+        shows: "A perturbation decays in both systems; the exact Floquet multipliers lie inside the unit circle as the averaged eigenvalues predict.",
+        numbers: &[("max Re λ (averaged)", "/max_real_part"), ("μ", "/mu"), ("a", "/a")] },
+    Section { id: "3.1-3.2", title: "Painlevé–Klein: the graphs of Φ", scene: "painleve_phi", figure: "phi.png",
+        shows: "The six qualitatively different graphs of Φ(R), their regions, and the roots for the worked example.",
+        numbers: &[("roots, σ = +1", "/given/0/roots"), ("case, σ = +1", "/given/0/case")] },
+    Section { id: "3.3-3.4", title: "Painlevé–Klein: the deformation equation", scene: "painleve_delta", figure: "portraits.png",
+        shows: "Equilibria of (25) with their stability, and phase portraits for ν = 0 and ν ≠ 0 for every class.",
+        numbers: &[("worked example equilibria", "/cases/6/equilibria")] },
+    Section { id: "3.5-3.6", title: "Painlevé–Klein: friction impact", scene: "painleve_klein_impact", figure: "impact.png",
+        shows: "The worked example with stick–slip switching: constant acceleration from x2(0) = −0.65, a friction impact and rest from −0.78.",
+        numbers: &[("events of the impact", "/cases/1/events"), ("final states", "/cases/1/final")] },
+    Section { id: "3.x", title: "Painlevé–Klein: the stiff limit", scene: "painleve_stiff_limit", figure: "stiff_limit.png",
+        shows: "ε = 0.1 … 0.001: R(t) → R* in fast time, the impact sharpening, switch times against ε.",
+        numbers: &[("rigid R*", "/rigid_R_star")] },
+    Section { id: "cost", title: "Work against precision", scene: "work_precision", figure: "kapitza_chaotic.png",
+        shows: "Error against time and f-evaluations for every method on the chaotic Kapitza orbit (other problems beside it).",
+        numbers: &[("slopes (chaotic Kapitza)", "/slopes_error_vs_f_evals/kapitza_chaotic"), ("periods per second at 1e-10", "/performance/periods_per_second_at_1e-10")] },
+];
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The report over the scene outputs under `out` (one folder per scene),
+/// with `derivations` (model name, key, LaTeX) shown in a final section.
+/// Sections whose outputs are missing say so and link nothing.
+pub fn index_html(out: &Path, derivations: &[(&str, &str, &str)]) -> String {
+    let mut html = String::from(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>mechlab report</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}img{max-width:100%;border:1px solid #ddd}table{border-collapse:collapse}td{border:1px solid #ddd;padding:2px 6px;vertical-align:top}pre{white-space:pre-wrap;background:#f6f6f6;padding:4px}</style></head><body>\n<h1>mechlab: the studies</h1>\n<p>Every section is one deliverable: its figure, the key numbers from the scene's <code>summary.json</code>, and what it shows. Regenerate with <code>cargo run --release --example report</code>.</p>\n",
+    );
+    html += "<ul>\n";
+    for s in SECTIONS {
+        html += &format!(
+            "<li><a href=\"#{}\">{} {}</a></li>\n",
+            s.id,
+            s.id,
+            escape(s.title)
+        );
+    }
+    html += "<li><a href=\"#derivations\">Derivations</a></li>\n</ul>\n";
+    for s in SECTIONS {
+        html += &format!("<h2 id=\"{}\">{} {}</h2>\n", s.id, s.id, escape(s.title));
+        let figure = out.join(s.scene).join(s.figure);
+        let summary_path = out.join(s.scene).join("summary.json");
+        let summary: Option<Value> = std::fs::read_to_string(&summary_path)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
+        if !figure.exists() || summary.is_none() {
+            html += &format!(
+                "<p><em>Not run yet: <code>cargo run --release --example {}</code>.</em></p>\n",
+                s.scene
+            );
+            continue;
+        }
+        html += &format!("<p>{}</p>\n<p><a href=\"{scene}/{fig}\"><img src=\"{scene}/{fig}\" alt=\"{}\"></a></p>\n", escape(s.shows), escape(s.title), scene = s.scene, fig = s.figure);
+        let summary = summary.unwrap_or(Value::Null);
+        html += "<table>\n";
+        for (label, pointer) in s.numbers {
+            let value = summary
+                .pointer(pointer)
+                .map(|v| v.to_string())
+                .unwrap_or_else(|| "–".into());
+            html += &format!(
+                "<tr><td>{}</td><td><code>{}</code></td></tr>\n",
+                escape(label),
+                escape(&value)
+            );
+        }
+        html += &format!(
+            "</table>\n<p>Data: <a href=\"{0}/summary.json\">{0}/summary.json</a></p>\n",
+            s.scene
+        );
+    }
+    html += "<h2 id=\"derivations\">Derivations</h2>\n<p>LaTeX of the derived expressions, in their readable forms.</p>\n";
+    for (model, key, latex) in derivations {
+        html += &format!(
+            "<p><b>{}</b> <code>{}</code></p><pre>{}</pre>\n",
+            escape(model),
+            escape(key),
+            escape(latex)
+        );
+    }
+    html += "</body></html>\n";
+    html
+}
+
+/// Every `href` and `src` of a page, for checking that they exist.
+pub fn links(html: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for attribute in ["href=\"", "src=\""] {
+        let mut rest = html;
+        while let Some(i) = rest.find(attribute) {
+            rest = &rest[i + attribute.len()..];
+            if let Some(j) = rest.find('"') {
+                out.push(rest[..j].to_string());
+                rest = &rest[j..];
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,43 @@
+//! The report builds from whatever outputs exist, and every link in it
+//! points to a file that exists (missing scenes are named, not linked).
+
+use mechlab::report::{index_html, links, SECTIONS};
+
+#[test]
+fn every_link_of_the_report_exists() {
+    let root = tempfile::tempdir().unwrap();
+    // Outputs for every other section; the rest are missing.
+    for (k, s) in SECTIONS.iter().enumerate() {
+        if k % 2 == 0 {
+            let dir = root.path().join(s.scene);
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join(s.figure), b"png").unwrap();
+            std::fs::write(
+                dir.join("summary.json"),
+                br#"{"eps": 0.1, "slope": [-1.0, -0.98]}"#,
+            )
+            .unwrap();
+        }
+    }
+    let html = index_html(
+        root.path(),
+        &[("kapitza", "hamiltonian", "\\frac{p^2}{2} < 1")],
+    );
+    let targets = links(&html);
+    assert!(
+        targets.iter().any(|l| l.ends_with(".png")),
+        "figures are linked"
+    );
+    for link in targets {
+        if let Some(anchor) = link.strip_prefix('#') {
+            assert!(
+                html.contains(&format!("id=\"{anchor}\"")),
+                "anchor {anchor}"
+            );
+        } else {
+            assert!(root.path().join(&link).exists(), "{link} does not exist");
+        }
+    }
+    assert!(html.contains("Not run yet"), "missing scenes are named");
+    assert!(html.contains("\\frac{p^2}{2} &lt; 1"), "LaTeX is escaped");
+}
