@@ -130,6 +130,9 @@ impl<Mo: ContactModel<C, M>, const C: usize, const M: usize> System<M> for Smoot
     }
 }
 
+/// An event condition g(t, y) of one contact in its current mode.
+type Condition<'a, const M: usize> = Box<dyn Fn(f64, &[f64; M]) -> f64 + 'a>;
+
 /// Settings of the switching integrator.
 #[derive(Clone, Copy, Debug)]
 pub struct StickSlip {
@@ -206,8 +209,8 @@ impl StickSlip {
                 run.outcome = Outcome::Rest;
                 break;
             }
-            let conditions: Vec<Box<dyn Fn(f64, &[f64; M]) -> f64 + '_>> = (0..C)
-                .map(|i| -> Box<dyn Fn(f64, &[f64; M]) -> f64 + '_> {
+            let conditions: Vec<Condition<'_, M>> = (0..C)
+                .map(|i| -> Condition<'_, M> {
                     match modes[i] {
                         Mode::Slide(sign) => {
                             Box::new(move |_, y: &[f64; M]| f64::from(sign) * y[C + i])

@@ -156,7 +156,7 @@ impl Scene {
             .filter_map(|w| w[1].split_once('='))
             .filter(|(k, _)| *k == name)
             .map(|(_, v)| v.to_string())
-            .last()
+            .next_back()
     }
 
     /// The text value of a knob.

@@ -467,6 +467,9 @@ impl ModelFile {
     }
 }
 
+/// Parses one expression of the file: (key, text, allowed symbol sets, dot() allowed).
+type ExprParser<'a> = dyn Fn(&str, &str, &[&Vec<String>], bool) -> Result<Expr, ModelError> + 'a;
+
 impl ModelFile {
     /// Contacts: each slides along one coordinate and holds another, every
     /// coordinate takes part in exactly one contact (the contact runtime
@@ -476,7 +479,7 @@ impl ModelFile {
         file: &str,
         coordinates: &[String],
         parameters: &Vec<String>,
-        parse: &dyn Fn(&str, &str, &[&Vec<String>], bool) -> Result<Expr, ModelError>,
+        parse: &ExprParser,
     ) -> Result<Vec<Contact>, ModelError> {
         let err = |key: String, reason: String| ModelError {
             file: file.to_string(),
