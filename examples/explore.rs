@@ -13,7 +13,7 @@ use mechlab::models;
 use mechlab::ode::Method;
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
 use mechlab::registry::Kind;
-use mechlab::scene::{knob, run, Scene, SceneError};
+use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
@@ -47,23 +47,13 @@ fn main() {
             knob("samples", "2000", "samples of the time series"),
             knob("periods", "300", "periods of the period map (models with a fast phase)"),
         ];
-        knobs.extend(
-            info.parameter_names
-                .iter()
-                .zip(info.parameter_defaults)
-                .zip(info.parameter_descriptions)
-                .map(|((n, d), h)| knob(n, d, h)),
-        );
+        knobs.extend(parameter_knobs(info, &[]));
         let scene = Scene::from_args(
             "explore",
             "any model by name: runs, portraits, period map, equilibria, energy",
             &knobs,
         )?;
-        let params: Vec<f64> = info
-            .parameter_names
-            .iter()
-            .map(|n| scene.number(n))
-            .collect::<Result<_, _>>()?;
+        let params = scene.parameter_values(info)?;
         let (n, contacts) = match model.kind() {
             Kind::Hamiltonian { dof, .. } => (dof, false),
             Kind::Contacts { count } => (count, true),

@@ -8,19 +8,15 @@
 //! of each graph class of `painleve_phi`, first ν = 0 then ν ≠ 0, and for the
 //! given parameters; equilibria marked (black: stable, red: unstable).
 
-use mechlab::models::painleve_klein::Params;
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, RED};
 use mechlab::scene::{knob, run, Knob, Scene};
-use mechlab::studies::painleve::{class_example, reduced, DeformationEquation, GRAPH_CLASSES};
+use mechlab::studies::painleve::{
+    class_example, parameter_knobs, params_from_scene, reduced, DeformationEquation, GRAPH_CLASSES,
+};
 
 fn knobs() -> Vec<Knob> {
-    let mut knobs: Vec<Knob> = Params::NAMES
-        .iter()
-        .zip(Params::DEFAULT_TEXTS)
-        .zip(Params::DESCRIPTIONS)
-        .map(|((name, default), help)| knob(name, default, help))
-        .collect();
+    let mut knobs = parameter_knobs();
     knobs.extend([
         knob(
             "sigma",
@@ -79,10 +75,7 @@ fn main() {
             "equilibria of the deformation equation (25) and phase portraits",
             &knobs,
         )?;
-        let mut params = Params::default();
-        for name in Params::NAMES {
-            params.set(name, scene.number(name)?)?;
-        }
+        let params = params_from_scene(&scene)?;
         let sigma = if scene.number("sigma")? >= 0.0 {
             1.0
         } else {

@@ -12,11 +12,11 @@
 //! equilibrium of the deformation equation, −0.78 outside it.
 
 use mechlab::contact::{Outcome, Smooth, StickSlip};
-use mechlab::models::painleve_klein::{Contacts, Params};
+use mechlab::models::painleve_klein::Contacts;
 use mechlab::ode::{Method, System};
 use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, RED};
 use mechlab::scene::{knob, run, Knob, Scene, SceneError};
-use mechlab::studies::painleve::{rod, worked_example_start};
+use mechlab::studies::painleve::{parameter_knobs, params_from_scene, rod, worked_example_start};
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values.fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
@@ -25,12 +25,7 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 fn knobs() -> Vec<Knob> {
-    let mut knobs: Vec<Knob> = Params::NAMES
-        .iter()
-        .zip(Params::DEFAULT_TEXTS)
-        .zip(Params::DESCRIPTIONS)
-        .map(|((name, default), help)| knob(name, default, help))
-        .collect();
+    let mut knobs = parameter_knobs();
     knobs.extend([
         knob(
             "x2_starts",
@@ -57,13 +52,7 @@ fn main() {
             "the worked example: stick–slip switching, friction impact, event table",
             &knobs,
         )?;
-        let mut params = Params::default();
-        for name in Params::NAMES {
-            params.set(name, scene.number(name)?)?;
-        }
-        if !(params.d > 0.0 && params.d < params.l && params.eps > 0.0 && params.k > 0.0) {
-            return Err(SceneError::Usage("need 0 < d < l, ε > 0 and k > 0".into()));
-        }
+        let params = params_from_scene(&scene)?;
         let t_end = scene.positive("t_end")?;
         let method = Method::parse(scene.text("method"), scene.positive("tol")?)?;
         let samples = scene.count("samples")?;

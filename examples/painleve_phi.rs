@@ -8,12 +8,11 @@
 //! σo = −1. For the given parameters, every root R* of X* = Φ(R) for σ = ±1
 //! with its Painlevé case.
 
-use mechlab::models::painleve_klein::Params;
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
 use mechlab::scene::{knob, run, Knob, Scene};
 use mechlab::studies::painleve::{
-    class_example, painleve_case, phi, phi_slope, reduced, rigid_rod_roots, slope_signs, Reduced,
-    GRAPH_CLASSES,
+    class_example, painleve_case, parameter_knobs, params_from_scene, phi, phi_slope, reduced,
+    rigid_rod_roots, slope_signs, Reduced, GRAPH_CLASSES,
 };
 
 fn graph(q: &Reduced, sigma: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
@@ -24,12 +23,7 @@ fn graph(q: &Reduced, sigma: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
 }
 
 fn knobs() -> Vec<Knob> {
-    let mut knobs: Vec<Knob> = Params::NAMES
-        .iter()
-        .zip(Params::DEFAULT_TEXTS)
-        .zip(Params::DESCRIPTIONS)
-        .map(|((name, default), help)| knob(name, default, help))
-        .collect();
+    let mut knobs = parameter_knobs();
     knobs.push(knob(
         "region_pixels",
         "120",
@@ -46,10 +40,7 @@ fn main() {
             "Φ(R): every graph class, its region, the roots for given parameters",
             &knobs,
         )?;
-        let mut params = Params::default();
-        for name in Params::NAMES {
-            params.set(name, scene.number(name)?)?;
-        }
+        let params = params_from_scene(&scene)?;
         let pixels = scene.count("region_pixels")?;
         let q = reduced(&params);
 

@@ -22,6 +22,26 @@ pub const fn knob(name: &'static str, default: &'static str, help: &'static str)
     }
 }
 
+/// Knobs for every parameter of a generated model, with the defaults of its
+/// model file except those `overrides` gives.
+pub fn parameter_knobs(
+    info: &'static crate::registry::ModelInfo,
+    overrides: &[(&'static str, &'static str)],
+) -> Vec<Knob> {
+    info.parameter_names
+        .iter()
+        .zip(info.parameter_defaults)
+        .zip(info.parameter_descriptions)
+        .map(|((&name, &default), &help)| {
+            let default = overrides
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map_or(default, |(_, v)| v);
+            knob(name, default, help)
+        })
+        .collect()
+}
+
 /// Why a scene could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
@@ -157,6 +177,17 @@ impl Scene {
             .filter(|(k, _)| *k == name)
             .map(|(_, v)| v.to_string())
             .next_back()
+    }
+
+    /// The values of the knobs of [`parameter_knobs`], in declaration order.
+    pub fn parameter_values(
+        &self,
+        info: &crate::registry::ModelInfo,
+    ) -> Result<Vec<f64>, SceneError> {
+        info.parameter_names
+            .iter()
+            .map(|n| self.number(n))
+            .collect()
     }
 
     /// The text value of a knob.

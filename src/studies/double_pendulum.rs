@@ -18,7 +18,7 @@ use crate::analysis::vibrational_stability::{
 };
 use crate::models::double_pendulum::{self as model, Exact, Params};
 use crate::ode::{Integrator, Method, OdeError};
-use crate::scene::{knob, Knob, Scene, SceneError};
+use crate::scene::{Knob, Scene, SceneError};
 use std::f64::consts::PI;
 
 /// mean(h²) of the base velocity profile h = −sin.
@@ -130,21 +130,10 @@ pub fn exact_stability_window(
     stability_window(&margin, 0.0, a_max, samples, 1e-6 * a_max)
 }
 
-/// Knobs for every parameter of the model, with the model file's defaults
-/// except the ones a scene overrides.
+/// Knobs for every parameter of the model (the model file's defaults
+/// except `overrides`).
 pub fn parameter_knobs(overrides: &[(&'static str, &'static str)]) -> Vec<Knob> {
-    Params::NAMES
-        .iter()
-        .zip(Params::DEFAULT_TEXTS)
-        .zip(Params::DESCRIPTIONS)
-        .map(|((&name, default), help)| {
-            let default = overrides
-                .iter()
-                .find(|(n, _)| *n == name)
-                .map_or(default, |(_, v)| v);
-            knob(name, default, help)
-        })
-        .collect()
+    crate::scene::parameter_knobs(&model::INFO, overrides)
 }
 
 /// The parameters set by the knobs of [`parameter_knobs`]: masses, lengths,

@@ -309,3 +309,26 @@ pub fn state_with_deformation(p: &Params, delta: f64, v: f64) -> [f64; 4] {
     let dx = ((p.l + delta).powi(2) - p.d * p.d).sqrt();
     [0.0, -dx, v, v]
 }
+
+/// Knobs for every parameter of the model file (its defaults).
+pub fn parameter_knobs() -> Vec<crate::scene::Knob> {
+    crate::scene::parameter_knobs(&crate::models::painleve_klein::INFO, &[])
+}
+
+/// The parameters set by those knobs: 0 < d < l, ε, k > 0, friction ≥ 0.
+pub fn params_from_scene(scene: &crate::scene::Scene) -> Result<Params, crate::scene::SceneError> {
+    let p = Params::from_values(&scene.parameter_values(&crate::models::painleve_klein::INFO)?);
+    if !(p.d > 0.0
+        && p.d < p.l
+        && p.eps > 0.0
+        && p.k > 0.0
+        && p.mu1 >= 0.0
+        && p.mu2 >= 0.0
+        && p.nu >= 0.0)
+    {
+        return Err(crate::scene::SceneError::Usage(
+            "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0".into(),
+        ));
+    }
+    Ok(p)
+}
