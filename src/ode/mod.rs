@@ -311,16 +311,9 @@ impl Integrator {
         events: &[Event<'_, N>],
         settings: EventSettings,
     ) -> Result<EventRun<N>, OdeError> {
-        check_initial(t0, y0, t1)?;
-        let mut locator = events::Locator::new(events, settings, t0, y0)?;
-        let (t, y) = self.run(system, t0, y0, t1, &mut |step| locator.scan(step))?;
-        let terminated = t != t1;
-        Ok(EventRun {
-            t,
-            y,
-            hits: locator.hits,
-            terminated,
-        })
+        Ok(self
+            .advance_with_events_sampled(system, t0, y0, t1, events, settings, &[])?
+            .0)
     }
 
     /// Like [`Integrator::advance_with_events`], and also returns the states
