@@ -19,7 +19,6 @@ use std::sync::Once;
 pub struct Rgb(pub u8, pub u8, pub u8);
 
 pub const BLACK: Rgb = Rgb(0, 0, 0);
-pub const WHITE: Rgb = Rgb(255, 255, 255);
 pub const GREY: Rgb = Rgb(150, 150, 150);
 pub const RED: Rgb = Rgb(214, 39, 40);
 pub const BLUE: Rgb = Rgb(31, 119, 180);
@@ -213,14 +212,9 @@ impl Figure {
         self.layers[k].push(Layer::Line(points.to_vec(), color));
     }
 
-    /// Fills the panel with a map of values in [0, 1] (row 0 at the bottom;
-    /// non-finite values stay white) in grey, with a colour bar.
-    pub fn grey_map(&mut self, k: usize, columns: usize, rows: usize, values: &[f64]) {
-        self.shaded_map(k, columns, rows, values, ColorMap::Grey, "");
-    }
-
-    /// Fills the panel with a map of values in [0, 1] in the colour map
-    /// `map`, with a colour bar labelled `label`.
+    /// Fills the panel with a map of values in [0, 1] (row 0 at the bottom,
+    /// non-finite values left white) in the colour map `map`, with a colour
+    /// bar labelled `label`.
     pub fn shaded_map(
         &mut self,
         k: usize,
