@@ -108,16 +108,16 @@ fn main() {
             }));
             for (k, t) in c.times.iter().enumerate() {
                 let (e, v) = (&c.exact[k], &c.averaged[k]);
-                rows.push(format!(
-                    "{case},{t},{},{},{},{},{},{},{},{}",
-                    e[0],
-                    e[1],
-                    v[0],
-                    v[1],
-                    exact_v[k][0],
-                    exact_v[k][1],
-                    averaged_v[k][0],
-                    averaged_v[k][1]
+                rows.push((
+                    case,
+                    *t,
+                    [e[0], e[1], v[0], v[1]],
+                    [
+                        exact_v[k][0],
+                        exact_v[k][1],
+                        averaged_v[k][0],
+                        averaged_v[k][1],
+                    ],
                 ));
             }
             series.push((c, exact_v, averaged_v));
@@ -197,7 +197,18 @@ fn main() {
         scene.save_figure(&figure, "averaging.png")?;
         scene.write_csv(
             "series.csv",
-            "case,t,phi1_exact,phi2_exact,phi1_limit,phi2_limit,v1_exact,v2_exact,v1_limit,v2_limit",
+            &[
+                "case",
+                "t",
+                "phi1_exact",
+                "phi2_exact",
+                "phi1_limit",
+                "phi2_limit",
+                "v1_exact",
+                "v2_exact",
+                "v1_limit",
+                "v2_limit",
+            ],
             rows,
         )?;
         for s in &summary_cases {

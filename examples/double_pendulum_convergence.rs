@@ -125,15 +125,20 @@ fn main() {
         scene.save_figure(&figure, "convergence.png")?;
         scene.write_csv(
             "convergence.csv",
-            "nu,max_dev_phi1,max_dev_phi2,nu_times_max_dev_phi1,nu_times_max_dev_phi2",
+            &[
+                "nu",
+                "max_dev_phi1",
+                "max_dev_phi2",
+                "nu_times_max_dev_phi1",
+                "nu_times_max_dev_phi2",
+            ],
             (0..count).map(|k| {
-                format!(
-                    "{},{},{},{},{}",
+                (
                     frequencies[k],
                     result.max_deviation[0][k],
                     result.max_deviation[1][k],
                     scaled[0][k],
-                    scaled[1][k]
+                    scaled[1][k],
                 )
             }),
         )?;

@@ -94,7 +94,7 @@ fn main() {
             println!(
                 "ν = {nu}: exact spectral radius {radius:.9}, averaged prediction {expected:.9}"
             );
-            rows.push(format!("{nu},{radius},{expected}"));
+            rows.push((nu, radius, expected));
             radii.push(
                 serde_json::json!({"nu": nu, "spectral_radius": radius, "predicted": expected,
                 "multipliers": multipliers.iter().map(|(re, im)| [*re, *im]).collect::<Vec<_>>()}),
@@ -173,14 +173,18 @@ fn main() {
             ],
         );
         scene.save_figure(&figure, "friction.png")?;
-        scene.write_csv("multipliers.csv", "nu,spectral_radius,predicted", rows)?;
+        scene.write_csv(
+            "multipliers.csv",
+            &["nu", "spectral_radius", "predicted"],
+            rows,
+        )?;
         scene.write_csv(
             "decay.csv",
-            "t,distance_exact,distance_limit",
+            &["t", "distance_exact", "distance_limit"],
             exact_curve
                 .iter()
                 .zip(&averaged_curve)
-                .map(|(e, a)| format!("{},{},{}", e.0, e.1, a.1)),
+                .map(|(e, a)| (e.0, e.1, a.1)),
         )?;
         if !max_re.is_finite() {
             return Err(SceneError::Numerical("no eigenvalues".into()));

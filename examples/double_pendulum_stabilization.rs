@@ -265,10 +265,14 @@ fn main() {
                 3 * p + 2,
                 &[("exact".into(), BLACK), ("a* (limit)".into(), GREY)],
             );
-            rows.extend(chart.iter().map(|(a, r)| format!("{p},{a},{r}")));
+            rows.extend(chart.iter().map(|(a, r)| (p, *a, *r)));
         }
         scene.save_figure(&figure, "stabilization.png")?;
-        scene.write_csv("exact_spectral_radius.csv", "panel,a,spectral_radius", rows)?;
+        scene.write_csv(
+            "exact_spectral_radius.csv",
+            &["panel", "a", "spectral_radius"],
+            rows,
+        )?;
         scene.write_summary(serde_json::json!({
             "params": {"m1": params.m1, "m2": params.m2, "l1": params.l1, "l2": params.l2, "g": params.g, "mu": params.mu},
             "nu": params.nu,

@@ -221,14 +221,12 @@ fn main() {
             .collect();
         scene.write_csv(
             "series.csv",
-            &header.join(","),
+            &header.iter().map(String::as_str).collect::<Vec<_>>(),
             result.times.iter().enumerate().map(|(k, t)| {
                 std::iter::once(*t)
                     .chain(result.exact[k].iter().copied())
                     .chain(averaged.get(k).into_iter().flatten().copied())
-                    .map(|x| x.to_string())
-                    .collect::<Vec<_>>()
-                    .join(",")
+                    .collect::<Vec<f64>>()
             }),
         )?;
         for e in &result.equilibria {

@@ -175,18 +175,13 @@ fn main() {
 
         scene.write_csv(
             "attractor.csv",
-            "q,p",
-            points
-                .iter()
-                .map(|p| format!("{:.12e},{:.12e}", p[0], p[1])),
+            &["q", "p"],
+            points.iter().map(|p| (p[0], p[1])),
         )?;
         scene.write_csv(
             "box_counting.csv",
-            "box_side,boxes",
-            sides
-                .iter()
-                .zip(&counted.boxes)
-                .map(|(s, n)| format!("{s:e},{n}")),
+            &["box_side", "boxes"],
+            sides.iter().zip(&counted.boxes),
         )?;
         println!(
             "lyapunov exponents per period {:.4} {:.4}, sum {:.4} (expected -mu T = {expected_sum:.4}), box-counting dimension {dimension:.3}, Kaplan-Yorke {kaplan_yorke:.3}",

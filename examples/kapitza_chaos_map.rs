@@ -106,10 +106,10 @@ fn main() {
         scene.save_figure(&viridis, "chaos_map_viridis.png")?;
         scene.write_csv(
             "chaos_map.csv",
-            "q,p,fli",
+            &["q", "p", "fli"],
             fli.iter().enumerate().map(|(k, v)| {
                 let (q, p) = cell(k);
-                format!("{q:.6},{p:.6},{v:.6}")
+                (q, p, *v)
             }),
         )?;
         scene.write_summary(serde_json::json!({

@@ -90,11 +90,8 @@ fn main() {
             let last = points[points.len() - 1];
             scene.write_csv(
                 "orbit.csv",
-                "period,q,p",
-                points
-                    .iter()
-                    .enumerate()
-                    .map(|(k, y)| format!("{k},{:.17e},{:.17e}", y[0], y[1])),
+                &["period", "q", "p"],
+                points.iter().enumerate().map(|(k, y)| (k, y[0], y[1])),
             )?;
             let mut figure = Figure::single(
                 800,
@@ -153,12 +150,7 @@ fn main() {
                 })?;
                 f_evals += stats.f_evals;
                 figure.points(0, points.iter().map(|y| (y[0], y[1])), palette(k), 1);
-                rows.extend(
-                    points
-                        .iter()
-                        .enumerate()
-                        .map(|(n, y)| format!("{k},{n},{:.12e},{:.12e}", y[0], y[1])),
-                );
+                rows.extend(points.iter().enumerate().map(|(n, y)| (k, n, y[0], y[1])));
             }
             figure.legend(
                 0,
@@ -172,7 +164,11 @@ fn main() {
             );
             let tag = format!("A{a}");
             scene.save_figure(&figure, &format!("portrait_{tag}.png"))?;
-            scene.write_csv(&format!("orbits_{tag}.csv"), "orbit,period,q,p", rows)?;
+            scene.write_csv(
+                &format!("orbits_{tag}.csv"),
+                &["orbit", "period", "q", "p"],
+                rows,
+            )?;
             summary.push(serde_json::json!({"A": a, "orbits": initial.len(), "periods": periods, "seconds": seconds, "f_evals": f_evals}));
         }
         scene.write_summary(serde_json::json!({"eps": eps, "mu": mu, "method": method.name(), "portraits": summary}))?;

@@ -146,14 +146,14 @@ fn main() {
                     points
                         .iter()
                         .enumerate()
-                        .map(|(n, y)| format!("{ca},{cmu},{s},{n},{:.12e},{:.12e}", y[0], y[1])),
+                        .map(|(n, y)| (*ca, *cmu, s, n, y[0], y[1])),
                 );
             }
         }
         scene.save_figure(&figure, "orbits_near_upper_position.png")?;
         scene.write_csv(
             "orbits_near_upper_position.csv",
-            "A,mu,orbit,period,q,p",
+            &["A", "mu", "orbit", "period", "q", "p"],
             rows,
         )?;
 
@@ -237,15 +237,14 @@ fn main() {
         scene.save_figure(&figure, "stability_chart.png")?;
         scene.write_csv(
             "stability_chart.csv",
-            "eps,A,stable",
+            &["eps", "A", "stable"],
             (0..ne)
                 .flat_map(|i| (0..na).map(move |j| (i, j)))
                 .map(|(i, j)| {
-                    format!(
-                        "{},{},{}",
+                    (
                         eps_values[i],
                         a_values[j],
-                        u8::from(chart[j * ne + i] > 0.0)
+                        u8::from(chart[j * ne + i] > 0.0),
                     )
                 }),
         )?;

@@ -88,9 +88,14 @@ fn main() {
                         "  t = {:.6}  point {}  case {:>2}  {} -> {}  v1 = {:+.6}  v2 = {:+.6}  R = {:.6}",
                         s.t, s.contact + 1, s.case, s.from, s.to, s.y[2], s.y[3], r
                     );
-                    event_rows.push(format!(
-                        "{x2},{},{},{},{},{},{},{},{}",
-                        s.t, s.contact + 1, s.case, s.from, s.to, s.y[2], s.y[3], r
+                    event_rows.push((
+                        x2,
+                        s.t,
+                        s.contact + 1,
+                        s.case.clone(),
+                        s.from.to_string(),
+                        s.to.to_string(),
+                        [s.y[2], s.y[3], r],
                     ));
                     serde_json::json!({"t": s.t, "point": s.contact + 1, "case": s.case,
                         "from": s.from.to_string(), "to": s.to.to_string(), "v1": s.y[2], "v2": s.y[3], "R": r})
@@ -183,22 +188,32 @@ fn main() {
                 figure.points(4 * k + 2, [(s.t, s.y[2])], RED, 7);
                 figure.points(4 * k + 3, [(s.t, s.y[3])], RED, 7);
             }
-            series.extend(run.samples.iter().zip(&rods).map(|((t, y), r)| {
-                format!(
-                    "{x2},{t},{},{},{},{},{},{},{}",
-                    y[0], y[1], y[2], y[3], r.delta, r.delta_rate, r.reaction
-                )
-            }));
+            series.extend(
+                run.samples
+                    .iter()
+                    .zip(&rods)
+                    .map(|((t, y), r)| (*x2, *t, *y, [r.delta, r.delta_rate, r.reaction])),
+            );
         }
         scene.save_figure(&figure, "impact.png")?;
         scene.write_csv(
             "events.csv",
-            "x2_0,t,point,case,from,to,v1,v2,R",
+            &["x2_0", "t", "point", "case", "from", "to", "v1", "v2", "R"],
             event_rows,
         )?;
         scene.write_csv(
             "series.csv",
-            "x2_0,t,x1,x2,v1,v2,delta,delta_rate,R",
+            &[
+                "x2_0",
+                "t",
+                "x1",
+                "x2",
+                "v1",
+                "v2",
+                "delta",
+                "delta_rate",
+                "R",
+            ],
             series,
         )?;
         scene.write_summary(serde_json::json!({ "cases": cases }))?;

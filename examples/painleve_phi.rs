@@ -173,10 +173,7 @@ fn main() {
                             palette(k),
                             (480 / pixels as i64).max(1) + 1,
                         );
-                        region_rows.push(format!(
-                            "{},{mu1},{mu2},{signs}",
-                            if panel == 6 { 1 } else { -1 }
-                        ));
+                        region_rows.push((if panel == 6 { 1 } else { -1 }, mu1, mu2, signs));
                     }
                 }
             }
@@ -209,7 +206,7 @@ fn main() {
         scene.save_figure(&figure, "phi.png")?;
         scene.write_csv(
             "regions.csv",
-            "sigma_o,mu1_star,mu2_star,signs",
+            &["sigma_o", "mu1_star", "mu2_star", "signs"],
             region_rows,
         )?;
         scene.write_summary(serde_json::json!({

@@ -73,9 +73,15 @@ fn main() {
                     "{label:8} ε = {eps:<6} {:?} at t = {:.6}, R = {final_r:.6}, {steps} steps, {f_evals} f, {:.4} s, events {events:?}",
                     result.outcome, result.t, seconds
                 );
-                rows.push(format!(
-                    "{label},{eps},{:?},{},{final_r},{steps},{f_evals},{seconds}",
-                    result.outcome, result.t
+                rows.push((
+                    label,
+                    eps,
+                    format!("{:?}", result.outcome),
+                    result.t,
+                    final_r,
+                    steps,
+                    f_evals,
+                    seconds,
                 ));
                 runs.push((label, eps, result, seconds, steps, final_r, params));
             }
@@ -174,7 +180,9 @@ fn main() {
         scene.save_figure(&figure, "stiff_limit.png")?;
         scene.write_csv(
             "runs.csv",
-            "case,eps,outcome,t_end,final_R,steps,f_evals,seconds",
+            &[
+                "case", "eps", "outcome", "t_end", "final_R", "steps", "f_evals", "seconds",
+            ],
             rows,
         )?;
         let summary: Vec<serde_json::Value> = runs

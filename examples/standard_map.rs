@@ -48,14 +48,14 @@ fn main() {
             let mut points = Vec::new();
             for n in 0..scene.count("length")? {
                 points.push(x);
-                rows.push(format!("{k},{n},{:.12e},{:.12e}", x.0, x.1));
+                rows.push((k, n, x.0, x.1));
                 x = standard_map(eps, x);
                 x.1 = (x.1 + PI).rem_euclid(2.0 * PI) - PI;
             }
             figure.points(0, points, palette(k), 1);
         }
         scene.save_figure(&figure, "orbits.png")?;
-        scene.write_csv("orbits.csv", "orbit,iterate,q,p", rows)?;
+        scene.write_csv("orbits.csv", &["orbit", "iterate", "q", "p"], rows)?;
 
         // FLI chaos map, rows in parallel (deterministic order).
         let start = std::time::Instant::now();
@@ -94,14 +94,13 @@ fn main() {
         scene.save_figure(&viridis, "chaos_map_viridis.png")?;
         scene.write_csv(
             "chaos_map.csv",
-            "q,p,fli",
+            &["q", "p", "fli"],
             (0..pixels * pixels).map(|k| {
                 let (i, j) = (k % pixels, k / pixels);
-                format!(
-                    "{:.6},{:.6},{:.6}",
+                (
                     -PI + 2.0 * PI * (i as f64 + 0.5) / pixels as f64,
                     -PI + 2.0 * PI * (j as f64 + 0.5) / pixels as f64,
-                    fli[k]
+                    fli[k],
                 )
             }),
         )?;

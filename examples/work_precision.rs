@@ -618,11 +618,22 @@ fn main() {
 
         scene.write_csv(
             "runs.csv",
-            "problem,method,tol_or_step,error,seconds,f_evals",
+            &[
+                "problem",
+                "method",
+                "tol_or_step",
+                "error",
+                "seconds",
+                "f_evals",
+            ],
             rows.iter().map(|r| {
-                format!(
-                    "{},{},{:e},{:e},{:e},{}",
-                    r.problem, r.method, r.tol_or_step, r.error, r.seconds, r.f_evals
+                (
+                    &r.problem,
+                    &r.method,
+                    r.tol_or_step,
+                    r.error,
+                    r.seconds,
+                    r.f_evals,
                 )
             }),
         )?;

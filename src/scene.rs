@@ -1,7 +1,10 @@
 //! The scenes contract: `cargo run --release --example <scene> -- [--set
 //! name=value]... [--out DIR]`. Output goes to `out/<scene>/` by default:
-//! PNG figures, CSV data and `summary.json`. Every file is written to a
-//! temporary name first and renamed, so results are never half-written.
+//! PNG (and SVG) figures, CSV data and `summary.json`. A scene's files are
+//! written into a hidden staging folder beside the output folder, which
+//! replaces the output folder as a whole when `summary.json` is written (the
+//! scene's last step): a crash never leaves half-written files or a mix of
+//! old and new results.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -19,6 +22,13 @@ pub const fn knob(name: &'static str, default: &'static str, help: &'static str)
         name,
         default,
         help,
+    }
+}
+
+impl Drop for Scene {
+    /// An unpublished staging folder (the scene failed) is removed.
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.staging);
     }
 }
 
@@ -90,6 +100,8 @@ pub struct Scene {
     knobs: Vec<Knob>,
     values: Vec<(String, String)>,
     pub out: PathBuf,
+    /// Where files are written until `write_summary` publishes them.
+    staging: PathBuf,
 }
 
 impl Scene {
@@ -159,11 +171,13 @@ impl Scene {
                 }
             }
         }
+        let staging = beside(&out, "new");
         Ok(Scene {
             name,
             knobs: knobs.to_vec(),
             values,
             out,
+            staging,
         })
     }
 
@@ -286,17 +300,17 @@ impl Scene {
     }
 
     /// Path of an output file, creating the output directory.
+    /// Where `file` is written (in the staging folder until published).
     pub fn path(&self, file: &str) -> Result<PathBuf, SceneError> {
-        std::fs::create_dir_all(&self.out).map_err(|source| SceneError::Io {
-            path: self.out.clone(),
+        std::fs::create_dir_all(&self.staging).map_err(|source| SceneError::Io {
+            path: self.staging.clone(),
             source,
         })?;
-        Ok(self.out.join(file))
+        Ok(self.staging.join(file))
     }
 
     /// Writes `file` (a `.png` name) and, where it stays small (no shaded
-    /// map), the same figure as SVG beside it; each through a temporary file
-    /// renamed into place.
+    /// map, few points), the same figure as SVG beside it.
     pub fn save_figure(
         &self,
         figure: &crate::plot::Figure,
@@ -307,48 +321,54 @@ impl Scene {
             path: path.to_path_buf(),
             source,
         };
-        let temporary = temporary_beside(&path);
-        figure
-            .save(&temporary)
-            .and_then(|_| std::fs::rename(&temporary, &path))
-            .map_err(|e| io(&path, e))?;
-        eprintln!("wrote {}", path.display());
+        figure.save(&path).map_err(|e| io(&path, e))?;
+        eprintln!("wrote {}", self.out.join(file).display());
         if figure.svg_is_cheap() {
             let svg = path.with_extension("svg");
-            let temporary = temporary_beside(&svg);
-            figure
-                .save_svg(&temporary)
-                .and_then(|_| std::fs::rename(&temporary, &svg))
-                .map_err(|e| io(&svg, e))?;
-            eprintln!("wrote {}", svg.display());
+            figure.save_svg(&svg).map_err(|e| io(&svg, e))?;
+            eprintln!(
+                "wrote {}",
+                self.out.join(file).with_extension("svg").display()
+            );
         }
-        Ok(path)
+        Ok(self.out.join(file))
     }
 
-    /// Writes CSV with a header line.
-    pub fn write_csv(
+    /// Writes CSV through the csv crate: the header, then one record per
+    /// row (tuples or structs of numbers and text); floats in the shortest
+    /// form that reads back exactly.
+    pub fn write_csv<R: serde::Serialize>(
         &self,
         file: &str,
-        header: &str,
-        rows: impl IntoIterator<Item = String>,
+        header: &[&str],
+        rows: impl IntoIterator<Item = R>,
     ) -> Result<PathBuf, SceneError> {
-        let mut text = String::from(header);
-        text.push('\n');
+        let path = self.path(file)?;
+        let io = |source: std::io::Error| SceneError::Io {
+            path: path.clone(),
+            source,
+        };
+        let mut writer = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_path(&path)
+            .map_err(|e| io(e.into()))?;
+        writer.write_record(header).map_err(|e| io(e.into()))?;
         for row in rows {
-            text += &row;
-            text.push('\n');
+            writer.serialize(row).map_err(|e| io(e.into()))?;
         }
-        self.write_text(file, &text)
+        writer.flush().map_err(io)?;
+        eprintln!("wrote {}", self.out.join(file).display());
+        Ok(self.out.join(file))
     }
 
     pub fn write_text(&self, file: &str, text: &str) -> Result<PathBuf, SceneError> {
         let path = self.path(file)?;
-        write_atomic(&path, text.as_bytes()).map_err(|source| SceneError::Io {
+        std::fs::write(&path, text).map_err(|source| SceneError::Io {
             path: path.clone(),
             source,
         })?;
-        eprintln!("wrote {}", path.display());
-        Ok(path)
+        eprintln!("wrote {}", self.out.join(file).display());
+        Ok(self.out.join(file))
     }
 
     /// Writes `summary.json` (with the scene's settings added).
@@ -358,18 +378,36 @@ impl Scene {
             map.insert("settings".into(), self.settings());
         }
         let text = serde_json::to_string_pretty(&summary).expect("JSON values serialise");
-        self.write_text("summary.json", &text)
+        let path = self.write_text("summary.json", &text)?;
+        self.publish()?;
+        Ok(path)
+    }
+
+    /// Replaces the output folder by the staging folder: the old results
+    /// are moved aside, the new ones renamed into place, the old removed.
+    fn publish(&self) -> Result<(), SceneError> {
+        let io = |path: &Path, source: std::io::Error| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let old = beside(&self.out, "old");
+        if self.out.exists() {
+            let _ = std::fs::remove_dir_all(&old);
+            std::fs::rename(&self.out, &old).map_err(|e| io(&self.out, e))?;
+        }
+        std::fs::rename(&self.staging, &self.out).map_err(|e| io(&self.out, e))?;
+        let _ = std::fs::remove_dir_all(&old);
+        Ok(())
     }
 }
 
-/// A temporary name in the same directory with the same extension (the
-/// image encoders choose the format by extension).
-fn temporary_beside(path: &Path) -> PathBuf {
-    let name = path
+/// A hidden sibling of a folder, unique to this process (`out/.scene.new-123`).
+fn beside(folder: &Path, role: &str) -> PathBuf {
+    let name = folder
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    path.with_file_name(format!(".tmp{}.{name}", std::process::id()))
+        .unwrap_or_else(|| "scene".into());
+    folder.with_file_name(format!(".{name}.{role}-{}", std::process::id()))
 }
 
 /// Writes a file atomically: a temporary file in the same directory, then rename.
