@@ -285,12 +285,24 @@ impl Scene {
         }
     }
 
-    /// The knobs and their values, for summaries.
+    /// The knobs and their values, for summaries: numbers as numbers,
+    /// lists of numbers as arrays, anything else as text.
     pub fn settings(&self) -> serde_json::Value {
+        let value = |text: &str| -> serde_json::Value {
+            let numbers: Option<Vec<f64>> = text
+                .split(',')
+                .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+                .collect();
+            match numbers {
+                Some(v) if v.len() == 1 => serde_json::json!(v[0]),
+                Some(v) => serde_json::json!(v),
+                None => serde_json::Value::String(text.to_string()),
+            }
+        };
         let map: serde_json::Map<String, serde_json::Value> = self
             .values
             .iter()
-            .map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone())))
+            .map(|(k, v)| (k.clone(), value(v)))
             .collect();
         serde_json::Value::Object(map)
     }
