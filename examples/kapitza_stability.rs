@@ -161,7 +161,7 @@ fn main() {
         let averaged_cases = [SQRT_2 - 0.3, SQRT_2 + 0.3];
         let titles: Vec<String> = averaged_cases
             .iter()
-            .map(|ca| format!("levels of the averaged H̄, A = {ca:.3}"))
+            .map(|ca| format!("levels of the averaged Hamiltonian, A = {ca:.3}"))
             .collect();
         let specs: Vec<PanelSpec> = titles
             .iter()

@@ -201,7 +201,7 @@ fn hamiltonian<const M: usize>(
                 .iter()
                 .map(|y| model.averaged_energy(params, y).unwrap_or(0.0) - h0)
                 .collect();
-            out.energy_label = "H̄(t) − H̄(0) along the averaged run";
+            out.energy_label = "averaged Hamiltonian: change along the averaged run";
             out.averaged = Some(averaged.iter().map(|y| y.to_vec()).collect());
             let map_times: Vec<f64> = (0..=settings.periods).map(|k| k as f64 * period).collect();
             let map = Integrator::new(settings.method)?.advance_sampled(
