@@ -198,75 +198,12 @@ fn main() {
             progress.update(k + 1);
         }
 
-        let mut specs = Vec::new();
-        for (
-            p,
-            Panels {
-                above,
-                below,
-                chart,
-                ..
-            },
-        ) in panels.iter().enumerate()
-        {
-            let extent = |runs: &Vec<Vec<(f64, f64)>>| {
-                runs.iter()
-                    .flatten()
-                    .fold(offset.abs(), |m, (_, y)| m.max(y.abs()))
-                    .min(3.5)
-                    * 1.1
-            };
-            let (ea, eb) = (extent(above), extent(below));
-            let r_max = chart.iter().fold(1.0f64, |m, (_, r)| m.max(*r)).min(3.0);
-            specs.push(PanelSpec::new(
-                &titles[3 * p],
-                "t",
-                "angle − equilibrium",
-                (0.0, t_long),
-                (-ea, ea),
-            ));
-            specs.push(PanelSpec::new(
-                &titles[3 * p + 1],
-                "t",
-                "angle − equilibrium",
-                (0.0, t_long),
-                (-eb, eb),
-            ));
-            specs.push(PanelSpec::new(
-                &titles[3 * p + 2],
-                "A",
-                "spectral radius ρ",
-                (0.0, chart.last().map_or(1.0, |c| c.0)),
-                (0.95, r_max * 1.02),
-            ));
-        }
-        let mut figure = Figure::grid(3, panels.len(), 520, 340, &specs);
-        let mut rows = Vec::new();
-        for (
-            p,
-            Panels {
-                above,
-                below,
-                chart,
-                a_star,
-            },
-        ) in panels.iter().enumerate()
-        {
-            for (i, color) in [(0, BLUE), (1, RED)] {
-                figure.line(3 * p, &above[i], color);
-                figure.line(3 * p + 1, &below[i], color);
-            }
-            let top = figure.panel(3 * p + 2).y_range.1;
-            figure.line(3 * p + 2, &[(*a_star, 0.95), (*a_star, top)], GREY);
-            figure.line(3 * p + 2, chart, BLACK);
-            figure.points(3 * p + 2, chart.iter().copied(), BLACK, 3);
-            figure.legend(3 * p, &[("φ₁".into(), BLUE), ("φ₂".into(), RED)]);
-            figure.legend(
-                3 * p + 2,
-                &[("exact".into(), BLACK), ("a* (limit)".into(), GREY)],
-            );
-            rows.extend(chart.iter().map(|(a, r)| (p, *a, *r)));
-        }
+        let figure = draw(&panels, &titles, offset, t_long);
+        let rows: Vec<(usize, f64, f64)> = panels
+            .iter()
+            .enumerate()
+            .flat_map(|(p, panel)| panel.chart.iter().map(move |(a, r)| (p, *a, *r)))
+            .collect();
         scene.save_figure(&figure, "stabilization.png")?;
         scene.write_csv(
             "exact_spectral_radius.csv",
@@ -281,4 +218,77 @@ fn main() {
         }))?;
         Ok(())
     });
+}
+
+/// Per unstable equilibrium: the limiting runs above and below a*, and the
+/// exact spectral radius against a with a* marked.
+fn draw(panels: &[Panels], titles: &[String], offset: f64, t_long: f64) -> Figure {
+    let mut specs = Vec::new();
+    for (
+        p,
+        Panels {
+            above,
+            below,
+            chart,
+            ..
+        },
+    ) in panels.iter().enumerate()
+    {
+        let extent = |runs: &Vec<Vec<(f64, f64)>>| {
+            runs.iter()
+                .flatten()
+                .fold(offset.abs(), |m, (_, y)| m.max(y.abs()))
+                .min(3.5)
+                * 1.1
+        };
+        let (ea, eb) = (extent(above), extent(below));
+        let r_max = chart.iter().fold(1.0f64, |m, (_, r)| m.max(*r)).min(3.0);
+        specs.push(PanelSpec::new(
+            &titles[3 * p],
+            "t",
+            "angle − equilibrium",
+            (0.0, t_long),
+            (-ea, ea),
+        ));
+        specs.push(PanelSpec::new(
+            &titles[3 * p + 1],
+            "t",
+            "angle − equilibrium",
+            (0.0, t_long),
+            (-eb, eb),
+        ));
+        specs.push(PanelSpec::new(
+            &titles[3 * p + 2],
+            "a",
+            "spectral radius ρ",
+            (0.0, chart.last().map_or(1.0, |c| c.0)),
+            (0.95, r_max * 1.02),
+        ));
+    }
+    let mut figure = Figure::grid(3, panels.len(), 520, 340, &specs);
+    for (
+        p,
+        Panels {
+            above,
+            below,
+            chart,
+            a_star,
+        },
+    ) in panels.iter().enumerate()
+    {
+        for (i, color) in [(0, BLUE), (1, RED)] {
+            figure.line(3 * p, &above[i], color);
+            figure.line(3 * p + 1, &below[i], color);
+        }
+        let top = figure.panel(3 * p + 2).y_range.1;
+        figure.line(3 * p + 2, &[(*a_star, 0.95), (*a_star, top)], GREY);
+        figure.line(3 * p + 2, chart, BLACK);
+        figure.points(3 * p + 2, chart.iter().copied(), BLACK, 3);
+        figure.legend(3 * p, &[("φ₁".into(), BLUE), ("φ₂".into(), RED)]);
+        figure.legend(
+            3 * p + 2,
+            &[("exact".into(), BLACK), ("a* (limit)".into(), GREY)],
+        );
+    }
+    figure
 }
