@@ -22,6 +22,23 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// One case of the figure: amplitude, start, deviations.
+#[derive(Debug, serde::Serialize)]
+struct Case {
+    a: f64,
+    phi0: [f64; 2],
+    max_deviation: Vec<f64>,
+    nu_times_max_deviation: [f64; 2],
+    max_velocity_difference: Vec<f64>,
+}
+
+#[derive(serde::Serialize)]
+struct Summary {
+    nu: f64,
+    t_end: f64,
+    cases: Vec<Case>,
+}
+
 fn main() {
     run(|| {
         let mut knobs = parameter_knobs(&[("nu", "1000")]);
@@ -101,11 +118,13 @@ fn main() {
                         .fold(0.0, f64::max)
                 })
                 .collect();
-            summary_cases.push(serde_json::json!({
-                "a": a, "phi0": [y0[0], y0[1]],
-                "max_deviation": deviation, "nu_times_max_deviation": [deviation[0] * params.nu, deviation[1] * params.nu],
-                "max_velocity_difference": velocity_gap,
-            }));
+            summary_cases.push(Case {
+                a: *a,
+                phi0: [y0[0], y0[1]],
+                nu_times_max_deviation: [deviation[0] * params.nu, deviation[1] * params.nu],
+                max_deviation: deviation,
+                max_velocity_difference: velocity_gap,
+            });
             for (k, t) in c.times.iter().enumerate() {
                 let (e, v) = (&c.exact[k], &c.averaged[k]);
                 rows.push((
@@ -212,11 +231,13 @@ fn main() {
             rows,
         )?;
         for s in &summary_cases {
-            println!("{s}");
+            println!("{s:?}");
         }
-        scene.write_summary(
-            serde_json::json!({ "nu": base.nu, "t_end": t_end, "cases": summary_cases }),
-        )?;
+        scene.write_summary(&Summary {
+            nu: base.nu,
+            t_end,
+            cases: summary_cases,
+        })?;
         Ok(())
     });
 }

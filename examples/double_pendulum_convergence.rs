@@ -146,13 +146,22 @@ fn main() {
             "slopes of max deviation against ν: φ1 {:.4}, φ2 {:.4}",
             slopes[0], slopes[1]
         );
-        scene.write_summary(serde_json::json!({
-            "t_obs": t_obs,
-            "nu": frequencies,
-            "max_dev": result.max_deviation,
-            "nu_times_max_dev": scaled,
-            "slope": slopes,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            t_obs: f64,
+            nu: Vec<f64>,
+            /// [coordinate][frequency]
+            max_dev: Vec<Vec<f64>>,
+            nu_times_max_dev: Vec<Vec<f64>>,
+            slope: Vec<f64>,
+        }
+        scene.write_summary(&Summary {
+            t_obs,
+            nu: frequencies,
+            max_dev: result.max_deviation,
+            nu_times_max_dev: scaled,
+            slope: slopes,
+        })?;
         Ok(())
     });
 }

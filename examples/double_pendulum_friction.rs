@@ -20,6 +20,27 @@ use mechlab::studies::double_pendulum::{
 };
 use std::f64::consts::PI;
 
+/// The exact system's multipliers at one frequency.
+#[derive(serde::Serialize)]
+struct ExactMultipliers {
+    nu: f64,
+    spectral_radius: f64,
+    /// exp(max Re λ · 2π/ν) from the averaged eigenvalues.
+    predicted: f64,
+    multipliers: Vec<[f64; 2]>,
+}
+
+#[derive(serde::Serialize)]
+struct Summary {
+    equilibrium: [f64; 2],
+    mu: f64,
+    a: f64,
+    nu: f64,
+    averaged_eigenvalues: Vec<[f64; 2]>,
+    max_real_part: f64,
+    exact: Vec<ExactMultipliers>,
+}
+
 fn main() {
     run(|| {
         let mut knobs = parameter_knobs(&[("mu", "0.3")]);
@@ -95,14 +116,16 @@ fn main() {
                 "ν = {nu}: exact spectral radius {radius:.9}, averaged prediction {expected:.9}"
             );
             rows.push((nu, radius, expected));
-            radii.push(
-                serde_json::json!({"nu": nu, "spectral_radius": radius, "predicted": expected,
-                "multipliers": multipliers.iter().map(|(re, im)| [*re, *im]).collect::<Vec<_>>()}),
-            );
+            radii.push(ExactMultipliers {
+                nu,
+                spectral_radius: radius,
+                predicted: expected,
+                multipliers: multipliers.iter().map(|(re, im)| [*re, *im]).collect(),
+            });
         }
         if radii
             .iter()
-            .any(|r| r["spectral_radius"].as_f64().unwrap_or(2.0) >= 1.0)
+            .any(|r| r.spectral_radius >= 1.0)
         {
             eprintln!("note: some exact multipliers are not inside the unit circle");
         }
@@ -129,7 +152,7 @@ fn main() {
         let gaps: Vec<f64> = nus
             .iter()
             .zip(&radii)
-            .map(|(_, r)| 1.0 - r["spectral_radius"].as_f64().unwrap_or(1.0))
+            .map(|(_, r)| 1.0 - r.spectral_radius)
             .collect();
         let gap_max = gaps.iter().fold(0.0f64, |m, g| m.max(*g)).max(1e-12);
         let gap_min = gaps.iter().fold(f64::MAX, |m, g| m.min(*g)).max(1e-12);
@@ -189,13 +212,15 @@ fn main() {
         if !max_re.is_finite() {
             return Err(SceneError::Numerical("no eigenvalues".into()));
         }
-        scene.write_summary(serde_json::json!({
-            "equilibrium": [phi.0, phi.1],
-            "mu": params.mu, "a": params.a, "nu": params.nu,
-            "averaged_eigenvalues": eigenvalues.iter().map(|(re, im)| [*re, *im]).collect::<Vec<_>>(),
-            "max_real_part": max_re,
-            "exact": radii,
-        }))?;
+        scene.write_summary(&Summary {
+            equilibrium: [phi.0, phi.1],
+            mu: params.mu,
+            a: params.a,
+            nu: params.nu,
+            averaged_eigenvalues: eigenvalues.iter().map(|(re, im)| [*re, *im]).collect(),
+            max_real_part: max_re,
+            exact: radii,
+        })?;
         Ok(())
     });
 }

@@ -190,16 +190,37 @@ fn main() {
         if lyapunov[0] <= 0.0 {
             eprintln!("note: the largest exponent is not positive: at these parameters the attractor is not chaotic");
         }
-        scene.write_summary(serde_json::json!({
-            "A": params.A, "eps": params.eps, "mu": params.mu,
-            "lyapunov": lyapunov,
-            "lyapunov_sum_expected": expected_sum,
-            "lyapunov_sum": lyapunov[0] + lyapunov[1],
-            "dimension": dimension,
-            "kaplan_yorke_dimension": kaplan_yorke,
-            "points": count,
-            "zoom_window": {"q": [q0, q1], "p": [p0, p1]},
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Window {
+            q: [f64; 2],
+            p: [f64; 2],
+        }
+        #[allow(non_snake_case)]
+        #[derive(serde::Serialize)]
+        struct Summary {
+            A: f64,
+            eps: f64,
+            mu: f64,
+            lyapunov: [f64; 2],
+            lyapunov_sum_expected: f64,
+            lyapunov_sum: f64,
+            dimension: f64,
+            kaplan_yorke_dimension: f64,
+            points: usize,
+            zoom_window: Window,
+        }
+        scene.write_summary(&Summary {
+            A: params.A,
+            eps: params.eps,
+            mu: params.mu,
+            lyapunov,
+            lyapunov_sum_expected: expected_sum,
+            lyapunov_sum: lyapunov[0] + lyapunov[1],
+            dimension,
+            kaplan_yorke_dimension: kaplan_yorke,
+            points: count,
+            zoom_window: Window { q: [q0, q1], p: [p0, p1] },
+        })?;
         Ok(())
     });
 }

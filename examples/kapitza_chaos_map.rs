@@ -112,13 +112,34 @@ fn main() {
                 (q, p, *v)
             }),
         )?;
-        scene.write_summary(serde_json::json!({
-            "A": params.A, "eps": params.eps, "mu": params.mu,
-            "pixels": pixels, "periods": periods,
-            "method": method.name(), "tol": scene.number("tol")?,
-            "chaotic_fraction": chaotic, "fli_regular_level": low,
-            "seconds": seconds, "f_evals": f_evals,
-        }))?;
+        #[allow(non_snake_case)]
+        #[derive(serde::Serialize)]
+        struct Summary {
+            A: f64,
+            eps: f64,
+            mu: f64,
+            pixels: usize,
+            periods: usize,
+            method: &'static str,
+            tol: f64,
+            chaotic_fraction: f64,
+            fli_regular_level: f64,
+            seconds: f64,
+            f_evals: u64,
+        }
+        scene.write_summary(&Summary {
+            A: params.A,
+            eps: params.eps,
+            mu: params.mu,
+            pixels,
+            periods,
+            method: method.name(),
+            tol: scene.number("tol")?,
+            chaotic_fraction: chaotic,
+            fli_regular_level: low,
+            seconds,
+            f_evals,
+        })?;
         Ok(())
     });
 }

@@ -56,12 +56,20 @@ fn main() {
         }
         scene.write_text("derivations.md", &markdown)?;
         scene.write_text("generated.rs", model.generated_code)?;
-        scene.write_summary(serde_json::json!({
-            "model": model.name,
-            "expressions": model.derivations.len(),
-            "generated_lines": model.generated_code.lines().count(),
-            "operation_counts": model.operation_counts,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            model: &'static str,
+            expressions: usize,
+            generated_lines: usize,
+            /// (function, derived, readable, emitted)
+            operation_counts: &'static [(&'static str, usize, usize, usize)],
+        }
+        scene.write_summary(&Summary {
+            model: model.name,
+            expressions: model.derivations.len(),
+            generated_lines: model.generated_code.lines().count(),
+            operation_counts: model.operation_counts,
+        })?;
         Ok(())
     });
 }

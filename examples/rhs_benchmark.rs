@@ -120,10 +120,21 @@ fn main() {
             per(best[2]),
             per(best[3])
         );
-        scene.write_summary(serde_json::json!({
-            "kapitza": {"generated_ns": per(best[0]), "hand_written_ns": per(best[1]), "ratio": rk},
-            "double_pendulum": {"generated_ns": per(best[2]), "hand_written_ns": per(best[3]), "ratio": rd},
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Timing {
+            generated_ns: f64,
+            hand_written_ns: f64,
+            ratio: f64,
+        }
+        #[derive(serde::Serialize)]
+        struct Summary {
+            kapitza: Timing,
+            double_pendulum: Timing,
+        }
+        scene.write_summary(&Summary {
+            kapitza: Timing { generated_ns: per(best[0]), hand_written_ns: per(best[1]), ratio: rk },
+            double_pendulum: Timing { generated_ns: per(best[2]), hand_written_ns: per(best[3]), ratio: rd },
+        })?;
         Ok(())
     });
 }

@@ -104,10 +104,23 @@ fn main() {
                 )
             }),
         )?;
-        scene.write_summary(serde_json::json!({
-            "eps": eps, "pixels": pixels, "iterations": iterations,
-            "chaotic_fraction": chaotic, "fli_regular_level": low, "seconds": seconds,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            eps: f64,
+            pixels: usize,
+            iterations: usize,
+            chaotic_fraction: f64,
+            fli_regular_level: f64,
+            seconds: f64,
+        }
+        scene.write_summary(&Summary {
+            eps,
+            pixels,
+            iterations,
+            chaotic_fraction: chaotic,
+            fli_regular_level: low,
+            seconds,
+        })?;
         Ok(())
     });
 }
