@@ -23,6 +23,22 @@ use mechlab::studies::double_pendulum::{
 };
 use rayon::prelude::*;
 
+/// What the summary says of one equilibrium (null where not applicable).
+#[derive(serde::Serialize)]
+struct EquilibriumEntry {
+    phi1: f64,
+    phi2: f64,
+    lambdas: [f64; 2],
+    stable_without_vibration: bool,
+    a_star: Option<f64>,
+    a_star_formula: Option<String>,
+    a_star_formula_latex: Option<String>,
+    /// [lower edge, upper edge or null] of the exact system at ν.
+    exact_window: Option<(f64, Option<f64>)>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<&'static str>,
+}
+
 /// What the figure shows of one unstable equilibrium.
 struct Panels {
     /// φ − φ_eq against t, per coordinate, slightly above and below a*.
@@ -141,18 +157,23 @@ fn main() {
                 "equilibrium {name}: λ = {:?}, stable without vibration: {}",
                 analysis.lambdas, analysis.stable_without_vibration
             );
-            let mut entry = serde_json::json!({
-                "phi1": phi.0, "phi2": phi.1,
-                "lambdas": analysis.lambdas,
-                "stable_without_vibration": analysis.stable_without_vibration,
-                "a_star": null, "a_star_formula": null, "a_star_formula_latex": null, "exact_window": null,
-            });
+            let mut entry = EquilibriumEntry {
+                phi1: phi.0,
+                phi2: phi.1,
+                lambdas: analysis.lambdas,
+                stable_without_vibration: analysis.stable_without_vibration,
+                a_star: None,
+                a_star_formula: None,
+                a_star_formula_latex: None,
+                exact_window: None,
+                reason: None,
+            };
             match analysis.stabilization {
                 Stabilization::AlreadyStable => println!("  stable for every a (all λ > 0)"),
                 Stabilization::Degenerate => {
                     println!("  not decided: a root λ is zero (degenerate equilibrium)");
-                    entry["reason"] =
-                        "a root of det(C − λA) is zero: the criterion does not apply".into();
+                    entry.reason =
+                        Some("a root of det(C − λA) is zero: the criterion does not apply");
                 }
                 Stabilization::Threshold {
                     lambda_star,
@@ -166,11 +187,10 @@ fn main() {
                         "  exact system at ν = {}: stable for a in {window:?}",
                         params.nu
                     );
-                    entry["a_star"] = a_star.into();
-                    entry["a_star_formula"] = text.into();
-                    entry["a_star_formula_latex"] = latex.into();
-                    entry["exact_window"] =
-                        window.map(|(lo, hi)| serde_json::json!([lo, hi])).into();
+                    entry.a_star = Some(a_star);
+                    entry.a_star_formula = Some(text);
+                    entry.a_star_formula_latex = Some(latex);
+                    entry.exact_window = window;
                     let y0 = [phi.0 + offset, phi.1 - offset, 0.0, 0.0];
                     let above =
                         limiting_run(method, &params, (1.0 + margin) * a_star, *phi, &y0, t_long)?;
@@ -210,12 +230,35 @@ fn main() {
             &["panel", "a", "spectral_radius"],
             rows,
         )?;
-        scene.write_summary(serde_json::json!({
-            "params": {"m1": params.m1, "m2": params.m2, "l1": params.l1, "l2": params.l2, "g": params.g, "mu": params.mu},
-            "nu": params.nu,
-            "mean_h2": mechlab::studies::double_pendulum::MEAN_H2,
-            "equilibria": entries,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Masses {
+            m1: f64,
+            m2: f64,
+            l1: f64,
+            l2: f64,
+            g: f64,
+            mu: f64,
+        }
+        #[derive(serde::Serialize)]
+        struct Summary {
+            params: Masses,
+            nu: f64,
+            mean_h2: f64,
+            equilibria: Vec<EquilibriumEntry>,
+        }
+        scene.write_summary(&Summary {
+            params: Masses {
+                m1: params.m1,
+                m2: params.m2,
+                l1: params.l1,
+                l2: params.l2,
+                g: params.g,
+                mu: params.mu,
+            },
+            nu: params.nu,
+            mean_h2: mechlab::studies::double_pendulum::MEAN_H2,
+            equilibria: entries,
+        })?;
         Ok(())
     });
 }

@@ -185,17 +185,48 @@ fn main() {
             ],
             rows,
         )?;
-        let summary: Vec<serde_json::Value> = runs
+        #[derive(serde::Serialize)]
+        struct Event {
+            t: f64,
+            point: usize,
+            case: String,
+        }
+        #[allow(non_snake_case)]
+        #[derive(serde::Serialize)]
+        struct Run {
+            case: &'static str,
+            eps: f64,
+            outcome: String,
+            t_end: f64,
+            final_R: f64,
+            steps: u64,
+            seconds: f64,
+            events: Vec<Event>,
+        }
+        #[allow(non_snake_case)]
+        #[derive(serde::Serialize)]
+        struct Summary {
+            rigid_R_star: Option<f64>,
+            runs: Vec<Run>,
+        }
+        let summary: Vec<Run> = runs
             .iter()
-            .map(|(label, eps, result, seconds, steps, final_r, _)| {
-                serde_json::json!({
-                    "case": label, "eps": eps, "outcome": format!("{:?}", result.outcome),
-                    "t_end": result.t, "final_R": final_r, "steps": steps, "seconds": seconds,
-                    "events": result.switches.iter().map(|s| serde_json::json!({"t": s.t, "point": s.contact + 1, "case": s.case})).collect::<Vec<_>>(),
-                })
+            .map(|(label, eps, result, seconds, steps, final_r, _)| Run {
+                case: label,
+                eps: *eps,
+                outcome: format!("{:?}", result.outcome),
+                t_end: result.t,
+                final_R: *final_r,
+                steps: *steps,
+                seconds: *seconds,
+                events: result
+                    .switches
+                    .iter()
+                    .map(|s| Event { t: s.t, point: s.contact + 1, case: s.case.clone() })
+                    .collect(),
             })
             .collect();
-        scene.write_summary(serde_json::json!({ "rigid_R_star": r_star, "runs": summary }))?;
+        scene.write_summary(&Summary { rigid_R_star: r_star, runs: summary })?;
         Ok(())
     });
 }
