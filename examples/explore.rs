@@ -113,15 +113,30 @@ fn main() {
             .iter()
             .fold(0.0f64, |m, e| m.max(e.abs()));
         println!("{}: max |change| {max_energy:.3e}", result.energy_label);
-        scene.write_summary(serde_json::json!({
-            "model": info.name,
-            "params": info.parameter_names.iter().zip(&params).map(|(n, v)| (n.to_string(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
-            "y0": y0,
-            "final_state": result.exact.last(),
-            "equilibria": result.equilibria.iter().map(|e| serde_json::json!({"q": e.q, "hessian_eigenvalues": e.hessian_eigenvalues, "stable": e.stable})).collect::<Vec<_>>(),
-            "energy": {"label": result.energy_label, "max_abs_change": max_energy},
-            "switches": result.switches,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Energy {
+            label: &'static str,
+            max_abs_change: f64,
+        }
+        #[derive(serde::Serialize)]
+        struct Summary<'a> {
+            model: &'static str,
+            params: std::collections::BTreeMap<&'static str, f64>,
+            y0: &'a [f64],
+            final_state: Option<&'a Vec<f64>>,
+            equilibria: &'a [mechlab::explore::Equilibrium],
+            energy: Energy,
+            switches: &'a [String],
+        }
+        scene.write_summary(&Summary {
+            model: info.name,
+            params: info.parameter_names.iter().copied().zip(params.iter().copied()).collect(),
+            y0: &y0,
+            final_state: result.exact.last(),
+            equilibria: &result.equilibria,
+            energy: Energy { label: result.energy_label, max_abs_change: max_energy },
+            switches: &result.switches,
+        })?;
         Ok(())
     });
 }

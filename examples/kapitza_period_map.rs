@@ -106,11 +106,27 @@ fn main() {
             );
             figure.points(0, points.iter().map(|y| (y[0], y[1])), palette(0), 1);
             scene.save_figure(&figure, "orbit.png")?;
-            scene.write_summary(serde_json::json!({
-                "final_state": last, "periods": periods, "method": method.name(),
-                "tol": scene.number("tol")?, "seconds": seconds, "f_evals": integrator.stats.f_evals,
-                "steps": integrator.stats.steps, "rejected": integrator.stats.rejected,
-            }))?;
+            #[derive(serde::Serialize)]
+            struct Orbit {
+                final_state: [f64; 2],
+                periods: usize,
+                method: &'static str,
+                tol: f64,
+                seconds: f64,
+                f_evals: u64,
+                steps: u64,
+                rejected: u64,
+            }
+            scene.write_summary(&Orbit {
+                final_state: last,
+                periods,
+                method: method.name(),
+                tol: scene.number("tol")?,
+                seconds,
+                f_evals: integrator.stats.f_evals,
+                steps: integrator.stats.steps,
+                rejected: integrator.stats.rejected,
+            })?;
             return Ok(());
         }
 
@@ -169,11 +185,40 @@ fn main() {
                 &["orbit", "period", "q", "p"],
                 rows,
             )?;
-            summary.push(serde_json::json!({"A": a, "orbits": initial.len(), "periods": periods, "seconds": seconds, "f_evals": f_evals}));
+            summary.push(Portrait {
+                A: a,
+                orbits: initial.len(),
+                periods,
+                seconds,
+                f_evals,
+            });
         }
-        scene.write_summary(serde_json::json!({"eps": eps, "mu": mu, "method": method.name(), "portraits": summary}))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            eps: f64,
+            mu: f64,
+            method: &'static str,
+            portraits: Vec<Portrait>,
+        }
+        scene.write_summary(&Summary {
+            eps,
+            mu,
+            method: method.name(),
+            portraits: summary,
+        })?;
         Ok(())
     });
+}
+
+/// One portrait of the presets.
+#[allow(non_snake_case)]
+#[derive(serde::Serialize)]
+struct Portrait {
+    A: f64,
+    orbits: usize,
+    periods: usize,
+    seconds: f64,
+    f_evals: u64,
 }
 
 fn range_p(points: &[[f64; 2]]) -> (f64, f64) {

@@ -258,14 +258,37 @@ fn main() {
         for (e, s) in &a_star_by_eps {
             println!("ε = {e}: A* = {s:?}, A* − √2 = {:?}", s.map(|x| x - SQRT_2));
         }
-        scene.write_summary(serde_json::json!({
-            "eps": eps, "mu": mu, "A": a,
-            "a_star": a_star, "a_star_averaged": SQRT_2,
-            "multipliers": multipliers.iter().map(|(re, im)| [re, im]).collect::<Vec<_>>(),
-            "determinant": det, "determinant_expected": (-mu * period).exp(),
-            "verdict": verdict.name(),
-            "a_star_by_eps": a_star_by_eps.iter().map(|(e, s)| serde_json::json!({"eps": e, "a_star": s})).collect::<Vec<_>>(),
-        }))?;
+        #[derive(serde::Serialize)]
+        struct AStar {
+            eps: f64,
+            a_star: Option<f64>,
+        }
+        #[allow(non_snake_case)]
+        #[derive(serde::Serialize)]
+        struct Summary {
+            eps: f64,
+            mu: f64,
+            A: f64,
+            a_star: Option<f64>,
+            a_star_averaged: f64,
+            multipliers: Vec<[f64; 2]>,
+            determinant: f64,
+            determinant_expected: f64,
+            verdict: &'static str,
+            a_star_by_eps: Vec<AStar>,
+        }
+        scene.write_summary(&Summary {
+            eps,
+            mu,
+            A: a,
+            a_star,
+            a_star_averaged: SQRT_2,
+            multipliers: multipliers.iter().map(|(re, im)| [*re, *im]).collect(),
+            determinant: det,
+            determinant_expected: (-mu * period).exp(),
+            verdict: verdict.name(),
+            a_star_by_eps: a_star_by_eps.iter().map(|&(eps, a_star)| AStar { eps, a_star }).collect(),
+        })?;
         Ok(())
     });
 }

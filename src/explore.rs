@@ -25,7 +25,7 @@ pub struct Settings {
 }
 
 /// An equilibrium of the effective potential (V + V_vibr, or V).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Equilibrium {
     pub q: Vec<f64>,
     /// Eigenvalues of the Hessian, ascending.
