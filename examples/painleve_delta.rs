@@ -11,7 +11,7 @@
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, RED};
 use mechlab::scene::{knob, run, Knob, Scene};
-use mechlab::studies::painleve::{
+use mechlab::studies::painleve::{DeformationEquilibrium, 
     class_example, parameter_knobs, params_from_scene, reduced, DeformationEquation, GRAPH_CLASSES,
 };
 
@@ -65,6 +65,15 @@ fn portrait(
         }
     }
     Ok(curves)
+}
+
+/// One portrait's equation and its equilibria.
+#[derive(serde::Serialize)]
+struct Case {
+    case: String,
+    x_star: f64,
+    sigma: f64,
+    equilibria: Vec<DeformationEquilibrium>,
 }
 
 fn main() {
@@ -147,14 +156,12 @@ fn main() {
                 specs_titles.push(format!("{name}, ν = {nu}"));
                 panels.push((window_x, rate, curves, system.equilibria(), stable));
             }
-            summary.push(serde_json::json!({
-                "case": name, "x_star": eq.reduced.x_star, "sigma": eq.sigma,
-                "equilibria": equilibria.iter().map(|e| serde_json::json!({
-                    "R_star": e.root, "delta_star": e.delta, "phi_slope": e.slope,
-                    "eigenvalues": e.eigenvalues.iter().map(|(re, im)| [*re, *im]).collect::<Vec<_>>(),
-                    "asymptotically_stable": e.asymptotically_stable,
-                })).collect::<Vec<_>>(),
-            }));
+            summary.push(Case {
+                case: name.clone(),
+                x_star: eq.reduced.x_star,
+                sigma: eq.sigma,
+                equilibria,
+            });
         }
         let specs: Vec<PanelSpec> = panels
             .iter()
@@ -171,7 +178,11 @@ fn main() {
             }
         }
         scene.save_figure(&figure, "portraits.png")?;
-        scene.write_summary(serde_json::json!({ "cases": summary }))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            cases: Vec<Case>,
+        }
+        scene.write_summary(&Summary { cases: summary })?;
         Ok(())
     });
 }

@@ -24,6 +24,36 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// One switch of the event table.
+#[allow(non_snake_case)]
+#[derive(serde::Serialize)]
+struct Event {
+    t: f64,
+    point: usize,
+    case: String,
+    from: String,
+    to: String,
+    v1: f64,
+    v2: f64,
+    R: f64,
+}
+
+/// One initial condition: its events and how it ends.
+#[derive(serde::Serialize)]
+struct Case {
+    x2_0: f64,
+    delta_0: f64,
+    events: Vec<Event>,
+    /// "rest" or "sliding".
+    r#final: &'static str,
+    t_end: f64,
+    /// The constant accelerations when sliding at the end.
+    acceleration: Option<[f64; 2]>,
+    final_state: [f64; 4],
+    steps: u64,
+    phases: usize,
+}
+
 fn knobs() -> Vec<Knob> {
     let mut knobs = parameter_knobs();
     knobs.extend([
@@ -79,7 +109,7 @@ fn main() {
                 run.outcome,
                 run.t
             );
-            let events: Vec<serde_json::Value> = run
+            let events: Vec<Event> = run
                 .switches
                 .iter()
                 .map(|s| {
@@ -97,12 +127,20 @@ fn main() {
                         s.to.to_string(),
                         [s.y[2], s.y[3], r],
                     ));
-                    serde_json::json!({"t": s.t, "point": s.contact + 1, "case": s.case,
-                        "from": s.from.to_string(), "to": s.to.to_string(), "v1": s.y[2], "v2": s.y[3], "R": r})
+                    Event {
+                        t: s.t,
+                        point: s.contact + 1,
+                        case: s.case.clone(),
+                        from: s.from.to_string(),
+                        to: s.to.to_string(),
+                        v1: s.y[2],
+                        v2: s.y[3],
+                        R: r,
+                    }
                 })
                 .collect();
             let (final_state, acceleration) = match run.outcome {
-                Outcome::Rest => ("rest", serde_json::Value::Null),
+                Outcome::Rest => ("rest", None),
                 Outcome::Moving => {
                     let f = Smooth {
                         model: &model,
@@ -113,14 +151,20 @@ fn main() {
                         "  sliding at the end with accelerations ({:.6}, {:.6})",
                         f[2], f[3]
                     );
-                    ("sliding", serde_json::json!([f[2], f[3]]))
+                    ("sliding", Some([f[2], f[3]]))
                 }
             };
-            cases.push(serde_json::json!({
-                "x2_0": x2, "delta_0": rod(&y0, &params).delta, "events": events,
-                "final": final_state, "t_end": run.t, "acceleration": acceleration,
-                "final_state": run.y, "steps": steps, "phases": run.phases.len(),
-            }));
+            cases.push(Case {
+                x2_0: x2,
+                delta_0: rod(&y0, &params).delta,
+                events,
+                r#final: final_state,
+                t_end: run.t,
+                acceleration,
+                final_state: run.y,
+                steps,
+                phases: run.phases.len(),
+            });
             figures_data.push((x2, run));
         }
 
@@ -216,7 +260,11 @@ fn main() {
             ],
             series,
         )?;
-        scene.write_summary(serde_json::json!({ "cases": cases }))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            cases: Vec<Case>,
+        }
+        scene.write_summary(&Summary { cases })?;
         Ok(())
     });
 }

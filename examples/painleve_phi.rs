@@ -15,6 +15,17 @@ use mechlab::studies::painleve::{
     rigid_rod_roots, slope_signs, Reduced, GRAPH_CLASSES,
 };
 
+/// The roots for the given parameters and one σ.
+#[derive(serde::Serialize)]
+struct Given {
+    sigma: f64,
+    signs: String,
+    roots: Vec<f64>,
+    /// Φ'(R) > 0 at each root.
+    rising: Vec<bool>,
+    case: &'static str,
+}
+
 fn graph(q: &Reduced, sigma: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
     (0..=400)
         .map(|i| lo + (hi - lo) * i as f64 / 400.0)
@@ -82,10 +93,13 @@ fn main() {
                 "given parameters, σ = {sigma:+}: slopes {}, X* = {:.6}, roots {roots:?} (Φ' > 0: {stable:?}): {}",
                 slope_signs(sigma, &q), q.x_star, painleve_case(roots.len())
             );
-            given.push(
-                serde_json::json!({"sigma": sigma, "signs": slope_signs(sigma, &q), "roots": roots,
-                "rising": stable, "case": painleve_case(roots.len())}),
-            );
+            given.push(Given {
+                sigma,
+                signs: slope_signs(sigma, &q),
+                case: painleve_case(roots.len()),
+                roots,
+                rising: stable,
+            });
         }
         titles.push("regions, σo = +1".into());
         titles.push("regions, σo = −1".into());
@@ -209,11 +223,18 @@ fn main() {
             &["sigma_o", "mu1_star", "mu2_star", "signs"],
             region_rows,
         )?;
-        scene.write_summary(serde_json::json!({
-            "classes": GRAPH_CLASSES.iter().map(|c| serde_json::json!({"signs": c.signs, "region": c.region, "roots": c.roots})).collect::<Vec<_>>(),
-            "reduced": {"x_star": q.x_star, "mu1_star": q.mu1, "mu2_star": q.mu2, "y1_star": q.y1, "y2_star": q.y2},
-            "given": given,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Summary {
+            classes: &'static [mechlab::studies::painleve::GraphClass],
+            /// X*, μ1*, μ2*, Y1*, Y2*, cos φ0 of the given parameters.
+            reduced: Reduced,
+            given: Vec<Given>,
+        }
+        scene.write_summary(&Summary {
+            classes: &GRAPH_CLASSES,
+            reduced: q,
+            given,
+        })?;
         Ok(())
     });
 }

@@ -38,7 +38,7 @@ pub fn worked_example_start(x2: f64) -> [f64; 4] {
 
 /// The reduced quantities of the rigid rod: X* = (X1 − X2)/cos φ0,
 /// μi* = μi tan φ0, Y1* = Y1/sin φ0, Y2* = Y2/sin φ0, φ0 = arcsin(d/l).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Reduced {
     pub x_star: f64,
     pub mu1: f64,
@@ -144,7 +144,7 @@ pub fn slope_signs(sigma: f64, q: &Reduced) -> String {
 /// One qualitatively different graph of Φ: its slope signs, the region of
 /// the parameters where it occurs (Δ = μ2* − μ1*, S = μ1* + μ2*, o = +1 if
 /// Y1* < −Y2* else −1), and what X* = Φ(R) can have as roots.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GraphClass {
     pub signs: &'static str,
     pub region: &'static str,
@@ -240,7 +240,7 @@ pub struct DeformationEquation {
 }
 
 /// An equilibrium of (25): δ* = ε² R*/k, δ' = 0, and its linearisation.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct DeformationEquilibrium {
     pub root: f64,
     pub delta: f64,
