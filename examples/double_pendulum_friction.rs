@@ -123,10 +123,7 @@ fn main() {
                 multipliers: multipliers.iter().map(|(re, im)| [*re, *im]).collect(),
             });
         }
-        if radii
-            .iter()
-            .any(|r| r.spectral_radius >= 1.0)
-        {
+        if radii.iter().any(|r| r.spectral_radius >= 1.0) {
             eprintln!("note: some exact multipliers are not inside the unit circle");
         }
 

@@ -130,11 +130,19 @@ fn main() {
         }
         scene.write_summary(&Summary {
             model: info.name,
-            params: info.parameter_names.iter().copied().zip(params.iter().copied()).collect(),
+            params: info
+                .parameter_names
+                .iter()
+                .copied()
+                .zip(params.iter().copied())
+                .collect(),
             y0: &y0,
             final_state: result.exact.last(),
             equilibria: &result.equilibria,
-            energy: Energy { label: result.energy_label, max_abs_change: max_energy },
+            energy: Energy {
+                label: result.energy_label,
+                max_abs_change: max_energy,
+            },
             switches: &result.switches,
         })?;
         Ok(())

@@ -201,7 +201,7 @@ fn main() {
             A: f64,
             eps: f64,
             mu: f64,
-            lyapunov: [f64; 2],
+            lyapunov: Vec<f64>,
             lyapunov_sum_expected: f64,
             lyapunov_sum: f64,
             dimension: f64,
@@ -213,13 +213,16 @@ fn main() {
             A: params.A,
             eps: params.eps,
             mu: params.mu,
-            lyapunov,
             lyapunov_sum_expected: expected_sum,
             lyapunov_sum: lyapunov[0] + lyapunov[1],
+            lyapunov,
             dimension,
             kaplan_yorke_dimension: kaplan_yorke,
             points: count,
-            zoom_window: Window { q: [q0, q1], p: [p0, p1] },
+            zoom_window: Window {
+                q: [q0, q1],
+                p: [p0, p1],
+            },
         })?;
         Ok(())
     });

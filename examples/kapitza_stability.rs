@@ -287,7 +287,10 @@ fn main() {
             determinant: det,
             determinant_expected: (-mu * period).exp(),
             verdict: verdict.name(),
-            a_star_by_eps: a_star_by_eps.iter().map(|&(eps, a_star)| AStar { eps, a_star }).collect(),
+            a_star_by_eps: a_star_by_eps
+                .iter()
+                .map(|&(eps, a_star)| AStar { eps, a_star })
+                .collect(),
         })?;
         Ok(())
     });

@@ -11,8 +11,9 @@
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, RED};
 use mechlab::scene::{knob, run, Knob, Scene};
-use mechlab::studies::painleve::{DeformationEquilibrium, 
-    class_example, parameter_knobs, params_from_scene, reduced, DeformationEquation, GRAPH_CLASSES,
+use mechlab::studies::painleve::{
+    class_example, parameter_knobs, params_from_scene, reduced, DeformationEquation,
+    DeformationEquilibrium, GRAPH_CLASSES,
 };
 
 fn knobs() -> Vec<Knob> {

@@ -222,11 +222,18 @@ fn main() {
                 events: result
                     .switches
                     .iter()
-                    .map(|s| Event { t: s.t, point: s.contact + 1, case: s.case.clone() })
+                    .map(|s| Event {
+                        t: s.t,
+                        point: s.contact + 1,
+                        case: s.case.clone(),
+                    })
                     .collect(),
             })
             .collect();
-        scene.write_summary(&Summary { rigid_R_star: r_star, runs: summary })?;
+        scene.write_summary(&Summary {
+            rigid_R_star: r_star,
+            runs: summary,
+        })?;
         Ok(())
     });
 }

@@ -132,8 +132,16 @@ fn main() {
             double_pendulum: Timing,
         }
         scene.write_summary(&Summary {
-            kapitza: Timing { generated_ns: per(best[0]), hand_written_ns: per(best[1]), ratio: rk },
-            double_pendulum: Timing { generated_ns: per(best[2]), hand_written_ns: per(best[3]), ratio: rd },
+            kapitza: Timing {
+                generated_ns: per(best[0]),
+                hand_written_ns: per(best[1]),
+                ratio: rk,
+            },
+            double_pendulum: Timing {
+                generated_ns: per(best[2]),
+                hand_written_ns: per(best[3]),
+                ratio: rd,
+            },
         })?;
         Ok(())
     });

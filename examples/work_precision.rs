@@ -22,8 +22,8 @@ use mechlab::plot::{palette, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Progress, Scene, SceneError};
 use mechlab::studies::painleve::state_with_deformation;
 use ode_solvers::{OutputType, SVector};
-use serde_json::json;
 use std::cell::RefCell;
+use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 use std::hint::black_box;
 use std::time::Instant;
@@ -128,6 +128,7 @@ impl Solver {
 }
 
 /// One measured run.
+#[derive(serde::Serialize)]
 struct Row {
     problem: &'static str,
     method: &'static str,
@@ -135,6 +136,41 @@ struct Row {
     error: f64,
     seconds: f64,
     f_evals: u64,
+}
+
+/// A run that failed or was skipped, with the reason.
+#[derive(serde::Serialize)]
+struct Failure {
+    problem: &'static str,
+    method: &'static str,
+    tol_or_step: f64,
+    reason: String,
+}
+
+/// Fitted slope of error against f-evaluations per method (None: no line).
+type Slopes = BTreeMap<String, Option<f64>>;
+
+/// The performance figures of the Kapitza period map (issue targets).
+#[derive(serde::Serialize)]
+struct Performance {
+    bare_rhs_ns: f64,
+    bare_rhs_latency_ns: f64,
+    overhead_dop853: f64,
+    overhead_rk4: f64,
+    overhead_dop853_against_latency: f64,
+    overhead_rk4_against_latency: f64,
+    #[serde(rename = "seconds_to_1e-10")]
+    seconds_to_1e_10: BTreeMap<String, f64>,
+    #[serde(rename = "peer_seconds_to_1e-10")]
+    peer_seconds_to_1e_10: Option<f64>,
+    #[serde(rename = "best_method_at_1e-10")]
+    best_method_at_1e_10: String,
+    #[serde(rename = "periods_per_second_at_1e-10")]
+    periods_per_second_at_1e_10: f64,
+    #[serde(rename = "speedup_over_peer_at_1e-10")]
+    speedup_over_peer_at_1e_10: Option<f64>,
+    #[serde(rename = "dop853_speedup_over_peer_dop853_at_1e-10")]
+    dop853_speedup_over_peer_dop853_at_1e_10: Option<f64>,
 }
 
 fn max_difference<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
@@ -302,7 +338,7 @@ fn sweep<S: System<N>, const N: usize, const M: usize>(
     min_seconds: f64,
     budget: f64,
     rows: &mut Vec<Row>,
-    failures: &mut Vec<serde_json::Value>,
+    failures: &mut Vec<Failure>,
 ) {
     let progress = Progress::new(problem, list.len());
     let start = Instant::now();
@@ -310,10 +346,12 @@ fn sweep<S: System<N>, const N: usize, const M: usize>(
     let mut over_budget: Vec<&'static str> = Vec::new();
     for (i, solver) in list.iter().enumerate() {
         if over_budget.contains(&solver.name()) {
-            failures.push(json!({
-                "problem": problem, "method": solver.name(), "tol_or_step": solver.setting(),
-                "reason": format!("skipped: a looser setting took over {budget} s"),
-            }));
+            failures.push(Failure {
+                problem,
+                method: solver.name(),
+                tol_or_step: solver.setting(),
+                reason: format!("skipped: a looser setting took over {budget} s"),
+            });
             progress.update(i + 1);
             continue;
         }
@@ -327,10 +365,12 @@ fn sweep<S: System<N>, const N: usize, const M: usize>(
                 seconds,
                 f_evals,
             }),
-            Err(reason) => failures.push(json!({
-                "problem": problem, "method": solver.name(),
-                "tol_or_step": solver.setting(), "reason": reason,
-            })),
+            Err(reason) => failures.push(Failure {
+                problem,
+                method: solver.name(),
+                tol_or_step: solver.setting(),
+                reason: reason.to_string(),
+            }),
         }
         if run_start.elapsed().as_secs_f64() > budget {
             over_budget.push(solver.name());
@@ -373,11 +413,7 @@ fn seconds_at(rows: &[&Row], target: f64) -> Option<f64> {
 
 const METHODS: [&str; 6] = ["rk4", "gauss4", "gauss6", "dop853", "radau5", PEER];
 
-fn plot_problem(
-    scene: &Scene,
-    problem: &str,
-    rows: &[&Row],
-) -> Result<serde_json::Value, SceneError> {
+fn plot_problem(scene: &Scene, problem: &str, rows: &[&Row]) -> Result<Slopes, SceneError> {
     let floor = 1e-16;
     let range = |f: &dyn Fn(&Row) -> f64| {
         let (lo, hi) = rows
@@ -414,7 +450,7 @@ fn plot_problem(
         ],
     );
     let mut legend = Vec::new();
-    let mut slopes = serde_json::Map::new();
+    let mut slopes = Slopes::new();
     for (k, method) in METHODS.iter().enumerate() {
         let mut mine: Vec<&Row> = rows
             .iter()
@@ -439,7 +475,7 @@ fn plot_problem(
             figure.points(panel, pts.iter().copied(), color, 5);
         }
         let s = slope(&by_evals);
-        slopes.insert(method.to_string(), json!(s));
+        slopes.insert(method.to_string(), s);
         let label = match s {
             Some(s) => format!("{method} slope {s:.1}"),
             None => method.to_string(),
@@ -449,7 +485,7 @@ fn plot_problem(
     figure.legend_at(1, &legend, true);
     figure.legend_at(0, &legend, true);
     scene.save_figure(&figure, &format!("{problem}.png"))?;
-    Ok(json!(slopes))
+    Ok(slopes)
 }
 
 fn main() {
@@ -476,9 +512,9 @@ fn main() {
         let budget = scene.positive("budget")?;
         let mut rows: Vec<Row> = Vec::new();
         let mut failures = Vec::new();
-        let mut agreements = serde_json::Map::new();
+        let mut agreements: BTreeMap<String, f64> = BTreeMap::new();
         let mut record = |name: &str, agreement: f64| {
-            agreements.insert(name.to_string(), json!(agreement));
+            agreements.insert(name.to_string(), agreement);
         };
 
         // (a) The Kapitza period map.
@@ -599,7 +635,7 @@ fn main() {
         }
 
         // Figures and slopes.
-        let mut slopes = serde_json::Map::new();
+        let mut slopes: BTreeMap<&str, Slopes> = BTreeMap::new();
         for problem in [
             "kapitza_regular",
             "kapitza_regular_global",
@@ -609,7 +645,7 @@ fn main() {
             "rod_eps_0.001",
         ] {
             let mine: Vec<&Row> = rows.iter().filter(|r| r.problem == problem).collect();
-            slopes.insert(problem.to_string(), plot_problem(&scene, problem, &mine)?);
+            slopes.insert(problem, plot_problem(&scene, problem, &mine)?);
         }
 
         // Performance ratios on the regular Kapitza orbit.
@@ -637,20 +673,21 @@ fn main() {
                 )
             }),
         )?;
-        let runs: Vec<serde_json::Value> = rows
-            .iter()
-            .map(|r| {
-                json!({"problem": r.problem, "method": r.method, "tol_or_step": r.tol_or_step,
-                       "error": r.error, "seconds": r.seconds, "f_evals": r.f_evals})
-            })
-            .collect();
-        scene.write_summary(json!({
-            "runs": runs,
-            "failed": failures,
-            "slopes_error_vs_f_evals": slopes,
-            "reference_agreement": agreements,
-            "performance": ratios,
-        }))?;
+        #[derive(serde::Serialize)]
+        struct Summary<'a> {
+            runs: &'a [Row],
+            failed: Vec<Failure>,
+            slopes_error_vs_f_evals: BTreeMap<&'a str, Slopes>,
+            reference_agreement: BTreeMap<String, f64>,
+            performance: Performance,
+        }
+        scene.write_summary(&Summary {
+            runs: &rows,
+            failed: failures,
+            slopes_error_vs_f_evals: slopes,
+            reference_agreement: agreements,
+            performance: ratios,
+        })?;
         Ok(())
     })
 }
@@ -684,7 +721,7 @@ fn performance(
     period: f64,
     periods: usize,
     rows: &[Row],
-) -> Result<serde_json::Value, SceneError> {
+) -> Result<Performance, SceneError> {
     // Overhead: integration time / (f-evaluations × time of one bare f), the
     // bare f timed on exactly the (t, y) at which the integrator called it.
     let overhead = |method: Method| -> Result<Overhead, SceneError> {
@@ -755,21 +792,21 @@ fn performance(
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .ok_or_else(|| SceneError::Numerical("no method reached 1e-10".into()))?;
     let peer = at(PEER);
-    Ok(json!({
-        "bare_rhs_ns": dop853.bare * 1e9,
-        "bare_rhs_latency_ns": dop853.latency * 1e9,
-        "overhead_dop853": dop853.against_throughput,
-        "overhead_rk4": rk4.against_throughput,
-        "overhead_dop853_against_latency": dop853.against_latency,
-        "overhead_rk4_against_latency": rk4.against_latency,
-        "seconds_to_1e-10": ours.iter().map(|(m, s)| (m.to_string(), json!(s))).collect::<serde_json::Map<_, _>>(),
-        "peer_seconds_to_1e-10": peer,
-        "best_method_at_1e-10": best_method,
-        "periods_per_second_at_1e-10": periods as f64 / best_seconds,
-        "speedup_over_peer_at_1e-10": peer.map(|p| p / best_seconds),
-        "dop853_speedup_over_peer_dop853_at_1e-10": match (peer, at("dop853")) {
-            (Some(p), Some(d)) => json!(p / d),
-            _ => json!(null),
+    Ok(Performance {
+        bare_rhs_ns: dop853.bare * 1e9,
+        bare_rhs_latency_ns: dop853.latency * 1e9,
+        overhead_dop853: dop853.against_throughput,
+        overhead_rk4: rk4.against_throughput,
+        overhead_dop853_against_latency: dop853.against_latency,
+        overhead_rk4_against_latency: rk4.against_latency,
+        seconds_to_1e_10: ours.iter().map(|(m, s)| (m.to_string(), *s)).collect(),
+        peer_seconds_to_1e_10: peer,
+        best_method_at_1e_10: best_method.to_string(),
+        periods_per_second_at_1e_10: periods as f64 / best_seconds,
+        speedup_over_peer_at_1e_10: peer.map(|p| p / best_seconds),
+        dop853_speedup_over_peer_dop853_at_1e_10: match (peer, at("dop853")) {
+            (Some(p), Some(d)) => Some(p / d),
+            _ => None,
         },
-    }))
+    })
 }

@@ -385,9 +385,8 @@ impl Scene {
 
     /// Writes `summary.json` (with the scene's settings added).
     pub fn write_summary<S: serde::Serialize>(&self, summary: &S) -> Result<PathBuf, SceneError> {
-        let mut summary = serde_json::to_value(summary).map_err(|e| {
-            SceneError::Numerical(format!("summary of {}: {e}", self.name))
-        })?;
+        let mut summary = serde_json::to_value(summary)
+            .map_err(|e| SceneError::Numerical(format!("summary of {}: {e}", self.name)))?;
         if let serde_json::Value::Object(map) = &mut summary {
             map.insert("scene".into(), self.name.into());
             map.insert("settings".into(), self.settings());
