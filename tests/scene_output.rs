@@ -17,7 +17,7 @@ fn results_are_replaced_together_or_not_at_all() {
         let s = scene(&out);
         s.write_text("a.txt", "old a").unwrap();
         s.write_text("b.txt", "old b").unwrap();
-        s.write_summary(serde_json::json!({"run": 1})).unwrap();
+        s.write_summary(&serde_json::json!({"run": 1})).unwrap();
     }
     assert_eq!(std::fs::read_to_string(out.join("a.txt")).unwrap(), "old a");
     {
@@ -33,7 +33,7 @@ fn results_are_replaced_together_or_not_at_all() {
         let s = scene(&out);
         s.write_csv("c.csv", &["x", "y"], [(1.0, 2.5), (0.1, 1e-300)])
             .unwrap();
-        s.write_summary(serde_json::json!({"run": 3})).unwrap();
+        s.write_summary(&serde_json::json!({"run": 3})).unwrap();
     }
     assert!(!out.join("a.txt").exists() && !out.join("b.txt").exists());
     assert_eq!(
