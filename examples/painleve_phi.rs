@@ -171,14 +171,7 @@ fn main() {
                         5.0 * (i as f64 + 0.5) / pixels as f64,
                         5.0 * (j as f64 + 0.5) / pixels as f64,
                     );
-                    let e = Reduced {
-                        x_star: 0.0,
-                        mu1,
-                        mu2,
-                        y1: 1.0,
-                        y2,
-                        cos_phi0: 0.6,
-                    };
+                    let e = Reduced::sample(mu1, mu2, y2);
                     let signs = slope_signs(1.0, &e);
                     if let Some(k) = GRAPH_CLASSES.iter().position(|c| c.signs == signs) {
                         figure.points(

@@ -48,6 +48,21 @@ pub struct Reduced {
     pub cos_phi0: f64,
 }
 
+impl Reduced {
+    /// Reduced quantities for drawing the classes: Y1* = 1, cos φ0 = 0.6,
+    /// X* = 0 (the examples and the region plots of `painleve_phi`).
+    pub fn sample(mu1: f64, mu2: f64, y2: f64) -> Reduced {
+        Reduced {
+            x_star: 0.0,
+            mu1,
+            mu2,
+            y1: 1.0,
+            y2,
+            cos_phi0: 0.6,
+        }
+    }
+}
+
 pub fn reduced(p: &Params) -> Reduced {
     let sin0 = p.d / p.l;
     let cos0 = (1.0 - sin0 * sin0).sqrt();
@@ -200,14 +215,7 @@ pub fn class_example(k: usize) -> Reduced {
         (3.5, 0.5, 0.0),
         (0.5, 3.5, 0.0),
     ][k];
-    let mut e = Reduced {
-        x_star: 0.0,
-        mu1,
-        mu2,
-        y1: 1.0,
-        y2,
-        cos_phi0: 0.6,
-    };
+    let mut e = Reduced::sample(mu1, mu2, y2);
     let kinks = [e.y1.min(-e.y2), e.y1.max(-e.y2)];
     let b = GRAPH_CLASSES[k].signs.as_bytes();
     let weight = match (b[0] != b[1], b[1] != b[2]) {
