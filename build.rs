@@ -22,6 +22,8 @@ mod generate;
 mod latex;
 #[path = "build/simplify.rs"]
 mod simplify;
+#[path = "build/taylor.rs"]
+mod taylor;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -11,8 +11,9 @@
 use crate::model::expr::{BinOp, Expr};
 use std::collections::HashMap;
 
+/// One operation of the DAG; children are indices of earlier nodes.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
-enum Node {
+pub enum Node {
     Lit(String),
     Var(String),
     Neg(usize),
@@ -408,6 +409,24 @@ impl Emitter {
         let value = self.text(i);
         self.lines.push(format!("let {name} = {value};"));
         self.bound.insert(i, name);
+    }
+}
+
+/// The DAG of a function: nodes in evaluation order (children before
+/// parents) and the named outputs of each stage. `build/taylor.rs` turns it
+/// into Taylor-coefficient recurrences.
+pub struct Dag {
+    pub nodes: Vec<Node>,
+    pub stages: Vec<Vec<(String, usize)>>,
+}
+
+impl Emitter {
+    /// The DAG built so far, instead of Rust text.
+    pub fn into_dag(self) -> Dag {
+        Dag {
+            nodes: self.nodes,
+            stages: self.stages,
+        }
     }
 }
 

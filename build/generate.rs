@@ -5,7 +5,20 @@ use crate::contacts::ContactDerivation;
 use crate::derive::{momentum_name, Derivation, Derived};
 use crate::emit::Emitter;
 use crate::model::Model;
+use crate::taylor::{recurrences, Signature};
 use serde::Serialize;
+
+/// A generated Taylor-coefficient function (layout in `templates/taylor.rs.tera`).
+#[derive(Serialize)]
+struct TaylorFunction {
+    name: String,
+    doc: String,
+    /// State length.
+    dim: usize,
+    /// `let &Params { .. } = params;`
+    params: String,
+    body: Vec<String>,
+}
 
 #[derive(Serialize)]
 struct Function {
@@ -56,6 +69,8 @@ struct Context<'a> {
     n: usize,
     /// For a contact model: the sliding coordinates and their velocities.
     contact_state: Vec<String>,
+    /// dθ/dt of the fast phase, if there is one.
+    model_phase_rate: String,
 }
 
 impl Context<'_> {
@@ -155,6 +170,49 @@ impl Context<'_> {
     }
 }
 
+impl Context<'_> {
+    /// Taylor-coefficient recurrences of x' = f, with f the outputs named
+    /// `outputs` of `stages` and x the variables `state`.
+    fn taylor(
+        &self,
+        name: &str,
+        doc: &str,
+        stages: &[Vec<(String, String)>],
+        outputs: &[String],
+        state: Vec<String>,
+    ) -> Result<TaylorFunction, String> {
+        let mut emitter = Emitter::default();
+        let phase = match &self.model.fast_phase {
+            Some(phase) => {
+                let rate = vec![("rate".to_string(), self.model_phase_rate.clone())];
+                emitter.stage(&rate).map_err(|e| format!("{name}: {e}"))?;
+                Some((phase.name.clone(), "rate".to_string()))
+            }
+            None => None,
+        };
+        for stage in stages {
+            emitter.stage(stage).map_err(|e| format!("{name}: {e}"))?;
+        }
+        let signature = Signature {
+            dim: state.len(),
+            state,
+            time: self.model.time.clone(),
+            phase,
+            parameters: self.model.parameters.iter().map(|p| p.name.clone()).collect(),
+        };
+        let body = recurrences(&emitter.into_dag(), &signature, outputs)
+            .map_err(|e| format!("{name}: {e}"))?;
+        let (_, prelude) = self.signature_and_prelude(Inputs::Params);
+        Ok(TaylorFunction {
+            name: name.into(),
+            doc: doc.into(),
+            dim: signature.dim,
+            params: prelude[0].clone(),
+            body: body.lines,
+        })
+    }
+}
+
 fn named(prefix: &str, values: &[String]) -> Vec<(String, String)> {
     values
         .iter()
@@ -195,6 +253,7 @@ pub fn render(
         model,
         n: derivation.dof,
         contact_state: Vec::new(),
+        model_phase_rate: derivation.phase_rate.clone(),
     };
     let n = cx.n();
     let m = 2 * n;
@@ -355,6 +414,8 @@ pub fn render(
         )?);
     }
 
+    let taylor_functions = taylor_functions(&cx, derivation, &velocity_stage)?;
+
     // Functions of q alone must not depend on anything else.
     let forbidden: Vec<String> = cx
         .velocities()
@@ -402,6 +463,7 @@ pub fn render(
             .unwrap_or_default(),
     );
     context.insert("functions", &functions);
+    context.insert("taylor_functions", &taylor_functions);
     context.insert(
         "operation_counts",
         &derivation
@@ -412,6 +474,70 @@ pub fn render(
     );
     tera.render("model.rs.tera", &context)
         .map_err(|e| format!("template model.rs.tera: {e:?}"))
+}
+
+/// The Taylor-coefficient functions of a model: the exact field, the
+/// averaged one, and the exact field with one tangent vector (FLI) or a full
+/// set (monodromy, Lyapunov spectrum), the tangent rates J·v as extra nodes.
+fn taylor_functions(
+    cx: &Context,
+    derivation: &Derivation,
+    velocity_stage: &[(String, String)],
+) -> Result<Vec<TaylorFunction>, String> {
+    let m = 2 * cx.n();
+    let mut state = cx.coordinates();
+    state.extend(cx.momenta());
+    let (rates, _) = vector("dp", &derivation.momentum_rates);
+    let mut rhs_names = cx.velocities();
+    rhs_names.extend(rates.iter().map(|(name, _)| name.clone()));
+    let mut functions = vec![cx.taylor(
+        "exact_taylor",
+        "Normalised Taylor coefficients out[k] = y^(k)(t)/k!, k = 0..=order, of the exact solution through (t, y).",
+        &[velocity_stage.to_vec(), rates.clone()],
+        &rhs_names,
+        state.clone(),
+    )?];
+    if cx.model.fast_phase.is_some() {
+        let (outs, _) = vector("f", &derivation.averaged_rhs);
+        let names: Vec<String> = outs.iter().map(|(n, _)| n.clone()).collect();
+        functions.push(cx.taylor(
+            "averaged_taylor",
+            "Normalised Taylor coefficients of the averaged solution through y.",
+            &[outs],
+            &names,
+            state.clone(),
+        )?);
+    }
+    let (jacobian, _) = matrix("j", &derivation.exact_jacobian);
+    for (tangents, name, doc) in [
+        (1, "exact_tangent_taylor", "Taylor coefficients of the exact solution and one tangent vector v' = J v: state [y; v]."),
+        (m, "exact_monodromy_taylor", "Taylor coefficients of the exact solution and a full set of tangent vectors V' = J V: state [y; V] (V column-major)."),
+    ] {
+        let mut full_state = state.clone();
+        let mut tangent_rates = Vec::new();
+        let mut outputs = rhs_names.clone();
+        for k in 0..tangents {
+            let components: Vec<String> = state.iter().map(|s| format!("tangent{k}_{s}")).collect();
+            for (i, component) in components.iter().enumerate() {
+                let terms: Vec<String> = (0..m)
+                    .filter(|&c| derivation.exact_jacobian[i][c].trim() != "0")
+                    .map(|c| format!("j_{i}_{c}*{}", components[c]))
+                    .collect();
+                let text = if terms.is_empty() { "0".to_string() } else { terms.join(" + ") };
+                tangent_rates.push((format!("{component}_rate"), text));
+                outputs.push(format!("{component}_rate"));
+            }
+            full_state.extend(components);
+        }
+        functions.push(cx.taylor(
+            name,
+            doc,
+            &[velocity_stage.to_vec(), rates.clone(), jacobian.clone(), tangent_rates],
+            &outputs,
+            full_state,
+        )?);
+    }
+    Ok(functions)
 }
 
 /// What every model template shows: names, parameters, derived expressions.
@@ -460,6 +586,7 @@ pub fn render_contacts(
             .chain(&derivation.velocities)
             .cloned()
             .collect(),
+        model_phase_rate: String::new(),
     };
     let functions = vec![
         cx.function(

@@ -11,8 +11,11 @@ mod events;
 mod gauss;
 mod radau5;
 mod rk4;
+pub mod series;
+mod taylor;
 
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
+pub use taylor::{order_for_tolerance, TaylorWork};
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
 pub trait System<const N: usize> {
@@ -20,6 +23,33 @@ pub trait System<const N: usize> {
     /// ∂f/∂y, when the system knows it (generated models do).
     fn jacobian(&self, _t: f64, _y: &[f64; N]) -> Option<[[f64; N]; N]> {
         None
+    }
+    /// The normalised Taylor coefficients `out[k] = y^(k)(t)/k!`,
+    /// k = 0..=order, of the solution through (t, y), for the `taylor`
+    /// method; false when the system has no recurrences (generated models
+    /// have them, see `build/taylor.rs`).
+    fn taylor(
+        &self,
+        _t: f64,
+        _y: &[f64; N],
+        _order: usize,
+        _work: &mut TaylorWork,
+        _out: &mut [[f64; N]],
+    ) -> bool {
+        false
+    }
+    /// The same for the system with tangent vectors, state z = [y; v₁; …]
+    /// with one or N tangent vectors (see `analysis::variational`), rows of
+    /// `out` flattened; false when not available.
+    fn taylor_variational(
+        &self,
+        _t: f64,
+        _z: &[f64],
+        _order: usize,
+        _work: &mut TaylorWork,
+        _out: &mut [f64],
+    ) -> bool {
+        false
     }
 }
 
@@ -62,14 +92,18 @@ pub enum Method {
     /// Radau IIA of order 5 (Hairer's RADAU5 scheme): implicit, L-stable, for
     /// stiff systems; Newton iterations with the system's Jacobian.
     Radau5 { rtol: f64, atol: f64 },
+    /// Taylor series with recurrences generated at build time: the order
+    /// follows from the tolerance, the step from the last two coefficients.
+    Taylor { tol: f64 },
 }
 
 /// Method names accepted by [`Method::parse`].
-pub const METHOD_NAMES: [&str; 5] = ["rk4", "dop853", "gauss4", "gauss6", "radau5"];
+pub const METHOD_NAMES: [&str; 6] = ["rk4", "dop853", "gauss4", "gauss6", "radau5", "taylor"];
 
 impl Method {
     /// A method by name: `rk4`, `gauss4`, `gauss6` take a step size, `dop853`
-    /// and `radau5` a tolerance (used as both relative and absolute tolerance).
+    /// and `radau5` a tolerance (used as both relative and absolute
+    /// tolerance), `taylor` a tolerance (which sets its order).
     pub fn parse(name: &str, tol_or_step: f64) -> Result<Method, OdeError> {
         let method = match name {
             "rk4" => Method::Rk4 { step: tol_or_step },
@@ -89,6 +123,7 @@ impl Method {
                 rtol: tol_or_step,
                 atol: tol_or_step,
             },
+            "taylor" => Method::Taylor { tol: tol_or_step },
             _ => return Err(OdeError::UnknownMethod(name.to_string())),
         };
         method.validate()?;
@@ -103,6 +138,7 @@ impl Method {
             Method::Gauss { stages: 2, .. } => "gauss4",
             Method::Gauss { .. } => "gauss6",
             Method::Radau5 { .. } => "radau5",
+            Method::Taylor { .. } => "taylor",
         }
     }
 
@@ -113,6 +149,7 @@ impl Method {
             Method::Dop853 { .. } => 8,
             Method::Gauss { stages, .. } => 2 * stages,
             Method::Radau5 { .. } => 5,
+            Method::Taylor { tol } => order_for_tolerance(*tol),
         }
     }
 
@@ -139,6 +176,7 @@ impl Method {
                 }
                 positive("step", step)
             }
+            Method::Taylor { tol } => positive("tolerance", tol),
         }
     }
 }
@@ -156,6 +194,10 @@ pub struct Stats {
     pub jac_evals: u64,
     /// Fixed-point iterations of implicit methods.
     pub iterations: u64,
+    /// Taylor method: the highest order used; `f_evals` then counts the
+    /// coefficient orders computed (each costs about one evaluation of the
+    /// right-hand side plus the Cauchy sums, which grow with the order).
+    pub order: u64,
 }
 
 impl std::ops::AddAssign for Stats {
@@ -165,6 +207,7 @@ impl std::ops::AddAssign for Stats {
         self.f_evals += o.f_evals;
         self.jac_evals += o.jac_evals;
         self.iterations += o.iterations;
+        self.order = self.order.max(o.order);
     }
 }
 
@@ -188,6 +231,8 @@ pub enum OdeError {
     /// The implicit stage equations did not converge.
     #[error("implicit stage equations did not converge at t = {t} with h = {h:e}, y = {y:?}")]
     NoConvergence { t: f64, h: f64, y: Vec<f64> },
+    #[error("method 'taylor' needs Taylor recurrences, which only the generated models' systems (exact, averaged, and their variational equations) have")]
+    TaylorUnavailable,
 }
 
 /// Solver state: the method, the last step size, statistics.
@@ -196,6 +241,8 @@ pub struct Integrator {
     method: Method,
     /// Step size to try next (adaptive methods), carried across calls.
     next_step: Option<f64>,
+    /// Workspace of the Taylor method.
+    taylor: taylor::TaylorState,
     pub stats: Stats,
     /// Upper bound on steps per call of [`Integrator::advance`].
     pub max_steps: u64,
@@ -207,6 +254,7 @@ impl Integrator {
         Ok(Integrator {
             method,
             next_step: None,
+            taylor: taylor::TaylorState::default(),
             stats: Stats::default(),
             max_steps: 10_000_000,
         })
@@ -390,6 +438,17 @@ impl Integrator {
                 t1,
                 step,
                 self.max_steps,
+                &mut self.stats,
+                observe,
+            ),
+            Method::Taylor { tol } => taylor::integrate(
+                system,
+                t0,
+                y0,
+                t1,
+                tol,
+                self.max_steps,
+                &mut self.taylor,
                 &mut self.stats,
                 observe,
             ),

@@ -1,0 +1,639 @@
+//! Taylor-coefficient recurrences from the DAG of a right-hand side.
+//!
+//! The Taylor method needs the normalised coefficients x^[k] = x^(k)(t0)/k!
+//! of the solution through (t0, x0). Every node u of the right-hand side's
+//! DAG (see `build/emit.rs`) gets its own coefficients u^[0..p]: order 0 is
+//! the ordinary evaluation, order n follows from lower orders by the
+//! recurrence of the node's operation (sums termwise, products by Cauchy
+//! sums, quotients, sqrt, powers, exp, ln, sin and cos as a pair), and the
+//! state's next order is x^[n+1] = f^[n]/(n+1).
+//!
+//! Nodes that depend on parameters only are plain numbers computed once per
+//! step; nodes linear in time (t, the fast phase θ = rate·t) have two
+//! non-zero coefficients, so sin and cos of the phase cost O(1) per order.
+//! Integer powers become chains of squares and products (the general power
+//! recurrence divides by u^[0] and fails at u = 0). The emitted function
+//! calls the kernels of `mechlab::ode::series`.
+
+use crate::emit::{Dag, Node};
+use std::collections::HashMap;
+
+/// How a node varies over a step.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Debug)]
+enum Class {
+    /// Depends on parameters only.
+    Constant,
+    /// c0 + c1·t.
+    Linear,
+    /// Anything else.
+    Series,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Op {
+    Literal(String),
+    Parameter(String),
+    State(usize),
+    Time,
+    /// The fast phase θ = rate·t; the child is the (constant) rate.
+    Phase(usize),
+    Neg(usize),
+    Add(usize, usize),
+    Sub(usize, usize),
+    Mul(usize, usize),
+    Div(usize, usize),
+    Square(usize),
+    Sqrt(usize),
+    /// u^α with a constant exponent α.
+    Power(usize, usize),
+    Exp(usize),
+    Ln(usize),
+    Sin(usize),
+    Cos(usize),
+}
+
+impl Op {
+    fn children(&self) -> Vec<usize> {
+        match *self {
+            Op::Literal(_) | Op::Parameter(_) | Op::State(_) | Op::Time => vec![],
+            Op::Phase(a)
+            | Op::Neg(a)
+            | Op::Square(a)
+            | Op::Sqrt(a)
+            | Op::Exp(a)
+            | Op::Ln(a)
+            | Op::Sin(a)
+            | Op::Cos(a) => vec![a],
+            Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Power(a, b) => {
+                vec![a, b]
+            }
+        }
+    }
+}
+
+/// What the variables of a right-hand side are.
+pub struct Signature {
+    /// State length.
+    pub dim: usize,
+    /// State components, in order.
+    pub state: Vec<String>,
+    /// The model's time variable.
+    pub time: String,
+    /// The fast phase's name and the stage output holding its rate.
+    pub phase: Option<(String, String)>,
+    pub parameters: Vec<String>,
+}
+
+/// The body of a generated Taylor-coefficient function.
+pub struct TaylorBody {
+    pub lines: Vec<String>,
+}
+
+struct Lowering<'a> {
+    dag: &'a Dag,
+    signature: &'a Signature,
+    outputs: HashMap<&'a str, usize>,
+    ops: Vec<Op>,
+    classes: Vec<Class>,
+    index: HashMap<Op, usize>,
+    memo: HashMap<usize, usize>,
+}
+
+impl Lowering<'_> {
+    fn intern(&mut self, op: Op) -> usize {
+        if let Some(&k) = self.index.get(&op) {
+            return k;
+        }
+        let class = |k: usize| self.classes[k];
+        let c = match op {
+            Op::Literal(_) | Op::Parameter(_) => Class::Constant,
+            Op::State(_) => Class::Series,
+            Op::Time | Op::Phase(_) => Class::Linear,
+            Op::Neg(a) => class(a),
+            Op::Add(a, b) | Op::Sub(a, b) => class(a).max(class(b)),
+            Op::Mul(a, b) => match (class(a), class(b)) {
+                (Class::Constant, other) | (other, Class::Constant) => other,
+                _ => Class::Series,
+            },
+            Op::Div(a, b) => match (class(a), class(b)) {
+                (other, Class::Constant) => other,
+                _ => Class::Series,
+            },
+            Op::Power(a, b) if class(a) == Class::Constant && class(b) == Class::Constant => {
+                Class::Constant
+            }
+            Op::Power(..) => Class::Series,
+            Op::Square(a) | Op::Sqrt(a) | Op::Exp(a) | Op::Ln(a) | Op::Sin(a) | Op::Cos(a) => {
+                if class(a) == Class::Constant {
+                    Class::Constant
+                } else {
+                    Class::Series
+                }
+            }
+        };
+        self.ops.push(op.clone());
+        self.classes.push(c);
+        self.index.insert(op, self.ops.len() - 1);
+        self.ops.len() - 1
+    }
+
+    fn literal(&mut self, value: &str) -> usize {
+        self.intern(Op::Literal(value.into()))
+    }
+
+    /// u^k for k ≥ 1 by squaring and multiplying.
+    fn power_chain(&mut self, u: usize, k: u32) -> usize {
+        match k {
+            1 => u,
+            _ if k % 2 == 0 => {
+                let half = self.power_chain(u, k / 2);
+                self.intern(Op::Square(half))
+            }
+            _ => {
+                let rest = self.power_chain(u, k - 1);
+                self.intern(Op::Mul(rest, u))
+            }
+        }
+    }
+
+    /// sin or cos of u; for a varying u its partner too, since the pair's
+    /// recurrences need each other.
+    fn trig(&mut self, sine: bool, u: usize) -> usize {
+        let s = self.intern(Op::Sin(u));
+        let c = self.intern(Op::Cos(u));
+        if sine {
+            s
+        } else {
+            c
+        }
+    }
+
+    fn lower(&mut self, i: usize) -> Result<usize, String> {
+        if let Some(&k) = self.memo.get(&i) {
+            return Ok(k);
+        }
+        let k = match self.dag.nodes[i].clone() {
+            Node::Lit(l) => self.literal(&l),
+            Node::Var(v) => self.variable(&v)?,
+            Node::Neg(a) => {
+                let a = self.lower(a)?;
+                self.intern(Op::Neg(a))
+            }
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
+                let (la, lb) = (self.lower(a)?, self.lower(b)?);
+                self.intern(match self.dag.nodes[i] {
+                    Node::Add(..) => Op::Add(la, lb),
+                    Node::Sub(..) => Op::Sub(la, lb),
+                    Node::Mul(..) if la == lb => Op::Square(la),
+                    Node::Mul(..) => Op::Mul(la, lb),
+                    _ => Op::Div(la, lb),
+                })
+            }
+            Node::Powi(a, k) => {
+                let a = self.lower(a)?;
+                match k {
+                    0 => self.literal("1.0"),
+                    k if k > 0 => self.power_chain(a, k.unsigned_abs()),
+                    k => {
+                        let one = self.literal("1.0");
+                        let p = self.power_chain(a, k.unsigned_abs());
+                        self.intern(Op::Div(one, p))
+                    }
+                }
+            }
+            Node::Sqrt(a) => {
+                let a = self.lower(a)?;
+                self.intern(Op::Sqrt(a))
+            }
+            Node::Powf(a, b) => {
+                let (a, b) = (self.lower(a)?, self.lower(b)?);
+                if self.classes[b] == Class::Constant {
+                    self.intern(Op::Power(a, b))
+                } else {
+                    // u^v = exp(v ln u) for a varying exponent.
+                    let ln = self.intern(Op::Ln(a));
+                    let product = self.intern(Op::Mul(b, ln));
+                    self.intern(Op::Exp(product))
+                }
+            }
+            Node::Call(f, a) => {
+                let a = self.lower(a)?;
+                match f {
+                    "sin" => self.trig(true, a),
+                    "cos" => self.trig(false, a),
+                    "tan" => {
+                        let (s, c) = (self.trig(true, a), self.trig(false, a));
+                        self.intern(Op::Div(s, c))
+                    }
+                    "exp" => self.intern(Op::Exp(a)),
+                    "ln" => self.intern(Op::Ln(a)),
+                    "sqrt" => self.intern(Op::Sqrt(a)),
+                    other => return Err(format!("no Taylor recurrence for '{other}'")),
+                }
+            }
+        };
+        self.memo.insert(i, k);
+        Ok(k)
+    }
+
+    fn variable(&mut self, v: &str) -> Result<usize, String> {
+        let s = self.signature;
+        if let Some(k) = s.state.iter().position(|x| x == v) {
+            return Ok(self.intern(Op::State(k)));
+        }
+        if v == s.time {
+            return Ok(self.intern(Op::Time));
+        }
+        if let Some((phase, rate)) = &s.phase {
+            if v == phase {
+                let root = *self
+                    .outputs
+                    .get(rate.as_str())
+                    .ok_or_else(|| format!("the phase rate '{rate}' is not a stage output"))?;
+                let r = self.lower(root)?;
+                return Ok(self.intern(Op::Phase(r)));
+            }
+        }
+        if let Some(&root) = self.outputs.get(v) {
+            return self.lower(root);
+        }
+        if s.parameters.iter().any(|p| p == v) {
+            return Ok(self.intern(Op::Parameter(v.into())));
+        }
+        Err(format!("unknown variable '{v}'"))
+    }
+}
+
+/// The body of a function computing x^[0..=order] of the solution of
+/// x' = f into `out`, where f is the list `outputs` (stage output names of
+/// `dag`, one per state component).
+pub fn recurrences(
+    dag: &Dag,
+    signature: &Signature,
+    outputs: &[String],
+) -> Result<TaylorBody, String> {
+    if outputs.len() != signature.state.len() {
+        return Err(format!(
+            "{} right-hand sides for {} state components",
+            outputs.len(),
+            signature.state.len()
+        ));
+    }
+    let mut lowering = Lowering {
+        dag,
+        signature,
+        outputs: dag
+            .stages
+            .iter()
+            .flatten()
+            .map(|(name, root)| (name.as_str(), *root))
+            .collect(),
+        ops: Vec::new(),
+        classes: Vec::new(),
+        index: HashMap::new(),
+        memo: HashMap::new(),
+    };
+    // Every state component has coefficients, used or not.
+    for k in 0..signature.state.len() {
+        lowering.intern(Op::State(k));
+    }
+    let mut roots = Vec::new();
+    for name in outputs {
+        let root = *lowering
+            .outputs
+            .get(name.as_str())
+            .ok_or_else(|| format!("'{name}' is not a stage output"))?;
+        roots.push(lowering.lower(root)?);
+    }
+    let needed = reachable(&lowering.ops, &roots);
+    let names = names(&lowering, dag, &needed);
+    Ok(Writer {
+        ops: &lowering.ops,
+        classes: &lowering.classes,
+        names: &names,
+        needed: &needed,
+        index: &lowering.index,
+    }
+    .body(&roots, signature.state.len()))
+}
+
+fn reachable(ops: &[Op], roots: &[usize]) -> Vec<bool> {
+    let mut needed = vec![false; ops.len()];
+    let mut stack: Vec<usize> = roots.to_vec();
+    stack.extend(
+        ops.iter()
+            .enumerate()
+            .filter(|(_, op)| matches!(op, Op::State(_)))
+            .map(|(k, _)| k),
+    );
+    while let Some(k) = stack.pop() {
+        if needed[k] {
+            continue;
+        }
+        needed[k] = true;
+        stack.extend(ops[k].children());
+        // The recurrence of sin needs cos and vice versa.
+        if let Op::Sin(u) | Op::Cos(u) = ops[k] {
+            for partner in [Op::Sin(u), Op::Cos(u)] {
+                if let Some(k) = ops.iter().position(|o| *o == partner) {
+                    stack.push(k);
+                }
+            }
+        }
+    }
+    needed
+}
+
+/// A readable name for every needed node: state names, the stage outputs'
+/// names (qd, dp0, j_0_1, ...), sin_q / cos_q / q_sq, else x1, x2, ...
+/// (constants k1, k2, ...).
+fn names(lowering: &Lowering, dag: &Dag, needed: &[bool]) -> Vec<String> {
+    let mut names: Vec<Option<String>> = vec![None; lowering.ops.len()];
+    let mut taken = std::collections::HashSet::new();
+    let mut give = |names: &mut Vec<Option<String>>, k: usize, name: String| {
+        if names[k].is_none() && !taken.contains(&name) {
+            taken.insert(name.clone());
+            names[k] = Some(name);
+        }
+    };
+    for (k, op) in lowering.ops.iter().enumerate() {
+        match op {
+            Op::State(i) => give(&mut names, k, lowering.signature.state[*i].clone()),
+            Op::Parameter(p) => give(&mut names, k, p.clone()),
+            Op::Time => give(&mut names, k, "time".into()),
+            _ => {}
+        }
+    }
+    for (name, root) in dag.stages.iter().flatten() {
+        if let Some(&k) = lowering.memo.get(root) {
+            give(&mut names, k, name.clone());
+        }
+    }
+    if let Some((phase, _)) = &lowering.signature.phase {
+        if let Some(k) = lowering.ops.iter().position(|o| matches!(o, Op::Phase(_))) {
+            give(&mut names, k, phase.clone());
+        }
+    }
+    let mut counter = 0;
+    for k in 0..lowering.ops.len() {
+        if !needed[k] || names[k].is_some() {
+            continue;
+        }
+        let readable = match &lowering.ops[k] {
+            Op::Sin(a) | Op::Cos(a) | Op::Square(a) => names[*a]
+                .as_ref()
+                .filter(|_| {
+                    matches!(
+                        lowering.ops[*a],
+                        Op::State(_) | Op::Phase(_) | Op::Time | Op::Parameter(_)
+                    )
+                })
+                .map(|n| match lowering.ops[k] {
+                    Op::Sin(_) => format!("sin_{n}"),
+                    Op::Cos(_) => format!("cos_{n}"),
+                    _ => format!("{n}_sq"),
+                }),
+            _ => None,
+        };
+        if let Some(r) = readable {
+            give(&mut names, k, r);
+        }
+        if names[k].is_none() {
+            counter += 1;
+            let prefix = if lowering.classes[k] == Class::Constant {
+                "k"
+            } else {
+                "x"
+            };
+            give(&mut names, k, format!("{prefix}{counter}"));
+        }
+    }
+    names.into_iter().map(|n| n.unwrap_or_default()).collect()
+}
+
+struct Writer<'a> {
+    ops: &'a [Op],
+    classes: &'a [Class],
+    names: &'a [String],
+    needed: &'a [bool],
+    index: &'a HashMap<Op, usize>,
+}
+
+impl Writer<'_> {
+    fn constant(&self, k: usize) -> bool {
+        self.classes[k] == Class::Constant
+    }
+
+    /// Value of a constant, or order-0 coefficient of a varying node.
+    fn value(&self, k: usize) -> String {
+        match &self.ops[k] {
+            Op::Literal(l) if l.starts_with('-') => format!("({l})"),
+            Op::Literal(l) => l.clone(),
+            _ if self.constant(k) => self.names[k].clone(),
+            _ => format!("{}[0]", self.names[k]),
+        }
+    }
+
+    /// Order-n coefficient of a varying node.
+    fn at(&self, k: usize, n: &str) -> String {
+        format!("{}[{n}]", self.names[k])
+    }
+
+    /// The scalar expression of a node from its children's values.
+    fn scalar(&self, k: usize) -> String {
+        let v = |c: usize| self.value(c);
+        match &self.ops[k] {
+            Op::Literal(l) => l.clone(),
+            Op::Parameter(p) => p.clone(),
+            Op::State(i) => format!("y[{i}]"),
+            Op::Time => "t".into(),
+            Op::Phase(r) => format!("{} * t", v(*r)),
+            Op::Neg(a) => format!("-{}", v(*a)),
+            Op::Add(a, b) => format!("{} + {}", v(*a), v(*b)),
+            Op::Sub(a, b) => format!("{} - {}", v(*a), v(*b)),
+            Op::Mul(a, b) => format!("{} * {}", v(*a), v(*b)),
+            Op::Div(a, b) => format!("{} / {}", v(*a), v(*b)),
+            Op::Square(a) => format!("{} * {}", v(*a), v(*a)),
+            Op::Sqrt(a) => format!("{}.sqrt()", v(*a)),
+            Op::Power(a, b) => format!("{}.powf({})", v(*a), v(*b)),
+            Op::Exp(a) => format!("{}.exp()", v(*a)),
+            Op::Ln(a) => format!("{}.ln()", v(*a)),
+            Op::Sin(a) => format!("{}.sin()", v(*a)),
+            Op::Cos(a) => format!("{}.cos()", v(*a)),
+        }
+    }
+
+    /// The sin/cos partner of node k, if k is one of a pair.
+    fn partner(&self, k: usize) -> Option<(usize, usize)> {
+        match self.ops[k] {
+            Op::Sin(u) | Op::Cos(u) => Some((
+                self.index[&Op::Sin(u)],
+                self.index[&Op::Cos(u)],
+            )),
+            _ => None,
+        }
+    }
+
+    /// Order-1 coefficient of a node linear in time.
+    fn slope(&self, k: usize) -> String {
+        let s = |c: usize| -> Option<String> {
+            (!self.constant(c)).then(|| self.at(c, "1"))
+        };
+        match self.ops[k] {
+            Op::Time => "1.0".into(),
+            Op::Phase(r) => self.value(r),
+            Op::Neg(a) => format!("-{}", self.at(a, "1")),
+            Op::Add(a, b) | Op::Sub(a, b) => match (s(a), s(b), &self.ops[k]) {
+                (Some(x), Some(y), Op::Add(..)) => format!("{x} + {y}"),
+                (Some(x), Some(y), _) => format!("{x} - {y}"),
+                (Some(x), None, _) => x,
+                (None, Some(y), Op::Add(..)) => y,
+                (None, Some(y), _) => format!("-{y}"),
+                (None, None, _) => unreachable!("a linear node varies"),
+            },
+            Op::Mul(a, b) if self.constant(a) => format!("{} * {}", self.value(a), self.at(b, "1")),
+            Op::Mul(a, b) => format!("{} * {}", self.at(a, "1"), self.value(b)),
+            Op::Div(a, b) => format!("{} / {}", self.at(a, "1"), self.value(b)),
+            _ => unreachable!("not a linear node"),
+        }
+    }
+
+    /// Line(s) computing the order-n coefficient of a series node.
+    fn recurrence(&self, k: usize, lines: &mut Vec<String>) {
+        let w = &self.names[k];
+        let at = |c: usize| self.at(c, "n");
+        let name = |c: usize| self.names[c].clone();
+        let expression = match self.ops[k] {
+            Op::State(_) => return,
+            Op::Neg(a) => format!("-{}", at(a)),
+            Op::Add(a, b) | Op::Sub(a, b) => {
+                let plus = matches!(self.ops[k], Op::Add(..));
+                match (self.constant(a), self.constant(b)) {
+                    (false, false) => format!("{} {} {}", at(a), if plus { "+" } else { "-" }, at(b)),
+                    (false, true) => at(a),
+                    (true, false) if plus => at(b),
+                    (true, false) => format!("-{}", at(b)),
+                    (true, true) => unreachable!("a series node varies"),
+                }
+            }
+            Op::Mul(a, b) => match (self.constant(a), self.constant(b)) {
+                (true, _) => format!("{} * {}", self.value(a), at(b)),
+                (_, true) => format!("{} * {}", at(a), self.value(b)),
+                _ => format!("series::product({}, {}, n)", name(a), name(b)),
+            },
+            Op::Div(a, b) => match (self.constant(a), self.constant(b)) {
+                (_, true) => format!("{} / {}", at(a), self.value(b)),
+                (true, false) => format!("series::quotient({w}, 0.0, {}, n)", name(b)),
+                _ => format!("series::quotient({w}, {}, {}, n)", at(a), name(b)),
+            },
+            Op::Square(a) => format!("series::square({}, n)", name(a)),
+            Op::Sqrt(a) => format!("series::sqrt({w}, {}, n)", at(a)),
+            Op::Power(a, b) => format!("series::power({w}, {}, {}, n)", name(a), self.value(b)),
+            Op::Exp(a) => format!("series::exp({w}, {}, n)", name(a)),
+            Op::Ln(a) => format!("series::ln({w}, {}, n)", name(a)),
+            Op::Sin(u) | Op::Cos(u) => {
+                let (s, c) = self.partner(k).expect("sin and cos come in pairs");
+                if k != s.min(c) {
+                    return;
+                }
+                let (sn, cn) = (name(s), name(c));
+                if self.classes[u] == Class::Linear {
+                    let rate = self.slope(u);
+                    lines.push(format!("{sn}[n] = {rate} * {cn}[n - 1] / n as f64;"));
+                    lines.push(format!("{cn}[n] = -{rate} * {sn}[n - 1] / n as f64;"));
+                } else {
+                    lines.push(format!(
+                        "({sn}[n], {cn}[n]) = series::sin_cos({sn}, {cn}, {}, n);",
+                        name(u)
+                    ));
+                }
+                return;
+            }
+            Op::Literal(_) | Op::Parameter(_) | Op::Time | Op::Phase(_) => {
+                unreachable!("constants and linear nodes have no recurrence")
+            }
+        };
+        lines.push(format!("{w}[n] = {expression};"));
+    }
+
+    fn body(&self, roots: &[usize], dim: usize) -> TaylorBody {
+        let mut lines = Vec::new();
+        let live: Vec<usize> = (0..self.ops.len()).filter(|&k| self.needed[k]).collect();
+        let varying: Vec<usize> = live.iter().copied().filter(|&k| !self.constant(k)).collect();
+        lines.push("// Constants of the step (parameters only).".into());
+        for &k in &live {
+            if self.constant(k) && !matches!(self.ops[k], Op::Literal(_) | Op::Parameter(_)) {
+                lines.push(format!("let {} = {};", self.names[k], self.scalar(k)));
+            }
+        }
+        let slot_names: Vec<&str> = varying.iter().map(|&k| self.names[k].as_str()).collect();
+        lines.push(format!(
+            "let [{}] = work.slots::<{}>();",
+            slot_names.join(", "),
+            varying.len()
+        ));
+        lines.push(
+            "assert!(order >= 1 && order < series::COEFFICIENTS && out.len() > order);".into(),
+        );
+        lines.push("// Order 0: the values at t.".into());
+        for &k in &varying {
+            let w = &self.names[k];
+            match self.ops[k] {
+                Op::Sin(_) | Op::Cos(_) => {
+                    let (s, c) = self.partner(k).expect("a pair");
+                    if k == s.min(c) {
+                        let Op::Sin(u) = self.ops[s] else { unreachable!() };
+                        lines.push(format!(
+                            "({}[0], {}[0]) = {}.sin_cos();",
+                            self.names[s],
+                            self.names[c],
+                            self.value(u)
+                        ));
+                    }
+                }
+                _ => lines.push(format!("{w}[0] = {};", self.scalar(k))),
+            }
+            if self.classes[k] == Class::Linear {
+                lines.push(format!("{w}[1] = {};", self.slope(k)));
+                lines.push(format!("{w}[2..=order].fill(0.0);"));
+            }
+        }
+        let rate = |n: &str, scale: &str| -> String {
+            let cells: Vec<String> = roots
+                .iter()
+                .map(|&r| {
+                    if self.constant(r) {
+                        if n == "0" {
+                            format!("{}{scale}", self.value(r))
+                        } else {
+                            "0.0".into()
+                        }
+                    } else {
+                        format!("{}{scale}", self.at(r, n))
+                    }
+                })
+                .collect();
+            format!("[{}]", cells.join(", "))
+        };
+        let state_slots = |lines: &mut Vec<String>, n: &str| {
+            for (i, &k) in varying.iter().enumerate().take(dim) {
+                debug_assert_eq!(self.ops[k], Op::State(i));
+                lines.push(format!("{}[{n}] = out[{n}][{i}];", self.names[k]));
+            }
+        };
+        lines.push("out[0] = *y;".into());
+        lines.push(format!("out[1] = {};", rate("0", "")));
+        state_slots(&mut lines, "1");
+        lines.push("for n in 1..order {".into());
+        for &k in &varying {
+            if self.classes[k] == Class::Series {
+                self.recurrence(k, &mut lines);
+            }
+        }
+        lines.push("let next = 1.0 / (n + 1) as f64;".into());
+        lines.push(format!("out[n + 1] = {};", rate("n", " * next")));
+        state_slots(&mut lines, "n + 1");
+        lines.push("}".into());
+        TaylorBody { lines }
+    }
+}

@@ -1,0 +1,167 @@
+//! The Taylor series method with generated recurrences.
+//!
+//! Each step asks the system for the normalised Taylor coefficients
+//! y^[0..=p] of the solution through (t, y) (`System::taylor`, generated at
+//! build time from the right-hand side's DAG) and sums the series. The
+//! order follows from the tolerance, p = max(2, ⌈−ln(tol)/2 + 1⌉), and the
+//! step from the last two coefficient norms (Jorba and Zou's rule in
+//! heyoka's variant): ρ = min_k (M/‖y^[k]‖)^{1/k} over k = p−1, p with
+//! M = max(1, ‖y‖∞) (absolute below 1, relative above), h = ρ e^{−2}
+//! e^{−0.7/(p−1)}. There is no error estimate and no rejected step. The
+//! polynomial of the step is the dense output.
+
+use super::series::MAX_ORDER;
+use super::{check_finite, Flow, Observer, OdeError, Stats, Step, System};
+
+/// Coefficient arrays for the generated recurrences, reused from step to
+/// step (no allocation per step).
+#[derive(Clone, Debug, Default)]
+pub struct TaylorWork {
+    slots: Vec<super::series::Coefficients>,
+}
+
+impl TaylorWork {
+    /// The first K coefficient arrays (grown on first use).
+    pub fn slots<const K: usize>(&mut self) -> &mut [super::series::Coefficients; K] {
+        if self.slots.len() < K {
+            self.slots.resize(K, [0.0; super::series::COEFFICIENTS]);
+        }
+        self.slots
+            .first_chunk_mut::<K>()
+            .expect("the workspace was just grown")
+    }
+}
+
+/// The order the method uses for tolerance `tol`.
+pub fn order_for_tolerance(tol: f64) -> usize {
+    ((-tol.ln() / 2.0 + 1.0).ceil().max(2.0) as usize).min(MAX_ORDER)
+}
+
+/// The solver state the Taylor method keeps between calls.
+#[derive(Clone, Debug, Default)]
+pub(super) struct TaylorState {
+    pub work: TaylorWork,
+    /// Coefficients of the current step, (order + 1) rows of N.
+    pub coefficients: Vec<f64>,
+}
+
+/// Σ_k c[k] h^k.
+#[inline(always)]
+fn horner<const N: usize>(c: &[[f64; N]], h: f64) -> [f64; N] {
+    let (last, lower) = c.split_last().expect("at least order 0");
+    let mut y = *last;
+    for row in lower.iter().rev() {
+        for i in 0..N {
+            y[i] = y[i] * h + row[i];
+        }
+    }
+    y
+}
+
+/// Jorba–Zou step size from the coefficients of order p−1 and p, times
+/// `safety` = e^{−2} e^{−0.7/(p−1)}; `None`
+/// when both vanish (the solution is a polynomial of lower degree).
+fn step_size<const N: usize>(c: &[[f64; N]], y: &[f64; N], safety: f64) -> Option<f64> {
+    let p = c.len() - 1;
+    let norm = |row: &[f64; N]| row.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = norm(y).max(1.0);
+    let rho = [p - 1, p]
+        .into_iter()
+        .filter_map(|k| {
+            let a = norm(&c[k]);
+            (a > 0.0).then(|| (scale / a).powf(1.0 / k as f64))
+        })
+        .fold(f64::INFINITY, f64::min);
+    rho.is_finite().then_some(rho * safety)
+}
+
+/// One accepted step: its polynomial is the dense output.
+struct TaylorStep<'a, const N: usize> {
+    t0: f64,
+    y0: [f64; N],
+    t1: f64,
+    y1: [f64; N],
+    coefficients: &'a [[f64; N]],
+}
+
+impl<const N: usize> Step<N> for TaylorStep<'_, N> {
+    fn start(&self) -> (f64, &[f64; N]) {
+        (self.t0, &self.y0)
+    }
+    fn end(&self) -> (f64, &[f64; N]) {
+        (self.t1, &self.y1)
+    }
+    fn state_at(&mut self, t: f64) -> Result<[f64; N], OdeError> {
+        Ok(horner(self.coefficients, t - self.t0))
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn integrate<S: System<N>, const N: usize>(
+    system: &S,
+    t0: f64,
+    y0: &[f64; N],
+    t1: f64,
+    tol: f64,
+    max_steps: u64,
+    state: &mut TaylorState,
+    stats: &mut Stats,
+    observe: Observer<'_, N>,
+) -> Result<(f64, [f64; N]), OdeError> {
+    let order = order_for_tolerance(tol);
+    stats.order = stats.order.max(order as u64);
+    state.coefficients.resize((order + 1) * N, 0.0);
+    let direction = (t1 - t0).signum();
+    let safety = (-2.0 - 0.7 / (order - 1) as f64).exp();
+    let (mut t, mut y) = (t0, *y0);
+    // Kahan-compensated time: a million steps lose no phase.
+    let mut carry = 0.0;
+    for _ in 0..max_steps {
+        let (c, _) = state.coefficients.as_chunks_mut::<N>();
+        if !system.taylor(t, &y, order, &mut state.work, c) {
+            return Err(OdeError::TaylorUnavailable);
+        }
+        stats.f_evals += order as u64;
+        let remaining = (t1 - t).abs();
+        let h = match step_size(c, &y, safety) {
+            Some(h) if h.is_finite() => h,
+            // Vanishing top coefficients: the series is exact.
+            None => remaining,
+            Some(_) => return Err(OdeError::NonFinite { t, y: y.to_vec() }),
+        };
+        if !(h > 0.0) && remaining > 0.0 {
+            return Err(OdeError::StepSizeUnderflow { t, h });
+        }
+        let last = h >= remaining;
+        let h = if last { remaining } else { h } * direction;
+        let y_new = horner(c, h);
+        let t_new = if last {
+            t1
+        } else {
+            let increment = h - carry;
+            let sum = t + increment;
+            carry = (sum - t) - increment;
+            sum
+        };
+        check_finite(t_new, &y_new)?;
+        if !last && t_new == t {
+            return Err(OdeError::StepSizeUnderflow { t, h });
+        }
+        stats.steps += 1;
+        let mut step = TaylorStep {
+            t0: t,
+            y0: y,
+            t1: t_new,
+            y1: y_new,
+            coefficients: c,
+        };
+        if let Flow::Stop { t, y } = observe(&mut step)? {
+            return Ok((t, y));
+        }
+        if last {
+            return Ok((t1, y_new));
+        }
+        (t, y) = (t_new, y_new);
+    }
+    Err(OdeError::TooManySteps { t, max_steps })
+}
