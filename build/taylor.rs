@@ -474,6 +474,17 @@ impl Writer<'_> {
         }
     }
 
+    /// Whether a series recurrence reads all coefficients of node k (sin and
+    /// cos of a linear node, and other linear nodes, read orders 0 and 1 only).
+    fn read_as_series(&self, k: usize) -> bool {
+        (0..self.ops.len()).any(|parent| {
+            self.needed[parent]
+                && self.classes[parent] == Class::Series
+                && !matches!(self.ops[parent], Op::Sin(_) | Op::Cos(_))
+                && self.ops[parent].children().contains(&k)
+        })
+    }
+
     /// Order-1 coefficient of a node linear in time.
     fn slope(&self, k: usize) -> String {
         let s = |c: usize| -> Option<String> {
@@ -539,8 +550,12 @@ impl Writer<'_> {
                 let (sn, cn) = (name(s), name(c));
                 if self.classes[u] == Class::Linear {
                     let rate = self.slope(u);
-                    lines.push(format!("{sn}[n] = {rate} * {cn}[n - 1] / n as f64;"));
-                    lines.push(format!("{cn}[n] = -{rate} * {sn}[n - 1] / n as f64;"));
+                    lines.push(format!(
+                        "{sn}[n] = {rate} * series::INVERSES[n] * {cn}[n - 1];"
+                    ));
+                    lines.push(format!(
+                        "{cn}[n] = -{rate} * series::INVERSES[n] * {sn}[n - 1];"
+                    ));
                 } else {
                     lines.push(format!(
                         "({sn}[n], {cn}[n]) = series::sin_cos({sn}, {cn}, {}, n);",
@@ -595,7 +610,9 @@ impl Writer<'_> {
             }
             if self.classes[k] == Class::Linear {
                 lines.push(format!("{w}[1] = {};", self.slope(k)));
-                lines.push(format!("{w}[2..=order].fill(0.0);"));
+                if self.read_as_series(k) {
+                    lines.push(format!("{w}[2..=order].fill(0.0);"));
+                }
             }
         }
         let rate = |n: &str, scale: &str| -> String {
@@ -630,7 +647,7 @@ impl Writer<'_> {
                 self.recurrence(k, &mut lines);
             }
         }
-        lines.push("let next = 1.0 / (n + 1) as f64;".into());
+        lines.push("let next = series::INVERSES[n + 1];".into());
         lines.push(format!("out[n + 1] = {};", rate("n", " * next")));
         state_slots(&mut lines, "n + 1");
         lines.push("}".into());

@@ -12,7 +12,7 @@ mod gauss;
 mod radau5;
 mod rk4;
 pub mod series;
-mod taylor;
+pub mod taylor;
 
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
 pub use taylor::{order_for_tolerance, TaylorWork};

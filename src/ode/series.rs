@@ -39,6 +39,18 @@ fn reversed_dot(a: &[f64], b: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
+/// 1/n for n = 0..COEFFICIENTS (1/0 stored as 0): the recurrences divide by
+/// the order, and a table keeps divisions off the processor's divider.
+pub const INVERSES: Coefficients = {
+    let mut w = [0.0; COEFFICIENTS];
+    let mut j = 1;
+    while j < COEFFICIENTS {
+        w[j] = 1.0 / j as f64;
+        j += 1;
+    }
+    w
+};
+
 /// The weights j = 0, 1, 2, … of the derivative sums Σ j u^[j] (…).
 const WEIGHTS: Coefficients = {
     let mut w = [0.0; COEFFICIENTS];
@@ -50,11 +62,13 @@ const WEIGHTS: Coefficients = {
     w
 };
 
-/// Σ_{j=1..n} j u^[j] x^[n−j] for one or two x sharing the weighted u.
+/// Σ_{j=1..n−1} j u^[j] x^[n−j] for two x sharing the weighted u: the
+/// derivative sums without their order-n term.
 #[inline(always)]
 fn derivative_dots(u: &Coefficients, x: &Coefficients, z: &Coefficients, n: usize) -> (f64, f64) {
-    let (u, w) = (&u[1..=n], &WEIGHTS[1..=n]);
-    let (x, z) = (&x[..n], &z[..n]);
+    let (u, w) = (&u[1..n], &WEIGHTS[1..n]);
+    let (x, z) = (&x[1..n], &z[1..n]);
+    let n = n - 1;
     let (mut a, mut b, mut c, mut d) = (0.0, 0.0, 0.0, 0.0);
     let mut j = 0;
     while j + 1 < n {
@@ -73,41 +87,40 @@ fn derivative_dots(u: &Coefficients, x: &Coefficients, z: &Coefficients, n: usiz
     (a + b, c + d)
 }
 
-/// (a·b)^[n] = Σ_{j=0..n} a^[n−j] b^[j].
+/// (a·b)^[n] = Σ_{j=0..n} a^[n−j] b^[j]. The two terms with order-n
+/// coefficients come last: the rest depends on earlier orders only, so the
+/// processor can sum it before a^[n] and b^[n] are known, and the chain from
+/// one node's order n to the next is one multiply-add long.
 #[inline(always)]
 pub fn product(a: &Coefficients, b: &Coefficients, n: usize) -> f64 {
-    reversed_dot(&a[..=n], &b[..=n])
+    let earlier = reversed_dot(&a[1..n], &b[1..n]);
+    earlier + a[n] * b[0] + a[0] * b[n]
 }
 
 /// (a²)^[n], using the symmetry of the Cauchy sum.
 #[inline(always)]
 pub fn square(a: &Coefficients, n: usize) -> f64 {
-    let half = n.div_ceil(2);
-    let pairs = 2.0 * reversed_dot(&a[n + 1 - half..=n], &a[..half]);
-    if n % 2 == 0 {
-        pairs + a[n / 2] * a[n / 2]
-    } else {
-        pairs
-    }
+    let h = (n - 1) / 2;
+    let pairs = reversed_dot(&a[n - h..n], &a[1..=h]);
+    let middle = if n % 2 == 0 { a[n / 2] * a[n / 2] } else { 0.0 };
+    2.0 * pairs + middle + 2.0 * a[0] * a[n]
 }
 
 /// (a/b)^[n] = (a^[n] − Σ_{j=1..n} w^[n−j] b^[j]) / b^[0], with w = a/b
 /// known below order n and `a_n` = a^[n] (0 for a constant numerator).
 #[inline(always)]
 pub fn quotient(w: &Coefficients, a_n: f64, b: &Coefficients, n: usize) -> f64 {
-    (a_n - reversed_dot(&w[..n], &b[1..=n])) / b[0]
+    let earlier = reversed_dot(&w[1..n], &b[1..n]);
+    let inverse = 1.0 / b[0];
+    (a_n - earlier - w[0] * b[n]) * inverse
 }
 
 /// (√b)^[n] from w = √b below order n and `b_n` = b^[n]:
 /// (b^[n] − Σ_{j=1..n−1} w^[n−j] w^[j]) / (2 w^[0]).
 #[inline(always)]
 pub fn sqrt(w: &Coefficients, b_n: f64, n: usize) -> f64 {
-    let inner = if n >= 2 {
-        reversed_dot(&w[1..n], &w[1..n])
-    } else {
-        0.0
-    };
-    (b_n - inner) / (2.0 * w[0])
+    let inner = reversed_dot(&w[1..n], &w[1..n]);
+    (b_n - inner) * (0.5 / w[0])
 }
 
 /// (b^α)^[n] = Σ_{j=0..n−1} (nα − j(α+1)) b^[n−j] w^[j] / (n b^[0]) for a
@@ -116,16 +129,17 @@ pub fn sqrt(w: &Coefficients, b_n: f64, n: usize) -> f64 {
 pub fn power(w: &Coefficients, b: &Coefficients, alpha: f64, n: usize) -> f64 {
     let nf = n as f64;
     let mut sum = 0.0;
-    for j in 0..n {
+    for j in 1..n {
         sum += (nf * alpha - j as f64 * (alpha + 1.0)) * b[n - j] * w[j];
     }
-    sum / (nf * b[0])
+    (sum + nf * alpha * b[n] * w[0]) / (nf * b[0])
 }
 
 /// (e^u)^[n] = (1/n) Σ_{j=1..n} j u^[j] w^[n−j], w = e^u below order n.
 #[inline(always)]
 pub fn exp(w: &Coefficients, u: &Coefficients, n: usize) -> f64 {
-    derivative_dots(u, w, w, n).0 / n as f64
+    let earlier = derivative_dots(u, w, w, n).0;
+    earlier * INVERSES[n] + u[n] * w[0]
 }
 
 /// (ln u)^[n] = (u^[n] − (1/n) Σ_{j=1..n−1} j w^[j] u^[n−j]) / u^[0].
@@ -142,7 +156,11 @@ pub fn ln(w: &Coefficients, u: &Coefficients, n: usize) -> f64 {
 /// s^[n] = (1/n) Σ j u^[j] c^[n−j], c^[n] = −(1/n) Σ j u^[j] s^[n−j].
 #[inline(always)]
 pub fn sin_cos(s: &Coefficients, c: &Coefficients, u: &Coefficients, n: usize) -> (f64, f64) {
-    let (sum_c, sum_s) = derivative_dots(u, c, s, n);
-    let inverse = 1.0 / n as f64;
-    (sum_c * inverse, -sum_s * inverse)
+    let (earlier_c, earlier_s) = derivative_dots(u, c, s, n);
+    let inverse = INVERSES[n];
+    // The order-n term j = n: n u^[n] c^[0] / n.
+    (
+        earlier_c * inverse + u[n] * c[0],
+        -(earlier_s * inverse + u[n] * s[0]),
+    )
 }

@@ -3,12 +3,12 @@
 //! Each step asks the system for the normalised Taylor coefficients
 //! y^[0..=p] of the solution through (t, y) (`System::taylor`, generated at
 //! build time from the right-hand side's DAG) and sums the series. The
-//! order follows from the tolerance, p = max(2, ⌈−ln(tol)/2 + 1⌉), and the
-//! step from the last two coefficient norms (Jorba and Zou's rule in
-//! heyoka's variant): ρ = min_k (M/‖y^[k]‖)^{1/k} over k = p−1, p with
-//! M = max(1, ‖y‖∞) (absolute below 1, relative above), h = ρ e^{−2}
-//! e^{−0.7/(p−1)}. There is no error estimate and no rejected step. The
-//! polynomial of the step is the dense output.
+//! order follows from the tolerance, p = ⌈−ln(tol)/κ + 1⌉, and the step
+//! from the last two coefficient norms (Jorba and Zou's rule as heyoka uses
+//! it): ρ = min_k (M/‖y^[k]‖)^{1/k} over k = p−1, p with M = max(1, ‖y‖∞)
+//! (absolute below 1, relative above), h = ρ e^{−κ} e^{−0.7/(p−1)}, with
+//! κ = [`SAFETY_EXPONENT`]. There is no error estimate and no rejected
+//! step. The polynomial of the step is the dense output.
 
 use super::series::MAX_ORDER;
 use super::{check_finite, Flow, Observer, OdeError, Stats, Step, System};
@@ -32,9 +32,18 @@ impl TaylorWork {
     }
 }
 
-/// The order the method uses for tolerance `tol`.
+/// κ in the step h = ρ e^{−κ} e^{−0.7/(p−1)}, where the terms of the series
+/// fall like e^{−κ k}. Jorba and Zou (and heyoka) take κ = 2 with
+/// p = ⌈−ln(tol)/2 + 1⌉; measured on the Kapitza period map (README), κ = 1.5
+/// with the order raised to match, p = ⌈−ln(tol)/1.5 + 1⌉, reaches the same
+/// error about 20 % faster: the steps are 40 % longer and generated
+/// recurrences make the extra orders cheap.
+pub const SAFETY_EXPONENT: f64 = 1.5;
+
+/// The order the method uses for tolerance `tol`: ⌈−ln(tol)/κ + 1⌉, at
+/// least 2, at most [`super::series::MAX_ORDER`].
 pub fn order_for_tolerance(tol: f64) -> usize {
-    ((-tol.ln() / 2.0 + 1.0).ceil().max(2.0) as usize).min(MAX_ORDER)
+    ((-tol.ln() / SAFETY_EXPONENT + 1.0).ceil().max(2.0) as usize).min(MAX_ORDER)
 }
 
 /// The solver state the Taylor method keeps between calls.
@@ -112,7 +121,7 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
     stats.order = stats.order.max(order as u64);
     state.coefficients.resize((order + 1) * N, 0.0);
     let direction = (t1 - t0).signum();
-    let safety = (-2.0 - 0.7 / (order - 1) as f64).exp();
+    let safety = (-SAFETY_EXPONENT - 0.7 / (order - 1) as f64).exp();
     let (mut t, mut y) = (t0, *y0);
     // Kahan-compensated time: a million steps lose no phase.
     let mut carry = 0.0;
@@ -165,3 +174,4 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
     }
     Err(OdeError::TooManySteps { t, max_steps })
 }
+
