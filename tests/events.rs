@@ -2,7 +2,9 @@
 //! convention, clean restarts, close and simultaneous events, a condition
 //! already zero at the start, and two crossings inside one step.
 
-use mechlab::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, System};
+use mechlab::ode::{
+    Direction, Event, EventSettings, Integrator, Method, OdeError, System, TaylorWork,
+};
 use std::f64::consts::PI;
 
 /// y'' = −y: y = (cos t, −sin t) from (1, 0).
@@ -10,6 +12,22 @@ struct Oscillator;
 impl System<2> for Oscillator {
     fn rhs(&self, _t: f64, y: &[f64; 2]) -> [f64; 2] {
         [y[1], -y[0]]
+    }
+    /// Hand-written recurrences: x^[k+1] = v^[k]/(k+1), v^[k+1] = −x^[k]/(k+1).
+    fn taylor(
+        &self,
+        _t: f64,
+        y: &[f64; 2],
+        order: usize,
+        _work: &mut TaylorWork,
+        out: &mut [[f64; 2]],
+    ) -> bool {
+        out[0] = *y;
+        for k in 0..order {
+            let next = 1.0 / (k + 1) as f64;
+            out[k + 1] = [out[k][1] * next, -out[k][0] * next];
+        }
+        true
     }
 }
 
@@ -19,6 +37,23 @@ impl System<1> for Clock {
     fn rhs(&self, _t: f64, _y: &[f64; 1]) -> [f64; 1] {
         [1.0]
     }
+    /// y = y0 + (t − t0): every coefficient past the first vanishes, so the
+    /// Taylor method's step rule meets its polynomial guard.
+    fn taylor(
+        &self,
+        _t: f64,
+        y: &[f64; 1],
+        order: usize,
+        _work: &mut TaylorWork,
+        out: &mut [[f64; 1]],
+    ) -> bool {
+        out[0] = *y;
+        out[1] = [1.0];
+        for row in &mut out[2..=order] {
+            *row = [0.0];
+        }
+        true
+    }
 }
 
 fn all_methods(tol: f64, step: f64) -> Vec<Method> {
@@ -27,14 +62,20 @@ fn all_methods(tol: f64, step: f64) -> Vec<Method> {
         Method::parse("radau5", tol).unwrap(),
         Method::parse("rk4", step).unwrap(),
         Method::parse("gauss6", step).unwrap(),
+        Method::parse("taylor", tol).unwrap(),
     ]
 }
 
 #[test]
 fn dense_output_is_as_accurate_as_the_steps() {
     let times: Vec<f64> = (1..=200).map(|i| i as f64 * 0.05).collect();
-    for (tol, bound) in [(1e-6, 1e-5), (1e-10, 1e-9)] {
-        let mut integrator = Integrator::new(Method::parse("dop853", tol).unwrap()).unwrap();
+    for (name, tol, bound) in [
+        ("dop853", 1e-6, 1e-5),
+        ("dop853", 1e-10, 1e-9),
+        ("taylor", 1e-6, 1e-5),
+        ("taylor", 1e-10, 1e-9),
+    ] {
+        let mut integrator = Integrator::new(Method::parse(name, tol).unwrap()).unwrap();
         let states = integrator
             .advance_sampled(&Oscillator, 0.0, &[1.0, 0.0], &times)
             .unwrap();
@@ -48,7 +89,7 @@ fn dense_output_is_as_accurate_as_the_steps() {
             .zip(&states)
             .map(|(t, y)| (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs()))
             .fold(0.0f64, f64::max);
-        assert!(worst < bound, "tol {tol}: worst dense error {worst:e}");
+        assert!(worst < bound, "{name} {tol}: worst dense error {worst:e}");
     }
 }
 
@@ -56,11 +97,11 @@ fn dense_output_is_as_accurate_as_the_steps() {
 fn dense_output_between_steps_is_as_good_as_at_the_steps() {
     // A wrong interpolant coefficient shows as errors of low order in h between
     // the steps, far above the global error seen at the step ends.
-    for tol in [1e-7, 1e-11] {
+    for (name, tol) in [("dop853", 1e-7), ("dop853", 1e-11), ("taylor", 1e-7), ("taylor", 1e-11)] {
         let exact_error = |t: f64, y: &[f64; 2]| (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs());
         let mut at_steps = 0.0f64;
         let mut ends = vec![0.0];
-        Integrator::new(Method::parse("dop853", tol).unwrap())
+        Integrator::new(Method::parse(name, tol).unwrap())
             .unwrap()
             .advance_observed(&Oscillator, 0.0, &[1.0, 0.0], 30.0, &mut |t, y| {
                 at_steps = at_steps.max(exact_error(t, y));
@@ -72,7 +113,7 @@ fn dense_output_between_steps_is_as_good_as_at_the_steps() {
             .windows(2)
             .flat_map(|w| [w[0] + (w[1] - w[0]) / 3.0, w[0] + 2.0 * (w[1] - w[0]) / 3.0])
             .collect();
-        let states = Integrator::new(Method::parse("dop853", tol).unwrap())
+        let states = Integrator::new(Method::parse(name, tol).unwrap())
             .unwrap()
             .advance_sampled(&Oscillator, 0.0, &[1.0, 0.0], &times)
             .unwrap();
@@ -83,7 +124,7 @@ fn dense_output_between_steps_is_as_good_as_at_the_steps() {
             .fold(0.0f64, f64::max);
         assert!(
             between < 2.0 * at_steps + 1e-15,
-            "tol {tol}: {between:e} between steps, {at_steps:e} at steps"
+            "{name} {tol}: {between:e} between steps, {at_steps:e} at steps"
         );
     }
 }
@@ -200,6 +241,7 @@ fn close_and_simultaneous_events_are_reported_in_order() {
     for method in [
         Method::parse("dop853", 1e-8).unwrap(),
         Method::Rk4 { step: 0.7 },
+        Method::parse("taylor", 1e-8).unwrap(),
     ] {
         let run = Integrator::new(method)
             .unwrap()
