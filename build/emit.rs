@@ -39,6 +39,10 @@ pub struct Emitter {
     counter: usize,
     /// Named outputs (root nodes) of each stage.
     stages: Vec<Vec<(String, usize)>>,
+    /// Keep sin/cos of an angle combination (φ1 − φ2) as one call instead of
+    /// products of each angle's sin and cos: cheaper for Taylor
+    /// recurrences, where a product costs as much as a sin/cos pair.
+    pub whole_angles: bool,
 }
 
 fn literal(value: f64) -> String {
@@ -150,7 +154,7 @@ impl Emitter {
             }
             Expr::Call(name, args) if matches!(name.as_str(), "sin" | "cos") => {
                 match angle_combination(&args[0]) {
-                    Some(k) if k.len() > 1 || k[0].1.abs() > 1 => {
+                    Some(k) if !self.whole_angles && (k.len() > 1 || k[0].1.abs() > 1) => {
                         let (c, s) = self.sin_cos_of_combination(&k);
                         if name == "sin" {
                             s

@@ -182,6 +182,7 @@ impl Context<'_> {
         state: Vec<String>,
     ) -> Result<TaylorFunction, String> {
         let mut emitter = Emitter::default();
+        emitter.whole_angles = true;
         let phase = match &self.model.fast_phase {
             Some(phase) => {
                 let rate = vec![("rate".to_string(), self.model_phase_rate.clone())];
@@ -198,7 +199,12 @@ impl Context<'_> {
             state,
             time: self.model.time.clone(),
             phase,
-            parameters: self.model.parameters.iter().map(|p| p.name.clone()).collect(),
+            parameters: self
+                .model
+                .parameters
+                .iter()
+                .map(|p| p.name.clone())
+                .collect(),
         };
         let body = recurrences(&emitter.into_dag(), &signature, outputs)
             .map_err(|e| format!("{name}: {e}"))?;
@@ -478,7 +484,8 @@ pub fn render(
 
 /// The Taylor-coefficient functions of a model: the exact field, the
 /// averaged one, and the exact field with one tangent vector (FLI) or a full
-/// set (monodromy, Lyapunov spectrum), the tangent rates J·v as extra nodes.
+/// set (monodromy, Lyapunov spectrum), the tangent rates as forward-mode
+/// derivatives of the field's nodes.
 fn taylor_functions(
     cx: &Context,
     derivation: &Derivation,
@@ -508,32 +515,19 @@ fn taylor_functions(
             state.clone(),
         )?);
     }
-    let (jacobian, _) = matrix("j", &derivation.exact_jacobian);
     for (tangents, name, doc) in [
         (1, "exact_tangent_taylor", "Taylor coefficients of the exact solution and one tangent vector v' = J v: state [y; v]."),
         (m, "exact_monodromy_taylor", "Taylor coefficients of the exact solution and a full set of tangent vectors V' = J V: state [y; V] (V column-major)."),
     ] {
         let mut full_state = state.clone();
-        let mut tangent_rates = Vec::new();
-        let mut outputs = rhs_names.clone();
         for k in 0..tangents {
-            let components: Vec<String> = state.iter().map(|s| format!("tangent{k}_{s}")).collect();
-            for (i, component) in components.iter().enumerate() {
-                let terms: Vec<String> = (0..m)
-                    .filter(|&c| derivation.exact_jacobian[i][c].trim() != "0")
-                    .map(|c| format!("j_{i}_{c}*{}", components[c]))
-                    .collect();
-                let text = if terms.is_empty() { "0".to_string() } else { terms.join(" + ") };
-                tangent_rates.push((format!("{component}_rate"), text));
-                outputs.push(format!("{component}_rate"));
-            }
-            full_state.extend(components);
+            full_state.extend(state.iter().map(|s| format!("tangent{k}_{s}")));
         }
         functions.push(cx.taylor(
             name,
             doc,
-            &[velocity_stage.to_vec(), rates.clone(), jacobian.clone(), tangent_rates],
-            &outputs,
+            &[velocity_stage.to_vec(), rates.clone()],
+            &rhs_names,
             full_state,
         )?);
     }

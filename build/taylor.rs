@@ -236,6 +236,109 @@ impl Lowering<'_> {
         Ok(k)
     }
 
+    fn multiply(&mut self, a: usize, b: usize) -> usize {
+        self.intern(Op::Mul(a, b))
+    }
+
+    fn sum(&mut self, a: Option<usize>, b: Option<usize>, subtract: bool) -> Option<usize> {
+        match (a, b) {
+            (Some(a), Some(b)) => Some(self.intern(if subtract {
+                Op::Sub(a, b)
+            } else {
+                Op::Add(a, b)
+            })),
+            (Some(a), None) => Some(a),
+            (None, Some(b)) if subtract => Some(self.intern(Op::Neg(b))),
+            (None, b) => b,
+        }
+    }
+
+    /// The forward-mode derivative δk of node k along tangent vector `t`
+    /// (state components dim·(1 + t) + i); `None` when it vanishes.
+    fn derivative(
+        &mut self,
+        k: usize,
+        dim: usize,
+        t: usize,
+        memo: &mut HashMap<usize, Option<usize>>,
+    ) -> Option<usize> {
+        if let Some(&d) = memo.get(&k) {
+            return d;
+        }
+        let d = if self.classes[k] == Class::Constant {
+            None
+        } else {
+            match self.ops[k].clone() {
+                Op::State(i) if i < dim => Some(self.intern(Op::State(dim * (1 + t) + i))),
+                Op::State(_) => None,
+                Op::Literal(_) | Op::Parameter(_) | Op::Time | Op::Phase(_) => None,
+                Op::Neg(a) => self
+                    .derivative(a, dim, t, memo)
+                    .map(|x| self.intern(Op::Neg(x))),
+                Op::Add(a, b) | Op::Sub(a, b) => {
+                    let (da, db) = (
+                        self.derivative(a, dim, t, memo),
+                        self.derivative(b, dim, t, memo),
+                    );
+                    self.sum(da, db, matches!(self.ops[k], Op::Sub(..)))
+                }
+                Op::Mul(a, b) => {
+                    let da = self
+                        .derivative(a, dim, t, memo)
+                        .map(|x| self.multiply(x, b));
+                    let db = self
+                        .derivative(b, dim, t, memo)
+                        .map(|y| self.multiply(a, y));
+                    self.sum(da, db, false)
+                }
+                Op::Div(a, b) => {
+                    // δ(a/b) = (δa − (a/b) δb) / b.
+                    let da = self.derivative(a, dim, t, memo);
+                    let db = self
+                        .derivative(b, dim, t, memo)
+                        .map(|y| self.multiply(k, y));
+                    self.sum(da, db, true).map(|n| self.intern(Op::Div(n, b)))
+                }
+                Op::Square(a) => self.derivative(a, dim, t, memo).map(|x| {
+                    let two_a = {
+                        let two = self.literal("2.0");
+                        self.multiply(two, a)
+                    };
+                    self.multiply(two_a, x)
+                }),
+                Op::Sqrt(a) => self.derivative(a, dim, t, memo).map(|x| {
+                    let two = self.literal("2.0");
+                    let two_w = self.multiply(two, k);
+                    self.intern(Op::Div(x, two_w))
+                }),
+                Op::Power(a, alpha) => self.derivative(a, dim, t, memo).map(|x| {
+                    let one = self.literal("1.0");
+                    let lowered = self.intern(Op::Sub(alpha, one));
+                    let power = self.intern(Op::Power(a, lowered));
+                    let slope = self.multiply(alpha, power);
+                    self.multiply(slope, x)
+                }),
+                Op::Exp(a) => self
+                    .derivative(a, dim, t, memo)
+                    .map(|x| self.multiply(k, x)),
+                Op::Ln(a) => self
+                    .derivative(a, dim, t, memo)
+                    .map(|x| self.intern(Op::Div(x, a))),
+                Op::Sin(a) => self.derivative(a, dim, t, memo).map(|x| {
+                    let c = self.intern(Op::Cos(a));
+                    self.multiply(c, x)
+                }),
+                Op::Cos(a) => self.derivative(a, dim, t, memo).map(|x| {
+                    let s = self.intern(Op::Sin(a));
+                    let product = self.multiply(s, x);
+                    self.intern(Op::Neg(product))
+                }),
+            }
+        };
+        memo.insert(k, d);
+        d
+    }
+
     fn variable(&mut self, v: &str) -> Result<usize, String> {
         let s = self.signature;
         if let Some(k) = s.state.iter().position(|x| x == v) {
@@ -266,19 +369,24 @@ impl Lowering<'_> {
 
 /// The body of a function computing x^[0..=order] of the solution of
 /// x' = f into `out`, where f is the list `outputs` (stage output names of
-/// `dag`, one per state component).
+/// `dag`, one per component of x). If the state is longer than f, the rest
+/// are K tangent vectors v with v' = (∂f/∂x) v, each as long as x: their
+/// rates are the forward-mode derivatives of f's nodes (δ(a·b) = δa·b +
+/// a·δb, δ sin u = cos u·δu, ...), extra nodes of the same DAG.
 pub fn recurrences(
     dag: &Dag,
     signature: &Signature,
     outputs: &[String],
 ) -> Result<TaylorBody, String> {
-    if outputs.len() != signature.state.len() {
+    let dim = outputs.len();
+    if dim == 0 || signature.state.len() % dim != 0 {
         return Err(format!(
             "{} right-hand sides for {} state components",
             outputs.len(),
             signature.state.len()
         ));
     }
+    let tangents = signature.state.len() / dim - 1;
     let mut lowering = Lowering {
         dag,
         signature,
@@ -304,6 +412,16 @@ pub fn recurrences(
             .get(name.as_str())
             .ok_or_else(|| format!("'{name}' is not a stage output"))?;
         roots.push(lowering.lower(root)?);
+    }
+    for t in 0..tangents {
+        let mut memo = HashMap::new();
+        for i in 0..dim {
+            let root = match lowering.derivative(roots[i], dim, t, &mut memo) {
+                Some(r) => r,
+                None => lowering.literal("0.0"),
+            };
+            roots.push(root);
+        }
     }
     let needed = reachable(&lowering.ops, &roots);
     let names = names(&lowering, dag, &needed);
@@ -466,10 +584,7 @@ impl Writer<'_> {
     /// The sin/cos partner of node k, if k is one of a pair.
     fn partner(&self, k: usize) -> Option<(usize, usize)> {
         match self.ops[k] {
-            Op::Sin(u) | Op::Cos(u) => Some((
-                self.index[&Op::Sin(u)],
-                self.index[&Op::Cos(u)],
-            )),
+            Op::Sin(u) | Op::Cos(u) => Some((self.index[&Op::Sin(u)], self.index[&Op::Cos(u)])),
             _ => None,
         }
     }
@@ -487,9 +602,7 @@ impl Writer<'_> {
 
     /// Order-1 coefficient of a node linear in time.
     fn slope(&self, k: usize) -> String {
-        let s = |c: usize| -> Option<String> {
-            (!self.constant(c)).then(|| self.at(c, "1"))
-        };
+        let s = |c: usize| -> Option<String> { (!self.constant(c)).then(|| self.at(c, "1")) };
         match self.ops[k] {
             Op::Time => "1.0".into(),
             Op::Phase(r) => self.value(r),
@@ -520,7 +633,9 @@ impl Writer<'_> {
             Op::Add(a, b) | Op::Sub(a, b) => {
                 let plus = matches!(self.ops[k], Op::Add(..));
                 match (self.constant(a), self.constant(b)) {
-                    (false, false) => format!("{} {} {}", at(a), if plus { "+" } else { "-" }, at(b)),
+                    (false, false) => {
+                        format!("{} {} {}", at(a), if plus { "+" } else { "-" }, at(b))
+                    }
                     (false, true) => at(a),
                     (true, false) if plus => at(b),
                     (true, false) => format!("-{}", at(b)),
@@ -574,7 +689,11 @@ impl Writer<'_> {
     fn body(&self, roots: &[usize], dim: usize) -> TaylorBody {
         let mut lines = Vec::new();
         let live: Vec<usize> = (0..self.ops.len()).filter(|&k| self.needed[k]).collect();
-        let varying: Vec<usize> = live.iter().copied().filter(|&k| !self.constant(k)).collect();
+        let varying: Vec<usize> = live
+            .iter()
+            .copied()
+            .filter(|&k| !self.constant(k))
+            .collect();
         lines.push("// Constants of the step (parameters only).".into());
         for &k in &live {
             if self.constant(k) && !matches!(self.ops[k], Op::Literal(_) | Op::Parameter(_)) {
@@ -597,7 +716,9 @@ impl Writer<'_> {
                 Op::Sin(_) | Op::Cos(_) => {
                     let (s, c) = self.partner(k).expect("a pair");
                     if k == s.min(c) {
-                        let Op::Sin(u) = self.ops[s] else { unreachable!() };
+                        let Op::Sin(u) = self.ops[s] else {
+                            unreachable!()
+                        };
                         lines.push(format!(
                             "({}[0], {}[0]) = {}.sin_cos();",
                             self.names[s],

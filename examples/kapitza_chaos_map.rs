@@ -25,10 +25,15 @@ fn main() {
                 knob("p_max", "3", "the map covers p in [-p_max, p_max]"),
                 knob(
                     "method",
-                    "dop853",
-                    "integrator (rk4, dop853, gauss4, gauss6, radau5)",
+                    "taylor",
+                    "integrator (taylor, dop853, rk4, gauss4, gauss6, radau5); taylor \
+                     at 1e-6 draws the picture of dop853 at 1e-8 in 60 % of the time",
                 ),
-                knob("tol", "1e-8", "tolerance (dop853, radau5) or step size"),
+                knob(
+                    "tol",
+                    "1e-6",
+                    "tolerance (taylor, dop853, radau5) or step size",
+                ),
             ],
         )?;
         let params = kapitza::Params {

@@ -66,6 +66,7 @@ impl Solver {
             Solver::Ours(Method::Rk4 { step }) | Solver::Ours(Method::Gauss { step, .. }) => step,
             Solver::Ours(Method::Dop853 { rtol, .. })
             | Solver::Ours(Method::Radau5 { rtol, .. }) => rtol,
+            Solver::Ours(Method::Taylor { tol }) => tol,
             Solver::Peer(tol) => tol,
         }
     }
@@ -318,6 +319,15 @@ fn solvers(fixed_steps: &[f64], stiff: bool) -> Vec<Solver> {
             Method::parse("radau5", 10f64.powi(-k)).unwrap(),
         ));
     }
+    // Taylor needs generated recurrences: the smooth problems' models have
+    // them, the rod's mode-combined contact field does not.
+    if !stiff {
+        for k in 3..=16 {
+            list.push(Solver::Ours(Method::Taylor {
+                tol: 10f64.powi(-k),
+            }));
+        }
+    }
     for &h in fixed_steps {
         list.push(Solver::Ours(Method::Rk4 { step: h }));
         if !stiff {
@@ -411,7 +421,39 @@ fn seconds_at(rows: &[&Row], target: f64) -> Option<f64> {
     })
 }
 
-const METHODS: [&str; 6] = ["rk4", "gauss4", "gauss6", "dop853", "radau5", PEER];
+const METHODS: [&str; 7] = [
+    "rk4", "gauss4", "gauss6", "dop853", "radau5", PEER, "taylor",
+];
+
+/// Time of dop853 over time of taylor at equal error, per smooth problem and
+/// target error (log-log interpolated along each method's runs).
+fn taylor_speedups(rows: &[Row]) -> BTreeMap<String, BTreeMap<String, Option<f64>>> {
+    let mut out = BTreeMap::new();
+    for problem in [
+        "kapitza_regular",
+        "kapitza_regular_global",
+        "kapitza_chaotic",
+        "double_pendulum",
+    ] {
+        let of = |method: &str| -> Vec<&Row> {
+            rows.iter()
+                .filter(|r| r.problem == problem && r.method == method)
+                .collect()
+        };
+        let (dop, taylor) = (of("dop853"), of("taylor"));
+        let ratios = [1e-6, 1e-8, 1e-10]
+            .into_iter()
+            .map(|target| {
+                let ratio = seconds_at(&dop, target)
+                    .zip(seconds_at(&taylor, target))
+                    .map(|(d, t)| d / t);
+                (format!("{target:e}"), ratio)
+            })
+            .collect();
+        out.insert(problem.to_string(), ratios);
+    }
+    out
+}
 
 fn plot_problem(scene: &Scene, problem: &str, rows: &[&Row]) -> Result<Slopes, SceneError> {
     let floor = 1e-16;
@@ -651,6 +693,11 @@ fn main() {
         // Performance ratios on the regular Kapitza orbit.
         let ratios = performance(&kapitza_system, &regular, period, periods, &rows)?;
         println!("{}", serde_json::to_string_pretty(&ratios).unwrap());
+        let speedups = taylor_speedups(&rows);
+        println!(
+            "dop853 time / taylor time at equal error: {}",
+            serde_json::to_string_pretty(&speedups).unwrap()
+        );
 
         scene.write_csv(
             "runs.csv",
@@ -680,6 +727,8 @@ fn main() {
             slopes_error_vs_f_evals: BTreeMap<&'a str, Slopes>,
             reference_agreement: BTreeMap<String, f64>,
             performance: Performance,
+            /// dop853 seconds / taylor seconds at equal error (1e-6, 1e-8, 1e-10).
+            taylor_speedup_over_dop853: BTreeMap<String, BTreeMap<String, Option<f64>>>,
         }
         scene.write_summary(&Summary {
             runs: &rows,
@@ -687,6 +736,7 @@ fn main() {
             slopes_error_vs_f_evals: slopes,
             reference_agreement: agreements,
             performance: ratios,
+            taylor_speedup_over_dop853: speedups,
         })?;
         Ok(())
     })

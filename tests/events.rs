@@ -97,7 +97,12 @@ fn dense_output_is_as_accurate_as_the_steps() {
 fn dense_output_between_steps_is_as_good_as_at_the_steps() {
     // A wrong interpolant coefficient shows as errors of low order in h between
     // the steps, far above the global error seen at the step ends.
-    for (name, tol) in [("dop853", 1e-7), ("dop853", 1e-11), ("taylor", 1e-7), ("taylor", 1e-11)] {
+    for (name, tol) in [
+        ("dop853", 1e-7),
+        ("dop853", 1e-11),
+        ("taylor", 1e-7),
+        ("taylor", 1e-11),
+    ] {
         let exact_error = |t: f64, y: &[f64; 2]| (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs());
         let mut at_steps = 0.0f64;
         let mut ends = vec![0.0];

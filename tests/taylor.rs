@@ -164,7 +164,12 @@ fn generated_coefficients_of_every_model_follow_the_field() {
         };
         let y2 = [rng.between(-PI, PI), rng.between(-2.0, 2.0)];
         check_generated("kapitza exact", &kapitza::Exact { params: kapitza }, t, &y2);
-        check_generated("kapitza averaged", &kapitza::Averaged { params: kapitza }, t, &y2);
+        check_generated(
+            "kapitza averaged",
+            &kapitza::Averaged { params: kapitza },
+            t,
+            &y2,
+        );
         let horizontal = horizontal_pendulum::Params::default();
         check_generated(
             "horizontal exact",
@@ -175,7 +180,12 @@ fn generated_coefficients_of_every_model_follow_the_field() {
         let mut dp = double_pendulum::Params::default();
         dp.mu = rng.between(0.0, 0.3);
         let y4: [f64; 4] = std::array::from_fn(|_| rng.between(-1.5, 1.5));
-        check_generated("double pendulum exact", &double_pendulum::Exact { params: dp }, t, &y4);
+        check_generated(
+            "double pendulum exact",
+            &double_pendulum::Exact { params: dp },
+            t,
+            &y4,
+        );
         check_generated(
             "double pendulum averaged",
             &double_pendulum::Averaged { params: dp },
@@ -185,7 +195,12 @@ fn generated_coefficients_of_every_model_follow_the_field() {
         let elastic = elastic_pendulum::Params::default();
         let mut ye: [f64; 4] = std::array::from_fn(|_| rng.between(-0.5, 0.5));
         ye[0] = 1.0 + 0.2 * ye[0]; // the spring length r
-        check_generated("elastic exact", &elastic_pendulum::Exact { params: elastic }, t, &ye);
+        check_generated(
+            "elastic exact",
+            &elastic_pendulum::Exact { params: elastic },
+            t,
+            &ye,
+        );
     }
 }
 
@@ -200,8 +215,7 @@ fn tangent_recurrences_give_the_monodromy_of_the_variational_equations() {
     let period = 2.0 * PI * params.eps;
     let y0 = [0.4, -0.2];
     let run = |method| {
-        monodromy::<_, 2, 6>(&mut Integrator::new(method).unwrap(), &system, period, &y0)
-            .unwrap()
+        monodromy::<_, 2, 6>(&mut Integrator::new(method).unwrap(), &system, period, &y0).unwrap()
     };
     let (y_taylor, m_taylor) = run(Method::Taylor { tol: 1e-15 });
     let (y_dop, m_dop) = run(Method::Dop853 {
@@ -221,7 +235,10 @@ fn tangent_recurrences_give_the_monodromy_of_the_variational_equations() {
     }
     // Liouville: det M = exp(−μ T).
     let det = m_taylor[0][0] * m_taylor[1][1] - m_taylor[0][1] * m_taylor[1][0];
-    assert!((det - (-params.mu * period).exp()).abs() < 1e-12, "det {det}");
+    assert!(
+        (det - (-params.mu * period).exp()).abs() < 1e-12,
+        "det {det}"
+    );
 }
 
 /// Kapitza period map over 100 periods: the error against a tighter run.
@@ -289,7 +306,10 @@ fn taylor_converges_to_dop853_on_kapitza_and_the_double_pendulum() {
             assert!(error < previous, "{name} tol {tol}: {error:e}");
             previous = error;
         }
-        assert!(previous < 1e-10, "{name}: taylor 1e-15 vs dop853 1e-14: {previous:e}");
+        assert!(
+            previous < 1e-10,
+            "{name}: taylor 1e-15 vs dop853 1e-14: {previous:e}"
+        );
     }
     let kapitza = kapitza::Params {
         A: 1.5,

@@ -174,4 +174,3 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
     }
     Err(OdeError::TooManySteps { t, max_steps })
 }
-
