@@ -145,7 +145,7 @@ impl Lowering<'_> {
     fn power_chain(&mut self, u: usize, k: u32) -> usize {
         match k {
             1 => u,
-            _ if k % 2 == 0 => {
+            _ if k.is_multiple_of(2) => {
                 let half = self.power_chain(u, k / 2);
                 self.intern(Op::Square(half))
             }
@@ -379,7 +379,7 @@ pub fn recurrences(
     outputs: &[String],
 ) -> Result<TaylorBody, String> {
     let dim = outputs.len();
-    if dim == 0 || signature.state.len() % dim != 0 {
+    if dim == 0 || !signature.state.len().is_multiple_of(dim) {
         return Err(format!(
             "{} right-hand sides for {} state components",
             outputs.len(),

@@ -54,7 +54,7 @@ fn main() {
                 knob(
                     "method",
                     "dop853",
-                    "integrator (rk4, dop853, gauss4, gauss6, radau5)",
+                    "integrator (rk4, dop853, taylor, gauss4, gauss6, radau5)",
                 ),
                 knob("tol", "1e-9", "tolerance (dop853, radau5) or step size"),
                 knob(

@@ -177,8 +177,10 @@ fn generated_coefficients_of_every_model_follow_the_field() {
             t,
             &y2,
         );
-        let mut dp = double_pendulum::Params::default();
-        dp.mu = rng.between(0.0, 0.3);
+        let dp = double_pendulum::Params {
+            mu: rng.between(0.0, 0.3),
+            ..Default::default()
+        };
         let y4: [f64; 4] = std::array::from_fn(|_| rng.between(-1.5, 1.5));
         check_generated(
             "double pendulum exact",

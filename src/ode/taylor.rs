@@ -138,7 +138,7 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
             None => remaining,
             Some(_) => return Err(OdeError::NonFinite { t, y: y.to_vec() }),
         };
-        if !(h > 0.0) && remaining > 0.0 {
+        if h <= 0.0 && remaining > 0.0 {
             return Err(OdeError::StepSizeUnderflow { t, h });
         }
         let last = h >= remaining;
