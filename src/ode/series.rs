@@ -102,7 +102,11 @@ pub fn product(a: &Coefficients, b: &Coefficients, n: usize) -> f64 {
 pub fn square(a: &Coefficients, n: usize) -> f64 {
     let h = (n - 1) / 2;
     let pairs = reversed_dot(&a[n - h..n], &a[1..=h]);
-    let middle = if n.is_multiple_of(2) { a[n / 2] * a[n / 2] } else { 0.0 };
+    let middle = if n.is_multiple_of(2) {
+        a[n / 2] * a[n / 2]
+    } else {
+        0.0
+    };
     2.0 * pairs + middle + 2.0 * a[0] * a[n]
 }
 
