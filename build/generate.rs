@@ -195,7 +195,6 @@ impl Context<'_> {
             emitter.stage(stage).map_err(|e| format!("{name}: {e}"))?;
         }
         let signature = Signature {
-            dim: state.len(),
             state,
             time: self.model.time.clone(),
             phase,
@@ -212,7 +211,7 @@ impl Context<'_> {
         Ok(TaylorFunction {
             name: name.into(),
             doc: doc.into(),
-            dim: signature.dim,
+            dim: signature.state.len(),
             params: prelude[0].clone(),
             body: body.lines,
         })

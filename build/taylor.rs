@@ -73,8 +73,6 @@ impl Op {
 
 /// What the variables of a right-hand side are.
 pub struct Signature {
-    /// State length.
-    pub dim: usize,
     /// State components, in order.
     pub state: Vec<String>,
     /// The model's time variable.
@@ -423,7 +421,7 @@ pub fn recurrences(
             roots.push(root);
         }
     }
-    let needed = reachable(&lowering.ops, &roots);
+    let needed = reachable(&lowering.ops, &lowering.index, &roots);
     let names = names(&lowering, dag, &needed);
     Ok(Writer {
         ops: &lowering.ops,
@@ -435,7 +433,7 @@ pub fn recurrences(
     .body(&roots, signature.state.len()))
 }
 
-fn reachable(ops: &[Op], roots: &[usize]) -> Vec<bool> {
+fn reachable(ops: &[Op], index: &HashMap<Op, usize>, roots: &[usize]) -> Vec<bool> {
     let mut needed = vec![false; ops.len()];
     let mut stack: Vec<usize> = roots.to_vec();
     stack.extend(
@@ -453,7 +451,7 @@ fn reachable(ops: &[Op], roots: &[usize]) -> Vec<bool> {
         // The recurrence of sin needs cos and vice versa.
         if let Op::Sin(u) | Op::Cos(u) = ops[k] {
             for partner in [Op::Sin(u), Op::Cos(u)] {
-                if let Some(k) = ops.iter().position(|o| *o == partner) {
+                if let Some(&k) = index.get(&partner) {
                     stack.push(k);
                 }
             }
