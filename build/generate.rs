@@ -297,15 +297,13 @@ pub fn render(
         &[outs],
         result,
     )?);
-    let (rates, _) = vector("dp", &derivation.momentum_rates);
-    let mut rhs_names = cx.velocities();
-    rhs_names.extend(rates.iter().map(|(name, _)| name.clone()));
+    let (exact_stages, rhs_names) = exact_field(&cx, derivation, &velocity_stage);
     functions.push(cx.function(
         "exact_rhs",
         "Hamilton's equations with forces: [q', p'] with q' = A⁻¹(p − b), p' = ∂L/∂q + Q.",
         Inputs::State,
         format!("[f64; {m}]"),
-        &[velocity_stage.clone(), rates],
+        &exact_stages,
         format!("[{}]", rhs_names.join(", ")),
     )?);
     let (outs, result) = matrix("j", &derivation.exact_jacobian);
@@ -481,6 +479,19 @@ pub fn render(
         .map_err(|e| format!("template model.rs.tera: {e:?}"))
 }
 
+/// The exact field as stages (velocities, then momentum rates) and the names
+/// of its outputs [q', p'].
+fn exact_field(
+    cx: &Context,
+    derivation: &Derivation,
+    velocity_stage: &[(String, String)],
+) -> (Vec<Vec<(String, String)>>, Vec<String>) {
+    let (rates, _) = vector("dp", &derivation.momentum_rates);
+    let mut names = cx.velocities();
+    names.extend(rates.iter().map(|(name, _)| name.clone()));
+    (vec![velocity_stage.to_vec(), rates], names)
+}
+
 /// The Taylor-coefficient functions of a model: the exact field, the
 /// averaged one, and the exact field with one tangent vector (FLI) or a full
 /// set (monodromy, Lyapunov spectrum), the tangent rates as forward-mode
@@ -493,13 +504,11 @@ fn taylor_functions(
     let m = 2 * cx.n();
     let mut state = cx.coordinates();
     state.extend(cx.momenta());
-    let (rates, _) = vector("dp", &derivation.momentum_rates);
-    let mut rhs_names = cx.velocities();
-    rhs_names.extend(rates.iter().map(|(name, _)| name.clone()));
+    let (exact_stages, rhs_names) = exact_field(cx, derivation, velocity_stage);
     let mut functions = vec![cx.taylor(
         "exact_taylor",
         "Normalised Taylor coefficients out[k] = y^(k)(t)/k!, k = 0..=order, of the exact solution through (t, y).",
-        &[velocity_stage.to_vec(), rates.clone()],
+        &exact_stages,
         &rhs_names,
         state.clone(),
     )?];
@@ -525,7 +534,7 @@ fn taylor_functions(
         functions.push(cx.taylor(
             name,
             doc,
-            &[velocity_stage.to_vec(), rates.clone()],
+            &exact_stages,
             &rhs_names,
             full_state,
         )?);
