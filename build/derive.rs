@@ -36,6 +36,7 @@ pub struct Derived {
 }
 
 /// The part of the derivation the code generator needs, as printed text.
+#[derive(Default)]
 pub struct Derivation {
     pub dof: usize,
     /// Everything derived, in reading order, for snapshots and reports.
@@ -65,6 +66,33 @@ pub struct Derivation {
     /// Arithmetic operations of the right-hand sides after CSE, as derived
     /// and in the readable form: (function, derived, readable, chosen).
     pub operation_counts: Vec<(String, usize, usize, usize)>,
+    /// The pieces of the numeric-solve form, for models whose velocities
+    /// are solved at run time (then `velocities`, `hamiltonian`, the
+    /// Jacobians, `averaged_*` and `vibrational_potential` are empty: the
+    /// generator builds them from these through the solve).
+    pub numeric: Option<NumericForm>,
+}
+
+/// What the generated code of the numeric-solve form evaluates: A(q) (in
+/// `Derivation::mass_matrix`), b(q, θ), V(q, θ), the momentum rates
+/// ∂L/∂q + Q at (q, q', θ) (in `Derivation::momentum_rates`), and for the
+/// averaged system b̄ = mean b, the modes of b over the phase and the rates
+/// of L̄₀ = ½ q'ᵀAq' + b̄ᵀq' − V̄ with the mean forces.
+pub struct NumericForm {
+    pub linear_term: Vec<String>,
+    /// V(q, θ) (with the phase, unlike `Derivation::potential`).
+    pub potential: String,
+    pub mean_linear_term: Vec<String>,
+    /// The modes of b over the phase: b = Σ_s h_s(θ) g_s(q) with h_s a
+    /// monomial sin(θ)^a cos(θ)^b (one mode, sin θ, for a vertical
+    /// vibration): the vectors g_s.
+    pub modes: Vec<Vec<String>>,
+    /// mean(h_s h_t), so that mean(b bᵀ) = Σ M_st g_s g_tᵀ and
+    /// V_vibr = ½ Σ M_st g_sᵀA⁻¹g_t: one solve per mode, not A⁻¹.
+    pub mode_products: Vec<Vec<f64>>,
+    /// mean(h_s), so that b̄ = Σ m_s g_s.
+    pub mode_means: Vec<f64>,
+    pub averaged_momentum_rates: Vec<String>,
 }
 
 /// A derivation failure, with the model quantity it concerns.
@@ -107,28 +135,7 @@ pub fn momentum_name(coordinate: &str) -> String {
 /// Coefficients are read off as Taylor coefficients in S and C.
 fn phase_mean(e: &Atom, phase: &str) -> Result<Atom, DeriveError> {
     let (s_name, c_name) = ("phase__sin", "phase__cos");
-    let s = var(s_name);
-    let c = var(c_name);
-    let replaced = e
-        .replace(atom(&format!("sin({phase})"))?.to_pattern())
-        .with(s.to_pattern())
-        .replace(atom(&format!("cos({phase})"))?.to_pattern())
-        .with(c.to_pattern());
-    if !is_zero(&replaced.derivative(symbol!(phase))) {
-        return Err(DeriveError {
-            key: "fast_phase".into(),
-            reason: format!(
-                "the phase '{phase}' enters other than through sin({phase}) and cos({phase}); rewrite multiple angles with addition formulas"
-            ),
-        });
-    }
-    fn double_factorial(n: i64) -> i64 {
-        if n <= 0 {
-            1
-        } else {
-            n * double_factorial(n - 2)
-        }
-    }
+    let replaced = trigonometric_polynomial(e, phase, s_name, c_name)?;
     let mut mean = num(0);
     let mut ds = replaced;
     let mut a = 0i64;
@@ -140,8 +147,9 @@ fn phase_mean(e: &Atom, phase: &str) -> Result<Atom, DeriveError> {
         while !is_zero(&dsc) {
             if a % 2 == 0 && b % 2 == 0 {
                 let coefficient = subst(&subst(&dsc, s_name, &num(0)), c_name, &num(0));
-                let weight = Atom::num(double_factorial(a - 1) * double_factorial(b - 1))
-                    / Atom::num(double_factorial(a + b) * a_factorial * b_factorial);
+                let (numerator, denominator) = monomial_mean(a, b);
+                let weight =
+                    Atom::num(numerator) / Atom::num(denominator * a_factorial * b_factorial);
                 mean = mean + coefficient * weight;
             }
             dsc = dsc.derivative(symbol!(c_name));
@@ -153,6 +161,86 @@ fn phase_mean(e: &Atom, phase: &str) -> Result<Atom, DeriveError> {
         a_factorial *= a;
     }
     Ok(mean)
+}
+
+/// `e` with sin(phase), cos(phase) replaced by the symbols `s_name`,
+/// `c_name`; an error if the phase enters any other way.
+fn trigonometric_polynomial(
+    e: &Atom,
+    phase: &str,
+    s_name: &str,
+    c_name: &str,
+) -> Result<Atom, DeriveError> {
+    let replaced = e
+        .replace(atom(&format!("sin({phase})"))?.to_pattern())
+        .with(var(s_name).to_pattern())
+        .replace(atom(&format!("cos({phase})"))?.to_pattern())
+        .with(var(c_name).to_pattern());
+    if !is_zero(&replaced.derivative(symbol!(phase))) {
+        return Err(DeriveError {
+            key: "fast_phase".into(),
+            reason: format!(
+                "the phase '{phase}' enters other than through sin({phase}) and cos({phase}); rewrite multiple angles with addition formulas"
+            ),
+        });
+    }
+    Ok(replaced)
+}
+
+/// mean over θ of sin(θ)^a cos(θ)^b as a fraction: (a−1)!!(b−1)!!/(a+b)!!
+/// for even a and b, 0 otherwise.
+pub fn monomial_mean(a: i64, b: i64) -> (i64, i64) {
+    fn double_factorial(n: i64) -> i64 {
+        if n <= 0 {
+            1
+        } else {
+            n * double_factorial(n - 2)
+        }
+    }
+    if a % 2 != 0 || b % 2 != 0 {
+        return (0, 1);
+    }
+    (
+        double_factorial(a - 1) * double_factorial(b - 1),
+        double_factorial(a + b),
+    )
+}
+
+/// The modes of a vector of trigonometric polynomials in the phase:
+/// v = Σ_s sin(θ)^{a_s} cos(θ)^{b_s} g_s, returned as ((a_s, b_s), g_s)
+/// for every monomial with a non-zero coefficient in some component.
+fn phase_modes(v: &[Atom], phase: &str) -> Result<Vec<((i64, i64), Vec<Atom>)>, DeriveError> {
+    let (s_name, c_name) = ("mode__sin", "mode__cos");
+    let mut modes: Vec<((i64, i64), Vec<Atom>)> = Vec::new();
+    for (i, e) in v.iter().enumerate() {
+        let mut ds = trigonometric_polynomial(e, phase, s_name, c_name)?;
+        let (mut a, mut a_factorial) = (0i64, 1i64);
+        while !is_zero(&ds) {
+            let (mut dsc, mut b, mut b_factorial) = (ds.clone(), 0i64, 1i64);
+            while !is_zero(&dsc) {
+                let coefficient = subst(&subst(&dsc, s_name, &num(0)), c_name, &num(0)).expand()
+                    / Atom::num(a_factorial * b_factorial);
+                if !is_zero(&coefficient) {
+                    let slot = match modes.iter().position(|(k, _)| *k == (a, b)) {
+                        Some(slot) => slot,
+                        None => {
+                            modes.push(((a, b), vec![num(0); v.len()]));
+                            modes.len() - 1
+                        }
+                    };
+                    modes[slot].1[i] = coefficient.expand();
+                }
+                dsc = dsc.derivative(symbol!(c_name));
+                b += 1;
+                b_factorial *= b;
+            }
+            ds = ds.derivative(symbol!(s_name));
+            a += 1;
+            a_factorial *= a;
+        }
+    }
+    modes.sort_by_key(|(k, _)| *k);
+    Ok(modes)
 }
 
 /// Determinant by cofactor expansion (the systems here have 1–3 degrees of freedom).
@@ -462,12 +550,6 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             });
         }
     }
-    if n > 3 {
-        return Err(DeriveError {
-            key: "coordinates".into(),
-            reason: "more than 3 degrees of freedom: the symbolic inverse of the mass matrix is only emitted up to 3".into(),
-        });
-    }
     let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
     let rate = match &model.fast_phase {
         Some(f) => atom(&f.rate.to_string())?,
@@ -519,20 +601,22 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             }
         }
     }
+    let mut readable_mass = vec![Vec::new(); n];
     for i in 0..n {
         for j in 0..n {
-            rec.record(
+            readable_mass[i].push(rec.record(
                 format!("mass_matrix[{i}][{j}]"),
                 "A = ∂²L/∂q'²",
                 &mass[i][j],
-            )?;
+            )?);
         }
     }
     let linear: Vec<Atom> = (0..n)
         .map(|i| at_rest(&lagrangian.derivative(symbol!(qd[i].as_str()))).expand())
         .collect();
+    let mut readable_linear = Vec::new();
     for (i, b) in linear.iter().enumerate() {
-        rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", b)?;
+        readable_linear.push(rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", b)?);
     }
     let potential = (-at_rest(&lagrangian)).expand();
     rec.record("potential", "V = −L at q' = 0", &potential)?;
@@ -554,6 +638,22 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         )?;
     }
 
+    if model.inverse == crate::model::Inverse::Numeric {
+        return numeric_form(
+            model,
+            Pieces {
+                lagrangian,
+                mass,
+                linear,
+                readable_mass,
+                readable_linear,
+                potential,
+                momenta,
+                rate,
+            },
+            rec,
+        );
+    }
     let (det, inv) = inverse(&mass);
     if is_zero(&det) {
         return Err(DeriveError {
@@ -661,7 +761,6 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
 
     let mut derivation = Derivation {
         dof: n,
-        derived: Vec::new(),
         velocities: if use_readable {
             readable_velocities
         } else {
@@ -676,16 +775,9 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         hamiltonian: hamiltonian_text,
         exact_jacobian,
         mass_matrix: matrix_text(&mass),
-        averaged_rhs: Vec::new(),
-        averaged_jacobian: Vec::new(),
-        averaged_hamiltonian: String::new(),
-        potential: String::new(),
-        vibrational_potential: String::new(),
-        potential_gradient: Vec::new(),
-        potential_hessian: Vec::new(),
-        effective_potential_hessian: Vec::new(),
         phase_rate: rate.to_string(),
         operation_counts: vec![exact_counts],
+        ..Default::default()
     };
 
     // Averaging over the fast phase.
@@ -761,17 +853,11 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         }
         None => (potential.clone(), num(0)),
     };
-    if !is_zero(&mean_potential.derivative(symbol!(model.time.as_str()))) {
-        return Err(DeriveError {
-            key: "lagrangian".into(),
-            reason: "the potential depends on time other than through a fast phase".into(),
-        });
-    }
-    derivation.potential = rec.record(
-        "mean_potential",
-        "V averaged over the phase",
-        &mean_potential,
-    )?;
+    (
+        derivation.potential,
+        derivation.potential_gradient,
+        derivation.potential_hessian,
+    ) = potential_derivatives(model, &mut rec, &mean_potential)?;
     derivation.vibrational_potential = rec.record(
         "vibrational_potential",
         "V_vibr = ½ mean(bᵀ A⁻¹ b)",
@@ -800,45 +886,233 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         "V + V_vibr",
         &[mean_potential.clone(), vibrational.clone()],
     )?;
-    derivation.potential_gradient = (0..n)
-        .map(|i| {
-            rec.record(
-                format!("potential_gradient[{i}]"),
-                "∂V/∂q",
-                &mean_potential.derivative(symbol!(q[i].as_str())),
-            )
-        })
-        .collect::<Result<_, _>>()?;
-    let hessian = |e: &Atom,
-                   key: &str,
-                   description: &str,
-                   rec: &mut Recorder|
-     -> Result<Vec<Vec<String>>, DeriveError> {
-        (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|j| {
-                        let d = e
-                            .derivative(symbol!(q[i].as_str()))
-                            .derivative(symbol!(q[j].as_str()));
-                        rec.record(format!("{key}[{i}][{j}]"), description, &d)
-                    })
-                    .collect()
-            })
-            .collect()
-    };
-    derivation.potential_hessian = hessian(
-        &mean_potential,
-        "potential_hessian",
-        "C = ∂²V/∂q²",
-        &mut rec,
-    )?;
-    derivation.effective_potential_hessian = hessian(
+    derivation.effective_potential_hessian = hessian_of(
         &effective,
+        &q,
         "effective_potential_hessian",
         "∂²(V + V_vibr)/∂q²",
         &mut rec,
     )?;
+    derivation.derived = rec.finish();
+    Ok(derivation)
+}
+
+/// The potential V̄ (averaged over the phase, if any), ∂V̄/∂q and
+/// C = ∂²V̄/∂q², recorded; V̄ must not depend on time.
+fn potential_derivatives(
+    model: &Model,
+    rec: &mut Recorder,
+    mean_potential: &Atom,
+) -> Result<(String, Vec<String>, Vec<Vec<String>>), DeriveError> {
+    if !is_zero(&mean_potential.derivative(symbol!(model.time.as_str()))) {
+        return Err(DeriveError {
+            key: "lagrangian".into(),
+            reason: "the potential depends on time other than through a fast phase".into(),
+        });
+    }
+    let q: Vec<String> = model.coordinates.iter().map(|c| c.name.clone()).collect();
+    let text = rec.record(
+        "mean_potential",
+        "V averaged over the phase",
+        mean_potential,
+    )?;
+    let gradient = q
+        .iter()
+        .enumerate()
+        .map(|(i, qi)| {
+            rec.record(
+                format!("potential_gradient[{i}]"),
+                "∂V/∂q",
+                &mean_potential.derivative(symbol!(qi.as_str())),
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    let hessian = hessian_of(mean_potential, &q, "potential_hessian", "C = ∂²V/∂q²", rec)?;
+    Ok((text, gradient, hessian))
+}
+
+/// The recorded Hessian of `e` in the coordinates `q`.
+fn hessian_of(
+    e: &Atom,
+    q: &[String],
+    key: &str,
+    description: &str,
+    rec: &mut Recorder,
+) -> Result<Vec<Vec<String>>, DeriveError> {
+    q.iter()
+        .enumerate()
+        .map(|(i, qi)| {
+            q.iter()
+                .enumerate()
+                .map(|(j, qj)| {
+                    let d = e
+                        .derivative(symbol!(qi.as_str()))
+                        .derivative(symbol!(qj.as_str()));
+                    rec.record(format!("{key}[{i}][{j}]"), description, &d)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// What both forms derive first.
+struct Pieces {
+    lagrangian: Atom,
+    mass: Vec<Vec<Atom>>,
+    linear: Vec<Atom>,
+    /// The same in their readable forms (checked against the above).
+    readable_mass: Vec<Vec<String>>,
+    readable_linear: Vec<String>,
+    potential: Atom,
+    momenta: Vec<Atom>,
+    rate: Atom,
+}
+
+/// The numeric-solve form: no inverse of A is formed symbolically, so the
+/// computer algebra stays polynomial in the size of the model.
+fn numeric_form(
+    model: &Model,
+    pieces: Pieces,
+    mut rec: Recorder,
+) -> Result<Derivation, DeriveError> {
+    let Pieces {
+        lagrangian,
+        mass,
+        linear,
+        readable_mass,
+        readable_linear,
+        potential,
+        momenta,
+        rate,
+    } = pieces;
+    let n = model.dof();
+    let q: Vec<String> = model.coordinates.iter().map(|c| c.name.clone()).collect();
+    let qd: Vec<String> = model
+        .coordinates
+        .iter()
+        .map(|c| c.velocity.clone())
+        .collect();
+    let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
+    let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
+    let forces: Vec<Atom> = model
+        .forces
+        .iter()
+        .map(|f| atom(&f.to_string()))
+        .collect::<Result<_, _>>()?;
+    let mut momentum_rates = Vec::new();
+    for i in 0..n {
+        let rate_i = (lagrangian.derivative(symbol!(q[i].as_str())) + &forces[i]).expand();
+        momentum_rates.push(rec.record(
+            format!("momentum_rates[{i}]"),
+            format!(
+                "d{}/dt = ∂L/∂{} + Q, at the velocities solved from A q' = p − b",
+                p[i], q[i]
+            ),
+            &rate_i,
+        )?);
+    }
+    let mut derivation = Derivation {
+        dof: n,
+        momentum_rates,
+        momenta: momenta.iter().map(|m| m.to_string()).collect(),
+        mass_matrix: readable_mass,
+        phase_rate: rate.to_string(),
+        ..Default::default()
+    };
+    let mut form = NumericForm {
+        linear_term: readable_linear,
+        potential: potential.to_string(),
+        mean_linear_term: Vec::new(),
+        modes: Vec::new(),
+        mode_products: Vec::new(),
+        mode_means: Vec::new(),
+        averaged_momentum_rates: Vec::new(),
+    };
+    let mean_potential = match &phase {
+        Some(th) => {
+            let depends_on_phase = |e: &Atom| !is_zero(&e.derivative(symbol!(th.as_str())));
+            if mass.iter().flatten().any(depends_on_phase) {
+                return Err(DeriveError {
+                    key: "lagrangian".into(),
+                    reason: format!("the mass matrix depends on the fast phase '{th}': averaging with a numeric solve of A needs A(q) alone"),
+                });
+            }
+            for (i, f) in forces.iter().enumerate() {
+                for v in &qd {
+                    let slope = f.derivative(symbol!(v.as_str()));
+                    let nonlinear = qd
+                        .iter()
+                        .any(|w| !is_zero(&slope.derivative(symbol!(w.as_str()))));
+                    if nonlinear || depends_on_phase(&slope) {
+                        return Err(DeriveError {
+                            key: format!("forces.{}", q[i]),
+                            reason: format!("averaging with a numeric solve of A needs forces linear in the velocities with coefficients free of the phase '{th}'"),
+                        });
+                    }
+                }
+            }
+            let mean_linear: Vec<Atom> = linear
+                .iter()
+                .map(|b| phase_mean(b, th).map(|m| m.expand()))
+                .collect::<Result<_, _>>()?;
+            for (i, b) in mean_linear.iter().enumerate() {
+                form.mean_linear_term.push(rec.record(
+                    format!("mean_linear_term[{i}]"),
+                    "b̄ = mean of b over the phase",
+                    b,
+                )?);
+            }
+            let modes = phase_modes(&linear, th)?;
+            for (s_index, ((a, b), g)) in modes.iter().enumerate() {
+                let mut texts = Vec::new();
+                for (i, component) in g.iter().enumerate() {
+                    texts.push(rec.record(
+                        format!("linear_term_modes[{s_index}][{i}]"),
+                        format!("b = Σ_s h_s(θ) g_s(q): g_{s_index}, the coefficient of sin(θ)^{a} cos(θ)^{b}"),
+                        component,
+                    )?);
+                }
+                form.modes.push(texts);
+            }
+            let mean = |a: i64, b: i64| {
+                let (numerator, denominator) = monomial_mean(a, b);
+                numerator as f64 / denominator as f64
+            };
+            form.mode_means = modes.iter().map(|((a, b), _)| mean(*a, *b)).collect();
+            form.mode_products = modes
+                .iter()
+                .map(|((a, b), _)| modes.iter().map(|((c, d), _)| mean(a + c, b + d)).collect())
+                .collect();
+            let mean_potential = phase_mean(&potential, th)?.expand();
+            let mut reduced = -mean_potential.clone();
+            for i in 0..n {
+                reduced = reduced + &mean_linear[i] * var(&qd[i]);
+                for j in 0..n {
+                    reduced = reduced + &mass[i][j] * var(&qd[i]) * var(&qd[j]) / num(2);
+                }
+            }
+            for i in 0..n {
+                let force = phase_mean(&forces[i], th)?;
+                let rate_i = (reduced.derivative(symbol!(q[i].as_str())) + force).expand();
+                form.averaged_momentum_rates.push(rec.record(
+                    format!("averaged_momentum_rates[{i}]"),
+                    format!(
+                        "d{}/dt of the averaged system without −∂V_vibr/∂{}: ∂L̄₀/∂{} + P̄, L̄₀ = ½ q'ᵀAq' + b̄ᵀq' − V̄, at q' = A⁻¹(p − b̄)",
+                        p[i], q[i], q[i]
+                    ),
+                    &rate_i,
+                )?);
+            }
+            mean_potential
+        }
+        None => potential.clone(),
+    };
+    (
+        derivation.potential,
+        derivation.potential_gradient,
+        derivation.potential_hessian,
+    ) = potential_derivatives(model, &mut rec, &mean_potential)?;
+    derivation.numeric = Some(form);
     derivation.derived = rec.finish();
     Ok(derivation)
 }

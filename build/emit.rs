@@ -25,6 +25,40 @@ pub enum Node {
     Sqrt(usize),
     Powf(usize, usize),
     Call(&'static str, usize),
+    /// Row `row` of column `column` of the solution X of A X = R, for the
+    /// linear system `Emitter::solves[solve]` (A symmetric positive
+    /// definite, factorised once per evaluation).
+    Solution {
+        solve: usize,
+        row: usize,
+        column: usize,
+    },
+}
+
+/// A linear system A X = R of the DAG: the matrix entries and the columns of
+/// R are nodes; `names` are the stage outputs that receive X, if any.
+#[derive(Clone, Debug)]
+pub struct Solve {
+    pub matrix: Vec<Vec<usize>>,
+    pub columns: Vec<Vec<usize>>,
+    pub names: Option<Vec<Vec<String>>>,
+}
+
+/// One step of a generated function's evaluation.
+#[derive(Clone, Debug)]
+pub enum Step {
+    /// Named expressions (of the inputs and earlier outputs).
+    Values(Vec<(String, String)>),
+    /// A X = R solved numerically (A symmetric positive definite): the
+    /// entries are expressions, X's columns become the outputs `names`.
+    Solve {
+        matrix: Vec<Vec<String>>,
+        columns: Vec<Vec<String>>,
+        names: Vec<Vec<String>>,
+    },
+    /// Named derivatives of earlier outputs: (name, output, the variables
+    /// to differentiate by in turn), by forward mode through the DAG.
+    Derivatives(Vec<(String, String, Vec<String>)>),
 }
 
 /// Builds the DAG of one function body.
@@ -43,6 +77,17 @@ pub struct Emitter {
     /// products of each angle's sin and cos: cheaper for Taylor
     /// recurrences, where a product costs as much as a sin/cos pair.
     pub whole_angles: bool,
+    /// Linear systems solved numerically (see [`Node::Solution`]).
+    solves: Vec<Solve>,
+    /// Stage outputs by name, so that a later stage's use of the name can be
+    /// differentiated through its definition.
+    outputs: HashMap<String, usize>,
+    /// Forward-mode derivatives already built: (node, variable) → node.
+    derivatives: HashMap<(usize, String), Option<usize>>,
+    /// Derivative solves already built: (solve, variable) → solve.
+    solve_derivatives: HashMap<(usize, String), Option<usize>>,
+    /// Factorised matrices already bound, by their entries.
+    factors: HashMap<Vec<Vec<usize>>, String>,
 }
 
 fn literal(value: f64) -> String {
@@ -220,8 +265,17 @@ impl Emitter {
         )
     }
 
-    fn children(node: &Node) -> Vec<usize> {
+    fn children(&self, node: &Node) -> Vec<usize> {
         match node {
+            Node::Solution { solve, .. } => {
+                let s = &self.solves[*solve];
+                s.matrix
+                    .iter()
+                    .chain(&s.columns)
+                    .flatten()
+                    .copied()
+                    .collect()
+            }
             Node::Lit(_) | Node::Var(_) => vec![],
             Node::Neg(a) | Node::Powi(a, _) | Node::Sqrt(a) | Node::Call(_, a) => vec![*a],
             Node::Add(a, b)
@@ -303,6 +357,7 @@ impl Emitter {
             Node::Sqrt(a) => format!("{}.sqrt()", atom(*a)),
             Node::Powf(a, b) => format!("{}.powf({})", atom(*a), t(*b)),
             Node::Call(f, a) => format!("{}.{f}()", atom(*a)),
+            Node::Solution { .. } => unreachable!("solutions are bound before use"),
         }
     }
 
@@ -327,8 +382,278 @@ impl Emitter {
             let e = Expr::parse(text).map_err(|err| format!("cannot read '{text}': {err}"))?;
             stage.push((name.clone(), self.build(&e)?));
         }
-        self.stages.push(stage);
+        self.stage_nodes(stage);
         Ok(())
+    }
+
+    /// Adds one step.
+    pub fn apply(&mut self, step: &Step) -> Result<(), String> {
+        match step {
+            Step::Values(outputs) => self.stage(outputs),
+            Step::Solve {
+                matrix,
+                columns,
+                names,
+            } => self.solve_stage(matrix, columns, names),
+            Step::Derivatives(list) => {
+                let mut stage = Vec::new();
+                for (name, output, variables) in list {
+                    let mut node = Some(
+                        self.output(output)
+                            .ok_or_else(|| format!("no output '{output}' to differentiate"))?,
+                    );
+                    for v in variables {
+                        node = node.and_then(|k| self.derivative(k, v));
+                    }
+                    let node = node.unwrap_or_else(|| self.zero());
+                    stage.push((name.clone(), node));
+                }
+                self.stage_nodes(stage);
+                Ok(())
+            }
+        }
+    }
+
+    /// Adds a stage of outputs that are already nodes of the DAG.
+    pub fn stage_nodes(&mut self, outputs: Vec<(String, usize)>) {
+        for (name, root) in &outputs {
+            self.outputs.insert(name.clone(), *root);
+        }
+        self.stages.push(outputs);
+    }
+
+    /// The node of an expression over earlier outputs and variables.
+    pub fn node(&mut self, text: &str) -> Result<usize, String> {
+        let e = Expr::parse(text).map_err(|err| format!("cannot read '{text}': {err}"))?;
+        self.build(&e)
+    }
+
+    /// Adds a stage solving A X = R numerically: `matrix` and the columns
+    /// of R are expressions (usually names of earlier outputs); the columns
+    /// of X become the outputs `names`.
+    pub fn solve_stage(
+        &mut self,
+        matrix: &[Vec<String>],
+        columns: &[Vec<String>],
+        names: &[Vec<String>],
+    ) -> Result<(), String> {
+        let matrix = matrix
+            .iter()
+            .map(|row| row.iter().map(|t| self.node(t)).collect())
+            .collect::<Result<Vec<Vec<usize>>, String>>()?;
+        let columns = columns
+            .iter()
+            .map(|col| col.iter().map(|t| self.node(t)).collect())
+            .collect::<Result<Vec<Vec<usize>>, String>>()?;
+        let solve = self.add_solve(matrix, columns, Some(names.to_vec()));
+        let mut stage = Vec::new();
+        for (column, col_names) in names.iter().enumerate() {
+            for (row, name) in col_names.iter().enumerate() {
+                let node = self.intern(Node::Solution { solve, row, column });
+                stage.push((name.clone(), node));
+            }
+        }
+        self.stage_nodes(stage);
+        Ok(())
+    }
+
+    fn add_solve(
+        &mut self,
+        matrix: Vec<Vec<usize>>,
+        columns: Vec<Vec<usize>>,
+        names: Option<Vec<Vec<String>>>,
+    ) -> usize {
+        self.solves.push(Solve {
+            matrix,
+            columns,
+            names,
+        });
+        self.solves.len() - 1
+    }
+
+    /// The root node of an earlier output.
+    pub fn output(&self, name: &str) -> Option<usize> {
+        self.outputs.get(name).copied()
+    }
+
+    fn zero(&mut self) -> usize {
+        self.intern(Node::Lit("0.0".into()))
+    }
+
+    fn lit(&mut self, value: f64) -> usize {
+        self.intern(Node::Lit(literal(value)))
+    }
+
+    /// The forward-mode derivative of node `i` with respect to the variable
+    /// `var` (a coordinate or momentum), through earlier outputs used by
+    /// name and through linear solves: δX = A⁻¹(δR − δA·X). `None` where it
+    /// vanishes.
+    pub fn derivative(&mut self, i: usize, var: &str) -> Option<usize> {
+        let key = (i, var.to_string());
+        if let Some(&d) = self.derivatives.get(&key) {
+            return d;
+        }
+        let d = match self.nodes[i].clone() {
+            Node::Lit(_) => None,
+            Node::Var(v) if v == var => Some(self.lit(1.0)),
+            Node::Var(v) => match self.outputs.get(&v).copied() {
+                Some(root) if root != i => self.derivative(root, var),
+                _ => None,
+            },
+            Node::Neg(a) => self.derivative(a, var).map(|x| self.intern(Node::Neg(x))),
+            Node::Add(a, b) | Node::Sub(a, b) => {
+                let subtract = matches!(self.nodes[i], Node::Sub(..));
+                let (da, db) = (self.derivative(a, var), self.derivative(b, var));
+                match (da, db) {
+                    (Some(x), Some(y)) => Some(self.intern(if subtract {
+                        Node::Sub(x, y)
+                    } else {
+                        Node::Add(x, y)
+                    })),
+                    (Some(x), None) => Some(x),
+                    (None, Some(y)) if subtract => Some(self.intern(Node::Neg(y))),
+                    (None, y) => y,
+                }
+            }
+            Node::Mul(a, b) => {
+                let da = self
+                    .derivative(a, var)
+                    .map(|x| self.intern(Node::Mul(x, b)));
+                let db = self
+                    .derivative(b, var)
+                    .map(|y| self.intern(Node::Mul(a, y)));
+                self.add_options(da, db)
+            }
+            Node::Div(a, b) => {
+                // δ(a/b) = δa/b − (a/b)·δb/b.
+                let da = self
+                    .derivative(a, var)
+                    .map(|x| self.intern(Node::Div(x, b)));
+                let db = self.derivative(b, var).map(|y| {
+                    let q = self.intern(Node::Mul(i, y));
+                    let q = self.intern(Node::Div(q, b));
+                    self.intern(Node::Neg(q))
+                });
+                self.add_options(da, db)
+            }
+            Node::Powi(a, k) => self.derivative(a, var).map(|x| {
+                let slope = match k {
+                    1 => self.lit(1.0),
+                    2 => {
+                        let two = self.lit(2.0);
+                        self.intern(Node::Mul(two, a))
+                    }
+                    _ => {
+                        let kk = self.lit(f64::from(k));
+                        let p = self.intern(Node::Powi(a, k - 1));
+                        self.intern(Node::Mul(kk, p))
+                    }
+                };
+                self.intern(Node::Mul(slope, x))
+            }),
+            Node::Sqrt(a) | Node::Call("sqrt", a) => self.derivative(a, var).map(|x| {
+                let two = self.lit(2.0);
+                let twice = self.intern(Node::Mul(two, i));
+                self.intern(Node::Div(x, twice))
+            }),
+            Node::Powf(a, b) => {
+                // δ(a^b) = a^b (δb ln a + b δa / a).
+                let da = self.derivative(a, var).map(|x| {
+                    let r = self.intern(Node::Div(x, a));
+                    self.intern(Node::Mul(b, r))
+                });
+                let db = self.derivative(b, var).map(|y| {
+                    let ln = self.intern(Node::Call("ln", a));
+                    self.intern(Node::Mul(y, ln))
+                });
+                self.add_options(da, db)
+                    .map(|s| self.intern(Node::Mul(i, s)))
+            }
+            Node::Call(f, a) => self.derivative(a, var).map(|x| {
+                let slope = match f {
+                    "sin" => self.intern(Node::Call("cos", a)),
+                    "cos" => {
+                        let s = self.intern(Node::Call("sin", a));
+                        self.intern(Node::Neg(s))
+                    }
+                    "tan" => {
+                        let c = self.intern(Node::Call("cos", a));
+                        let c2 = self.intern(Node::Powi(c, 2));
+                        let one = self.lit(1.0);
+                        self.intern(Node::Div(one, c2))
+                    }
+                    "exp" => i,
+                    "ln" => {
+                        let one = self.lit(1.0);
+                        self.intern(Node::Div(one, a))
+                    }
+                    other => unreachable!("no derivative rule for '{other}'"),
+                };
+                self.intern(Node::Mul(slope, x))
+            }),
+            Node::Solution { solve, row, column } => self.solve_derivative(solve, var).map(|s| {
+                self.intern(Node::Solution {
+                    solve: s,
+                    row,
+                    column,
+                })
+            }),
+        };
+        self.derivatives.insert(key, d);
+        d
+    }
+
+    fn add_options(&mut self, a: Option<usize>, b: Option<usize>) -> Option<usize> {
+        match (a, b) {
+            (Some(x), Some(y)) => Some(self.intern(Node::Add(x, y))),
+            (x, None) => x,
+            (None, y) => y,
+        }
+    }
+
+    /// The linear system of the derivative of a solve's solution: same
+    /// matrix, right-hand sides δR − δA·X.
+    fn solve_derivative(&mut self, solve: usize, var: &str) -> Option<usize> {
+        let key = (solve, var.to_string());
+        if let Some(&s) = self.solve_derivatives.get(&key) {
+            return s;
+        }
+        let Solve {
+            matrix, columns, ..
+        } = self.solves[solve].clone();
+        let n = matrix.len();
+        let d_matrix: Vec<Vec<Option<usize>>> = matrix
+            .iter()
+            .map(|row| row.iter().map(|&a| self.derivative(a, var)).collect())
+            .collect();
+        let mut new_columns = Vec::new();
+        let mut any = false;
+        for (c, column) in columns.iter().enumerate() {
+            let mut new_column = Vec::new();
+            for r in 0..n {
+                let mut acc = self.derivative(column[r], var);
+                for (j, da) in d_matrix[r].iter().enumerate() {
+                    if let Some(da) = *da {
+                        let x = self.intern(Node::Solution {
+                            solve,
+                            row: j,
+                            column: c,
+                        });
+                        let product = self.intern(Node::Mul(da, x));
+                        acc = Some(match acc {
+                            Some(a) => self.intern(Node::Sub(a, product)),
+                            None => self.intern(Node::Neg(product)),
+                        });
+                    }
+                }
+                any |= acc.is_some();
+                new_column.push(acc.unwrap_or_else(|| self.zero()));
+            }
+            new_columns.push(new_column);
+        }
+        let s = any.then(|| self.add_solve(matrix, new_columns, None));
+        self.solve_derivatives.insert(key, s);
+        s
     }
 
     /// Emits every stage: shared nodes (counted over all stages) become `let`
@@ -345,7 +670,7 @@ impl Emitter {
                 continue;
             }
             seen[i] = true;
-            for c in Self::children(&self.nodes[i]) {
+            for c in self.children(&self.nodes[i]) {
                 uses[c] += 1;
                 stack.push(c);
             }
@@ -359,11 +684,18 @@ impl Emitter {
                     continue;
                 }
                 reachable[i] = true;
-                stack.extend(Self::children(&self.nodes[i]));
+                stack.extend(self.children(&self.nodes[i]));
             }
             let roots: Vec<usize> = stage.iter().map(|(_, r)| *r).collect();
             for i in 0..self.nodes.len() {
-                if !reachable[i] || self.bound.contains_key(&i) || roots.contains(&i) {
+                if !reachable[i] || self.bound.contains_key(&i) {
+                    continue;
+                }
+                if let Node::Solution { solve, .. } = self.nodes[i] {
+                    self.bind_solve(solve);
+                    continue;
+                }
+                if roots.contains(&i) {
                     continue;
                 }
                 let trivial = matches!(
@@ -375,12 +707,74 @@ impl Emitter {
                 }
             }
             for (name, root) in stage {
+                if self.bound.get(root) == Some(name) {
+                    continue;
+                }
                 let value = self.text(*root);
                 self.lines.push(format!("let {name} = {value};"));
                 self.bound.insert(*root, name.clone());
             }
         }
         self.lines
+    }
+
+    /// Binds every solution of a linear system: the matrix is factorised
+    /// once (shared by every system with the same matrix), then each column
+    /// is solved into its output names or fresh ones.
+    fn bind_solve(&mut self, solve: usize) {
+        let Solve {
+            matrix,
+            columns,
+            names,
+        } = self.solves[solve].clone();
+        let factor = match self.factors.get(&matrix) {
+            Some(f) => f.clone(),
+            None => {
+                let name = if self.factors.is_empty() {
+                    "factor".to_string()
+                } else {
+                    format!("factor{}", self.factors.len() + 1)
+                };
+                let rows: Vec<String> = matrix
+                    .iter()
+                    .map(|row| {
+                        let cells: Vec<String> = row.iter().map(|&a| self.text(a)).collect();
+                        format!("[{}]", cells.join(", "))
+                    })
+                    .collect();
+                self.lines.push(format!(
+                    "let {name} = crate::linalg::Cholesky::new([{}]);",
+                    rows.join(", ")
+                ));
+                self.factors.insert(matrix.clone(), name.clone());
+                name
+            }
+        };
+        for (c, column) in columns.iter().enumerate() {
+            let outputs: Vec<String> = match &names {
+                Some(names) => names[c].clone(),
+                None => (0..column.len())
+                    .map(|_| {
+                        self.counter += 1;
+                        format!("cse_x{}", self.counter)
+                    })
+                    .collect(),
+            };
+            let rhs: Vec<String> = column.iter().map(|&r| self.text(r)).collect();
+            self.lines.push(format!(
+                "let [{}] = {factor}.solve([{}]);",
+                outputs.join(", "),
+                rhs.join(", ")
+            ));
+            for (row, name) in outputs.into_iter().enumerate() {
+                let node = self.intern(Node::Solution {
+                    solve,
+                    row,
+                    column: c,
+                });
+                self.bound.insert(node, name);
+            }
+        }
     }
 
     /// Binds node `i` to a new name; sin and cos of one argument share `sin_cos`.
@@ -422,6 +816,7 @@ impl Emitter {
 pub struct Dag {
     pub nodes: Vec<Node>,
     pub stages: Vec<Vec<(String, usize)>>,
+    pub solves: Vec<Solve>,
 }
 
 impl Emitter {
@@ -430,6 +825,7 @@ impl Emitter {
         Dag {
             nodes: self.nodes,
             stages: self.stages,
+            solves: self.solves,
         }
     }
 }
@@ -439,9 +835,15 @@ impl Emitter {
 /// which a readable form and a derived form of the same right-hand side are
 /// compared.
 pub fn operation_count(stages: &[Vec<(String, String)>]) -> Result<usize, String> {
+    let steps: Vec<Step> = stages.iter().cloned().map(Step::Values).collect();
+    step_operation_count(&steps)
+}
+
+/// [`operation_count`] of a function given as steps.
+pub fn step_operation_count(steps: &[Step]) -> Result<usize, String> {
     let mut emitter = Emitter::default();
-    for stage in stages {
-        emitter.stage(stage)?;
+    for step in steps {
+        emitter.apply(step)?;
     }
     Ok(emitter
         .nodes
@@ -456,6 +858,8 @@ pub fn operation_count(stages: &[Vec<(String, String)>]) -> Result<usize, String
             // folded into the neighbouring addition.
             Node::Div(..) => 4,
             Node::Neg(_) => 0,
+            // Forward and back substitution (the factorisation is shared).
+            Node::Solution { solve, .. } => 2 * emitter.solves[*solve].matrix.len(),
             // x^k by repeated squaring.
             Node::Powi(_, k) => {
                 let k = k.unsigned_abs();

@@ -3,25 +3,27 @@
 
 use crate::contacts::ContactDerivation;
 use crate::derive::{momentum_name, Derivation, Derived};
-use crate::emit::Emitter;
+use crate::emit::{Emitter, Step};
 use crate::model::Model;
 use crate::taylor::{recurrences, Signature};
 use serde::Serialize;
 
 /// A generated Taylor-coefficient function (layout in `templates/taylor.rs.tera`).
 #[derive(Serialize)]
-struct TaylorFunction {
+pub struct TaylorFunction {
     name: String,
     doc: String,
-    /// State length.
+    /// State length (of the solution, without tangents).
     dim: usize,
+    /// Whether it takes tangent columns (`z: &[f64]`, flat `out`).
+    variational: bool,
     /// `let &Params { .. } = params;`
     params: String,
     body: Vec<String>,
 }
 
 #[derive(Serialize)]
-struct Function {
+pub struct Function {
     name: String,
     doc: String,
     args: String,
@@ -48,7 +50,7 @@ struct DerivedEntry {
 
 /// What a function reads from its arguments.
 #[derive(Clone, Copy)]
-enum Inputs {
+pub enum Inputs {
     /// Parameters only.
     Params,
     /// Coordinates only (`q: &[f64; N]`).
@@ -63,8 +65,8 @@ enum Inputs {
     ContactState,
 }
 
-struct Context<'a> {
-    model: &'a Model,
+pub struct Context<'a> {
+    pub model: &'a Model,
     /// Degrees of freedom (contacts, for a contact model).
     n: usize,
     /// For a contact model: the sliding coordinates and their velocities.
@@ -74,24 +76,24 @@ struct Context<'a> {
 }
 
 impl Context<'_> {
-    fn n(&self) -> usize {
+    pub fn n(&self) -> usize {
         self.n
     }
-    fn coordinates(&self) -> Vec<String> {
+    pub fn coordinates(&self) -> Vec<String> {
         self.model
             .coordinates
             .iter()
             .map(|c| c.name.clone())
             .collect()
     }
-    fn velocities(&self) -> Vec<String> {
+    pub fn velocities(&self) -> Vec<String> {
         self.model
             .coordinates
             .iter()
             .map(|c| c.velocity.clone())
             .collect()
     }
-    fn momenta(&self) -> Vec<String> {
+    pub fn momenta(&self) -> Vec<String> {
         self.coordinates()
             .iter()
             .map(|c| momentum_name(c))
@@ -153,10 +155,24 @@ impl Context<'_> {
         stages: &[Vec<(String, String)>],
         result: String,
     ) -> Result<Function, String> {
+        let steps: Vec<Step> = stages.iter().cloned().map(Step::Values).collect();
+        self.function_steps(name, doc, inputs, ret, &steps, result)
+    }
+
+    /// A function evaluating `steps`, returning `result`.
+    pub fn function_steps(
+        &self,
+        name: &str,
+        doc: &str,
+        inputs: Inputs,
+        ret: String,
+        steps: &[Step],
+        result: String,
+    ) -> Result<Function, String> {
         let (args, mut body) = self.signature_and_prelude(inputs);
         let mut emitter = Emitter::default();
-        for stage in stages {
-            emitter.stage(stage).map_err(|e| format!("{name}: {e}"))?;
+        for step in steps {
+            emitter.apply(step).map_err(|e| format!("{name}: {e}"))?;
         }
         body.extend(emitter.finish());
         Ok(Function {
@@ -171,13 +187,12 @@ impl Context<'_> {
 }
 
 impl Context<'_> {
-    /// Taylor-coefficient recurrences of x' = f, with f the outputs named
-    /// `outputs` of `stages` and x the variables `state`.
-    fn taylor(
+    /// Taylor-coefficient recurrences of x' = f, f given as steps.
+    pub fn taylor_steps(
         &self,
         name: &str,
         doc: &str,
-        stages: &[Vec<(String, String)>],
+        steps: &[Step],
         outputs: &[String],
         state: Vec<String>,
     ) -> Result<TaylorFunction, String> {
@@ -191,8 +206,8 @@ impl Context<'_> {
             }
             None => None,
         };
-        for stage in stages {
-            emitter.stage(stage).map_err(|e| format!("{name}: {e}"))?;
+        for step in steps {
+            emitter.apply(step).map_err(|e| format!("{name}: {e}"))?;
         }
         let signature = Signature {
             state,
@@ -211,14 +226,15 @@ impl Context<'_> {
         Ok(TaylorFunction {
             name: name.into(),
             doc: doc.into(),
-            dim: signature.state.len(),
+            dim: outputs.len(),
+            variational: signature.state.len() > outputs.len(),
             params: prelude[0].clone(),
             body: body.lines,
         })
     }
 }
 
-fn named(prefix: &str, values: &[String]) -> Vec<(String, String)> {
+pub fn named(prefix: &str, values: &[String]) -> Vec<(String, String)> {
     values
         .iter()
         .enumerate()
@@ -226,7 +242,7 @@ fn named(prefix: &str, values: &[String]) -> Vec<(String, String)> {
         .collect()
 }
 
-fn matrix(prefix: &str, m: &[Vec<String>]) -> (Vec<(String, String)>, String) {
+pub fn matrix(prefix: &str, m: &[Vec<String>]) -> (Vec<(String, String)>, String) {
     let mut outputs = Vec::new();
     let mut rows = Vec::new();
     for (i, row) in m.iter().enumerate() {
@@ -241,7 +257,7 @@ fn matrix(prefix: &str, m: &[Vec<String>]) -> (Vec<(String, String)>, String) {
     (outputs, format!("[{}]", rows.join(", ")))
 }
 
-fn vector(prefix: &str, values: &[String]) -> (Vec<(String, String)>, String) {
+pub fn vector(prefix: &str, values: &[String]) -> (Vec<(String, String)>, String) {
     let outputs = named(prefix, values);
     let names: Vec<String> = outputs.iter().map(|(n, _)| n.clone()).collect();
     (outputs, format!("[{}]", names.join(", ")))
@@ -262,162 +278,10 @@ pub fn render(
     };
     let n = cx.n();
     let m = 2 * n;
-    let velocity_stage: Vec<(String, String)> = cx
-        .velocities()
-        .into_iter()
-        .zip(derivation.velocities.iter().cloned())
-        .collect();
-    let mut functions = Vec::new();
-
-    if model.fast_phase.is_some() {
-        functions.push(cx.function(
-            "phase_rate",
-            "dθ/dt of the fast phase θ.",
-            Inputs::Params,
-            "f64".into(),
-            &[vec![("rate".into(), derivation.phase_rate.clone())]],
-            "rate".into(),
-        )?);
-    }
-    let (outs, result) = vector("v", &derivation.velocities);
-    functions.push(cx.function(
-        "velocities",
-        "Velocities q' = A⁻¹(p − b) at state y = [q, p].",
-        Inputs::State,
-        format!("[f64; {n}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = vector("p", &derivation.momenta);
-    functions.push(cx.function(
-        "momenta",
-        "Momenta p = A q' + b from coordinates and velocities.",
-        Inputs::CoordinatesVelocities,
-        format!("[f64; {n}]"),
-        &[outs],
-        result,
-    )?);
-    let (exact_stages, rhs_names) = exact_field(&cx, derivation, &velocity_stage);
-    functions.push(cx.function(
-        "exact_rhs",
-        "Hamilton's equations with forces: [q', p'] with q' = A⁻¹(p − b), p' = ∂L/∂q + Q.",
-        Inputs::State,
-        format!("[f64; {m}]"),
-        &exact_stages,
-        format!("[{}]", rhs_names.join(", ")),
-    )?);
-    let (outs, result) = matrix("j", &derivation.exact_jacobian);
-    functions.push(cx.function(
-        "exact_jacobian",
-        "Jacobian ∂(q', p')/∂(q, p) of the exact field.",
-        Inputs::State,
-        format!("[[f64; {m}]; {m}]"),
-        &[velocity_stage.clone(), outs],
-        result,
-    )?);
-    functions.push(cx.function(
-        "hamiltonian",
-        "Hamiltonian H(q, p, t).",
-        Inputs::State,
-        "f64".into(),
-        &[vec![("h".into(), derivation.hamiltonian.clone())]],
-        "h".into(),
-    )?);
-    let (outs, result) = matrix("a", &derivation.mass_matrix);
-    functions.push(cx.function(
-        "mass_matrix",
-        "Mass matrix A(q) = ∂²L/∂q'².",
-        Inputs::Coordinates,
-        format!("[[f64; {n}]; {n}]"),
-        &[outs],
-        result,
-    )?);
-    functions.push(cx.function(
-        "potential",
-        "Potential energy V(q) (averaged over the phase).",
-        Inputs::Coordinates,
-        "f64".into(),
-        &[vec![("v".into(), derivation.potential.clone())]],
-        "v".into(),
-    )?);
-    let (outs, result) = vector("g", &derivation.potential_gradient);
-    functions.push(cx.function(
-        "potential_gradient",
-        "∂V/∂q.",
-        Inputs::Coordinates,
-        format!("[f64; {n}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = matrix("c", &derivation.potential_hessian);
-    functions.push(cx.function(
-        "potential_hessian",
-        "C = ∂²V/∂q².",
-        Inputs::Coordinates,
-        format!("[[f64; {n}]; {n}]"),
-        &[outs],
-        result,
-    )?);
-
-    if model.fast_phase.is_some() {
-        functions.push(cx.function(
-            "vibrational_potential",
-            "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b).",
-            Inputs::Coordinates,
-            "f64".into(),
-            &[vec![("w".into(), derivation.vibrational_potential.clone())]],
-            "w".into(),
-        )?);
-        let effective = format!(
-            "({}) + ({})",
-            derivation.potential, derivation.vibrational_potential
-        );
-        functions.push(cx.function(
-            "effective_potential",
-            "Effective potential V + V_vibr of the averaged system.",
-            Inputs::Coordinates,
-            "f64".into(),
-            &[vec![("v".into(), effective)]],
-            "v".into(),
-        )?);
-        let (outs, result) = matrix("b", &derivation.effective_potential_hessian);
-        functions.push(cx.function(
-            "effective_potential_hessian",
-            "∂²(V + V_vibr)/∂q².",
-            Inputs::Coordinates,
-            format!("[[f64; {n}]; {n}]"),
-            &[outs],
-            result,
-        )?);
-        let (outs, result) = vector("f", &derivation.averaged_rhs);
-        functions.push(cx.function(
-            "averaged_rhs",
-            "Averaged equations: q' = ∂H̄/∂p, p' = −∂H̄/∂q + P̄.",
-            Inputs::AveragedState,
-            format!("[f64; {m}]"),
-            &[outs],
-            result,
-        )?);
-        let (outs, result) = matrix("j", &derivation.averaged_jacobian);
-        functions.push(cx.function(
-            "averaged_jacobian",
-            "Jacobian of the averaged field.",
-            Inputs::AveragedState,
-            format!("[[f64; {m}]; {m}]"),
-            &[outs],
-            result,
-        )?);
-        functions.push(cx.function(
-            "averaged_hamiltonian",
-            "Averaged Hamiltonian H̄(q, p).",
-            Inputs::AveragedState,
-            "f64".into(),
-            &[vec![("h".into(), derivation.averaged_hamiltonian.clone())]],
-            "h".into(),
-        )?);
-    }
-
-    let taylor_functions = taylor_functions(&cx, derivation, &velocity_stage)?;
+    let (functions, taylor_functions) = match &derivation.numeric {
+        Some(form) => crate::numeric::functions(&cx, derivation, form)?,
+        None => symbolic_functions(&cx, derivation)?,
+    };
 
     // Functions of q alone must not depend on anything else.
     let forbidden: Vec<String> = cx
@@ -479,6 +343,180 @@ pub fn render(
         .map_err(|e| format!("template model.rs.tera: {e:?}"))
 }
 
+/// The functions both forms have as closed forms: the phase rate, momenta,
+/// mass matrix, potential and its derivatives.
+pub fn common_functions(cx: &Context, derivation: &Derivation) -> Result<Vec<Function>, String> {
+    let n = cx.n();
+    let mut functions = Vec::new();
+    if cx.model.fast_phase.is_some() {
+        functions.push(cx.function(
+            "phase_rate",
+            "dθ/dt of the fast phase θ.",
+            Inputs::Params,
+            "f64".into(),
+            &[vec![("rate".into(), derivation.phase_rate.clone())]],
+            "rate".into(),
+        )?);
+    }
+    let (outs, result) = vector("p", &derivation.momenta);
+    functions.push(cx.function(
+        "momenta",
+        "Momenta p = A q' + b from coordinates and velocities.",
+        Inputs::CoordinatesVelocities,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = matrix("a", &derivation.mass_matrix);
+    functions.push(cx.function(
+        "mass_matrix",
+        "Mass matrix A(q) = ∂²L/∂q'².",
+        Inputs::Coordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &[outs],
+        result,
+    )?);
+    functions.push(cx.function(
+        "potential",
+        "Potential energy V(q) (averaged over the phase).",
+        Inputs::Coordinates,
+        "f64".into(),
+        &[vec![("v".into(), derivation.potential.clone())]],
+        "v".into(),
+    )?);
+    let (outs, result) = vector("g", &derivation.potential_gradient);
+    functions.push(cx.function(
+        "potential_gradient",
+        "∂V/∂q.",
+        Inputs::Coordinates,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = matrix("c", &derivation.potential_hessian);
+    functions.push(cx.function(
+        "potential_hessian",
+        "C = ∂²V/∂q².",
+        Inputs::Coordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &[outs],
+        result,
+    )?);
+    Ok(functions)
+}
+
+/// The functions of the symbolic-inverse form: every quantity a closed form.
+fn symbolic_functions(
+    cx: &Context,
+    derivation: &Derivation,
+) -> Result<(Vec<Function>, Vec<TaylorFunction>), String> {
+    let n = cx.n();
+    let m = 2 * n;
+    let model = cx.model;
+    let velocity_stage: Vec<(String, String)> = cx
+        .velocities()
+        .into_iter()
+        .zip(derivation.velocities.iter().cloned())
+        .collect();
+    let mut functions = common_functions(cx, derivation)?;
+    let (outs, result) = vector("v", &derivation.velocities);
+    functions.push(cx.function(
+        "velocities",
+        "Velocities q' = A⁻¹(p − b) at state y = [q, p].",
+        Inputs::State,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (exact_stages, rhs_names) = exact_field(cx, derivation, &velocity_stage);
+    functions.push(cx.function(
+        "exact_rhs",
+        "Hamilton's equations with forces: [q', p'] with q' = A⁻¹(p − b), p' = ∂L/∂q + Q.",
+        Inputs::State,
+        format!("[f64; {m}]"),
+        &exact_stages,
+        format!("[{}]", rhs_names.join(", ")),
+    )?);
+    let (outs, result) = matrix("j", &derivation.exact_jacobian);
+    functions.push(cx.function(
+        "exact_jacobian",
+        "Jacobian ∂(q', p')/∂(q, p) of the exact field.",
+        Inputs::State,
+        format!("[[f64; {m}]; {m}]"),
+        &[velocity_stage.clone(), outs],
+        result,
+    )?);
+    functions.push(cx.function(
+        "hamiltonian",
+        "Hamiltonian H(q, p, t).",
+        Inputs::State,
+        "f64".into(),
+        &[vec![("h".into(), derivation.hamiltonian.clone())]],
+        "h".into(),
+    )?);
+
+    if model.fast_phase.is_some() {
+        functions.push(cx.function(
+            "vibrational_potential",
+            "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b).",
+            Inputs::Coordinates,
+            "f64".into(),
+            &[vec![("w".into(), derivation.vibrational_potential.clone())]],
+            "w".into(),
+        )?);
+        let effective = format!(
+            "({}) + ({})",
+            derivation.potential, derivation.vibrational_potential
+        );
+        functions.push(cx.function(
+            "effective_potential",
+            "Effective potential V + V_vibr of the averaged system.",
+            Inputs::Coordinates,
+            "f64".into(),
+            &[vec![("v".into(), effective)]],
+            "v".into(),
+        )?);
+        let (outs, result) = matrix("b", &derivation.effective_potential_hessian);
+        functions.push(cx.function(
+            "effective_potential_hessian",
+            "∂²(V + V_vibr)/∂q².",
+            Inputs::Coordinates,
+            format!("[[f64; {n}]; {n}]"),
+            &[outs],
+            result,
+        )?);
+        let (outs, result) = vector("f", &derivation.averaged_rhs);
+        functions.push(cx.function(
+            "averaged_rhs",
+            "Averaged equations: q' = ∂H̄/∂p, p' = −∂H̄/∂q + P̄.",
+            Inputs::AveragedState,
+            format!("[f64; {m}]"),
+            &[outs],
+            result,
+        )?);
+        let (outs, result) = matrix("j", &derivation.averaged_jacobian);
+        functions.push(cx.function(
+            "averaged_jacobian",
+            "Jacobian of the averaged field.",
+            Inputs::AveragedState,
+            format!("[[f64; {m}]; {m}]"),
+            &[outs],
+            result,
+        )?);
+        functions.push(cx.function(
+            "averaged_hamiltonian",
+            "Averaged Hamiltonian H̄(q, p).",
+            Inputs::AveragedState,
+            "f64".into(),
+            &[vec![("h".into(), derivation.averaged_hamiltonian.clone())]],
+            "h".into(),
+        )?);
+    }
+
+    let taylor_functions = taylor_functions(cx, derivation, &velocity_stage)?;
+    Ok((functions, taylor_functions))
+}
+
 /// The exact field as stages (velocities, then momentum rates) and the names
 /// of its outputs [q', p'].
 fn exact_field(
@@ -493,52 +531,63 @@ fn exact_field(
 }
 
 /// The Taylor-coefficient functions of a model: the exact field, the
-/// averaged one, and the exact field with one tangent vector (FLI) or a full
-/// set (monodromy, Lyapunov spectrum), the tangent rates as forward-mode
-/// derivatives of the field's nodes.
+/// averaged one, and the exact field with tangent vectors (FLI, monodromy,
+/// Lyapunov spectrum), the tangent rates as forward-mode derivatives of the
+/// field's nodes.
 fn taylor_functions(
     cx: &Context,
     derivation: &Derivation,
     velocity_stage: &[(String, String)],
 ) -> Result<Vec<TaylorFunction>, String> {
-    let m = 2 * cx.n();
-    let mut state = cx.coordinates();
-    state.extend(cx.momenta());
     let (exact_stages, rhs_names) = exact_field(cx, derivation, velocity_stage);
-    let mut functions = vec![cx.taylor(
-        "exact_taylor",
-        "Normalised Taylor coefficients out[k] = y^(k)(t)/k!, k = 0..=order, of the exact solution through (t, y).",
-        &exact_stages,
-        &rhs_names,
-        state.clone(),
-    )?];
-    if cx.model.fast_phase.is_some() {
+    let exact: Vec<Step> = exact_stages.into_iter().map(Step::Values).collect();
+    let averaged = cx.model.fast_phase.as_ref().map(|_| {
         let (outs, _) = vector("f", &derivation.averaged_rhs);
         let names: Vec<String> = outs.iter().map(|(n, _)| n.clone()).collect();
-        functions.push(cx.taylor(
+        (vec![Step::Values(outs)], names)
+    });
+    taylor_set(
+        cx,
+        (&exact, &rhs_names),
+        averaged.as_ref().map(|(s, n)| (&s[..], &n[..])),
+    )
+}
+
+/// The Taylor functions from the steps and outputs of the exact and (with a
+/// fast phase) averaged fields: the solutions and the exact variational
+/// equations.
+pub fn taylor_set(
+    cx: &Context,
+    exact: (&[Step], &[String]),
+    averaged: Option<(&[Step], &[String])>,
+) -> Result<Vec<TaylorFunction>, String> {
+    let mut state = cx.coordinates();
+    state.extend(cx.momenta());
+    let mut functions = vec![cx.taylor_steps(
+        "exact_taylor",
+        "Normalised Taylor coefficients out[k] = y^(k)(t)/k!, k = 0..=order, of the exact solution through (t, y).",
+        exact.0,
+        exact.1,
+        state.clone(),
+    )?];
+    if let Some((steps, names)) = averaged {
+        functions.push(cx.taylor_steps(
             "averaged_taylor",
             "Normalised Taylor coefficients of the averaged solution through y.",
-            &[outs],
-            &names,
+            steps,
+            names,
             state.clone(),
         )?);
     }
-    for (tangents, name, doc) in [
-        (1, "exact_tangent_taylor", "Taylor coefficients of the exact solution and one tangent vector v' = J v: state [y; v]."),
-        (m, "exact_monodromy_taylor", "Taylor coefficients of the exact solution and a full set of tangent vectors V' = J V: state [y; V] (V column-major)."),
-    ] {
-        let mut full_state = state.clone();
-        for k in 0..tangents {
-            full_state.extend(state.iter().map(|s| format!("tangent{k}_{s}")));
-        }
-        functions.push(cx.taylor(
-            name,
-            doc,
-            &exact_stages,
-            &rhs_names,
-            full_state,
-        )?);
-    }
+    let mut with_tangent = state.clone();
+    with_tangent.extend(state.iter().map(|s| format!("tangent_{s}")));
+    functions.push(cx.taylor_steps(
+        "exact_variational_taylor",
+        "Taylor coefficients of the exact solution and its tangent vectors V' = J V: z = [y; V] with any number of columns (one for the FLI, a full set for the monodromy matrix), out flat with rows of z.len(). The tangent recurrences are the forward-mode derivatives of the field's nodes, run once per column.",
+        exact.0,
+        exact.1,
+        with_tangent,
+    )?);
     Ok(functions)
 }
 
@@ -650,7 +699,11 @@ pub fn render_contacts(
 }
 
 /// Renders the registry module listing every model.
-pub fn render_registry(tera: &tera::Tera, models: &[Model]) -> Result<String, String> {
+pub fn render_registry(
+    tera: &tera::Tera,
+    models: &[Model],
+    users_models: bool,
+) -> Result<String, String> {
     #[derive(Serialize)]
     struct Entry {
         name: String,
@@ -665,6 +718,7 @@ pub fn render_registry(tera: &tera::Tera, models: &[Model]) -> Result<String, St
         .collect();
     let mut context = tera::Context::new();
     context.insert("models", &entries);
+    context.insert("users_models", &users_models);
     tera.render("registry.rs.tera", &context)
         .map_err(|e| format!("template registry.rs.tera: {e:?}"))
 }

@@ -50,11 +50,36 @@ enum Op {
     Ln(usize),
     Sin(usize),
     Cos(usize),
+    /// Row `row` of column `column` of X in A X = R, for the system
+    /// `Lowering::solves[solve]`; its children are A's entries and R's.
+    Solution {
+        solve: usize,
+        row: usize,
+        column: usize,
+    },
+}
+
+/// A linear system A X = R over lowered nodes.
+#[derive(Clone, Debug)]
+struct Solve {
+    matrix: Vec<Vec<usize>>,
+    columns: Vec<Vec<usize>>,
+    /// Its solution nodes, column by column.
+    solutions: Vec<Vec<usize>>,
 }
 
 impl Op {
-    fn children(&self) -> Vec<usize> {
+    fn children(&self, solves: &[Solve]) -> Vec<usize> {
         match *self {
+            Op::Solution { solve, .. } => {
+                let s = &solves[solve];
+                s.matrix
+                    .iter()
+                    .chain(&s.columns)
+                    .flatten()
+                    .copied()
+                    .collect()
+            }
             Op::Literal(_) | Op::Parameter(_) | Op::State(_) | Op::Time => vec![],
             Op::Phase(a)
             | Op::Neg(a)
@@ -95,6 +120,11 @@ struct Lowering<'a> {
     classes: Vec<Class>,
     index: HashMap<Op, usize>,
     memo: HashMap<usize, usize>,
+    solves: Vec<Solve>,
+    /// Lowered systems by the emitter's solve index.
+    solve_memo: HashMap<usize, usize>,
+    /// Tangent systems by (solve, tangent).
+    tangent_solves: HashMap<(usize, usize), Option<usize>>,
 }
 
 impl Lowering<'_> {
@@ -123,6 +153,17 @@ impl Lowering<'_> {
             Op::Power(..) => Class::Series,
             Op::Square(a) | Op::Sqrt(a) | Op::Exp(a) | Op::Ln(a) | Op::Sin(a) | Op::Cos(a) => {
                 if class(a) == Class::Constant {
+                    Class::Constant
+                } else {
+                    Class::Series
+                }
+            }
+            Op::Solution { .. } => {
+                let constant = op
+                    .children(&self.solves)
+                    .iter()
+                    .all(|&c| class(c) == Class::Constant);
+                if constant {
                     Class::Constant
                 } else {
                     Class::Series
@@ -214,6 +255,35 @@ impl Lowering<'_> {
                     self.intern(Op::Exp(product))
                 }
             }
+            Node::Solution { solve, row, column } => {
+                let s = match self.solve_memo.get(&solve) {
+                    Some(&s) => s,
+                    None => {
+                        let source = &self.dag.solves[solve];
+                        let mut matrix = Vec::new();
+                        for row in source.matrix.clone() {
+                            matrix.push(
+                                row.iter()
+                                    .map(|&a| self.lower(a))
+                                    .collect::<Result<Vec<_>, _>>()?,
+                            );
+                        }
+                        let mut columns = Vec::new();
+                        for column in self.dag.solves[solve].columns.clone() {
+                            columns.push(
+                                column
+                                    .iter()
+                                    .map(|&r| self.lower(r))
+                                    .collect::<Result<Vec<_>, _>>()?,
+                            );
+                        }
+                        let s = self.add_solve(matrix, columns);
+                        self.solve_memo.insert(solve, s);
+                        s
+                    }
+                };
+                self.solves[s].solutions[column][row]
+            }
             Node::Call(f, a) => {
                 let a = self.lower(a)?;
                 match f {
@@ -232,6 +302,80 @@ impl Lowering<'_> {
         };
         self.memo.insert(i, k);
         Ok(k)
+    }
+
+    /// Adds a lowered system and interns its solution nodes together (so
+    /// that they are consecutive: one place computes them all).
+    fn add_solve(&mut self, matrix: Vec<Vec<usize>>, columns: Vec<Vec<usize>>) -> usize {
+        let s = self.solves.len();
+        let (rows, count) = (matrix.len(), columns.len());
+        self.solves.push(Solve {
+            matrix,
+            columns,
+            solutions: Vec::new(),
+        });
+        let solutions = (0..count)
+            .map(|column| {
+                (0..rows)
+                    .map(|row| {
+                        self.intern(Op::Solution {
+                            solve: s,
+                            row,
+                            column,
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        self.solves[s].solutions = solutions;
+        s
+    }
+
+    /// The tangent system of a solve: same matrix, right-hand sides
+    /// δR − δA·X (forward mode through A X = R).
+    fn solve_derivative(
+        &mut self,
+        solve: usize,
+        dim: usize,
+        t: usize,
+        memo: &mut HashMap<usize, Option<usize>>,
+    ) -> Option<usize> {
+        if let Some(&d) = self.tangent_solves.get(&(solve, t)) {
+            return d;
+        }
+        let Solve {
+            matrix,
+            columns,
+            solutions,
+        } = self.solves[solve].clone();
+        let d_matrix: Vec<Vec<Option<usize>>> = matrix
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|&a| self.derivative(a, dim, t, memo))
+                    .collect()
+            })
+            .collect();
+        let mut any = false;
+        let mut new_columns = Vec::new();
+        for (c, column) in columns.iter().enumerate() {
+            let mut new_column = Vec::new();
+            for (r, &rhs) in column.iter().enumerate() {
+                let mut acc = self.derivative(rhs, dim, t, memo);
+                for (j, da) in d_matrix[r].iter().enumerate() {
+                    if let Some(da) = *da {
+                        let product = self.multiply(da, solutions[c][j]);
+                        acc = self.sum(acc, Some(product), true);
+                    }
+                }
+                any |= acc.is_some();
+                new_column.push(acc.unwrap_or_else(|| self.literal("0.0")));
+            }
+            new_columns.push(new_column);
+        }
+        let d = any.then(|| self.add_solve(matrix, new_columns));
+        self.tangent_solves.insert((solve, t), d);
+        d
     }
 
     fn multiply(&mut self, a: usize, b: usize) -> usize {
@@ -331,6 +475,9 @@ impl Lowering<'_> {
                     let product = self.multiply(s, x);
                     self.intern(Op::Neg(product))
                 }),
+                Op::Solution { solve, row, column } => self
+                    .solve_derivative(solve, dim, t, memo)
+                    .map(|d| self.solves[d].solutions[column][row]),
             }
         };
         memo.insert(k, d);
@@ -385,6 +532,11 @@ pub fn recurrences(
         ));
     }
     let tangents = signature.state.len() / dim - 1;
+    if tangents > 1 {
+        return Err(format!(
+            "{tangents} tangent vectors: the recurrences are generated for one and looped over the columns at run time"
+        ));
+    }
     let mut lowering = Lowering {
         dag,
         signature,
@@ -398,6 +550,9 @@ pub fn recurrences(
         classes: Vec::new(),
         index: HashMap::new(),
         memo: HashMap::new(),
+        solves: Vec::new(),
+        solve_memo: HashMap::new(),
+        tangent_solves: HashMap::new(),
     };
     // Every state component has coefficients, used or not.
     for k in 0..signature.state.len() {
@@ -421,7 +576,7 @@ pub fn recurrences(
             roots.push(root);
         }
     }
-    let needed = reachable(&lowering.ops, &lowering.index, &roots);
+    let needed = reachable(&lowering.ops, &lowering.index, &lowering.solves, &roots);
     let names = names(&lowering, dag, &needed);
     Ok(Writer {
         ops: &lowering.ops,
@@ -429,11 +584,18 @@ pub fn recurrences(
         names: &names,
         needed: &needed,
         index: &lowering.index,
+        solves: &lowering.solves,
+        declared: Default::default(),
     }
-    .body(&roots, signature.state.len()))
+    .body(&roots, dim, tangents == 1))
 }
 
-fn reachable(ops: &[Op], index: &HashMap<Op, usize>, roots: &[usize]) -> Vec<bool> {
+fn reachable(
+    ops: &[Op],
+    index: &HashMap<Op, usize>,
+    solves: &[Solve],
+    roots: &[usize],
+) -> Vec<bool> {
     let mut needed = vec![false; ops.len()];
     let mut stack: Vec<usize> = roots.to_vec();
     stack.extend(
@@ -447,7 +609,11 @@ fn reachable(ops: &[Op], index: &HashMap<Op, usize>, roots: &[usize]) -> Vec<boo
             continue;
         }
         needed[k] = true;
-        stack.extend(ops[k].children());
+        stack.extend(ops[k].children(solves));
+        // The solutions of one system are computed together.
+        if let Op::Solution { solve, .. } = ops[k] {
+            stack.extend(solves[solve].solutions.iter().flatten());
+        }
         // The recurrence of sin needs cos and vice versa.
         if let Op::Sin(u) | Op::Cos(u) = ops[k] {
             for partner in [Op::Sin(u), Op::Cos(u)] {
@@ -533,6 +699,9 @@ struct Writer<'a> {
     names: &'a [String],
     needed: &'a [bool],
     index: &'a HashMap<Op, usize>,
+    solves: &'a [Solve],
+    /// Factorisations already declared in the emitted body, by name.
+    declared: std::cell::RefCell<std::collections::HashSet<String>>,
 }
 
 impl Writer<'_> {
@@ -576,6 +745,114 @@ impl Writer<'_> {
             Op::Ln(a) => format!("{}.ln()", v(*a)),
             Op::Sin(a) => format!("{}.sin()", v(*a)),
             Op::Cos(a) => format!("{}.cos()", v(*a)),
+            Op::Solution { .. } => unreachable!("solutions are computed by `solve_lines`"),
+        }
+    }
+
+    /// Whether node k is the first solution of its system (where the
+    /// system's lines go), and the system.
+    fn first_solution(&self, k: usize) -> Option<&Solve> {
+        match self.ops[k] {
+            Op::Solution { solve, .. } => {
+                let s = &self.solves[solve];
+                (s.solutions[0][0] == k).then_some(s)
+            }
+            _ => None,
+        }
+    }
+
+    /// The factor's name of a system: that of the first system with the
+    /// same matrix, from its first solution's name.
+    fn factor_name(&self, s: &Solve) -> String {
+        format!(
+            "factor_{}",
+            self.names[self.factor_owner(s).solutions[0][0]]
+        )
+    }
+
+    /// Declares a system's factorisation unless it is declared already.
+    fn declare_factor(&self, s: &Solve, lines: &mut Vec<String>) {
+        if self.declared.borrow_mut().insert(self.factor_name(s)) {
+            lines.push(self.factor_line(s));
+        }
+    }
+
+    /// `let factor = Cholesky::new(A at order 0);`
+    fn factor_line(&self, s: &Solve) -> String {
+        let rows: Vec<String> = s
+            .matrix
+            .iter()
+            .map(|row| {
+                let cells: Vec<String> = row.iter().map(|&a| self.value(a)).collect();
+                format!("[{}]", cells.join(", "))
+            })
+            .collect();
+        format!(
+            "let {} = crate::linalg::Cholesky::new([{}]);",
+            self.factor_name(s),
+            rows.join(", ")
+        )
+    }
+
+    /// Order 0 (or a constant system): factorise A (unless a system with
+    /// the same matrix did, or it is constant) and solve each column.
+    fn solve_lines(&self, s: &Solve, lines: &mut Vec<String>) {
+        let constant = self.constant(s.solutions[0][0]);
+        let factor = self.factor_name(s);
+        if constant || !self.constant_matrix(s) {
+            self.declare_factor(s, lines);
+        }
+        for (column, solutions) in s.columns.iter().zip(&s.solutions) {
+            let rhs: Vec<String> = column.iter().map(|&r| self.value(r)).collect();
+            let targets: Vec<String> = solutions
+                .iter()
+                .map(|&x| {
+                    if constant {
+                        self.names[x].clone()
+                    } else {
+                        format!("{}[0]", self.names[x])
+                    }
+                })
+                .collect();
+            lines.push(format!(
+                "{}[{}] = {factor}.solve([{}]);",
+                if constant { "let " } else { "" },
+                targets.join(", "),
+                rhs.join(", ")
+            ));
+        }
+    }
+
+    /// Order n of a varying system: x^[n] = (A^[0])⁻¹ (r^[n] − Σ_{k≥1} A^[k] x^[n−k]).
+    fn solve_recurrence(&self, s: &Solve, lines: &mut Vec<String>) {
+        let factor = self.factor_name(s);
+        for (column, solutions) in s.columns.iter().zip(&s.solutions) {
+            let rhs: Vec<String> = column
+                .iter()
+                .enumerate()
+                .map(|(r, &rhs)| {
+                    let mut terms = vec![if self.constant(rhs) {
+                        "0.0".to_string()
+                    } else {
+                        self.at(rhs, "n")
+                    }];
+                    for (j, &a) in s.matrix[r].iter().enumerate() {
+                        if !self.constant(a) {
+                            terms.push(format!(
+                                "series::product_tail({}, {}, n)",
+                                self.names[a], self.names[solutions[j]]
+                            ));
+                        }
+                    }
+                    terms.join(" - ")
+                })
+                .collect();
+            let targets: Vec<String> = solutions.iter().map(|&x| self.at(x, "n")).collect();
+            lines.push(format!(
+                "[{}] = {factor}.solve([{}]);",
+                targets.join(", "),
+                rhs.join(", ")
+            ));
         }
     }
 
@@ -594,7 +871,7 @@ impl Writer<'_> {
             self.needed[parent]
                 && self.classes[parent] == Class::Series
                 && !matches!(self.ops[parent], Op::Sin(_) | Op::Cos(_))
-                && self.ops[parent].children().contains(&k)
+                && self.ops[parent].children(self.solves).contains(&k)
         })
     }
 
@@ -627,6 +904,12 @@ impl Writer<'_> {
         let name = |c: usize| self.names[c].clone();
         let expression = match self.ops[k] {
             Op::State(_) => return,
+            Op::Solution { .. } => {
+                if let Some(s) = self.first_solution(k) {
+                    self.solve_recurrence(s, lines);
+                }
+                return;
+            }
             Op::Neg(a) => format!("-{}", at(a)),
             Op::Add(a, b) | Op::Sub(a, b) => {
                 let plus = matches!(self.ops[k], Op::Add(..));
@@ -684,7 +967,40 @@ impl Writer<'_> {
         lines.push(format!("{w}[n] = {expression};"));
     }
 
-    fn body(&self, roots: &[usize], dim: usize) -> TaylorBody {
+    /// The solve whose factorisation system `s` uses: the first one with
+    /// the same matrix (a tangent system reuses its base system's factor).
+    fn factor_owner<'s>(&'s self, s: &'s Solve) -> &'s Solve {
+        self.solves
+            .iter()
+            .find(|o| o.matrix == s.matrix && self.needed[o.solutions[0][0]])
+            .unwrap_or(s)
+    }
+
+    /// Whether every entry of a system's matrix is constant over the step.
+    fn constant_matrix(&self, s: &Solve) -> bool {
+        s.matrix.iter().flatten().all(|&a| self.constant(a))
+    }
+
+    /// Whether node k depends on the tangent vector (state components ≥ dim).
+    fn tangent_dependence(&self, dim: usize) -> Vec<bool> {
+        let mut dependent = vec![false; self.ops.len()];
+        for k in 0..self.ops.len() {
+            dependent[k] = match self.ops[k] {
+                Op::State(i) => i >= dim,
+                ref op => op.children(self.solves).iter().any(|&c| dependent[c]),
+            };
+        }
+        dependent
+    }
+
+    /// The body of a Taylor-coefficient function. Without tangents the state
+    /// is `y: &[f64; DIM]` and `out` rows `[f64; DIM]`. With one tangent
+    /// (state [y; v] in the lowering) the function is variational: `z` holds
+    /// y and any number of tangent columns, `out` is flat with rows of
+    /// z.len(); the base recurrences run once, then the tangent
+    /// recurrences once per column (a run-time loop, so the generated code
+    /// does not grow with the number of tangents).
+    fn body(&self, roots: &[usize], dim: usize, variational: bool) -> TaylorBody {
         let mut lines = Vec::new();
         let live: Vec<usize> = (0..self.ops.len()).filter(|&k| self.needed[k]).collect();
         let varying: Vec<usize> = live
@@ -694,8 +1010,22 @@ impl Writer<'_> {
             .collect();
         lines.push("// Constants of the step (parameters only).".into());
         for &k in &live {
-            if self.constant(k) && !matches!(self.ops[k], Op::Literal(_) | Op::Parameter(_)) {
-                lines.push(format!("let {} = {};", self.names[k], self.scalar(k)));
+            if !self.constant(k) || matches!(self.ops[k], Op::Literal(_) | Op::Parameter(_)) {
+                continue;
+            }
+            match self.ops[k] {
+                Op::Solution { .. } => {
+                    if let Some(s) = self.first_solution(k) {
+                        self.solve_lines(s, &mut lines);
+                    }
+                }
+                _ => lines.push(format!("let {} = {};", self.names[k], self.scalar(k))),
+            }
+        }
+        // Factors of constant matrices are constants too.
+        for s in self.solves {
+            if self.needed[s.solutions[0][0]] && self.constant_matrix(s) {
+                self.declare_factor(s, &mut lines);
             }
         }
         let slot_names: Vec<&str> = varying.iter().map(|&k| self.names[k].as_str()).collect();
@@ -704,38 +1034,62 @@ impl Writer<'_> {
             slot_names.join(", "),
             varying.len()
         ));
-        lines.push(
-            "assert!(order >= 1 && order < series::COEFFICIENTS && out.len() > order);".into(),
-        );
-        lines.push("// Order 0: the values at t.".into());
-        for &k in &varying {
-            let w = &self.names[k];
-            match self.ops[k] {
-                Op::Sin(_) | Op::Cos(_) => {
-                    let (s, c) = self.partner(k).expect("a pair");
-                    if k == s.min(c) {
-                        let Op::Sin(u) = self.ops[s] else {
-                            unreachable!()
-                        };
-                        lines.push(format!(
-                            "({}[0], {}[0]) = {}.sin_cos();",
-                            self.names[s],
-                            self.names[c],
-                            self.value(u)
-                        ));
-                    }
-                }
-                _ => lines.push(format!("{w}[0] = {};", self.scalar(k))),
-            }
-            if self.classes[k] == Class::Linear {
-                lines.push(format!("{w}[1] = {};", self.slope(k)));
-                if self.read_as_series(k) {
-                    lines.push(format!("{w}[2..=order].fill(0.0);"));
-                }
-            }
+        let dependent = if variational {
+            self.tangent_dependence(dim)
+        } else {
+            vec![false; self.ops.len()]
+        };
+        let base: Vec<usize> = varying.iter().copied().filter(|&k| !dependent[k]).collect();
+        let tangent: Vec<usize> = varying.iter().copied().filter(|&k| dependent[k]).collect();
+        if variational {
+            lines.push("let len = z.len();".into());
+            lines.push(format!("let columns = len / {dim} - 1;"));
+            lines.push(format!(
+                "assert!(order >= 1 && order < series::COEFFICIENTS && columns >= 1 && len == {dim} * (1 + columns) && out.len() > order * len);"
+            ));
+            lines.push("out[..len].copy_from_slice(z);".into());
+            lines.push("// The solution.".into());
+            self.orders(&base, &roots[..dim], "0", &mut lines);
+            lines.push(
+                "// Each tangent vector in turn: the same recurrences, reading the solution's."
+                    .into(),
+            );
+            lines.push("for column in 0..columns {".into());
+            lines.push(format!("let offset = {dim} * (1 + column);"));
+            self.orders(&tangent, &roots[dim..], "offset", &mut lines);
+            lines.push("}".into());
+        } else {
+            lines.push(
+                "assert!(order >= 1 && order < series::COEFFICIENTS && out.len() > order);".into(),
+            );
+            lines.push("out[0] = *y;".into());
+            self.orders(&base, roots, "", &mut lines);
         }
-        let rate = |n: &str, scale: &str| -> String {
-            let cells: Vec<String> = roots
+        TaylorBody { lines }
+    }
+
+    /// Order 0, then orders 1..order of the nodes `nodes` (in evaluation
+    /// order, their state components first), whose rates are `roots`. The
+    /// state's coefficients are written to `out` at column `offset` (flat
+    /// rows of `len`), or to `out[n][i]` when `offset` is empty.
+    fn orders(&self, nodes: &[usize], roots: &[usize], offset: &str, lines: &mut Vec<String>) {
+        let dim = roots.len();
+        let cell = |n: &str, i: usize| -> String {
+            match offset {
+                "" => format!("out[{n}][{i}]"),
+                "0" => format!("out[({n}) * len + {i}]"),
+                o => format!("out[({n}) * len + {o} + {i}]"),
+            }
+        };
+        lines.push("// Order 0: the values at t.".into());
+        for (i, &k) in nodes.iter().enumerate().take(dim) {
+            lines.push(format!("{}[0] = {};", self.names[k], cell("0", i)));
+        }
+        for &k in &nodes[dim..] {
+            self.order_zero(k, lines);
+        }
+        let rates = |n: &str, scale: &str| -> Vec<String> {
+            roots
                 .iter()
                 .map(|&r| {
                     if self.constant(r) {
@@ -748,28 +1102,63 @@ impl Writer<'_> {
                         format!("{}{scale}", self.at(r, n))
                     }
                 })
-                .collect();
-            format!("[{}]", cells.join(", "))
+                .collect()
         };
-        let state_slots = |lines: &mut Vec<String>, n: &str| {
-            for (i, &k) in varying.iter().enumerate().take(dim) {
-                debug_assert_eq!(self.ops[k], Op::State(i));
-                lines.push(format!("{}[{n}] = out[{n}][{i}];", self.names[k]));
+        let store = |lines: &mut Vec<String>, row: &str, values: Vec<String>| {
+            if offset.is_empty() {
+                lines.push(format!("out[{row}] = [{}];", values.join(", ")));
+            } else {
+                for (i, v) in values.into_iter().enumerate() {
+                    lines.push(format!("{} = {v};", cell(row, i)));
+                }
+            }
+            for (i, &k) in nodes.iter().enumerate().take(dim) {
+                debug_assert!(matches!(self.ops[k], Op::State(_)));
+                lines.push(format!("{}[{row}] = {};", self.names[k], cell(row, i)));
             }
         };
-        lines.push("out[0] = *y;".into());
-        lines.push(format!("out[1] = {};", rate("0", "")));
-        state_slots(&mut lines, "1");
+        store(lines, "1", rates("0", ""));
         lines.push("for n in 1..order {".into());
-        for &k in &varying {
+        for &k in &nodes[dim..] {
             if self.classes[k] == Class::Series {
-                self.recurrence(k, &mut lines);
+                self.recurrence(k, lines);
             }
         }
         lines.push("let next = series::INVERSES[n + 1];".into());
-        lines.push(format!("out[n + 1] = {};", rate("n", " * next")));
-        state_slots(&mut lines, "n + 1");
+        store(lines, "n + 1", rates("n", " * next"));
         lines.push("}".into());
-        TaylorBody { lines }
+    }
+
+    /// The order-0 line(s) of a varying node that is not a state component.
+    fn order_zero(&self, k: usize, lines: &mut Vec<String>) {
+        let w = &self.names[k];
+        match self.ops[k] {
+            Op::Sin(_) | Op::Cos(_) => {
+                let (s, c) = self.partner(k).expect("a pair");
+                if k == s.min(c) {
+                    let Op::Sin(u) = self.ops[s] else {
+                        unreachable!()
+                    };
+                    lines.push(format!(
+                        "({}[0], {}[0]) = {}.sin_cos();",
+                        self.names[s],
+                        self.names[c],
+                        self.value(u)
+                    ));
+                }
+            }
+            Op::Solution { .. } => {
+                if let Some(s) = self.first_solution(k) {
+                    self.solve_lines(s, lines);
+                }
+            }
+            _ => lines.push(format!("{w}[0] = {};", self.scalar(k))),
+        }
+        if self.classes[k] == Class::Linear {
+            lines.push(format!("{w}[1] = {};", self.slope(k)));
+            if self.read_as_series(k) {
+                lines.push(format!("{w}[2..=order].fill(0.0);"));
+            }
+        }
     }
 }

@@ -25,6 +25,7 @@
 pub mod analysis;
 pub mod contact;
 pub mod explore;
+pub mod linalg;
 pub mod model;
 pub mod models;
 pub mod ode;
@@ -33,3 +34,4 @@ pub mod registry;
 pub mod report;
 pub mod scene;
 pub mod studies;
+pub mod test_models;

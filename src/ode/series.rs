@@ -97,6 +97,14 @@ pub fn product(a: &Coefficients, b: &Coefficients, n: usize) -> f64 {
     earlier + a[n] * b[0] + a[0] * b[n]
 }
 
+/// Σ_{k=1..n} a^[k] x^[n−k]: the product's order-n sum without the term
+/// a^[0] x^[n], for the recurrence of a linear solve A x = r, whose order n
+/// is x^[n] = (A^[0])⁻¹ (r^[n] − Σ_{k=1..n} A^[k] x^[n−k]).
+#[inline(always)]
+pub fn product_tail(a: &Coefficients, x: &Coefficients, n: usize) -> f64 {
+    reversed_dot(&a[1..n], &x[1..n]) + a[n] * x[0]
+}
+
 /// (a²)^[n], using the symmetry of the Cauchy sum.
 #[inline(always)]
 pub fn square(a: &Coefficients, n: usize) -> f64 {

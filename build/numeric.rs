@@ -1,0 +1,433 @@
+//! Generated functions of the numeric-solve form (models of 3 or more
+//! degrees of freedom by default, see `SYMBOLIC_INVERSE_MAX_DOF`).
+//!
+//! The derivation gives closed forms of A(q), b(q, θ), V, the momentum
+//! rates ∂L/∂q + Q at (q, q', θ), and for the averaged system b̄, the modes
+//! of b over the phase and the rates of L̄₀ = ½ q'ᵀAq' + b̄ᵀq' − V̄.
+//! Everything that needs A⁻¹ is computed here as steps of the emitter's DAG:
+//! - exact field: A q' = p − b (one Cholesky factorisation), then p';
+//! - H = ½ (p − b)ᵀq' + V;
+//! - V_vibr = ½ mean(bᵀA⁻¹b): with b = Σ_s h_s(θ) g_s(q) over its modes in
+//!   the phase (one, sin θ, for a vertical vibration) and the numbers
+//!   M_st = mean(h_s h_t), V_vibr = ½ Σ M_st g_sᵀx_t with A x_t = g_t: one
+//!   solve per mode, with the same factorisation, never A⁻¹ itself;
+//! - averaged field: q' = A⁻¹(p − b̄), p' = ∂L̄₀/∂q + P̄ − ∂W/∂q with
+//!   W = V_vibr − ½ b̄ᵀA⁻¹b̄ (so that H̄ = ½(p − b̄)ᵀA⁻¹(p − b̄) + V̄ + W,
+//!   the mean of H over the phase);
+//! - Jacobians, ∂W/∂q and the Hessian of V + V_vibr as forward-mode
+//!   derivatives through the solves (δX = A⁻¹(δR − δA X)), so no quantity
+//!   is approximated by finite differences.
+
+use crate::derive::{Derivation, NumericForm};
+use crate::emit::Step;
+use crate::generate::{
+    common_functions, matrix, taylor_set, Context, Function, Inputs, TaylorFunction,
+};
+
+/// The name of entry (i, j) of a symmetric matrix `prefix` (upper triangle).
+fn entry(prefix: &str, i: usize, j: usize) -> String {
+    format!("{prefix}_{}_{}", i.min(j), i.max(j))
+}
+
+/// The upper triangle of a symmetric matrix as named outputs.
+fn upper(prefix: &str, m: &[Vec<String>]) -> Vec<(String, String)> {
+    let n = m.len();
+    (0..n)
+        .flat_map(|i| (i..n).map(move |j| (i, j)))
+        .map(|(i, j)| (entry(prefix, i, j), m[i][j].clone()))
+        .collect()
+}
+
+/// The full matrix of names of a symmetric matrix.
+fn names(prefix: &str, n: usize) -> Vec<Vec<String>> {
+    (0..n)
+        .map(|i| (0..n).map(|j| entry(prefix, i, j)).collect())
+        .collect()
+}
+
+/// Σ_i x_i·y_i as text.
+fn dot(x: &[String], y: &[String]) -> String {
+    let terms: Vec<String> = x.iter().zip(y).map(|(a, b)| format!("{a}*{b}")).collect();
+    format!("({})", terms.join("+"))
+}
+
+/// Steps of x_t = A⁻¹g_t for every mode g_t of b over the phase (as
+/// `x{t}_{i}`) and V_vibr = ½ Σ M_st g_s·x_t (as `w_vibr`), from the
+/// coordinates alone.
+fn vibrational_steps(derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
+    let n = derivation.dof;
+    let mut values = upper("a", &derivation.mass_matrix);
+    for (s, mode) in form.modes.iter().enumerate() {
+        values.extend(
+            mode.iter()
+                .enumerate()
+                .map(|(i, g)| (format!("g{s}_{i}"), g.clone())),
+        );
+    }
+    let mut steps = vec![Step::Values(values)];
+    if !form.modes.is_empty() {
+        steps.push(Step::Solve {
+            matrix: names("a", n),
+            columns: (0..form.modes.len())
+                .map(|s| (0..n).map(|i| format!("g{s}_{i}")).collect())
+                .collect(),
+            names: (0..form.modes.len())
+                .map(|s| (0..n).map(|i| format!("x{s}_{i}")).collect())
+                .collect(),
+        });
+    }
+    let w_vibr = mode_quadratic_form(n, &form.mode_products);
+    steps.push(Step::Values(vec![("w_vibr".into(), w_vibr)]));
+    steps
+}
+
+/// ½ Σ_st weights_st g_s·x_t as text ("0" without modes).
+fn mode_quadratic_form(n: usize, weights: &[Vec<f64>]) -> String {
+    let mut terms = Vec::new();
+    for (s, row) in weights.iter().enumerate() {
+        for (t, &weight) in row.iter().enumerate() {
+            if weight != 0.0 {
+                let g: Vec<String> = (0..n).map(|i| format!("g{s}_{i}")).collect();
+                let x: Vec<String> = (0..n).map(|i| format!("x{t}_{i}")).collect();
+                terms.push(format!("{weight:?}*{}", dot(&g, &x)));
+            }
+        }
+    }
+    if terms.is_empty() {
+        "0".into()
+    } else {
+        format!("({})/2", terms.join("+"))
+    }
+}
+
+/// The exact field: A, p − b, the solve for q', then p'.
+fn exact_steps(
+    cx: &Context,
+    derivation: &Derivation,
+    form: &NumericForm,
+) -> (Vec<Step>, Vec<String>) {
+    let n = cx.n();
+    let momenta = cx.momenta();
+    let mut values = upper("a", &derivation.mass_matrix);
+    values.extend((0..n).map(|i| {
+        (
+            format!("r{i}"),
+            format!("{}-({})", momenta[i], form.linear_term[i]),
+        )
+    }));
+    let rates: Vec<(String, String)> = (0..n)
+        .map(|i| (format!("dp{i}"), derivation.momentum_rates[i].clone()))
+        .collect();
+    let mut outputs = cx.velocities();
+    outputs.extend(rates.iter().map(|(name, _)| name.clone()));
+    let steps = vec![
+        Step::Values(values),
+        Step::Solve {
+            matrix: names("a", n),
+            columns: vec![(0..n).map(|i| format!("r{i}")).collect()],
+            names: vec![cx.velocities()],
+        },
+        Step::Values(rates),
+    ];
+    (steps, outputs)
+}
+
+/// The averaged field: q' = A⁻¹(p − b̄) (named like the velocities, which
+/// the averaged rates use), W and its gradient, then [q', p'] as `f0..`.
+fn averaged_steps(
+    cx: &Context,
+    derivation: &Derivation,
+    form: &NumericForm,
+) -> (Vec<Step>, Vec<String>) {
+    let n = cx.n();
+    let momenta = cx.momenta();
+    let coordinates = cx.coordinates();
+    let mut steps = vibrational_steps(derivation, form);
+    let shifted: Vec<(String, String)> = (0..n)
+        .map(|i| {
+            (
+                format!("rbar{i}"),
+                format!("{}-({})", momenta[i], form.mean_linear_term[i]),
+            )
+        })
+        .collect();
+    steps.push(Step::Values(shifted));
+    steps.push(Step::Solve {
+        matrix: names("a", n),
+        columns: vec![(0..n).map(|i| format!("rbar{i}")).collect()],
+        names: vec![cx.velocities()],
+    });
+    steps.push(Step::Values(vec![("w".into(), dynamic_potential(n, form))]));
+    steps.push(Step::Derivatives(
+        coordinates
+            .iter()
+            .enumerate()
+            .map(|(k, q)| (format!("dw{k}"), "w".to_string(), vec![q.clone()]))
+            .collect(),
+    ));
+    let mut field: Vec<(String, String)> = cx
+        .velocities()
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| (format!("f{i}"), v))
+        .collect();
+    field.extend((0..n).map(|k| {
+        (
+            format!("f{}", n + k),
+            format!("({})-dw{k}", form.averaged_momentum_rates[k]),
+        )
+    }));
+    let outputs = field.iter().map(|(name, _)| name.clone()).collect();
+    steps.push(Step::Values(field));
+    (steps, outputs)
+}
+
+/// W = V_vibr − ½ b̄ᵀA⁻¹b̄ = ½ Σ (M_st − m_s m_t) g_s·x_t, the part of H̄
+/// besides V̄ that depends on q alone.
+fn dynamic_potential(n: usize, form: &NumericForm) -> String {
+    if form.mode_means.iter().all(|m| *m == 0.0) {
+        return "w_vibr".into();
+    }
+    let weights: Vec<Vec<f64>> = form
+        .mode_products
+        .iter()
+        .zip(&form.mode_means)
+        .map(|(row, ms)| {
+            row.iter()
+                .zip(&form.mode_means)
+                .map(|(mst, mt)| mst - ms * mt)
+                .collect()
+        })
+        .collect();
+    mode_quadratic_form(n, &weights)
+}
+
+/// Named derivatives ∂out_i/∂var_k of a vector field: a Jacobian.
+fn jacobian(prefix: &str, outputs: &[String], variables: &[String]) -> (Step, String) {
+    let names: Vec<Vec<String>> = outputs
+        .iter()
+        .enumerate()
+        .map(|(i, _)| {
+            (0..variables.len())
+                .map(|k| format!("{prefix}_{i}_{k}"))
+                .collect()
+        })
+        .collect();
+    let list = outputs
+        .iter()
+        .enumerate()
+        .flat_map(|(i, out)| {
+            variables
+                .iter()
+                .enumerate()
+                .map(move |(k, v)| (format!("{prefix}_{i}_{k}"), out.clone(), vec![v.clone()]))
+        })
+        .collect();
+    let rows: Vec<String> = names
+        .iter()
+        .map(|r| format!("[{}]", r.join(", ")))
+        .collect();
+    (Step::Derivatives(list), format!("[{}]", rows.join(", ")))
+}
+
+/// A vector field of the numeric form: its steps and outputs, and what its
+/// Hamiltonian needs (the first `hamiltonian_steps` steps, then the
+/// expression `hamiltonian`).
+struct Field<'a> {
+    /// `exact` or `averaged`: the functions are `<prefix>_rhs`,
+    /// `<prefix>_jacobian` and the Hamiltonian.
+    prefix: &'a str,
+    inputs: Inputs,
+    /// Documentation of the field, its Jacobian and its Hamiltonian.
+    docs: [&'a str; 3],
+    steps: &'a [Step],
+    outputs: &'a [String],
+    hamiltonian_steps: usize,
+    hamiltonian: String,
+}
+
+/// The field's function, its Jacobian and its Hamiltonian.
+fn field_functions(
+    cx: &Context,
+    field: Field,
+    state: &[String],
+    functions: &mut Vec<Function>,
+) -> Result<(), String> {
+    let m = 2 * cx.n();
+    functions.push(cx.function_steps(
+        &format!("{}_rhs", field.prefix),
+        field.docs[0],
+        field.inputs,
+        format!("[f64; {m}]"),
+        field.steps,
+        format!("[{}]", field.outputs.join(", ")),
+    )?);
+    let (derivatives, result) = jacobian("j", field.outputs, state);
+    let mut steps = field.steps.to_vec();
+    steps.push(derivatives);
+    functions.push(cx.function_steps(
+        &format!("{}_jacobian", field.prefix),
+        field.docs[1],
+        field.inputs,
+        format!("[[f64; {m}]; {m}]"),
+        &steps,
+        result,
+    )?);
+    let mut steps = field.steps[..field.hamiltonian_steps].to_vec();
+    steps.push(Step::Values(vec![("h".into(), field.hamiltonian)]));
+    let name = match field.prefix {
+        "exact" => "hamiltonian".to_string(),
+        other => format!("{other}_hamiltonian"),
+    };
+    functions.push(cx.function_steps(
+        &name,
+        field.docs[2],
+        field.inputs,
+        "f64".into(),
+        &steps,
+        "h".into(),
+    )?);
+    Ok(())
+}
+
+/// Every generated function of a numeric-solve model.
+pub fn functions(
+    cx: &Context,
+    derivation: &Derivation,
+    form: &NumericForm,
+) -> Result<(Vec<Function>, Vec<TaylorFunction>), String> {
+    let n = cx.n();
+    let mut state = cx.coordinates();
+    state.extend(cx.momenta());
+    let mut functions = common_functions(cx, derivation)?;
+    let (exact, exact_outputs) = exact_steps(cx, derivation, form);
+    functions.push(cx.function_steps(
+        "velocities",
+        "Velocities q' solved from A(q) q' = p − b (Cholesky) at state y = [q, p].",
+        Inputs::State,
+        format!("[f64; {n}]"),
+        &exact[..2],
+        format!("[{}]", cx.velocities().join(", ")),
+    )?);
+    let residuals: Vec<String> = (0..n).map(|i| format!("r{i}")).collect();
+    let hamiltonian = format!(
+        "{}/2+({})",
+        dot(&residuals, &cx.velocities()),
+        form.potential
+    );
+    field_functions(
+        cx,
+        Field {
+            prefix: "exact",
+            inputs: Inputs::State,
+            docs: [
+                "Hamilton's equations with forces: [q', p'] with A q' = p − b solved numerically, p' = ∂L/∂q + Q.",
+                "Jacobian ∂(q', p')/∂(q, p) of the exact field (forward mode through the solve).",
+                "Hamiltonian H(q, p, t) = ½ (p − b)ᵀq' + V.",
+            ],
+            steps: &exact,
+            outputs: &exact_outputs,
+            hamiltonian_steps: 2,
+            hamiltonian,
+        },
+        &state,
+        &mut functions,
+    )?;
+    let averaged = match cx.model.fast_phase {
+        Some(_) => Some(averaged_functions(
+            cx,
+            derivation,
+            form,
+            &state,
+            &mut functions,
+        )?),
+        None => None,
+    };
+    let taylor = taylor_set(
+        cx,
+        (&exact, &exact_outputs),
+        averaged.as_ref().map(|(s, o)| (&s[..], &o[..])),
+    )?;
+    Ok((functions, taylor))
+}
+
+/// The functions of the averaged system and the vibrational potential;
+/// returns the averaged field's steps and outputs (for its recurrences).
+fn averaged_functions(
+    cx: &Context,
+    derivation: &Derivation,
+    form: &NumericForm,
+    state: &[String],
+    functions: &mut Vec<Function>,
+) -> Result<(Vec<Step>, Vec<String>), String> {
+    let n = cx.n();
+    let vibrational = vibrational_steps(derivation, form);
+    functions.push(cx.function_steps(
+        "vibrational_potential",
+        "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b) = ½ Σ M_st g_sᵀA⁻¹g_t over the modes g_s of b.",
+        Inputs::Coordinates,
+        "f64".into(),
+        &vibrational,
+        "w_vibr".into(),
+    )?);
+    let mut effective = vibrational.clone();
+    effective.push(Step::Values(vec![(
+        "v".into(),
+        format!("({})+w_vibr", derivation.potential),
+    )]));
+    functions.push(cx.function_steps(
+        "effective_potential",
+        "Effective potential V + V_vibr of the averaged system.",
+        Inputs::Coordinates,
+        "f64".into(),
+        &effective,
+        "v".into(),
+    )?);
+    let coordinates = cx.coordinates();
+    let hessian: Vec<(String, String, Vec<String>)> = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            (
+                format!("b_{i}_{j}"),
+                "v".to_string(),
+                vec![coordinates[i].clone(), coordinates[j].clone()],
+            )
+        })
+        .collect();
+    effective.push(Step::Derivatives(hessian));
+    let (_, result) = matrix("b", &vec![vec![String::new(); n]; n]);
+    functions.push(cx.function_steps(
+        "effective_potential_hessian",
+        "∂²(V + V_vibr)/∂q² (forward mode through the solves).",
+        Inputs::Coordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &effective,
+        result,
+    )?);
+    let (averaged, outputs) = averaged_steps(cx, derivation, form);
+    let shifted: Vec<String> = (0..n).map(|i| format!("rbar{i}")).collect();
+    let hamiltonian = format!(
+        "{}/2+w+({})",
+        dot(&shifted, &cx.velocities()),
+        derivation.potential
+    );
+    field_functions(
+        cx,
+        Field {
+            prefix: "averaged",
+            inputs: Inputs::AveragedState,
+            docs: [
+                "Averaged equations: q' = A⁻¹(p − b̄), p' = ∂L̄₀/∂q + P̄ − ∂W/∂q.",
+                "Jacobian of the averaged field (forward mode through the solves).",
+                "Averaged Hamiltonian H̄(q, p) = ½ (p − b̄)ᵀA⁻¹(p − b̄) + V̄ + W.",
+            ],
+            steps: &averaged,
+            outputs: &outputs,
+            hamiltonian_steps: averaged.len() - 2,
+            hamiltonian,
+        },
+        state,
+        functions,
+    )?;
+    Ok((averaged, outputs))
+}
