@@ -1,8 +1,11 @@
 //! Scene `rhs_benchmark`: speed of the generated right-hand sides against
-//! careful hand-written ones (issue: ratio generated / hand-written ≤ 1.1).
-//! Both are evaluated on the same pseudo-random states in one run.
+//! careful hand-written ones (symbolic-inverse form: ratio ≤ 1.1; the
+//! triple pendulum's numeric-solve form against a hand-written field with the
+//! same Cholesky solve: ≤ 1.3). All are evaluated on the same pseudo-random
+//! states in one run.
 
-use mechlab::models::{double_pendulum as dp, kapitza};
+use mechlab::linalg::Cholesky;
+use mechlab::models::{double_pendulum as dp, kapitza, triple_pendulum as tp};
 use mechlab::scene::{knob, run, Scene};
 use std::hint::black_box;
 use std::time::Instant;
@@ -32,6 +35,43 @@ fn double_pendulum_by_hand(t: f64, y: &[f64; 4], p: &dp::Params) -> [f64; 4] {
     let dp1 = -k + (p.m1 + p.m2) * p.l1 * (p.g * s1 - wd * c1 * v1) - p.mu * v1;
     let dp2 = k + p.m2 * p.l2 * (p.g * s2 - wd * c2 * v2) - p.mu * (v2 - v1);
     [v1, v2, dp1, dp2]
+}
+
+/// The triple pendulum on the vibrating base, written out: with M_i the
+/// mass at or below rod i, A_ij = l_i l_j M_max(i,j) cos(φ_i − φ_j),
+/// b_i = −ẇ l_i M_i sin φ_i, and p_i' = −Σ_j l_i l_j M_max(i,j)
+/// sin(φ_i − φ_j) φ_i' φ_j' − ẇ l_i M_i cos φ_i φ_i' + g l_i M_i sin φ_i + Q_i.
+fn triple_pendulum_by_hand(t: f64, y: &[f64; 6], p: &tp::Params) -> [f64; 6] {
+    let l = [p.l1, p.l2, p.l3];
+    let below = [p.m1 + p.m2 + p.m3, p.m2 + p.m3, p.m3];
+    let wd = -p.a * (p.nu * t).sin();
+    let sc: [(f64, f64); 3] = std::array::from_fn(|i| y[i].sin_cos());
+    // sin and cos of φ_i − φ_j for i < j.
+    let diff = |i: usize, j: usize| {
+        let ((si, ci), (sj, cj)) = (sc[i], sc[j]);
+        (si * cj - ci * sj, ci * cj + si * sj)
+    };
+    let (d01, d02, d12) = (diff(0, 1), diff(0, 2), diff(1, 2));
+    let k01 = l[0] * l[1] * below[1];
+    let k02 = l[0] * l[2] * below[2];
+    let k12 = l[1] * l[2] * below[2];
+    let a = [
+        [l[0] * l[0] * below[0], k01 * d01.1, k02 * d02.1],
+        [k01 * d01.1, l[1] * l[1] * below[1], k12 * d12.1],
+        [k02 * d02.1, k12 * d12.1, l[2] * l[2] * below[2]],
+    ];
+    let r: [f64; 3] = std::array::from_fn(|i| y[3 + i] + wd * l[i] * below[i] * sc[i].0);
+    let v = Cholesky::new(a).solve(r);
+    let coupling = [
+        -k01 * d01.0 * v[0] * v[1] - k02 * d02.0 * v[0] * v[2],
+        k01 * d01.0 * v[0] * v[1] - k12 * d12.0 * v[1] * v[2],
+        k02 * d02.0 * v[0] * v[2] + k12 * d12.0 * v[1] * v[2],
+    ];
+    let friction = [-p.mu * v[0], -p.mu * (v[1] - v[0]), -p.mu * (v[2] - v[1])];
+    let rate = |i: usize| {
+        coupling[i] + l[i] * below[i] * (p.g * sc[i].0 - wd * sc[i].1 * v[i]) + friction[i]
+    };
+    [v[0], v[1], v[2], rate(0), rate(1), rate(2)]
 }
 
 fn time<const N: usize>(states: &[[f64; N]], f: impl Fn(f64, &[f64; N]) -> [f64; N]) -> (f64, f64) {
@@ -67,12 +107,19 @@ fn main() {
         let d_states: Vec<[f64; 4]> = (0..n)
             .map(|_| [random(), random(), random(), random()])
             .collect();
+        let t_states: Vec<[f64; 6]> = (0..n).map(|_| std::array::from_fn(|_| random())).collect();
         let kp = kapitza::Params {
             mu: 0.1,
             ..Default::default()
         };
         let pp = dp::Params {
             mu: 0.1,
+            ..Default::default()
+        };
+        let tpp = tp::Params {
+            mu: 0.1,
+            m2: 1.3,
+            l3: 0.7,
             ..Default::default()
         };
         // Same results first (the benchmark compares equal work).
@@ -100,16 +147,30 @@ fn main() {
                 "{a:?} vs {b:?}"
             );
         }
+        for y in t_states.iter().take(1000) {
+            let (a, b) = (
+                tp::exact_rhs(0.3, y, &tpp),
+                triple_pendulum_by_hand(0.3, y, &tpp),
+            );
+            assert!(
+                a.iter()
+                    .zip(&b)
+                    .all(|(x, z)| (x - z).abs() < 1e-8 * (1.0 + z.abs())),
+                "{a:?} vs {b:?}"
+            );
+        }
         // Best of five alternating rounds each.
-        let mut best = [f64::INFINITY; 4];
+        let mut best = [f64::INFINITY; 6];
         for _ in 0..5 {
             best[0] = best[0].min(time(&k_states, |t, y| kapitza::exact_rhs(t, y, &kp)).0);
             best[1] = best[1].min(time(&k_states, |t, y| kapitza_by_hand(t, y, &kp)).0);
             best[2] = best[2].min(time(&d_states, |t, y| dp::exact_rhs(t, y, &pp)).0);
             best[3] = best[3].min(time(&d_states, |t, y| double_pendulum_by_hand(t, y, &pp)).0);
+            best[4] = best[4].min(time(&t_states, |t, y| tp::exact_rhs(t, y, &tpp)).0);
+            best[5] = best[5].min(time(&t_states, |t, y| triple_pendulum_by_hand(t, y, &tpp)).0);
         }
         let per = |s: f64| s / n as f64 * 1e9;
-        let (rk, rd) = (best[0] / best[1], best[2] / best[3]);
+        let (rk, rd, rt) = (best[0] / best[1], best[2] / best[3], best[4] / best[5]);
         println!(
             "kapitza exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {rk:.3}",
             per(best[0]),
@@ -119,6 +180,11 @@ fn main() {
             "double_pendulum exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {rd:.3}",
             per(best[2]),
             per(best[3])
+        );
+        println!(
+            "triple_pendulum exact_rhs (numeric solve): generated {:.2} ns, hand-written {:.2} ns, ratio {rt:.3}",
+            per(best[4]),
+            per(best[5])
         );
         #[derive(serde::Serialize)]
         struct Timing {
@@ -130,6 +196,7 @@ fn main() {
         struct Summary {
             kapitza: Timing,
             double_pendulum: Timing,
+            triple_pendulum: Timing,
         }
         scene.write_summary(&Summary {
             kapitza: Timing {
@@ -141,6 +208,11 @@ fn main() {
                 generated_ns: per(best[2]),
                 hand_written_ns: per(best[3]),
                 ratio: rd,
+            },
+            triple_pendulum: Timing {
+                generated_ns: per(best[4]),
+                hand_written_ns: per(best[5]),
+                ratio: rt,
             },
         })?;
         Ok(())

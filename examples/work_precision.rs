@@ -16,7 +16,7 @@
 
 use mechlab::contact::{Mode, Smooth};
 use mechlab::models::painleve_klein::{self as painleve, Contacts};
-use mechlab::models::{double_pendulum as dp, kapitza};
+use mechlab::models::{double_pendulum as dp, kapitza, triple_pendulum};
 use mechlab::ode::{Integrator, Method, OdeError, System};
 use mechlab::plot::{palette, Figure, PanelSpec};
 use mechlab::scene::{knob, run, Progress, Scene, SceneError};
@@ -390,6 +390,42 @@ fn sweep<S: System<N>, const N: usize, const M: usize>(
     eprintln!("{problem}: {:.1} s", start.elapsed().as_secs_f64());
 }
 
+/// A pendulum on a base vibrating at `nu`, t ∈ [0, 10]: every method against
+/// a DOP853 reference checked with Gauss 6; returns the references' agreement.
+fn vibrating_base<S: System<N>, const N: usize, const M: usize>(
+    problem: &'static str,
+    system: &S,
+    y0: &[f64; N],
+    nu: f64,
+    (min_seconds, budget): (f64, f64),
+    rows: &mut Vec<Row>,
+    failures: &mut Vec<Failure>,
+) -> Result<f64, SceneError> {
+    let forcing = TAU / nu;
+    let steps: Vec<f64> = [4, 8, 16, 32, 64, 128, 256]
+        .iter()
+        .map(|&k| forcing / k as f64)
+        .collect();
+    let list = solvers(&steps, false);
+    let check = Method::Gauss {
+        stages: 3,
+        step: forcing / 256.0,
+    };
+    let (how, agreement) = reference_end::<_, N, M>(system, y0, 10.0, 1, check)?;
+    sweep::<_, N, M>(
+        problem,
+        system,
+        y0,
+        &how,
+        &list,
+        min_seconds,
+        budget,
+        rows,
+        failures,
+    );
+    Ok(agreement)
+}
+
 /// Least-squares slope of log(error) against log(cost), over the points
 /// above the method's round-off floor (10× its smallest error) and below 1e-2;
 /// none if they do not lie on a line (r² < 0.9).
@@ -434,6 +470,7 @@ fn taylor_speedups(rows: &[Row]) -> BTreeMap<String, BTreeMap<String, Option<f64
         "kapitza_regular_global",
         "kapitza_chaotic",
         "double_pendulum",
+        "triple_pendulum",
     ] {
         let of = |method: &str| -> Vec<&Row> {
             rows.iter()
@@ -610,37 +647,39 @@ fn main() {
             );
         }
 
-        // (b) The double pendulum on the vibrating base, ν = 100, t ∈ [0, 10].
+        // (b) Pendulums on the vibrating base, t ∈ [0, 10]: the double pendulum
+        // at ν = 100 (symbolic inverse), the triple at ν = 200 (numeric solve).
+        let settings = (min_seconds, budget);
         let pp = dp::Params {
             nu: 100.0,
             ..Default::default()
         };
-        let pendulum = dp::Exact { params: pp };
         let y0 = [0.3, -0.2, 0.0, 0.0];
-        let forcing = TAU / pp.nu;
-        let list = solvers(&per_period(&[4, 8, 16, 32, 64, 128, 256], forcing), false);
-        let (how, agreement) = reference_end::<_, 4, 5>(
-            &pendulum,
-            &y0,
-            10.0,
-            1,
-            Method::Gauss {
-                stages: 3,
-                step: forcing / 256.0,
-            },
-        )?;
-        record("double_pendulum", agreement);
-        sweep::<_, 4, 5>(
+        let agreement = vibrating_base::<_, 4, 5>(
             "double_pendulum",
-            &pendulum,
+            &dp::Exact { params: pp },
             &y0,
-            &how,
-            &list,
-            min_seconds,
-            budget,
+            pp.nu,
+            settings,
             &mut rows,
             &mut failures,
-        );
+        )?;
+        record("double_pendulum", agreement);
+        let tp = triple_pendulum::Params {
+            nu: 200.0,
+            ..Default::default()
+        };
+        let y0 = [0.3, -0.2, 0.1, 0.0, 0.0, 0.0];
+        let agreement = vibrating_base::<_, 6, 7>(
+            "triple_pendulum",
+            &triple_pendulum::Exact { params: tp },
+            &y0,
+            tp.nu,
+            settings,
+            &mut rows,
+            &mut failures,
+        )?;
+        record("triple_pendulum", agreement);
 
         // (c) The sliding deformable rod, ε = 0.01 and 0.001, t ∈ [0, 2], from R(0) = 3.
         for (problem, eps) in [("rod_eps_0.01", 1e-2), ("rod_eps_0.001", 1e-3)] {
@@ -683,6 +722,7 @@ fn main() {
             "kapitza_regular_global",
             "kapitza_chaotic",
             "double_pendulum",
+            "triple_pendulum",
             "rod_eps_0.01",
             "rod_eps_0.001",
         ] {
