@@ -48,6 +48,14 @@ fn the_shipped_models_are_accepted() {
     for info in mechlab::models::ALL {
         Model::parse(info.source_file, info.source).unwrap_or_else(|e| panic!("{e}"));
     }
+    // The opt-in models of models/extra/ (not built by default).
+    let file = "models/extra/six_link_pendulum.toml";
+    let text = include_str!("../models/extra/six_link_pendulum.toml");
+    let model = Model::parse(file, text).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        (model.dof(), model.inverse),
+        (6, mechlab::model::Inverse::Numeric)
+    );
 }
 
 #[test]
@@ -275,4 +283,47 @@ fn malformed_contacts_name_the_problem() {
         "rayleigh",
         "unknown symbol 'w'",
     );
+}
+
+/// Sizes are bounded before any recursion over an expression: a file too
+/// large, an expression too long or nested too deep is an error naming the
+/// key, never a stack overflow (these would overflow the parser otherwise).
+#[test]
+fn oversized_and_deeply_nested_models_are_errors() {
+    let lagrangian = |l: &str| GOOD.replace("lagrangian = \"", &format!("lagrangian = \"{l} + "));
+    let nested = format!("{}q{}", "(".repeat(5000), ")".repeat(5000));
+    assert_error(
+        &lagrangian(&nested),
+        "lagrangian",
+        "characters: an expression may have at most 10000",
+    );
+    let nested = format!("{}q{}", "(".repeat(150), ")".repeat(150));
+    assert_error(
+        &lagrangian(&nested),
+        "lagrangian",
+        "nested more than 100 levels deep",
+    );
+    let e = error(&lagrangian(&nested));
+    assert!(
+        e.reason.len() < 200,
+        "the message quotes the expression's start only: {e}"
+    );
+    assert_error(
+        &lagrangian(&"-".repeat(3000)),
+        "lagrangian",
+        "nested more than 100 levels deep",
+    );
+    let padding = format!("\n# {}\n", "x".repeat(300 * 1024));
+    assert_error(
+        &format!("{GOOD}{padding}"),
+        "(file)",
+        "a model file may have at most 262144",
+    );
+    // Long but legal: a sum of 900 terms is read (its tree is 900 deep).
+    let sum: Vec<String> = (0..900).map(|i| format!("{i}*q")).collect();
+    Model::parse(
+        "models/toy.toml",
+        &lagrangian(&format!("({})", sum.join("+"))),
+    )
+    .expect("a long sum within the limits is a valid expression");
 }

@@ -133,7 +133,14 @@ struct Parser {
     tokens: Vec<(usize, Token)>,
     pos: usize,
     end: usize,
+    /// Current nesting (signs, parentheses, calls, exponents).
+    depth: usize,
 }
+
+/// The deepest nesting the parser accepts: every nesting is a level of
+/// recursion here and in every later pass over the tree, so it is bounded
+/// (a model file nested deeper gets an error, not a stack overflow).
+pub const MAX_NESTING: usize = 100;
 
 impl Parser {
     fn peek(&self) -> Option<&Token> {
@@ -180,6 +187,16 @@ impl Parser {
     }
 
     fn unary(&mut self) -> Result<Expr, ParseError> {
+        if self.depth >= MAX_NESTING {
+            return self.error(format!("nested more than {MAX_NESTING} levels deep"));
+        }
+        self.depth += 1;
+        let result = self.signed();
+        self.depth -= 1;
+        result
+    }
+
+    fn signed(&mut self) -> Result<Expr, ParseError> {
         match self.peek() {
             Some(Token::Op('-')) => {
                 self.pos += 1;
@@ -250,6 +267,7 @@ impl Expr {
             tokens,
             pos: 0,
             end: text.len(),
+            depth: 0,
         };
         let expr = parser.sum()?;
         if parser.pos != parser.tokens.len() {

@@ -42,6 +42,13 @@ pub struct ModelFile {
     pub inverse: Option<String>,
 }
 
+/// The largest model file read (bytes): a Lagrangian of a few links is a
+/// few kilobytes.
+pub const MAX_FILE_BYTES: usize = 256 * 1024;
+
+/// The longest expression of a model file (characters).
+pub const MAX_EXPRESSION_CHARS: usize = 10_000;
+
 /// Up to this many degrees of freedom the mass matrix is inverted
 /// symbolically by default. Measured: the double pendulum's symbolic form
 /// builds in about 2 s and runs as fast as hand-written code; a triple
@@ -214,6 +221,15 @@ impl Model {
             key: key.to_string(),
             reason,
         };
+        if text.len() > MAX_FILE_BYTES {
+            return Err(err(
+                "(file)",
+                format!(
+                    "{} bytes: a model file may have at most {MAX_FILE_BYTES}",
+                    text.len()
+                ),
+            ));
+        }
         let spec: ModelFile = toml::from_str(text).map_err(|e| {
             let message = e.message().to_string();
             let key = match e.span() {
@@ -371,8 +387,18 @@ impl ModelFile {
                      allowed: &[&Vec<String>],
                      dot_allowed: bool|
          -> Result<Expr, ModelError> {
-            let expr =
-                Expr::parse(text).map_err(|e| err(key, format!("cannot parse '{text}': {e}")))?;
+            let length = text.chars().count();
+            if length > MAX_EXPRESSION_CHARS {
+                return Err(err(
+                    key,
+                    format!("{length} characters: an expression may have at most {MAX_EXPRESSION_CHARS}"),
+                ));
+            }
+            let expr = Expr::parse(text).map_err(|e| {
+                let quoted: String = text.chars().take(60).collect();
+                let more = if length > 60 { "…" } else { "" };
+                err(key, format!("cannot parse '{quoted}{more}': {e}"))
+            })?;
             expr.check_calls().map_err(|reason| err(key, reason))?;
             for symbol in expr.symbols() {
                 if !allowed.iter().any(|set| set.contains(&symbol)) {
