@@ -175,10 +175,33 @@ fn build_model(
         write_formatted(&partial, &code);
         std::fs::rename(&partial, &cached)
             .unwrap_or_else(|e| fail(format!("cannot write {}: {e}", cached.display())));
+        prune_cache(cache, &model.name, &cached);
     }
     std::fs::copy(&cached, generated.join(format!("{}.rs", model.name)))
         .unwrap_or_else(|e| fail(format!("cannot copy {}: {e}", cached.display())));
     (model, hit)
+}
+
+/// Removes the model's other cached versions (earlier texts or code).
+fn prune_cache(cache: &Path, name: &str, keep: &Path) {
+    let prefix = format!("{name}-");
+    let Ok(entries) = std::fs::read_dir(cache) else {
+        return;
+    };
+    for entry in entries.filter_map(|e| e.ok()) {
+        let path = entry.path();
+        let stale = path != keep
+            && entry
+                .file_name()
+                .to_string_lossy()
+                .strip_prefix(&prefix)
+                .is_some_and(|rest| {
+                    rest.len() == "0123456789abcdef.rs".len() && rest.ends_with(".rs")
+                });
+        if stale {
+            let _ = std::fs::remove_file(path);
+        }
+    }
 }
 
 /// Derives one model and renders its module; errors name the file.

@@ -731,9 +731,9 @@ impl Emitter {
             Some(f) => f.clone(),
             None => {
                 let name = if self.factors.is_empty() {
-                    "factor".to_string()
+                    "factor__".to_string()
                 } else {
-                    format!("factor{}", self.factors.len() + 1)
+                    format!("factor__{}", self.factors.len() + 1)
                 };
                 let rows: Vec<String> = matrix
                     .iter()

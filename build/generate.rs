@@ -17,6 +17,8 @@ pub struct TaylorFunction {
     dim: usize,
     /// Whether it takes tangent columns (`z: &[f64]`, flat `out`).
     variational: bool,
+    /// The time argument's name (the model's).
+    time: String,
     /// `let &Params { .. } = params;`
     params: String,
     body: Vec<String>,
@@ -100,20 +102,27 @@ impl Context<'_> {
             .collect()
     }
 
+    /// The arguments and first lines of a generated function. The inputs
+    /// are unpacked into the model's own names, state first (an argument is
+    /// read once, before any name of the model can shadow it), then the
+    /// parameters (`params` is a reserved name); the time argument has the
+    /// model's name for time, so no parameter can shadow it.
     fn signature_and_prelude(&self, inputs: Inputs) -> (String, Vec<String>) {
         let n = self.n();
+        let time = &self.model.time;
         let params: Vec<String> = self
             .model
             .parameters
             .iter()
             .map(|p| p.name.clone())
             .collect();
-        let mut prelude = vec![format!("let &Params {{ {} }} = params;", params.join(", "))];
+        let params_line = format!("let &Params {{ {} }} = params;", params.join(", "));
         let phase_line = self
             .model
             .fast_phase
             .as_ref()
-            .map(|f| format!("let {} = t * phase_rate(params);", f.name));
+            .map(|f| format!("let {} = {time} * phase_rate(params);", f.name));
+        let mut prelude = Vec::new();
         let args = match inputs {
             Inputs::Params => "params: &Params".to_string(),
             Inputs::Coordinates => {
@@ -121,10 +130,12 @@ impl Context<'_> {
                 format!("q: &[f64; {n}], params: &Params")
             }
             Inputs::CoordinatesVelocities => {
-                prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
-                prelude.push(format!("let [{}] = *qd;", self.velocities().join(", ")));
-                prelude.extend(phase_line);
-                format!("t: f64, q: &[f64; {n}], qd: &[f64; {n}], params: &Params")
+                prelude.push(format!(
+                    "let ([{}], [{}]) = (*q, *qd);",
+                    self.coordinates().join(", "),
+                    self.velocities().join(", ")
+                ));
+                format!("{time}: f64, q: &[f64; {n}], qd: &[f64; {n}], params: &Params")
             }
             Inputs::ContactState => {
                 prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
@@ -135,13 +146,16 @@ impl Context<'_> {
                 names.extend(self.momenta());
                 prelude.push(format!("let [{}] = *y;", names.join(", ")));
                 if matches!(inputs, Inputs::State) {
-                    prelude.extend(phase_line);
-                    format!("t: f64, y: &[f64; {}], params: &Params", 2 * n)
+                    format!("{time}: f64, y: &[f64; {}], params: &Params", 2 * n)
                 } else {
                     format!("y: &[f64; {}], params: &Params", 2 * n)
                 }
             }
         };
+        prelude.push(params_line);
+        if matches!(inputs, Inputs::State | Inputs::CoordinatesVelocities) {
+            prelude.extend(phase_line);
+        }
         (args, prelude)
     }
 
@@ -200,9 +214,9 @@ impl Context<'_> {
         emitter.whole_angles = true;
         let phase = match &self.model.fast_phase {
             Some(phase) => {
-                let rate = vec![("rate".to_string(), self.model_phase_rate.clone())];
+                let rate = vec![("rate__".to_string(), self.model_phase_rate.clone())];
                 emitter.stage(&rate).map_err(|e| format!("{name}: {e}"))?;
-                Some((phase.name.clone(), "rate".to_string()))
+                Some((phase.name.clone(), "rate__".to_string()))
             }
             None => None,
         };
@@ -222,23 +236,25 @@ impl Context<'_> {
         };
         let body = recurrences(&emitter.into_dag(), &signature, outputs)
             .map_err(|e| format!("{name}: {e}"))?;
-        let (_, prelude) = self.signature_and_prelude(Inputs::Params);
         Ok(TaylorFunction {
             name: name.into(),
             doc: doc.into(),
             dim: outputs.len(),
             variational: signature.state.len() > outputs.len(),
-            params: prelude[0].clone(),
+            time: self.model.time.clone(),
+            params: body.params_line,
             body: body.lines,
         })
     }
 }
 
+/// Outputs `{prefix}__{i}`: generated names contain `__`, which no name of a
+/// model file may, so they never shadow a parameter or coordinate.
 pub fn named(prefix: &str, values: &[String]) -> Vec<(String, String)> {
     values
         .iter()
         .enumerate()
-        .map(|(i, v)| (format!("{prefix}{i}"), v.clone()))
+        .map(|(i, v)| (format!("{prefix}__{i}"), v.clone()))
         .collect()
 }
 
@@ -248,7 +264,7 @@ pub fn matrix(prefix: &str, m: &[Vec<String>]) -> (Vec<(String, String)>, String
     for (i, row) in m.iter().enumerate() {
         let mut cells = Vec::new();
         for (j, v) in row.iter().enumerate() {
-            let name = format!("{prefix}_{i}_{j}");
+            let name = format!("{prefix}__{i}_{j}");
             outputs.push((name.clone(), v.clone()));
             cells.push(name);
         }
@@ -354,8 +370,8 @@ pub fn common_functions(cx: &Context, derivation: &Derivation) -> Result<Vec<Fun
             "dθ/dt of the fast phase θ.",
             Inputs::Params,
             "f64".into(),
-            &[vec![("rate".into(), derivation.phase_rate.clone())]],
-            "rate".into(),
+            &[vec![("rate__".into(), derivation.phase_rate.clone())]],
+            "rate__".into(),
         )?);
     }
     let (outs, result) = vector("p", &derivation.momenta);
@@ -381,8 +397,8 @@ pub fn common_functions(cx: &Context, derivation: &Derivation) -> Result<Vec<Fun
         "Potential energy V(q) (averaged over the phase).",
         Inputs::Coordinates,
         "f64".into(),
-        &[vec![("v".into(), derivation.potential.clone())]],
-        "v".into(),
+        &[vec![("v__".into(), derivation.potential.clone())]],
+        "v__".into(),
     )?);
     let (outs, result) = vector("g", &derivation.potential_gradient);
     functions.push(cx.function(
@@ -451,8 +467,8 @@ fn symbolic_functions(
         "Hamiltonian H(q, p, t).",
         Inputs::State,
         "f64".into(),
-        &[vec![("h".into(), derivation.hamiltonian.clone())]],
-        "h".into(),
+        &[vec![("h__".into(), derivation.hamiltonian.clone())]],
+        "h__".into(),
     )?);
 
     if model.fast_phase.is_some() {
@@ -461,8 +477,11 @@ fn symbolic_functions(
             "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b).",
             Inputs::Coordinates,
             "f64".into(),
-            &[vec![("w".into(), derivation.vibrational_potential.clone())]],
-            "w".into(),
+            &[vec![(
+                "w__".into(),
+                derivation.vibrational_potential.clone(),
+            )]],
+            "w__".into(),
         )?);
         let effective = format!(
             "({}) + ({})",
@@ -473,8 +492,8 @@ fn symbolic_functions(
             "Effective potential V + V_vibr of the averaged system.",
             Inputs::Coordinates,
             "f64".into(),
-            &[vec![("v".into(), effective)]],
-            "v".into(),
+            &[vec![("v__".into(), effective)]],
+            "v__".into(),
         )?);
         let (outs, result) = matrix("b", &derivation.effective_potential_hessian);
         functions.push(cx.function(
@@ -508,8 +527,11 @@ fn symbolic_functions(
             "Averaged Hamiltonian H̄(q, p).",
             Inputs::AveragedState,
             "f64".into(),
-            &[vec![("h".into(), derivation.averaged_hamiltonian.clone())]],
-            "h".into(),
+            &[vec![(
+                "h__".into(),
+                derivation.averaged_hamiltonian.clone(),
+            )]],
+            "h__".into(),
         )?);
     }
 
@@ -677,16 +699,16 @@ pub fn render_contacts(
             "Energy function E = Σ q'∂L/∂q' − L on the guides.",
             Inputs::ContactState,
             "f64".into(),
-            &[vec![("e".into(), derivation.energy.clone())]],
-            "e".into(),
+            &[vec![("e__".into(), derivation.energy.clone())]],
+            "e__".into(),
         )?,
         cx.function(
             "dissipation_power",
             "P_D = Σ q'∂D/∂q': the rate at which the Rayleigh function dissipates energy.",
             Inputs::ContactState,
             "f64".into(),
-            &[vec![("p".into(), derivation.dissipation_power.clone())]],
-            "p".into(),
+            &[vec![("p__".into(), derivation.dissipation_power.clone())]],
+            "p__".into(),
         )?,
     ];
     let mut context = base_context(model, source_file, &derivation.derived);

@@ -26,7 +26,7 @@ use crate::generate::{
 
 /// The name of entry (i, j) of a symmetric matrix `prefix` (upper triangle).
 fn entry(prefix: &str, i: usize, j: usize) -> String {
-    format!("{prefix}_{}_{}", i.min(j), i.max(j))
+    format!("{prefix}__{}_{}", i.min(j), i.max(j))
 }
 
 /// The upper triangle of a symmetric matrix as named outputs.
@@ -52,32 +52,33 @@ fn dot(x: &[String], y: &[String]) -> String {
 }
 
 /// Steps of x_t = A⁻¹g_t for every mode g_t of b over the phase (as
-/// `x{t}_{i}`) and V_vibr = ½ Σ M_st g_s·x_t (as `w_vibr`), from the
-/// coordinates alone.
+/// `solved{t}__{i}`) and V_vibr = ½ Σ M_st g_s·x_t (as `v_vibr__`), from
+/// the coordinates alone. (Generated names contain `__`, which no name of a
+/// model file may: they never shadow a parameter.)
 fn vibrational_steps(derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
     let n = derivation.dof;
-    let mut values = upper("a", &derivation.mass_matrix);
+    let mut values = upper("mass", &derivation.mass_matrix);
     for (s, mode) in form.modes.iter().enumerate() {
         values.extend(
             mode.iter()
                 .enumerate()
-                .map(|(i, g)| (format!("g{s}_{i}"), g.clone())),
+                .map(|(i, g)| (format!("mode{s}__{i}"), g.clone())),
         );
     }
     let mut steps = vec![Step::Values(values)];
     if !form.modes.is_empty() {
         steps.push(Step::Solve {
-            matrix: names("a", n),
+            matrix: names("mass", n),
             columns: (0..form.modes.len())
-                .map(|s| (0..n).map(|i| format!("g{s}_{i}")).collect())
+                .map(|s| (0..n).map(|i| format!("mode{s}__{i}")).collect())
                 .collect(),
             names: (0..form.modes.len())
-                .map(|s| (0..n).map(|i| format!("x{s}_{i}")).collect())
+                .map(|s| (0..n).map(|i| format!("solved{s}__{i}")).collect())
                 .collect(),
         });
     }
     let w_vibr = mode_quadratic_form(n, &form.mode_products);
-    steps.push(Step::Values(vec![("w_vibr".into(), w_vibr)]));
+    steps.push(Step::Values(vec![("v_vibr__".into(), w_vibr)]));
     steps
 }
 
@@ -87,8 +88,8 @@ fn mode_quadratic_form(n: usize, weights: &[Vec<f64>]) -> String {
     for (s, row) in weights.iter().enumerate() {
         for (t, &weight) in row.iter().enumerate() {
             if weight != 0.0 {
-                let g: Vec<String> = (0..n).map(|i| format!("g{s}_{i}")).collect();
-                let x: Vec<String> = (0..n).map(|i| format!("x{t}_{i}")).collect();
+                let g: Vec<String> = (0..n).map(|i| format!("mode{s}__{i}")).collect();
+                let x: Vec<String> = (0..n).map(|i| format!("solved{t}__{i}")).collect();
                 terms.push(format!("{weight:?}*{}", dot(&g, &x)));
             }
         }
@@ -108,23 +109,23 @@ fn exact_steps(
 ) -> (Vec<Step>, Vec<String>) {
     let n = cx.n();
     let momenta = cx.momenta();
-    let mut values = upper("a", &derivation.mass_matrix);
+    let mut values = upper("mass", &derivation.mass_matrix);
     values.extend((0..n).map(|i| {
         (
-            format!("r{i}"),
+            format!("residual__{i}"),
             format!("{}-({})", momenta[i], form.linear_term[i]),
         )
     }));
     let rates: Vec<(String, String)> = (0..n)
-        .map(|i| (format!("dp{i}"), derivation.momentum_rates[i].clone()))
+        .map(|i| (format!("dp__{i}"), derivation.momentum_rates[i].clone()))
         .collect();
     let mut outputs = cx.velocities();
     outputs.extend(rates.iter().map(|(name, _)| name.clone()));
     let steps = vec![
         Step::Values(values),
         Step::Solve {
-            matrix: names("a", n),
-            columns: vec![(0..n).map(|i| format!("r{i}")).collect()],
+            matrix: names("mass", n),
+            columns: vec![(0..n).map(|i| format!("residual__{i}")).collect()],
             names: vec![cx.velocities()],
         },
         Step::Values(rates),
@@ -146,35 +147,38 @@ fn averaged_steps(
     let shifted: Vec<(String, String)> = (0..n)
         .map(|i| {
             (
-                format!("rbar{i}"),
+                format!("residual_mean__{i}"),
                 format!("{}-({})", momenta[i], form.mean_linear_term[i]),
             )
         })
         .collect();
     steps.push(Step::Values(shifted));
     steps.push(Step::Solve {
-        matrix: names("a", n),
-        columns: vec![(0..n).map(|i| format!("rbar{i}")).collect()],
+        matrix: names("mass", n),
+        columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
         names: vec![cx.velocities()],
     });
-    steps.push(Step::Values(vec![("w".into(), dynamic_potential(n, form))]));
+    steps.push(Step::Values(vec![(
+        "w__".into(),
+        dynamic_potential(n, form),
+    )]));
     steps.push(Step::Derivatives(
         coordinates
             .iter()
             .enumerate()
-            .map(|(k, q)| (format!("dw{k}"), "w".to_string(), vec![q.clone()]))
+            .map(|(k, q)| (format!("dw__{k}"), "w__".to_string(), vec![q.clone()]))
             .collect(),
     ));
     let mut field: Vec<(String, String)> = cx
         .velocities()
         .into_iter()
         .enumerate()
-        .map(|(i, v)| (format!("f{i}"), v))
+        .map(|(i, v)| (format!("f__{i}"), v))
         .collect();
     field.extend((0..n).map(|k| {
         (
-            format!("f{}", n + k),
-            format!("({})-dw{k}", form.averaged_momentum_rates[k]),
+            format!("f__{}", n + k),
+            format!("({})-dw__{k}", form.averaged_momentum_rates[k]),
         )
     }));
     let outputs = field.iter().map(|(name, _)| name.clone()).collect();
@@ -186,7 +190,7 @@ fn averaged_steps(
 /// besides V̄ that depends on q alone.
 fn dynamic_potential(n: usize, form: &NumericForm) -> String {
     if form.mode_means.iter().all(|m| *m == 0.0) {
-        return "w_vibr".into();
+        return "v_vibr__".into();
     }
     let weights: Vec<Vec<f64>> = form
         .mode_products
@@ -209,7 +213,7 @@ fn jacobian(prefix: &str, outputs: &[String], variables: &[String]) -> (Step, St
         .enumerate()
         .map(|(i, _)| {
             (0..variables.len())
-                .map(|k| format!("{prefix}_{i}_{k}"))
+                .map(|k| format!("{prefix}__{i}_{k}"))
                 .collect()
         })
         .collect();
@@ -220,7 +224,7 @@ fn jacobian(prefix: &str, outputs: &[String], variables: &[String]) -> (Step, St
             variables
                 .iter()
                 .enumerate()
-                .map(move |(k, v)| (format!("{prefix}_{i}_{k}"), out.clone(), vec![v.clone()]))
+                .map(move |(k, v)| (format!("{prefix}__{i}_{k}"), out.clone(), vec![v.clone()]))
         })
         .collect();
     let rows: Vec<String> = names
@@ -274,7 +278,7 @@ fn field_functions(
         result,
     )?);
     let mut steps = field.steps[..field.hamiltonian_steps].to_vec();
-    steps.push(Step::Values(vec![("h".into(), field.hamiltonian)]));
+    steps.push(Step::Values(vec![("h__".into(), field.hamiltonian)]));
     let name = match field.prefix {
         "exact" => "hamiltonian".to_string(),
         other => format!("{other}_hamiltonian"),
@@ -285,7 +289,7 @@ fn field_functions(
         field.inputs,
         "f64".into(),
         &steps,
-        "h".into(),
+        "h__".into(),
     )?);
     Ok(())
 }
@@ -309,7 +313,7 @@ pub fn functions(
         &exact[..2],
         format!("[{}]", cx.velocities().join(", ")),
     )?);
-    let residuals: Vec<String> = (0..n).map(|i| format!("r{i}")).collect();
+    let residuals: Vec<String> = (0..n).map(|i| format!("residual__{i}")).collect();
     let hamiltonian = format!(
         "{}/2+({})",
         dot(&residuals, &cx.velocities()),
@@ -368,12 +372,12 @@ fn averaged_functions(
         Inputs::Coordinates,
         "f64".into(),
         &vibrational,
-        "w_vibr".into(),
+        "v_vibr__".into(),
     )?);
     let mut effective = vibrational.clone();
     effective.push(Step::Values(vec![(
-        "v".into(),
-        format!("({})+w_vibr", derivation.potential),
+        "v__".into(),
+        format!("({})+v_vibr__", derivation.potential),
     )]));
     functions.push(cx.function_steps(
         "effective_potential",
@@ -381,15 +385,15 @@ fn averaged_functions(
         Inputs::Coordinates,
         "f64".into(),
         &effective,
-        "v".into(),
+        "v__".into(),
     )?);
     let coordinates = cx.coordinates();
     let hessian: Vec<(String, String, Vec<String>)> = (0..n)
         .flat_map(|i| (0..n).map(move |j| (i, j)))
         .map(|(i, j)| {
             (
-                format!("b_{i}_{j}"),
-                "v".to_string(),
+                format!("b__{i}_{j}"),
+                "v__".to_string(),
                 vec![coordinates[i].clone(), coordinates[j].clone()],
             )
         })
@@ -405,9 +409,9 @@ fn averaged_functions(
         result,
     )?);
     let (averaged, outputs) = averaged_steps(cx, derivation, form);
-    let shifted: Vec<String> = (0..n).map(|i| format!("rbar{i}")).collect();
+    let shifted: Vec<String> = (0..n).map(|i| format!("residual_mean__{i}")).collect();
     let hamiltonian = format!(
-        "{}/2+w+({})",
+        "{}/2+w__+({})",
         dot(&shifted, &cx.velocities()),
         derivation.potential
     );

@@ -109,8 +109,19 @@ pub struct Signature {
 
 /// The body of a generated Taylor-coefficient function.
 pub struct TaylorBody {
+    /// `let &Params { .. } = params;`, with parameters whose names the
+    /// function needs for itself bound under other names.
+    pub params_line: String,
     pub lines: Vec<String>,
 }
+
+/// Names the generated Taylor functions use for themselves (arguments,
+/// loop variables, the kernels' module): no node is named so. The time
+/// argument carries the model's name for time and is reserved too.
+const OWN_NAMES: [&str; 13] = [
+    "y", "z", "params", "order", "work", "out", "n", "next", "len", "columns", "column", "offset",
+    "series",
+];
 
 struct Lowering<'a> {
     dag: &'a Dag,
@@ -578,6 +589,18 @@ pub fn recurrences(
     }
     let needed = reachable(&lowering.ops, &lowering.index, &lowering.solves, &roots);
     let names = names(&lowering, dag, &needed);
+    // Parameters bound under their node's name (another where the function
+    // needs the parameter's name for itself), unused ones not at all.
+    let fields: Vec<String> = signature
+        .parameters
+        .iter()
+        .map(|p| match lowering.index.get(&Op::Parameter(p.clone())) {
+            Some(&k) if names[k] == *p => p.clone(),
+            Some(&k) => format!("{p}: {}", names[k]),
+            None => format!("{p}: _"),
+        })
+        .collect();
+    let params_line = format!("let &Params {{ {} }} = params;", fields.join(", "));
     Ok(Writer {
         ops: &lowering.ops,
         classes: &lowering.classes,
@@ -586,8 +609,9 @@ pub fn recurrences(
         index: &lowering.index,
         solves: &lowering.solves,
         declared: Default::default(),
+        time: &signature.time,
     }
-    .body(&roots, dim, tangents == 1))
+    .body(&roots, dim, tangents == 1, params_line))
 }
 
 fn reachable(
@@ -631,7 +655,11 @@ fn reachable(
 /// (constants k1, k2, ...).
 fn names(lowering: &Lowering, dag: &Dag, needed: &[bool]) -> Vec<String> {
     let mut names: Vec<Option<String>> = vec![None; lowering.ops.len()];
-    let mut taken = std::collections::HashSet::new();
+    let mut taken: std::collections::HashSet<String> = OWN_NAMES
+        .iter()
+        .map(|s| s.to_string())
+        .chain([lowering.signature.time.clone()])
+        .collect();
     let mut give = |names: &mut Vec<Option<String>>, k: usize, name: String| {
         if names[k].is_none() && !taken.contains(&name) {
             taken.insert(name.clone());
@@ -680,13 +708,13 @@ fn names(lowering: &Lowering, dag: &Dag, needed: &[bool]) -> Vec<String> {
         if let Some(r) = readable {
             give(&mut names, k, r);
         }
-        if names[k].is_none() {
+        let prefix = if lowering.classes[k] == Class::Constant {
+            "k"
+        } else {
+            "x"
+        };
+        while names[k].is_none() {
             counter += 1;
-            let prefix = if lowering.classes[k] == Class::Constant {
-                "k"
-            } else {
-                "x"
-            };
             give(&mut names, k, format!("{prefix}{counter}"));
         }
     }
@@ -702,6 +730,8 @@ struct Writer<'a> {
     solves: &'a [Solve],
     /// Factorisations already declared in the emitted body, by name.
     declared: std::cell::RefCell<std::collections::HashSet<String>>,
+    /// The time argument's name (the model's).
+    time: &'a str,
 }
 
 impl Writer<'_> {
@@ -729,10 +759,10 @@ impl Writer<'_> {
         let v = |c: usize| self.value(c);
         match &self.ops[k] {
             Op::Literal(l) => l.clone(),
-            Op::Parameter(p) => p.clone(),
+            Op::Parameter(_) => self.names[k].clone(),
             Op::State(i) => format!("y[{i}]"),
-            Op::Time => "t".into(),
-            Op::Phase(r) => format!("{} * t", v(*r)),
+            Op::Time => self.time.to_string(),
+            Op::Phase(r) => format!("{} * {}", v(*r), self.time),
             Op::Neg(a) => format!("-{}", v(*a)),
             Op::Add(a, b) => format!("{} + {}", v(*a), v(*b)),
             Op::Sub(a, b) => format!("{} - {}", v(*a), v(*b)),
@@ -1000,7 +1030,13 @@ impl Writer<'_> {
     /// z.len(); the base recurrences run once, then the tangent
     /// recurrences once per column (a run-time loop, so the generated code
     /// does not grow with the number of tangents).
-    fn body(&self, roots: &[usize], dim: usize, variational: bool) -> TaylorBody {
+    fn body(
+        &self,
+        roots: &[usize],
+        dim: usize,
+        variational: bool,
+        params_line: String,
+    ) -> TaylorBody {
         let mut lines = Vec::new();
         let live: Vec<usize> = (0..self.ops.len()).filter(|&k| self.needed[k]).collect();
         let varying: Vec<usize> = live
@@ -1065,7 +1101,7 @@ impl Writer<'_> {
             lines.push("out[0] = *y;".into());
             self.orders(&base, roots, "", &mut lines);
         }
-        TaylorBody { lines }
+        TaylorBody { params_line, lines }
     }
 
     /// Order 0, then orders 1..order of the nodes `nodes` (in evaluation

@@ -199,11 +199,12 @@ pub struct Contact {
 }
 
 const RESERVED: &[&str] = &[
-    "pi", "e", "i", "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false",
-    "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref",
-    "return", "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe",
-    "use", "where", "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final",
-    "macro", "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
+    "params", "pi", "e", "i", "as", "break", "const", "continue", "crate", "else", "enum",
+    "extern", "false", "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move",
+    "mut", "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true",
+    "type", "unsafe", "use", "where", "while", "async", "await", "dyn", "abstract", "become",
+    "box", "do", "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield",
+    "try", "gen",
 ];
 
 fn is_identifier(name: &str) -> bool {
@@ -339,6 +340,14 @@ impl ModelFile {
             }
             if RESERVED.contains(&name) || super::expr::FUNCTIONS.iter().any(|(f, _)| *f == name) {
                 return Err(err(key, format!("'{name}' is a reserved name")));
+            }
+            if name.starts_with("cse_") {
+                return Err(err(
+                    key,
+                    format!(
+                        "'{name}': names beginning with 'cse_' are reserved for the generated code"
+                    ),
+                ));
             }
             if !seen.insert(name.to_string()) {
                 return Err(err(key, format!("'{name}' is declared twice")));
