@@ -639,6 +639,14 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
     context.insert("source_file", source_file);
     context.insert("params", &params);
     context.insert("derived", &derived);
+    context.insert(
+        "amplitude",
+        &model
+            .fast_phase
+            .as_ref()
+            .and_then(|f| f.amplitude.clone())
+            .unwrap_or_default(),
+    );
     context
 }
 
@@ -730,12 +738,15 @@ pub fn render_registry(
     struct Entry {
         name: String,
         doc: String,
+        /// Degrees of freedom of a Hamiltonian model, 0 for a contact model.
+        dof: usize,
     }
     let entries: Vec<Entry> = models
         .iter()
         .map(|m| Entry {
             name: m.name.clone(),
             doc: format!("{:?}", m.description),
+            dof: if m.contacts.is_empty() { m.dof() } else { 0 },
         })
         .collect();
     let mut context = tera::Context::new();

@@ -27,6 +27,9 @@ pub struct ModelInfo {
     /// Defaults of the model file, as text.
     pub parameter_defaults: &'static [&'static str],
     pub parameter_descriptions: &'static [&'static str],
+    /// The parameter that scales the vibration, if the model file names one
+    /// (`[fast_phase] amplitude`).
+    pub amplitude: Option<&'static str>,
     pub derivations: &'static [DerivedExpression],
     /// Cost of the right-hand sides after CSE (arithmetic operations,
     /// transcendental calls weighted 20, divisions 4): (function, as derived
@@ -129,3 +132,40 @@ impl fmt::Display for ParameterError {
 }
 
 impl std::error::Error for ParameterError {}
+
+/// A generated Hamiltonian model at its own sizes: D degrees of freedom, a
+/// state of S = 2D, and V = S + S² for the state with a full set of tangent
+/// vectors (stable Rust cannot compute S and V from D, so the generated
+/// registry states all three). Analyses written once over this trait are
+/// monomorphised per model by [`crate::models::with_fixed`], so they run at
+/// the speed of code written for that model.
+pub trait Fixed<const D: usize, const S: usize, const V: usize>: Sync + 'static {
+    type Exact: crate::ode::System<S> + Sync;
+    /// The averaged system (the exact one again for a model without a fast
+    /// phase, where [`Fixed::averaged`] gives None).
+    type Averaged: crate::ode::System<S> + Sync;
+    fn info(&self) -> &'static ModelInfo;
+    fn has_fast_phase(&self) -> bool;
+    /// Which coordinates are angles.
+    fn periodic(&self) -> [bool; D];
+    fn exact(&self, params: &[f64]) -> Self::Exact;
+    fn averaged(&self, params: &[f64]) -> Option<Self::Averaged>;
+    /// The period of the fast phase.
+    fn phase_period(&self, params: &[f64]) -> Option<f64>;
+    fn mass_matrix(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
+    /// ∂V/∂q and C = ∂²V/∂q² of the potential averaged over the phase.
+    fn potential_gradient(&self, params: &[f64], q: &[f64; D]) -> [f64; D];
+    fn potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
+    /// V + V_vibr (V without a fast phase) and its Hessian.
+    fn effective_potential(&self, params: &[f64], q: &[f64; D]) -> f64;
+    fn effective_potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
+}
+
+/// Work to run on one model at its own sizes (see [`Fixed`]).
+pub trait WithFixed {
+    type Output;
+    fn run<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output;
+}

@@ -73,6 +73,8 @@ pub enum SceneError {
     /// A numerical failure (divergence, ...), with context.
     #[error("{0}")]
     Numerical(String),
+    #[error(transparent)]
+    Stability(#[from] crate::analysis::stability::StabilityError),
 }
 
 impl From<crate::ode::OdeError> for SceneError {

@@ -473,4 +473,3 @@ fn too_large_models_are_refused_with_a_reason() {
     let ok = mechlab::model::Model::parse("models/chain.toml", &chain(2, "")).unwrap();
     assert_eq!(ok.inverse, mechlab::model::Inverse::Symbolic);
 }
-

@@ -9,6 +9,7 @@ pub mod fit;
 pub mod floquet;
 pub mod lyapunov;
 pub mod period_map;
+pub mod stability;
 pub mod standard_map;
 pub mod variational;
 pub mod vibrational_stability;

@@ -119,6 +119,9 @@ pub struct FastPhaseSpec {
     pub name: String,
     /// dθ/dt as an expression in the parameters.
     pub rate: String,
+    /// The parameter that scales the vibration (the default of the
+    /// `stability` analysis), if any.
+    pub amplitude: Option<String>,
     #[serde(default)]
     pub description: String,
 }
@@ -164,6 +167,8 @@ pub struct Parameter {
 pub struct FastPhase {
     pub name: String,
     pub rate: Expr,
+    /// The parameter that scales the vibration, if the file names one.
+    pub amplitude: Option<String>,
     pub description: String,
 }
 
@@ -443,11 +448,20 @@ impl ModelFile {
         };
 
         let fast_phase = match &self.fast_phase {
-            Some(p) => Some(FastPhase {
-                name: p.name.clone(),
-                rate: parse("fast_phase.rate", &p.rate, &[&parameters], false)?,
-                description: p.description.clone(),
-            }),
+            Some(p) => {
+                if let Some(a) = p.amplitude.as_ref().filter(|a| !parameters.contains(a)) {
+                    return Err(err(
+                        "fast_phase.amplitude",
+                        format!("'{a}' is not a parameter of the model"),
+                    ));
+                }
+                Some(FastPhase {
+                    name: p.name.clone(),
+                    rate: parse("fast_phase.rate", &p.rate, &[&parameters], false)?,
+                    amplitude: p.amplitude.clone(),
+                    description: p.description.clone(),
+                })
+            }
             None => None,
         };
 

@@ -1,0 +1,467 @@
+//! Stabilisation by vibration for any model with a fast phase, by name: the
+//! equilibria of the system without vibration that stay equilibria of the
+//! averaged system, the roots λ of det(C − λA) = 0, the threshold of the
+//! vibration's amplitude from the averaged system, and the exact system's
+//! stability window in the amplitude from its Floquet multipliers.
+//!
+//! The threshold needs no scan: V_vibr is quadratic in the amplitude a (it
+//! is ½ mean(bᵀA⁻¹b) and b is linear in the base's velocity), so the Hessian
+//! of V + V_vibr at an equilibrium is C + a²K. The equilibrium is stable in
+//! the averaged system iff C + a²K is positive definite; with K positive
+//! definite that is a² > μ_max, the largest root of det(−C − μK) = 0. The
+//! generated Hessian is evaluated at a = 0, 1, 2 to find C and K, and the
+//! quadratic dependence is checked (else the reason is given).
+
+use super::floquet::{floquet_multipliers, monodromy, spectral_radius, stability_window};
+use super::vibrational_stability::generalized_eigenvalues;
+use crate::analysis::period_map::wrap_angle;
+use crate::ode::{Integrator, Method, OdeError, System};
+use crate::registry::{Fixed, WithFixed};
+use nalgebra::DMatrix;
+use serde::Serialize;
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+
+/// How the analysis runs.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// The parameter that scales the vibration.
+    pub amplitude: String,
+    /// The exact window is searched on (0, a_max]; None: 3 a* (3 times the
+    /// amplitude's value where there is no a*).
+    pub a_max: Option<f64>,
+    /// Equal steps on (0, a_max] that bracket the window's edges.
+    pub samples: usize,
+    /// The edges are bisected to this (absolute) tolerance.
+    pub edge_tolerance: f64,
+    /// Integration method of the monodromy matrices.
+    pub method: Method,
+}
+
+/// What the analysis says about one equilibrium.
+#[derive(Clone, Debug, Serialize)]
+pub struct EquilibriumStability {
+    pub q: Vec<f64>,
+    /// Roots of det(C − λA) = 0, ascending.
+    pub lambdas: Vec<f64>,
+    pub stable_without_vibration: bool,
+    /// The amplitude above which the averaged system is stable here.
+    pub a_star: Option<f64>,
+    /// Why there is no a*, when there is none.
+    pub reason: Option<String>,
+    /// The first interval of the amplitude on which the exact system is
+    /// stable at (q, 0): [lower, upper] (upper null if beyond a_max).
+    pub exact_window: Option<[Option<f64>; 2]>,
+    /// Why there is no exact window, when there is none.
+    pub exact_reason: Option<String>,
+    /// (a, spectral radius of the monodromy matrix) where it was computed.
+    pub spectral_radius: Vec<[f64; 2]>,
+}
+
+/// The result (and summary) of the analysis.
+#[derive(Clone, Debug, Serialize)]
+pub struct Stability {
+    pub model: String,
+    pub amplitude: String,
+    pub params: BTreeMap<String, f64>,
+    pub equilibria: Vec<EquilibriumStability>,
+    /// Equilibria of the system without vibration that the vibration moves
+    /// (not equilibria of the averaged system).
+    pub moved_by_vibration: Vec<Vec<f64>>,
+}
+
+/// Why the analysis cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum StabilityError {
+    #[error("no Hamiltonian model named '{0}'")]
+    UnknownModel(String),
+    #[error("model '{0}' has no fast phase: there is no vibration to stabilise by")]
+    NoFastPhase(String),
+    #[error(
+        "model '{model}' has no parameter '{name}' to use as the amplitude (parameters: {known})"
+    )]
+    UnknownAmplitude {
+        model: String,
+        name: String,
+        known: String,
+    },
+    #[error("{0} parameter values for model '{1}'")]
+    ParameterCount(usize, String),
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// Runs the analysis on the model `name` with parameter values `params`
+/// (declaration order).
+pub fn stability(
+    name: &str,
+    params: &[f64],
+    settings: &Settings,
+) -> Result<Stability, StabilityError> {
+    crate::models::with_fixed(name, Analysis { params, settings })
+        .ok_or_else(|| StabilityError::UnknownModel(name.to_string()))?
+}
+
+struct Analysis<'a> {
+    params: &'a [f64],
+    settings: &'a Settings,
+}
+
+impl WithFixed for Analysis<'_> {
+    type Output = Result<Stability, StabilityError>;
+    fn run<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        if !model.has_fast_phase() {
+            return Err(StabilityError::NoFastPhase(info.name.into()));
+        }
+        if self.params.len() != info.parameter_names.len() {
+            return Err(StabilityError::ParameterCount(
+                self.params.len(),
+                info.name.into(),
+            ));
+        }
+        let amplitude = info
+            .parameter_names
+            .iter()
+            .position(|p| *p == self.settings.amplitude)
+            .ok_or_else(|| StabilityError::UnknownAmplitude {
+                model: info.name.into(),
+                name: self.settings.amplitude.clone(),
+                known: info.parameter_names.join(", "),
+            })?;
+        let mut result = Stability {
+            model: info.name.into(),
+            amplitude: self.settings.amplitude.clone(),
+            params: info
+                .parameter_names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(self.params.iter().copied())
+                .collect(),
+            equilibria: Vec::new(),
+            moved_by_vibration: Vec::new(),
+        };
+        for q in equilibria_without_vibration(model, self.params) {
+            if !stays_in_averaged_system(model, self.params, &q) {
+                result.moved_by_vibration.push(q.to_vec());
+                continue;
+            }
+            let mut analysed = averaged_verdict(model, self.params, amplitude, &q);
+            exact_window(
+                model,
+                self.params,
+                amplitude,
+                &q,
+                self.settings,
+                &mut analysed,
+            )?;
+            result.equilibria.push(analysed);
+        }
+        Ok(result)
+    }
+}
+
+/// Equilibria of the potential V without vibration: Newton's method on the
+/// generated ∂V/∂q with the generated C, from a grid of starts (angles at
+/// multiples of 2π/m, m = 8 up to 3 degrees of freedom and 4 beyond, other
+/// coordinates on [−2, 2]); duplicates merged (angles modulo 2π).
+fn equilibria_without_vibration<
+    F: Fixed<D, S, V>,
+    const D: usize,
+    const S: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+) -> Vec<[f64; D]> {
+    let periodic = model.periodic();
+    let per_angle = if D <= 3 { 8 } else { 4 };
+    let lengths = [-2.0, -1.0, -0.5, 0.5, 1.0, 2.0];
+    let axis: Vec<Vec<f64>> = periodic
+        .iter()
+        .map(|&p| {
+            if p {
+                (0..per_angle)
+                    .map(|k| wrap_angle(2.0 * PI * k as f64 / per_angle as f64))
+                    .collect()
+            } else {
+                lengths.to_vec()
+            }
+        })
+        .collect();
+    let total: usize = axis.iter().map(Vec::len).product();
+    let mut found: Vec<[f64; D]> = Vec::new();
+    for mut k in 0..total {
+        let mut q = [0.0; D];
+        for (i, values) in axis.iter().enumerate() {
+            q[i] = values[k % values.len()];
+            k /= values.len();
+        }
+        let Some(q) = newton(
+            |q| model.potential_gradient(params, q),
+            |q| model.potential_hessian(params, q),
+            q,
+        ) else {
+            continue;
+        };
+        let q: [f64; D] =
+            std::array::from_fn(|i| if periodic[i] { wrap_angle(q[i]) } else { q[i] });
+        let same = |e: &[f64; D]| {
+            (0..D).all(|i| {
+                let d = if periodic[i] {
+                    wrap_angle(e[i] - q[i])
+                } else {
+                    e[i] - q[i]
+                };
+                d.abs() < 1e-7
+            })
+        };
+        if !found.iter().any(same) {
+            found.push(q);
+        }
+    }
+    found.sort_by(|a, b| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| x.total_cmp(y))
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    found
+}
+
+/// Newton's method for gradient(q) = 0; None unless it converges.
+fn newton<const D: usize>(
+    gradient: impl Fn(&[f64; D]) -> [f64; D],
+    hessian: impl Fn(&[f64; D]) -> [[f64; D]; D],
+    mut q: [f64; D],
+) -> Option<[f64; D]> {
+    for _ in 0..60 {
+        let g = gradient(&q);
+        let h = DMatrix::from_fn(D, D, |i, j| hessian(&q)[i][j]);
+        let step = h.lu().solve(&nalgebra::DVector::from_column_slice(&g))?;
+        for i in 0..D {
+            q[i] -= step[i];
+        }
+        if !q.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        if step.norm() < 1e-13 * (1.0 + q.iter().map(|x| x.abs()).fold(0.0, f64::max)) {
+            let g = gradient(&q);
+            let scale = 1.0
+                + hessian(&q)
+                    .iter()
+                    .flatten()
+                    .map(|x| x.abs())
+                    .fold(0.0, f64::max);
+            return (g.iter().map(|x| x.abs()).fold(0.0, f64::max) < 1e-9 * scale).then_some(q);
+        }
+    }
+    None
+}
+
+/// Whether ∇(V + V_vibr) vanishes at q too (central differences of the
+/// generated V + V_vibr, relative to its Hessian's scale).
+fn stays_in_averaged_system<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    model: &F,
+    params: &[f64],
+    q: &[f64; D],
+) -> bool {
+    let scale = 1.0
+        + model
+            .effective_potential_hessian(params, q)
+            .iter()
+            .flatten()
+            .map(|x| x.abs())
+            .fold(0.0, f64::max);
+    (0..D).all(|i| {
+        let h = 1e-5;
+        let (mut up, mut down) = (*q, *q);
+        up[i] += h;
+        down[i] -= h;
+        let slope = (model.effective_potential(params, &up)
+            - model.effective_potential(params, &down))
+            / (2.0 * h);
+        slope.abs() < 1e-6 * scale
+    })
+}
+
+/// The roots λ, the verdict without vibration and a* from C + a²K.
+fn averaged_verdict<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    model: &F,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64; D],
+) -> EquilibriumStability {
+    let c = model.potential_hessian(params, q);
+    let lambdas = generalized_eigenvalues(&model.mass_matrix(params, q), &c)
+        .map(|l| l.to_vec())
+        .unwrap_or_default();
+    let stable_without_vibration = !lambdas.is_empty() && lambdas.iter().all(|l| *l > 0.0);
+    let (a_star, reason) = threshold(model, params, amplitude, q, stable_without_vibration);
+    EquilibriumStability {
+        q: q.to_vec(),
+        lambdas,
+        stable_without_vibration,
+        a_star,
+        reason,
+        exact_window: None,
+        exact_reason: None,
+        spectral_radius: Vec::new(),
+    }
+}
+
+fn hessian_at<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    model: &F,
+    params: &[f64],
+    amplitude: usize,
+    a: f64,
+    q: &[f64; D],
+) -> DMatrix<f64> {
+    let mut p = params.to_vec();
+    p[amplitude] = a;
+    let h = model.effective_potential_hessian(&p, q);
+    let m = DMatrix::from_fn(D, D, |i, j| h[i][j]);
+    (&m + m.transpose()) * 0.5
+}
+
+fn positive_definite(m: &DMatrix<f64>) -> bool {
+    m.clone().cholesky().is_some()
+}
+
+/// a* with C + a*²K on the edge of positive definiteness, or why none.
+fn threshold<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    model: &F,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64; D],
+    stable_without_vibration: bool,
+) -> (Option<f64>, Option<String>) {
+    let name = model.info().parameter_names[amplitude];
+    let c = hessian_at(model, params, amplitude, 0.0, q);
+    let k = hessian_at(model, params, amplitude, 1.0, q) - &c;
+    let k2 = hessian_at(model, params, amplitude, 2.0, q) - &c;
+    let scale = 1.0 + c.amax() + k.amax();
+    if (&k2 - &k * 4.0).amax() > 1e-8 * scale {
+        return (
+            None,
+            Some(format!(
+                "V + V_vibr is not C + {name}²K: V_vibr is not quadratic in '{name}'"
+            )),
+        );
+    }
+    if stable_without_vibration {
+        return (None, Some("stable without vibration".into()));
+    }
+    if k.amax() <= 1e-12 * scale {
+        return (
+            None,
+            Some(format!(
+                "V_vibr has no curvature here (its Hessian does not change with '{name}', e.g. an isotropic vibration): no amplitude stabilises it"
+            )),
+        );
+    }
+    if let Some(cholesky) = k.clone().cholesky() {
+        // −C x = μ K x ⇔ (L⁻¹(−C)L⁻ᵀ) y = μ y with K = L Lᵀ.
+        let l_inv = cholesky
+            .l()
+            .try_inverse()
+            .unwrap_or_else(|| DMatrix::zeros(D, D));
+        let m = &l_inv * (-&c) * l_inv.transpose();
+        let m = (&m + m.transpose()) * 0.5;
+        let mu = m.symmetric_eigenvalues().max();
+        return (Some(mu.max(0.0).sqrt()), None);
+    }
+    // K only semidefinite: bisect on s = a², where C + sK grows with s.
+    let definite = |s: f64| positive_definite(&(&c + &k * s));
+    let mut high = c.amax() / k.amax().max(1e-300);
+    for _ in 0..40 {
+        if definite(high) {
+            break;
+        }
+        high *= 4.0;
+    }
+    if !definite(high) {
+        return (
+            None,
+            Some(format!(
+                "no amplitude stabilises it: '{name}' does not act on an unstable direction"
+            )),
+        );
+    }
+    let mut low = 0.0;
+    while high - low > 1e-14 * high {
+        let mid = 0.5 * (low + high);
+        if definite(mid) {
+            high = mid;
+        } else {
+            low = mid;
+        }
+    }
+    (Some(high.sqrt()), None)
+}
+
+/// The exact system's stability window in the amplitude at (q, 0), from
+/// the spectral radius of its monodromy matrix over one period of the
+/// phase, if (q, 0) is a solution of the exact system for every amplitude.
+fn exact_window<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    model: &F,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64; D],
+    settings: &Settings,
+    out: &mut EquilibriumStability,
+) -> Result<(), OdeError> {
+    let Some(a_star) = out.a_star else {
+        out.exact_reason = Some("no threshold in the averaged system".into());
+        return Ok(());
+    };
+    let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+    let with = |a: f64| {
+        let mut p = params.to_vec();
+        p[amplitude] = a;
+        p
+    };
+    let probe = with(a_star.max(params[amplitude]));
+    let period = model.phase_period(&probe).unwrap_or(f64::NAN);
+    let exact = model.exact(&probe);
+    let moving = (0..8).any(|k| {
+        let f = exact.rhs(period * k as f64 / 8.0, &y0);
+        f.iter().map(|x| x.abs()).fold(0.0, f64::max) > 1e-9
+    });
+    if moving {
+        out.exact_reason =
+            Some("(q, 0) is not a solution of the exact system: the vibration moves it".into());
+        return Ok(());
+    }
+    let a_max = settings.a_max.unwrap_or(3.0 * a_star);
+    let curve = RefCell::new(Vec::new());
+    let margin = |a: f64| -> Result<f64, OdeError> {
+        let p = with(a);
+        let period = model.phase_period(&p).unwrap_or(f64::NAN);
+        let mut integrator = Integrator::new(settings.method)?;
+        let (_, m) = monodromy::<_, S, V>(&mut integrator, &model.exact(&p), period, &y0)?;
+        let radius = spectral_radius(&floquet_multipliers(&m));
+        curve.borrow_mut().push([a, radius]);
+        Ok(radius - 1.0 - 1e-6)
+    };
+    let window = stability_window(
+        &margin,
+        0.0,
+        a_max,
+        settings.samples,
+        settings.edge_tolerance,
+    )?;
+    match window {
+        Some((low, high)) => out.exact_window = Some([Some(low), high]),
+        None => out.exact_reason = Some(format!("not stable for any amplitude up to {a_max}")),
+    }
+    let mut curve = curve.into_inner();
+    curve.sort_by(|x, y| x[0].total_cmp(&y[0]));
+    out.spectral_radius = curve;
+    Ok(())
+}

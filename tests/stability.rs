@@ -1,0 +1,174 @@
+//! The `stability` analysis on any model by name, against the closed forms
+//! and the study-specific computations it generalises.
+
+use mechlab::analysis::floquet::{first_stability_onset, jury_margin, monodromy};
+use mechlab::analysis::stability::{stability, EquilibriumStability, Settings, StabilityError};
+use mechlab::models::{self, kapitza};
+use mechlab::ode::{Integrator, Method, OdeError};
+use mechlab::studies::double_pendulum::{self as study, threshold_closed_form};
+use std::f64::consts::PI;
+
+fn settings(amplitude: &str) -> Settings {
+    Settings {
+        amplitude: amplitude.into(),
+        a_max: None,
+        samples: 60,
+        edge_tolerance: 1e-11,
+        method: Method::parse("dop853", 1e-12).unwrap(),
+    }
+}
+
+fn defaults(name: &str) -> Vec<f64> {
+    models::dynamic(name).unwrap().defaults()
+}
+
+fn at<'a>(result: &'a [EquilibriumStability], q: &[f64]) -> &'a EquilibriumStability {
+    result
+        .iter()
+        .find(|e| {
+            e.q.iter()
+                .zip(q)
+                .all(|(a, b)| mechlab::analysis::period_map::wrap_angle(a - b).abs() < 1e-8)
+        })
+        .unwrap_or_else(|| panic!("no equilibrium at {q:?} in {result:#?}"))
+}
+
+/// Kapitza: a* = √2 from the averaged system, and the exact lower edge equals
+/// the one found with the Jury criterion |tr M| − 1 − det M on the 2×2
+/// monodromy matrix (as `kapitza_stability` finds A*), to 1e-9.
+#[test]
+fn kapitza_threshold_and_exact_edge() {
+    let result = stability("kapitza", &defaults("kapitza"), &settings("A")).unwrap();
+    assert_eq!(result.equilibria.len(), 2, "{result:#?}");
+    let upright = at(&result.equilibria, &[0.0]);
+    assert!(!upright.stable_without_vibration);
+    assert!((upright.lambdas[0] + 1.0).abs() < 1e-12);
+    assert!((upright.a_star.unwrap() - 2f64.sqrt()).abs() < 1e-12);
+    let hanging = at(&result.equilibria, &[PI]);
+    assert!(hanging.stable_without_vibration && hanging.a_star.is_none());
+    let eps = 0.1;
+    let jury = |a: f64| -> Result<f64, OdeError> {
+        let params = kapitza::Params { A: a, eps, mu: 0.0 };
+        let mut integrator = Integrator::new(Method::parse("dop853", 1e-12)?)?;
+        let (_, m) = monodromy::<_, 2, 6>(
+            &mut integrator,
+            &kapitza::Exact { params },
+            2.0 * PI * eps,
+            &[0.0, 0.0],
+        )?;
+        Ok(jury_margin(&m))
+    };
+    let reference = first_stability_onset(&jury, 0.0, 4.0, 400, 1e-11)
+        .unwrap()
+        .unwrap();
+    let [low, _] = upright.exact_window.unwrap();
+    assert!(
+        (low.unwrap() - reference).abs() < 1e-9,
+        "{low:?} vs {reference}"
+    );
+    // The exact threshold lies above √2 by about 0.62 ε².
+    assert!((reference - 2f64.sqrt() - 0.62 * eps * eps).abs() < 0.01 * eps * eps);
+    // The spectral radius is 1 inside the window and larger outside.
+    let inside = upright
+        .spectral_radius
+        .iter()
+        .filter(|p| p[0] > reference + 0.1 && p[0] < 3.0);
+    assert!(inside.clone().count() > 3 && inside.clone().all(|p| (p[1] - 1.0).abs() < 1e-6));
+}
+
+/// The double pendulum: a* at all four equilibria equals the closed form of
+/// Study 2 (or none where it is stable without vibration), and the exact
+/// window's lower edge at ν = 100 equals the study's.
+#[test]
+fn double_pendulum_thresholds_are_the_closed_forms() {
+    let params = defaults("double_pendulum");
+    let result = stability("double_pendulum", &params, &settings("a")).unwrap();
+    assert_eq!(result.equilibria.len(), 4);
+    let p = models::double_pendulum::Params::from_values(&params);
+    for phi in study::EQUILIBRIA {
+        let e = at(&result.equilibria, &[phi.0, phi.1]);
+        match threshold_closed_form(&p, phi) {
+            Some(a) => assert!(
+                (e.a_star.unwrap() - a).abs() < 1e-9,
+                "{phi:?}: {:?} vs {a}",
+                e.a_star
+            ),
+            None => assert!(e.stable_without_vibration && e.a_star.is_none(), "{phi:?}"),
+        }
+    }
+    let upright = at(&result.equilibria, &[0.0, 0.0]);
+    let window =
+        study::exact_stability_window(&p, (0.0, 0.0), 3.0 * upright.a_star.unwrap(), 60, 1e-12)
+            .unwrap()
+            .unwrap();
+    let [low, high] = upright.exact_window.unwrap();
+    // The study bisects to 1e-6·a_max; this analysis to 1e-11.
+    assert!(
+        (low.unwrap() - window.0).abs() < 1e-5,
+        "{low:?} vs {window:?}"
+    );
+    assert_eq!(high.is_some(), window.1.is_some());
+}
+
+/// The N-link chains (numeric-solve form): a* of the upright from the
+/// normal modes of the hanging chain, a*² = 2/λ_min(A₀⁻¹D).
+#[test]
+fn chain_thresholds_match_the_normal_modes() {
+    for (name, expected) in [
+        ("triple_pendulum", 2.19323942081245),
+        ("quadruple_pendulum", 2.490107120232377),
+    ] {
+        let mut fast = settings("a");
+        fast.samples = 8;
+        fast.edge_tolerance = 1e-6;
+        let result = stability(name, &defaults(name), &fast).unwrap();
+        let upright = at(&result.equilibria, &vec![0.0; result.equilibria[0].q.len()]);
+        assert!(
+            (upright.a_star.unwrap() - expected).abs() < 1e-9,
+            "{name}: {:?}",
+            upright.a_star
+        );
+        // Every link hanging: stable without vibration.
+        let hanging = at(&result.equilibria, &vec![PI; upright.q.len()]);
+        assert!(hanging.stable_without_vibration);
+        assert_eq!(result.equilibria.len(), 1 << upright.q.len());
+    }
+}
+
+/// A pivot on a circle vibrates isotropically: V_vibr = A²/4 is flat, no
+/// amplitude stabilises the upright, and the analysis says why.
+#[test]
+fn an_isotropic_vibration_has_no_threshold() {
+    let result = stability(
+        "circle_pendulum",
+        &defaults("circle_pendulum"),
+        &settings("A"),
+    )
+    .unwrap();
+    let upright = at(&result.equilibria, &[0.0]);
+    assert!(upright.a_star.is_none() && upright.exact_window.is_none());
+    assert!(
+        upright.reason.as_deref().unwrap().contains("no curvature"),
+        "{upright:#?}"
+    );
+}
+
+#[test]
+fn bad_requests_are_typed_errors() {
+    let e = stability(
+        "painleve_klein",
+        &defaults("painleve_klein"),
+        &settings("mu1"),
+    )
+    .unwrap_err();
+    assert!(matches!(e, StabilityError::UnknownModel(_)), "{e}");
+    let e = stability("kapitza", &defaults("kapitza"), &settings("B")).unwrap_err();
+    assert!(
+        e.to_string().contains("no parameter 'B'") && e.to_string().contains("A, eps, mu"),
+        "{e}"
+    );
+    let e = stability("no_such_model", &[], &settings("A")).unwrap_err();
+    assert!(matches!(e, StabilityError::UnknownModel(_)));
+    let e = stability("kapitza", &[1.0], &settings("A")).unwrap_err();
+    assert!(matches!(e, StabilityError::ParameterCount(1, _)));
+}
