@@ -75,6 +75,8 @@ pub enum SceneError {
     Numerical(String),
     #[error(transparent)]
     Stability(#[from] crate::analysis::stability::StabilityError),
+    #[error(transparent)]
+    Averaging(#[from] crate::analysis::averaging::AveragingError),
 }
 
 impl From<crate::ode::OdeError> for SceneError {

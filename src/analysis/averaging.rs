@@ -109,3 +109,177 @@ where
         fits,
     })
 }
+
+/// How [`convergence`] runs.
+#[derive(Clone, Debug)]
+pub struct ConvergenceSettings {
+    /// The parameter swept to change the phase's frequency (None: the one
+    /// parameter the model file's phase rate depends on).
+    pub parameter: Option<String>,
+    /// Its values; the frequency ν = 2π/T of each is measured from the model.
+    pub values: Vec<f64>,
+    /// The common initial state [q; p] (None: q = 0.2, −0.1, 0.2, …, p = 0).
+    pub y0: Option<Vec<f64>>,
+    /// The deviation is the maximum over [0, t_obs].
+    pub t_obs: f64,
+    pub method: Method,
+}
+
+/// Theorem 2 on any model by name: the maximal deviation of each coordinate
+/// between the exact and averaged runs from the same state, against the
+/// frequency of the phase, and its fitted exponent (−1 where the theorem
+/// holds).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct AveragingConvergence {
+    pub model: String,
+    pub parameter: String,
+    pub values: Vec<f64>,
+    pub frequencies: Vec<f64>,
+    pub coordinates: Vec<String>,
+    pub y0: Vec<f64>,
+    /// [coordinate][value]
+    pub max_deviation: Vec<Vec<f64>>,
+    /// The fitted exponent of each coordinate's deviation against ν.
+    pub slope: Vec<f64>,
+    /// The fitted level c in deviation ≈ c ν^slope.
+    pub level: Vec<f64>,
+}
+
+/// Why [`convergence`] cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum AveragingError {
+    #[error("no Hamiltonian model named '{0}'")]
+    UnknownModel(String),
+    #[error("model '{0}' has no fast phase: there is no averaged system")]
+    NoFastPhase(String),
+    #[error("model '{model}': {reason}")]
+    Parameter { model: String, reason: String },
+    #[error("model '{model}': the initial state has {got} components, the model {expected}")]
+    State {
+        model: String,
+        got: usize,
+        expected: usize,
+    },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// Runs [`AveragingConvergence`] on the model `name` with parameter values
+/// `params` (declaration order).
+pub fn convergence(
+    name: &str,
+    params: &[f64],
+    settings: &ConvergenceSettings,
+) -> Result<AveragingConvergence, AveragingError> {
+    crate::models::with_fixed(name, Sweep { params, settings })
+        .ok_or_else(|| AveragingError::UnknownModel(name.to_string()))?
+}
+
+struct Sweep<'a> {
+    params: &'a [f64],
+    settings: &'a ConvergenceSettings,
+}
+
+/// The parameter the model file's phase rate depends on, if exactly one.
+fn rate_parameter(info: &crate::registry::ModelInfo) -> Option<String> {
+    let model = crate::model::Model::parse(info.source_file, info.source).ok()?;
+    let symbols = model.fast_phase?.rate.symbols();
+    (symbols.len() == 1)
+        .then(|| symbols.into_iter().next())
+        .flatten()
+}
+
+impl crate::registry::WithFixed for Sweep<'_> {
+    type Output = Result<AveragingConvergence, AveragingError>;
+    fn run<F: crate::registry::Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        let bad = |reason: String| AveragingError::Parameter {
+            model: info.name.into(),
+            reason,
+        };
+        if !model.has_fast_phase() {
+            return Err(AveragingError::NoFastPhase(info.name.into()));
+        }
+        if self.params.len() != info.parameter_names.len() {
+            return Err(bad(format!("{} parameter values", self.params.len())));
+        }
+        let parameter = match &self.settings.parameter {
+            Some(p) => p.clone(),
+            None => rate_parameter(info).ok_or_else(|| {
+                bad(
+                    "the phase rate depends on more than one parameter: name the one to sweep"
+                        .into(),
+                )
+            })?,
+        };
+        let index = info
+            .parameter_names
+            .iter()
+            .position(|p| *p == parameter)
+            .ok_or_else(|| {
+                bad(format!(
+                    "no parameter '{parameter}' (parameters: {})",
+                    info.parameter_names.join(", ")
+                ))
+            })?;
+        let y0: [f64; S] = match &self.settings.y0 {
+            Some(y) => y.as_slice().try_into().map_err(|_| AveragingError::State {
+                model: info.name.into(),
+                got: y.len(),
+                expected: S,
+            })?,
+            None => std::array::from_fn(|i| match i {
+                i if i < D && i % 2 == 0 => 0.2,
+                i if i < D => -0.1,
+                _ => 0.0,
+            }),
+        };
+        let with = |value: f64| {
+            let mut p = self.params.to_vec();
+            p[index] = value;
+            p
+        };
+        let mut frequencies = Vec::new();
+        for &value in &self.settings.values {
+            let period = model
+                .phase_period(&with(value))
+                .filter(|t| t.is_finite() && *t > 0.0);
+            let period = period.ok_or_else(|| {
+                bad(format!(
+                    "{parameter} = {value} gives no finite period of the phase"
+                ))
+            })?;
+            frequencies.push(2.0 * std::f64::consts::PI / period);
+        }
+        let systems = |nu: f64| {
+            let k = frequencies.iter().position(|f| *f == nu).unwrap_or(0);
+            let p = with(self.settings.values[k]);
+            let averaged = model
+                .averaged(&p)
+                .expect("a model with a fast phase has an averaged system");
+            (model.exact(&p), averaged)
+        };
+        let run = deviation_against_frequency(
+            self.settings.method,
+            &systems,
+            &y0,
+            self.settings.t_obs,
+            &frequencies,
+            D,
+        )?;
+        Ok(AveragingConvergence {
+            model: info.name.into(),
+            parameter,
+            values: self.settings.values.clone(),
+            frequencies,
+            coordinates: info.coordinates.iter().map(|c| c.to_string()).collect(),
+            y0: y0.to_vec(),
+            max_deviation: run.max_deviation,
+            slope: run.fits.iter().map(|f| f.slope).collect(),
+            level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
+        })
+    }
+}
