@@ -42,7 +42,7 @@ fn main() {
             knob("model", "kapitza", "the model (a file models/<name>.toml)"),
             knob("y0", "auto", "initial state, comma-separated: [q; p] or [s; s'] (auto: q = 0.3, 0.5, …, p = 0; contacts: s = 0, −0.3, …, s' = 1)"),
             knob("t_end", "20", "length of the run"),
-            knob("method", "dop853", "integration method (rk4, dop853, gauss4, gauss6, radau5)"),
+            knob("method", "dop853", "integration method (rk4, dop853, gauss4, gauss6, radau5, taylor)"),
             knob("tol", "1e-10", "tolerance, or step for fixed-step methods"),
             knob("samples", "2000", "samples of the time series"),
             knob("periods", "300", "periods of the period map (models with a fast phase)"),

@@ -10,8 +10,8 @@
 //! explorer is for looking, the study scenes for measuring.
 
 use crate::contact::{ContactError, ContactModel, StickSlip};
-use crate::ode::{Integrator, Method, OdeError, System};
-use crate::registry::{DynamicModel, Kind};
+use crate::ode::{Integrator, Method, OdeError};
+use crate::registry::{DynamicModel, Fixed, Kind, WithFixed};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -62,28 +62,6 @@ pub enum ExploreError {
     /// A state of the wrong length or an unsupported size.
     #[error("{0}")]
     Shape(String),
-}
-
-struct Exact<'a, const M: usize> {
-    model: &'a dyn DynamicModel,
-    params: &'a [f64],
-}
-
-impl<const M: usize> System<M> for Exact<'_, M> {
-    fn rhs(&self, t: f64, y: &[f64; M]) -> [f64; M] {
-        to_array(&self.model.exact_rhs(self.params, t, y))
-    }
-}
-
-struct Averaged<'a, const M: usize> {
-    model: &'a dyn DynamicModel,
-    params: &'a [f64],
-}
-
-impl<const M: usize> System<M> for Averaged<'_, M> {
-    fn rhs(&self, _t: f64, y: &[f64; M]) -> [f64; M] {
-        to_array(&self.model.averaged_rhs(self.params, y).unwrap_or_default())
-    }
 }
 
 struct Contacts<'a> {
@@ -152,15 +130,21 @@ pub fn explore(
             y0.len()
         )));
     }
+    let name = model.info().name;
+    let runs = HamiltonianRuns {
+        model,
+        params,
+        y0,
+        settings,
+    };
     match (model.kind(), expected) {
-        (Kind::Hamiltonian { .. }, 2) => hamiltonian::<2>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 4) => hamiltonian::<4>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 6) => hamiltonian::<6>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 8) => hamiltonian::<8>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 10) => hamiltonian::<10>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 12) => hamiltonian::<12>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 14) => hamiltonian::<14>(model, params, y0, settings),
-        (Kind::Hamiltonian { .. }, 16) => hamiltonian::<16>(model, params, y0, settings),
+        (Kind::Hamiltonian { .. }, _) => {
+            crate::models::with_fixed(name, runs).unwrap_or_else(|| {
+                Err(ExploreError::Shape(format!(
+                    "'{name}' is not a generated Hamiltonian model"
+                )))
+            })
+        }
         (Kind::Contacts { .. }, 2) => contacts::<1, 2>(model, params, y0, settings),
         (Kind::Contacts { .. }, 4) => contacts::<2, 4>(model, params, y0, settings),
         (Kind::Contacts { .. }, 6) => contacts::<3, 6>(model, params, y0, settings),
@@ -176,59 +160,75 @@ fn grid(t_end: f64, samples: usize) -> Vec<f64> {
         .collect()
 }
 
-fn hamiltonian<const M: usize>(
-    model: &dyn DynamicModel,
-    params: &[f64],
-    y0: &[f64],
-    settings: &Settings,
-) -> Result<Exploration, ExploreError> {
-    let y0: [f64; M] = to_array(y0);
-    let times = grid(settings.t_end, settings.samples);
-    let exact_system = Exact::<M> { model, params };
-    let exact =
-        Integrator::new(settings.method)?.advance_sampled(&exact_system, 0.0, &y0, &times)?;
-    let mut out = Exploration {
-        exact: exact.iter().map(|y| y.to_vec()).collect(),
-        equilibria: equilibria(model, params),
-        ..Default::default()
-    };
-    match model.phase_period(params) {
-        Some(period) => {
-            let averaged_system = Averaged::<M> { model, params };
-            let averaged = Integrator::new(settings.method)?.advance_sampled(
-                &averaged_system,
-                0.0,
-                &y0,
-                &times,
-            )?;
-            let h0 = model.averaged_energy(params, &y0).unwrap_or(0.0);
-            out.energy_change = averaged
-                .iter()
-                .map(|y| model.averaged_energy(params, y).unwrap_or(0.0) - h0)
-                .collect();
-            out.energy_label = "averaged Hamiltonian: change along the averaged run";
-            out.averaged = Some(averaged.iter().map(|y| y.to_vec()).collect());
-            let map_times: Vec<f64> = (0..=settings.periods).map(|k| k as f64 * period).collect();
-            let map = Integrator::new(settings.method)?.advance_sampled(
-                &exact_system,
-                0.0,
-                &y0,
-                &map_times,
-            )?;
-            out.period_map = Some(map.iter().map(|y| y.to_vec()).collect());
+/// The runs of a Hamiltonian model at its own sizes, on its generated
+/// systems (so every method, `taylor` included, is available).
+struct HamiltonianRuns<'a> {
+    model: &'a dyn DynamicModel,
+    params: &'a [f64],
+    y0: &'a [f64],
+    settings: &'a Settings,
+}
+
+impl WithFixed for HamiltonianRuns<'_> {
+    type Output = Result<Exploration, ExploreError>;
+    fn run<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+        self,
+        fixed: &'static F,
+    ) -> Self::Output {
+        let HamiltonianRuns {
+            model,
+            params,
+            settings,
+            ..
+        } = self;
+        let y0: [f64; S] = to_array(self.y0);
+        let times = grid(settings.t_end, settings.samples);
+        let exact_system = fixed.exact(params);
+        let exact =
+            Integrator::new(settings.method)?.advance_sampled(&exact_system, 0.0, &y0, &times)?;
+        let mut out = Exploration {
+            exact: exact.iter().map(|y| y.to_vec()).collect(),
+            equilibria: equilibria(model, params),
+            ..Default::default()
+        };
+        match (fixed.phase_period(params), fixed.averaged(params)) {
+            (Some(period), Some(averaged_system)) => {
+                let averaged = Integrator::new(settings.method)?.advance_sampled(
+                    &averaged_system,
+                    0.0,
+                    &y0,
+                    &times,
+                )?;
+                let h0 = model.averaged_energy(params, &y0).unwrap_or(0.0);
+                out.energy_change = averaged
+                    .iter()
+                    .map(|y| model.averaged_energy(params, y).unwrap_or(0.0) - h0)
+                    .collect();
+                out.energy_label = "averaged Hamiltonian: change along the averaged run";
+                out.averaged = Some(averaged.iter().map(|y| y.to_vec()).collect());
+                let map_times: Vec<f64> =
+                    (0..=settings.periods).map(|k| k as f64 * period).collect();
+                let map = Integrator::new(settings.method)?.advance_sampled(
+                    &exact_system,
+                    0.0,
+                    &y0,
+                    &map_times,
+                )?;
+                out.period_map = Some(map.iter().map(|y| y.to_vec()).collect());
+            }
+            _ => {
+                let h0 = model.energy(params, 0.0, &y0);
+                out.energy_change = times
+                    .iter()
+                    .zip(&exact)
+                    .map(|(t, y)| model.energy(params, *t, y) - h0)
+                    .collect();
+                out.energy_label = "H(t) − H(0) along the exact run";
+            }
         }
-        None => {
-            let h0 = model.energy(params, 0.0, &y0);
-            out.energy_change = times
-                .iter()
-                .zip(&exact)
-                .map(|(t, y)| model.energy(params, *t, y) - h0)
-                .collect();
-            out.energy_label = "H(t) − H(0) along the exact run";
-        }
+        out.times = times;
+        Ok(out)
     }
-    out.times = times;
-    Ok(out)
 }
 
 fn contacts<const C: usize, const M: usize>(

@@ -67,3 +67,34 @@ fn kapitza_equilibria_match_the_closed_form() {
     let saddle = (2.0 / (a * a)).acos();
     assert!(!at(saddle).stable && !at(-saddle).stable);
 }
+
+/// Through the generated systems `explore` offers every method, `taylor`
+/// included: its runs agree with DOP853's (Kapitza, symbolic form; the
+/// triple pendulum, numeric-solve form).
+#[test]
+fn explore_runs_with_taylor() {
+    for name in ["kapitza", "triple_pendulum"] {
+        let model = models::dynamic(name).unwrap();
+        let n = match model.kind() {
+            Kind::Hamiltonian { dof, .. } => dof,
+            Kind::Contacts { .. } => unreachable!(),
+        };
+        let y0: Vec<f64> = (0..2 * n).map(|i| if i < n { 0.3 } else { 0.0 }).collect();
+        let run = |method: &str, tol: f64| {
+            let settings = Settings {
+                method: Method::parse(method, tol).unwrap(),
+                ..settings()
+            };
+            explore(model, &model.defaults(), &y0, &settings).unwrap()
+        };
+        let (taylor, dop) = (run("taylor", 1e-13), run("dop853", 1e-13));
+        let last = |runs: &Vec<Vec<f64>>| runs.last().unwrap().clone();
+        for (a, b) in last(&taylor.exact).iter().zip(&last(&dop.exact)) {
+            assert!((a - b).abs() < 1e-9, "{name}: {a} vs {b}");
+        }
+        let (ta, da) = (taylor.averaged.unwrap(), dop.averaged.unwrap());
+        for (a, b) in last(&ta).iter().zip(&last(&da)) {
+            assert!((a - b).abs() < 1e-9, "{name} averaged: {a} vs {b}");
+        }
+    }
+}
