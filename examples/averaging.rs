@@ -10,6 +10,7 @@ use mechlab::analysis::averaging::{convergence, AveragingConvergence, Convergenc
 use mechlab::models;
 use mechlab::ode::Method;
 use mechlab::plot::{palette, Figure, PanelSpec};
+use mechlab::registry::display_name;
 use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
 
 fn main() {
@@ -144,7 +145,7 @@ fn figure(result: &AveragingConvergence) -> Figure {
             .collect();
         figure.line(0, &fit, palette(k));
         legend.push((
-            format!("{coordinate}: slope {:.3}", result.slope[k]),
+            format!("{}: slope {:.3}", display_name(coordinate), result.slope[k]),
             palette(k),
         ));
     }

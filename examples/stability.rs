@@ -7,10 +7,11 @@
 //!
 //! `cargo run --release --example stability -- --set model=triple_pendulum`
 
-use mechlab::analysis::stability::{stability, EquilibriumStability, Settings};
+use mechlab::analysis::stability::{stability, EquilibriumStability, Settings, Stability};
 use mechlab::models;
 use mechlab::ode::Method;
 use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
+use mechlab::registry::display_name;
 use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
 
 fn main() {
@@ -81,7 +82,7 @@ fn main() {
             .filter(|e| !e.spectral_radius.is_empty())
             .collect();
         if !drawn.is_empty() {
-            scene.save_figure(&figure(&drawn, &result.amplitude), "spectral_radius.png")?;
+            scene.save_figure(&figure(&drawn, &result), "spectral_radius.png")?;
         }
         scene.write_summary(&result)?;
         Ok(())
@@ -91,17 +92,20 @@ fn main() {
 /// One panel per equilibrium with an exact window: the spectral radius of
 /// the monodromy matrix against the amplitude, a* of the averaged system
 /// and the window's edges.
-fn figure(equilibria: &[&EquilibriumStability], amplitude: &str) -> Figure {
+fn figure(equilibria: &[&EquilibriumStability], result: &Stability) -> Figure {
+    let info = mechlab::registry::find(&result.model).expect("the analysed model exists");
+    let amplitude = display_name(&result.amplitude);
+    let amplitude = amplitude.as_str();
     let titles: Vec<String> = equilibria
         .iter()
         .map(|e| {
-            format!(
-                "q = ({})",
-                e.q.iter()
-                    .map(|x| format!("{x:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
+            let at: Vec<String> = info
+                .coordinates
+                .iter()
+                .zip(&e.q)
+                .map(|(c, x)| format!("{} = {x:.3}", display_name(c)))
+                .collect();
+            at.join(", ")
         })
         .collect();
     // The radius is drawn up to 3 (it is ≈ 1 + growth per period).

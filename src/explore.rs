@@ -171,7 +171,7 @@ struct HamiltonianRuns<'a> {
 
 impl WithFixed for HamiltonianRuns<'_> {
     type Output = Result<Exploration, ExploreError>;
-    fn run<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
         self,
         fixed: &'static F,
     ) -> Self::Output {

@@ -33,5 +33,6 @@ pub mod plot;
 pub mod registry;
 pub mod report;
 pub mod scene;
+pub mod scenes;
 pub mod studies;
 pub mod test_models;

@@ -67,6 +67,7 @@ impl ColorMap {
 }
 
 /// What a panel shows: its title, axis labels, ranges and scales.
+#[derive(Clone, Copy)]
 pub struct PanelSpec<'a> {
     pub title: &'a str,
     pub x_label: &'a str,

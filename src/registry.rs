@@ -39,6 +39,20 @@ pub struct ModelInfo {
     pub generated_code: &'static str,
 }
 
+impl ModelInfo {
+    /// Parameter values in declaration order as name → value; None if there
+    /// are not exactly as many values as parameters.
+    pub fn named_values(&self, values: &[f64]) -> Option<std::collections::BTreeMap<String, f64>> {
+        (values.len() == self.parameter_names.len()).then(|| {
+            self.parameter_names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(values.iter().copied())
+                .collect()
+        })
+    }
+}
+
 /// Finds a model by name.
 pub fn find(name: &str) -> Option<&'static ModelInfo> {
     crate::models::ALL.iter().find(|m| m.name == name)
@@ -134,12 +148,14 @@ impl fmt::Display for ParameterError {
 impl std::error::Error for ParameterError {}
 
 /// A generated Hamiltonian model at its own sizes: D degrees of freedom, a
-/// state of S = 2D, and V = S + S² for the state with a full set of tangent
-/// vectors (stable Rust cannot compute S and V from D, so the generated
-/// registry states all three). Analyses written once over this trait are
+/// state of S = 2D, T = 2S for the state with one tangent vector and
+/// V = S + S² with a full set (stable Rust cannot compute them from D, so
+/// the generated registry states all four). Analyses written once over this trait are
 /// monomorphised per model by [`crate::models::with_fixed`], so they run at
 /// the speed of code written for that model.
-pub trait Fixed<const D: usize, const S: usize, const V: usize>: Sync + 'static {
+pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
+    Sync + 'static
+{
     type Exact: crate::ode::System<S> + Sync;
     /// The averaged system (the exact one again for a model without a fast
     /// phase, where [`Fixed::averaged`] gives None).
@@ -164,8 +180,54 @@ pub trait Fixed<const D: usize, const S: usize, const V: usize>: Sync + 'static 
 /// Work to run on one model at its own sizes (see [`Fixed`]).
 pub trait WithFixed {
     type Output;
-    fn run<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
         self,
         model: &'static F,
     ) -> Self::Output;
+}
+
+/// A name of a model file in the notation of the figures: Greek names as
+/// letters, trailing digits as subscripts, momenta as p_φ₁ (`phi1` → φ₁,
+/// `p_phi1` → p_φ₁, `eps` → ε, `A` → A).
+pub fn display_name(name: &str) -> String {
+    const GREEK: [(&str, &str); 24] = [
+        ("alpha", "α"),
+        ("beta", "β"),
+        ("gamma", "γ"),
+        ("delta", "δ"),
+        ("epsilon", "ε"),
+        ("eps", "ε"),
+        ("zeta", "ζ"),
+        ("eta", "η"),
+        ("theta", "θ"),
+        ("kappa", "κ"),
+        ("lambda", "λ"),
+        ("mu", "μ"),
+        ("nu", "ν"),
+        ("xi", "ξ"),
+        ("pi", "π"),
+        ("rho", "ρ"),
+        ("sigma", "σ"),
+        ("tau", "τ"),
+        ("phi", "φ"),
+        ("chi", "χ"),
+        ("psi", "ψ"),
+        ("omega", "ω"),
+        ("Omega", "Ω"),
+        ("Phi", "Φ"),
+    ];
+    if let Some(coordinate) = name.strip_prefix("p_") {
+        return format!("p_{}", display_name(coordinate));
+    }
+    let stem = name.trim_end_matches(|c: char| c.is_ascii_digit());
+    let digits = &name[stem.len()..];
+    let stem = GREEK
+        .iter()
+        .find(|(latin, _)| *latin == stem)
+        .map_or(stem, |(_, greek)| greek);
+    let subscripts: String = digits
+        .chars()
+        .map(|d| char::from_u32(0x2080 + d.to_digit(10).unwrap_or(0)).unwrap_or(d))
+        .collect();
+    format!("{stem}{subscripts}")
 }

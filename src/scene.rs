@@ -77,6 +77,8 @@ pub enum SceneError {
     Stability(#[from] crate::analysis::stability::StabilityError),
     #[error(transparent)]
     Averaging(#[from] crate::analysis::averaging::AveragingError),
+    #[error(transparent)]
+    ChaosMap(#[from] crate::analysis::chaos_map::ChaosMapError),
 }
 
 impl From<crate::ode::OdeError> for SceneError {

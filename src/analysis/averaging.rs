@@ -191,7 +191,13 @@ fn rate_parameter(info: &crate::registry::ModelInfo) -> Option<String> {
 
 impl crate::registry::WithFixed for Sweep<'_> {
     type Output = Result<AveragingConvergence, AveragingError>;
-    fn run<F: crate::registry::Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    fn run<
+        F: crate::registry::Fixed<D, S, T, V>,
+        const D: usize,
+        const S: usize,
+        const T: usize,
+        const V: usize,
+    >(
         self,
         model: &'static F,
     ) -> Self::Output {
@@ -203,7 +209,7 @@ impl crate::registry::WithFixed for Sweep<'_> {
         if !model.has_fast_phase() {
             return Err(AveragingError::NoFastPhase(info.name.into()));
         }
-        if self.params.len() != info.parameter_names.len() {
+        if info.named_values(self.params).is_none() {
             return Err(bad(format!("{} parameter values", self.params.len())));
         }
         let parameter = match &self.settings.parameter {

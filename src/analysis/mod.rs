@@ -4,6 +4,7 @@
 //! of exact and averaged systems, and stabilisation by vibration.
 
 pub mod averaging;
+pub mod chaos_map;
 pub mod dimension;
 pub mod fit;
 pub mod floquet;

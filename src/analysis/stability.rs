@@ -110,7 +110,7 @@ struct Analysis<'a> {
 
 impl WithFixed for Analysis<'_> {
     type Output = Result<Stability, StabilityError>;
-    fn run<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
         self,
         model: &'static F,
     ) -> Self::Output {
@@ -118,12 +118,9 @@ impl WithFixed for Analysis<'_> {
         if !model.has_fast_phase() {
             return Err(StabilityError::NoFastPhase(info.name.into()));
         }
-        if self.params.len() != info.parameter_names.len() {
-            return Err(StabilityError::ParameterCount(
-                self.params.len(),
-                info.name.into(),
-            ));
-        }
+        let params = info
+            .named_values(self.params)
+            .ok_or_else(|| StabilityError::ParameterCount(self.params.len(), info.name.into()))?;
         let amplitude = info
             .parameter_names
             .iter()
@@ -136,12 +133,7 @@ impl WithFixed for Analysis<'_> {
         let mut result = Stability {
             model: info.name.into(),
             amplitude: self.settings.amplitude.clone(),
-            params: info
-                .parameter_names
-                .iter()
-                .map(|n| n.to_string())
-                .zip(self.params.iter().copied())
-                .collect(),
+            params,
             equilibria: Vec::new(),
             moved_by_vibration: Vec::new(),
         };
@@ -170,9 +162,10 @@ impl WithFixed for Analysis<'_> {
 /// multiples of 2π/m, m = 8 up to 3 degrees of freedom and 4 beyond, other
 /// coordinates on [−2, 2]); duplicates merged (angles modulo 2π).
 fn equilibria_without_vibration<
-    F: Fixed<D, S, V>,
+    F: Fixed<D, S, T, V>,
     const D: usize,
     const S: usize,
+    const T: usize,
     const V: usize,
 >(
     model: &F,
@@ -266,7 +259,13 @@ fn newton<const D: usize>(
 
 /// Whether ∇(V + V_vibr) vanishes at q too (central differences of the
 /// generated V + V_vibr, relative to its Hessian's scale).
-fn stays_in_averaged_system<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+fn stays_in_averaged_system<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
     model: &F,
     params: &[f64],
     q: &[f64; D],
@@ -291,7 +290,13 @@ fn stays_in_averaged_system<F: Fixed<D, S, V>, const D: usize, const S: usize, c
 }
 
 /// The roots λ, the verdict without vibration and a* from C + a²K.
-fn averaged_verdict<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+fn averaged_verdict<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
     model: &F,
     params: &[f64],
     amplitude: usize,
@@ -315,7 +320,13 @@ fn averaged_verdict<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: 
     }
 }
 
-fn hessian_at<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+fn hessian_at<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
     model: &F,
     params: &[f64],
     amplitude: usize,
@@ -334,7 +345,13 @@ fn positive_definite(m: &DMatrix<f64>) -> bool {
 }
 
 /// a* with C + a*²K on the edge of positive definiteness, or why none.
-fn threshold<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+fn threshold<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
     model: &F,
     params: &[f64],
     amplitude: usize,
@@ -408,7 +425,13 @@ fn threshold<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
 /// The exact system's stability window in the amplitude at (q, 0), from
 /// the spectral radius of its monodromy matrix over one period of the
 /// phase, if (q, 0) is a solution of the exact system for every amplitude.
-fn exact_window<F: Fixed<D, S, V>, const D: usize, const S: usize, const V: usize>(
+fn exact_window<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
     model: &F,
     params: &[f64],
     amplitude: usize,

@@ -1,0 +1,241 @@
+//! The FLI chaos map of the period map of any model with a fast phase, by
+//! name: every pixel of a plane of two state components (through a given
+//! state) shaded by the fast Lyapunov indicator of its orbit. For one degree
+//! of freedom the plane is the cylinder (q, p).
+
+use super::lyapunov::{fast_lyapunov_indicator, fli_shading};
+use crate::ode::{Integrator, Method, OdeError};
+use crate::registry::{Fixed, WithFixed};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+
+/// What [`chaos_map`] draws.
+#[derive(Clone, Debug)]
+pub struct ChaosMapSettings {
+    /// The state components ([q; p] indices) along the map's two axes.
+    pub axes: [usize; 2],
+    /// The range of each axis (None: [−π, π] for an angle, [−p_max, p_max]
+    /// otherwise).
+    pub ranges: [Option<(f64, f64)>; 2],
+    /// The half-width of the default range of an axis that is not an angle.
+    pub p_max: f64,
+    /// The state the plane passes through (its other components); None: 0.
+    pub through: Option<Vec<f64>>,
+    /// Pixels per side.
+    pub pixels: usize,
+    /// Periods of the phase per pixel.
+    pub periods: usize,
+    pub method: Method,
+}
+
+/// The map and its key numbers (the FLI values are not serialised: they go
+/// to a CSV beside the summary).
+#[derive(Clone, Debug, Serialize)]
+pub struct ChaosMap {
+    pub model: String,
+    pub params: BTreeMap<String, f64>,
+    /// The names of the two axes' state components.
+    pub axes: [String; 2],
+    pub ranges: [(f64, f64); 2],
+    pub through: Vec<f64>,
+    pub pixels: usize,
+    pub periods: usize,
+    pub method: &'static str,
+    /// Share of pixels above twice the regular level.
+    pub chaotic_fraction: f64,
+    /// ln(periods): the FLI of a regular orbit.
+    pub fli_regular_level: f64,
+    pub seconds: f64,
+    pub f_evals: u64,
+    /// Row-major from the lower left: pixel (i, j) at index j·pixels + i.
+    #[serde(skip)]
+    pub fli: Vec<f64>,
+    /// Grey levels in [0, 1] for the figure (1 = most chaotic).
+    #[serde(skip)]
+    pub shades: Vec<f64>,
+}
+
+impl ChaosMap {
+    /// The centre of pixel k (row-major from the lower left).
+    pub fn pixel(&self, k: usize) -> (f64, f64) {
+        pixel_centre(&self.ranges, self.pixels, k)
+    }
+}
+
+fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64) {
+    let (i, j) = (k % pixels, k / pixels);
+    let at = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / pixels as f64;
+    (at(ranges[0], i), at(ranges[1], j))
+}
+
+/// Why [`chaos_map`] cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ChaosMapError {
+    #[error("no Hamiltonian model named '{0}'")]
+    UnknownModel(String),
+    #[error("model '{0}' has no fast phase: it has no period map")]
+    NoFastPhase(String),
+    #[error("model '{model}': {reason}")]
+    Request { model: String, reason: String },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// The FLI map of the model `name` with parameter values `params`
+/// (declaration order); `row_done` is called as each row is finished (from
+/// the worker threads).
+pub fn chaos_map(
+    name: &str,
+    params: &[f64],
+    settings: &ChaosMapSettings,
+    row_done: &(dyn Fn() + Sync),
+) -> Result<ChaosMap, ChaosMapError> {
+    let work = Map {
+        params,
+        settings,
+        row_done,
+    };
+    crate::models::with_fixed(name, work).ok_or_else(|| ChaosMapError::UnknownModel(name.into()))?
+}
+
+struct Map<'a> {
+    params: &'a [f64],
+    settings: &'a ChaosMapSettings,
+    row_done: &'a (dyn Fn() + Sync),
+}
+
+impl WithFixed for Map<'_> {
+    type Output = Result<ChaosMap, ChaosMapError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        let bad = |reason: String| ChaosMapError::Request {
+            model: info.name.into(),
+            reason,
+        };
+        let settings = self.settings;
+        let period = match model.phase_period(self.params) {
+            Some(t) if model.has_fast_phase() => t,
+            _ => return Err(ChaosMapError::NoFastPhase(info.name.into())),
+        };
+        let params = info
+            .named_values(self.params)
+            .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
+        let names: Vec<&str> = info
+            .coordinates
+            .iter()
+            .chain(info.momenta)
+            .copied()
+            .collect();
+        if settings.axes.iter().any(|&a| a >= S) || settings.axes[0] == settings.axes[1] {
+            return Err(bad(format!(
+                "the axes must be two different state components among {}",
+                names.join(", ")
+            )));
+        }
+        let through: [f64; S] = match &settings.through {
+            Some(y) => y.as_slice().try_into().map_err(|_| {
+                bad(format!(
+                    "the state to pass through has {} components, not {S}",
+                    y.len()
+                ))
+            })?,
+            None => [0.0; S],
+        };
+        let periodic = model.periodic();
+        let ranges: [(f64, f64); 2] = std::array::from_fn(|k| {
+            let axis = settings.axes[k];
+            settings.ranges[k].unwrap_or(if axis < D && periodic[axis] {
+                (-PI, PI)
+            } else {
+                (-settings.p_max, settings.p_max)
+            })
+        });
+        let system = model.exact(self.params);
+        // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
+        let w0 = [(1.0 / S as f64).sqrt(); S];
+        let pixels = settings.pixels;
+        let start = std::time::Instant::now();
+        let rows: Vec<Result<(Vec<f64>, u64), OdeError>> = (0..pixels)
+            .into_par_iter()
+            .map(|j| {
+                let mut integrator = Integrator::new(settings.method)?;
+                let row = (0..pixels)
+                    .map(|i| {
+                        let (x, y) = pixel_centre(&ranges, pixels, j * pixels + i);
+                        let mut y0 = through;
+                        y0[settings.axes[0]] = x;
+                        y0[settings.axes[1]] = y;
+                        fast_lyapunov_indicator::<_, S, T>(
+                            &mut integrator,
+                            &system,
+                            period,
+                            &y0,
+                            &w0,
+                            settings.periods,
+                        )
+                    })
+                    .collect::<Result<Vec<f64>, _>>()?;
+                (self.row_done)();
+                Ok((row, integrator.stats.f_evals))
+            })
+            .collect();
+        let seconds = start.elapsed().as_secs_f64();
+        let (mut fli, mut f_evals) = (Vec::with_capacity(pixels * pixels), 0);
+        for row in rows {
+            let (values, evals) = row?;
+            fli.extend(values);
+            f_evals += evals;
+        }
+        let shading = fli_shading(&fli, settings.periods);
+        Ok(ChaosMap {
+            model: info.name.into(),
+            params,
+            axes: settings.axes.map(|a| names[a].to_string()),
+            ranges,
+            through: through.to_vec(),
+            pixels,
+            periods: settings.periods,
+            method: settings.method.name(),
+            chaotic_fraction: shading.chaotic_fraction,
+            fli_regular_level: shading.regular_level,
+            seconds,
+            f_evals,
+            fli,
+            shades: shading.shades,
+        })
+    }
+}
+
+impl ChaosMap {
+    /// The map in grey and in viridis (the chaotic layer dark in grey,
+    /// bright in viridis), axes in the model's notation.
+    pub fn figures(&self) -> [crate::plot::Figure; 2] {
+        use crate::plot::{ColorMap, Figure, PanelSpec};
+        use crate::registry::display_name;
+        let params: Vec<String> = self
+            .params
+            .iter()
+            .map(|(k, v)| format!("{} = {v}", display_name(k)))
+            .collect();
+        let title = format!(
+            "{}: FLI map, {}, {} periods",
+            self.model,
+            params.join(", "),
+            self.periods
+        );
+        let (x, y) = (display_name(&self.axes[0]), display_name(&self.axes[1]));
+        let side = self.pixels.max(360);
+        let spec = PanelSpec::new(&title, &x, &y, self.ranges[0], self.ranges[1]);
+        let label = "FLI: regular level (0) to the 99th percentile (1)";
+        [ColorMap::Grey, ColorMap::Viridis].map(|colors| {
+            let mut figure = Figure::single(side + 90, side + 75, spec);
+            figure.shaded_map(0, self.pixels, self.pixels, &self.shades, colors, label);
+            figure
+        })
+    }
+}

@@ -1,0 +1,125 @@
+//! The FLI chaos map of any model by name against the direct computation
+//! of `kapitza_chaos_map` and of a plane of the double pendulum.
+
+use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings};
+use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
+use mechlab::models::{self, double_pendulum, kapitza};
+use mechlab::ode::{Integrator, Method};
+use std::f64::consts::{FRAC_1_SQRT_2, PI};
+
+fn settings(axes: [usize; 2], pixels: usize, periods: usize) -> ChaosMapSettings {
+    ChaosMapSettings {
+        axes,
+        ranges: [None, None],
+        p_max: 3.0,
+        through: None,
+        pixels,
+        periods,
+        method: Method::parse("taylor", 1e-6).unwrap(),
+    }
+}
+
+/// Same FLI per pixel as the Kapitza scene's own loop (cell centres on
+/// [−π, π] × [−p_max, p_max], tangent (1, 1)/√2), to 1e-9.
+#[test]
+fn kapitza_map_is_the_scene_s_map() {
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    let map = chaos_map(
+        "kapitza",
+        &params.values(),
+        &settings([0, 1], 12, 40),
+        &|| {},
+    )
+    .unwrap();
+    assert_eq!((map.axes[0].as_str(), map.axes[1].as_str()), ("q", "p_q"));
+    let system = kapitza::Exact { params };
+    let mut integrator = Integrator::new(Method::parse("taylor", 1e-6).unwrap()).unwrap();
+    for k in 0..144 {
+        let (i, j) = (k % 12, k / 12);
+        let q = -PI + 2.0 * PI * (i as f64 + 0.5) / 12.0;
+        let p = -3.0 + 6.0 * (j as f64 + 0.5) / 12.0;
+        let direct = fast_lyapunov_indicator::<_, 2, 4>(
+            &mut integrator,
+            &system,
+            2.0 * PI * 0.1,
+            &[q, p],
+            &[FRAC_1_SQRT_2; 2],
+            40,
+        )
+        .unwrap();
+        assert!(
+            (map.fli[k] - direct).abs() < 1e-9,
+            "pixel {k}: {} vs {direct}",
+            map.fli[k]
+        );
+        assert_eq!(map.pixel(k), (q, p));
+    }
+    assert!(map.fli.iter().all(|f| f.is_finite()) && map.chaotic_fraction < 0.5);
+}
+
+/// A plane (φ₁, p_φ₁) of the double pendulum through a given state.
+#[test]
+fn a_plane_of_a_larger_model() {
+    let params = double_pendulum::Params::default();
+    let mut s = settings([0, 2], 3, 10);
+    s.through = Some(vec![0.0, 0.1, 0.0, 0.05]);
+    s.ranges = [None, Some((-1.0, 1.0))];
+    let map = chaos_map("double_pendulum", &params.values(), &s, &|| {}).unwrap();
+    assert_eq!(map.axes, ["phi1".to_string(), "p_phi1".to_string()]);
+    let system = double_pendulum::Exact { params };
+    let mut integrator = Integrator::new(Method::parse("taylor", 1e-6).unwrap()).unwrap();
+    for k in [0, 4, 8] {
+        let (x, y) = map.pixel(k);
+        let direct = fast_lyapunov_indicator::<_, 4, 8>(
+            &mut integrator,
+            &system,
+            2.0 * PI / params.nu,
+            &[x, 0.1, y, 0.05],
+            &[0.5; 4],
+            10,
+        )
+        .unwrap();
+        assert!((map.fli[k] - direct).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn bad_requests_are_typed_errors() {
+    let kapitza = models::dynamic("kapitza").unwrap().defaults();
+    let e = chaos_map("kapitza", &kapitza, &settings([0, 2], 2, 2), &|| {}).unwrap_err();
+    assert!(e.to_string().contains("q, p_q"), "{e}");
+    let e = chaos_map("kapitza", &kapitza, &settings([1, 1], 2, 2), &|| {}).unwrap_err();
+    assert!(matches!(e, ChaosMapError::Request { .. }));
+    let mut s = settings([0, 1], 2, 2);
+    s.through = Some(vec![0.0; 3]);
+    assert!(chaos_map("kapitza", &kapitza, &s, &|| {}).is_err());
+    let none = models::dynamic("painleve_klein").unwrap().defaults();
+    assert!(matches!(
+        chaos_map("painleve_klein", &none, &settings([0, 1], 2, 2), &|| {}),
+        Err(ChaosMapError::UnknownModel(_))
+    ));
+}
+
+/// Figure labels use the model's notation.
+#[test]
+fn names_are_drawn_in_the_notation_of_the_studies() {
+    use mechlab::registry::display_name;
+    for (name, shown) in [
+        ("phi1", "φ₁"),
+        ("p_phi1", "p_φ₁"),
+        ("eps", "ε"),
+        ("A", "A"),
+        ("l12", "l₁₂"),
+        ("p_q", "p_q"),
+        ("nu", "ν"),
+        ("tau", "τ"),
+        ("mu1", "μ₁"),
+        ("phid", "phid"),
+    ] {
+        assert_eq!(display_name(name), shown);
+    }
+}
