@@ -41,8 +41,8 @@ fn main() {
             ),
             knob(
                 "values",
-                "400,800,1600,3200,6400",
-                "its values, comma-separated",
+                "auto",
+                "its values, comma-separated (auto: ν at 4…64 times the model's frequency)",
             ),
             knob(
                 "y0",
@@ -62,7 +62,9 @@ fn main() {
         let settings = ConvergenceSettings {
             parameter: (scene.text("parameter") != "auto")
                 .then(|| scene.text("parameter").to_string()),
-            values: scene.numbers("values")?,
+            values: (scene.text("values") != "auto")
+                .then(|| scene.numbers("values"))
+                .transpose()?,
             y0: (scene.text("y0") != "auto")
                 .then(|| scene.numbers("y0"))
                 .transpose()?,

@@ -55,6 +55,9 @@ fn main() {
             method: Method::parse(scene.text("method"), scene.positive("tol")?)?,
         };
         let result = stability(&name, &scene.parameter_values(info)?, &settings)?;
+        for q in &result.moved_by_vibration {
+            eprintln!("q = {q:?}: an equilibrium without vibration that the vibration moves");
+        }
         for e in &result.equilibria {
             eprintln!(
                 "q = {:?}: λ = {:?}, a* = {:?} {}, exact window {:?}",

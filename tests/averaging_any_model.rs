@@ -8,7 +8,7 @@ use mechlab::ode::Method;
 fn settings(parameter: Option<&str>, values: &[f64]) -> ConvergenceSettings {
     ConvergenceSettings {
         parameter: parameter.map(str::to_string),
-        values: values.to_vec(),
+        values: Some(values.to_vec()),
         y0: None,
         t_obs: 2.0,
         method: Method::parse("dop853", 1e-11).unwrap(),
@@ -48,7 +48,15 @@ fn deviation_falls_like_one_over_the_frequency() {
             assert!(hi < 1.5 * lo, "{name}: ν·deviation {levels:?}");
         }
     }
-    // Kapitza's rate is 1/ε: the swept parameter is ε, ν = 1/ε.
+    // Kapitza's rate is 1/ε: the swept parameter is ε, ν = 1/ε; without
+    // values, ν runs over 4…64 times the default frequency 1/ε = 10.
+    let mut auto = settings(None, &[]);
+    auto.values = None;
+    let result = convergence("kapitza", &defaults("kapitza"), &auto).unwrap();
+    assert!(
+        (result.values[0] - 0.025).abs() < 1e-15 && (result.frequencies[4] - 640.0).abs() < 1e-9
+    );
+    assert!((result.slope[0] + 1.0).abs() < 0.15, "{:?}", result.slope);
     let result = convergence(
         "kapitza",
         &defaults("kapitza"),

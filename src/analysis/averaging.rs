@@ -116,8 +116,11 @@ pub struct ConvergenceSettings {
     /// The parameter swept to change the phase's frequency (None: the one
     /// parameter the model file's phase rate depends on).
     pub parameter: Option<String>,
-    /// Its values; the frequency ν = 2π/T of each is measured from the model.
-    pub values: Vec<f64>,
+    /// Its values; the frequency ν = 2π/T of each is measured from the
+    /// model. None: the values at which ν is 4, 8, 16, 32 and 64 times the
+    /// frequency at the given parameters (for a rate proportional or
+    /// inversely proportional to the parameter).
+    pub values: Option<Vec<f64>>,
     /// The common initial state [q; p] (None: q = 0.2, −0.1, 0.2, …, p = 0).
     pub y0: Option<Vec<f64>>,
     /// The deviation is the maximum over [0, t_obs].
@@ -148,7 +151,7 @@ pub struct AveragingConvergence {
 /// Why [`convergence`] cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum AveragingError {
-    #[error("no Hamiltonian model named '{0}'")]
+    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
     UnknownModel(String),
     #[error("model '{0}' has no fast phase: there is no averaged system")]
     NoFastPhase(String),
@@ -248,21 +251,41 @@ impl crate::registry::WithFixed for Sweep<'_> {
             p[index] = value;
             p
         };
-        let mut frequencies = Vec::new();
-        for &value in &self.settings.values {
-            let period = model
+        let frequency = |value: f64| {
+            model
                 .phase_period(&with(value))
-                .filter(|t| t.is_finite() && *t > 0.0);
-            let period = period.ok_or_else(|| {
+                .filter(|t| t.is_finite() && *t > 0.0)
+                .map(|t| 2.0 * std::f64::consts::PI / t)
+        };
+        let values = match &self.settings.values {
+            Some(values) => values.clone(),
+            None => {
+                let p0 = self.params[index];
+                let (f1, f2) = (frequency(p0), frequency(2.0 * p0));
+                let ratio = f1.zip(f2).map(|(a, b)| b / a).unwrap_or(f64::NAN);
+                let factors = [4.0, 8.0, 16.0, 32.0, 64.0];
+                if (ratio - 2.0).abs() < 1e-9 {
+                    factors.map(|k| p0 * k).to_vec()
+                } else if (ratio - 0.5).abs() < 1e-9 {
+                    factors.map(|k| p0 / k).to_vec()
+                } else {
+                    return Err(bad(format!(
+                        "the frequency is not proportional or inversely proportional to '{parameter}': give the values"
+                    )));
+                }
+            }
+        };
+        let mut frequencies = Vec::new();
+        for &value in &values {
+            frequencies.push(frequency(value).ok_or_else(|| {
                 bad(format!(
                     "{parameter} = {value} gives no finite period of the phase"
                 ))
-            })?;
-            frequencies.push(2.0 * std::f64::consts::PI / period);
+            })?);
         }
         let systems = |nu: f64| {
             let k = frequencies.iter().position(|f| *f == nu).unwrap_or(0);
-            let p = with(self.settings.values[k]);
+            let p = with(values[k]);
             let averaged = model
                 .averaged(&p)
                 .expect("a model with a fast phase has an averaged system");
@@ -279,7 +302,7 @@ impl crate::registry::WithFixed for Sweep<'_> {
         Ok(AveragingConvergence {
             model: info.name.into(),
             parameter,
-            values: self.settings.values.clone(),
+            values: values.clone(),
             frequencies,
             coordinates: info.coordinates.iter().map(|c| c.to_string()).collect(),
             y0: y0.to_vec(),

@@ -43,8 +43,12 @@ pub struct ChaosMap {
     pub pixels: usize,
     pub periods: usize,
     pub method: &'static str,
-    /// Share of pixels above twice the regular level.
+    /// Share of pixels above twice the regular level (diverged ones too).
     pub chaotic_fraction: f64,
+    /// Pixels whose orbit left the model's domain (a non-finite state, or a
+    /// step-size underflow at a singular point): their FLI is +∞, shaded as
+    /// the most chaotic.
+    pub diverged: usize,
     /// ln(periods): the FLI of a regular orbit.
     pub fli_regular_level: f64,
     pub seconds: f64,
@@ -73,7 +77,7 @@ fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64)
 /// Why [`chaos_map`] cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum ChaosMapError {
-    #[error("no Hamiltonian model named '{0}'")]
+    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
     UnknownModel(String),
     #[error("model '{0}' has no fast phase: it has no period map")]
     NoFastPhase(String),
@@ -164,22 +168,32 @@ impl WithFixed for Map<'_> {
             .into_par_iter()
             .map(|j| {
                 let mut integrator = Integrator::new(settings.method)?;
-                let row = (0..pixels)
-                    .map(|i| {
-                        let (x, y) = pixel_centre(&ranges, pixels, j * pixels + i);
-                        let mut y0 = through;
-                        y0[settings.axes[0]] = x;
-                        y0[settings.axes[1]] = y;
-                        fast_lyapunov_indicator::<_, S, T>(
-                            &mut integrator,
-                            &system,
-                            period,
-                            &y0,
-                            &w0,
-                            settings.periods,
-                        )
-                    })
-                    .collect::<Result<Vec<f64>, _>>()?;
+                let mut row = Vec::with_capacity(pixels);
+                for i in 0..pixels {
+                    let (x, y) = pixel_centre(&ranges, pixels, j * pixels + i);
+                    let mut y0 = through;
+                    y0[settings.axes[0]] = x;
+                    y0[settings.axes[1]] = y;
+                    let fli = fast_lyapunov_indicator::<_, S, T>(
+                        &mut integrator,
+                        &system,
+                        period,
+                        &y0,
+                        &w0,
+                        settings.periods,
+                    );
+                    row.push(match fli {
+                        Ok(fli) => fli,
+                        // The orbit left the model's domain or ran into a
+                        // singular point (a non-finite state, or steps
+                        // shrinking to nothing): infinitely chaotic, counted.
+                        Err(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. }) => {
+                            integrator = Integrator::new(settings.method)?;
+                            f64::INFINITY
+                        }
+                        Err(e) => return Err(e),
+                    });
+                }
                 (self.row_done)();
                 Ok((row, integrator.stats.f_evals))
             })
@@ -202,6 +216,7 @@ impl WithFixed for Map<'_> {
             periods: settings.periods,
             method: settings.method.name(),
             chaotic_fraction: shading.chaotic_fraction,
+            diverged: fli.iter().filter(|f| f.is_infinite()).count(),
             fli_regular_level: shading.regular_level,
             seconds,
             f_evals,

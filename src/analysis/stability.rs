@@ -74,7 +74,7 @@ pub struct Stability {
 /// Why the analysis cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum StabilityError {
-    #[error("no Hamiltonian model named '{0}'")]
+    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
     UnknownModel(String),
     #[error("model '{0}' has no fast phase: there is no vibration to stabilise by")]
     NoFastPhase(String),

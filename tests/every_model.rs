@@ -1,0 +1,146 @@
+//! Every generic analysis on every model file in `models/`: a result with
+//! properties that hold for any model, or a typed refusal with its reason.
+
+use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
+use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings};
+use mechlab::analysis::stability::{stability, Settings, StabilityError};
+use mechlab::models;
+use mechlab::ode::Method;
+use mechlab::registry::Kind;
+use nalgebra::DMatrix;
+
+#[test]
+fn every_analysis_runs_on_every_model_or_says_why_not() {
+    for info in models::ALL {
+        let model = models::dynamic(info.name).unwrap();
+        let params = model.defaults();
+        let Kind::Hamiltonian { dof: n, .. } = model.kind() else {
+            let e = stability(info.name, &params, &stability_settings("mu1")).unwrap_err();
+            assert!(
+                matches!(e, StabilityError::UnknownModel(_))
+                    && e.to_string().contains("contact model")
+            );
+            let e = convergence(info.name, &params, &averaging_settings()).unwrap_err();
+            assert!(matches!(e, AveragingError::UnknownModel(_)));
+            let e = chaos_map(info.name, &params, &map_settings(5), &|| {}).unwrap_err();
+            assert!(matches!(e, ChaosMapError::UnknownModel(_)));
+            continue;
+        };
+        let amplitude = info
+            .amplitude
+            .expect("every vibrating model names its amplitude");
+        check_stability(info.name, &params, amplitude, n);
+        let result = convergence(info.name, &params, &averaging_settings()).unwrap();
+        for (c, slope) in result.coordinates.iter().zip(&result.slope) {
+            assert!(
+                (slope + 1.0).abs() < 0.2,
+                "{}: {c}: slope {slope}",
+                info.name
+            );
+        }
+        // The FLI is a maximum over the iterations: more periods never lower it.
+        let (short, long) = (
+            chaos_map(info.name, &params, &map_settings(4), &|| {}).unwrap(),
+            chaos_map(info.name, &params, &map_settings(8), &|| {}).unwrap(),
+        );
+        assert_eq!(short.fli.len(), 9);
+        // A pixel whose orbit left the model's domain (+∞: the elastic
+        // pendulum's plane crosses r = 0) stays so.
+        for (a, b) in short.fli.iter().zip(&long.fli) {
+            assert!(
+                *b >= *a && !a.is_nan(),
+                "{}: FLI {a} after 4 periods, {b} after 8",
+                info.name
+            );
+        }
+        assert_eq!(
+            short.diverged,
+            short.fli.iter().filter(|f| f.is_infinite()).count()
+        );
+    }
+}
+
+/// Each reported equilibrium is one of V + V_vibr, has n roots λ, and where
+/// there is a threshold C + a²K is positive definite just above a* and not
+/// just below.
+fn check_stability(name: &str, params: &[f64], amplitude: &str, n: usize) {
+    let model = models::dynamic(name).unwrap();
+    let result = stability(name, params, &stability_settings(amplitude)).unwrap();
+    let k = model
+        .info()
+        .parameter_names
+        .iter()
+        .position(|p| *p == amplitude)
+        .unwrap();
+    let hessian = |a: f64, q: &[f64]| {
+        let mut p = params.to_vec();
+        p[k] = a;
+        DMatrix::from_row_slice(n, n, &model.effective_potential_hessian(&p, q).unwrap())
+    };
+    for e in &result.equilibria {
+        assert_eq!(e.lambdas.len(), n, "{name}");
+        let v = |q: &[f64]| model.effective_potential(params, q).unwrap();
+        for i in 0..n {
+            let h = 1e-5;
+            let (mut up, mut down) = (e.q.clone(), e.q.clone());
+            up[i] += h;
+            down[i] -= h;
+            assert!(
+                ((v(&up) - v(&down)) / (2.0 * h)).abs() < 1e-6,
+                "{name}: not stationary at {:?}",
+                e.q
+            );
+        }
+        assert_eq!(
+            e.stable_without_vibration,
+            e.lambdas.iter().all(|l| *l > 0.0)
+        );
+        match e.a_star {
+            Some(a) => {
+                assert!(
+                    hessian(a * (1.0 + 1e-6), &e.q).cholesky().is_some(),
+                    "{name} {:?}",
+                    e.q
+                );
+                assert!(
+                    hessian(a * (1.0 - 1e-6), &e.q).cholesky().is_none(),
+                    "{name} {:?}",
+                    e.q
+                );
+            }
+            None => assert!(e.reason.is_some(), "{name}: no a* and no reason"),
+        }
+    }
+}
+
+fn stability_settings(amplitude: &str) -> Settings {
+    Settings {
+        amplitude: amplitude.into(),
+        a_max: None,
+        samples: 6,
+        edge_tolerance: 1e-4,
+        method: Method::parse("taylor", 1e-10).unwrap(),
+    }
+}
+
+fn averaging_settings() -> ConvergenceSettings {
+    ConvergenceSettings {
+        parameter: None,
+        values: None,
+        y0: None,
+        t_obs: 2.0,
+        method: Method::parse("dop853", 1e-11).unwrap(),
+    }
+}
+
+fn map_settings(periods: usize) -> ChaosMapSettings {
+    ChaosMapSettings {
+        axes: [0, 1],
+        ranges: [None, None],
+        p_max: 1.0,
+        through: None,
+        pixels: 3,
+        periods,
+        method: Method::parse("taylor", 1e-8).unwrap(),
+    }
+}
