@@ -142,3 +142,181 @@ pub fn chaos_map_scene(
     scene.write_summary(&map)?;
     Ok(())
 }
+
+/// The `averaging` scene: Theorem 2 on any model — the deviation between
+/// the exact and averaged runs from the same state against the phase's
+/// frequency, with the fitted slopes, and ν × deviation. `values` takes a
+/// list, `auto`, or `geometric:first,last,count`.
+pub fn averaging_scene(
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
+    use crate::analysis::averaging::{convergence, ConvergenceSettings};
+    let default = |name: &str, value: &'static str| -> &'static str {
+        overrides
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(value, |(_, v)| v)
+    };
+    let info = model_from_args(default("model", "double_pendulum"))?;
+    let [method, tol] = method_knobs(default("method", "dop853"), default("tol", "1e-11"));
+    let mut knobs = vec![
+        knob("model", default("model", "double_pendulum"), "the model (a file models/<name>.toml) with a fast phase"),
+        knob("parameter", default("parameter", "auto"), "the parameter swept to change ν (auto: the one the phase rate depends on)"),
+        knob("values", default("values", "auto"), "its values: a list, geometric:first,last,count, or auto (ν at 4…64 times the model's frequency)"),
+        knob("y0", default("y0", "auto"), "the common initial state [q; p], comma-separated (auto: q = 0.2, −0.1, …, p = 0)"),
+        knob("t_obs", default("t_obs", "2"), "the deviation is the maximum over [0, t_obs]"),
+        method,
+        tol,
+    ];
+    knobs.extend(parameter_knobs(info, overrides));
+    let scene = Scene::from_args(
+        scene_name,
+        "exact against averaged: the deviation against the frequency",
+        &knobs,
+    )?;
+    let settings = ConvergenceSettings {
+        parameter: (scene.text("parameter") != "auto").then(|| scene.text("parameter").to_string()),
+        values: values_from(&scene)?,
+        y0: (scene.text("y0") != "auto")
+            .then(|| scene.numbers("y0"))
+            .transpose()?,
+        t_obs: scene.positive("t_obs")?,
+        method: method_from(&scene)?,
+    };
+    let result = convergence(info.name, &scene.parameter_values(info)?, &settings)?;
+    for (c, s) in result.coordinates.iter().zip(&result.slope) {
+        eprintln!("{c}: max deviation ∝ ν^{s:.4}");
+    }
+    let rows: Vec<(f64, f64, String, f64, f64)> = result
+        .coordinates
+        .iter()
+        .enumerate()
+        .flat_map(|(c, name)| {
+            let result = &result;
+            (0..result.values.len()).map(move |k| {
+                (
+                    result.values[k],
+                    result.frequencies[k],
+                    name.clone(),
+                    result.max_deviation[c][k],
+                    result.frequency_times_deviation[c][k],
+                )
+            })
+        })
+        .collect();
+    let header = [
+        result.parameter.as_str(),
+        "frequency",
+        "coordinate",
+        "max_deviation",
+        "frequency_times_max_deviation",
+    ];
+    scene.write_csv("convergence.csv", &header, rows)?;
+    scene.save_figure(&averaging_figure(&result), "convergence.png")?;
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
+/// A list of values, `auto` (None), or `geometric:first,last,count`.
+fn values_from(scene: &Scene) -> Result<Option<Vec<f64>>, SceneError> {
+    let text = scene.text("values");
+    if text == "auto" {
+        return Ok(None);
+    }
+    let Some(spec) = text.strip_prefix("geometric:") else {
+        return scene.numbers("values").map(Some);
+    };
+    let bad = |reason: &str| SceneError::BadValue {
+        name: "values".into(),
+        value: text.into(),
+        reason: reason.into(),
+    };
+    let parts: Vec<f64> = spec
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad("geometric:first,last,count with numbers"))?;
+    let [first, last, count] = parts.as_slice() else {
+        return Err(bad("geometric:first,last,count"));
+    };
+    if !(*first > 0.0 && *last > 0.0 && *count >= 2.0 && count.fract() == 0.0) {
+        return Err(bad("first and last positive, count a whole number ≥ 2"));
+    }
+    let n = *count as usize;
+    Ok(Some(
+        (0..n)
+            .map(|k| first * (last / first).powf(k as f64 / (n - 1) as f64))
+            .collect(),
+    ))
+}
+
+/// Max deviation against ν (log–log, with the fits) and ν × max deviation.
+fn averaging_figure(
+    result: &crate::analysis::averaging::AveragingConvergence,
+) -> crate::plot::Figure {
+    use crate::plot::{palette, Figure, PanelSpec};
+    use crate::registry::display_name;
+    let range = |values: &mut dyn Iterator<Item = f64>| {
+        let (lo, hi) = values
+            .filter(|v| *v > 0.0)
+            .fold((f64::MAX, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+        (lo / 1.5, hi * 1.5)
+    };
+    let x = range(&mut result.frequencies.iter().copied());
+    let y = range(&mut result.max_deviation.iter().flatten().copied());
+    let scaled = range(&mut result.frequency_times_deviation.iter().flatten().copied());
+    let title = format!(
+        "{}: exact against averaged, t ≤ {}",
+        result.model, result.t_obs
+    );
+    let specs = [
+        PanelSpec::new(
+            &title,
+            "frequency ν of the phase",
+            "max |exact − averaged|",
+            x,
+            y,
+        )
+        .log_log(),
+        PanelSpec::new(
+            "ν × max deviation: levels off where the deviation is c/ν",
+            "frequency ν of the phase",
+            "ν × max deviation",
+            x,
+            (0.0, scaled.1),
+        )
+        .log_x(),
+    ];
+    let mut figure = Figure::grid(2, 1, 620, 460, &specs);
+    let mut legend = Vec::new();
+    for (k, coordinate) in result.coordinates.iter().enumerate() {
+        let points: Vec<(f64, f64)> = result
+            .frequencies
+            .iter()
+            .copied()
+            .zip(result.max_deviation[k].iter().copied())
+            .collect();
+        figure.points(0, points.iter().copied(), palette(k), 4);
+        let fit: Vec<(f64, f64)> = [x.0 * 1.5, x.1 / 1.5]
+            .iter()
+            .map(|nu| (*nu, result.level[k] * nu.powf(result.slope[k])))
+            .collect();
+        figure.line(0, &fit, palette(k));
+        let scaled: Vec<(f64, f64)> = result
+            .frequencies
+            .iter()
+            .copied()
+            .zip(result.frequency_times_deviation[k].iter().copied())
+            .collect();
+        figure.line(1, &scaled, palette(k));
+        figure.points(1, scaled, palette(k), 4);
+        legend.push((
+            format!("{}: slope {:.3}", display_name(coordinate), result.slope[k]),
+            palette(k),
+        ));
+    }
+    figure.legend_at(0, &legend, true);
+    figure.legend_at(1, &legend, true);
+    figure
+}

@@ -140,8 +140,12 @@ pub struct AveragingConvergence {
     pub frequencies: Vec<f64>,
     pub coordinates: Vec<String>,
     pub y0: Vec<f64>,
+    pub t_obs: f64,
     /// [coordinate][value]
     pub max_deviation: Vec<Vec<f64>>,
+    /// ν × max deviation, [coordinate][value]: levels off where the
+    /// deviation is c/ν.
+    pub frequency_times_deviation: Vec<Vec<f64>>,
     /// The fitted exponent of each coordinate's deviation against ν.
     pub slope: Vec<f64>,
     /// The fitted level c in deviation ≈ c ν^slope.
@@ -299,6 +303,11 @@ impl crate::registry::WithFixed for Sweep<'_> {
             &frequencies,
             D,
         )?;
+        let frequency_times_deviation = run
+            .max_deviation
+            .iter()
+            .map(|d| d.iter().zip(&frequencies).map(|(d, nu)| d * nu).collect())
+            .collect();
         Ok(AveragingConvergence {
             model: info.name.into(),
             parameter,
@@ -306,6 +315,8 @@ impl crate::registry::WithFixed for Sweep<'_> {
             frequencies,
             coordinates: info.coordinates.iter().map(|c| c.to_string()).collect(),
             y0: y0.to_vec(),
+            t_obs: self.settings.t_obs,
+            frequency_times_deviation,
             max_deviation: run.max_deviation,
             slope: run.fits.iter().map(|f| f.slope).collect(),
             level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
