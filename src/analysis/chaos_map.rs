@@ -237,12 +237,17 @@ impl ChaosMap {
             .iter()
             .map(|(k, v)| format!("{} = {v}", display_name(k)))
             .collect();
-        let title = format!(
-            "{}: FLI map, {}, {} periods",
-            self.model,
-            params.join(", "),
-            self.periods
-        );
+        // The parameters fit in the title of a small model only (all are in
+        // the summary).
+        let title = match params.len() {
+            0..=4 => format!(
+                "{}: FLI map, {}, {} periods",
+                self.model,
+                params.join(", "),
+                self.periods
+            ),
+            _ => format!("{}: FLI map, {} periods", self.model, self.periods),
+        };
         let (x, y) = (display_name(&self.axes[0]), display_name(&self.axes[1]));
         let side = self.pixels.max(360);
         let spec = PanelSpec::new(&title, &x, &y, self.ranges[0], self.ranges[1]);
