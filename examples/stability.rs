@@ -3,40 +3,34 @@
 //! that stays one of the averaged system: the roots λ of det(C − λA) = 0,
 //! the threshold a* of the amplitude from V + V_vibr = C + a²K (or why there
 //! is none), and the exact system's stability window from its Floquet
-//! multipliers, drawn as the spectral radius against the amplitude.
+//! multipliers, drawn as the spectral radius against the amplitude. With
+//! `--set chart=x,y`, the stability chart of one equilibrium in two
+//! parameters, its boundaries located by bisection.
 //!
 //! `cargo run --release --example stability -- --set model=triple_pendulum`
+//! `cargo run --release --example stability -- --set chart=eps,A --set chart_y_max=12`
 
-use mechlab::analysis::stability::{stability, EquilibriumStability, Settings, Stability};
-use mechlab::models;
-use mechlab::ode::Method;
-use mechlab::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
-use mechlab::registry::display_name;
+use mechlab::analysis::stability::{stability, stability_chart, ChartSettings, Settings};
 use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
+use mechlab::scenes::{method_from, method_knobs, model_from_args};
 
 fn main() {
     run(|| {
-        let name = Scene::peek("model").unwrap_or_else(|| "kapitza".into());
-        let info = mechlab::registry::find(&name).ok_or_else(|| SceneError::BadValue {
-            name: "model".into(),
-            value: name.clone(),
-            reason: format!(
-                "no such model (known: {})",
-                models::ALL
-                    .iter()
-                    .map(|m| m.name)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        })?;
+        let info = model_from_args("kapitza")?;
+        let [method, tol] = method_knobs("dop853", "1e-10");
         let mut knobs = vec![
             knob("model", "kapitza", "the model (a file models/<name>.toml) with a fast phase"),
             knob("amplitude", info.amplitude.unwrap_or("(none)"), "the parameter that scales the vibration (default: the model file's [fast_phase] amplitude)"),
-            knob("method", "dop853", "integration method of the monodromy matrices (dop853, taylor, ...)"),
-            knob("tol", "1e-10", "its tolerance"),
+            method,
+            tol,
             knob("samples", "40", "amplitudes sampled on (0, a_max] to bracket the exact window's edges"),
             knob("a_max", "auto", "largest amplitude of the exact window (auto: 3 a*)"),
-            knob("edge_tolerance", "1e-9", "the window's edges are bisected to this"),
+            knob("edge_tolerance", "1e-9", "the window's edges and the chart's boundaries are bisected to this"),
+            knob("chart", "none", "two parameters x,y for a stability chart of the equilibrium chart_q (none: no chart)"),
+            knob("chart_q", "0", "the equilibrium of the chart, comma-separated (0: all coordinates zero)"),
+            knob("chart_x", "0.02,0.5,40", "first, last value and count of x"),
+            knob("chart_y_max", "12", "y is sampled on (0, chart_y_max]"),
+            knob("chart_y_samples", "120", "samples of y that bracket the boundaries"),
         ];
         knobs.extend(parameter_knobs(info, &[]));
         let scene = Scene::from_args(
@@ -44,122 +38,102 @@ fn main() {
             "stabilisation by vibration of any model's equilibria",
             &knobs,
         )?;
+        let params = scene.parameter_values(info)?;
         let settings = Settings {
             amplitude: scene.text("amplitude").to_string(),
-            a_max: match scene.text("a_max") {
-                "auto" => None,
-                _ => Some(scene.positive("a_max")?),
-            },
+            a_max: (scene.text("a_max") != "auto")
+                .then(|| scene.positive("a_max"))
+                .transpose()?,
             samples: scene.count("samples")?,
             edge_tolerance: scene.positive("edge_tolerance")?,
-            method: Method::parse(scene.text("method"), scene.positive("tol")?)?,
+            method: method_from(&scene)?,
         };
-        let result = stability(&name, &scene.parameter_values(info)?, &settings)?;
+        let result = stability(info.name, &params, &settings)?;
         for q in &result.moved_by_vibration {
             eprintln!("q = {q:?}: an equilibrium without vibration that the vibration moves");
         }
         for e in &result.equilibria {
+            let reason = e.reason.as_deref().unwrap_or("");
             eprintln!(
-                "q = {:?}: λ = {:?}, a* = {:?} {}, exact window {:?}",
-                e.q,
-                e.lambdas,
-                e.a_star,
-                e.reason.as_deref().unwrap_or(""),
-                e.exact_window
+                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?}",
+                e.q, e.lambdas, e.a_star, e.exact_window
             );
         }
-        let rows: Vec<(usize, f64, f64)> = result
+        let rows = result
             .equilibria
             .iter()
             .enumerate()
-            .flat_map(|(k, e)| e.spectral_radius.iter().map(move |p| (k, p[0], p[1])))
-            .collect();
+            .flat_map(|(k, e)| e.spectral_radius.iter().map(move |p| (k, p[0], p[1])));
         scene.write_csv(
             "spectral_radius.csv",
             &["equilibrium", "amplitude", "spectral_radius"],
-            &rows,
+            rows,
         )?;
-        let drawn: Vec<&EquilibriumStability> = result
-            .equilibria
-            .iter()
-            .filter(|e| !e.spectral_radius.is_empty())
-            .collect();
-        if !drawn.is_empty() {
-            scene.save_figure(&figure(&drawn, &result), "spectral_radius.png")?;
+        if let Some(figure) = result.figure() {
+            scene.save_figure(&figure, "spectral_radius.png")?;
+        }
+        if scene.text("chart") != "none" {
+            let chart = stability_chart(
+                info.name,
+                &params,
+                &chart_settings(&scene, &settings, info.coordinates.len())?,
+            )?;
+            let rows = chart
+                .boundaries
+                .iter()
+                .zip(&chart.x_values)
+                .flat_map(|(edges, x)| edges.iter().map(move |y| (*x, *y)));
+            scene.write_csv(
+                "chart_boundaries.csv",
+                &[chart.x.as_str(), chart.y.as_str()],
+                rows,
+            )?;
+            scene.save_figure(&chart.figure(), "chart.png")?;
+            scene.write_text(
+                "chart.json",
+                &serde_json::to_string_pretty(&chart).unwrap_or_default(),
+            )?;
         }
         scene.write_summary(&result)?;
         Ok(())
     });
 }
 
-/// One panel per equilibrium with an exact window: the spectral radius of
-/// the monodromy matrix against the amplitude, a* of the averaged system
-/// and the window's edges.
-fn figure(equilibria: &[&EquilibriumStability], result: &Stability) -> Figure {
-    let info = mechlab::registry::find(&result.model).expect("the analysed model exists");
-    let amplitude = display_name(&result.amplitude);
-    let amplitude = amplitude.as_str();
-    let titles: Vec<String> = equilibria
-        .iter()
-        .map(|e| {
-            let at: Vec<String> = info
-                .coordinates
-                .iter()
-                .zip(&e.q)
-                .map(|(c, x)| format!("{} = {x:.3}", display_name(c)))
-                .collect();
-            at.join(", ")
-        })
-        .collect();
-    // The radius is drawn up to 3 (it is ≈ 1 + growth per period).
-    let top = |e: &EquilibriumStability| {
-        let highest = e.spectral_radius.iter().map(|p| p[1]).fold(1.0, f64::max);
-        highest.min(3.0) + 0.05
+/// The chart's settings from its knobs.
+fn chart_settings(
+    scene: &Scene,
+    settings: &Settings,
+    dof: usize,
+) -> Result<ChartSettings, SceneError> {
+    let bad = |name: &str, reason: &str| SceneError::BadValue {
+        name: name.into(),
+        value: scene.text(name).into(),
+        reason: reason.into(),
     };
-    let specs: Vec<PanelSpec> = equilibria
-        .iter()
-        .zip(&titles)
-        .map(|(e, title)| {
-            let a_max = e.spectral_radius.last().map_or(1.0, |p| p[0]);
-            PanelSpec::new(
-                title,
-                amplitude,
-                "spectral radius",
-                (0.0, a_max),
-                (0.9, top(e)),
-            )
-        })
-        .collect();
-    let mut figure = Figure::grid(
-        specs.len().min(3),
-        specs.len().div_ceil(3),
-        520,
-        380,
-        &specs,
-    );
-    for (k, e) in equilibria.iter().enumerate() {
-        let curve: Vec<(f64, f64)> = e.spectral_radius.iter().map(|p| (p[0], p[1])).collect();
-        figure.line(
-            k,
-            &[(0.0, 1.0), (curve.last().map_or(1.0, |p| p.0), 1.0)],
-            GREY,
-        );
-        figure.line(k, &curve, BLUE);
-        let vertical = |x: f64| [(x, 0.901), (x, top(e) - 0.001)];
-        if let Some(a) = e.a_star {
-            figure.line(k, &vertical(a), BLACK);
-        }
-        for edge in e.exact_window.iter().flatten().flatten() {
-            figure.line(k, &vertical(*edge), RED);
-        }
-        figure.legend(
-            k,
-            &[
-                ("exact: spectral radius".into(), BLUE),
-                ("averaged: a*".into(), BLACK),
-                ("exact window edges".into(), RED),
-            ],
-        );
+    let Some((x, y)) = scene.text("chart").split_once(',') else {
+        return Err(bad("chart", "two parameter names x,y"));
+    };
+    let [first, last, count] = scene.numbers("chart_x")?[..] else {
+        return Err(bad("chart_x", "first,last,count"));
+    };
+    if !(count >= 2.0 && count.fract() == 0.0) {
+        return Err(bad("chart_x", "a whole count of at least 2"));
     }
-    figure
+    let n = count as usize;
+    Ok(ChartSettings {
+        q: if scene.text("chart_q") == "0" {
+            vec![0.0; dof]
+        } else {
+            scene.numbers("chart_q")?
+        },
+        x: x.trim().into(),
+        x_values: (0..n)
+            .map(|k| first + (last - first) * k as f64 / (n - 1) as f64)
+            .collect(),
+        y: y.trim().into(),
+        y_max: scene.positive("chart_y_max")?,
+        y_samples: scene.count("chart_y_samples")?,
+        edge_tolerance: settings.edge_tolerance,
+        method: settings.method,
+    })
 }

@@ -172,3 +172,45 @@ fn bad_requests_are_typed_errors() {
     let e = stability("kapitza", &[1.0], &settings("A")).unwrap_err();
     assert!(matches!(e, StabilityError::ParameterCount(1, _)));
 }
+
+/// The chart's first boundary at each ε is Kapitza's exact A*(ε) (Jury
+/// criterion on the 2×2 monodromy matrix), to 1e-8; above it a second
+/// boundary closes the window (parametric resonance) for the larger ε.
+#[test]
+fn kapitza_chart_boundaries_are_the_exact_thresholds() {
+    use mechlab::analysis::stability::{stability_chart, ChartSettings};
+    let settings = ChartSettings {
+        q: vec![0.0],
+        x: "eps".into(),
+        x_values: vec![0.1, 0.3],
+        y: "A".into(),
+        y_max: 6.0,
+        y_samples: 60,
+        edge_tolerance: 1e-11,
+        method: Method::parse("dop853", 1e-12).unwrap(),
+    };
+    let chart = stability_chart("kapitza", &defaults("kapitza"), &settings).unwrap();
+    for (k, &eps) in settings.x_values.iter().enumerate() {
+        let jury = |a: f64| -> Result<f64, OdeError> {
+            let params = kapitza::Params { A: a, eps, mu: 0.0 };
+            let mut integrator = Integrator::new(Method::parse("dop853", 1e-12)?)?;
+            let (_, m) = monodromy::<_, 2, 6>(
+                &mut integrator,
+                &kapitza::Exact { params },
+                2.0 * PI * eps,
+                &[0.0, 0.0],
+            )?;
+            Ok(jury_margin(&m))
+        };
+        let reference = first_stability_onset(&jury, 0.0, 6.0, 600, 1e-11)
+            .unwrap()
+            .unwrap();
+        let first = chart.boundaries[k][0];
+        assert!(
+            (first - reference).abs() < 1e-8,
+            "ε = {eps}: {first} vs {reference}"
+        );
+        assert!(!chart.stable[k][0] && chart.stable[k].iter().any(|s| *s));
+    }
+    assert!(chart.boundaries[1].len() >= 2, "{:?}", chart.boundaries);
+}

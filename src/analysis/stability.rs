@@ -488,3 +488,299 @@ fn exact_window<
     out.spectral_radius = curve;
     Ok(())
 }
+
+/// What [`stability_chart`] computes.
+#[derive(Clone, Debug)]
+pub struct ChartSettings {
+    /// The equilibrium (q) whose periodic solution (q, 0) is judged.
+    pub q: Vec<f64>,
+    /// The parameter along the horizontal axis and its values.
+    pub x: String,
+    pub x_values: Vec<f64>,
+    /// The parameter along the vertical axis, sampled on (0, y_max].
+    pub y: String,
+    pub y_max: f64,
+    pub y_samples: usize,
+    /// Each boundary is bisected to this tolerance in y.
+    pub edge_tolerance: f64,
+    pub method: Method,
+}
+
+/// A stability chart of the exact system in two parameters (an Ince–Strutt
+/// chart): for every x, the y-values where the spectral radius of the
+/// monodromy matrix at (q, 0) crosses 1, located by bisection.
+#[derive(Clone, Debug, Serialize)]
+pub struct StabilityChart {
+    pub model: String,
+    pub q: Vec<f64>,
+    pub x: String,
+    pub y: String,
+    pub x_values: Vec<f64>,
+    pub y_values: Vec<f64>,
+    /// [x][y sample]: stable (spectral radius ≤ 1 + 1e-6).
+    pub stable: Vec<Vec<bool>>,
+    /// [x]: the boundaries in y, ascending.
+    pub boundaries: Vec<Vec<f64>>,
+}
+
+/// The stability chart of the model `name` (see [`StabilityChart`]).
+pub fn stability_chart(
+    name: &str,
+    params: &[f64],
+    settings: &ChartSettings,
+) -> Result<StabilityChart, StabilityError> {
+    crate::models::with_fixed(name, Chart { params, settings })
+        .ok_or_else(|| StabilityError::UnknownModel(name.to_string()))?
+}
+
+struct Chart<'a> {
+    params: &'a [f64],
+    settings: &'a ChartSettings,
+}
+
+impl WithFixed for Chart<'_> {
+    type Output = Result<StabilityChart, StabilityError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        use rayon::prelude::*;
+        let info = model.info();
+        let settings = self.settings;
+        if !model.has_fast_phase() {
+            return Err(StabilityError::NoFastPhase(info.name.into()));
+        }
+        info.named_values(self.params)
+            .ok_or_else(|| StabilityError::ParameterCount(self.params.len(), info.name.into()))?;
+        let index = |name: &str| {
+            info.parameter_names
+                .iter()
+                .position(|p| *p == name)
+                .ok_or_else(|| StabilityError::UnknownAmplitude {
+                    model: info.name.into(),
+                    name: name.into(),
+                    known: info.parameter_names.join(", "),
+                })
+        };
+        let (ix, iy) = (index(&settings.x)?, index(&settings.y)?);
+        let q: [f64; D] = settings.q.as_slice().try_into().map_err(|_| {
+            StabilityError::ParameterCount(
+                settings.q.len(),
+                format!("{} (coordinates of the equilibrium)", info.name),
+            )
+        })?;
+        let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+        let margin = |x: f64, y: f64| -> Result<f64, OdeError> {
+            let mut p = self.params.to_vec();
+            p[ix] = x;
+            p[iy] = y;
+            let period = model.phase_period(&p).unwrap_or(f64::NAN);
+            let mut integrator = Integrator::new(settings.method)?;
+            let (_, m) = monodromy::<_, S, V>(&mut integrator, &model.exact(&p), period, &y0)?;
+            Ok(spectral_radius(&floquet_multipliers(&m)) - 1.0 - 1e-6)
+        };
+        let y_values: Vec<f64> = (1..=settings.y_samples)
+            .map(|k| settings.y_max * k as f64 / settings.y_samples as f64)
+            .collect();
+        let columns: Vec<Result<(Vec<bool>, Vec<f64>), OdeError>> = settings
+            .x_values
+            .par_iter()
+            .map(|&x| {
+                let margins: Vec<f64> = y_values
+                    .iter()
+                    .map(|&y| margin(x, y))
+                    .collect::<Result<_, _>>()?;
+                let mut edges = Vec::new();
+                for k in 1..y_values.len() {
+                    if (margins[k - 1] > 0.0) != (margins[k] > 0.0) {
+                        let (mut low, mut high) = (y_values[k - 1], y_values[k]);
+                        let stable_low = margins[k - 1] <= 0.0;
+                        while high - low > settings.edge_tolerance {
+                            let mid = 0.5 * (low + high);
+                            if (margin(x, mid)? <= 0.0) == stable_low {
+                                low = mid;
+                            } else {
+                                high = mid;
+                            }
+                        }
+                        edges.push(0.5 * (low + high));
+                    }
+                }
+                Ok((margins.iter().map(|m| *m <= 0.0).collect(), edges))
+            })
+            .collect();
+        let (mut stable, mut boundaries) = (Vec::new(), Vec::new());
+        for column in columns {
+            let (s, b) = column?;
+            stable.push(s);
+            boundaries.push(b);
+        }
+        Ok(StabilityChart {
+            model: info.name.into(),
+            q: settings.q.clone(),
+            x: settings.x.clone(),
+            y: settings.y.clone(),
+            x_values: settings.x_values.clone(),
+            y_values,
+            stable,
+            boundaries,
+        })
+    }
+}
+
+impl Stability {
+    /// One panel per equilibrium with an exact window: the spectral radius
+    /// of the monodromy matrix against the amplitude, a* of the averaged
+    /// system (black) and the window's edges (red). None without one.
+    pub fn figure(&self) -> Option<crate::plot::Figure> {
+        use crate::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
+        use crate::registry::display_name;
+        let drawn: Vec<&EquilibriumStability> = self
+            .equilibria
+            .iter()
+            .filter(|e| !e.spectral_radius.is_empty())
+            .collect();
+        if drawn.is_empty() {
+            return None;
+        }
+        let info = crate::registry::find(&self.model)?;
+        let amplitude = display_name(&self.amplitude);
+        let titles: Vec<String> = drawn
+            .iter()
+            .map(|e| {
+                let at: Vec<String> = info
+                    .coordinates
+                    .iter()
+                    .zip(&e.q)
+                    .map(|(c, x)| format!("{} = {x:.3}", display_name(c)))
+                    .collect();
+                at.join(", ")
+            })
+            .collect();
+        // The radius is drawn up to 3 (it is ≈ 1 + growth per period).
+        let top = |e: &EquilibriumStability| {
+            let highest = e.spectral_radius.iter().map(|p| p[1]).fold(1.0, f64::max);
+            highest.min(3.0) + 0.05
+        };
+        let specs: Vec<PanelSpec> = drawn
+            .iter()
+            .zip(&titles)
+            .map(|(e, title)| {
+                let a_max = e.spectral_radius.last().map_or(1.0, |p| p[0]);
+                PanelSpec::new(
+                    title,
+                    &amplitude,
+                    "spectral radius",
+                    (0.0, a_max),
+                    (0.9, top(e)),
+                )
+            })
+            .collect();
+        let mut figure = Figure::grid(
+            specs.len().min(3),
+            specs.len().div_ceil(3),
+            520,
+            380,
+            &specs,
+        );
+        for (k, e) in drawn.iter().enumerate() {
+            let curve: Vec<(f64, f64)> = e.spectral_radius.iter().map(|p| (p[0], p[1])).collect();
+            figure.line(
+                k,
+                &[(0.0, 1.0), (curve.last().map_or(1.0, |p| p.0), 1.0)],
+                GREY,
+            );
+            figure.line(k, &curve, BLUE);
+            let vertical = |x: f64| [(x, 0.901), (x, top(e) - 0.001)];
+            if let Some(a) = e.a_star {
+                figure.line(k, &vertical(a), BLACK);
+            }
+            for edge in e.exact_window.iter().flatten().flatten() {
+                figure.line(k, &vertical(*edge), RED);
+            }
+            let legend = [
+                ("exact: spectral radius".to_string(), BLUE),
+                ("averaged: a*".to_string(), BLACK),
+                ("exact window edges".to_string(), RED),
+            ];
+            figure.legend(k, &legend);
+        }
+        Some(figure)
+    }
+}
+
+impl StabilityChart {
+    /// The stable intervals in y at column i: from the first sample's
+    /// verdict, toggled at each located boundary.
+    pub fn stable_intervals(&self, i: usize) -> Vec<(f64, f64)> {
+        let y_max = self.y_values.last().copied().unwrap_or(0.0);
+        let mut stable = self.stable[i].first().copied().unwrap_or(false);
+        let (mut from, mut out) = (0.0, Vec::new());
+        for &edge in self.boundaries[i].iter().chain([&y_max]) {
+            if stable && edge > from {
+                out.push((from, edge));
+            }
+            from = edge;
+            stable = !stable;
+        }
+        out
+    }
+
+    /// The chart: the stable intervals between the located boundaries
+    /// filled in grey, the boundaries as curves (the i-th boundaries of
+    /// neighbouring columns joined where both columns have as many and they
+    /// lie close), and their points.
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{Figure, PanelSpec, Rgb, BLUE};
+        use crate::registry::display_name;
+        let (x, y) = (display_name(&self.x), display_name(&self.y));
+        let first = self.x_values.first().copied().unwrap_or(0.0);
+        let last = self.x_values.last().copied().unwrap_or(1.0);
+        let width = (last - first) / (self.x_values.len().max(2) - 1) as f64;
+        let y_max = self.y_values.last().copied().unwrap_or(1.0);
+        let title = format!(
+            "{}: stability of the equilibrium q = {:?} (grey: stable)",
+            self.model, self.q
+        );
+        let spec = PanelSpec::new(
+            &title,
+            &x,
+            &y,
+            (first - width / 2.0, last + width / 2.0),
+            (0.0, y_max),
+        );
+        let mut figure = Figure::single(720, 540, spec);
+        let fill = Rgb(200, 200, 200);
+        for (i, &xi) in self.x_values.iter().enumerate() {
+            for (low, high) in self.stable_intervals(i) {
+                // A column of vertical strokes fills the interval.
+                for k in 0..24 {
+                    let at = xi + width * (k as f64 / 23.0 - 0.5);
+                    figure.line(0, &[(at, low), (at, high)], fill);
+                }
+            }
+        }
+        let most = self.boundaries.iter().map(Vec::len).max().unwrap_or(0);
+        for b in 0..most {
+            for i in 1..self.x_values.len() {
+                let (left, right) = (&self.boundaries[i - 1], &self.boundaries[i]);
+                if let (Some(p), Some(q)) = (left.get(b), right.get(b)) {
+                    if left.len() == right.len() && (p - q).abs() < 0.1 * y_max {
+                        figure.line(
+                            0,
+                            &[(self.x_values[i - 1], *p), (self.x_values[i], *q)],
+                            BLUE,
+                        );
+                    }
+                }
+            }
+            let points = self
+                .boundaries
+                .iter()
+                .zip(&self.x_values)
+                .filter_map(|(e, x)| e.get(b).map(|y| (*x, *y)));
+            figure.points(0, points, BLUE, 3);
+        }
+        figure
+    }
+}
