@@ -582,7 +582,9 @@ impl WithFixed for Chart<'_> {
         let y_values: Vec<f64> = (1..=settings.y_samples)
             .map(|k| settings.y_max * k as f64 / settings.y_samples as f64)
             .collect();
-        let columns: Vec<Result<(Vec<bool>, Vec<f64>), OdeError>> = settings
+        // Per x: the verdict at each y sample and the located boundaries.
+        type Column = Result<(Vec<bool>, Vec<f64>), OdeError>;
+        let columns: Vec<Column> = settings
             .x_values
             .par_iter()
             .map(|&x| {
