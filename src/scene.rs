@@ -79,6 +79,8 @@ pub enum SceneError {
     Averaging(#[from] crate::analysis::averaging::AveragingError),
     #[error(transparent)]
     ChaosMap(#[from] crate::analysis::chaos_map::ChaosMapError),
+    #[error(transparent)]
+    Portrait(#[from] crate::analysis::period_map::PortraitError),
 }
 
 impl From<crate::ode::OdeError> for SceneError {

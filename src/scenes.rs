@@ -320,3 +320,84 @@ fn averaging_figure(
     figure.legend_at(1, &legend, true);
     figure
 }
+
+/// The `period_map` scene: orbits of the period map of any model with a
+/// fast phase on the cylinder (q, p), or on a plane of two state
+/// components. Seeds: `--set seeds=…` (states separated by `;`) or a line
+/// of `count` seeds along the first axis.
+pub fn period_map_scene(
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
+    use crate::analysis::period_map::{portrait, PortraitSettings};
+    let default = |name: &str, value: &'static str| -> &'static str {
+        overrides
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(value, |(_, v)| v)
+    };
+    let info = model_from_args(default("model", "kapitza"))?;
+    let [method, tol] = method_knobs(default("method", "taylor"), default("tol", "1e-10"));
+    let mut knobs = vec![
+        knob("model", default("model", "kapitza"), "the model (a file models/<name>.toml) with a fast phase"),
+        knob("axes", default("axes", "0,1"), "the state components [q; p] drawn (0 = first coordinate)"),
+        knob("seeds", default("seeds", "line"), "initial states [q; p], comma-separated, several separated by ';' (line: `count` seeds along the first axis)"),
+        knob("count", default("count", "24"), "seeds on the line"),
+        knob("p_max", default("p_max", "2.5"), "the line covers [−p_max, p_max] when the first axis is not an angle"),
+        knob("periods", default("periods", "500"), "periods per orbit"),
+        method,
+        tol,
+    ];
+    knobs.extend(parameter_knobs(info, overrides));
+    let scene = Scene::from_args(scene_name, "orbits of the period map of any model", &knobs)?;
+    let axes = scene.numbers("axes")?;
+    let [x, y] = axes.as_slice() else {
+        return Err(SceneError::BadValue {
+            name: "axes".into(),
+            value: scene.text("axes").into(),
+            reason: "two indices".into(),
+        });
+    };
+    let seeds = match scene.text("seeds") {
+        "line" => None,
+        text => Some(
+            text.split(';')
+                .map(|s| {
+                    s.split(',')
+                        .map(|v| v.trim().parse::<f64>())
+                        .collect::<Result<Vec<f64>, _>>()
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|_| SceneError::BadValue {
+                    name: "seeds".into(),
+                    value: text.into(),
+                    reason: "numbers separated by ',' and states by ';'".into(),
+                })?,
+        ),
+    };
+    let settings = PortraitSettings {
+        axes: [*x as usize, *y as usize],
+        seeds,
+        count: scene.count("count")?,
+        p_max: scene.positive("p_max")?,
+        periods: scene.count("periods")?,
+        method: method_from(&scene)?,
+    };
+    let result = portrait(info.name, &scene.parameter_values(info)?, &settings)?;
+    for (k, reason) in &result.failed {
+        eprintln!("orbit {k} stopped: {reason}");
+    }
+    scene.save_figure(&result.figure(), "period_map.png")?;
+    let rows = result
+        .orbits
+        .iter()
+        .enumerate()
+        .flat_map(|(k, orbit)| orbit.iter().map(move |(a, b)| (k, *a, *b)));
+    scene.write_csv(
+        "orbits.csv",
+        &["orbit", result.axes[0].as_str(), result.axes[1].as_str()],
+        rows,
+    )?;
+    scene.write_summary(&result)?;
+    Ok(())
+}

@@ -123,3 +123,40 @@ fn names_are_drawn_in_the_notation_of_the_studies() {
         assert_eq!(display_name(name), shown);
     }
 }
+
+/// The period-map portrait of any model: the orbit from a seed equals the
+/// period map iterated directly (Kapitza), projected on the chosen axes.
+#[test]
+fn portraits_are_the_period_map_iterated() {
+    use mechlab::analysis::period_map::{orbit, portrait, PortraitSettings};
+    let params = kapitza::Params {
+        A: 1.5,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    let settings = PortraitSettings {
+        axes: [1, 0],
+        seeds: Some(vec![vec![0.3, 0.0], vec![2.0, 0.5]]),
+        count: 0,
+        p_max: 1.0,
+        periods: 50,
+        method: Method::parse("taylor", 1e-12).unwrap(),
+    };
+    let result = portrait("kapitza", &params.values(), &settings).unwrap();
+    let mut integrator = Integrator::new(settings.method).unwrap();
+    for (k, seed) in [[0.3, 0.0], [2.0, 0.5]].iter().enumerate() {
+        let direct = orbit(
+            &mut integrator,
+            &kapitza::Exact { params },
+            2.0 * PI * 0.1,
+            seed,
+            50,
+            &[true, false],
+        )
+        .unwrap();
+        assert_eq!(result.orbits[k].len(), 51);
+        for (p, y) in result.orbits[k].iter().zip(&direct) {
+            assert!((p.0 - y[1]).abs() < 1e-12 && (p.1 - y[0]).abs() < 1e-12);
+        }
+    }
+}

@@ -3,11 +3,13 @@
 
 use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings};
+use mechlab::analysis::period_map::{portrait, PortraitSettings};
 use mechlab::analysis::stability::{stability, Settings, StabilityError};
 use mechlab::models;
 use mechlab::ode::Method;
 use mechlab::registry::Kind;
 use nalgebra::DMatrix;
+use std::f64::consts::PI;
 
 #[test]
 fn every_analysis_runs_on_every_model_or_says_why_not() {
@@ -24,6 +26,7 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
             assert!(matches!(e, AveragingError::UnknownModel(_)));
             let e = chaos_map(info.name, &params, &map_settings(5), &|| {}).unwrap_err();
             assert!(matches!(e, ChaosMapError::UnknownModel(_)));
+            assert!(portrait(info.name, &params, &portrait_settings(1)).is_err());
             continue;
         };
         let amplitude = info
@@ -130,6 +133,18 @@ fn averaging_settings() -> ConvergenceSettings {
         y0: None,
         t_obs: 2.0,
         method: Method::parse("dop853", 1e-11).unwrap(),
+    }
+}
+
+/// Three orbits on the plane (q₁, p₁) of a model of n degrees of freedom.
+fn portrait_settings(n: usize) -> PortraitSettings {
+    PortraitSettings {
+        axes: [0, n],
+        seeds: None,
+        count: 3,
+        p_max: 0.5,
+        periods: 20,
+        method: Method::parse("taylor", 1e-10).unwrap(),
     }
 }
 

@@ -2,6 +2,7 @@
 
 use crate::ode::{Integrator, Method, OdeError, Stats, System};
 use rayon::prelude::*;
+use std::f64::consts::PI;
 
 /// Wraps an angle into [−π, π).
 pub fn wrap_angle(x: f64) -> f64 {
@@ -68,4 +69,201 @@ pub fn orbits<S: System<N> + Sync, const N: usize>(
             Ok((points, integrator.stats))
         })
         .collect()
+}
+
+/// What [`portrait`] computes.
+#[derive(Clone, Debug)]
+pub struct PortraitSettings {
+    /// The state components ([q; p] indices) drawn.
+    pub axes: [usize; 2],
+    /// Initial states (full [q; p]); None: `count` seeds on a line along the
+    /// first axis (over [−π, π) for an angle, [−p_max, p_max] otherwise)
+    /// through the zero state.
+    pub seeds: Option<Vec<Vec<f64>>>,
+    pub count: usize,
+    pub p_max: f64,
+    pub periods: usize,
+    pub method: Method,
+}
+
+/// Orbits of the period map of any model with a fast phase, projected on
+/// two state components (angles in [−π, π)); orbits that left the model's
+/// domain are listed with their reason instead.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Portrait {
+    pub model: String,
+    pub params: std::collections::BTreeMap<String, f64>,
+    pub axes: [String; 2],
+    pub seeds: Vec<Vec<f64>>,
+    pub periods: usize,
+    /// Orbits that stopped, with the reason (the others are in `orbits`).
+    pub failed: Vec<(usize, String)>,
+    pub seconds: f64,
+    /// Per seed, the projected points (empty for a failed orbit).
+    #[serde(skip)]
+    pub orbits: Vec<Vec<(f64, f64)>>,
+}
+
+/// Why [`portrait`] cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum PortraitError {
+    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
+    UnknownModel(String),
+    #[error("model '{0}' has no fast phase: it has no period map")]
+    NoFastPhase(String),
+    #[error("model '{model}': {reason}")]
+    Request { model: String, reason: String },
+}
+
+/// The orbits of the model `name` with parameter values `params`.
+pub fn portrait(
+    name: &str,
+    params: &[f64],
+    settings: &PortraitSettings,
+) -> Result<Portrait, PortraitError> {
+    crate::models::with_fixed(name, Portraits { params, settings })
+        .ok_or_else(|| PortraitError::UnknownModel(name.into()))?
+}
+
+struct Portraits<'a> {
+    params: &'a [f64],
+    settings: &'a PortraitSettings,
+}
+
+impl crate::registry::WithFixed for Portraits<'_> {
+    type Output = Result<Portrait, PortraitError>;
+    fn run<
+        F: crate::registry::Fixed<D, S, T, V>,
+        const D: usize,
+        const S: usize,
+        const T: usize,
+        const V: usize,
+    >(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        let settings = self.settings;
+        let bad = |reason: String| PortraitError::Request {
+            model: info.name.into(),
+            reason,
+        };
+        let params = info
+            .named_values(self.params)
+            .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
+        let period = match model.phase_period(self.params) {
+            Some(t) if model.has_fast_phase() => t,
+            _ => return Err(PortraitError::NoFastPhase(info.name.into())),
+        };
+        let names: Vec<&str> = info
+            .coordinates
+            .iter()
+            .chain(info.momenta)
+            .copied()
+            .collect();
+        if settings.axes.iter().any(|&a| a >= S) || settings.axes[0] == settings.axes[1] {
+            return Err(bad(format!(
+                "the axes must be two different state components among {}",
+                names.join(", ")
+            )));
+        }
+        let periodic = model.periodic();
+        let wrap: Vec<bool> = (0..S).map(|i| i < D && periodic[i]).collect();
+        let seeds: Vec<[f64; S]> = match &settings.seeds {
+            Some(seeds) => seeds
+                .iter()
+                .map(|s| {
+                    s.as_slice()
+                        .try_into()
+                        .map_err(|_| bad(format!("a seed has {} components, not {S}", s.len())))
+                })
+                .collect::<Result<_, _>>()?,
+            None => {
+                let axis = settings.axes[0];
+                let (lo, hi) = if wrap[axis] {
+                    (-PI, PI)
+                } else {
+                    (-settings.p_max, settings.p_max)
+                };
+                (0..settings.count)
+                    .map(|k| {
+                        let mut y = [0.0; S];
+                        y[axis] = lo + (hi - lo) * (k as f64 + 0.5) / settings.count.max(1) as f64;
+                        y
+                    })
+                    .collect()
+            }
+        };
+        let start = std::time::Instant::now();
+        let runs = orbits(
+            settings.method,
+            &model.exact(self.params),
+            period,
+            &seeds,
+            settings.periods,
+            &wrap,
+        );
+        let (mut projected, mut failed) = (Vec::new(), Vec::new());
+        for (k, run) in runs.into_iter().enumerate() {
+            match run {
+                Ok((points, _)) => projected.push(
+                    points
+                        .iter()
+                        .map(|y| (y[settings.axes[0]], y[settings.axes[1]]))
+                        .collect(),
+                ),
+                Err(e) => {
+                    failed.push((k, e.to_string()));
+                    projected.push(Vec::new());
+                }
+            }
+        }
+        Ok(Portrait {
+            model: info.name.into(),
+            params,
+            axes: settings.axes.map(|a| names[a].to_string()),
+            seeds: seeds.iter().map(|s| s.to_vec()).collect(),
+            periods: settings.periods,
+            failed,
+            seconds: start.elapsed().as_secs_f64(),
+            orbits: projected,
+        })
+    }
+}
+
+impl Portrait {
+    /// The orbits as dots, a colour per orbit, axes in the model's notation.
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{palette, Figure, PanelSpec};
+        use crate::registry::display_name;
+        let range = |k: usize| {
+            let values = self
+                .orbits
+                .iter()
+                .flatten()
+                .map(|p| if k == 0 { p.0 } else { p.1 });
+            let (lo, hi) = values.fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
+            if lo > hi {
+                (-1.0, 1.0)
+            } else {
+                (
+                    lo - 0.05 * (hi - lo).max(1e-9),
+                    hi + 0.05 * (hi - lo).max(1e-9),
+                )
+            }
+        };
+        let title = format!(
+            "{}: period map, {} orbits × {} periods",
+            self.model,
+            self.orbits.len(),
+            self.periods
+        );
+        let (x, y) = (display_name(&self.axes[0]), display_name(&self.axes[1]));
+        let mut figure =
+            Figure::single(720, 620, PanelSpec::new(&title, &x, &y, range(0), range(1)));
+        for (k, orbit) in self.orbits.iter().enumerate() {
+            figure.points(0, orbit.iter().copied(), palette(k), 1);
+        }
+        figure
+    }
 }
