@@ -40,6 +40,28 @@ pub struct ModelInfo {
 }
 
 impl ModelInfo {
+    /// The names of the Hamiltonian state [q; p].
+    pub fn state_names(&self) -> Vec<&'static str> {
+        self.coordinates
+            .iter()
+            .chain(self.momenta)
+            .copied()
+            .collect()
+    }
+
+    /// The names of two different state components chosen as a plane's
+    /// axes, or why they cannot be.
+    pub fn plane(&self, axes: [usize; 2]) -> Result<[String; 2], String> {
+        let names = self.state_names();
+        if axes.iter().any(|&a| a >= names.len()) || axes[0] == axes[1] {
+            return Err(format!(
+                "the axes must be two different state components among {}",
+                names.join(", ")
+            ));
+        }
+        Ok(axes.map(|a| names[a].to_string()))
+    }
+
     /// Parameter values in declaration order as name → value; None if there
     /// are not exactly as many values as parameters.
     pub fn named_values(&self, values: &[f64]) -> Option<std::collections::BTreeMap<String, f64>> {

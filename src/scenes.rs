@@ -25,6 +25,32 @@ pub fn model_from_args(default: &str) -> Result<&'static ModelInfo, SceneError> 
     })
 }
 
+/// A preset's defaults: its value of a knob, or the generic scene's.
+struct Defaults<'a>(&'a [(&'static str, &'static str)]);
+
+impl Defaults<'_> {
+    fn get(&self, name: &str, generic: &'static str) -> &'static str {
+        self.0
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(generic, |(_, v)| v)
+    }
+}
+
+/// The two state components of the `axes` knob.
+fn axes_from(scene: &Scene) -> Result<[usize; 2], SceneError> {
+    match scene.numbers("axes")?[..] {
+        [x, y] if x >= 0.0 && y >= 0.0 && x.fract() == 0.0 && y.fract() == 0.0 => {
+            Ok([x as usize, y as usize])
+        }
+        _ => Err(SceneError::BadValue {
+            name: "axes".into(),
+            value: scene.text("axes").into(),
+            reason: "two indices of state components".into(),
+        }),
+    }
+}
+
 /// `method` and `tol` knobs with these defaults.
 pub fn method_knobs(method: &'static str, tol: &'static str) -> [Knob; 2] {
     [
@@ -53,12 +79,8 @@ pub fn chaos_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    let default = |name: &str, value: &'static str| -> &'static str {
-        overrides
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map_or(value, |(_, v)| v)
-    };
+    let defaults = Defaults(overrides);
+    let default = |name: &str, value: &'static str| defaults.get(name, value);
     let info = model_from_args(default("model", "kapitza"))?;
     let [method, tol] = method_knobs(default("method", "taylor"), default("tol", "1e-6"));
     let mut knobs = vec![
@@ -101,16 +123,9 @@ pub fn chaos_map_scene(
         "FLI chaos map of the period map of any model",
         &knobs,
     )?;
-    let axes = scene.numbers("axes")?;
-    let [x, y] = axes.as_slice() else {
-        return Err(SceneError::BadValue {
-            name: "axes".into(),
-            value: scene.text("axes").into(),
-            reason: "two indices".into(),
-        });
-    };
+    let axes = axes_from(&scene)?;
     let settings = ChaosMapSettings {
-        axes: [*x as usize, *y as usize],
+        axes,
         ranges: [None, None],
         p_max: scene.positive("p_max")?,
         through: (scene.text("through") != "0")
@@ -152,12 +167,8 @@ pub fn averaging_scene(
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use crate::analysis::averaging::{convergence, ConvergenceSettings};
-    let default = |name: &str, value: &'static str| -> &'static str {
-        overrides
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map_or(value, |(_, v)| v)
-    };
+    let defaults = Defaults(overrides);
+    let default = |name: &str, value: &'static str| defaults.get(name, value);
     let info = model_from_args(default("model", "double_pendulum"))?;
     let [method, tol] = method_knobs(default("method", "dop853"), default("tol", "1e-11"));
     let mut knobs = vec![
@@ -330,12 +341,8 @@ pub fn period_map_scene(
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use crate::analysis::period_map::{portrait, PortraitSettings};
-    let default = |name: &str, value: &'static str| -> &'static str {
-        overrides
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map_or(value, |(_, v)| v)
-    };
+    let defaults = Defaults(overrides);
+    let default = |name: &str, value: &'static str| defaults.get(name, value);
     let info = model_from_args(default("model", "kapitza"))?;
     let [method, tol] = method_knobs(default("method", "taylor"), default("tol", "1e-10"));
     let mut knobs = vec![
@@ -350,14 +357,7 @@ pub fn period_map_scene(
     ];
     knobs.extend(parameter_knobs(info, overrides));
     let scene = Scene::from_args(scene_name, "orbits of the period map of any model", &knobs)?;
-    let axes = scene.numbers("axes")?;
-    let [x, y] = axes.as_slice() else {
-        return Err(SceneError::BadValue {
-            name: "axes".into(),
-            value: scene.text("axes").into(),
-            reason: "two indices".into(),
-        });
-    };
+    let axes = axes_from(&scene)?;
     let seeds = match scene.text("seeds") {
         "line" => None,
         text => Some(
@@ -376,7 +376,7 @@ pub fn period_map_scene(
         ),
     };
     let settings = PortraitSettings {
-        axes: [*x as usize, *y as usize],
+        axes,
         seeds,
         count: scene.count("count")?,
         p_max: scene.positive("p_max")?,

@@ -60,6 +60,25 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
             short.diverged,
             short.fli.iter().filter(|f| f.is_infinite()).count()
         );
+        // Orbits start at their seeds; angles stay in [−π, π).
+        let orbits = portrait(info.name, &params, &portrait_settings(n)).unwrap();
+        let periodic = model.periodic();
+        for (seed, orbit) in orbits.seeds.iter().zip(&orbits.orbits) {
+            if orbit.is_empty() {
+                continue; // stopped (listed in `failed` with its reason)
+            }
+            assert_eq!(orbit.len(), 21);
+            assert_eq!(orbit[0], (seed[0], seed[n]));
+            if periodic[0] {
+                assert!(
+                    orbit.iter().all(|p| (-PI..PI).contains(&p.0)),
+                    "{}",
+                    info.name
+                );
+            }
+        }
+        let stopped = orbits.orbits.iter().filter(|o| o.is_empty()).count();
+        assert_eq!(orbits.failed.len(), stopped);
     }
 }
 

@@ -129,18 +129,7 @@ impl WithFixed for Map<'_> {
         let params = info
             .named_values(self.params)
             .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
-        let names: Vec<&str> = info
-            .coordinates
-            .iter()
-            .chain(info.momenta)
-            .copied()
-            .collect();
-        if settings.axes.iter().any(|&a| a >= S) || settings.axes[0] == settings.axes[1] {
-            return Err(bad(format!(
-                "the axes must be two different state components among {}",
-                names.join(", ")
-            )));
-        }
+        let axes = info.plane(settings.axes).map_err(bad)?;
         let through: [f64; S] = match &settings.through {
             Some(y) => y.as_slice().try_into().map_err(|_| {
                 bad(format!(
@@ -209,7 +198,7 @@ impl WithFixed for Map<'_> {
         Ok(ChaosMap {
             model: info.name.into(),
             params,
-            axes: settings.axes.map(|a| names[a].to_string()),
+            axes,
             ranges,
             through: through.to_vec(),
             pixels,

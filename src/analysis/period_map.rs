@@ -155,18 +155,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
             Some(t) if model.has_fast_phase() => t,
             _ => return Err(PortraitError::NoFastPhase(info.name.into())),
         };
-        let names: Vec<&str> = info
-            .coordinates
-            .iter()
-            .chain(info.momenta)
-            .copied()
-            .collect();
-        if settings.axes.iter().any(|&a| a >= S) || settings.axes[0] == settings.axes[1] {
-            return Err(bad(format!(
-                "the axes must be two different state components among {}",
-                names.join(", ")
-            )));
-        }
+        let axes = info.plane(settings.axes).map_err(bad)?;
         let periodic = model.periodic();
         let wrap: Vec<bool> = (0..S).map(|i| i < D && periodic[i]).collect();
         let seeds: Vec<[f64; S]> = match &settings.seeds {
@@ -221,7 +210,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
         Ok(Portrait {
             model: info.name.into(),
             params,
-            axes: settings.axes.map(|a| names[a].to_string()),
+            axes,
             seeds: seeds.iter().map(|s| s.to_vec()).collect(),
             periods: settings.periods,
             failed,
