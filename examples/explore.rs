@@ -12,7 +12,7 @@ use mechlab::explore::{explore, Exploration, Settings};
 use mechlab::models;
 use mechlab::ode::Method;
 use mechlab::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
-use mechlab::registry::{Kind, ModelInfo};
+use mechlab::registry::{display_name, Kind, ModelInfo};
 use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -159,12 +159,14 @@ fn draw(
     contacts: bool,
     settings: &Settings,
 ) -> Figure {
-    let coordinate_names: Vec<&str> = info.coordinates.to_vec();
+    // Labels in the model's notation (φ₁, p_φ₁, x₁′).
+    let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
+    let coordinate_names: Vec<&str> = names.iter().map(String::as_str).collect();
     let velocity = |i: usize| {
         if contacts {
             format!("{}′", coordinate_names[i])
         } else {
-            info.momenta[i].to_string()
+            display_name(info.momenta[i])
         }
     };
     let mut titles = Vec::new();
