@@ -13,15 +13,13 @@ use mechlab::analysis::floquet::{
     first_stability_onset, floquet_multipliers, jury_margin, monodromy, Verdict,
 };
 use mechlab::analysis::period_map::orbit;
+use mechlab::analysis::stability::{stability_chart, ChartSettings};
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
-use mechlab::plot::{palette, ColorMap, Figure, PanelSpec, BLUE, GREY, RED};
-use mechlab::scene::{knob, run, Progress, Scene, SceneError};
+use mechlab::plot::{palette, Figure, PanelSpec, BLUE, RED};
+use mechlab::scene::{knob, run, Scene, SceneError};
 use rayon::prelude::*;
 use std::f64::consts::{PI, SQRT_2};
-
-/// The shade of the stable region: the legend's grey.
-const STABLE_SHADE: f64 = 1.0 - 150.0 / 255.0;
 
 const KNOBS: &[mechlab::scene::Knob] = &[
     knob("A", "1.6", "pivot amplitude to judge"),
@@ -186,68 +184,39 @@ fn main() {
         }
         scene.save_figure(&figure, "averaged_portraits.png")?;
 
-        // Stability chart in the (ε, A) plane.
-        let (ne, na, a_max) = (
-            scene.count("chart_eps")?,
-            scene.count("chart_a")?,
-            scene.positive("chart_a_max")?,
-        );
-        let eps_values: Vec<f64> = (0..ne)
-            .map(|i| 0.02 + 0.48 * i as f64 / (ne - 1).max(1) as f64)
-            .collect();
-        let a_values: Vec<f64> = (0..na)
-            .map(|j| a_max * (j as f64 + 0.5) / na as f64)
-            .collect();
-        let progress = Progress::new("stability chart (ε rows)", ne);
-        let mut chart = vec![0.0; ne * na];
-        for (i, &e) in eps_values.iter().enumerate() {
-            let column: Vec<Result<f64, SceneError>> = a_values
-                .par_iter()
-                .map(|&ca| stability_margin(ca, e, mu, method).map(|r| r.0))
-                .collect();
-            for (j, g) in column.into_iter().enumerate() {
-                chart[j * ne + i] = if g? <= 0.0 { STABLE_SHADE } else { 0.0 };
-            }
-            progress.update(i + 1);
-        }
-        let mut figure = Figure::single(
-            800,
-            600,
-            PanelSpec::new(
-                &format!("upper position stable (grey), μ = {mu}"),
-                "ε",
-                "A",
-                (0.02, 0.5),
-                (0.0, a_max),
-            ),
-        );
-        figure.shaded_map(
-            0,
-            ne,
-            na,
-            &chart,
-            ColorMap::Grey,
-            "stable (grey) or not (white)",
-        );
+        // Stability chart in the (ε, A) plane: the boundaries located by
+        // bisection (the generic chart of `stability`).
+        let (ne, na) = (scene.count("chart_eps")?, scene.count("chart_a")?);
+        let chart_settings = ChartSettings {
+            q: vec![0.0],
+            x: "eps".into(),
+            x_values: (0..ne)
+                .map(|i| 0.02 + 0.48 * i as f64 / (ne - 1).max(1) as f64)
+                .collect(),
+            y: "A".into(),
+            y_max: scene.positive("chart_a_max")?,
+            y_samples: na,
+            edge_tolerance: 1e-6,
+            method,
+        };
+        let params = kapitza::Params { A: a, eps, mu };
+        let chart = stability_chart("kapitza", &params.values(), &chart_settings)?;
+        let mut figure = chart.figure();
         figure.line(0, &[(0.02, SQRT_2), (0.5, SQRT_2)], RED);
         figure.legend(
             0,
-            &[("averaged A* = √2".into(), RED), ("stable".into(), GREY)],
+            &[
+                ("averaged A* = √2".into(), RED),
+                ("exact boundaries".into(), BLUE),
+            ],
         );
         scene.save_figure(&figure, "stability_chart.png")?;
-        scene.write_csv(
-            "stability_chart.csv",
-            &["eps", "A", "stable"],
-            (0..ne)
-                .flat_map(|i| (0..na).map(move |j| (i, j)))
-                .map(|(i, j)| {
-                    (
-                        eps_values[i],
-                        a_values[j],
-                        u8::from(chart[j * ne + i] > 0.0),
-                    )
-                }),
-        )?;
+        let rows = chart
+            .boundaries
+            .iter()
+            .zip(&chart.x_values)
+            .flat_map(|(edges, e)| edges.iter().map(move |a| (*e, *a)));
+        scene.write_csv("stability_chart.csv", &["eps", "A_boundary"], rows)?;
 
         // A*(ε) against √2.
         let eps_list = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
