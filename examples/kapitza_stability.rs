@@ -9,11 +9,9 @@
 //! |tr M| − 1 − det M, bracketed on a scan and bisected to 1e-10. The
 //! averaged system predicts A* = √2 (V = cos q + A²/4 sin²q has V''(0) = A²/2 − 1).
 
-use mechlab::analysis::floquet::{
-    first_stability_onset, floquet_multipliers, jury_margin, monodromy, Verdict,
-};
+use mechlab::analysis::floquet::{floquet_multipliers, monodromy, Verdict};
 use mechlab::analysis::period_map::orbit;
-use mechlab::analysis::stability::{stability_chart, ChartSettings};
+use mechlab::analysis::stability::{stability, stability_chart, ChartSettings, Settings};
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
 use mechlab::plot::{palette, Figure, PanelSpec, BLUE, RED};
@@ -36,38 +34,34 @@ const KNOBS: &[mechlab::scene::Knob] = &[
     knob("chart_a_max", "12", "largest A of the chart"),
 ];
 
-/// |tr M| − 1 − det M of the upper position: negative inside the stability region.
-fn stability_margin(
-    a: f64,
-    eps: f64,
-    mu: f64,
-    method: Method,
-) -> Result<(f64, [[f64; 2]; 2]), SceneError> {
+/// The monodromy matrix of the upper position over one period.
+fn upper_monodromy(a: f64, eps: f64, mu: f64, method: Method) -> Result<[[f64; 2]; 2], SceneError> {
     let params = kapitza::Params { A: a, eps, mu };
     let mut integrator = Integrator::new(method)?;
+    let y0 = [0.0, 0.0];
     let (_, m) = monodromy::<_, 2, 6>(
         &mut integrator,
         &kapitza::Exact { params },
         2.0 * PI * eps,
-        &[0.0, 0.0],
+        &y0,
     )?;
-    Ok((jury_margin(&m), m))
+    Ok(m)
 }
 
-/// The smallest A in (0, a_max) where q = 0 becomes stable, or None.
-fn critical_amplitude(
-    eps: f64,
-    mu: f64,
-    method: Method,
-    a_max: f64,
-) -> Result<Option<f64>, SceneError> {
-    first_stability_onset(
-        &|a| stability_margin(a, eps, mu, method).map(|r| r.0),
-        0.0,
-        a_max,
-        400,
-        1e-10,
-    )
+/// The exact A* at which the upper position becomes stable (the lower
+/// edge of its window in (0, 4], from the generic `stability`), or None.
+fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<Option<f64>, SceneError> {
+    let settings = Settings {
+        amplitude: "A".into(),
+        a_max: Some(4.0),
+        samples: 400,
+        edge_tolerance: 1e-10,
+        method,
+    };
+    let params = kapitza::Params { A: SQRT_2, eps, mu };
+    let result = stability("kapitza", &params.values(), &settings)?;
+    let upper = result.equilibria.iter().find(|e| e.q[0].abs() < 1e-9);
+    Ok(upper.and_then(|e| e.exact_window).and_then(|[low, _]| low))
 }
 
 fn main() {
@@ -85,8 +79,8 @@ fn main() {
         let method = Method::parse("dop853", scene.positive("tol")?)?;
         let period = 2.0 * PI * eps;
 
-        let a_star = critical_amplitude(eps, mu, method, 4.0)?;
-        let (_, m) = stability_margin(a, eps, mu, method)?;
+        let a_star = critical_amplitude(eps, mu, method)?;
+        let m = upper_monodromy(a, eps, mu, method)?;
         let multipliers = floquet_multipliers(&m);
         let verdict = Verdict::from_multipliers(&multipliers, 1e-7);
         let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
@@ -222,7 +216,7 @@ fn main() {
         let eps_list = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3];
         let a_star_by_eps: Vec<(f64, Option<f64>)> = eps_list
             .par_iter()
-            .map(|&e| critical_amplitude(e, 0.0, method, 4.0).map(|s| (e, s)))
+            .map(|&e| critical_amplitude(e, 0.0, method).map(|s| (e, s)))
             .collect::<Result<_, _>>()?;
         for (e, s) in &a_star_by_eps {
             println!("ε = {e}: A* = {s:?}, A* − √2 = {:?}", s.map(|x| x - SQRT_2));
