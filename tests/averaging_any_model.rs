@@ -84,6 +84,16 @@ fn bad_requests_are_typed_errors() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("no parameter 'nu'"), "{e}");
+    let e = convergence(
+        "kapitza",
+        &defaults("kapitza"),
+        &settings(Some("A"), &[1.0, 2.0]),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("does not change the frequency"),
+        "{e}"
+    );
     let mut bad_state = settings(None, &[100.0]);
     bad_state.y0 = Some(vec![0.1, 0.0]);
     let e = convergence("double_pendulum", &defaults("double_pendulum"), &bad_state).unwrap_err();

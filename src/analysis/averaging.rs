@@ -287,6 +287,14 @@ impl crate::registry::WithFixed for Sweep<'_> {
                 ))
             })?);
         }
+        let distinct = frequencies
+            .iter()
+            .any(|f| (f - frequencies[0]).abs() > 1e-12 * f.abs());
+        if !distinct {
+            return Err(bad(format!(
+                "'{parameter}' does not change the frequency of the phase (or fewer than two values): nothing to fit against"
+            )));
+        }
         let systems = |nu: f64| {
             let k = frequencies.iter().position(|f| *f == nu).unwrap_or(0);
             let p = with(values[k]);
