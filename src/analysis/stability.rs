@@ -753,12 +753,35 @@ impl StabilityChart {
         );
         let mut figure = Figure::single(720, 540, spec);
         let fill = Rgb(200, 200, 200);
-        for (i, &xi) in self.x_values.iter().enumerate() {
-            for (low, high) in self.stable_intervals(i) {
-                // A column of vertical strokes fills the interval.
-                for k in 0..24 {
-                    let at = xi + width * (k as f64 / 23.0 - 0.5);
-                    figure.line(0, &[(at, low), (at, high)], fill);
+        // Vertical strokes fill the stable intervals. Between neighbouring
+        // columns with as many intervals their ends are interpolated (the
+        // region follows the located boundaries); otherwise each column
+        // fills half the way to its neighbours.
+        let intervals: Vec<Vec<(f64, f64)>> = (0..self.x_values.len())
+            .map(|i| self.stable_intervals(i))
+            .collect();
+        let strokes = 24;
+        let mut stroke =
+            |x: f64, (low, high): (f64, f64)| figure.line(0, &[(x, low), (x, high)], fill);
+        for i in 0..self.x_values.len() {
+            let xi = self.x_values[i];
+            let matched = |j: usize| {
+                intervals
+                    .get(j)
+                    .is_some_and(|o| o.len() == intervals[i].len())
+            };
+            for k in 0..=strokes / 2 {
+                let t = k as f64 / strokes as f64;
+                for (side, j) in [(1.0, i + 1), (-1.0, i.wrapping_sub(1))] {
+                    let x = xi + side * t * width;
+                    for (n, &(low, high)) in intervals[i].iter().enumerate() {
+                        if matched(j) {
+                            let (l2, h2) = intervals[j][n];
+                            stroke(x, (low + t * (l2 - low), high + t * (h2 - high)));
+                        } else {
+                            stroke(x, (low, high));
+                        }
+                    }
                 }
             }
         }
