@@ -113,6 +113,9 @@ fn to_array<const N: usize>(v: &[f64]) -> [f64; N] {
 }
 
 /// Runs everything the explorer shows for `model` from `y0`.
+/// (`#[inline]`: the per-model instances are compiled in the crates that
+/// call this, not in the library on every rebuild.)
+#[inline]
 pub fn explore(
     model: &dyn DynamicModel,
     params: &[f64],

@@ -173,6 +173,9 @@ pub enum AveragingError {
 
 /// Runs [`AveragingConvergence`] on the model `name` with parameter values
 /// `params` (declaration order).
+/// (`#[inline]`: the per-model instances are compiled in the crates that
+/// call this, not in the library on every rebuild.)
+#[inline]
 pub fn convergence(
     name: &str,
     params: &[f64],

@@ -90,6 +90,9 @@ pub enum ChaosMapError {
 /// The FLI map of the model `name` with parameter values `params`
 /// (declaration order); `row_done` is called as each row is finished (from
 /// the worker threads).
+/// (`#[inline]`: the per-model instances are compiled in the crates that
+/// call this, not in the library on every rebuild.)
+#[inline]
 pub fn chaos_map(
     name: &str,
     params: &[f64],

@@ -116,6 +116,9 @@ pub enum PortraitError {
 }
 
 /// The orbits of the model `name` with parameter values `params`.
+/// (`#[inline]`: the per-model instances are compiled in the crates that
+/// call this, not in the library on every rebuild.)
+#[inline]
 pub fn portrait(
     name: &str,
     params: &[f64],

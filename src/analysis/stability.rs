@@ -94,6 +94,9 @@ pub enum StabilityError {
 
 /// Runs the analysis on the model `name` with parameter values `params`
 /// (declaration order).
+/// (`#[inline]`: the per-model instances are compiled in the crates that
+/// call this, not in the library on every rebuild.)
+#[inline]
 pub fn stability(
     name: &str,
     params: &[f64],
@@ -524,6 +527,9 @@ pub struct StabilityChart {
 }
 
 /// The stability chart of the model `name` (see [`StabilityChart`]).
+/// (`#[inline]`: the per-model instances are compiled in the crates that
+/// call this, not in the library on every rebuild.)
+#[inline]
 pub fn stability_chart(
     name: &str,
     params: &[f64],
