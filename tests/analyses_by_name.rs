@@ -1,0 +1,13 @@
+//! The generic analyses by model name (`stability`, `averaging`,
+//! `chaos_map`, the period-map portrait) in one test binary: each analysis
+//! is instantiated for every model of `models/`, and one binary compiles
+//! those instances once rather than once per file.
+
+#[path = "analyses_by_name/averaging.rs"]
+mod averaging;
+#[path = "analyses_by_name/chaos_map.rs"]
+mod chaos_map;
+#[path = "analyses_by_name/every_model.rs"]
+mod every_model;
+#[path = "analyses_by_name/stability.rs"]
+mod stability;
