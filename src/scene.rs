@@ -78,9 +78,7 @@ pub enum SceneError {
     #[error(transparent)]
     Averaging(#[from] crate::analysis::averaging::AveragingError),
     #[error(transparent)]
-    ChaosMap(#[from] crate::analysis::chaos_map::ChaosMapError),
-    #[error(transparent)]
-    Portrait(#[from] crate::analysis::period_map::PortraitError),
+    PeriodMap(#[from] crate::analysis::period_map::PeriodMapError),
 }
 
 impl From<crate::ode::OdeError> for SceneError {

@@ -56,6 +56,37 @@ fn axes_from(scene: &Scene) -> Result<[usize; 2], SceneError> {
     }
 }
 
+/// The knobs of a generic scene — the model, the scene's own knobs, method
+/// and tolerance (each with the preset's default where `overrides` gives
+/// one), then every parameter of the chosen model — and the parsed scene.
+/// `defaults` are the generic scene's (model, method, tolerance).
+fn generic_scene(
+    scene_name: &'static str,
+    about: &str,
+    overrides: &[(&'static str, &'static str)],
+    (model, method, tol): (&'static str, &'static str, &'static str),
+    own: &[(&'static str, &'static str, &'static str)],
+) -> Result<(&'static ModelInfo, Scene), SceneError> {
+    let defaults = Defaults(overrides);
+    let model = defaults.get("model", model);
+    let info = model_from_args(model)?;
+    let mut knobs = vec![knob(
+        "model",
+        model,
+        "the model (a file models/<name>.toml) with a fast phase",
+    )];
+    knobs.extend(
+        own.iter()
+            .map(|&(name, value, help)| knob(name, defaults.get(name, value), help)),
+    );
+    knobs.extend(method_knobs(
+        defaults.get("method", method),
+        defaults.get("tol", tol),
+    ));
+    knobs.extend(parameter_knobs(info, overrides));
+    Ok((info, Scene::from_args(scene_name, about, &knobs)?))
+}
+
 /// `method` and `tol` knobs with these defaults.
 pub fn method_knobs(method: &'static str, tol: &'static str) -> [Knob; 2] {
     [
@@ -85,49 +116,30 @@ pub fn chaos_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    let defaults = Defaults(overrides);
-    let default = |name: &str, value: &'static str| defaults.get(name, value);
-    let info = model_from_args(default("model", "kapitza"))?;
-    let [method, tol] = method_knobs(default("method", "taylor"), default("tol", "1e-6"));
-    let mut knobs = vec![
-        knob(
-            "model",
-            default("model", "kapitza"),
-            "the model (a file models/<name>.toml) with a fast phase",
-        ),
-        knob(
-            "axes",
-            default("axes", "0,1"),
-            "the state components [q; p] along the two axes (0 = first coordinate)",
-        ),
-        knob(
-            "through",
-            default("through", "0"),
-            "the state the plane passes through, comma-separated (0: all zero)",
-        ),
-        knob(
-            "pixels",
-            default("pixels", "300"),
-            "resolution (pixels per side)",
-        ),
-        knob(
-            "periods",
-            default("periods", "180"),
-            "periods of the phase per pixel",
-        ),
-        knob(
-            "p_max",
-            default("p_max", "3"),
-            "an axis that is not an angle covers [−p_max, p_max]",
-        ),
-        method,
-        tol,
-    ];
-    knobs.extend(parameter_knobs(info, overrides));
-    let scene = Scene::from_args(
+    let (info, scene) = generic_scene(
         scene_name,
         "FLI chaos map of the period map of any model",
-        &knobs,
+        overrides,
+        ("kapitza", "taylor", "1e-6"),
+        &[
+            (
+                "axes",
+                "0,1",
+                "the state components [q; p] along the two axes (0 = first coordinate)",
+            ),
+            (
+                "through",
+                "0",
+                "the state the plane passes through, comma-separated (0: all zero)",
+            ),
+            ("pixels", "300", "resolution (pixels per side)"),
+            ("periods", "180", "periods of the phase per pixel"),
+            (
+                "p_max",
+                "3",
+                "an axis that is not an angle covers [−p_max, p_max]",
+            ),
+        ],
     )?;
     let axes = axes_from(&scene)?;
     let settings = ChaosMapSettings {
@@ -174,24 +186,17 @@ pub fn averaging_scene(
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use crate::analysis::averaging::{convergence, ConvergenceSettings};
-    let defaults = Defaults(overrides);
-    let default = |name: &str, value: &'static str| defaults.get(name, value);
-    let info = model_from_args(default("model", "double_pendulum"))?;
-    let [method, tol] = method_knobs(default("method", "dop853"), default("tol", "1e-11"));
-    let mut knobs = vec![
-        knob("model", default("model", "double_pendulum"), "the model (a file models/<name>.toml) with a fast phase"),
-        knob("parameter", default("parameter", "auto"), "the parameter swept to change ν (auto: the one the phase rate depends on)"),
-        knob("values", default("values", "auto"), "its values: a list, geometric:first,last,count, or auto (ν at 4…64 times the model's frequency)"),
-        knob("y0", default("y0", "auto"), "the common initial state [q; p], comma-separated (auto: q = 0.2, −0.1, …, p = 0)"),
-        knob("t_obs", default("t_obs", "2"), "the deviation is the maximum over [0, t_obs]"),
-        method,
-        tol,
-    ];
-    knobs.extend(parameter_knobs(info, overrides));
-    let scene = Scene::from_args(
+    let (info, scene) = generic_scene(
         scene_name,
         "exact against averaged: the deviation against the frequency",
-        &knobs,
+        overrides,
+        ("double_pendulum", "dop853", "1e-11"),
+        &[
+            ("parameter", "auto", "the parameter swept to change ν (auto: the one the phase rate depends on)"),
+            ("values", "auto", "its values: a list, geometric:first,last,count, or auto (ν at 4…64 times the model's frequency)"),
+            ("y0", "auto", "the common initial state [q; p], comma-separated (auto: q = 0.2, −0.1, …, p = 0)"),
+            ("t_obs", "2", "the deviation is the maximum over [0, t_obs]"),
+        ],
     )?;
     let settings = ConvergenceSettings {
         parameter: (scene.text("parameter") != "auto").then(|| scene.text("parameter").to_string()),
@@ -349,22 +354,19 @@ pub fn period_map_scene(
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use crate::analysis::period_map::{portrait, PortraitSettings};
-    let defaults = Defaults(overrides);
-    let default = |name: &str, value: &'static str| defaults.get(name, value);
-    let info = model_from_args(default("model", "kapitza"))?;
-    let [method, tol] = method_knobs(default("method", "taylor"), default("tol", "1e-10"));
-    let mut knobs = vec![
-        knob("model", default("model", "kapitza"), "the model (a file models/<name>.toml) with a fast phase"),
-        knob("axes", default("axes", "0,1"), "the state components [q; p] drawn (0 = first coordinate)"),
-        knob("seeds", default("seeds", "line"), "initial states [q; p], comma-separated, several separated by ';' (line: `count` seeds along the first axis)"),
-        knob("count", default("count", "24"), "seeds on the line"),
-        knob("p_max", default("p_max", "2.5"), "the line covers [−p_max, p_max] when the first axis is not an angle"),
-        knob("periods", default("periods", "500"), "periods per orbit"),
-        method,
-        tol,
-    ];
-    knobs.extend(parameter_knobs(info, overrides));
-    let scene = Scene::from_args(scene_name, "orbits of the period map of any model", &knobs)?;
+    let (info, scene) = generic_scene(
+        scene_name,
+        "orbits of the period map of any model",
+        overrides,
+        ("kapitza", "taylor", "1e-10"),
+        &[
+            ("axes", "0,1", "the state components [q; p] drawn (0 = first coordinate)"),
+            ("seeds", "line", "initial states [q; p], comma-separated, several separated by ';' (line: `count` seeds along the first axis)"),
+            ("count", "24", "seeds on the line"),
+            ("p_max", "2.5", "the line covers [−p_max, p_max] when the first axis is not an angle"),
+            ("periods", "500", "periods per orbit"),
+        ],
+    )?;
     let axes = axes_from(&scene)?;
     let seeds = match scene.text("seeds") {
         "line" => None,

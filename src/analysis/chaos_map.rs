@@ -74,18 +74,8 @@ fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64)
     (at(ranges[0], i), at(ranges[1], j))
 }
 
-/// Why [`chaos_map`] cannot run.
-#[derive(Debug, thiserror::Error)]
-pub enum ChaosMapError {
-    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
-    UnknownModel(String),
-    #[error("model '{0}' has no fast phase: it has no period map")]
-    NoFastPhase(String),
-    #[error("model '{model}': {reason}")]
-    Request { model: String, reason: String },
-    #[error(transparent)]
-    Ode(#[from] OdeError),
-}
+/// Why [`chaos_map`] cannot run: the errors of the period map's analyses.
+pub use super::period_map::PeriodMapError as ChaosMapError;
 
 /// The FLI map of the model `name` with parameter values `params`
 /// (declaration order); `row_done` is called as each row is finished (from

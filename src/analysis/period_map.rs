@@ -104,15 +104,17 @@ pub struct Portrait {
     pub orbits: Vec<Vec<(f64, f64)>>,
 }
 
-/// Why [`portrait`] cannot run.
+/// Why an analysis of the period map ([`portrait`], the chaos map) cannot run.
 #[derive(Debug, thiserror::Error)]
-pub enum PortraitError {
+pub enum PeriodMapError {
     #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
     UnknownModel(String),
     #[error("model '{0}' has no fast phase: it has no period map")]
     NoFastPhase(String),
     #[error("model '{model}': {reason}")]
     Request { model: String, reason: String },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
 }
 
 /// The orbits of the model `name` with parameter values `params`.
@@ -123,9 +125,9 @@ pub fn portrait(
     name: &str,
     params: &[f64],
     settings: &PortraitSettings,
-) -> Result<Portrait, PortraitError> {
+) -> Result<Portrait, PeriodMapError> {
     crate::models::with_fixed(name, Portraits { params, settings })
-        .ok_or_else(|| PortraitError::UnknownModel(name.into()))?
+        .ok_or_else(|| PeriodMapError::UnknownModel(name.into()))?
 }
 
 struct Portraits<'a> {
@@ -134,7 +136,7 @@ struct Portraits<'a> {
 }
 
 impl crate::registry::WithFixed for Portraits<'_> {
-    type Output = Result<Portrait, PortraitError>;
+    type Output = Result<Portrait, PeriodMapError>;
     fn run<
         F: crate::registry::Fixed<D, S, T, V>,
         const D: usize,
@@ -147,7 +149,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
     ) -> Self::Output {
         let info = model.info();
         let settings = self.settings;
-        let bad = |reason: String| PortraitError::Request {
+        let bad = |reason: String| PeriodMapError::Request {
             model: info.name.into(),
             reason,
         };
@@ -156,7 +158,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
             .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
         let period = match model.phase_period(self.params) {
             Some(t) if model.has_fast_phase() => t,
-            _ => return Err(PortraitError::NoFastPhase(info.name.into())),
+            _ => return Err(PeriodMapError::NoFastPhase(info.name.into())),
         };
         let axes = info.plane(settings.axes).map_err(bad)?;
         let periodic = model.periodic();

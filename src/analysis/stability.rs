@@ -118,12 +118,7 @@ impl WithFixed for Analysis<'_> {
         model: &'static F,
     ) -> Self::Output {
         let info = model.info();
-        if !model.has_fast_phase() {
-            return Err(StabilityError::NoFastPhase(info.name.into()));
-        }
-        let params = info
-            .named_values(self.params)
-            .ok_or_else(|| StabilityError::ParameterCount(self.params.len(), info.name.into()))?;
+        let params = vibrating_model(model, self.params)?;
         let amplitude = info
             .parameter_names
             .iter()
@@ -425,6 +420,50 @@ fn threshold<
     (Some(high.sqrt()), None)
 }
 
+/// Multipliers within this of the unit circle count as stable (the
+/// integration error of a conservative system's monodromy matrix).
+const STABLE_SLACK: f64 = 1e-6;
+
+/// The spectral radius of the exact system's monodromy matrix over one
+/// period of the phase from `y0`, at parameter values `params`.
+fn spectral_radius_at<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    y0: &[f64; S],
+    method: Method,
+) -> Result<f64, OdeError> {
+    let period = model.phase_period(params).unwrap_or(f64::NAN);
+    let mut integrator = Integrator::new(method)?;
+    let (_, m) = monodromy::<_, S, V>(&mut integrator, &model.exact(params), period, y0)?;
+    Ok(spectral_radius(&floquet_multipliers(&m)))
+}
+
+/// The parameters by name of a model with a fast phase, or why it cannot be
+/// analysed (no phase, a wrong number of values).
+fn vibrating_model<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+) -> Result<BTreeMap<String, f64>, StabilityError> {
+    let info = model.info();
+    if !model.has_fast_phase() {
+        return Err(StabilityError::NoFastPhase(info.name.into()));
+    }
+    info.named_values(params)
+        .ok_or_else(|| StabilityError::ParameterCount(params.len(), info.name.into()))
+}
+
 /// The exact system's stability window in the amplitude at (q, 0), from
 /// the spectral radius of its monodromy matrix over one period of the
 /// phase, if (q, 0) is a solution of the exact system for every amplitude.
@@ -467,13 +506,9 @@ fn exact_window<
     let a_max = settings.a_max.unwrap_or(3.0 * a_star);
     let curve = RefCell::new(Vec::new());
     let margin = |a: f64| -> Result<f64, OdeError> {
-        let p = with(a);
-        let period = model.phase_period(&p).unwrap_or(f64::NAN);
-        let mut integrator = Integrator::new(settings.method)?;
-        let (_, m) = monodromy::<_, S, V>(&mut integrator, &model.exact(&p), period, &y0)?;
-        let radius = spectral_radius(&floquet_multipliers(&m));
+        let radius = spectral_radius_at(model, &with(a), &y0, settings.method)?;
         curve.borrow_mut().push([a, radius]);
-        Ok(radius - 1.0 - 1e-6)
+        Ok(radius - 1.0 - STABLE_SLACK)
     };
     let window = stability_window(
         &margin,
@@ -553,11 +588,7 @@ impl WithFixed for Chart<'_> {
         use rayon::prelude::*;
         let info = model.info();
         let settings = self.settings;
-        if !model.has_fast_phase() {
-            return Err(StabilityError::NoFastPhase(info.name.into()));
-        }
-        info.named_values(self.params)
-            .ok_or_else(|| StabilityError::ParameterCount(self.params.len(), info.name.into()))?;
+        vibrating_model(model, self.params)?;
         let index = |name: &str| {
             info.parameter_names
                 .iter()
@@ -580,10 +611,7 @@ impl WithFixed for Chart<'_> {
             let mut p = self.params.to_vec();
             p[ix] = x;
             p[iy] = y;
-            let period = model.phase_period(&p).unwrap_or(f64::NAN);
-            let mut integrator = Integrator::new(settings.method)?;
-            let (_, m) = monodromy::<_, S, V>(&mut integrator, &model.exact(&p), period, &y0)?;
-            Ok(spectral_radius(&floquet_multipliers(&m)) - 1.0 - 1e-6)
+            Ok(spectral_radius_at(model, &p, &y0, settings.method)? - 1.0 - STABLE_SLACK)
         };
         let y_values: Vec<f64> = (1..=settings.y_samples)
             .map(|k| settings.y_max * k as f64 / settings.y_samples as f64)

@@ -33,6 +33,24 @@ fn at<'a>(result: &'a [EquilibriumStability], q: &[f64]) -> &'a EquilibriumStabi
         .unwrap_or_else(|| panic!("no equilibrium at {q:?} in {result:#?}"))
 }
 
+/// Kapitza's exact A*(ε) as `kapitza_stability` found it before the generic
+/// analysis: the first A in (0, a_max] where the Jury criterion
+/// |tr M| − 1 − det M of the 2×2 monodromy matrix becomes ≤ 0 (100 samples
+/// per unit of A, bisected to 1e-11).
+fn jury_threshold(eps: f64, a_max: f64) -> f64 {
+    let jury = |a: f64| -> Result<f64, OdeError> {
+        let params = kapitza::Params { A: a, eps, mu: 0.0 };
+        let mut integrator = Integrator::new(Method::parse("dop853", 1e-12)?)?;
+        let system = kapitza::Exact { params };
+        let (_, m) = monodromy::<_, 2, 6>(&mut integrator, &system, 2.0 * PI * eps, &[0.0, 0.0])?;
+        Ok(jury_margin(&m))
+    };
+    let samples = (100.0 * a_max) as usize;
+    first_stability_onset(&jury, 0.0, a_max, samples, 1e-11)
+        .unwrap()
+        .expect("the upper position becomes stable below a_max")
+}
+
 /// Kapitza: a* = √2 from the averaged system, and the exact lower edge equals
 /// the one found with the Jury criterion |tr M| − 1 − det M on the 2×2
 /// monodromy matrix (as `kapitza_stability` finds A*), to 1e-9.
@@ -47,20 +65,7 @@ fn kapitza_threshold_and_exact_edge() {
     let hanging = at(&result.equilibria, &[PI]);
     assert!(hanging.stable_without_vibration && hanging.a_star.is_none());
     let eps = 0.1;
-    let jury = |a: f64| -> Result<f64, OdeError> {
-        let params = kapitza::Params { A: a, eps, mu: 0.0 };
-        let mut integrator = Integrator::new(Method::parse("dop853", 1e-12)?)?;
-        let (_, m) = monodromy::<_, 2, 6>(
-            &mut integrator,
-            &kapitza::Exact { params },
-            2.0 * PI * eps,
-            &[0.0, 0.0],
-        )?;
-        Ok(jury_margin(&m))
-    };
-    let reference = first_stability_onset(&jury, 0.0, 4.0, 400, 1e-11)
-        .unwrap()
-        .unwrap();
+    let reference = jury_threshold(eps, 4.0);
     let [low, _] = upright.exact_window.unwrap();
     assert!(
         (low.unwrap() - reference).abs() < 1e-9,
@@ -191,20 +196,7 @@ fn kapitza_chart_boundaries_are_the_exact_thresholds() {
     };
     let chart = stability_chart("kapitza", &defaults("kapitza"), &settings).unwrap();
     for (k, &eps) in settings.x_values.iter().enumerate() {
-        let jury = |a: f64| -> Result<f64, OdeError> {
-            let params = kapitza::Params { A: a, eps, mu: 0.0 };
-            let mut integrator = Integrator::new(Method::parse("dop853", 1e-12)?)?;
-            let (_, m) = monodromy::<_, 2, 6>(
-                &mut integrator,
-                &kapitza::Exact { params },
-                2.0 * PI * eps,
-                &[0.0, 0.0],
-            )?;
-            Ok(jury_margin(&m))
-        };
-        let reference = first_stability_onset(&jury, 0.0, 6.0, 600, 1e-11)
-            .unwrap()
-            .unwrap();
+        let reference = jury_threshold(eps, 6.0);
         let first = chart.boundaries[k][0];
         assert!(
             (first - reference).abs() < 1e-8,
