@@ -42,26 +42,34 @@ fn main() {
             let present = root.join(name).join("summary.json").exists();
             if mode == "all" || (mode == "missing" && !present) {
                 eprintln!("running {name} …");
-                let status =
-                    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-                        .args([
-                            "run",
-                            "--release",
-                            "--quiet",
-                            "--example",
-                            name,
-                            "--",
-                            "--out",
-                        ])
-                        .arg(root.join(name))
-                        .status()
-                        .map_err(|e| {
-                            SceneError::Usage(format!("cannot run cargo for {name}: {e}"))
-                        })?;
+                // The benchmark among them runs through `cargo bench`.
+                let target = if name == "work_precision" {
+                    ["bench", "--bench"]
+                } else {
+                    ["run", "--example"]
+                };
+                let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+                let status = Command::new(cargo)
+                    .args([
+                        target[0],
+                        "--release",
+                        "--quiet",
+                        target[1],
+                        name,
+                        "--",
+                        "--out",
+                    ])
+                    .arg(root.join(name))
+                    .status()
+                    .map_err(|source| SceneError::Spawn {
+                        scene: name.into(),
+                        source,
+                    })?;
                 if !status.success() {
-                    return Err(SceneError::Numerical(format!(
-                        "scene {name} failed ({status})"
-                    )));
+                    return Err(SceneError::SceneFailed {
+                        scene: name.into(),
+                        status,
+                    });
                 }
             }
         }
@@ -85,9 +93,7 @@ fn main() {
             .filter(|l| !l.starts_with('#') && !root.join(l).exists())
             .collect();
         if !missing.is_empty() {
-            return Err(SceneError::Numerical(format!(
-                "the report links files that do not exist: {missing:?}"
-            )));
+            return Err(SceneError::BrokenLinks(missing));
         }
         let path = root.join("index.html");
         std::fs::create_dir_all(&root).map_err(|source| SceneError::Io {

@@ -11,7 +11,8 @@
 
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Integrator, Method, OdeError};
-use crate::registry::{DynamicModel, Fixed, Kind, WithFixed};
+use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
+use crate::registry::{display_name, DynamicModel, Fixed, Kind, WithFixed};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -373,4 +374,163 @@ pub fn equilibria(model: &dyn DynamicModel, params: &[f64]) -> Vec<Equilibrium> 
         });
     }
     found
+}
+
+/// Limits of the finite values, widened a little ((−1, 1) if none).
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
+    if lo > hi {
+        return (-1.0, 1.0);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-9);
+    (lo - pad, hi + pad)
+}
+
+
+/// The figure: per degree of freedom the time series, the phase portrait
+/// and the period map (or the velocity), then the energy change and the
+/// exact−averaged deviation.
+pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Figure {
+    let info = model.info();
+    let (n, contacts) = match model.kind() {
+        Kind::Hamiltonian { dof, .. } => (dof, false),
+        Kind::Contacts { count } => (count, true),
+    };
+    // Labels in the model's notation (φ₁, p_φ₁, x₁′).
+    let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
+    let coordinate_names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let velocity = |i: usize| {
+        if contacts {
+            format!("{}′", coordinate_names[i])
+        } else {
+            display_name(info.momenta[i])
+        }
+    };
+    let mut titles = Vec::new();
+    for (i, q) in coordinate_names.iter().enumerate() {
+        titles.push(format!("{q}(t)"));
+        titles.push(format!("phase portrait ({q}, {})", velocity(i)));
+        titles.push(if result.period_map.is_some() {
+            format!("period map ({q}, {})", velocity(i))
+        } else {
+            format!("{}(t)", velocity(i))
+        });
+    }
+    titles.push(result.energy_label.to_string());
+    if result.averaged.is_some() {
+        titles.push("|exact − averaged| of the coordinates".into());
+    }
+    let column = |k: usize, rows: &[Vec<f64>]| rows.iter().map(move |y| y[k]).collect::<Vec<f64>>();
+    let mut specs = Vec::new();
+    let t_range = (0.0, t_end);
+    let averaged = result.averaged.clone().unwrap_or_default();
+    for i in 0..n {
+        let q: Vec<f64> = column(i, &result.exact)
+            .into_iter()
+            .chain(column(i, &averaged))
+            .collect();
+        let p: Vec<f64> = column(n + i, &result.exact)
+            .into_iter()
+            .chain(column(n + i, &averaged))
+            .collect();
+        specs.push(PanelSpec::new(
+            &titles[3 * i],
+            "t",
+            coordinate_names[i],
+            t_range,
+            range(q.iter().copied()),
+        ));
+        specs.push(PanelSpec::new(
+            &titles[3 * i + 1],
+            coordinate_names[i],
+            "",
+            range(q.iter().copied()),
+            range(p.iter().copied()),
+        ));
+        match &result.period_map {
+            Some(map) => specs.push(PanelSpec::new(
+                &titles[3 * i + 2],
+                coordinate_names[i],
+                "",
+                range(column(i, map).into_iter()),
+                range(column(n + i, map).into_iter()),
+            )),
+            None => specs.push(PanelSpec::new(
+                &titles[3 * i + 2],
+                "t",
+                "",
+                t_range,
+                range(p.iter().copied()),
+            )),
+        }
+    }
+    specs.push(PanelSpec::new(
+        &titles[3 * n],
+        "t",
+        "",
+        t_range,
+        range(result.energy_change.iter().copied().chain([0.0])),
+    ));
+    let deviation: Vec<Vec<(f64, f64)>> = (0..n)
+        .map(|i| {
+            result
+                .times
+                .iter()
+                .zip(result.exact.iter().zip(&averaged))
+                .map(|(t, (e, a))| (*t, (e[i] - a[i]).abs()))
+                .collect()
+        })
+        .collect();
+    if result.averaged.is_some() {
+        specs.push(PanelSpec::new(
+            &titles[3 * n + 1],
+            "t",
+            "",
+            t_range,
+            range(deviation.iter().flatten().map(|p| p.1).chain([0.0])),
+        ));
+    }
+    let mut figure = Figure::grid(3, specs.len().div_ceil(3), 460, 340, &specs);
+    let series = |k: usize, rows: &[Vec<f64>]| {
+        result
+            .times
+            .iter()
+            .zip(rows)
+            .map(|(t, y)| (*t, y[k]))
+            .collect::<Vec<_>>()
+    };
+    let pairs = |a: usize, b: usize, rows: &[Vec<f64>]| {
+        rows.iter().map(|y| (y[a], y[b])).collect::<Vec<_>>()
+    };
+    for i in 0..n {
+        figure.line(3 * i, &series(i, &result.exact), palette(0));
+        figure.line(3 * i + 1, &pairs(i, n + i, &result.exact), palette(0));
+        if result.averaged.is_some() {
+            figure.line(3 * i, &series(i, &averaged), BLACK);
+            figure.line(3 * i + 1, &pairs(i, n + i, &averaged), BLACK);
+            figure.legend(
+                3 * i,
+                &[("exact".into(), palette(0)), ("averaged".into(), BLACK)],
+            );
+        }
+        match &result.period_map {
+            Some(map) => figure.points(3 * i + 2, pairs(i, n + i, map), RED, 3),
+            None => figure.line(3 * i + 2, &series(n + i, &result.exact), palette(1)),
+        }
+    }
+    let energy: Vec<(f64, f64)> = result
+        .times
+        .iter()
+        .copied()
+        .zip(result.energy_change.iter().copied())
+        .collect();
+    figure.line(3 * n, &energy, GREY);
+    for (i, d) in deviation.iter().enumerate() {
+        if result.averaged.is_some() {
+            figure.line(3 * n + 1, d, palette(i));
+        }
+    }
+    figure
 }

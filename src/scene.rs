@@ -70,33 +70,42 @@ pub enum SceneError {
         path: PathBuf,
         source: std::io::Error,
     },
-    /// A numerical failure (divergence, ...), with context.
-    #[error("{0}")]
-    Numerical(String),
+    #[error(transparent)]
+    Ode(#[from] crate::ode::OdeError),
+    #[error(transparent)]
+    Contact(#[from] crate::contact::ContactError),
+    #[error(transparent)]
+    Parameter(#[from] crate::registry::ParameterError),
+    #[error(transparent)]
+    Study(#[from] crate::studies::StudyError),
+    #[error(transparent)]
+    Explore(#[from] crate::explore::ExploreError),
     #[error(transparent)]
     Stability(#[from] crate::analysis::stability::StabilityError),
     #[error(transparent)]
     Averaging(#[from] crate::analysis::averaging::AveragingError),
     #[error(transparent)]
     PeriodMap(#[from] crate::analysis::period_map::PeriodMapError),
-}
-
-impl From<crate::ode::OdeError> for SceneError {
-    fn from(e: crate::ode::OdeError) -> Self {
-        SceneError::Numerical(e.to_string())
-    }
-}
-
-impl From<crate::contact::ContactError> for SceneError {
-    fn from(e: crate::contact::ContactError) -> Self {
-        SceneError::Numerical(e.to_string())
-    }
-}
-
-impl From<crate::registry::ParameterError> for SceneError {
-    fn from(e: crate::registry::ParameterError) -> Self {
-        SceneError::Usage(e.to_string())
-    }
+    /// Another scene, run by this one, could not start or failed.
+    #[error("cannot run scene {scene}: {source}")]
+    Spawn {
+        scene: String,
+        source: std::io::Error,
+    },
+    #[error("scene {scene} failed ({status})")]
+    SceneFailed {
+        scene: String,
+        status: std::process::ExitStatus,
+    },
+    /// Links of a written page to files that do not exist.
+    #[error("the page links files that do not exist: {0:?}")]
+    BrokenLinks(Vec<String>),
+    /// A summary that does not serialise (a non-string map key, ...).
+    #[error("summary of scene {scene}: {source}")]
+    Summary {
+        scene: &'static str,
+        source: serde_json::Error,
+    },
 }
 
 /// A parsed command line of a scene.
@@ -170,6 +179,8 @@ impl Scene {
                     out = PathBuf::from(next()?);
                     i += 2;
                 }
+                // `cargo bench` passes it to a benchmark run as a scene.
+                "--bench" => i += 1,
                 other => {
                     return Err(SceneError::Usage(format!(
                         "unexpected argument '{other}' (see --help)"
@@ -391,8 +402,10 @@ impl Scene {
 
     /// Writes `summary.json` (with the scene's settings added).
     pub fn write_summary<S: serde::Serialize>(&self, summary: &S) -> Result<PathBuf, SceneError> {
-        let mut summary = serde_json::to_value(summary)
-            .map_err(|e| SceneError::Numerical(format!("summary of {}: {e}", self.name)))?;
+        let mut summary = serde_json::to_value(summary).map_err(|source| SceneError::Summary {
+            scene: self.name,
+            source,
+        })?;
         if let serde_json::Value::Object(map) = &mut summary {
             map.insert("scene".into(), self.name.into());
             map.insert("settings".into(), self.settings());

@@ -142,6 +142,15 @@ impl Method {
         }
     }
 
+    /// The number [`Method::parse`] took: tolerance or step size.
+    pub fn accuracy(&self) -> f64 {
+        match *self {
+            Method::Rk4 { step } | Method::Gauss { step, .. } => step,
+            Method::Dop853 { rtol, .. } | Method::Radau5 { rtol, .. } => rtol,
+            Method::Taylor { tol } => tol,
+        }
+    }
+
     /// Classical order of the method.
     pub fn order(&self) -> usize {
         match self {

@@ -1,6 +1,40 @@
-//! What the scenes of one study share: closed forms derived by hand (to test
-//! the generated code against, and to print in reports) and the runs that
-//! more than one scene makes.
+//! The runs of the three studies' scenes, each returning a typed result
+//! (the scene's summary, with the data its figures are drawn from), and the
+//! closed forms derived by hand that the generated code is tested against.
 
 pub mod double_pendulum;
+pub mod kapitza;
 pub mod painleve;
+
+use crate::ode::OdeError;
+
+/// Why a study's run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+    /// One orbit of a set, with its start.
+    #[error("orbit {index} from {start:?}: {source}")]
+    Orbit {
+        index: usize,
+        start: Vec<f64>,
+        source: OdeError,
+    },
+    #[error(transparent)]
+    Stability(#[from] crate::analysis::stability::StabilityError),
+    #[error(transparent)]
+    Contact(#[from] crate::contact::ContactError),
+    /// One case of a set, by its index and the value that sets it apart.
+    #[error("case {index} ({value}): {source}")]
+    Case {
+        index: usize,
+        value: f64,
+        source: crate::contact::ContactError,
+    },
+    /// Settings that do not fit together.
+    #[error("{setting}: {reason}")]
+    Settings {
+        setting: &'static str,
+        reason: String,
+    },
+}
