@@ -6,6 +6,8 @@
 //! cos φ = (x1 − x2)/(l + δ), sin φ = d/(l + δ), R = k ε⁻² δ + ν ε⁻¹ δ'.
 
 pub mod impact;
+pub mod deformation;
+pub mod graphs;
 pub mod stiff_limit;
 
 use crate::models::painleve_klein::Params;
