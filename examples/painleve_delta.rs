@@ -16,8 +16,16 @@ fn main() {
     run(|| {
         let mut knobs = parameter_knobs();
         knobs.extend([
-            knob("sigma", "1", "sliding direction σ = ±1 for the given parameters"),
-            knob("starts", "7", "initial points per side of the portrait grid"),
+            knob(
+                "sigma",
+                "1",
+                "sliding direction σ = ±1 for the given parameters",
+            ),
+            knob(
+                "starts",
+                "7",
+                "initial points per side of the portrait grid",
+            ),
             knob("t_end", "3", "length of each trajectory, in units of ε"),
         ]);
         let scene = Scene::from_args(
@@ -25,9 +33,18 @@ fn main() {
             "equilibria of the deformation equation (25) and phase portraits",
             &knobs,
         )?;
-        let sigma = if scene.number("sigma")? >= 0.0 { 1.0 } else { -1.0 };
+        let sigma = if scene.number("sigma")? >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
         let params = params_from_scene(&scene)?;
-        let result = deformation(&params, sigma, scene.count("starts")?, scene.positive("t_end")?)?;
+        let result = deformation(
+            &params,
+            sigma,
+            scene.count("starts")?,
+            scene.positive("t_end")?,
+        )?;
         for case in &result.cases {
             println!("{}: X* = {:.4}", case.case, case.x_star);
             for e in &case.equilibria {

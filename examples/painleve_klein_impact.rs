@@ -20,7 +20,11 @@ fn main() {
     run(|| {
         let mut knobs = parameter_knobs();
         knobs.extend([
-            knob("x2_starts", "-0.65,-0.78", "x2(0) of each case (x1 = 0, x1' = x2' = 10)"),
+            knob(
+                "x2_starts",
+                "-0.65,-0.78",
+                "x2(0) of each case (x1 = 0, x1' = x2' = 10)",
+            ),
             knob("t_end", "4", "end time (a case at rest ends earlier)"),
             knob("samples", "4000", "samples per case for the figures"),
         ]);
@@ -52,7 +56,17 @@ fn main() {
         scene.save_figure(&result.figure(), "impact.png")?;
         let header = ["x2_0", "t", "point", "case", "from", "to", "v1", "v2", "R"];
         scene.write_csv("events.csv", &header, result.event_rows())?;
-        let header = ["x2_0", "t", "x1", "x2", "v1", "v2", "delta", "delta_rate", "R"];
+        let header = [
+            "x2_0",
+            "t",
+            "x1",
+            "x2",
+            "v1",
+            "v2",
+            "delta",
+            "delta_rate",
+            "R",
+        ];
         scene.write_csv("series.csv", &header, result.series_rows())?;
         scene.write_summary(&result)?;
         Ok(())

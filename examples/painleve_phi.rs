@@ -15,7 +15,11 @@ use mechlab::studies::painleve::{parameter_knobs, params_from_scene};
 fn main() {
     run(|| {
         let mut knobs = parameter_knobs();
-        knobs.push(knob("region_pixels", "120", "resolution of the region plots"));
+        knobs.push(knob(
+            "region_pixels",
+            "120",
+            "resolution of the region plots",
+        ));
         let scene = Scene::from_args(
             "painleve_phi",
             "Φ(R): every graph class, its region, the roots for given parameters",
@@ -23,7 +27,13 @@ fn main() {
         )?;
         let result = phi_graphs(&params_from_scene(&scene)?, scene.count("region_pixels")?);
         for ((_, roots), class) in result.examples.iter().zip(result.classes) {
-            println!("class {}: {}; {} (example: {} roots)", class.signs, class.region, class.roots, roots.len());
+            println!(
+                "class {}: {}; {} (example: {} roots)",
+                class.signs,
+                class.region,
+                class.roots,
+                roots.len()
+            );
         }
         for g in &result.given {
             println!(

@@ -17,7 +17,11 @@ fn main() {
     run(|| {
         let mut knobs = vec![
             knob("eps_values", "0.1,0.03,0.01,0.001", "values of ε"),
-            knob("x2_regular", "-0.65", "x2(0) of the regular case at ε = 0.1"),
+            knob(
+                "x2_regular",
+                "-0.65",
+                "x2(0) of the regular case at ε = 0.1",
+            ),
             knob("x2_impact", "-0.78", "x2(0) of the impact case at ε = 0.1"),
             knob("t_end", "2", "end time"),
         ];
@@ -36,14 +40,20 @@ fn main() {
         })?;
         println!("rigid rod: stable root R* = {:?}", result.rigid_R_star);
         for r in &result.runs {
-            let events: Vec<(f64, usize, &str)> = r.events.iter().map(|e| (e.t, e.point, e.case.as_str())).collect();
+            let events: Vec<(f64, usize, &str)> = r
+                .events
+                .iter()
+                .map(|e| (e.t, e.point, e.case.as_str()))
+                .collect();
             println!(
                 "{:8} ε = {:<6} {} at t = {:.6}, R = {:.6}, {} steps, {} f, {:.4} s, events {events:?}",
                 r.case, r.eps, r.outcome, r.t_end, r.final_R, r.steps, r.f_evals, r.seconds
             );
         }
         scene.save_figure(&result.figure(), "stiff_limit.png")?;
-        let header = ["case", "eps", "outcome", "t_end", "final_R", "steps", "f_evals", "seconds"];
+        let header = [
+            "case", "eps", "outcome", "t_end", "final_R", "steps", "f_evals", "seconds",
+        ];
         scene.write_csv("runs.csv", &header, result.rows())?;
         scene.write_summary(&result)?;
         Ok(())

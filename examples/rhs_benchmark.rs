@@ -6,7 +6,7 @@
 
 use mechlab::linalg::Cholesky;
 use mechlab::models::{double_pendulum as dp, kapitza, triple_pendulum as tp};
-use mechlab::scene::{knob, run, Scene};
+use mechlab::scene::{knob, run, Scene, SceneError};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -84,6 +84,71 @@ fn time<const N: usize>(states: &[[f64; N]], f: impl Fn(f64, &[f64; N]) -> [f64;
     (start.elapsed().as_secs_f64(), black_box(sum))
 }
 
+/// Generated against hand-written on the same states: one right-hand side
+/// timed in nanoseconds per evaluation.
+#[derive(serde::Serialize)]
+struct Timing {
+    generated_ns: f64,
+    hand_written_ns: f64,
+    ratio: f64,
+}
+
+/// Checks that both give the same results on the first 1000 states (the
+/// benchmark compares equal work), then times them in five alternating
+/// rounds (the best of each).
+fn compare<const N: usize>(
+    name: &str,
+    states: &[[f64; N]],
+    generated: impl Fn(f64, &[f64; N]) -> [f64; N],
+    by_hand: impl Fn(f64, &[f64; N]) -> [f64; N],
+) -> Result<Timing, SceneError> {
+    for y in states.iter().take(1000) {
+        let (a, b) = (generated(0.3, y), by_hand(0.3, y));
+        if !a
+            .iter()
+            .zip(&b)
+            .all(|(x, z)| (x - z).abs() < 1e-8 * (1.0 + z.abs()))
+        {
+            return Err(SceneError::BadValue {
+                name: name.into(),
+                value: format!("{y:?}"),
+                reason: format!("generated {a:?} but hand-written {b:?}"),
+            });
+        }
+    }
+    let mut best = [f64::INFINITY; 2];
+    for _ in 0..5 {
+        best[0] = best[0].min(time(states, &generated).0);
+        best[1] = best[1].min(time(states, &by_hand).0);
+    }
+    let per = |s: f64| s / states.len() as f64 * 1e9;
+    let timing = Timing {
+        generated_ns: per(best[0]),
+        hand_written_ns: per(best[1]),
+        ratio: best[0] / best[1],
+    };
+    println!(
+        "{name} exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {:.3}",
+        timing.generated_ns, timing.hand_written_ns, timing.ratio
+    );
+    Ok(timing)
+}
+
+/// `count` states with components uniform in [−3, 3) (a fixed LCG, so
+/// every run times the same states).
+fn random_states<const N: usize>(count: usize, seed: u64) -> Vec<[f64; N]> {
+    let mut seed = seed;
+    let mut random = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0
+    };
+    (0..count)
+        .map(|_| std::array::from_fn(|_| random()))
+        .collect()
+}
+
 fn main() {
     run(|| {
         let scene = Scene::from_args(
@@ -96,18 +161,6 @@ fn main() {
             )],
         )?;
         let n = scene.count("evaluations")?;
-        let mut seed = 1u64;
-        let mut random = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 6.0 - 3.0
-        };
-        let k_states: Vec<[f64; 2]> = (0..n).map(|_| [random(), random()]).collect();
-        let d_states: Vec<[f64; 4]> = (0..n)
-            .map(|_| [random(), random(), random(), random()])
-            .collect();
-        let t_states: Vec<[f64; 6]> = (0..n).map(|_| std::array::from_fn(|_| random())).collect();
         let kp = kapitza::Params {
             mu: 0.1,
             ..Default::default()
@@ -122,99 +175,29 @@ fn main() {
             l3: 0.7,
             ..Default::default()
         };
-        // Same results first (the benchmark compares equal work).
-        for y in k_states.iter().take(1000) {
-            let (a, b) = (
-                kapitza::exact_rhs(0.3, y, &kp),
-                kapitza_by_hand(0.3, y, &kp),
-            );
-            assert!(
-                a.iter()
-                    .zip(&b)
-                    .all(|(x, z)| (x - z).abs() < 1e-9 * (1.0 + z.abs())),
-                "{a:?} vs {b:?}"
-            );
-        }
-        for y in d_states.iter().take(1000) {
-            let (a, b) = (
-                dp::exact_rhs(0.3, y, &pp),
-                double_pendulum_by_hand(0.3, y, &pp),
-            );
-            assert!(
-                a.iter()
-                    .zip(&b)
-                    .all(|(x, z)| (x - z).abs() < 1e-8 * (1.0 + z.abs())),
-                "{a:?} vs {b:?}"
-            );
-        }
-        for y in t_states.iter().take(1000) {
-            let (a, b) = (
-                tp::exact_rhs(0.3, y, &tpp),
-                triple_pendulum_by_hand(0.3, y, &tpp),
-            );
-            assert!(
-                a.iter()
-                    .zip(&b)
-                    .all(|(x, z)| (x - z).abs() < 1e-8 * (1.0 + z.abs())),
-                "{a:?} vs {b:?}"
-            );
-        }
-        // Best of five alternating rounds each.
-        let mut best = [f64::INFINITY; 6];
-        for _ in 0..5 {
-            best[0] = best[0].min(time(&k_states, |t, y| kapitza::exact_rhs(t, y, &kp)).0);
-            best[1] = best[1].min(time(&k_states, |t, y| kapitza_by_hand(t, y, &kp)).0);
-            best[2] = best[2].min(time(&d_states, |t, y| dp::exact_rhs(t, y, &pp)).0);
-            best[3] = best[3].min(time(&d_states, |t, y| double_pendulum_by_hand(t, y, &pp)).0);
-            best[4] = best[4].min(time(&t_states, |t, y| tp::exact_rhs(t, y, &tpp)).0);
-            best[5] = best[5].min(time(&t_states, |t, y| triple_pendulum_by_hand(t, y, &tpp)).0);
-        }
-        let per = |s: f64| s / n as f64 * 1e9;
-        let (rk, rd, rt) = (best[0] / best[1], best[2] / best[3], best[4] / best[5]);
-        println!(
-            "kapitza exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {rk:.3}",
-            per(best[0]),
-            per(best[1])
-        );
-        println!(
-            "double_pendulum exact_rhs: generated {:.2} ns, hand-written {:.2} ns, ratio {rd:.3}",
-            per(best[2]),
-            per(best[3])
-        );
-        println!(
-            "triple_pendulum exact_rhs (numeric solve): generated {:.2} ns, hand-written {:.2} ns, ratio {rt:.3}",
-            per(best[4]),
-            per(best[5])
-        );
-        #[derive(serde::Serialize)]
-        struct Timing {
-            generated_ns: f64,
-            hand_written_ns: f64,
-            ratio: f64,
-        }
-        #[derive(serde::Serialize)]
-        struct Summary {
-            kapitza: Timing,
-            double_pendulum: Timing,
-            triple_pendulum: Timing,
-        }
-        scene.write_summary(&Summary {
-            kapitza: Timing {
-                generated_ns: per(best[0]),
-                hand_written_ns: per(best[1]),
-                ratio: rk,
-            },
-            double_pendulum: Timing {
-                generated_ns: per(best[2]),
-                hand_written_ns: per(best[3]),
-                ratio: rd,
-            },
-            triple_pendulum: Timing {
-                generated_ns: per(best[4]),
-                hand_written_ns: per(best[5]),
-                ratio: rt,
-            },
-        })?;
+        let kapitza = compare(
+            "kapitza",
+            &random_states(n, 1),
+            |t, y| kapitza::exact_rhs(t, y, &kp),
+            |t, y| kapitza_by_hand(t, y, &kp),
+        )?;
+        let double_pendulum = compare(
+            "double_pendulum",
+            &random_states(n, 2),
+            |t, y| dp::exact_rhs(t, y, &pp),
+            |t, y| double_pendulum_by_hand(t, y, &pp),
+        )?;
+        let triple_pendulum = compare(
+            "triple_pendulum (numeric solve)",
+            &random_states(n, 3),
+            |t, y| tp::exact_rhs(t, y, &tpp),
+            |t, y| triple_pendulum_by_hand(t, y, &tpp),
+        )?;
+        scene.write_summary(&serde_json::json!({
+            "kapitza": kapitza,
+            "double_pendulum": double_pendulum,
+            "triple_pendulum": triple_pendulum,
+        }))?;
         Ok(())
     });
 }

@@ -12,7 +12,7 @@
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Integrator, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
-use crate::registry::{display_name, DynamicModel, Fixed, Kind, WithFixed};
+use crate::registry::{display_name, DynamicModel, Fixed, Kind, ModelInfo, WithFixed};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -388,28 +388,18 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-
-/// The figure: per degree of freedom the time series, the phase portrait
-/// and the period map (or the velocity), then the energy change and the
-/// exact−averaged deviation.
-pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Figure {
-    let info = model.info();
-    let (n, contacts) = match model.kind() {
-        Kind::Hamiltonian { dof, .. } => (dof, false),
-        Kind::Contacts { count } => (count, true),
-    };
-    // Labels in the model's notation (φ₁, p_φ₁, x₁′).
+/// The panel titles, in the model's notation (φ₁, p_φ₁, x₁′).
+fn panel_titles(result: &Exploration, info: &ModelInfo, contacts: bool) -> Vec<String> {
     let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
-    let coordinate_names: Vec<&str> = names.iter().map(String::as_str).collect();
     let velocity = |i: usize| {
         if contacts {
-            format!("{}′", coordinate_names[i])
+            format!("{}′", names[i])
         } else {
             display_name(info.momenta[i])
         }
     };
     let mut titles = Vec::new();
-    for (i, q) in coordinate_names.iter().enumerate() {
+    for (i, q) in names.iter().enumerate() {
         titles.push(format!("{q}(t)"));
         titles.push(format!("phase portrait ({q}, {})", velocity(i)));
         titles.push(if result.period_map.is_some() {
@@ -422,6 +412,21 @@ pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Fig
     if result.averaged.is_some() {
         titles.push("|exact − averaged| of the coordinates".into());
     }
+    titles
+}
+
+/// The figure: per degree of freedom the time series, the phase portrait
+/// and the period map (or the velocity), then the energy change and the
+/// exact−averaged deviation.
+pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Figure {
+    let info = model.info();
+    let (n, contacts) = match model.kind() {
+        Kind::Hamiltonian { dof, .. } => (dof, false),
+        Kind::Contacts { count } => (count, true),
+    };
+    let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
+    let coordinate_names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let titles = panel_titles(result, info, contacts);
     let column = |k: usize, rows: &[Vec<f64>]| rows.iter().map(move |y| y[k]).collect::<Vec<f64>>();
     let mut specs = Vec::new();
     let t_range = (0.0, t_end);

@@ -276,10 +276,13 @@ pub struct UpperPosition {
     pub a_star_by_eps: Vec<AStar>,
     /// (A, μ, label) of the three orbit panels, and their orbits.
     #[serde(skip)]
-    pub cases: Vec<(f64, f64, &'static str, Vec<Vec<[f64; 2]>>)>,
+    pub cases: Vec<(f64, f64, &'static str, Orbits)>,
     #[serde(skip)]
     pub chart: StabilityChart,
 }
+
+/// Orbits of the period map, each a list of states (q, p).
+pub type Orbits = Vec<Vec<[f64; 2]>>;
 
 /// Starts of the orbits near the upper position.
 const NEAR_UPPER: [[f64; 2]; 4] = [[0.05, 0.0], [0.15, 0.0], [0.3, 0.0], [0.0, 0.25]];

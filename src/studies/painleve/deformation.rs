@@ -2,7 +2,9 @@
 //! phase portraits without and with damping, for an example of each graph
 //! class and for the given parameters.
 
-use super::{class_example, reduced, DeformationEquation, DeformationEquilibrium, Params, GRAPH_CLASSES};
+use super::{
+    class_example, reduced, DeformationEquation, DeformationEquilibrium, Params, GRAPH_CLASSES,
+};
 use crate::ode::{Integrator, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, RED};
 
@@ -49,12 +51,20 @@ fn trajectories(
                 x0 + (x1 - x0) * (i as f64 + 0.5) / starts as f64,
                 y0 + (y1 - y0) * (j as f64 + 0.5) / starts as f64,
             ];
-            let states = Integrator::new(Method::parse("dop853", 1e-9)?)?.advance_sampled(eq, 0.0, &start, &times)?;
+            let states = Integrator::new(Method::parse("dop853", 1e-9)?)?
+                .advance_sampled(eq, 0.0, &start, &times)?;
             let inside = |y: &[f64; 2]| {
-                y[0] >= x0 - (x1 - x0) && y[0] <= x1 + (x1 - x0) && y[1].abs() <= 3.0 * (y1 - y0).abs()
+                y[0] >= x0 - (x1 - x0)
+                    && y[0] <= x1 + (x1 - x0)
+                    && y[1].abs() <= 3.0 * (y1 - y0).abs()
             };
             let mut curve = vec![(start[0], start[1])];
-            curve.extend(states.iter().take_while(|y| inside(y)).map(|y| (y[0], y[1])));
+            curve.extend(
+                states
+                    .iter()
+                    .take_while(|y| inside(y))
+                    .map(|y| (y[0], y[1])),
+            );
             curves.push(curve);
         }
     }
@@ -64,14 +74,33 @@ fn trajectories(
 /// An example of each class (σ = 1), then the given parameters with `sigma`;
 /// each drawn without damping and with the rod's ν, trajectories of
 /// `t_end` (in units of ε) from `starts`² points.
-pub fn deformation(params: &Params, sigma: f64, starts: usize, t_end: f64) -> Result<Deformation, OdeError> {
-    let equation = |reduced, sigma| DeformationEquation { reduced, sigma, k: params.k, nu: params.nu, eps: params.eps };
+pub fn deformation(
+    params: &Params,
+    sigma: f64,
+    starts: usize,
+    t_end: f64,
+) -> Result<Deformation, OdeError> {
+    let equation = |reduced, sigma| DeformationEquation {
+        reduced,
+        sigma,
+        k: params.k,
+        nu: params.nu,
+        eps: params.eps,
+    };
     let mut equations: Vec<(String, DeformationEquation)> = GRAPH_CLASSES
         .iter()
         .enumerate()
-        .map(|(k, c)| (format!("class {}", c.signs), equation(class_example(k), 1.0)))
+        .map(|(k, c)| {
+            (
+                format!("class {}", c.signs),
+                equation(class_example(k), 1.0),
+            )
+        })
         .collect();
-    equations.push((format!("given parameters, σ = {sigma:+}"), equation(reduced(params), sigma)));
+    equations.push((
+        format!("given parameters, σ = {sigma:+}"),
+        equation(reduced(params), sigma),
+    ));
     let mut cases = Vec::new();
     let mut portraits = Vec::new();
     for (name, eq) in equations {
@@ -94,10 +123,19 @@ pub fn deformation(params: &Params, sigma: f64, starts: usize, t_end: f64) -> Re
                 window,
                 rate,
                 curves: trajectories(&system, (window, (-rate, rate)), starts, t_end * params.eps)?,
-                equilibria: system.equilibria().iter().map(|e| (e.delta, e.slope > 0.0)).collect(),
+                equilibria: system
+                    .equilibria()
+                    .iter()
+                    .map(|e| (e.delta, e.slope > 0.0))
+                    .collect(),
             });
         }
-        cases.push(Case { case: name, x_star: eq.reduced.x_star, sigma: eq.sigma, equilibria });
+        cases.push(Case {
+            case: name,
+            x_star: eq.reduced.x_star,
+            sigma: eq.sigma,
+            equilibria,
+        });
     }
     Ok(Deformation { cases, portraits })
 }

@@ -66,7 +66,10 @@ pub fn phi_graphs(params: &Params, region_pixels: usize) -> PhiGraphs {
                 sigma,
                 signs: slope_signs(sigma, &q),
                 case: painleve_case(roots.len()),
-                rising: roots.iter().map(|r| phi_slope(*r, sigma, &q) > 0.0).collect(),
+                rising: roots
+                    .iter()
+                    .map(|r| phi_slope(*r, sigma, &q) > 0.0)
+                    .collect(),
                 roots,
             }
         })
@@ -85,7 +88,14 @@ pub fn phi_graphs(params: &Params, region_pixels: usize) -> PhiGraphs {
             }
         }
     }
-    PhiGraphs { classes: &GRAPH_CLASSES, reduced: q, given, examples, regions, region_pixels }
+    PhiGraphs {
+        classes: &GRAPH_CLASSES,
+        reduced: q,
+        given,
+        examples,
+        regions,
+        region_pixels,
+    }
 }
 
 impl PhiGraphs {
@@ -96,11 +106,16 @@ impl PhiGraphs {
             .examples
             .iter()
             .zip(self.classes)
-            .map(|((_, roots), c)| format!("slopes {}: {} roots of X* = Φ(R)", c.signs, roots.len()))
+            .map(|((_, roots), c)| {
+                format!("slopes {}: {} roots of X* = Φ(R)", c.signs, roots.len())
+            })
             .collect();
         titles.push("regions, σo = +1".into());
         titles.push("regions, σo = −1".into());
-        titles.push(format!("given: X* = {:.3}, σ = +1 (blue), −1 (red)", q.x_star));
+        titles.push(format!(
+            "given: X* = {:.3}, σ = +1 (blue), −1 (red)",
+            q.x_star
+        ));
         let span = |values: &mut dyn Iterator<Item = f64>| {
             let (a, b) = values.fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
             (a - 0.5, b + 0.5)
@@ -114,11 +129,33 @@ impl PhiGraphs {
             specs.push(PanelSpec::new(&titles[k], "R", "Φ", (lo, hi), values));
         }
         let n = self.examples.len();
-        specs.push(PanelSpec::new(&titles[n], "μ₁*", "μ₂*", (0.0, 5.0), (0.0, 5.0)));
-        specs.push(PanelSpec::new(&titles[n + 1], "μ₁*", "μ₂*", (0.0, 5.0), (0.0, 5.0)));
+        specs.push(PanelSpec::new(
+            &titles[n],
+            "μ₁*",
+            "μ₂*",
+            (0.0, 5.0),
+            (0.0, 5.0),
+        ));
+        specs.push(PanelSpec::new(
+            &titles[n + 1],
+            "μ₁*",
+            "μ₂*",
+            (0.0, 5.0),
+            (0.0, 5.0),
+        ));
         let (glo, ghi) = (q.y1.min(-q.y2) - 3.0, q.y1.max(-q.y2) + 3.0);
-        let mut given = [1.0, -1.0].iter().flat_map(|s| graph(q, *s, glo, ghi)).map(|p| p.1).chain([q.x_star]);
-        specs.push(PanelSpec::new(&titles[n + 2], "R", "Φ", (glo, ghi), span(&mut given)));
+        let mut given = [1.0, -1.0]
+            .iter()
+            .flat_map(|s| graph(q, *s, glo, ghi))
+            .map(|p| p.1)
+            .chain([q.x_star]);
+        specs.push(PanelSpec::new(
+            &titles[n + 2],
+            "R",
+            "Φ",
+            (glo, ghi),
+            span(&mut given),
+        ));
         let mut figure = Figure::grid(3, 3, 480, 360, &specs);
         for (k, ((e, roots), (lo, hi))) in self.examples.iter().zip(&ranges).enumerate() {
             figure.line(k, &graph(e, 1.0, *lo, *hi), palette(k));
@@ -127,17 +164,38 @@ impl PhiGraphs {
         }
         let size = (480 / self.region_pixels as i64).max(1) + 1;
         for (sigma_o, mu1, mu2, signs) in &self.regions {
-            let k = self.classes.iter().position(|c| c.signs == *signs).unwrap_or(0);
+            let k = self
+                .classes
+                .iter()
+                .position(|c| c.signs == *signs)
+                .unwrap_or(0);
             let panel = if *sigma_o == 1 { n } else { n + 1 };
             figure.points(panel, [(*mu1, *mu2)], palette(k), size);
         }
-        let legend: Vec<(String, _)> =
-            self.classes.iter().enumerate().map(|(k, c)| (c.signs.to_string(), palette(k))).collect();
+        let legend: Vec<(String, _)> = self
+            .classes
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (c.signs.to_string(), palette(k)))
+            .collect();
         figure.legend(n, &legend[..3]);
-        figure.legend(n + 1, &[legend[0].clone(), legend[3].clone(), legend[4].clone(), legend[5].clone()]);
+        figure.legend(
+            n + 1,
+            &[
+                legend[0].clone(),
+                legend[3].clone(),
+                legend[4].clone(),
+                legend[5].clone(),
+            ],
+        );
         for (sigma, color) in [(1.0, palette(0)), (-1.0, RED)] {
             figure.line(n + 2, &graph(q, sigma, glo, ghi), color);
-            figure.points(n + 2, rigid_rod_roots(sigma, q).iter().map(|r| (*r, q.x_star)), color, 7);
+            figure.points(
+                n + 2,
+                rigid_rod_roots(sigma, q).iter().map(|r| (*r, q.x_star)),
+                color,
+                7,
+            );
         }
         figure.line(n + 2, &[(glo, q.x_star), (ghi, q.x_star)], GREY);
         figure

@@ -70,7 +70,11 @@ pub fn impact(s: &ImpactSettings) -> Result<Impact, StudyError> {
         let y0 = worked_example_start(x2);
         let run = integrator
             .run(&model, 0.0, &y0, s.t_end, &times)
-            .map_err(|source| StudyError::Case { index, value: x2, source })?;
+            .map_err(|source| StudyError::Case {
+                index,
+                value: x2,
+                source,
+            })?;
         let events = run
             .switches
             .iter()
@@ -88,7 +92,11 @@ pub fn impact(s: &ImpactSettings) -> Result<Impact, StudyError> {
         let (r#final, acceleration) = match run.outcome {
             Outcome::Rest => ("rest", None),
             Outcome::Moving => {
-                let f = Smooth { model: &model, modes: run.modes }.rhs(run.t, &run.y);
+                let f = Smooth {
+                    model: &model,
+                    modes: run.modes,
+                }
+                .rhs(run.t, &run.y);
                 ("sliding", Some([f[2], f[3]]))
             }
         };
@@ -105,7 +113,10 @@ pub fn impact(s: &ImpactSettings) -> Result<Impact, StudyError> {
             run,
         });
     }
-    Ok(Impact { cases, params: s.params })
+    Ok(Impact {
+        cases,
+        params: s.params,
+    })
 }
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -133,18 +144,43 @@ impl Impact {
             let rods: Vec<_> = samples.iter().map(|(_, y)| rod(y, p)).collect();
             let t_range = (0.0, c.run.t.max(1e-9));
             let speeds = |i: usize| range(samples.iter().map(|(_, y)| y[i]).chain([0.0]));
-            let phase = (range(rods.iter().map(|r| r.delta)), range(rods.iter().map(|r| r.delta_rate)));
+            let phase = (
+                range(rods.iter().map(|r| r.delta)),
+                range(rods.iter().map(|r| r.delta_rate)),
+            );
             specs.push(PanelSpec::new(&titles[4 * k], "δ", "δ′", phase.0, phase.1));
-            specs.push(PanelSpec::new(&titles[4 * k + 1], "t", "R", t_range, range(rods.iter().map(|r| r.reaction))));
-            specs.push(PanelSpec::new(&titles[4 * k + 2], "t", "v₁", t_range, speeds(2)));
-            specs.push(PanelSpec::new(&titles[4 * k + 3], "t", "v₂", t_range, speeds(3)));
+            specs.push(PanelSpec::new(
+                &titles[4 * k + 1],
+                "t",
+                "R",
+                t_range,
+                range(rods.iter().map(|r| r.reaction)),
+            ));
+            specs.push(PanelSpec::new(
+                &titles[4 * k + 2],
+                "t",
+                "v₁",
+                t_range,
+                speeds(2),
+            ));
+            specs.push(PanelSpec::new(
+                &titles[4 * k + 3],
+                "t",
+                "v₂",
+                t_range,
+                speeds(3),
+            ));
         }
         let mut figure = Figure::grid(4, self.cases.len(), 400, 330, &specs);
         for (k, c) in self.cases.iter().enumerate() {
             let samples = &c.run.samples;
             let rods: Vec<_> = samples.iter().map(|(_, y)| rod(y, p)).collect();
             let phase: Vec<(f64, f64)> = rods.iter().map(|r| (r.delta, r.delta_rate)).collect();
-            let force: Vec<(f64, f64)> = samples.iter().zip(&rods).map(|((t, _), r)| (*t, r.reaction)).collect();
+            let force: Vec<(f64, f64)> = samples
+                .iter()
+                .zip(&rods)
+                .map(|((t, _), r)| (*t, r.reaction))
+                .collect();
             let speed = |i: usize| samples.iter().map(|(t, y)| (*t, y[i])).collect::<Vec<_>>();
             figure.line(4 * k, &phase, BLUE);
             figure.line(4 * k + 1, &force, BLACK);
@@ -162,11 +198,21 @@ impl Impact {
     }
 
     /// Rows (x2(0), t, point, case, from, to, [v1, v2, R]) of the events.
-    pub fn event_rows(&self) -> impl Iterator<Item = (f64, f64, usize, &str, &str, &str, [f64; 3])> + '_ {
+    pub fn event_rows(
+        &self,
+    ) -> impl Iterator<Item = (f64, f64, usize, &str, &str, &str, [f64; 3])> + '_ {
         self.cases.iter().flat_map(|c| {
-            c.events
-                .iter()
-                .map(move |e| (c.x2_0, e.t, e.point, e.case.as_str(), e.from.as_str(), e.to.as_str(), [e.v1, e.v2, e.R]))
+            c.events.iter().map(move |e| {
+                (
+                    c.x2_0,
+                    e.t,
+                    e.point,
+                    e.case.as_str(),
+                    e.from.as_str(),
+                    e.to.as_str(),
+                    [e.v1, e.v2, e.R],
+                )
+            })
         })
     }
 

@@ -5,9 +5,9 @@
 //! δ = √((x1 − x2)² + d²) − l, δ' = (x1' − x2')(x1 − x2)/(l + δ),
 //! cos φ = (x1 − x2)/(l + δ), sin φ = d/(l + δ), R = k ε⁻² δ + ν ε⁻¹ δ'.
 
-pub mod impact;
 pub mod deformation;
 pub mod graphs;
+pub mod impact;
 pub mod stiff_limit;
 
 use crate::models::painleve_klein::Params;

@@ -79,7 +79,11 @@ pub fn stiff_limit(s: &StiffLimitSettings) -> Result<StiffLimit, StudyError> {
             let clock = Instant::now();
             let run = StickSlip::new(s.method)
                 .run(&Contacts { params }, 0.0, &y0, s.t_end, &times)
-                .map_err(|source| StudyError::Case { index, value: eps, source })?;
+                .map_err(|source| StudyError::Case {
+                    index,
+                    value: eps,
+                    source,
+                })?;
             runs.push(Run {
                 case,
                 eps,
@@ -92,14 +96,22 @@ pub fn stiff_limit(s: &StiffLimitSettings) -> Result<StiffLimit, StudyError> {
                 events: run
                     .switches
                     .iter()
-                    .map(|sw| Event { t: sw.t, point: sw.contact + 1, case: sw.case.clone() })
+                    .map(|sw| Event {
+                        t: sw.t,
+                        point: sw.contact + 1,
+                        case: sw.case.clone(),
+                    })
                     .collect(),
                 run,
                 params,
             });
         }
     }
-    Ok(StiffLimit { rigid_R_star: rigid_r_star, runs, eps_values: s.eps_values.clone() })
+    Ok(StiffLimit {
+        rigid_R_star: rigid_r_star,
+        runs,
+        eps_values: s.eps_values.clone(),
+    })
 }
 
 impl StiffLimit {
@@ -115,22 +127,50 @@ impl StiffLimit {
                 .filter(|r| r.case == case)
                 .flat_map(|r| {
                     let factor = if case == "impact" { r.eps } else { 1.0 };
-                    r.run.samples.iter().map(move |(_, y)| factor * rod(y, &r.params).reaction)
+                    r.run
+                        .samples
+                        .iter()
+                        .map(move |(_, y)| factor * rod(y, &r.params).reaction)
                 })
                 .fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)))
         };
         let (lo_r, hi_r) = scaled_force("regular");
         let (lo_i, hi_i) = scaled_force("impact");
-        let all_times: Vec<f64> = self.runs.iter().flat_map(|r| r.events.iter().map(|e| e.t)).collect();
+        let all_times: Vec<f64> = self
+            .runs
+            .iter()
+            .flat_map(|r| r.events.iter().map(|e| e.t))
+            .collect();
         let t_lo = all_times.iter().fold(f64::MAX, |m, t| m.min(*t)).max(1e-9);
-        let t_hi = all_times.iter().fold(0.0f64, |m, t| m.max(*t)).max(2.0 * t_lo);
+        let t_hi = all_times
+            .iter()
+            .fold(0.0f64, |m, t| m.max(*t))
+            .max(2.0 * t_lo);
         let eps_lo = self.eps_values.iter().fold(f64::MAX, |m, e| m.min(*e));
         let eps_hi = self.eps_values.iter().fold(0.0f64, |m, e| m.max(*e));
         let specs = [
-            PanelSpec::new("regular: R against t/ε", "t/ε", "R", (0.0, tau_regular), (lo_r.min(hi_r - 0.1), hi_r)),
-            PanelSpec::new("impact: εR against t/ε", "t/ε", "εR", (0.0, tau_impact), (lo_i, hi_i * 1.05)),
-            PanelSpec::new("impact: switch times against ε", "ε", "t", (eps_lo / 1.5, eps_hi * 1.5), (t_lo / 1.5, t_hi * 1.5))
-                .log_log(),
+            PanelSpec::new(
+                "regular: R against t/ε",
+                "t/ε",
+                "R",
+                (0.0, tau_regular),
+                (lo_r.min(hi_r - 0.1), hi_r),
+            ),
+            PanelSpec::new(
+                "impact: εR against t/ε",
+                "t/ε",
+                "εR",
+                (0.0, tau_impact),
+                (lo_i, hi_i * 1.05),
+            ),
+            PanelSpec::new(
+                "impact: switch times against ε",
+                "ε",
+                "t",
+                (eps_lo / 1.5, eps_hi * 1.5),
+                (t_lo / 1.5, t_hi * 1.5),
+            )
+            .log_log(),
         ];
         let mut figure = Figure::grid(3, 1, 560, 440, &specs);
         let mut legend = Vec::new();
@@ -138,7 +178,12 @@ impl StiffLimit {
             let is_impact = r.case == "impact";
             let k = usize::from(is_impact);
             let factor = if is_impact { r.eps } else { 1.0 };
-            let color = palette(self.eps_values.iter().position(|e| *e == r.eps).unwrap_or(0));
+            let color = palette(
+                self.eps_values
+                    .iter()
+                    .position(|e| *e == r.eps)
+                    .unwrap_or(0),
+            );
             let force = |t: f64, y: &[f64; 4]| (t / r.eps, factor * rod(y, &r.params).reaction);
             let curve: Vec<(f64, f64)> = r.run.samples.iter().map(|(t, y)| force(*t, y)).collect();
             figure.line(k, &curve, color);
@@ -163,8 +208,17 @@ impl StiffLimit {
 
     /// Rows (case, ε, outcome, t_end, final R, steps, f-evaluations, seconds).
     pub fn rows(&self) -> impl Iterator<Item = (&str, f64, &str, f64, f64, u64, u64, f64)> + '_ {
-        self.runs
-            .iter()
-            .map(|r| (r.case, r.eps, r.outcome.as_str(), r.t_end, r.final_R, r.steps, r.f_evals, r.seconds))
+        self.runs.iter().map(|r| {
+            (
+                r.case,
+                r.eps,
+                r.outcome.as_str(),
+                r.t_end,
+                r.final_R,
+                r.steps,
+                r.f_evals,
+                r.seconds,
+            )
+        })
     }
 }
