@@ -1,4 +1,5 @@
-//! Scene `rhs_benchmark`: speed of the generated right-hand sides against
+//! Benchmark `rhs_benchmark` (`cargo bench --bench rhs_benchmark`, a scene
+//! writing to `out/rhs_benchmark/`): speed of the generated right-hand sides against
 //! careful hand-written ones (symbolic-inverse form: ratio ≤ 1.1; the
 //! triple pendulum's numeric-solve form against a hand-written field with the
 //! same Cholesky solve: ≤ 1.3). All are evaluated on the same pseudo-random
