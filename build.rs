@@ -20,6 +20,8 @@ mod model;
 
 #[path = "build/contacts.rs"]
 mod contacts;
+#[path = "build/deprit.rs"]
+mod deprit;
 #[path = "build/derive.rs"]
 mod derive;
 #[path = "build/emit.rs"]

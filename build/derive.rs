@@ -71,6 +71,8 @@ pub struct Derivation {
     /// Jacobians, `averaged_*` and `vibrational_potential` are empty: the
     /// generator builds them from these through the solve).
     pub numeric: Option<NumericForm>,
+    /// The second-order averaged system (symbolic form with a fast phase).
+    pub second_order: Option<crate::deprit::SecondOrderForm>,
 }
 
 /// What the generated code of the numeric-solve form evaluates: A(q) (in
@@ -209,7 +211,7 @@ pub fn monomial_mean(a: i64, b: i64) -> (i64, i64) {
 /// The modes of a vector of trigonometric polynomials in the phase:
 /// v = Σ_s sin(θ)^{a_s} cos(θ)^{b_s} g_s, returned as ((a_s, b_s), g_s)
 /// for every monomial with a non-zero coefficient in some component.
-fn phase_modes(v: &[Atom], phase: &str) -> Result<Vec<((i64, i64), Vec<Atom>)>, DeriveError> {
+pub fn phase_modes(v: &[Atom], phase: &str) -> Result<Vec<((i64, i64), Vec<Atom>)>, DeriveError> {
     let (s_name, c_name) = ("mode__sin", "mode__cos");
     let mut modes: Vec<((i64, i64), Vec<Atom>)> = Vec::new();
     for (i, e) in v.iter().enumerate() {
@@ -849,6 +851,15 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                         .collect()
                 })
                 .collect();
+            derivation.second_order = Some(crate::deprit::second_order_form(
+                &hamiltonian,
+                &averaged_hamiltonian,
+                &averaged_forces,
+                (th, &rate),
+                &q,
+                &p,
+                &mut rec,
+            )?);
             (mean_potential, vibrational)
         }
         None => (potential.clone(), num(0)),

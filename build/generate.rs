@@ -337,6 +337,7 @@ pub fn render(
     );
     context.insert("momenta", &cx.momenta());
     context.insert("has_phase", &model.fast_phase.is_some());
+    context.insert("has_second_order", &derivation.second_order.is_some());
     context.insert(
         "phase",
         &model
@@ -535,6 +536,9 @@ fn symbolic_functions(
         )?);
     }
 
+    if let Some(second) = &derivation.second_order {
+        functions.extend(second_order_functions(cx, second)?);
+    }
     let taylor_functions = taylor_functions(cx, derivation, &velocity_stage)?;
     Ok((functions, taylor_functions))
 }
@@ -754,4 +758,90 @@ pub fn render_registry(
     context.insert("users_models", &users_models);
     tera.render("registry.rs.tera", &context)
         .map_err(|e| format!("template registry.rs.tera: {e:?}"))
+}
+
+/// The second-order averaged system: K̄ = H̄ + εK̄₁ + ε²K̄₂ (ε = 1/rate), its
+/// field, its Hessian in the state and the first-order map's shift, the
+/// derivatives by forward mode through the DAG.
+fn second_order_functions(
+    cx: &Context,
+    second: &crate::deprit::SecondOrderForm,
+) -> Result<Vec<Function>, String> {
+    let q = cx.coordinates();
+    let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
+    let n = q.len();
+    let m = 2 * n;
+    let state: Vec<String> = q.iter().chain(&p).cloned().collect();
+    let k_bar = Step::Values(vec![("k__".into(), second.hamiltonian.clone())]);
+    let gradient = |value: &str, prefix: &str| {
+        Step::Derivatives(
+            state
+                .iter()
+                .enumerate()
+                .map(|(i, v)| (format!("{prefix}__{i}"), value.to_string(), vec![v.clone()]))
+                .collect(),
+        )
+    };
+    // J∇: [∂/∂p; −∂/∂q] of the gradient named `prefix`.
+    let symplectic = |prefix: &str, extra: &dyn Fn(usize) -> String| {
+        let mut parts: Vec<String> = (0..n).map(|i| format!("{prefix}__{}", n + i)).collect();
+        parts.extend((0..n).map(|i| format!("-{prefix}__{i}{}", extra(i))));
+        format!("[{}]", parts.join(", "))
+    };
+    let forces = Step::Values(
+        second
+            .forces
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (format!("force__{i}"), f.clone()))
+            .collect(),
+    );
+    let hessian = Step::Derivatives(
+        (0..m)
+            .flat_map(|i| (0..m).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                (
+                    format!("k__{i}_{j}"),
+                    "k__".to_string(),
+                    vec![state[i].clone(), state[j].clone()],
+                )
+            })
+            .collect(),
+    );
+    let (_, hessian_result) = matrix("k", &vec![vec![String::new(); m]; m]);
+    let generator = Step::Values(vec![("chi__".into(), second.generator.clone())]);
+    Ok(vec![
+        cx.function_steps(
+            "averaged2_hamiltonian",
+            "Averaged Hamiltonian to second order, K̄ = H̄ + εK̄₁ + ε²K̄₂ with ε = 1/rate.",
+            Inputs::AveragedState,
+            "f64".into(),
+            &[k_bar.clone()],
+            "k__".into(),
+        )?,
+        cx.function_steps(
+            "averaged2_rhs",
+            "Second-order averaged equations: q' = ∂K̄/∂p, p' = −∂K̄/∂q + P̄.",
+            Inputs::AveragedState,
+            format!("[f64; {m}]"),
+            &[k_bar.clone(), forces, gradient("k__", "dk")],
+            symplectic("dk", &|i| format!(" + force__{i}")),
+        )?,
+        cx.function_steps(
+            "averaged2_hessian",
+            "Hessian ∂²K̄/∂y² of the second-order averaged Hamiltonian in the state y = [q; p].",
+            Inputs::AveragedState,
+            format!("[[f64; {m}]; {m}]"),
+            &[k_bar, hessian],
+            hessian_result,
+        )?,
+        cx.function_steps(
+            "averaged2_shift",
+            "J∇(εχ₁) at (y′, θ(t)): the exact state is y = y′ + shift to first order in ε.",
+            Inputs::State,
+            format!("[f64; {m}]"),
+            &[generator, gradient("chi__", "dchi")],
+            symplectic("dchi", &|_| String::new()),
+        )?,
+    ])
 }

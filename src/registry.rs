@@ -182,6 +182,9 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     /// The averaged system (the exact one again for a model without a fast
     /// phase, where [`Fixed::averaged`] gives None).
     type Averaged: crate::ode::System<S> + Sync;
+    /// The system averaged to second order in ε = 1/rate (the exact one
+    /// again where [`Fixed::averaged2`] gives None).
+    type Averaged2: crate::ode::System<S> + Sync;
     fn info(&self) -> &'static ModelInfo;
     fn has_fast_phase(&self) -> bool;
     /// Which coordinates are angles.
@@ -190,6 +193,12 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     fn averaged(&self, params: &[f64]) -> Option<Self::Averaged>;
     /// The period of the fast phase.
     fn phase_period(&self, params: &[f64]) -> Option<f64>;
+    /// The second-order averaged system, its Hessian ∂²K̄/∂y² and the
+    /// first-order map's shift y − y′ at time t: None where it is not
+    /// derived (no fast phase, or the numeric-solve form).
+    fn averaged2(&self, params: &[f64]) -> Option<Self::Averaged2>;
+    fn averaged2_hessian(&self, params: &[f64], y: &[f64; S]) -> Option<[[f64; S]; S]>;
+    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64; S]) -> Option<[f64; S]>;
     fn mass_matrix(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
     /// ∂V/∂q and C = ∂²V/∂q² of the potential averaged over the phase.
     fn potential_gradient(&self, params: &[f64], q: &[f64; D]) -> [f64; D];

@@ -17,7 +17,7 @@ use super::vibrational_stability::generalized_eigenvalues;
 use crate::analysis::period_map::wrap_angle;
 use crate::ode::{Integrator, Method, OdeError, System};
 use crate::registry::{Fixed, WithFixed};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -48,6 +48,10 @@ pub struct EquilibriumStability {
     pub stable_without_vibration: bool,
     /// The amplitude above which the averaged system is stable here.
     pub a_star: Option<f64>,
+    /// The same threshold from the system averaged to second order in
+    /// ε = 1/rate at the given rate (null where it is not derived or not
+    /// found): it moves a* by O(ε²) towards the exact lower edge.
+    pub a_star_second_order: Option<f64>,
     /// Why there is no a*, when there is none.
     pub reason: Option<String>,
     /// The first interval of the amplitude on which the exact system is
@@ -306,11 +310,14 @@ fn averaged_verdict<
         .unwrap_or_default();
     let stable_without_vibration = !lambdas.is_empty() && lambdas.iter().all(|l| *l > 0.0);
     let (a_star, reason) = threshold(model, params, amplitude, q, stable_without_vibration);
+    let a_star_second_order =
+        a_star.and_then(|a| second_order_threshold(model, params, amplitude, q, a));
     EquilibriumStability {
         q: q.to_vec(),
         lambdas,
         stable_without_vibration,
         a_star,
+        a_star_second_order,
         reason,
         exact_window: None,
         exact_reason: None,
@@ -418,6 +425,78 @@ fn threshold<
         }
     }
     (Some(high.sqrt()), None)
+}
+
+/// The equilibrium of the second-order averaged system near (q, 0) (by
+/// Newton on its field; it moves by O(ε²) where K̄ has terms odd in p), and
+/// whether K̄'s Hessian is positive definite there; None where the
+/// second-order system is not derived or Newton does not converge.
+fn second_order_stable<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    q: &[f64; D],
+) -> Option<bool> {
+    let system = model.averaged2(params)?;
+    let mut y = [0.0; S];
+    y[..D].copy_from_slice(q);
+    let mut hessian = DMatrix::zeros(S, S);
+    for _ in 0..20 {
+        let h = model.averaged2_hessian(params, &y)?;
+        hessian = DMatrix::from_fn(S, S, |i, j| 0.5 * (h[i][j] + h[j][i]));
+        // The field is J∇K̄ (+ forces): ∇K̄ = −J f without forces.
+        let f = system.rhs(0.0, &y);
+        let gradient = DVector::from_fn(S, |i, _| if i < D { -f[D + i] } else { f[i - D] });
+        if gradient.amax() < 1e-13 * (1.0 + hessian.amax()) {
+            return Some(positive_definite(&hessian));
+        }
+        let step = hessian.clone().lu().solve(&gradient)?;
+        for (yi, di) in y.iter_mut().zip(step.iter()) {
+            *yi -= di;
+        }
+    }
+    (hessian.amax().is_finite()).then(|| positive_definite(&hessian))
+}
+
+/// The amplitude at which the second-order averaged system's equilibrium
+/// near (q, 0) becomes stable (K̄'s Hessian positive definite), by
+/// bisection in [a*/2, 2a*] to 1e-13.
+fn second_order_threshold<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64; D],
+    a_star: f64,
+) -> Option<f64> {
+    let stable = |a: f64| {
+        let mut p = params.to_vec();
+        p[amplitude] = a;
+        second_order_stable(model, &p, q)
+    };
+    let (mut low, mut high) = (0.5 * a_star, 2.0 * a_star);
+    if stable(low)? || !stable(high)? {
+        return None;
+    }
+    while high - low > 1e-13 * high {
+        let mid = 0.5 * (low + high);
+        if stable(mid)? {
+            high = mid;
+        } else {
+            low = mid;
+        }
+    }
+    Some(high)
 }
 
 /// Multipliers within this of the unit circle count as stable (the
