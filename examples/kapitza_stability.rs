@@ -43,12 +43,15 @@ fn main() {
             method: Method::parse("dop853", scene.positive("tol")?)?,
         })?;
         println!(
-            "ε = {}, μ = {}: A* = {:?} (averaged: √2); at A = {}: multipliers {:?}, det M = {} (exp(−μT) = {}): {}",
-            result.eps, result.mu, result.a_star, result.A, result.multipliers,
+            "ε = {}, μ = {}: A* = {:?} (averaged: √2, to second order: {:?}); at A = {}: multipliers {:?}, det M = {} (exp(−μT) = {}): {}",
+            result.eps, result.mu, result.a_star, result.a_star_second_order, result.A, result.multipliers,
             result.determinant, result.determinant_expected, result.verdict
         );
         for s in &result.a_star_by_eps {
-            println!("ε = {}: A* = {:?}", s.eps, s.a_star);
+            println!(
+                "ε = {}: A* = {:?}, second order {:?}",
+                s.eps, s.a_star, s.a_star_second_order
+            );
         }
         scene.save_figure(&result.orbits_figure(), "orbits_near_upper_position.png")?;
         let header = ["A", "mu", "orbit", "period", "q", "p"];

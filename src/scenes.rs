@@ -196,6 +196,7 @@ pub fn averaging_scene(
             ("values", "auto", "its values: a list, geometric:first,last,count, or auto (ν at 4…64 times the model's frequency)"),
             ("y0", "auto", "the common initial state [q; p], comma-separated (auto: q = 0.2, −0.1, …, p = 0)"),
             ("t_obs", "2", "the deviation is the maximum over [0, t_obs]"),
+            ("order", "1", "1: the averaged system from the same state; 2: the system averaged to second order, from the transformed state and mapped back"),
         ],
     )?;
     let settings = ConvergenceSettings {
@@ -206,6 +207,7 @@ pub fn averaging_scene(
             .transpose()?,
         t_obs: scene.positive("t_obs")?,
         method: method_from(&scene)?,
+        order: scene.count("order")?,
     };
     let result = convergence(info.name, &scene.parameter_values(info)?, &settings)?;
     for (c, s) in result.coordinates.iter().zip(&result.slope) {
@@ -288,11 +290,36 @@ fn averaging_figure(
     };
     let x = range(&mut result.frequencies.iter().copied());
     let y = range(&mut result.max_deviation.iter().flatten().copied());
-    let scaled = range(&mut result.frequency_times_deviation.iter().flatten().copied());
+    // ν^order × deviation levels off where the deviation is c/ν^order.
+    let order = result.order as i32;
+    let scaled_of = |k: usize| -> Vec<(f64, f64)> {
+        result
+            .frequencies
+            .iter()
+            .zip(&result.max_deviation[k])
+            .map(|(nu, d)| (*nu, d * nu.powi(order)))
+            .collect()
+    };
+    let scaled = range(
+        &mut (0..result.coordinates.len())
+            .flat_map(scaled_of)
+            .map(|p| p.1),
+    );
     let title = format!(
-        "{}: exact against averaged, t ≤ {}",
+        "{}: exact against averaged (order {order}), t ≤ {}",
         result.model, result.t_obs
     );
+    let (power, scaled_title) = if order == 1 {
+        (
+            "ν × max deviation".to_string(),
+            "ν × max deviation: levels off where the deviation is c/ν".to_string(),
+        )
+    } else {
+        (
+            format!("ν^{order} × max deviation"),
+            format!("ν^{order} × max deviation: levels off where the deviation is c/ν^{order}"),
+        )
+    };
     let specs = [
         PanelSpec::new(
             &title,
@@ -303,9 +330,9 @@ fn averaging_figure(
         )
         .log_log(),
         PanelSpec::new(
-            "ν × max deviation: levels off where the deviation is c/ν",
+            &scaled_title,
             "frequency ν of the phase",
-            "ν × max deviation",
+            &power,
             x,
             (0.0, scaled.1),
         )
@@ -326,12 +353,7 @@ fn averaging_figure(
             .map(|nu| (*nu, result.level[k] * nu.powf(result.slope[k])))
             .collect();
         figure.line(0, &fit, palette(k));
-        let scaled: Vec<(f64, f64)> = result
-            .frequencies
-            .iter()
-            .copied()
-            .zip(result.frequency_times_deviation[k].iter().copied())
-            .collect();
+        let scaled = scaled_of(k);
         figure.line(1, &scaled, palette(k));
         figure.points(1, scaled, palette(k), 4);
         legend.push((

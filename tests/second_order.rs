@@ -159,3 +159,66 @@ fn double_pendulum_second_order_threshold_meets_the_exact_edge() {
         "exact {exact}, second order {second}"
     );
 }
+
+/// Theorem 2 one order higher: the exact run against the second-order
+/// averaged run from the transformed state (mapped back) deviates like
+/// 1/ν², where the first-order comparison deviates like 1/ν.
+#[test]
+fn second_order_trajectories_deviate_like_one_over_nu_squared() {
+    use mechlab::analysis::averaging::{convergence, ConvergenceSettings};
+    let params = dp::Params::default();
+    for (order, expected) in [(1, -1.0), (2, -2.0)] {
+        let settings = ConvergenceSettings {
+            parameter: Some("nu".into()),
+            values: Some(vec![400.0, 800.0, 1600.0, 3200.0]),
+            y0: None,
+            t_obs: 2.0,
+            method: Method::parse("dop853", 1e-12).unwrap(),
+            order,
+        };
+        let result = convergence("double_pendulum", &params.values(), &settings).unwrap();
+        for slope in &result.slope {
+            assert!(
+                (slope - expected).abs() < 0.1,
+                "order {order}: slope {slope}"
+            );
+        }
+    }
+    let kapitza = kapitza::Params {
+        A: 1.5,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    let settings = ConvergenceSettings {
+        parameter: Some("eps".into()),
+        values: Some(vec![0.02, 0.01, 0.005, 0.0025]),
+        y0: Some(vec![2.5, 0.3]),
+        t_obs: 3.0,
+        method: Method::parse("dop853", 1e-12).unwrap(),
+        order: 2,
+    };
+    let result = convergence("kapitza", &kapitza.values(), &settings).unwrap();
+    assert!(
+        (result.slope[0] + 2.0).abs() < 0.1,
+        "Kapitza: slope {}",
+        result.slope[0]
+    );
+}
+
+/// A model in the numeric-solve form has no second-order system: a typed
+/// error, not a panic.
+#[test]
+fn second_order_is_an_error_where_it_is_not_derived() {
+    use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
+    let params = mechlab::models::triple_pendulum::Params::default();
+    let settings = ConvergenceSettings {
+        parameter: None,
+        values: None,
+        y0: None,
+        t_obs: 1.0,
+        method: Method::parse("dop853", 1e-10).unwrap(),
+        order: 2,
+    };
+    let error = convergence("triple_pendulum", &params.values(), &settings).unwrap_err();
+    assert!(matches!(error, AveragingError::Order(_, 2)), "{error}");
+}

@@ -159,6 +159,57 @@ impl WithFixed for Analysis<'_> {
     }
 }
 
+/// The averaged analysis at one equilibrium `q` of the system without
+/// vibration (roots, a*, the second-order threshold; no exact window).
+#[inline]
+pub fn averaged_stability(
+    name: &str,
+    params: &[f64],
+    amplitude: &str,
+    q: &[f64],
+) -> Result<EquilibriumStability, StabilityError> {
+    crate::models::with_fixed(
+        name,
+        AtEquilibrium {
+            params,
+            amplitude,
+            q,
+        },
+    )
+    .ok_or_else(|| StabilityError::UnknownModel(name.to_string()))?
+}
+
+struct AtEquilibrium<'a> {
+    params: &'a [f64],
+    amplitude: &'a str,
+    q: &'a [f64],
+}
+
+impl WithFixed for AtEquilibrium<'_> {
+    type Output = Result<EquilibriumStability, StabilityError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        vibrating_model(model, self.params)?;
+        let amplitude = info
+            .parameter_names
+            .iter()
+            .position(|p| *p == self.amplitude)
+            .ok_or_else(|| StabilityError::UnknownAmplitude {
+                model: info.name.into(),
+                name: self.amplitude.into(),
+                known: info.parameter_names.join(", "),
+            })?;
+        let q: [f64; D] = self
+            .q
+            .try_into()
+            .map_err(|_| StabilityError::ParameterCount(self.q.len(), info.name.into()))?;
+        Ok(averaged_verdict(model, self.params, amplitude, &q))
+    }
+}
+
 /// Equilibria of the potential V without vibration: Newton's method on the
 /// generated ∂V/∂q with the generated C, from a grid of starts (angles at
 /// multiples of 2π/m, m = 8 up to 3 degrees of freedom and 4 beyond, other

@@ -133,7 +133,7 @@ pub fn exact_stability_window(
         let p = Params { a, ..*params };
         exact_multipliers(&p, phi, tol).map(|(r, _)| r - 1.0 - 1e-6)
     };
-    stability_window(&margin, 0.0, a_max, samples, 1e-6 * a_max)
+    stability_window(&margin, 0.0, a_max, samples, 1e-11 * a_max)
 }
 
 /// Knobs for every parameter of the model (the model file's defaults
@@ -391,6 +391,8 @@ pub struct EquilibriumEntry {
     pub lambdas: [f64; 2],
     pub stable_without_vibration: bool,
     pub a_star: Option<f64>,
+    /// The threshold of the system averaged to second order in 1/ν.
+    pub a_star_second_order: Option<f64>,
     pub a_star_formula: Option<String>,
     pub a_star_formula_latex: Option<String>,
     /// [lower edge, upper edge or null] of the exact system at ν.
@@ -477,6 +479,7 @@ pub fn stabilization_study(
             lambdas: analysis.lambdas,
             stable_without_vibration: analysis.stable_without_vibration,
             a_star: None,
+            a_star_second_order: None,
             a_star_formula: None,
             a_star_formula_latex: None,
             exact_window: None,
@@ -494,6 +497,13 @@ pub fn stabilization_study(
                 let a_max = s.a_max_factor * a_star;
                 entry.exact_window = exact_stability_window(&params, *phi, a_max, 240, tol)?;
                 entry.a_star = Some(a_star);
+                entry.a_star_second_order = crate::analysis::stability::averaged_stability(
+                    "double_pendulum",
+                    &params.values(),
+                    "a",
+                    &[phi.0, phi.1],
+                )?
+                .a_star_second_order;
                 entry.a_star_formula = Some(text);
                 entry.a_star_formula_latex = Some(latex);
                 let y0 = [phi.0 + s.offset, phi.1 - s.offset, 0.0, 0.0];

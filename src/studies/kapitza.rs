@@ -225,8 +225,9 @@ impl SingleOrbit {
 }
 
 /// The exact A* at which the upper position becomes stable (the lower edge
-/// of its window in (0, 4], from the generic `stability`), or None.
-pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<Option<f64>, StudyError> {
+/// of its window in (0, 4]) and the second-order averaged threshold, both
+/// from the generic `stability`.
+pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<AStar, StudyError> {
     let settings = Settings {
         amplitude: "A".into(),
         a_max: Some(4.0),
@@ -237,7 +238,11 @@ pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<Option<f6
     let params = Params { A: SQRT_2, eps, mu };
     let result = stability("kapitza", &params.values(), &settings)?;
     let upper = result.equilibria.iter().find(|e| e.q[0].abs() < 1e-9);
-    Ok(upper.and_then(|e| e.exact_window).and_then(|[low, _]| low))
+    Ok(AStar {
+        eps,
+        a_star: upper.and_then(|e| e.exact_window).and_then(|[low, _]| low),
+        a_star_second_order: upper.and_then(|e| e.a_star_second_order),
+    })
 }
 
 /// What `kapitza_stability` computes.
@@ -252,11 +257,13 @@ pub struct UpperPositionSettings {
     pub method: Method,
 }
 
-/// A* at one ε.
+/// A* at one ε: exact (Floquet) and from the second-order averaged system
+/// (√2 + 7√2/16 ε² + O(ε⁴)).
 #[derive(Debug, serde::Serialize)]
 pub struct AStar {
     pub eps: f64,
     pub a_star: Option<f64>,
+    pub a_star_second_order: Option<f64>,
 }
 
 /// The stability of the upper position: A*, the multipliers at the given A,
@@ -269,6 +276,8 @@ pub struct UpperPosition {
     pub A: f64,
     pub a_star: Option<f64>,
     pub a_star_averaged: f64,
+    /// The threshold of the system averaged to second order in ε.
+    pub a_star_second_order: Option<f64>,
     pub multipliers: Vec<[f64; 2]>,
     pub determinant: f64,
     pub determinant_expected: f64,
@@ -291,7 +300,8 @@ pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyE
     check(&s.params)?;
     let Params { A: a, eps, mu } = s.params;
     let period = period(&s.params);
-    let a_star = critical_amplitude(eps, mu, s.method)?;
+    let critical = critical_amplitude(eps, mu, s.method)?;
+    let a_star = critical.a_star;
     let mut integrator = Integrator::new(s.method)?;
     let (_, m) = monodromy::<_, 2, 6>(
         &mut integrator,
@@ -348,7 +358,7 @@ pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyE
 
     let a_star_by_eps = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3]
         .par_iter()
-        .map(|&eps| critical_amplitude(eps, 0.0, s.method).map(|a_star| AStar { eps, a_star }))
+        .map(|&eps| critical_amplitude(eps, 0.0, s.method))
         .collect::<Result<_, _>>()?;
     Ok(UpperPosition {
         eps,
@@ -356,6 +366,7 @@ pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyE
         A: a,
         a_star,
         a_star_averaged: SQRT_2,
+        a_star_second_order: critical.a_star_second_order,
         multipliers: multipliers.iter().map(|(re, im)| [*re, *im]).collect(),
         determinant: m[0][0] * m[1][1] - m[0][1] * m[1][0],
         determinant_expected: (-mu * period).exp(),
@@ -430,10 +441,16 @@ impl UpperPosition {
         let mut figure = self.chart.figure();
         let (first, last) = (self.chart.x_values[0], *self.chart.x_values.last().unwrap());
         figure.line(0, &[(first, SQRT_2), (last, SQRT_2)], RED);
+        let second = self
+            .a_star_by_eps
+            .iter()
+            .filter_map(|s| Some((s.eps, s.a_star_second_order?)));
+        figure.points(0, second, BLACK, 6);
         figure.legend(
             0,
             &[
                 ("averaged A* = √2".into(), RED),
+                ("second-order averaged A*".into(), BLACK),
                 ("exact boundaries".into(), BLUE),
             ],
         );

@@ -12,6 +12,7 @@ fn settings(parameter: Option<&str>, values: &[f64]) -> ConvergenceSettings {
         y0: None,
         t_obs: 2.0,
         method: Method::parse("dop853", 1e-11).unwrap(),
+        order: 1,
     }
 }
 

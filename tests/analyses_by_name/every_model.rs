@@ -152,6 +152,7 @@ fn averaging_settings() -> ConvergenceSettings {
         y0: None,
         t_obs: 2.0,
         method: Method::parse("dop853", 1e-11).unwrap(),
+        order: 1,
     }
 }
 
