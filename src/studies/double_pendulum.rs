@@ -464,6 +464,7 @@ fn limiting_run(
 /// For every equilibrium: the roots of det(C − λA) = 0, stability without
 /// vibration, a* (number and closed formula), the exact window at ν, long
 /// limiting runs either side of a*, and the exact spectral radius against a.
+#[inline]
 pub fn stabilization_study(
     s: &StabilizationSettings,
     progress: &(dyn Fn(usize) + Sync),

@@ -227,6 +227,7 @@ impl SingleOrbit {
 /// The exact A* at which the upper position becomes stable (the lower edge
 /// of its window in (0, 4]) and the second-order averaged threshold, both
 /// from the generic `stability`.
+#[inline]
 pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<AStar, StudyError> {
     let settings = Settings {
         amplitude: "A".into(),
@@ -296,6 +297,9 @@ pub type Orbits = Vec<Vec<[f64; 2]>>;
 /// Starts of the orbits near the upper position.
 const NEAR_UPPER: [[f64; 2]; 4] = [[0.05, 0.0], [0.15, 0.0], [0.3, 0.0], [0.0, 0.25]];
 
+/// (`#[inline]`, as the generic analyses it calls: their per-model
+/// instances compile in the caller, not in the library.)
+#[inline]
 pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyError> {
     check(&s.params)?;
     let Params { A: a, eps, mu } = s.params;
