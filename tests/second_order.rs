@@ -222,3 +222,46 @@ fn second_order_is_an_error_where_it_is_not_derived() {
     let error = convergence("triple_pendulum", &params.values(), &settings).unwrap_err();
     assert!(matches!(error, AveragingError::Order(_, 2)), "{error}");
 }
+
+/// Every model file with a second-order system: its trajectories deviate
+/// like 1/ν² from the exact ones (a wrong K̄₁, such as the circular
+/// pivot's A²p/2, or a wrong map would leave −1).
+#[test]
+fn every_second_order_model_converges_like_one_over_nu_squared() {
+    use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
+    let mut checked = Vec::new();
+    for info in mechlab::models::ALL {
+        let settings = ConvergenceSettings {
+            parameter: None,
+            values: None,
+            y0: None,
+            t_obs: 2.0,
+            method: Method::parse("dop853", 1e-12).unwrap(),
+            order: 2,
+        };
+        let defaults: Vec<f64> = info
+            .parameter_defaults
+            .iter()
+            .map(|d| d.parse().unwrap())
+            .collect();
+        match convergence(info.name, &defaults, &settings) {
+            Ok(result) => {
+                for (c, slope) in result.coordinates.iter().zip(&result.slope) {
+                    assert!(
+                        (slope + 2.0).abs() < 0.15,
+                        "{}: {c} slope {slope}",
+                        info.name
+                    );
+                }
+                checked.push(info.name);
+            }
+            Err(
+                AveragingError::Order(..)
+                | AveragingError::NoFastPhase(_)
+                | AveragingError::UnknownModel(_),
+            ) => {}
+            Err(e) => panic!("{}: {e}", info.name),
+        }
+    }
+    assert!(checked.len() >= 6, "{checked:?}");
+}
