@@ -139,6 +139,8 @@ pub fn chaos_map_scene(
                 "3",
                 "an axis that is not an angle covers [−p_max, p_max]",
             ),
+            ("tile_rows", "10", "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
+            ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the map"),
         ],
     )?;
     let axes = axes_from(&scene)?;
@@ -152,14 +154,22 @@ pub fn chaos_map_scene(
         pixels: scene.count("pixels")?,
         periods: scene.count("periods")?,
         method: method_from(&scene)?,
+        tiles: tiles_from(&scene)?,
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
-    let map = chaos_map(
+    let map = match chaos_map(
         info.name,
         &scene.parameter_values(info)?,
         &settings,
         &|| progress.inc(),
-    )?;
+    ) {
+        // A job of an array: its tiles are written, the last run merges.
+        Err(crate::analysis::chaos_map::ChaosMapError::Partial) => {
+            eprintln!("tiles {} written", scene.text("only_tiles"));
+            return Ok(());
+        }
+        map => map?,
+    };
     let [grey, viridis] = map.figures();
     scene.save_figure(&grey, "chaos_map.png")?;
     scene.save_figure(&viridis, "chaos_map_viridis.png")?;
@@ -174,6 +184,38 @@ pub fn chaos_map_scene(
     )?;
     scene.write_summary(&map)?;
     Ok(())
+}
+
+/// The tiles of the `tile_rows` and `only_tiles` knobs, in
+/// `out/<scene>.tiles/` beside the scene's output folder.
+fn tiles_from(scene: &Scene) -> Result<Option<crate::analysis::chaos_map::Tiles>, SceneError> {
+    let rows = scene.number("tile_rows")?;
+    if rows == 0.0 {
+        return Ok(None);
+    }
+    let only = match scene.text("only_tiles") {
+        "all" => None,
+        _ => Some(
+            scene
+                .numbers("only_tiles")?
+                .iter()
+                .map(|k| {
+                    (*k >= 0.0 && k.fract() == 0.0)
+                        .then_some(*k as usize)
+                        .ok_or_else(|| SceneError::BadValue {
+                            name: "only_tiles".into(),
+                            value: scene.text("only_tiles").into(),
+                            reason: "tile indices are whole numbers from 0".into(),
+                        })
+                })
+                .collect::<Result<_, _>>()?,
+        ),
+    };
+    Ok(Some(crate::analysis::chaos_map::Tiles {
+        folder: scene.out.with_extension("tiles"),
+        rows: scene.count("tile_rows")?,
+        only,
+    }))
 }
 
 /// The `averaging` scene: Theorem 2 on any model — the deviation between

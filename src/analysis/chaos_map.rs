@@ -28,6 +28,24 @@ pub struct ChaosMapSettings {
     /// Periods of the phase per pixel.
     pub periods: usize,
     pub method: Method,
+    /// Cut the map into tiles of whole rows, each written to a file when
+    /// done (None: one run in memory).
+    pub tiles: Option<Tiles>,
+}
+
+/// A sweep cut into deterministic tiles of `rows` rows each (the last may
+/// be shorter), written as `<folder>/<fingerprint>/tile_<k>.bin` when done
+/// (the fingerprint hashes the model, parameters and settings, so another
+/// sweep never mixes in). A run loads the tiles present and computes the
+/// others, so an interrupted run resumes; every row starts a fresh
+/// integrator, so the merged map equals a single run's bit for bit.
+#[derive(Clone, Debug)]
+pub struct Tiles {
+    pub folder: std::path::PathBuf,
+    pub rows: usize,
+    /// Compute only these tiles and stop before merging (a job of a job
+    /// array, an MPI rank): None computes every missing tile and merges.
+    pub only: Option<Vec<usize>>,
 }
 
 /// The map and its key numbers (the FLI values are not serialised: they go
@@ -76,6 +94,87 @@ fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64)
 
 /// Why [`chaos_map`] cannot run: the errors of the period map's analyses.
 pub use super::period_map::PeriodMapError as ChaosMapError;
+
+/// Why a tile cannot be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum TileError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: a tile of another sweep (settings, model or parameters differ): remove the folder or choose another", path.display())]
+    OtherSweep { path: std::path::PathBuf },
+    #[error("{}: not a complete tile file", path.display())]
+    Truncated { path: std::path::PathBuf },
+    #[error("tile {tile} does not exist: the map has {count} tiles")]
+    NoSuchTile { tile: usize, count: usize },
+}
+
+const TILE_MAGIC: &[u8; 16] = b"mechlab-tile-v1\n";
+
+/// A tile on disk: magic, the sweep's fingerprint, its f-evaluations, then
+/// its FLI values as little-endian f64 (exact, infinities included).
+fn write_tile(
+    path: &std::path::Path,
+    fingerprint: u64,
+    f_evals: u64,
+    values: &[f64],
+) -> Result<(), TileError> {
+    let io = |source| TileError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut bytes = Vec::with_capacity(32 + 8 * values.len());
+    bytes.extend_from_slice(TILE_MAGIC);
+    bytes.extend_from_slice(&fingerprint.to_le_bytes());
+    bytes.extend_from_slice(&f_evals.to_le_bytes());
+    for v in values {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let partial = path.with_extension("partial");
+    std::fs::write(&partial, &bytes).map_err(io)?;
+    std::fs::rename(&partial, path).map_err(io)
+}
+
+/// The tile at `path` if it exists: (f-evaluations, values).
+fn read_tile(
+    path: &std::path::Path,
+    fingerprint: u64,
+    count: usize,
+) -> Result<Option<(u64, Vec<f64>)>, TileError> {
+    let bytes = match std::fs::read(path) {
+        Ok(bytes) => bytes,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => {
+            return Err(TileError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+        }
+    };
+    let word =
+        |k: usize| u64::from_le_bytes(bytes[16 + 8 * k..24 + 8 * k].try_into().expect("8 bytes"));
+    if bytes.len() != 32 + 8 * count || &bytes[..16] != TILE_MAGIC {
+        return Err(TileError::Truncated {
+            path: path.to_path_buf(),
+        });
+    }
+    if word(0) != fingerprint {
+        return Err(TileError::OtherSweep {
+            path: path.to_path_buf(),
+        });
+    }
+    let values = (0..count).map(|k| f64::from_bits(word(2 + k))).collect();
+    Ok(Some((word(1), values)))
+}
+
+/// FNV-1a of the text: a fingerprint stable across runs and platforms.
+fn fingerprint(text: &str) -> u64 {
+    text.bytes().fold(0xcbf29ce484222325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x100000001b3)
+    })
+}
 
 /// The FLI map of the model `name` with parameter values `params`
 /// (declaration order); `row_done` is called as each row is finished (from
@@ -145,48 +244,72 @@ impl WithFixed for Map<'_> {
         // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
         let w0 = [(1.0 / S as f64).sqrt(); S];
         let pixels = settings.pixels;
+        // One row of FLI values and its f-evaluations; a fresh integrator
+        // per row, so a row's values do not depend on what ran before.
+        let row = |j: usize| -> Result<(Vec<f64>, u64), OdeError> {
+            let mut integrator = Integrator::new(settings.method)?;
+            let mut row = Vec::with_capacity(pixels);
+            for i in 0..pixels {
+                let (x, y) = pixel_centre(&ranges, pixels, j * pixels + i);
+                let mut y0 = through;
+                y0[settings.axes[0]] = x;
+                y0[settings.axes[1]] = y;
+                let fli = fast_lyapunov_indicator::<_, S, T>(
+                    &mut integrator,
+                    &system,
+                    period,
+                    &y0,
+                    &w0,
+                    settings.periods,
+                );
+                row.push(match fli {
+                    Ok(fli) => fli,
+                    // The orbit left the model's domain or ran into a
+                    // singular point (a non-finite state, or steps
+                    // shrinking to nothing): infinitely chaotic, counted.
+                    Err(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. }) => {
+                        integrator = Integrator::new(settings.method)?;
+                        f64::INFINITY
+                    }
+                    Err(e) => return Err(e),
+                });
+            }
+            (self.row_done)();
+            Ok((row, integrator.stats.f_evals))
+        };
+        let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
+            let rows: Vec<(Vec<f64>, u64)> =
+                range.into_par_iter().map(row).collect::<Result<_, _>>()?;
+            Ok(rows
+                .into_iter()
+                .fold((Vec::new(), 0), |(mut all, evals), (values, e)| {
+                    all.extend(values);
+                    (all, evals + e)
+                }))
+        };
         let start = std::time::Instant::now();
-        let rows: Vec<Result<(Vec<f64>, u64), OdeError>> = (0..pixels)
-            .into_par_iter()
-            .map(|j| {
-                let mut integrator = Integrator::new(settings.method)?;
-                let mut row = Vec::with_capacity(pixels);
-                for i in 0..pixels {
-                    let (x, y) = pixel_centre(&ranges, pixels, j * pixels + i);
-                    let mut y0 = through;
-                    y0[settings.axes[0]] = x;
-                    y0[settings.axes[1]] = y;
-                    let fli = fast_lyapunov_indicator::<_, S, T>(
-                        &mut integrator,
-                        &system,
-                        period,
-                        &y0,
-                        &w0,
-                        settings.periods,
-                    );
-                    row.push(match fli {
-                        Ok(fli) => fli,
-                        // The orbit left the model's domain or ran into a
-                        // singular point (a non-finite state, or steps
-                        // shrinking to nothing): infinitely chaotic, counted.
-                        Err(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. }) => {
-                            integrator = Integrator::new(settings.method)?;
-                            f64::INFINITY
-                        }
-                        Err(e) => return Err(e),
-                    });
+        let (fli, f_evals) = match &settings.tiles {
+            None => rows_of(0..pixels)?,
+            Some(tiles) => {
+                let key = format!(
+                    "{} {:?} {:?} {:?} {:?} {} {} {:?} {}",
+                    info.name,
+                    self.params,
+                    settings.axes,
+                    ranges,
+                    through,
+                    pixels,
+                    settings.periods,
+                    settings.method,
+                    tiles.rows
+                );
+                match run_tiles(tiles, fingerprint(&key), pixels, &rows_of)? {
+                    Some(map) => map,
+                    None => return Err(ChaosMapError::Partial),
                 }
-                (self.row_done)();
-                Ok((row, integrator.stats.f_evals))
-            })
-            .collect();
+            }
+        };
         let seconds = start.elapsed().as_secs_f64();
-        let (mut fli, mut f_evals) = (Vec::with_capacity(pixels * pixels), 0);
-        for row in rows {
-            let (values, evals) = row?;
-            fli.extend(values);
-            f_evals += evals;
-        }
         let shading = fli_shading(&fli, settings.periods);
         Ok(ChaosMap {
             model: info.name.into(),
@@ -206,6 +329,58 @@ impl WithFixed for Map<'_> {
             shades: shading.shades,
         })
     }
+}
+
+/// Computes the missing tiles (or only `tiles.only`), then merges every
+/// tile into the map's values and f-evaluations; None if only some tiles
+/// were asked for.
+fn run_tiles(
+    tiles: &Tiles,
+    fingerprint: u64,
+    pixels: usize,
+    rows_of: &dyn Fn(std::ops::Range<usize>) -> Result<(Vec<f64>, u64), OdeError>,
+) -> Result<Option<(Vec<f64>, u64)>, ChaosMapError> {
+    let rows = tiles.rows.max(1);
+    let count = pixels.div_ceil(rows);
+    let span = |k: usize| k * rows..((k + 1) * rows).min(pixels);
+    let folder = tiles.folder.join(format!("{fingerprint:016x}"));
+    let path = |k: usize| folder.join(format!("tile_{k}.bin"));
+    std::fs::create_dir_all(&folder).map_err(|source| TileError::Io {
+        path: folder.clone(),
+        source,
+    })?;
+    let wanted: Vec<usize> = match &tiles.only {
+        Some(only) => {
+            if let Some(&tile) = only.iter().find(|&&k| k >= count) {
+                return Err(TileError::NoSuchTile { tile, count }.into());
+            }
+            only.clone()
+        }
+        None => (0..count).collect(),
+    };
+    let mut merged = vec![None; count];
+    for k in wanted.iter().copied() {
+        let size = span(k).len() * pixels;
+        let tile = match read_tile(&path(k), fingerprint, size)? {
+            Some(tile) => tile,
+            None => {
+                let (values, evals) = rows_of(span(k))?;
+                write_tile(&path(k), fingerprint, evals, &values)?;
+                eprintln!("tile {}/{count} done ({} orbits)", k + 1, size);
+                (evals, values)
+            }
+        };
+        merged[k] = Some(tile);
+    }
+    if tiles.only.is_some() {
+        return Ok(None);
+    }
+    let (mut fli, mut f_evals) = (Vec::with_capacity(pixels * pixels), 0);
+    for tile in merged.into_iter().flatten() {
+        f_evals += tile.0;
+        fli.extend(tile.1);
+    }
+    Ok(Some((fli, f_evals)))
 }
 
 impl ChaosMap {

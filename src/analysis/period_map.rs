@@ -113,6 +113,12 @@ pub enum PeriodMapError {
     NoFastPhase(String),
     #[error("model '{model}': {reason}")]
     Request { model: String, reason: String },
+    /// Only some tiles of a map were asked for: they are written, there is
+    /// no map to return.
+    #[error("the tiles asked for are written; run without `only` to merge them into the map")]
+    Partial,
+    #[error(transparent)]
+    Tile(#[from] super::chaos_map::TileError),
     #[error(transparent)]
     Ode(#[from] OdeError),
 }

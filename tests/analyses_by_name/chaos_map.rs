@@ -1,7 +1,7 @@
 //! The FLI chaos map of any model by name against the direct computation
 //! of `kapitza_chaos_map` and of a plane of the double pendulum.
 
-use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings};
+use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings, TileError, Tiles};
 use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
 use mechlab::models::{self, double_pendulum, kapitza};
 use mechlab::ode::{Integrator, Method};
@@ -16,6 +16,7 @@ fn settings(axes: [usize; 2], pixels: usize, periods: usize) -> ChaosMapSettings
         pixels,
         periods,
         method: Method::parse("taylor", 1e-6).unwrap(),
+        tiles: None,
     }
 }
 
@@ -159,4 +160,81 @@ fn portraits_are_the_period_map_iterated() {
             assert!((p.0 - y[1]).abs() < 1e-12 && (p.1 - y[0]).abs() < 1e-12);
         }
     }
+}
+
+/// Tiles: an interrupted run (two tiles of seven), then a resumed one that
+/// computes only the missing rows, merge into the single run's map bit for
+/// bit; a damaged tile or a tile that does not exist is a typed error.
+#[test]
+fn tiles_resume_and_merge_bit_for_bit() {
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    let whole = chaos_map(
+        "kapitza",
+        &params.values(),
+        &settings([0, 1], 20, 30),
+        &|| {},
+    )
+    .unwrap();
+    let folder = tempfile::tempdir().unwrap();
+    let tiled = |only: Option<Vec<usize>>| ChaosMapSettings {
+        tiles: Some(Tiles {
+            folder: folder.path().to_path_buf(),
+            rows: 3,
+            only,
+        }),
+        ..settings([0, 1], 20, 30)
+    };
+    let rows = std::sync::atomic::AtomicUsize::new(0);
+    let count = || rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let first = chaos_map(
+        "kapitza",
+        &params.values(),
+        &tiled(Some(vec![1, 6])),
+        &|| {
+            count();
+        },
+    );
+    assert!(matches!(first, Err(ChaosMapError::Partial)));
+    assert_eq!(rows.swap(0, std::sync::atomic::Ordering::Relaxed), 3 + 2);
+    let resumed = chaos_map("kapitza", &params.values(), &tiled(None), &|| {
+        count();
+    })
+    .unwrap();
+    assert_eq!(rows.load(std::sync::atomic::Ordering::Relaxed), 20 - 5);
+    let bits = |m: &[f64]| m.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&resumed.fli), bits(&whole.fli));
+    assert_eq!(resumed.f_evals, whole.f_evals);
+
+    let sweep = std::fs::read_dir(folder.path())
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let tile = sweep.join("tile_2.bin");
+    let bytes = std::fs::read(&tile).unwrap();
+    std::fs::write(&tile, &bytes[..bytes.len() - 3]).unwrap();
+    let damaged = chaos_map("kapitza", &params.values(), &tiled(None), &|| {});
+    assert!(
+        matches!(
+            damaged,
+            Err(ChaosMapError::Tile(TileError::Truncated { .. }))
+        ),
+        "{damaged:?}"
+    );
+    let missing = chaos_map("kapitza", &params.values(), &tiled(Some(vec![7])), &|| {});
+    assert!(
+        matches!(
+            missing,
+            Err(ChaosMapError::Tile(TileError::NoSuchTile {
+                tile: 7,
+                count: 7
+            }))
+        ),
+        "{missing:?}"
+    );
 }

@@ -177,5 +177,6 @@ fn map_settings(periods: usize) -> ChaosMapSettings {
         pixels: 3,
         periods,
         method: Method::parse("taylor", 1e-8).unwrap(),
+        tiles: None,
     }
 }
