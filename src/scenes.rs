@@ -157,19 +157,28 @@ pub fn chaos_map_scene(
         tiles: tiles_from(&scene)?,
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
-    let map = match chaos_map(
-        info.name,
-        &scene.parameter_values(info)?,
-        &settings,
-        &|| progress.inc(),
-    ) {
+    let params = scene.parameter_values(info)?;
+    let run =
+        |settings: &ChaosMapSettings| chaos_map(info.name, &params, settings, &|| progress.inc());
+    #[cfg(feature = "mpi")]
+    if let Some(ranks) = ranks::Ranks::start(&settings)? {
+        return ranks.run(&settings, &run, &|map| write_chaos_map(&scene, map));
+    }
+    match run(&settings) {
         // A job of an array: its tiles are written, the last run merges.
         Err(crate::analysis::chaos_map::ChaosMapError::Partial) => {
             eprintln!("tiles {} written", scene.text("only_tiles"));
-            return Ok(());
+            Ok(())
         }
-        map => map?,
-    };
+        map => write_chaos_map(&scene, &map?),
+    }
+}
+
+/// The chaos map's figures, CSV and summary.
+fn write_chaos_map(
+    scene: &Scene,
+    map: &crate::analysis::chaos_map::ChaosMap,
+) -> Result<(), SceneError> {
     let [grey, viridis] = map.figures();
     scene.save_figure(&grey, "chaos_map.png")?;
     scene.save_figure(&viridis, "chaos_map_viridis.png")?;
@@ -182,8 +191,78 @@ pub fn chaos_map_scene(
         &[map.axes[0].as_str(), map.axes[1].as_str(), "fli"],
         rows,
     )?;
-    scene.write_summary(&map)?;
+    scene.write_summary(map)?;
     Ok(())
+}
+
+/// A chaos map across the ranks of `mpirun` (feature `mpi`).
+#[cfg(feature = "mpi")]
+mod ranks {
+    use super::{ChaosMapSettings, SceneError};
+    use crate::analysis::chaos_map::{ChaosMap, ChaosMapError};
+    use mpi::traits::{Communicator, CommunicatorCollectives};
+
+    /// The ranks: each computes the tiles k with k mod size = rank; after a
+    /// barrier the first merges them (all on disk now) and writes the
+    /// scene's files while the others wait (they share its output folder).
+    pub struct Ranks {
+        _universe: mpi::environment::Universe,
+        world: mpi::topology::SimpleCommunicator,
+    }
+
+    impl Ranks {
+        /// None for a single process (no `mpirun`, or one rank).
+        pub fn start(settings: &ChaosMapSettings) -> Result<Option<Ranks>, SceneError> {
+            let Some(universe) = mpi::initialize() else {
+                return Ok(None);
+            };
+            let world = universe.world();
+            if world.size() < 2 {
+                return Ok(None);
+            }
+            if settings.tiles.is_none() {
+                return Err(SceneError::Usage(
+                    "under mpirun the ranks share the map by tiles: set tile_rows > 0".into(),
+                ));
+            }
+            Ok(Some(Ranks {
+                _universe: universe,
+                world,
+            }))
+        }
+
+        pub fn run(
+            self,
+            settings: &ChaosMapSettings,
+            map: &dyn Fn(&ChaosMapSettings) -> Result<ChaosMap, ChaosMapError>,
+            write: &dyn Fn(&ChaosMap) -> Result<(), SceneError>,
+        ) -> Result<(), SceneError> {
+            let (rank, size) = (self.world.rank() as usize, self.world.size() as usize);
+            let mut mine = settings.clone();
+            if let Some(tiles) = &mut mine.tiles {
+                let count = settings.pixels.div_ceil(tiles.rows.max(1));
+                tiles.only = Some((0..count).filter(|k| k % size == rank).collect());
+            }
+            let computed = match map(&mine) {
+                Err(ChaosMapError::Partial) => Ok(()),
+                Err(e) => Err(e),
+                Ok(_) => Ok(()),
+            };
+            self.world.barrier();
+            let written = match (rank, computed) {
+                (0, Ok(())) => {
+                    let mut all = settings.clone();
+                    if let Some(tiles) = &mut all.tiles {
+                        tiles.only = None;
+                    }
+                    map(&all).map_err(SceneError::from).and_then(|m| write(&m))
+                }
+                (_, computed) => computed.map_err(SceneError::from),
+            };
+            self.world.barrier();
+            written
+        }
+    }
 }
 
 /// The tiles of the `tile_rows` and `only_tiles` knobs, in
