@@ -195,7 +195,7 @@ fn to_atom(series: &Series, phase: &str) -> Result<Atom, DeriveError> {
             Harmonic::Cos(k) => c * &crate::derive::atom(&format!("cos({k}*{phase})"))?,
             Harmonic::Sin(k) => c * &crate::derive::atom(&format!("sin({k}*{phase})"))?,
         };
-        sum = sum + term;
+        sum += term;
     }
     Ok(sum)
 }

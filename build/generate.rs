@@ -816,7 +816,7 @@ fn second_order_functions(
             "Averaged Hamiltonian to second order, K̄ = H̄ + εK̄₁ + ε²K̄₂ with ε = 1/rate.",
             Inputs::AveragedState,
             "f64".into(),
-            &[k_bar.clone()],
+            std::slice::from_ref(&k_bar),
             "k__".into(),
         )?,
         cx.function_steps(
