@@ -277,25 +277,6 @@ impl crate::registry::WithFixed for Sweep<'_> {
         if info.named_values(self.params).is_none() {
             return Err(bad(format!("{} parameter values", self.params.len())));
         }
-        let parameter = match &self.settings.parameter {
-            Some(p) => p.clone(),
-            None => rate_parameter(info).ok_or_else(|| {
-                bad(
-                    "the phase rate depends on more than one parameter: name the one to sweep"
-                        .into(),
-                )
-            })?,
-        };
-        let index = info
-            .parameter_names
-            .iter()
-            .position(|p| *p == parameter)
-            .ok_or_else(|| {
-                bad(format!(
-                    "no parameter '{parameter}' (parameters: {})",
-                    info.parameter_names.join(", ")
-                ))
-            })?;
         let y0: [f64; S] = match &self.settings.y0 {
             Some(y) => y.as_slice().try_into().map_err(|_| AveragingError::State {
                 model: info.name.into(),
@@ -308,51 +289,12 @@ impl crate::registry::WithFixed for Sweep<'_> {
                 _ => 0.0,
             }),
         };
+        let (parameter, index, values, frequencies) = swept(model, self.params, self.settings)?;
         let with = |value: f64| {
             let mut p = self.params.to_vec();
             p[index] = value;
             p
         };
-        let frequency = |value: f64| {
-            model
-                .phase_period(&with(value))
-                .filter(|t| t.is_finite() && *t > 0.0)
-                .map(|t| 2.0 * std::f64::consts::PI / t)
-        };
-        let values = match &self.settings.values {
-            Some(values) => values.clone(),
-            None => {
-                let p0 = self.params[index];
-                let (f1, f2) = (frequency(p0), frequency(2.0 * p0));
-                let ratio = f1.zip(f2).map(|(a, b)| b / a).unwrap_or(f64::NAN);
-                let factors = [4.0, 8.0, 16.0, 32.0, 64.0];
-                if (ratio - 2.0).abs() < 1e-9 {
-                    factors.map(|k| p0 * k).to_vec()
-                } else if (ratio - 0.5).abs() < 1e-9 {
-                    factors.map(|k| p0 / k).to_vec()
-                } else {
-                    return Err(bad(format!(
-                        "the frequency is not proportional or inversely proportional to '{parameter}': give the values"
-                    )));
-                }
-            }
-        };
-        let mut frequencies = Vec::new();
-        for &value in &values {
-            frequencies.push(frequency(value).ok_or_else(|| {
-                bad(format!(
-                    "{parameter} = {value} gives no finite period of the phase"
-                ))
-            })?);
-        }
-        let distinct = frequencies
-            .iter()
-            .any(|f| (f - frequencies[0]).abs() > 1e-12 * f.abs());
-        if !distinct {
-            return Err(bad(format!(
-                "'{parameter}' does not change the frequency of the phase (or fewer than two values): nothing to fit against"
-            )));
-        }
         let run = match self.settings.order {
             1 => {
                 let systems = |nu: f64| {
@@ -420,4 +362,87 @@ impl crate::registry::WithFixed for Sweep<'_> {
             level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
         })
     }
+}
+
+/// The swept parameter, its index, its values and the phase's frequency at
+/// each (checked to change).
+#[allow(clippy::type_complexity)]
+fn swept<
+    F: crate::registry::Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    settings: &ConvergenceSettings,
+) -> Result<(String, usize, Vec<f64>, Vec<f64>), AveragingError> {
+    let info = model.info();
+    let bad = |reason: String| AveragingError::Parameter {
+        model: info.name.into(),
+        reason,
+    };
+    let parameter = match &settings.parameter {
+        Some(p) => p.clone(),
+        None => rate_parameter(info).ok_or_else(|| {
+            bad("the phase rate depends on more than one parameter: name the one to sweep".into())
+        })?,
+    };
+    let index = info
+        .parameter_names
+        .iter()
+        .position(|p| *p == parameter)
+        .ok_or_else(|| {
+            bad(format!(
+                "no parameter '{parameter}' (parameters: {})",
+                info.parameter_names.join(", ")
+            ))
+        })?;
+    let with = |value: f64| {
+        let mut p = params.to_vec();
+        p[index] = value;
+        p
+    };
+    let frequency = |value: f64| {
+        model
+            .phase_period(&with(value))
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .map(|t| 2.0 * std::f64::consts::PI / t)
+    };
+    let values = match &settings.values {
+        Some(values) => values.clone(),
+        None => {
+            let p0 = params[index];
+            let (f1, f2) = (frequency(p0), frequency(2.0 * p0));
+            let ratio = f1.zip(f2).map(|(a, b)| b / a).unwrap_or(f64::NAN);
+            let factors = [4.0, 8.0, 16.0, 32.0, 64.0];
+            if (ratio - 2.0).abs() < 1e-9 {
+                factors.map(|k| p0 * k).to_vec()
+            } else if (ratio - 0.5).abs() < 1e-9 {
+                factors.map(|k| p0 / k).to_vec()
+            } else {
+                return Err(bad(format!(
+                    "the frequency is not proportional or inversely proportional to '{parameter}': give the values"
+                )));
+            }
+        }
+    };
+    let mut frequencies = Vec::new();
+    for &value in &values {
+        frequencies.push(frequency(value).ok_or_else(|| {
+            bad(format!(
+                "{parameter} = {value} gives no finite period of the phase"
+            ))
+        })?);
+    }
+    let distinct = frequencies
+        .iter()
+        .any(|f| (f - frequencies[0]).abs() > 1e-12 * f.abs());
+    if !distinct {
+        return Err(bad(format!(
+            "'{parameter}' does not change the frequency of the phase (or fewer than two values): nothing to fit against"
+        )));
+    }
+    Ok((parameter, index, values, frequencies))
 }
