@@ -864,11 +864,17 @@ impl Stability {
             for edge in e.exact_window.iter().flatten().flatten() {
                 figure.line(k, &vertical(*edge), RED);
             }
-            let legend = [
+            let value = |a: Option<f64>| a.map_or("none".to_string(), |a| format!("{a:.7}"));
+            let lower = e.exact_window.and_then(|[low, _]| low);
+            let mut legend = vec![
                 ("exact: spectral radius".to_string(), BLUE),
-                ("averaged: a*".to_string(), BLACK),
-                ("exact window edges".to_string(), RED),
+                (format!("averaged: a* = {}", value(e.a_star)), BLACK),
+                (format!("exact window edges (lower {})", value(lower)), RED),
             ];
+            if e.a_star_second_order.is_some() {
+                let text = format!("second-order averaged: {}", value(e.a_star_second_order));
+                legend.push((text, GREY));
+            }
             figure.legend(k, &legend);
         }
         Some(figure)
