@@ -65,6 +65,7 @@ pub struct Portrait {
 }
 
 /// The portrait at `params`: `seeds` orbits of `periods` periods, on all cores.
+#[inline]
 pub fn portrait(
     params: Params,
     seeds: usize,
@@ -167,6 +168,7 @@ pub struct SingleOrbit {
 }
 
 /// The orbit from `y0`, timed `repeat` times (the fastest run is reported).
+#[inline]
 pub fn single_orbit(
     params: Params,
     y0: [f64; 2],
@@ -516,6 +518,7 @@ pub struct AttractorSettings {
 /// (their sum is −μT) and its box-counting dimension (box sides 1/4 …
 /// 1/256 of the extent; the fit leaves out the coarsest and the finest,
 /// which 10⁵ points cannot fill).
+#[inline]
 pub fn attractor(s: &AttractorSettings) -> Result<Attractor, StudyError> {
     check(&s.params)?;
     let system = Exact { params: s.params };
