@@ -241,7 +241,9 @@ mod ranks {
             let mut mine = settings.clone();
             if let Some(tiles) = &mut mine.tiles {
                 let count = settings.pixels.div_ceil(tiles.rows.max(1));
-                tiles.only = Some((0..count).filter(|k| k % size == rank).collect());
+                let share: Vec<usize> = (0..count).filter(|k| k % size == rank).collect();
+                eprintln!("rank {rank} of {size}: tiles {share:?}");
+                tiles.only = Some(share);
             }
             let computed = match map(&mine) {
                 Err(ChaosMapError::Partial) => Ok(()),

@@ -1,6 +1,8 @@
 //! With the `mpi` feature: `mpirun -n 2` of the `chaos_map` scene (ranks
 //! taking tiles, the first merging them) gives the single process's map bit
-//! for bit. Needs OpenMPI (README, "On a cluster").
+//! for bit. Needs OpenMPI and the example built with the feature
+//! (`cargo build --release --features mpi --example chaos_map`; README,
+//! "On a cluster").
 #![cfg(feature = "mpi")]
 
 use std::path::PathBuf;

@@ -132,7 +132,9 @@ fn write_tile(
     for v in values {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
-    let partial = path.with_extension("partial");
+    // Unique per process: two runs of one sweep at once (two jobs given the
+    // same tile) each write whole files, and the last rename wins.
+    let partial = path.with_extension(format!("partial.{}", std::process::id()));
     std::fs::write(&partial, &bytes).map_err(io)?;
     std::fs::rename(&partial, path).map_err(io)
 }
