@@ -270,8 +270,7 @@ mod ranks {
 /// The tiles of the `tile_rows` and `only_tiles` knobs, in
 /// `out/<scene>.tiles/` beside the scene's output folder.
 fn tiles_from(scene: &Scene) -> Result<Option<crate::analysis::chaos_map::Tiles>, SceneError> {
-    let rows = scene.number("tile_rows")?;
-    if rows == 0.0 {
+    if scene.number("tile_rows")? == 0.0 {
         return Ok(None);
     }
     let only = match scene.text("only_tiles") {

@@ -123,15 +123,7 @@ impl WithFixed for Analysis<'_> {
     ) -> Self::Output {
         let info = model.info();
         let params = vibrating_model(model, self.params)?;
-        let amplitude = info
-            .parameter_names
-            .iter()
-            .position(|p| *p == self.settings.amplitude)
-            .ok_or_else(|| StabilityError::UnknownAmplitude {
-                model: info.name.into(),
-                name: self.settings.amplitude.clone(),
-                known: info.parameter_names.join(", "),
-            })?;
+        let amplitude = parameter_index(info, &self.settings.amplitude)?;
         let mut result = Stability {
             model: info.name.into(),
             amplitude: self.settings.amplitude.clone(),
@@ -157,6 +149,18 @@ impl WithFixed for Analysis<'_> {
         }
         Ok(result)
     }
+}
+
+/// The index of the parameter `name` of the model, or an error listing them.
+fn parameter_index(info: &crate::registry::ModelInfo, name: &str) -> Result<usize, StabilityError> {
+    info.parameter_names
+        .iter()
+        .position(|p| *p == name)
+        .ok_or_else(|| StabilityError::UnknownAmplitude {
+            model: info.name.into(),
+            name: name.into(),
+            known: info.parameter_names.join(", "),
+        })
 }
 
 /// The averaged analysis at one equilibrium `q` of the system without
@@ -193,15 +197,7 @@ impl WithFixed for AtEquilibrium<'_> {
     ) -> Self::Output {
         let info = model.info();
         vibrating_model(model, self.params)?;
-        let amplitude = info
-            .parameter_names
-            .iter()
-            .position(|p| *p == self.amplitude)
-            .ok_or_else(|| StabilityError::UnknownAmplitude {
-                model: info.name.into(),
-                name: self.amplitude.into(),
-                known: info.parameter_names.join(", "),
-            })?;
+        let amplitude = parameter_index(info, self.amplitude)?;
         let q: [f64; D] = self
             .q
             .try_into()
@@ -719,17 +715,10 @@ impl WithFixed for Chart<'_> {
         let info = model.info();
         let settings = self.settings;
         vibrating_model(model, self.params)?;
-        let index = |name: &str| {
-            info.parameter_names
-                .iter()
-                .position(|p| *p == name)
-                .ok_or_else(|| StabilityError::UnknownAmplitude {
-                    model: info.name.into(),
-                    name: name.into(),
-                    known: info.parameter_names.join(", "),
-                })
-        };
-        let (ix, iy) = (index(&settings.x)?, index(&settings.y)?);
+        let (ix, iy) = (
+            parameter_index(info, &settings.x)?,
+            parameter_index(info, &settings.y)?,
+        );
         let q: [f64; D] = settings.q.as_slice().try_into().map_err(|_| {
             StabilityError::ParameterCount(
                 settings.q.len(),
