@@ -749,6 +749,16 @@ impl Writer<'_> {
         }
     }
 
+    /// [`Writer::value`], as the recurrences' number type `Num` where
+    /// `varying` (a constant among varying entries of one array).
+    fn value_as(&self, k: usize, varying: bool) -> String {
+        if varying && self.constant(k) {
+            format!("Num::from({})", self.value(k))
+        } else {
+            self.value(k)
+        }
+    }
+
     /// Order-n coefficient of a varying node.
     fn at(&self, k: usize, n: &str) -> String {
         format!("{}[{n}]", self.names[k])
@@ -762,12 +772,12 @@ impl Writer<'_> {
             Op::Parameter(_) => self.names[k].clone(),
             Op::State(i) => format!("y[{i}]"),
             Op::Time => self.time.to_string(),
-            Op::Phase(r) => format!("{} * {}", v(*r), self.time),
+            Op::Phase(r) => format!("{} * {}", self.time, v(*r)),
             Op::Neg(a) => format!("-{}", v(*a)),
-            Op::Add(a, b) => format!("{} + {}", v(*a), v(*b)),
-            Op::Sub(a, b) => format!("{} - {}", v(*a), v(*b)),
-            Op::Mul(a, b) => format!("{} * {}", v(*a), v(*b)),
-            Op::Div(a, b) => format!("{} / {}", v(*a), v(*b)),
+            Op::Add(a, b) => self.binary(*a, "+", *b),
+            Op::Sub(a, b) => self.binary(*a, "-", *b),
+            Op::Mul(a, b) => self.binary(*a, "*", *b),
+            Op::Div(a, b) => self.binary(*a, "/", *b),
             Op::Square(a) => format!("{} * {}", v(*a), v(*a)),
             Op::Sqrt(a) => format!("{}.sqrt()", v(*a)),
             Op::Power(a, b) => format!("{}.powf({})", v(*a), v(*b)),
@@ -776,6 +786,19 @@ impl Writer<'_> {
             Op::Sin(a) => format!("{}.sin()", v(*a)),
             Op::Cos(a) => format!("{}.cos()", v(*a)),
             Op::Solution { .. } => unreachable!("solutions are computed by `solve_lines`"),
+        }
+    }
+
+    /// `a op b` from the children's values. The recurrences' number type
+    /// `Num` takes f64 on the right only: a constant left of a varying
+    /// node is swapped to the right of + and × (the same rounding), and
+    /// made a `Num` before − and /.
+    fn binary(&self, a: usize, op: &str, b: usize) -> String {
+        let (x, y) = (self.value(a), self.value(b));
+        match (self.constant(a) && !self.constant(b), op) {
+            (true, "+" | "*") => format!("{y} {op} {x}"),
+            (true, _) => format!("Num::from({x}) {op} {y}"),
+            (false, _) => format!("{x} {op} {y}"),
         }
     }
 
@@ -809,11 +832,12 @@ impl Writer<'_> {
 
     /// `let factor = Cholesky::new(A at order 0);`
     fn factor_line(&self, s: &Solve) -> String {
+        let varying = !self.constant_matrix(s);
         let rows: Vec<String> = s
             .matrix
             .iter()
             .map(|row| {
-                let cells: Vec<String> = row.iter().map(|&a| self.value(a)).collect();
+                let cells: Vec<String> = row.iter().map(|&a| self.value_as(a, varying)).collect();
                 format!("[{}]", cells.join(", "))
             })
             .collect();
@@ -833,7 +857,10 @@ impl Writer<'_> {
             self.declare_factor(s, lines);
         }
         for (column, solutions) in s.columns.iter().zip(&s.solutions) {
-            let rhs: Vec<String> = column.iter().map(|&r| self.value(r)).collect();
+            let rhs: Vec<String> = column
+                .iter()
+                .map(|&r| self.value_as(r, !constant))
+                .collect();
             let targets: Vec<String> = solutions
                 .iter()
                 .map(|&x| {
@@ -862,7 +889,7 @@ impl Writer<'_> {
                 .enumerate()
                 .map(|(r, &rhs)| {
                     let mut terms = vec![if self.constant(rhs) {
-                        "0.0".to_string()
+                        "Num::from(0.0)".to_string()
                     } else {
                         self.at(rhs, "n")
                     }];
@@ -920,7 +947,7 @@ impl Writer<'_> {
                 (None, Some(y), _) => format!("-{y}"),
                 (None, None, _) => unreachable!("a linear node varies"),
             },
-            Op::Mul(a, b) if self.constant(a) => format!("{} * {}", self.value(a), self.at(b, "1")),
+            Op::Mul(a, b) if self.constant(a) => format!("{} * {}", self.at(b, "1"), self.value(a)),
             Op::Mul(a, b) => format!("{} * {}", self.at(a, "1"), self.value(b)),
             Op::Div(a, b) => format!("{} / {}", self.at(a, "1"), self.value(b)),
             _ => unreachable!("not a linear node"),
@@ -954,7 +981,7 @@ impl Writer<'_> {
                 }
             }
             Op::Mul(a, b) => match (self.constant(a), self.constant(b)) {
-                (true, _) => format!("{} * {}", self.value(a), at(b)),
+                (true, _) => format!("{} * {}", at(b), self.value(a)),
                 (_, true) => format!("{} * {}", at(a), self.value(b)),
                 _ => format!("series::product({}, {}, n)", name(a), name(b)),
             },
@@ -975,12 +1002,15 @@ impl Writer<'_> {
                 }
                 let (sn, cn) = (name(s), name(c));
                 if self.classes[u] == Class::Linear {
-                    let rate = self.slope(u);
+                    let rate = match self.slope(u) {
+                        simple if !simple.contains(' ') => simple,
+                        sum => format!("({sum})"),
+                    };
                     lines.push(format!(
-                        "{sn}[n] = {rate} * series::INVERSES[n] * {cn}[n - 1];"
+                        "{sn}[n] = {cn}[n - 1] * ({rate} * series::INVERSES[n]);"
                     ));
                     lines.push(format!(
-                        "{cn}[n] = -{rate} * series::INVERSES[n] * {sn}[n - 1];"
+                        "{cn}[n] = -({sn}[n - 1] * ({rate} * series::INVERSES[n]));"
                     ));
                 } else {
                     lines.push(format!(
@@ -1130,9 +1160,9 @@ impl Writer<'_> {
                 .map(|&r| {
                     if self.constant(r) {
                         if n == "0" {
-                            format!("{}{scale}", self.value(r))
+                            format!("Num::from({}){scale}", self.value(r))
                         } else {
-                            "0.0".into()
+                            "Num::from(0.0)".into()
                         }
                     } else {
                         format!("{}{scale}", self.at(r, n))
@@ -1191,9 +1221,9 @@ impl Writer<'_> {
             _ => lines.push(format!("{w}[0] = {};", self.scalar(k))),
         }
         if self.classes[k] == Class::Linear {
-            lines.push(format!("{w}[1] = {};", self.slope(k)));
+            lines.push(format!("{w}[1] = Num::from({});", self.slope(k)));
             if self.read_as_series(k) {
-                lines.push(format!("{w}[2..=order].fill(0.0);"));
+                lines.push(format!("{w}[2..=order].fill(Num::from(0.0));"));
             }
         }
     }

@@ -8,29 +8,32 @@
 //! registers (nalgebra's would do the same work through its generic
 //! storage, with checks the generated code does not need).
 
+use crate::ode::series::Scalar;
+
 /// The Cholesky factor L (A = L Lᵀ) of a symmetric positive definite
-/// matrix, with the reciprocals of its diagonal.
+/// matrix, with the reciprocals of its diagonal; over f64, or over
+/// [`crate::ode::Lanes`] (one matrix per lane) in the batch recurrences.
 ///
 /// A matrix that is not positive definite (a model at a singular point of
 /// its coordinates) gives NaN entries, which the integrators report as a
 /// divergence at that time and state: never a silent wrong number.
 #[derive(Clone, Copy, Debug)]
-pub struct Cholesky<const N: usize> {
-    lower: [[f64; N]; N],
-    inverse_diagonal: [f64; N],
+pub struct Cholesky<L, const N: usize> {
+    lower: [[L; N]; N],
+    inverse_diagonal: [L; N],
 }
 
-impl<const N: usize> Cholesky<N> {
+impl<L: Scalar, const N: usize> Cholesky<L, N> {
     /// Factorises `a` (only its lower triangle is read).
     #[inline]
-    pub fn new(a: [[f64; N]; N]) -> Self {
-        let mut lower = [[0.0; N]; N];
-        let mut inverse_diagonal = [0.0; N];
+    pub fn new(a: [[L; N]; N]) -> Self {
+        let mut lower = [[L::default(); N]; N];
+        let mut inverse_diagonal = [L::default(); N];
         for j in 0..N {
             let d = a[j][j] - dot(&lower[j][..j], &lower[j][..j]);
-            let pivot = if d > 0.0 { d.sqrt() } else { f64::NAN };
+            let pivot = d.positive_sqrt();
             lower[j][j] = pivot;
-            inverse_diagonal[j] = 1.0 / pivot;
+            inverse_diagonal[j] = pivot.recip();
             for i in j + 1..N {
                 let s = a[i][j] - dot(&lower[i][..j], &lower[j][..j]);
                 lower[i][j] = s * inverse_diagonal[j];
@@ -42,23 +45,36 @@ impl<const N: usize> Cholesky<N> {
         }
     }
 
-    /// x with A x = b: forward substitution with L, back substitution with Lᵀ.
+    /// x with A x = b: forward substitution with L, back substitution with
+    /// Lᵀ. The right-hand side may be a batch where A is one f64 matrix.
     #[inline]
-    pub fn solve(&self, b: [f64; N]) -> [f64; N] {
-        let mut y = [0.0; N];
+    pub fn solve<B: Scalar + std::ops::Mul<L, Output = B>>(&self, b: [B; N]) -> [B; N] {
+        let mut y = [B::default(); N];
         for i in 0..N {
-            y[i] = (b[i] - dot(&self.lower[i][..i], &y[..i])) * self.inverse_diagonal[i];
+            let mut earlier = B::from(-0.0);
+            for k in 0..i {
+                earlier += y[k] * self.lower[i][k];
+            }
+            y[i] = (b[i] - earlier) * self.inverse_diagonal[i];
         }
-        let mut x = [0.0; N];
+        let mut x = [B::default(); N];
         for i in (0..N).rev() {
-            let later: f64 = (i + 1..N).map(|k| self.lower[k][i] * x[k]).sum();
+            let mut later = B::from(-0.0);
+            for k in i + 1..N {
+                later += x[k] * self.lower[k][i];
+            }
             x[i] = (y[i] - later) * self.inverse_diagonal[i];
         }
         x
     }
 }
 
+/// Σ a_k b_k from −0.0 up, as `Iterator::sum` adds.
 #[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+fn dot<L: Scalar>(a: &[L], b: &[L]) -> L {
+    let mut sum = L::from(-0.0);
+    for (x, y) in a.iter().zip(b) {
+        sum += *x * *y;
+    }
+    sum
 }

@@ -3,7 +3,7 @@
 //! already zero at the start, and two crossings inside one step.
 
 use mechlab::ode::{
-    Direction, Event, EventSettings, Integrator, Method, OdeError, System, TaylorWork,
+    Direction, Event, EventSettings, Integrator, Method, OdeError, Scalar, System, TaylorWork,
 };
 use std::f64::consts::PI;
 
@@ -14,13 +14,13 @@ impl System<2> for Oscillator {
         [y[1], -y[0]]
     }
     /// Hand-written recurrences: x^[k+1] = v^[k]/(k+1), v^[k+1] = −x^[k]/(k+1).
-    fn taylor(
+    fn taylor<Num: Scalar>(
         &self,
-        _t: f64,
-        y: &[f64; 2],
+        _t: Num,
+        y: &[Num; 2],
         order: usize,
-        _work: &mut TaylorWork,
-        out: &mut [[f64; 2]],
+        _work: &mut TaylorWork<Num>,
+        out: &mut [[Num; 2]],
     ) -> bool {
         out[0] = *y;
         for k in 0..order {
@@ -39,18 +39,18 @@ impl System<1> for Clock {
     }
     /// y = y0 + (t − t0): every coefficient past the first vanishes, so the
     /// Taylor method's step rule meets its polynomial guard.
-    fn taylor(
+    fn taylor<Num: Scalar>(
         &self,
-        _t: f64,
-        y: &[f64; 1],
+        _t: Num,
+        y: &[Num; 1],
         order: usize,
-        _work: &mut TaylorWork,
-        out: &mut [[f64; 1]],
+        _work: &mut TaylorWork<Num>,
+        out: &mut [[Num; 1]],
     ) -> bool {
         out[0] = *y;
-        out[1] = [1.0];
+        out[1] = [Num::from(1.0)];
         for row in &mut out[2..=order] {
-            *row = [0.0];
+            *row = [Num::from(0.0)];
         }
         true
     }

@@ -3,8 +3,8 @@
 //! state) shaded by the fast Lyapunov indicator of its orbit. For one degree
 //! of freedom the plane is the cylinder (q, p).
 
-use super::lyapunov::{fast_lyapunov_indicator, fli_shading};
-use crate::ode::{Integrator, Method, OdeError};
+use super::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators, fli_shading};
+use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, LANES};
 use crate::registry::{Fixed, WithFixed};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -246,38 +246,60 @@ impl WithFixed for Map<'_> {
         // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
         let w0 = [(1.0 / S as f64).sqrt(); S];
         let pixels = settings.pixels;
+        let start_of = |k: usize| {
+            let (x, y) = pixel_centre(&ranges, pixels, k);
+            let mut y0 = through;
+            y0[settings.axes[0]] = x;
+            y0[settings.axes[1]] = y;
+            y0
+        };
         // One row of FLI values and its f-evaluations; a fresh integrator
         // per row, so a row's values do not depend on what ran before.
+        // The Taylor method runs the row in batches of LANES orbits.
         let row = |j: usize| -> Result<(Vec<f64>, u64), OdeError> {
-            let mut integrator = Integrator::new(settings.method)?;
-            let mut row = Vec::with_capacity(pixels);
-            for i in 0..pixels {
-                let (x, y) = pixel_centre(&ranges, pixels, j * pixels + i);
-                let mut y0 = through;
-                y0[settings.axes[0]] = x;
-                y0[settings.axes[1]] = y;
-                let fli = fast_lyapunov_indicator::<_, S, T>(
-                    &mut integrator,
-                    &system,
-                    period,
-                    &y0,
-                    &w0,
-                    settings.periods,
-                );
-                row.push(match fli {
-                    Ok(fli) => fli,
-                    // The orbit left the model's domain or ran into a
-                    // singular point (a non-finite state, or steps
-                    // shrinking to nothing): infinitely chaotic, counted.
-                    Err(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. }) => {
-                        integrator = Integrator::new(settings.method)?;
-                        f64::INFINITY
+            let starts: Vec<[f64; S]> = (0..pixels).map(|i| start_of(j * pixels + i)).collect();
+            let (values, f_evals) = match settings.method {
+                Method::Taylor { .. } => {
+                    let mut integrator = LaneIntegrator::new(settings.method)?;
+                    let values = starts
+                        .chunks(LANES)
+                        .flat_map(|batch| {
+                            fast_lyapunov_indicators::<_, S, T>(
+                                &mut integrator,
+                                &system,
+                                period,
+                                batch,
+                                &w0,
+                                settings.periods,
+                            )
+                        })
+                        .map(pixel_value)
+                        .collect::<Result<_, _>>()?;
+                    (values, integrator.stats.f_evals)
+                }
+                _ => {
+                    let mut integrator = Integrator::new(settings.method)?;
+                    let mut values = Vec::with_capacity(pixels);
+                    for y0 in &starts {
+                        let fli = fast_lyapunov_indicator::<_, S, T>(
+                            &mut integrator,
+                            &system,
+                            period,
+                            y0,
+                            &w0,
+                            settings.periods,
+                        );
+                        if fli.is_err() {
+                            // A clean state for the next orbit.
+                            integrator = Integrator::new(settings.method)?;
+                        }
+                        values.push(pixel_value(fli)?);
                     }
-                    Err(e) => return Err(e),
-                });
-            }
+                    (values, integrator.stats.f_evals)
+                }
+            };
             (self.row_done)();
-            Ok((row, integrator.stats.f_evals))
+            Ok((values, f_evals))
         };
         let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
             let rows: Vec<(Vec<f64>, u64)> =
@@ -330,6 +352,16 @@ impl WithFixed for Map<'_> {
             fli,
             shades: shading.shades,
         })
+    }
+}
+
+/// A pixel's FLI; an orbit that left the model's domain or ran into a
+/// singular point (a non-finite state, or steps shrinking to nothing) is
+/// infinitely chaotic, counted; other errors end the map.
+fn pixel_value(fli: Result<f64, OdeError>) -> Result<f64, OdeError> {
+    match fli {
+        Err(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. }) => Ok(f64::INFINITY),
+        other => other,
     }
 }
 

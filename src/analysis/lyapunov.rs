@@ -3,7 +3,7 @@
 
 use super::period_map::wrap_angle;
 use super::variational::Variational;
-use crate::ode::{Integrator, OdeError, System};
+use crate::ode::{Integrator, LaneIntegrator, OdeError, System, LANES};
 use nalgebra::DMatrix;
 
 /// The full Lyapunov spectrum of the period map (exponents per period, in
@@ -65,25 +65,86 @@ pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
     w0: &[f64; N],
     periods: usize,
 ) -> Result<f64, OdeError> {
-    assert_eq!(M, 2 * N, "the FLI needs M = 2N");
     let variational = Variational::<S, N, M>::new(system);
     let mut z = Variational::<S, N, M>::pack(y0, &[*w0]);
-    let norm0 = w0.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let mut log_scale = 0.0;
-    let mut fli = f64::NEG_INFINITY;
+    let mut fli = Fli::<N, M>::new(w0);
     for _ in 0..periods {
         z = integrator.advance(&variational, 0.0, &z, period)?;
-        let w = Variational::<S, N, M>::tangent(&z, 0);
-        let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt();
-        fli = fli.max(log_scale + (norm / norm0).ln());
+        fli.after_period(&mut z);
+    }
+    Ok(fli.value)
+}
+
+/// The FLI of up to [`LANES`] orbits started at `starts`, integrated
+/// together by the batch Taylor method; each orbit's value (or error) is
+/// the one [`fast_lyapunov_indicator`] gives it with the same tolerance.
+pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
+    integrator: &mut LaneIntegrator,
+    system: &S,
+    period: f64,
+    starts: &[[f64; N]],
+    w0: &[f64; N],
+    periods: usize,
+) -> Vec<Result<f64, OdeError>> {
+    assert!(starts.len() <= LANES, "at most {LANES} orbits per batch");
+    let variational = Variational::<S, N, M>::new(system);
+    let mut z: [[f64; M]; LANES] = std::array::from_fn(|l| {
+        Variational::<S, N, M>::pack(starts.get(l).unwrap_or(&starts[0]), &[*w0])
+    });
+    let mut running: [bool; LANES] = std::array::from_fn(|l| l < starts.len());
+    let mut fli = [Fli::<N, M>::new(w0); LANES];
+    let mut results: Vec<Result<f64, OdeError>> = vec![Ok(f64::NEG_INFINITY); starts.len()];
+    for _ in 0..periods {
+        let ends = integrator.advance(&variational, 0.0, &z, running, period);
+        let integrated = running;
+        for (l, end) in ends.into_iter().enumerate().filter(|&(l, _)| integrated[l]) {
+            match end {
+                Ok(end) => {
+                    z[l] = end;
+                    fli[l].after_period(&mut z[l]);
+                }
+                Err(e) => (results[l], running[l]) = (Err(e), false),
+            }
+        }
+    }
+    for (l, result) in results.iter_mut().enumerate() {
+        if running[l] {
+            *result = Ok(fli[l].value);
+        }
+    }
+    results
+}
+
+/// One orbit's FLI so far: the largest ln(‖w‖/‖w₀‖), with the logarithms
+/// of the renormalisations kept.
+#[derive(Clone, Copy, Debug)]
+struct Fli<const N: usize, const M: usize> {
+    norm0: f64,
+    log_scale: f64,
+    value: f64,
+}
+
+impl<const N: usize, const M: usize> Fli<N, M> {
+    fn new(w0: &[f64; N]) -> Self {
+        assert_eq!(M, 2 * N, "the FLI needs M = 2N");
+        Fli {
+            norm0: w0.iter().map(|x| x * x).sum::<f64>().sqrt(),
+            log_scale: 0.0,
+            value: f64::NEG_INFINITY,
+        }
+    }
+
+    /// Takes in the state [y; w] after a period; renormalises w when large.
+    fn after_period(&mut self, z: &mut [f64; M]) {
+        let norm = z[N..].iter().map(|x| x * x).sum::<f64>().sqrt();
+        self.value = self.value.max(self.log_scale + (norm / self.norm0).ln());
         if norm > 1e100 {
-            log_scale += norm.ln();
+            self.log_scale += norm.ln();
             for x in &mut z[N..] {
                 *x /= norm;
             }
         }
     }
-    Ok(fli)
 }
 
 /// Grey levels for a chaos map from FLI values after `iterations` periods.

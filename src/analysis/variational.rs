@@ -3,7 +3,7 @@
 //! The state length M = N + N·K must be given explicitly (stable Rust has no
 //! arithmetic on const generics); [`Variational::new`] checks it.
 
-use crate::ode::{System, TaylorWork};
+use crate::ode::{Scalar, System, TaylorWork};
 
 /// The system and K tangent vectors: M = N + N·K.
 pub struct Variational<'a, S, const N: usize, const M: usize> {
@@ -66,13 +66,13 @@ impl<S: System<N>, const N: usize, const M: usize> System<M> for Variational<'_,
         }
         out
     }
-    fn taylor(
+    fn taylor<Num: Scalar>(
         &self,
-        t: f64,
-        z: &[f64; M],
+        t: Num,
+        z: &[Num; M],
         order: usize,
-        work: &mut TaylorWork,
-        out: &mut [[f64; M]],
+        work: &mut TaylorWork<Num>,
+        out: &mut [[Num; M]],
     ) -> bool {
         self.system
             .taylor_variational(t, z, order, work, out.as_flattened_mut())

@@ -9,13 +9,18 @@
 mod dop853;
 mod events;
 mod gauss;
+mod lanes;
 mod radau5;
 mod rk4;
 pub mod series;
 pub mod taylor;
+mod taylor_lanes;
 
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
+pub use lanes::{Lanes, LANES};
+pub use series::Scalar;
 pub use taylor::{order_for_tolerance, TaylorWork};
+pub use taylor_lanes::{LaneIntegrator, LaneResult};
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
 pub trait System<const N: usize> {
@@ -27,27 +32,28 @@ pub trait System<const N: usize> {
     /// The normalised Taylor coefficients `out[k] = y^(k)(t)/k!`,
     /// k = 0..=order, of the solution through (t, y), for the `taylor`
     /// method; false when the system has no recurrences (generated models
-    /// have them, see `build/taylor.rs`).
-    fn taylor(
+    /// have them, see `build/taylor.rs`). `Num` is f64 for one orbit, or
+    /// [`Lanes`] for a batch of orbits, one per lane.
+    fn taylor<Num: Scalar>(
         &self,
-        _t: f64,
-        _y: &[f64; N],
+        _t: Num,
+        _y: &[Num; N],
         _order: usize,
-        _work: &mut TaylorWork,
-        _out: &mut [[f64; N]],
+        _work: &mut TaylorWork<Num>,
+        _out: &mut [[Num; N]],
     ) -> bool {
         false
     }
     /// The same for the system with tangent vectors, state z = [y; v₁; …]
     /// with one or N tangent vectors (see `analysis::variational`), rows of
     /// `out` flattened; false when not available.
-    fn taylor_variational(
+    fn taylor_variational<Num: Scalar>(
         &self,
-        _t: f64,
-        _z: &[f64],
+        _t: Num,
+        _z: &[Num],
         _order: usize,
-        _work: &mut TaylorWork,
-        _out: &mut [f64],
+        _work: &mut TaylorWork<Num>,
+        _out: &mut [Num],
     ) -> bool {
         false
     }
@@ -242,6 +248,9 @@ pub enum OdeError {
     NoConvergence { t: f64, h: f64, y: Vec<f64> },
     #[error("method 'taylor' needs Taylor recurrences, which only the generated models' systems (exact, averaged, and their variational equations) have")]
     TaylorUnavailable,
+    /// Only the Taylor method integrates batches of orbits.
+    #[error("method '{0}' has no batch mode (only 'taylor' integrates {lanes} orbits at once)", lanes = LANES)]
+    NoBatchMode(&'static str),
 }
 
 /// Solver state: the method, the last step size, statistics.

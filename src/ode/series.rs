@@ -7,6 +7,89 @@
 //! < n of itself). The sums are split over four accumulators: shorter
 //! rounding chains (a form of pairwise summation) and independent
 //! additions the processor can overlap.
+//!
+//! The kernels and the generated recurrences are generic over the
+//! [`Scalar`] they compute with: `f64` for one orbit, or
+//! [`Lanes`](super::lanes::Lanes) for a batch of orbits, one per SIMD lane,
+//! with the same operations in the same order (so every lane's result is
+//! the scalar one, bit for bit).
+
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
+
+/// What the recurrences compute with: `f64`, or a batch of f64 lanes.
+/// Arithmetic with f64 is on the right only (`x * A`, `Num::from(2.0) - x`):
+/// a bound `f64: Mul<Num>` would shadow `f64: Mul<f64>` in the generated
+/// functions' constants.
+pub trait Scalar:
+    Copy
+    + Default
+    + From<f64>
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+{
+    fn sin_cos(self) -> (Self, Self);
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
+    fn sqrt(self) -> Self;
+    fn exp(self) -> Self;
+    fn ln(self) -> Self;
+    fn powf(self, alpha: f64) -> Self;
+    /// 1/x.
+    fn recip(self) -> Self;
+    /// √x where x > 0, NaN elsewhere (a Cholesky pivot).
+    fn positive_sqrt(self) -> Self;
+}
+
+impl Scalar for f64 {
+    #[inline(always)]
+    fn sin_cos(self) -> (f64, f64) {
+        f64::sin_cos(self)
+    }
+    #[inline(always)]
+    fn sin(self) -> f64 {
+        f64::sin(self)
+    }
+    #[inline(always)]
+    fn cos(self) -> f64 {
+        f64::cos(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> f64 {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn exp(self) -> f64 {
+        f64::exp(self)
+    }
+    #[inline(always)]
+    fn ln(self) -> f64 {
+        f64::ln(self)
+    }
+    #[inline(always)]
+    fn powf(self, alpha: f64) -> f64 {
+        f64::powf(self, alpha)
+    }
+    #[inline(always)]
+    fn recip(self) -> f64 {
+        1.0 / self
+    }
+    #[inline(always)]
+    fn positive_sqrt(self) -> f64 {
+        if self > 0.0 {
+            f64::sqrt(self)
+        } else {
+            f64::NAN
+        }
+    }
+}
 
 /// Coefficient capacity: orders 0..=31.
 pub const COEFFICIENTS: usize = 32;
@@ -14,17 +97,17 @@ pub const COEFFICIENTS: usize = 32;
 pub const MAX_ORDER: usize = COEFFICIENTS - 1;
 
 /// The normalised Taylor coefficients of one node.
-pub type Coefficients = [f64; COEFFICIENTS];
+pub type Coefficients<L = f64> = [L; COEFFICIENTS];
 
 /// Σ_j a[len−1−j]·b[j] over equal-length slices (a Cauchy-product term).
 #[inline(always)]
-fn reversed_dot(a: &[f64], b: &[f64]) -> f64 {
+fn reversed_dot<L: Scalar>(a: &[L], b: &[L]) -> L {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
     let chunks_a = a.rchunks_exact(4);
     let chunks_b = b.chunks_exact(4);
     let (rest_a, rest_b) = (chunks_a.remainder(), chunks_b.remainder());
-    let mut acc = [0.0f64; 4];
+    let mut acc = [L::default(); 4];
     for (x, y) in chunks_a.zip(chunks_b) {
         acc[0] += x[3] * y[0];
         acc[1] += x[2] * y[1];
@@ -32,7 +115,7 @@ fn reversed_dot(a: &[f64], b: &[f64]) -> f64 {
         acc[3] += x[0] * y[3];
     }
     let r = rest_a.len();
-    let mut tail = 0.0;
+    let mut tail = L::default();
     for i in 0..r {
         tail += rest_a[r - 1 - i] * rest_b[i];
     }
@@ -65,14 +148,20 @@ const WEIGHTS: Coefficients = {
 /// Σ_{j=1..n−1} j u^[j] x^[n−j] for two x sharing the weighted u: the
 /// derivative sums without their order-n term.
 #[inline(always)]
-fn derivative_dots(u: &Coefficients, x: &Coefficients, z: &Coefficients, n: usize) -> (f64, f64) {
+fn derivative_dots<L: Scalar>(
+    u: &Coefficients<L>,
+    x: &Coefficients<L>,
+    z: &Coefficients<L>,
+    n: usize,
+) -> (L, L) {
     let (u, w) = (&u[1..n], &WEIGHTS[1..n]);
     let (x, z) = (&x[1..n], &z[1..n]);
     let n = n - 1;
-    let (mut a, mut b, mut c, mut d) = (0.0, 0.0, 0.0, 0.0);
+    let zero = L::default();
+    let (mut a, mut b, mut c, mut d) = (zero, zero, zero, zero);
     let mut j = 0;
     while j + 1 < n {
-        let (du0, du1) = (w[j] * u[j], w[j + 1] * u[j + 1]);
+        let (du0, du1) = (u[j] * w[j], u[j + 1] * w[j + 1]);
         a += du0 * x[n - 1 - j];
         b += du1 * x[n - 2 - j];
         c += du0 * z[n - 1 - j];
@@ -80,7 +169,7 @@ fn derivative_dots(u: &Coefficients, x: &Coefficients, z: &Coefficients, n: usiz
         j += 2;
     }
     if j < n {
-        let du = w[j] * u[j];
+        let du = u[j] * w[j];
         a += du * x[n - 1 - j];
         c += du * z[n - 1 - j];
     }
@@ -92,7 +181,7 @@ fn derivative_dots(u: &Coefficients, x: &Coefficients, z: &Coefficients, n: usiz
 /// processor can sum it before a^[n] and b^[n] are known, and the chain from
 /// one node's order n to the next is one multiply-add long.
 #[inline(always)]
-pub fn product(a: &Coefficients, b: &Coefficients, n: usize) -> f64 {
+pub fn product<L: Scalar>(a: &Coefficients<L>, b: &Coefficients<L>, n: usize) -> L {
     let earlier = reversed_dot(&a[1..n], &b[1..n]);
     earlier + a[n] * b[0] + a[0] * b[n]
 }
@@ -101,65 +190,65 @@ pub fn product(a: &Coefficients, b: &Coefficients, n: usize) -> f64 {
 /// a^[0] x^[n], for the recurrence of a linear solve A x = r, whose order n
 /// is x^[n] = (A^[0])⁻¹ (r^[n] − Σ_{k=1..n} A^[k] x^[n−k]).
 #[inline(always)]
-pub fn product_tail(a: &Coefficients, x: &Coefficients, n: usize) -> f64 {
+pub fn product_tail<L: Scalar>(a: &Coefficients<L>, x: &Coefficients<L>, n: usize) -> L {
     reversed_dot(&a[1..n], &x[1..n]) + a[n] * x[0]
 }
 
 /// (a²)^[n], using the symmetry of the Cauchy sum.
 #[inline(always)]
-pub fn square(a: &Coefficients, n: usize) -> f64 {
+pub fn square<L: Scalar>(a: &Coefficients<L>, n: usize) -> L {
     let h = (n - 1) / 2;
     let pairs = reversed_dot(&a[n - h..n], &a[1..=h]);
     let middle = if n.is_multiple_of(2) {
         a[n / 2] * a[n / 2]
     } else {
-        0.0
+        L::default()
     };
-    2.0 * pairs + middle + 2.0 * a[0] * a[n]
+    pairs * 2.0 + middle + a[0] * 2.0 * a[n]
 }
 
 /// (a/b)^[n] = (a^[n] − Σ_{j=1..n} w^[n−j] b^[j]) / b^[0], with w = a/b
 /// known below order n and `a_n` = a^[n] (0 for a constant numerator).
 #[inline(always)]
-pub fn quotient(w: &Coefficients, a_n: f64, b: &Coefficients, n: usize) -> f64 {
+pub fn quotient<L: Scalar>(w: &Coefficients<L>, a_n: L, b: &Coefficients<L>, n: usize) -> L {
     let earlier = reversed_dot(&w[1..n], &b[1..n]);
-    let inverse = 1.0 / b[0];
+    let inverse = b[0].recip();
     (a_n - earlier - w[0] * b[n]) * inverse
 }
 
 /// (√b)^[n] from w = √b below order n and `b_n` = b^[n]:
 /// (b^[n] − Σ_{j=1..n−1} w^[n−j] w^[j]) / (2 w^[0]).
 #[inline(always)]
-pub fn sqrt(w: &Coefficients, b_n: f64, n: usize) -> f64 {
+pub fn sqrt<L: Scalar>(w: &Coefficients<L>, b_n: L, n: usize) -> L {
     let inner = reversed_dot(&w[1..n], &w[1..n]);
-    (b_n - inner) * (0.5 / w[0])
+    (b_n - inner) * (w[0].recip() * 0.5)
 }
 
 /// (b^α)^[n] = Σ_{j=0..n−1} (nα − j(α+1)) b^[n−j] w^[j] / (n b^[0]) for a
 /// constant real α (integer powers are products instead: this divides by b^[0]).
 #[inline(always)]
-pub fn power(w: &Coefficients, b: &Coefficients, alpha: f64, n: usize) -> f64 {
+pub fn power<L: Scalar>(w: &Coefficients<L>, b: &Coefficients<L>, alpha: f64, n: usize) -> L {
     let nf = n as f64;
-    let mut sum = 0.0;
+    let mut sum = L::default();
     for j in 1..n {
-        sum += (nf * alpha - j as f64 * (alpha + 1.0)) * b[n - j] * w[j];
+        sum += b[n - j] * (nf * alpha - j as f64 * (alpha + 1.0)) * w[j];
     }
-    (sum + nf * alpha * b[n] * w[0]) / (nf * b[0])
+    (sum + b[n] * (nf * alpha) * w[0]) / (b[0] * nf)
 }
 
 /// (e^u)^[n] = (1/n) Σ_{j=1..n} j u^[j] w^[n−j], w = e^u below order n.
 #[inline(always)]
-pub fn exp(w: &Coefficients, u: &Coefficients, n: usize) -> f64 {
+pub fn exp<L: Scalar>(w: &Coefficients<L>, u: &Coefficients<L>, n: usize) -> L {
     let earlier = derivative_dots(u, w, w, n).0;
     earlier * INVERSES[n] + u[n] * w[0]
 }
 
 /// (ln u)^[n] = (u^[n] − (1/n) Σ_{j=1..n−1} j w^[j] u^[n−j]) / u^[0].
 #[inline(always)]
-pub fn ln(w: &Coefficients, u: &Coefficients, n: usize) -> f64 {
-    let mut sum = 0.0;
+pub fn ln<L: Scalar>(w: &Coefficients<L>, u: &Coefficients<L>, n: usize) -> L {
+    let mut sum = L::default();
     for j in 1..n {
-        sum += WEIGHTS[j] * w[j] * u[n - j];
+        sum += w[j] * WEIGHTS[j] * u[n - j];
     }
     (u[n] - sum / n as f64) / u[0]
 }
@@ -167,7 +256,12 @@ pub fn ln(w: &Coefficients, u: &Coefficients, n: usize) -> f64 {
 /// (sin u, cos u)^[n] from s = sin u, c = cos u below order n:
 /// s^[n] = (1/n) Σ j u^[j] c^[n−j], c^[n] = −(1/n) Σ j u^[j] s^[n−j].
 #[inline(always)]
-pub fn sin_cos(s: &Coefficients, c: &Coefficients, u: &Coefficients, n: usize) -> (f64, f64) {
+pub fn sin_cos<L: Scalar>(
+    s: &Coefficients<L>,
+    c: &Coefficients<L>,
+    u: &Coefficients<L>,
+    n: usize,
+) -> (L, L) {
     let (earlier_c, earlier_s) = derivative_dots(u, c, s, n);
     let inverse = INVERSES[n];
     // The order-n term j = n: n u^[n] c^[0] / n.

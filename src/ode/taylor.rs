@@ -10,21 +10,23 @@
 //! κ = [`SAFETY_EXPONENT`]. There is no error estimate and no rejected
 //! step. The polynomial of the step is the dense output.
 
-use super::series::MAX_ORDER;
+use super::series::{Coefficients, Scalar, MAX_ORDER};
 use super::{check_finite, Flow, Observer, OdeError, Stats, Step, System};
 
 /// Coefficient arrays for the generated recurrences, reused from step to
-/// step (no allocation per step).
+/// step (no allocation per step); `L` is f64, or [`super::Lanes`] for
+/// a batch.
 #[derive(Clone, Debug, Default)]
-pub struct TaylorWork {
-    slots: Vec<super::series::Coefficients>,
+pub struct TaylorWork<L = f64> {
+    slots: Vec<Coefficients<L>>,
 }
 
-impl TaylorWork {
+impl<L: Scalar> TaylorWork<L> {
     /// The first K coefficient arrays (grown on first use).
-    pub fn slots<const K: usize>(&mut self) -> &mut [super::series::Coefficients; K] {
+    pub fn slots<const K: usize>(&mut self) -> &mut [Coefficients<L>; K] {
         if self.slots.len() < K {
-            self.slots.resize(K, [0.0; super::series::COEFFICIENTS]);
+            self.slots
+                .resize(K, [L::default(); super::series::COEFFICIENTS]);
         }
         self.slots
             .first_chunk_mut::<K>()
@@ -54,9 +56,9 @@ pub(super) struct TaylorState {
     pub coefficients: Vec<f64>,
 }
 
-/// Σ_k c[k] h^k.
+/// Σ_k c[k] h^k (lane by lane for a batch).
 #[inline(always)]
-fn horner<const N: usize>(c: &[[f64; N]], h: f64) -> [f64; N] {
+pub(super) fn horner<L: Scalar, const N: usize>(c: &[[L; N]], h: L) -> [L; N] {
     let (last, lower) = c.split_last().expect("at least order 0");
     let mut y = *last;
     for row in lower.iter().rev() {
@@ -68,20 +70,64 @@ fn horner<const N: usize>(c: &[[f64; N]], h: f64) -> [f64; N] {
 }
 
 /// Jorba–Zou step size from the coefficients of order p−1 and p, times
-/// `safety` = e^{−2} e^{−0.7/(p−1)}; `None`
+/// `safety` = e^{−κ} e^{−0.7/(p−1)}; `None`
 /// when both vanish (the solution is a polynomial of lower degree).
 fn step_size<const N: usize>(c: &[[f64; N]], y: &[f64; N], safety: f64) -> Option<f64> {
     let p = c.len() - 1;
     let norm = |row: &[f64; N]| row.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let scale = norm(y).max(1.0);
+    step_from_norms(norm(y), [norm(&c[p - 1]), norm(&c[p])], p, safety)
+}
+
+/// The step size from ‖y‖∞ and the norms of the coefficients of order
+/// p−1 and p (see [`step_size`]).
+pub(super) fn step_from_norms(
+    y_norm: f64,
+    top_norms: [f64; 2],
+    p: usize,
+    safety: f64,
+) -> Option<f64> {
+    let scale = y_norm.max(1.0);
     let rho = [p - 1, p]
         .into_iter()
-        .filter_map(|k| {
-            let a = norm(&c[k]);
-            (a > 0.0).then(|| (scale / a).powf(1.0 / k as f64))
-        })
+        .zip(top_norms)
+        .filter_map(|(k, a)| (a > 0.0).then(|| (scale / a).powf(1.0 / k as f64)))
         .fold(f64::INFINITY, f64::min);
     rho.is_finite().then_some(rho * safety)
+}
+
+/// The step to take from t towards t1 (`remaining` = |t1 − t| away), and
+/// whether it is the last one.
+pub(super) fn step_to_take<const N: usize>(
+    step: Option<f64>,
+    remaining: f64,
+    t: f64,
+    y: &[f64; N],
+) -> Result<(f64, bool), OdeError> {
+    let h = match step {
+        Some(h) if h.is_finite() => h,
+        // Vanishing top coefficients: the series is exact.
+        None => remaining,
+        Some(_) => return Err(OdeError::NonFinite { t, y: y.to_vec() }),
+    };
+    if h <= 0.0 && remaining > 0.0 {
+        return Err(OdeError::StepSizeUnderflow { t, h });
+    }
+    let last = h >= remaining;
+    Ok((if last { remaining } else { h }, last))
+}
+
+/// t + h with Kahan compensation (`carry`): a million steps lose no phase.
+#[inline(always)]
+pub(super) fn compensated_sum(t: f64, h: f64, carry: &mut f64) -> f64 {
+    let increment = h - *carry;
+    let sum = t + increment;
+    *carry = (sum - t) - increment;
+    sum
+}
+
+/// The step's safety factor e^{−κ} e^{−0.7/(p−1)} at order p.
+pub(super) fn safety(order: usize) -> f64 {
+    (-SAFETY_EXPONENT - 0.7 / (order - 1) as f64).exp()
 }
 
 /// One accepted step: its polynomial is the dense output.
@@ -121,9 +167,8 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
     stats.order = stats.order.max(order as u64);
     state.coefficients.resize((order + 1) * N, 0.0);
     let direction = (t1 - t0).signum();
-    let safety = (-SAFETY_EXPONENT - 0.7 / (order - 1) as f64).exp();
+    let safety = safety(order);
     let (mut t, mut y) = (t0, *y0);
-    // Kahan-compensated time: a million steps lose no phase.
     let mut carry = 0.0;
     for _ in 0..max_steps {
         let (c, _) = state.coefficients.as_chunks_mut::<N>();
@@ -132,25 +177,13 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
         }
         stats.f_evals += order as u64;
         let remaining = (t1 - t).abs();
-        let h = match step_size(c, &y, safety) {
-            Some(h) if h.is_finite() => h,
-            // Vanishing top coefficients: the series is exact.
-            None => remaining,
-            Some(_) => return Err(OdeError::NonFinite { t, y: y.to_vec() }),
-        };
-        if h <= 0.0 && remaining > 0.0 {
-            return Err(OdeError::StepSizeUnderflow { t, h });
-        }
-        let last = h >= remaining;
-        let h = if last { remaining } else { h } * direction;
+        let (h, last) = step_to_take(step_size(c, &y, safety), remaining, t, &y)?;
+        let h = h * direction;
         let y_new = horner(c, h);
         let t_new = if last {
             t1
         } else {
-            let increment = h - carry;
-            let sum = t + increment;
-            carry = (sum - t) - increment;
-            sum
+            compensated_sum(t, h, &mut carry)
         };
         check_finite(t_new, &y_new)?;
         if !last && t_new == t {

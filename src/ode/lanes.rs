@@ -1,0 +1,145 @@
+//! A batch of [`LANES`] f64 values, one per orbit, for the batch Taylor
+//! method: every operation acts lane by lane, in plain loops over an
+//! array that the compiler turns into SIMD instructions for the processor
+//! it builds for (see `.cargo/config.toml`), with no intrinsics and no
+//! nightly features. The transcendental functions (at order 0 of a step
+//! only) call the scalar ones lane by lane.
+
+use super::series::Scalar;
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
+
+/// Orbits per batch: eight f64 fill one AVX-512 register or two AVX ones.
+/// Measured on the Kapitza chaos map (README, "Sweeps"): 8 lanes beat 4.
+pub const LANES: usize = 8;
+
+/// One f64 per lane.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(64))]
+pub struct Lanes(pub [f64; LANES]);
+
+impl Lanes {
+    /// Every lane `x`.
+    #[inline(always)]
+    pub const fn splat(x: f64) -> Lanes {
+        Lanes([x; LANES])
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Lanes {
+        Lanes(self.0.map(f))
+    }
+    #[inline(always)]
+    fn zip(self, other: Lanes, f: impl Fn(f64, f64) -> f64) -> Lanes {
+        let mut out = [0.0; LANES];
+        for i in 0..LANES {
+            out[i] = f(self.0[i], other.0[i]);
+        }
+        Lanes(out)
+    }
+    /// |x| lane by lane.
+    #[inline(always)]
+    pub fn abs(self) -> Lanes {
+        self.map(f64::abs)
+    }
+    /// max(x, y) lane by lane, as `f64::max`.
+    #[inline(always)]
+    pub fn max(self, other: Lanes) -> Lanes {
+        self.zip(other, f64::max)
+    }
+}
+
+impl From<f64> for Lanes {
+    #[inline(always)]
+    fn from(x: f64) -> Lanes {
+        Lanes::splat(x)
+    }
+}
+
+macro_rules! lane_operator {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for Lanes {
+            type Output = Lanes;
+            #[inline(always)]
+            fn $method(self, other: Lanes) -> Lanes {
+                self.zip(other, |a, b| a $op b)
+            }
+        }
+        impl $trait<f64> for Lanes {
+            type Output = Lanes;
+            #[inline(always)]
+            fn $method(self, other: f64) -> Lanes {
+                self.map(|a| a $op other)
+            }
+        }
+        impl $trait<Lanes> for f64 {
+            type Output = Lanes;
+            #[inline(always)]
+            fn $method(self, other: Lanes) -> Lanes {
+                other.map(|b| self $op b)
+            }
+        }
+    };
+}
+
+lane_operator!(Add, add, +);
+lane_operator!(Sub, sub, -);
+lane_operator!(Mul, mul, *);
+lane_operator!(Div, div, /);
+
+impl Neg for Lanes {
+    type Output = Lanes;
+    #[inline(always)]
+    fn neg(self) -> Lanes {
+        self.map(|a| -a)
+    }
+}
+
+impl AddAssign for Lanes {
+    #[inline(always)]
+    fn add_assign(&mut self, other: Lanes) {
+        *self = *self + other;
+    }
+}
+
+impl Scalar for Lanes {
+    #[inline]
+    fn sin_cos(self) -> (Lanes, Lanes) {
+        let mut s = [0.0; LANES];
+        let mut c = [0.0; LANES];
+        for i in 0..LANES {
+            (s[i], c[i]) = self.0[i].sin_cos();
+        }
+        (Lanes(s), Lanes(c))
+    }
+    #[inline]
+    fn sin(self) -> Lanes {
+        self.map(f64::sin)
+    }
+    #[inline]
+    fn cos(self) -> Lanes {
+        self.map(f64::cos)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Lanes {
+        self.map(f64::sqrt)
+    }
+    #[inline]
+    fn exp(self) -> Lanes {
+        self.map(f64::exp)
+    }
+    #[inline]
+    fn ln(self) -> Lanes {
+        self.map(f64::ln)
+    }
+    #[inline]
+    fn powf(self, alpha: f64) -> Lanes {
+        self.map(|a| a.powf(alpha))
+    }
+    #[inline(always)]
+    fn recip(self) -> Lanes {
+        self.map(|a| 1.0 / a)
+    }
+    #[inline(always)]
+    fn positive_sqrt(self) -> Lanes {
+        self.map(<f64 as Scalar>::positive_sqrt)
+    }
+}
