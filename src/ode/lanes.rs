@@ -5,6 +5,7 @@
 //! nightly features. The transcendental functions (at order 0 of a step
 //! only) call the scalar ones lane by lane.
 
+use super::kernels;
 use super::series::Scalar;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
@@ -101,12 +102,19 @@ impl AddAssign for Lanes {
 }
 
 impl Scalar for Lanes {
+    /// [`kernels::sin_cos`] in every lane: the reduced form for all lanes
+    /// at once, then libm for lanes past its range.
     #[inline]
     fn sin_cos(self) -> (Lanes, Lanes) {
         let mut s = [0.0; LANES];
         let mut c = [0.0; LANES];
         for i in 0..LANES {
-            (s[i], c[i]) = self.0[i].sin_cos();
+            (s[i], c[i]) = kernels::reduced_sin_cos(self.0[i]);
+        }
+        for i in 0..LANES {
+            if !kernels::reducible(self.0[i]) {
+                (s[i], c[i]) = self.0[i].sin_cos();
+            }
         }
         (Lanes(s), Lanes(c))
     }

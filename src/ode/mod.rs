@@ -9,6 +9,7 @@
 mod dop853;
 mod events;
 mod gauss;
+pub mod kernels;
 mod lanes;
 mod radau5;
 mod rk4;

@@ -51,7 +51,7 @@ pub trait Scalar:
 impl Scalar for f64 {
     #[inline(always)]
     fn sin_cos(self) -> (f64, f64) {
-        f64::sin_cos(self)
+        super::kernels::sin_cos(self)
     }
     #[inline(always)]
     fn sin(self) -> f64 {

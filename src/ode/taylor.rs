@@ -86,13 +86,32 @@ pub(super) fn step_from_norms(
     p: usize,
     safety: f64,
 ) -> Option<f64> {
+    step_from_exponent(step_exponent(y_norm, top_norms, p), safety)
+}
+
+/// log2 ρ = min_k log2(M/‖y^[k]‖)/k over k = p−1, p with M = max(1, ‖y‖∞);
+/// +∞ when both norms vanish. Branch-free, so that the batch method
+/// computes it for all lanes at once.
+#[inline(always)]
+pub(super) fn step_exponent(y_norm: f64, top_norms: [f64; 2], p: usize) -> f64 {
+    use super::kernels::log2;
+    use super::series::INVERSES;
     let scale = y_norm.max(1.0);
-    let rho = [p - 1, p]
-        .into_iter()
-        .zip(top_norms)
-        .filter_map(|(k, a)| (a > 0.0).then(|| (scale / a).powf(1.0 / k as f64)))
-        .fold(f64::INFINITY, f64::min);
-    rho.is_finite().then_some(rho * safety)
+    let exponent = |a: f64, k: usize| {
+        let e = log2(scale / a) * INVERSES[k];
+        if a > 0.0 {
+            e
+        } else {
+            f64::INFINITY
+        }
+    };
+    exponent(top_norms[0], p - 1).min(exponent(top_norms[1], p))
+}
+
+/// ρ·safety from log2 ρ; `None` for log2 ρ = +∞ (the series is exact).
+#[inline(always)]
+pub(super) fn step_from_exponent(exponent: f64, safety: f64) -> Option<f64> {
+    (exponent < f64::INFINITY).then(|| super::kernels::exp2(exponent) * safety)
 }
 
 /// The step to take from t towards t1 (`remaining` = |t1 − t| away), and

@@ -12,7 +12,9 @@
 
 use super::lanes::{Lanes, LANES};
 use super::series::MAX_ORDER;
-use super::taylor::{compensated_sum, horner, safety, step_from_norms, step_to_take};
+use super::taylor::{
+    compensated_sum, horner, safety, step_exponent, step_from_exponent, step_to_take,
+};
 use super::{order_for_tolerance, Method, OdeError, Stats, System, TaylorWork};
 
 /// The result of one lane.
@@ -96,13 +98,18 @@ impl LaneIntegrator {
                 row_norms(&lanes.y),
                 [row_norms(&c[order - 1]), row_norms(&c[order])],
             );
+            // The step rule for all lanes at once (vectorised), then lane by lane.
+            let mut exponents = [0.0; LANES];
+            for (l, exponent) in exponents.iter_mut().enumerate() {
+                *exponent = step_exponent(y_norm.0[l], [top[0].0[l], top[1].0[l]], order);
+            }
             let mut h = [0.0; LANES];
             let mut last = [false; LANES];
             let stepping = running;
             for l in (0..LANES).filter(|&l| stepping[l]) {
                 self.stats.f_evals += order as u64;
                 let y = lanes.state(l);
-                let step = step_from_norms(y_norm.0[l], [top[0].0[l], top[1].0[l]], order, safety);
+                let step = step_from_exponent(exponents[l], safety);
                 match step_to_take(step, (t1 - lanes.t[l]).abs(), lanes.t[l], &y) {
                     Ok((step, is_last)) => (h[l], last[l]) = (step * direction, is_last),
                     Err(e) => (results[l], running[l]) = (Err(e), false),
