@@ -11,11 +11,12 @@
 //! orbit's recurrences are a chain of dependent operations.
 
 use super::lanes::{Lanes, LANES};
-use super::series::MAX_ORDER;
 use super::taylor::{
     compensated_sum, horner, safety, step_exponent, step_from_exponent, step_to_take,
 };
-use super::{order_for_tolerance, Method, OdeError, Stats, System, TaylorWork};
+use super::{
+    check_finite, check_initial, order_for_tolerance, Method, OdeError, Stats, System, TaylorWork,
+};
 
 /// The result of one lane.
 pub type LaneResult<const N: usize> = Result<[f64; N], OdeError>;
@@ -40,8 +41,7 @@ impl LaneIntegrator {
         let Method::Taylor { tol } = method else {
             return Err(OdeError::NoBatchMode(method.name()));
         };
-        // Validates the tolerance as the scalar integrator does.
-        super::Integrator::new(method)?;
+        method.validate()?;
         Ok(LaneIntegrator {
             tol,
             work: TaylorWork::default(),
@@ -63,20 +63,15 @@ impl LaneIntegrator {
     ) -> [LaneResult<N>; LANES] {
         let mut results: [LaneResult<N>; LANES] = std::array::from_fn(|l| Ok(y0[l]));
         let mut running = active;
-        for l in 0..LANES {
-            let bad = !t0.is_finite() || !t1.is_finite() || y0[l].iter().any(|x| !x.is_finite());
-            if running[l] && bad {
-                results[l] = Err(OdeError::NonFiniteInitialState {
-                    t: t0,
-                    y: y0[l].to_vec(),
-                });
-                running[l] = false;
+        for l in (0..LANES).filter(|&l| active[l]) {
+            if let Err(e) = check_initial(t0, &y0[l], t1) {
+                (results[l], running[l]) = (Err(e), false);
             }
         }
         if t1 == t0 {
             return results;
         }
-        let order = order_for_tolerance(self.tol).min(MAX_ORDER);
+        let order = order_for_tolerance(self.tol);
         self.stats.order = self.stats.order.max(order as u64);
         self.coefficients.resize((order + 1) * N, Lanes::default());
         let direction = (t1 - t0).signum();
@@ -159,11 +154,8 @@ impl<const N: usize> Run<N> {
             compensated_sum(t, h, &mut self.carry[l])
         };
         let y: [f64; N] = std::array::from_fn(|i| y_new[i].0[l]);
-        if !t_new.is_finite() || y.iter().any(|x| !x.is_finite()) {
-            return Some(Err(OdeError::NonFinite {
-                t: t_new,
-                y: y.to_vec(),
-            }));
+        if let Err(e) = check_finite(t_new, &y) {
+            return Some(Err(e));
         }
         if !last && t_new == t {
             return Some(Err(OdeError::StepSizeUnderflow { t, h }));
