@@ -67,7 +67,7 @@ pub const SECTIONS: &[Section] = &[
         numbers: &[("slopes (chaotic Kapitza)", "/slopes_error_vs_f_evals/kapitza_chaotic"), ("periods per second at 1e-10", "/performance/periods_per_second_at_1e-10")] },
 ];
 
-fn escape(s: &str) -> String {
+pub fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")

@@ -86,6 +86,8 @@ pub enum SceneError {
     Averaging(#[from] crate::analysis::averaging::AveragingError),
     #[error(transparent)]
     PeriodMap(#[from] crate::analysis::period_map::PeriodMapError),
+    #[error(transparent)]
+    Serve(#[from] crate::studio::server::ServeError),
     /// Another scene, run by this one, could not start or failed.
     #[error("cannot run scene {scene}: {source}")]
     Spawn {

@@ -169,7 +169,8 @@ impl Method {
         }
     }
 
-    fn validate(&self) -> Result<(), OdeError> {
+    /// A positive, finite tolerance or step (0 or NaN is refused).
+    pub fn validate(&self) -> Result<(), OdeError> {
         let positive = |what: &'static str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())

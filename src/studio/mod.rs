@@ -1,0 +1,694 @@
+//! The studio: an interactive page over the period map of any model of
+//! `models/`, served by a local web server ([`server`]). This module holds
+//! what the page asks for, as library calls the tests reach without HTTP:
+//! the models and their derivations as MathML, an orbit of the period map
+//! handed over in chunks as it grows, the level sets of the averaged
+//! Hamiltonian with the equilibria, and the FLI chaos map of a view at
+//! growing resolutions.
+
+pub mod contour;
+pub mod server;
+
+use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
+use crate::analysis::period_map::{period_map, wrap_angle, PeriodMapError};
+use crate::ode::{Integrator, Method, OdeError};
+use crate::registry::{DynamicModel, Fixed, Kind, ModelInfo, ParameterError, WithFixed};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::time::{Duration, Instant};
+
+/// The largest requests the studio computes: a click never starts an hour
+/// of work.
+pub const MAX_PERIODS: usize = 100_000;
+pub const MAX_CHAOS_PIXELS: usize = 400;
+pub const MAX_CHAOS_PERIODS: usize = 2_000;
+pub const MAX_GRID: usize = 400;
+
+/// Why the studio cannot answer a request. Each names what was wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum StudioError {
+    #[error("no model '{name}' in models/ (known: {})", known.join(", "))]
+    UnknownModel {
+        name: String,
+        known: Vec<&'static str>,
+    },
+    #[error("model '{0}' is a contact model: it has no Hamiltonian phase plane (its derivations are shown)")]
+    ContactModel(String),
+    #[error("model '{0}' has no fast phase: it has no period map (its derivations and equilibria are shown)")]
+    NoFastPhase(String),
+    #[error("model '{model}': {problem}")]
+    BadRequest {
+        model: String,
+        problem: RequestProblem,
+    },
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+    #[error(transparent)]
+    PeriodMap(#[from] PeriodMapError),
+}
+
+/// What is wrong with a request's numbers.
+#[derive(Debug, thiserror::Error)]
+pub enum RequestProblem {
+    #[error("the seed has {got} components; the state [q; p] has {expected}")]
+    SeedLength { got: usize, expected: usize },
+    #[error("the state to pass through has {got} components; the state [q; p] has {expected}")]
+    ThroughLength { got: usize, expected: usize },
+    #[error("{what} must be finite")]
+    NotFinite { what: &'static str },
+    #[error("the axes must be two different state components among 0..{components}")]
+    Axes { components: usize },
+    #[error("the range of axis {axis} must be an interval of finite numbers, low < high")]
+    Range { axis: usize },
+    #[error("{what} must be between 1 and {max}, got {got}")]
+    Count {
+        what: &'static str,
+        got: usize,
+        max: usize,
+    },
+}
+
+/// A parameter as the page shows it: a slider around the model file's value.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParameterSummary {
+    pub name: &'static str,
+    pub symbol: String,
+    pub default: f64,
+    pub description: &'static str,
+}
+
+/// One model of `models/` as the page lists it.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelSummary {
+    pub name: &'static str,
+    pub source_file: &'static str,
+    /// `hamiltonian` or `contacts`.
+    pub kind: &'static str,
+    pub dof: usize,
+    pub fast_phase: bool,
+    /// The state's names [q; p] in the figures' notation.
+    pub state: Vec<String>,
+    /// Per state component: an angle (shown mod 2π).
+    pub periodic: Vec<bool>,
+    pub parameters: Vec<ParameterSummary>,
+    /// The parameter that scales the vibration, if the model names one.
+    pub amplitude: Option<&'static str>,
+    pub default_axes: [usize; 2],
+    pub default_ranges: [[f64; 2]; 2],
+}
+
+/// Every model of `models/`, in file-name order.
+pub fn models() -> Vec<ModelSummary> {
+    crate::models::ALL
+        .iter()
+        .filter_map(|info| crate::models::dynamic(info.name).map(|m| summary(info, m)))
+        .collect()
+}
+
+fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
+    let (kind, dof, fast_phase) = match model.kind() {
+        Kind::Hamiltonian { dof, fast_phase } => ("hamiltonian", dof, fast_phase),
+        Kind::Contacts { count } => ("contacts", count, false),
+    };
+    let mut periodic = model.periodic();
+    periodic.resize(2 * dof, false);
+    let state = info.state_names();
+    let default_axes = [0, dof.min(state.len().saturating_sub(1))];
+    let default_ranges = default_axes.map(|a| {
+        if periodic.get(a).copied().unwrap_or(false) {
+            [-PI, PI]
+        } else {
+            [-3.0, 3.0]
+        }
+    });
+    ModelSummary {
+        name: info.name,
+        source_file: info.source_file,
+        kind,
+        dof,
+        fast_phase,
+        state: state
+            .iter()
+            .map(|n| crate::registry::display_name(n))
+            .collect(),
+        periodic,
+        parameters: info
+            .parameter_names
+            .iter()
+            .zip(model.defaults())
+            .zip(info.parameter_descriptions)
+            .map(|((&name, default), &description)| ParameterSummary {
+                name,
+                symbol: crate::registry::display_name(name),
+                default,
+                description,
+            })
+            .collect(),
+        amplitude: info.amplitude,
+        default_axes,
+        default_ranges,
+    }
+}
+
+/// A derived expression as the page shows it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Derivation {
+    pub key: &'static str,
+    pub description: &'static str,
+    pub mathml: String,
+}
+
+/// The derivations a student reads first: L, H, the averaged H to each
+/// order, V_vibr and the effective potential, the equations of motion.
+pub fn derivations(name: &str) -> Result<Vec<Derivation>, StudioError> {
+    let info = find(name)?;
+    const SHOWN: [&str; 8] = [
+        "lagrangian",
+        "hamiltonian",
+        "averaged_hamiltonian",
+        "averaged_hamiltonian_second_order",
+        "vibrational_potential",
+        "effective_potential",
+        "free_force[",
+        "normal_force[",
+    ];
+    let shown = |key: &str| {
+        SHOWN
+            .iter()
+            .any(|s| key == *s || (s.ends_with('[') && key.starts_with(s)))
+            || key.starts_with("velocities[")
+            || key.starts_with("momentum_rates[")
+    };
+    Ok(info
+        .derivations
+        .iter()
+        .filter(|d| shown(d.key))
+        .map(|d| Derivation {
+            key: d.key,
+            description: d.description,
+            mathml: crate::mathml::mathml(d.latex, true),
+        })
+        .collect())
+}
+
+fn find(name: &str) -> Result<&'static ModelInfo, StudioError> {
+    crate::registry::find(name).ok_or_else(|| StudioError::UnknownModel {
+        name: name.into(),
+        known: crate::models::ALL.iter().map(|m| m.name).collect(),
+    })
+}
+
+fn find_dynamic(
+    name: &str,
+) -> Result<(&'static ModelInfo, &'static dyn DynamicModel), StudioError> {
+    let info = find(name)?;
+    let model = crate::models::dynamic(info.name).ok_or_else(|| StudioError::UnknownModel {
+        name: name.into(),
+        known: crate::models::ALL.iter().map(|m| m.name).collect(),
+    })?;
+    Ok((info, model))
+}
+
+fn default_method() -> String {
+    "taylor".into()
+}
+fn default_tol() -> f64 {
+    1e-10
+}
+
+/// What every request names: the model, its parameters (the model file's
+/// values where not given), the method and the plane drawn.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Setup {
+    pub model: String,
+    #[serde(default)]
+    pub params: BTreeMap<String, f64>,
+    #[serde(default = "default_method")]
+    pub method: String,
+    #[serde(default = "default_tol")]
+    pub tol: f64,
+    /// The state components along the page's axes (default: q₁, p₁).
+    #[serde(default)]
+    pub axes: Option<[usize; 2]>,
+    /// The state the plane passes through (default 0).
+    #[serde(default)]
+    pub through: Option<Vec<f64>>,
+}
+
+/// A [`Setup`] checked against its model.
+#[derive(Clone)]
+pub struct Resolved {
+    pub info: &'static ModelInfo,
+    pub model: &'static dyn DynamicModel,
+    pub dof: usize,
+    pub fast_phase: bool,
+    pub params: Vec<f64>,
+    pub method: Method,
+    pub axes: [usize; 2],
+    pub through: Vec<f64>,
+}
+
+impl Setup {
+    pub fn resolve(&self) -> Result<Resolved, StudioError> {
+        let (info, model) = find_dynamic(&self.model)?;
+        let bad = |problem| StudioError::BadRequest {
+            model: info.name.into(),
+            problem,
+        };
+        let (dof, fast_phase) = match model.kind() {
+            Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
+            Kind::Contacts { .. } => return Err(StudioError::ContactModel(info.name.into())),
+        };
+        let mut params = model.defaults();
+        for (name, &value) in &self.params {
+            let k = info
+                .parameter_names
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| ParameterError::Unknown {
+                    model: info.name,
+                    name: name.clone(),
+                    known: info.parameter_names,
+                })?;
+            if !value.is_finite() {
+                return Err(ParameterError::NotFinite {
+                    model: info.name,
+                    name: name.clone(),
+                    value,
+                }
+                .into());
+            }
+            params[k] = value;
+        }
+        let method = Method::parse(&self.method, self.tol)?;
+        method.validate()?;
+        let states = 2 * dof;
+        let axes = self.axes.unwrap_or([0, dof]);
+        if axes[0] == axes[1] || axes.iter().any(|&a| a >= states) {
+            return Err(bad(RequestProblem::Axes { components: states }));
+        }
+        let through = self.through.clone().unwrap_or_else(|| vec![0.0; states]);
+        if through.len() != states {
+            return Err(bad(RequestProblem::ThroughLength {
+                got: through.len(),
+                expected: states,
+            }));
+        }
+        if through.iter().any(|x| !x.is_finite()) {
+            return Err(bad(RequestProblem::NotFinite {
+                what: "the state to pass through",
+            }));
+        }
+        Ok(Resolved {
+            info,
+            model,
+            dof,
+            fast_phase,
+            params,
+            method,
+            axes,
+            through,
+        })
+    }
+}
+
+impl Resolved {
+    fn bad(&self, problem: RequestProblem) -> StudioError {
+        StudioError::BadRequest {
+            model: self.info.name.into(),
+            problem,
+        }
+    }
+
+    fn ranges(&self, ranges: &[[f64; 2]; 2]) -> Result<[(f64, f64); 2], StudioError> {
+        for (axis, r) in ranges.iter().enumerate() {
+            if !(r[0].is_finite() && r[1].is_finite() && r[0] < r[1]) {
+                return Err(self.bad(RequestProblem::Range { axis }));
+            }
+        }
+        Ok(ranges.map(|r| (r[0], r[1])))
+    }
+
+    fn count(&self, what: &'static str, got: usize, max: usize) -> Result<usize, StudioError> {
+        if got == 0 || got > max {
+            return Err(self.bad(RequestProblem::Count { what, got, max }));
+        }
+        Ok(got)
+    }
+
+    fn needs_period_map(&self) -> Result<(), StudioError> {
+        if self.fast_phase {
+            Ok(())
+        } else {
+            Err(StudioError::NoFastPhase(self.info.name.into()))
+        }
+    }
+}
+
+/// A click on the page: an orbit of the period map from `seed` (the full
+/// state [q; p]), `periods` iterates.
+#[derive(Clone, Debug, Deserialize)]
+pub struct OrbitRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub seed: Vec<f64>,
+    pub periods: usize,
+}
+
+impl OrbitRequest {
+    /// The request checked: its model has a period map, the seed is a
+    /// finite state of the right size, the periods are within bounds.
+    pub fn check(&self) -> Result<Resolved, StudioError> {
+        let setup = self.setup.resolve()?;
+        setup.needs_period_map()?;
+        setup.count("periods", self.periods, MAX_PERIODS)?;
+        if self.seed.len() != 2 * setup.dof {
+            return Err(setup.bad(RequestProblem::SeedLength {
+                got: self.seed.len(),
+                expected: 2 * setup.dof,
+            }));
+        }
+        if self.seed.iter().any(|x| !x.is_finite()) {
+            return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
+        }
+        Ok(setup)
+    }
+}
+
+/// Points of an orbit projected on the page's axes (angles in [−π, π)), in
+/// order: the first chunk starts with the seed.
+#[derive(Clone, Debug, Serialize)]
+pub struct OrbitChunk {
+    pub points: Vec<[f64; 2]>,
+}
+
+/// How an orbit ended.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct OrbitEnd {
+    /// Iterates computed (the seed not counted).
+    pub periods: usize,
+    /// The page went away (a superseded request): the orbit stopped early.
+    pub cancelled: bool,
+    pub f_evals: u64,
+    pub seconds: f64,
+}
+
+/// How often a growing orbit is handed over.
+const CHUNK_INTERVAL: Duration = Duration::from_millis(40);
+const CHUNK_POINTS: usize = 4096;
+
+/// Computes the orbit of `request`, handing its points to `sink` in chunks
+/// as they come (at least every 40 ms); `sink` returns false when nobody
+/// listens any more, which stops the orbit. An orbit that leaves the
+/// model's domain ends with the integrator's error after the points before.
+#[inline]
+pub fn orbit(
+    request: &OrbitRequest,
+    sink: &mut dyn FnMut(OrbitChunk) -> bool,
+) -> Result<OrbitEnd, StudioError> {
+    let setup = request.check()?;
+    let work = OrbitWork {
+        setup: &setup,
+        seed: &request.seed,
+        periods: request.periods,
+        sink,
+    };
+    crate::models::with_fixed(setup.info.name, work)
+        .ok_or_else(|| StudioError::ContactModel(setup.info.name.into()))?
+}
+
+struct OrbitWork<'a> {
+    setup: &'a Resolved,
+    seed: &'a [f64],
+    periods: usize,
+    sink: &'a mut dyn FnMut(OrbitChunk) -> bool,
+}
+
+impl WithFixed for OrbitWork<'_> {
+    type Output = Result<OrbitEnd, StudioError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let setup = self.setup;
+        let started = Instant::now();
+        let period = model
+            .phase_period(&setup.params)
+            .ok_or_else(|| StudioError::NoFastPhase(setup.info.name.into()))?;
+        let system = model.exact(&setup.params);
+        let periodic = model.periodic();
+        let mut y: [f64; S] = std::array::from_fn(|k| self.seed[k]);
+        let project = |y: &[f64; S]| {
+            setup.axes.map(|a| {
+                if a < D && periodic[a] {
+                    wrap_angle(y[a])
+                } else {
+                    y[a]
+                }
+            })
+        };
+        let mut integrator = Integrator::new(setup.method)?;
+        let mut chunk = vec![project(&y)];
+        let mut last_sent = Instant::now();
+        let end = |periods, cancelled, integrator: &Integrator| OrbitEnd {
+            periods,
+            cancelled,
+            f_evals: integrator.stats.f_evals,
+            seconds: started.elapsed().as_secs_f64(),
+        };
+        for k in 0..self.periods {
+            y = match period_map(&mut integrator, &system, period, &y) {
+                Ok(y) => y,
+                Err(error) => {
+                    // The points before the failure are the page's to keep.
+                    (self.sink)(OrbitChunk { points: chunk });
+                    return Err(error.into());
+                }
+            };
+            for (x, &angle) in y.iter_mut().zip(&periodic) {
+                if angle {
+                    *x = wrap_angle(*x);
+                }
+            }
+            chunk.push(project(&y));
+            if chunk.len() >= CHUNK_POINTS || last_sent.elapsed() >= CHUNK_INTERVAL {
+                if !(self.sink)(OrbitChunk {
+                    points: std::mem::take(&mut chunk),
+                }) {
+                    return Ok(end(k + 1, true, &integrator));
+                }
+                last_sent = Instant::now();
+            }
+        }
+        let listening = chunk.is_empty() || (self.sink)(OrbitChunk { points: chunk });
+        Ok(end(self.periods, !listening, &integrator))
+    }
+}
+
+/// The chaos map of the current view, coarse first.
+#[derive(Clone, Debug, Deserialize)]
+pub struct ChaosRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub ranges: [[f64; 2]; 2],
+    /// Pixels per side of each refinement, in order.
+    pub levels: Vec<usize>,
+    pub periods: usize,
+}
+
+impl ChaosRequest {
+    /// The request checked, with the view's ranges.
+    pub fn check(&self) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
+        let setup = self.setup.resolve()?;
+        setup.needs_period_map()?;
+        let ranges = setup.ranges(&self.ranges)?;
+        setup.count("periods", self.periods, MAX_CHAOS_PERIODS)?;
+        setup.count("the number of levels", self.levels.len(), 8)?;
+        for &pixels in &self.levels {
+            setup.count("pixels per side", pixels, MAX_CHAOS_PIXELS)?;
+        }
+        Ok((setup, ranges))
+    }
+}
+
+/// One refinement of the chaos map.
+#[derive(Clone, Debug, Serialize)]
+pub struct ChaosLevel {
+    pub pixels: usize,
+    /// Grey levels in [0, 1] (1 = most chaotic), row-major from the lower left.
+    pub shades: Vec<f64>,
+    /// The FLI of each pixel (null: the orbit left the model's domain).
+    pub fli: Vec<Option<f64>>,
+    /// ln(periods): the FLI of a regular orbit.
+    pub regular_level: f64,
+    pub chaotic_fraction: f64,
+    pub seconds: f64,
+}
+
+/// The FLI map of the view at each resolution of `request.levels` (rows
+/// on all cores; the Taylor method in batches), each handed to `sink` when
+/// done; `sink` returns false to stop before the next.
+#[inline]
+pub fn chaos(
+    request: &ChaosRequest,
+    sink: &mut dyn FnMut(ChaosLevel) -> bool,
+) -> Result<(), StudioError> {
+    let (setup, ranges) = request.check()?;
+    for &pixels in &request.levels {
+        let settings = ChaosMapSettings {
+            axes: setup.axes,
+            ranges: ranges.map(Some),
+            p_max: 1.0,
+            through: Some(setup.through.clone()),
+            pixels,
+            periods: request.periods,
+            method: setup.method,
+            tiles: None,
+        };
+        let map = chaos_map(setup.info.name, &setup.params, &settings, &|| {})?;
+        let level = ChaosLevel {
+            pixels,
+            shades: map.shades,
+            fli: map
+                .fli
+                .iter()
+                .map(|v| v.is_finite().then_some(*v))
+                .collect(),
+            regular_level: map.fli_regular_level,
+            chaotic_fraction: map.chaotic_fraction,
+            seconds: map.seconds,
+        };
+        if !sink(level) {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// The overlays of a view: level sets of the averaged Hamiltonian (of H
+/// without a fast phase) and the equilibria of V + V_vibr.
+#[derive(Clone, Debug, Deserialize)]
+pub struct OverlayRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub ranges: [[f64; 2]; 2],
+    /// Grid points per side for the level sets.
+    pub grid: usize,
+    /// Number of level sets (besides those through unstable equilibria).
+    pub levels: usize,
+}
+
+/// One level set, as segments (x₀, y₀, x₁, y₁) on the page's axes.
+#[derive(Clone, Debug, Serialize)]
+pub struct LevelSet {
+    pub value: f64,
+    /// Through an unstable equilibrium: a separatrix of the averaged system.
+    pub separatrix: bool,
+    pub segments: Vec<[f64; 4]>,
+}
+
+/// An equilibrium of V + V_vibr (at p = 0).
+#[derive(Clone, Debug, Serialize)]
+pub struct EquilibriumMark {
+    pub q: Vec<f64>,
+    /// Where it sits on the page's axes.
+    pub point: [f64; 2],
+    /// Its other state components equal the plane's: it lies on the view.
+    pub on_plane: bool,
+    pub stable: bool,
+    pub hessian_eigenvalues: Vec<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Overlay {
+    /// Which function the level sets are of.
+    pub function: &'static str,
+    pub levels: Vec<LevelSet>,
+    pub equilibria: Vec<EquilibriumMark>,
+}
+
+/// The level sets and equilibria of a view.
+pub fn overlay(request: &OverlayRequest) -> Result<Overlay, StudioError> {
+    let setup = request.setup.resolve()?;
+    let ranges = setup.ranges(&request.ranges)?;
+    let grid = setup.count("grid points per side", request.grid, MAX_GRID)?;
+    let count = setup.count("level sets", request.levels, 100)?;
+    let model = setup.model;
+    let params = &setup.params;
+    let value = |x: f64, y: f64| {
+        let mut state = setup.through.clone();
+        state[setup.axes[0]] = x;
+        state[setup.axes[1]] = y;
+        if setup.fast_phase {
+            model.averaged_energy(params, &state).unwrap_or(f64::NAN)
+        } else {
+            model.energy(params, 0.0, &state)
+        }
+    };
+    let field = contour::Field::sample(ranges, grid, value);
+    let equilibria: Vec<EquilibriumMark> = crate::explore::equilibria(model, params)
+        .into_iter()
+        .map(|e| {
+            let mut state = e.q.clone();
+            state.resize(2 * setup.dof, 0.0);
+            let periodic = model.periodic();
+            let same = |k: usize| {
+                let d = state[k] - setup.through[k];
+                let d = if periodic.get(k).copied().unwrap_or(false) {
+                    wrap_angle(d)
+                } else {
+                    d
+                };
+                d.abs() < 1e-9
+            };
+            let point = setup.axes.map(|a| {
+                if periodic.get(a).copied().unwrap_or(false) {
+                    wrap_angle(state[a])
+                } else {
+                    state[a]
+                }
+            });
+            EquilibriumMark {
+                on_plane: (0..state.len())
+                    .filter(|k| !setup.axes.contains(k))
+                    .all(same),
+                point,
+                stable: e.stable,
+                hessian_eigenvalues: e.hessian_eigenvalues,
+                q: e.q,
+            }
+        })
+        .collect();
+    let mut levels: Vec<LevelSet> = field
+        .quantiles(count)
+        .into_iter()
+        .map(|v| LevelSet {
+            value: v,
+            separatrix: false,
+            segments: field.segments(v),
+        })
+        .collect();
+    for e in equilibria.iter().filter(|e| !e.stable && e.on_plane) {
+        let v = value(e.point[0], e.point[1]);
+        if v.is_finite() {
+            levels.push(LevelSet {
+                value: v,
+                separatrix: true,
+                segments: field.segments(v),
+            });
+        }
+    }
+    Ok(Overlay {
+        function: if setup.fast_phase {
+            "averaged Hamiltonian H̄"
+        } else {
+            "Hamiltonian H"
+        },
+        levels,
+        equilibria,
+    })
+}

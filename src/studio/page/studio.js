@@ -1,0 +1,553 @@
+// mechlab studio: the page. Plain script, no framework, no network beyond
+// the studio's own API. `window.studio` holds the state (read by the
+// browser test).
+"use strict";
+
+const studio = {
+  ready: false,
+  models: [],
+  model: null,
+  params: {},
+  axes: [0, 1],
+  through: [],
+  view: { x: [-Math.PI, Math.PI], y: [-3, 3] },
+  orbits: [],
+  overlay: null,
+  chaos: null,
+  nextId: 1,
+  pointsReceived: 0,
+};
+window.studio = studio;
+
+const $ = (id) => document.getElementById(id);
+const canvas = $("plane");
+const ctx = canvas.getContext("2d");
+
+// ---------- talking to the server ----------
+
+async function errorOf(response) {
+  try {
+    const body = await response.json();
+    return body.error || response.statusText;
+  } catch (_) {
+    return `${response.status} ${response.statusText}`;
+  }
+}
+
+async function getJson(url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(await errorOf(response));
+  return response.json();
+}
+
+async function postJson(url, body, signal) {
+  const response = await fetch(url, { method: "POST", body: JSON.stringify(body), signal,
+    headers: { "content-type": "application/json" } });
+  if (!response.ok) throw new Error(await errorOf(response));
+  return response.json();
+}
+
+// Posts `body` and calls `onLine` with every NDJSON line as it arrives.
+async function postStream(url, body, signal, onLine) {
+  const response = await fetch(url, { method: "POST", body: JSON.stringify(body), signal,
+    headers: { "content-type": "application/json" } });
+  if (!response.ok) throw new Error(await errorOf(response));
+  const reader = response.body.getReader();
+  const decoder = new TextDecoder();
+  let pending = "";
+  for (;;) {
+    const { value, done } = await reader.read();
+    if (done) break;
+    pending += decoder.decode(value, { stream: true });
+    let newline;
+    while ((newline = pending.indexOf("\n")) >= 0) {
+      const line = pending.slice(0, newline);
+      pending = pending.slice(newline + 1);
+      if (line.trim()) onLine(JSON.parse(line));
+    }
+  }
+}
+
+function setup() {
+  return {
+    model: studio.model.name,
+    params: { ...studio.params },
+    method: $("method").value,
+    tol: Number($("tol").value),
+    axes: studio.axes,
+    through: studio.through,
+  };
+}
+
+function say(text) { $("message").textContent = text || ""; }
+const aborted = (e) => e && e.name === "AbortError";
+
+// ---------- coordinates ----------
+
+function toWorld(px, py) {
+  const { x, y } = studio.view;
+  return [x[0] + (px / canvas.width) * (x[1] - x[0]), y[1] - (py / canvas.height) * (y[1] - y[0])];
+}
+function toPixel(wx, wy) {
+  const { x, y } = studio.view;
+  return [((wx - x[0]) / (x[1] - x[0])) * canvas.width, ((y[1] - wy) / (y[1] - y[0])) * canvas.height];
+}
+const stateName = (k) => studio.model.state[k];
+
+// ---------- drawing ----------
+
+let dirty = true;
+function redraw() { dirty = true; }
+function frame() {
+  if (dirty) { dirty = false; draw(ctx, canvas.width, canvas.height); }
+  requestAnimationFrame(frame);
+}
+
+function orbitColor(id) { return `hsl(${(id * 137.508) % 360}, 75%, 42%)`; }
+
+function draw(g, width, height) {
+  g.fillStyle = "#fff";
+  g.fillRect(0, 0, width, height);
+  if (!studio.model) return;
+  if ($("show-chaos").checked && studio.chaos) drawChaos(g);
+  drawGrid(g, width, height);
+  if (studio.overlay && $("show-levels").checked) drawLevels(g);
+  for (const orbit of studio.orbits) {
+    g.fillStyle = orbit.color;
+    for (const [x, y] of orbit.points) {
+      const [px, py] = toPixel(x, y);
+      g.fillRect(px - 0.8, py - 0.8, 1.6, 1.6);
+    }
+  }
+  if (studio.overlay && $("show-equilibria").checked) drawEquilibria(g);
+}
+
+function drawGrid(g, width, height) {
+  g.strokeStyle = "#e4e4e4";
+  g.lineWidth = 1;
+  g.fillStyle = "#666";
+  g.font = "11px sans-serif";
+  const { x, y } = studio.view;
+  for (const [axis, range] of [[0, x], [1, y]]) {
+    const step = niceStep((range[1] - range[0]) / 8);
+    for (let v = Math.ceil(range[0] / step) * step; v <= range[1]; v += step) {
+      const [px, py] = toPixel(axis === 0 ? v : x[0], axis === 0 ? y[0] : v);
+      g.beginPath();
+      if (axis === 0) { g.moveTo(px, 0); g.lineTo(px, height); } else { g.moveTo(0, py); g.lineTo(width, py); }
+      g.stroke();
+      const label = Math.abs(v) < step * 1e-9 ? "0" : v.toPrecision(3).replace(/\.?0+$/, "");
+      if (axis === 0) g.fillText(label, px + 2, height - 4); else g.fillText(label, 3, py - 2);
+    }
+  }
+  g.fillStyle = "#222";
+  g.font = "italic 14px serif";
+  g.fillText(stateName(studio.axes[0]), width - 40, height - 18);
+  g.fillText(stateName(studio.axes[1]), 30, 16);
+}
+
+function niceStep(raw) {
+  const power = Math.pow(10, Math.floor(Math.log10(raw)));
+  const mantissa = raw / power;
+  return (mantissa < 1.5 ? 1 : mantissa < 3.5 ? 2 : mantissa < 7.5 ? 5 : 10) * power;
+}
+
+function drawLevels(g) {
+  for (const level of studio.overlay.levels) {
+    g.strokeStyle = level.separatrix ? "rgba(200, 40, 40, 0.8)" : "rgba(90, 90, 90, 0.45)";
+    g.lineWidth = level.separatrix ? 1.6 : 1;
+    g.beginPath();
+    for (const [x0, y0, x1, y1] of level.segments) {
+      const [a, b] = toPixel(x0, y0);
+      const [c, d] = toPixel(x1, y1);
+      g.moveTo(a, b);
+      g.lineTo(c, d);
+    }
+    g.stroke();
+  }
+}
+
+function drawEquilibria(g) {
+  for (const e of studio.overlay.equilibria) {
+    if (!e.on_plane) continue;
+    const [px, py] = toPixel(e.point[0], e.point[1]);
+    g.beginPath();
+    g.arc(px, py, 6, 0, 2 * Math.PI);
+    g.lineWidth = 2;
+    g.strokeStyle = e.stable ? "#127a2a" : "#c02020";
+    g.fillStyle = e.stable ? "#2fb34c" : "#fff";
+    g.fill();
+    g.stroke();
+  }
+}
+
+// A colour map from dark blue (regular) to yellow (chaotic).
+function shadeColor(s) {
+  const stops = [[35, 23, 80], [40, 110, 150], [60, 170, 110], [250, 225, 40]];
+  const t = Math.min(Math.max(s, 0), 1) * (stops.length - 1);
+  const k = Math.min(Math.floor(t), stops.length - 2);
+  const f = t - k;
+  return stops[k].map((c, i) => Math.round(c + f * (stops[k + 1][i] - c)));
+}
+
+function chaosImage(level) {
+  const n = level.pixels;
+  const image = document.createElement("canvas");
+  image.width = n;
+  image.height = n;
+  const data = image.getContext("2d").createImageData(n, n);
+  for (let k = 0; k < n * n; k++) {
+    const i = k % n, j = Math.floor(k / n);
+    const [r, g, b] = shadeColor(level.shades[k]);
+    const at = ((n - 1 - j) * n + i) * 4;
+    data.data.set([r, g, b, 255], at);
+  }
+  image.getContext("2d").putImageData(data, 0, 0);
+  return image;
+}
+
+function drawChaos(g) {
+  const { image, ranges } = studio.chaos;
+  const [x0, y1] = toPixel(ranges[0][0], ranges[1][1]);
+  const [x1, y0] = toPixel(ranges[0][1], ranges[1][0]);
+  g.imageSmoothingEnabled = false;
+  g.globalAlpha = 0.85;
+  g.drawImage(image, x0, y1, x1 - x0, y0 - y1);
+  g.globalAlpha = 1;
+}
+
+// ---------- orbits ----------
+
+function orbitRequest(orbit) {
+  return { ...setup(), seed: orbit.seed, periods: orbit.periods };
+}
+
+function startOrbit(orbit) {
+  if (orbit.controller) orbit.controller.abort();
+  orbit.controller = new AbortController();
+  orbit.points = [];
+  orbit.done = false;
+  orbit.error = null;
+  orbit.params = { ...studio.params };
+  const request = orbitRequest(orbit);
+  postStream("/api/orbit", request, orbit.controller.signal, (line) => {
+    if (line.points) {
+      for (const p of line.points) orbit.points.push(p);
+      studio.pointsReceived += line.points.length;
+      redraw();
+    } else if (line.end) {
+      orbit.done = true;
+      orbit.end = line.end;
+    } else if (line.error) {
+      orbit.error = line.error;
+      orbit.done = true;
+      say(`orbit ${orbit.id}: ${line.error}`);
+    }
+  }).catch((e) => {
+    if (aborted(e)) return;
+    orbit.error = e.message;
+    orbit.done = true;
+    say(`orbit ${orbit.id}: ${e.message}`);
+  }).finally(() => { listOrbits(); redraw(); });
+}
+
+function seedAt(x, y) {
+  if (!studio.model.fast_phase) {
+    say(`model '${studio.model.name}' has no fast phase: there is no period map to draw`);
+    return;
+  }
+  const seed = studio.through.slice();
+  seed[studio.axes[0]] = x;
+  seed[studio.axes[1]] = y;
+  const id = studio.nextId++;
+  const orbit = { id, seed, color: orbitColor(id), periods: Math.max(1, Math.round(Number($("periods").value))), points: [] };
+  studio.orbits.push(orbit);
+  say("");
+  startOrbit(orbit);
+  listOrbits();
+}
+
+function listOrbits() {
+  const list = $("orbit-list");
+  list.innerHTML = "";
+  for (const orbit of studio.orbits) {
+    const item = document.createElement("li");
+    item.style.color = orbit.color;
+    const seed = orbit.seed.map((v) => v.toFixed(3)).join(", ");
+    item.textContent = `(${seed}) ${orbit.points.length} pts${orbit.error ? " stopped" : orbit.done ? "" : " …"}`;
+    if (orbit.error) { item.className = "error"; item.title = orbit.error; }
+    list.appendChild(item);
+  }
+}
+
+function removeOrbits(keep) {
+  for (const orbit of studio.orbits.slice(keep)) if (orbit.controller) orbit.controller.abort();
+  studio.orbits = studio.orbits.slice(0, keep);
+  listOrbits();
+  redraw();
+}
+
+// ---------- overlays ----------
+
+let overlayController = null;
+let chaosController = null;
+
+function viewRanges() { return [studio.view.x.slice(), studio.view.y.slice()]; }
+
+async function refreshOverlay() {
+  if (overlayController) overlayController.abort();
+  overlayController = new AbortController();
+  const wanted = $("show-levels").checked || $("show-equilibria").checked;
+  if (!wanted || studio.model.kind !== "hamiltonian") { studio.overlay = null; redraw(); return; }
+  try {
+    studio.overlay = await postJson("/api/overlay",
+      { ...setup(), ranges: viewRanges(), grid: 160, levels: 14 }, overlayController.signal);
+    redraw();
+  } catch (e) {
+    if (!aborted(e)) say(`overlay: ${e.message}`);
+  }
+}
+
+async function refreshChaos() {
+  if (chaosController) chaosController.abort();
+  chaosController = null;
+  if (!$("show-chaos").checked || !studio.model.fast_phase) { studio.chaos = null; redraw(); return; }
+  chaosController = new AbortController();
+  const ranges = viewRanges();
+  const request = { ...setup(), ranges, levels: [24, 48, 96, 192],
+    periods: Math.max(1, Math.round(Number($("chaos-periods").value))) };
+  try {
+    await postStream("/api/chaos", request, chaosController.signal, (line) => {
+      if (line.error) { say(`chaos map: ${line.error}`); return; }
+      studio.chaos = { ...line, ranges, image: chaosImage(line) };
+      $("status").textContent = `FLI ${line.pixels}² in ${line.seconds.toFixed(2)} s, chaotic ${(100 * line.chaotic_fraction).toFixed(1)} %`;
+      redraw();
+    });
+  } catch (e) {
+    if (!aborted(e)) say(`chaos map: ${e.message}`);
+  }
+}
+
+// Waits until the changes stop for `ms` before calling `work`.
+function debounce(work, ms) {
+  let timer = null;
+  return () => { clearTimeout(timer); timer = setTimeout(work, ms); };
+}
+const refreshOverlays = debounce(() => { refreshOverlay(); refreshChaos(); }, 150);
+const rerunOrbits = debounce(() => { for (const orbit of studio.orbits) startOrbit(orbit); listOrbits(); }, 40);
+
+// ---------- the model and its controls ----------
+
+function sliderRange(value) {
+  if (value > 0) return [0, 2.5 * value];
+  if (value < 0) return [2.5 * value, 0];
+  return [0, 1];
+}
+
+function buildParameters(model) {
+  const box = $("params");
+  box.innerHTML = "";
+  for (const p of model.parameters) {
+    const row = document.createElement("div");
+    row.className = "param";
+    row.title = p.description;
+    const [lo, hi] = sliderRange(p.default);
+    row.innerHTML = `<span>${p.symbol}</span><input type="range" id="param-${p.name}" min="${lo}" max="${hi}" step="${(hi - lo) / 500}" value="${p.default}"><input type="number" id="value-${p.name}" step="any" value="${p.default}">`;
+    box.appendChild(row);
+    const slider = row.querySelector("input[type=range]");
+    const number = row.querySelector("input[type=number]");
+    const set = (value) => {
+      if (!Number.isFinite(value)) { say(`${p.name}: not a number`); return; }
+      studio.params[p.name] = value;
+      rerunOrbits();
+      refreshOverlays();
+    };
+    slider.addEventListener("input", () => { number.value = slider.value; set(Number(slider.value)); });
+    number.addEventListener("change", () => { slider.value = number.value; set(Number(number.value)); });
+    studio.params[p.name] = p.default;
+  }
+}
+
+function buildAxes(model) {
+  for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
+    const select = $(id);
+    select.innerHTML = model.state.map((name, i) => `<option value="${i}">${name}</option>`).join("");
+    select.value = String(studio.axes[k]);
+  }
+  $("axes-row").style.display = model.state.length > 2 ? "" : "none";
+}
+
+function defaultView(model) {
+  studio.view = { x: model.default_ranges[0].slice(), y: model.default_ranges[1].slice() };
+}
+
+async function chooseModel(name) {
+  const model = studio.models.find((m) => m.name === name);
+  if (!model) return;
+  removeOrbits(0);
+  studio.ready = false;
+  studio.model = model;
+  studio.params = {};
+  studio.axes = model.default_axes.slice();
+  studio.through = new Array(model.state.length).fill(0);
+  studio.overlay = null;
+  studio.chaos = null;
+  $("model").value = name;
+  $("model-file").textContent = model.source_file;
+  $("levels-of").textContent = model.fast_phase ? "H̄" : "H";
+  $("derivations-model").textContent = name;
+  buildParameters(model);
+  buildAxes(model);
+  defaultView(model);
+  say(model.kind !== "hamiltonian" ? `model '${name}' is a contact model: no phase plane here, its derivations are below`
+    : model.fast_phase ? "" : `model '${name}' has no fast phase: no period map; the level sets of H and the equilibria are shown`);
+  history.replaceState(null, "", `#${name}`);
+  redraw();
+  refreshOverlays();
+  try {
+    const formulas = await getJson(`/api/models/${name}/derivations`);
+    $("formulas").innerHTML = formulas.map((d) =>
+      `<div class="formula"><div class="what">${d.description} <code>${d.key}</code></div>${d.mathml}</div>`).join("");
+  } catch (e) {
+    say(`derivations: ${e.message}`);
+  }
+  studio.ready = true;
+}
+
+// ---------- pointer: click to seed, drag to pan, wheel to zoom ----------
+
+let press = null;
+canvas.addEventListener("mousedown", (e) => {
+  press = { x: e.offsetX, y: e.offsetY, view: { x: studio.view.x.slice(), y: studio.view.y.slice() }, moved: false };
+});
+canvas.addEventListener("mousemove", (e) => {
+  if (studio.model) {
+    const [x, y] = toWorld(e.offsetX, e.offsetY);
+    $("hover").textContent = `${stateName(studio.axes[0])} = ${x.toFixed(4)}, ${stateName(studio.axes[1])} = ${y.toFixed(4)}`;
+  }
+  if (!press) return;
+  const dx = e.offsetX - press.x, dy = e.offsetY - press.y;
+  if (!press.moved && Math.hypot(dx, dy) < 4) return;
+  press.moved = true;
+  const sx = (press.view.x[1] - press.view.x[0]) / canvas.width;
+  const sy = (press.view.y[1] - press.view.y[0]) / canvas.height;
+  studio.view = { x: press.view.x.map((v) => v - dx * sx), y: press.view.y.map((v) => v + dy * sy) };
+  redraw();
+});
+window.addEventListener("mouseup", (e) => {
+  if (!press) return;
+  const wasDrag = press.moved;
+  press = null;
+  if (wasDrag) { refreshOverlays(); return; }
+  if (e.target !== canvas || !studio.model) return;
+  const [x, y] = toWorld(e.offsetX, e.offsetY);
+  seedAt(x, y);
+});
+canvas.addEventListener("wheel", (e) => {
+  e.preventDefault();
+  const [cx, cy] = toWorld(e.offsetX, e.offsetY);
+  const factor = Math.exp(0.0015 * e.deltaY);
+  studio.view = {
+    x: studio.view.x.map((v) => cx + (v - cx) * factor),
+    y: studio.view.y.map((v) => cy + (v - cy) * factor),
+  };
+  redraw();
+  refreshOverlays();
+}, { passive: false });
+
+// ---------- export ----------
+
+function download(name, blob) {
+  const link = document.createElement("a");
+  link.href = URL.createObjectURL(blob);
+  link.download = name;
+  link.click();
+  setTimeout(() => URL.revokeObjectURL(link.href), 1000);
+}
+
+function exportSvg() {
+  const w = canvas.width, h = canvas.height;
+  const parts = [`<svg xmlns="http://www.w3.org/2000/svg" width="${w}" height="${h}" viewBox="0 0 ${w} ${h}"><rect width="${w}" height="${h}" fill="#fff"/>`];
+  if ($("show-chaos").checked && studio.chaos) {
+    const { image, ranges } = studio.chaos;
+    const [x0, y1] = toPixel(ranges[0][0], ranges[1][1]);
+    const [x1, y0] = toPixel(ranges[0][1], ranges[1][0]);
+    parts.push(`<image href="${image.toDataURL()}" x="${x0}" y="${y1}" width="${x1 - x0}" height="${y0 - y1}" opacity="0.85" style="image-rendering:pixelated"/>`);
+  }
+  if (studio.overlay && $("show-levels").checked) {
+    for (const level of studio.overlay.levels) {
+      const d = level.segments.map(([a, b, c, e]) => {
+        const [p, q] = toPixel(a, b), [r, s] = toPixel(c, e);
+        return `M${p.toFixed(1)} ${q.toFixed(1)}L${r.toFixed(1)} ${s.toFixed(1)}`;
+      }).join("");
+      parts.push(`<path d="${d}" stroke="${level.separatrix ? "#c82828" : "#999"}" fill="none"/>`);
+    }
+  }
+  for (const orbit of studio.orbits) {
+    const d = orbit.points.map(([x, y]) => { const [p, q] = toPixel(x, y); return `M${p.toFixed(1)} ${q.toFixed(1)}h0.1`; }).join("");
+    parts.push(`<path d="${d}" stroke="${orbit.color}" stroke-width="1.6" stroke-linecap="round" fill="none"/>`);
+  }
+  parts.push("</svg>");
+  download(`studio_${studio.model.name}.svg`, new Blob(parts, { type: "image/svg+xml" }));
+}
+
+function exportCsv() {
+  const names = studio.axes.map(stateName);
+  const rows = [`orbit,${names[0]},${names[1]},${Object.keys(studio.params).join(",")}`];
+  for (const orbit of studio.orbits) {
+    const values = Object.values(orbit.params).join(",");
+    for (const [x, y] of orbit.points) rows.push(`${orbit.id},${x},${y},${values}`);
+  }
+  download(`studio_${studio.model.name}.csv`, new Blob([rows.join("\n") + "\n"], { type: "text/csv" }));
+}
+
+// ---------- wiring ----------
+
+function wire() {
+  $("model").addEventListener("change", () => chooseModel($("model").value));
+  $("undo").addEventListener("click", () => removeOrbits(studio.orbits.length - 1));
+  $("clear").addEventListener("click", () => removeOrbits(0));
+  $("reset-view").addEventListener("click", () => { defaultView(studio.model); redraw(); refreshOverlays(); });
+  for (const id of ["method", "tol"]) $(id).addEventListener("change", () => { rerunOrbits(); refreshOverlays(); });
+  for (const id of ["show-levels", "show-equilibria"]) $(id).addEventListener("change", () => { refreshOverlay(); redraw(); });
+  for (const id of ["show-chaos", "chaos-periods"]) $(id).addEventListener("change", refreshChaos);
+  for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
+    $(id).addEventListener("change", () => {
+      const axes = studio.axes.slice();
+      axes[k] = Number($(id).value);
+      if (axes[0] === axes[1]) { say("the two axes must differ"); $(id).value = String(studio.axes[k]); return; }
+      studio.axes = axes;
+      const periodic = axes.map((a) => studio.model.periodic[a]);
+      studio.view = { x: periodic[0] ? [-Math.PI, Math.PI] : [-3, 3], y: periodic[1] ? [-Math.PI, Math.PI] : [-3, 3] };
+      removeOrbits(0);
+      refreshOverlays();
+    });
+  }
+  $("export-png").addEventListener("click", () => canvas.toBlob((blob) => download(`studio_${studio.model.name}.png`, blob)));
+  $("export-svg").addEventListener("click", exportSvg);
+  $("export-csv").addEventListener("click", exportCsv);
+  // Points per second, for the status line.
+  let last = 0;
+  setInterval(() => {
+    const rate = studio.pointsReceived - last;
+    last = studio.pointsReceived;
+    if (rate > 0) $("status").textContent = `${rate} points/s`;
+    if (studio.orbits.some((o) => !o.done)) listOrbits();
+  }, 1000);
+}
+
+async function start() {
+  wire();
+  requestAnimationFrame(frame);
+  try {
+    studio.models = await getJson("/api/models");
+  } catch (e) {
+    say(`cannot list the models: ${e.message}`);
+    return;
+  }
+  $("model").innerHTML = studio.models.map((m) => `<option value="${m.name}">${m.name}</option>`).join("");
+  const wanted = location.hash.slice(1);
+  const first = studio.models.find((m) => m.name === wanted) || studio.models.find((m) => m.name === "kapitza") || studio.models[0];
+  await chooseModel(first.name);
+}
+
+start();

@@ -1,0 +1,237 @@
+//! The studio's HTTP server (axum): one static page with its script and
+//! style (served from the binary: no network, no CDN) and a JSON API.
+//!
+//! | route | answer |
+//! |---|---|
+//! | `GET /api/models` | every model with its parameters ([`super::models`]) |
+//! | `GET /api/models/{name}/derivations` | its derivations as MathML |
+//! | `POST /api/orbit` | an orbit of the period map, streamed as NDJSON lines |
+//! | `POST /api/chaos` | the FLI map of a view at growing resolutions, NDJSON |
+//! | `POST /api/overlay` | level sets of H̄ and the equilibria, JSON |
+//!
+//! The numerics run on blocking threads; a streamed answer stops computing
+//! when the page drops it (a superseded request). Every error is a JSON
+//! `{"error": …}` with a 4xx status, or an `{"error": …}` line ending a
+//! stream; a panic in one request is caught and reported, and the server
+//! goes on.
+
+use super::{ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
+use axum::body::{Body, Bytes};
+use axum::extract::Path;
+use axum::http::{header, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::Router;
+use serde::Serialize;
+use std::net::SocketAddr;
+
+const PAGE: &str = include_str!("page/index.html");
+const SCRIPT: &str = include_str!("page/studio.js");
+const STYLE: &str = include_str!("page/studio.css");
+
+/// Why the studio cannot serve.
+#[derive(Debug, thiserror::Error)]
+pub enum ServeError {
+    #[error("cannot listen on {addr}: {source}")]
+    Bind {
+        addr: SocketAddr,
+        source: std::io::Error,
+    },
+    #[error("the server stopped: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Why one request failed: a 4xx or 5xx answer with `{"error": message}`.
+#[derive(Debug, thiserror::Error)]
+pub enum ApiError {
+    #[error(transparent)]
+    Studio(#[from] StudioError),
+    #[error("the request is not valid JSON for this route: {0}")]
+    Json(#[from] serde_json::Error),
+    #[error("no route {0}")]
+    NotFound(String),
+    #[error("internal error (the server goes on): {0}")]
+    Internal(String),
+}
+
+impl ApiError {
+    fn status(&self) -> StatusCode {
+        match self {
+            ApiError::Studio(StudioError::UnknownModel { .. }) | ApiError::NotFound(_) => {
+                StatusCode::NOT_FOUND
+            }
+            ApiError::Studio(StudioError::ContactModel(_) | StudioError::NoFastPhase(_)) => {
+                StatusCode::UNPROCESSABLE_ENTITY
+            }
+            ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
+            ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct ErrorBody {
+    error: String,
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let body = ErrorBody {
+            error: self.to_string(),
+        };
+        (self.status(), axum::Json(body)).into_response()
+    }
+}
+
+/// The studio's routes.
+pub fn router() -> Router {
+    Router::new()
+        .route(
+            "/",
+            get(|| async { asset("text/html; charset=utf-8", PAGE) }),
+        )
+        .route(
+            "/studio.js",
+            get(|| async { asset("text/javascript; charset=utf-8", SCRIPT) }),
+        )
+        .route(
+            "/studio.css",
+            get(|| async { asset("text/css; charset=utf-8", STYLE) }),
+        )
+        .route("/api/models", get(|| async { axum::Json(super::models()) }))
+        .route("/api/models/{name}/derivations", get(derivations))
+        .route("/api/orbit", post(orbit))
+        .route("/api/chaos", post(chaos))
+        .route("/api/overlay", post(overlay))
+        .fallback(|uri: axum::http::Uri| async move { ApiError::NotFound(uri.to_string()) })
+}
+
+fn asset(content_type: &'static str, text: &'static str) -> Response {
+    ([(header::CONTENT_TYPE, content_type)], text).into_response()
+}
+
+/// Serves the studio on 127.0.0.1:`port` (0: any free port) until Ctrl-C,
+/// printing its address once listening.
+pub fn run(port: u16) -> Result<(), ServeError> {
+    let runtime = tokio::runtime::Runtime::new()?;
+    runtime.block_on(async {
+        let addr = SocketAddr::from(([127, 0, 0, 1], port));
+        let listener = tokio::net::TcpListener::bind(addr)
+            .await
+            .map_err(|source| ServeError::Bind { addr, source })?;
+        println!(
+            "studio: http://{}/  (Ctrl-C stops it)",
+            listener.local_addr()?
+        );
+        axum::serve(listener, router())
+            .with_graceful_shutdown(async {
+                // Without a signal handler the server runs until killed.
+                let _ = tokio::signal::ctrl_c().await;
+            })
+            .await?;
+        Ok(())
+    })
+}
+
+async fn derivations(Path(name): Path<String>) -> Result<Response, ApiError> {
+    Ok(axum::Json(super::derivations(&name)?).into_response())
+}
+
+async fn overlay(body: Bytes) -> Result<Response, ApiError> {
+    let request: OverlayRequest = serde_json::from_slice(&body)?;
+    let answer = blocking(move || super::overlay(&request).map_err(ApiError::from)).await?;
+    Ok(axum::Json(answer).into_response())
+}
+
+async fn orbit(body: Bytes) -> Result<Response, ApiError> {
+    let request: OrbitRequest = serde_json::from_slice(&body)?;
+    request.check()?;
+    Ok(stream(move |send| {
+        let end = super::orbit(&request, &mut |chunk| send(&chunk))?;
+        send(&Ended { end });
+        Ok(())
+    }))
+}
+
+async fn chaos(body: Bytes) -> Result<Response, ApiError> {
+    let request: ChaosRequest = serde_json::from_slice(&body)?;
+    request.check()?;
+    Ok(stream(move |send| {
+        super::chaos(&request, &mut |level| send(&level))
+    }))
+}
+
+#[derive(Serialize)]
+struct Ended {
+    end: super::OrbitEnd,
+}
+
+/// Runs `work` on a blocking thread, catching a panic as an internal error.
+async fn blocking<R: Send + 'static>(
+    work: impl FnOnce() -> Result<R, ApiError> + Send + 'static,
+) -> Result<R, ApiError> {
+    tokio::task::spawn_blocking(move || {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
+            .unwrap_or_else(|panic| Err(ApiError::Internal(panic_text(&panic))))
+    })
+    .await
+    .map_err(|e| ApiError::Internal(e.to_string()))?
+}
+
+fn panic_text(panic: &Box<dyn std::any::Any + Send>) -> String {
+    panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".into())
+}
+
+/// An NDJSON answer: `work` runs on a blocking thread and sends lines with
+/// `send`, which returns false once the page has dropped the answer (then
+/// `work` should stop). An error or a panic ends the stream with an
+/// `{"error": …}` line.
+fn stream(
+    work: impl FnOnce(&mut dyn FnMut(&dyn erased::Line) -> bool) -> Result<(), StudioError>
+        + Send
+        + 'static,
+) -> Response {
+    let (tx, rx) = tokio::sync::mpsc::channel::<Bytes>(8);
+    tokio::task::spawn_blocking(move || {
+        let mut send = |line: &dyn erased::Line| tx.blocking_send(line.ndjson()).is_ok();
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&mut send)));
+        let error = match outcome {
+            Ok(Ok(())) => return,
+            Ok(Err(e)) => ApiError::Studio(e),
+            Err(panic) => ApiError::Internal(panic_text(&panic)),
+        };
+        send(&ErrorBody {
+            error: error.to_string(),
+        });
+    });
+    let lines = futures_util::stream::unfold(rx, |mut rx| async move {
+        rx.recv()
+            .await
+            .map(|line| (Ok::<_, std::convert::Infallible>(line), rx))
+    });
+    (
+        [(header::CONTENT_TYPE, "application/x-ndjson")],
+        Body::from_stream(lines),
+    )
+        .into_response()
+}
+
+mod erased {
+    /// A value sent as one NDJSON line (object-safe `Serialize`).
+    pub trait Line {
+        fn ndjson(&self) -> axum::body::Bytes;
+    }
+    impl<T: serde::Serialize> Line for T {
+        fn ndjson(&self) -> axum::body::Bytes {
+            let mut bytes = serde_json::to_vec(self).unwrap_or_else(|e| {
+                format!("{{\"error\":\"cannot encode an answer: {e}\"}}").into_bytes()
+            });
+            bytes.push(b'\n');
+            bytes.into()
+        }
+    }
+}
