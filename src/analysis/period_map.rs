@@ -6,6 +6,10 @@ use std::f64::consts::PI;
 
 /// Wraps an angle into [−π, π).
 pub fn wrap_angle(x: f64) -> f64 {
+    // Already in range: unchanged (the shift by π would round it).
+    if (-PI..PI).contains(&x) {
+        return x;
+    }
     let two_pi = std::f64::consts::TAU;
     let w = (x + std::f64::consts::PI).rem_euclid(two_pi) - std::f64::consts::PI;
     // rem_euclid can return two_pi for tiny negative inputs.

@@ -57,6 +57,8 @@ pub enum RequestProblem {
     SeedLength { got: usize, expected: usize },
     #[error("the state to pass through has {got} components; the state [q; p] has {expected}")]
     ThroughLength { got: usize, expected: usize },
+    #[error("the request has a field '{0}' that this route does not know")]
+    UnknownField(String),
     #[error("{what} must be finite")]
     NotFinite { what: &'static str },
     #[error("the axes must be two different state components among 0..{components}")]
@@ -222,7 +224,6 @@ fn default_tol() -> f64 {
 /// What every request names: the model, its parameters (the model file's
 /// values where not given), the method and the plane drawn.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct Setup {
     pub model: String,
     #[serde(default)]
@@ -253,8 +254,19 @@ pub struct Resolved {
 }
 
 impl Setup {
-    pub fn resolve(&self) -> Result<Resolved, StudioError> {
+    /// The setup checked against its model; `unknown` are the request's
+    /// fields that no route knows.
+    pub fn resolve(
+        &self,
+        unknown: &BTreeMap<String, serde_json::Value>,
+    ) -> Result<Resolved, StudioError> {
         let (info, model) = find_dynamic(&self.model)?;
+        if let Some(field) = unknown.keys().next() {
+            return Err(StudioError::BadRequest {
+                model: info.name.into(),
+                problem: RequestProblem::UnknownField(field.clone()),
+            });
+        }
         let bad = |problem| StudioError::BadRequest {
             model: info.name.into(),
             problem,
@@ -357,13 +369,16 @@ pub struct OrbitRequest {
     pub setup: Setup,
     pub seed: Vec<f64>,
     pub periods: usize,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
 }
 
 impl OrbitRequest {
     /// The request checked: its model has a period map, the seed is a
     /// finite state of the right size, the periods are within bounds.
     pub fn check(&self) -> Result<Resolved, StudioError> {
-        let setup = self.setup.resolve()?;
+        let setup = self.setup.resolve(&self.unknown)?;
         setup.needs_period_map()?;
         setup.count("periods", self.periods, MAX_PERIODS)?;
         if self.seed.len() != 2 * setup.dof {
@@ -498,12 +513,15 @@ pub struct ChaosRequest {
     /// Pixels per side of each refinement, in order.
     pub levels: Vec<usize>,
     pub periods: usize,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
 }
 
 impl ChaosRequest {
     /// The request checked, with the view's ranges.
     pub fn check(&self) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
-        let setup = self.setup.resolve()?;
+        let setup = self.setup.resolve(&self.unknown)?;
         setup.needs_period_map()?;
         let ranges = setup.ranges(&self.ranges)?;
         setup.count("periods", self.periods, MAX_CHAOS_PERIODS)?;
@@ -580,6 +598,9 @@ pub struct OverlayRequest {
     pub grid: usize,
     /// Number of level sets (besides those through unstable equilibria).
     pub levels: usize,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
 }
 
 /// One level set, as segments (x₀, y₀, x₁, y₁) on the page's axes.
@@ -613,7 +634,7 @@ pub struct Overlay {
 
 /// The level sets and equilibria of a view.
 pub fn overlay(request: &OverlayRequest) -> Result<Overlay, StudioError> {
-    let setup = request.setup.resolve()?;
+    let setup = request.setup.resolve(&request.unknown)?;
     let ranges = setup.ranges(&request.ranges)?;
     let grid = setup.count("grid points per side", request.grid, MAX_GRID)?;
     let count = setup.count("level sets", request.levels, 100)?;

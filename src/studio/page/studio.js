@@ -93,6 +93,9 @@ function toPixel(wx, wy) {
   return [((wx - x[0]) / (x[1] - x[0])) * canvas.width, ((y[1] - wy) / (y[1] - y[0])) * canvas.height];
 }
 const stateName = (k) => studio.model.state[k];
+// For the browser test: where a point is drawn, and the colour there.
+studio.pixelOf = (x, y) => toPixel(x, y);
+studio.colorAt = (px, py) => Array.from(ctx.getImageData(Math.round(px), Math.round(py), 1, 1).data);
 
 // ---------- drawing ----------
 

@@ -1,0 +1,564 @@
+//! The studio: its HTTP API answers what the library computes for the same
+//! settings, bad requests get errors that name the problem, and (ignored
+//! unless asked for, as it needs Chromium) a real browser seeds orbits by
+//! clicks and sweeps a parameter.
+//!
+//! `cargo test --release --test studio -- --ignored browser` runs the
+//! browser test (needs `apt-get install chromium chromium-driver`).
+
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use http_body_util::BodyExt;
+use mechlab::analysis::chaos_map::{chaos_map, ChaosMapSettings};
+use mechlab::analysis::period_map::{orbit, period_map, wrap_angle};
+use mechlab::models::kapitza;
+use mechlab::ode::{Integrator, Method};
+use mechlab::registry::Fixed;
+use mechlab::studio::server::router;
+use serde_json::{json, Value};
+use tower::ServiceExt;
+
+/// Sends one request to the router; the status and the body's text.
+async fn call(method: &str, uri: &str, body: Option<Value>) -> (StatusCode, String, String) {
+    let request = Request::builder()
+        .method(method)
+        .uri(uri)
+        .header("content-type", "application/json")
+        .body(body.map_or_else(Body::empty, |b| Body::from(b.to_string())))
+        .unwrap();
+    let response = router().oneshot(request).await.unwrap();
+    let status = response.status();
+    let content_type = response
+        .headers()
+        .get("content-type")
+        .map(|v| v.to_str().unwrap().to_string())
+        .unwrap_or_default();
+    let bytes = response.into_body().collect().await.unwrap().to_bytes();
+    (
+        status,
+        content_type,
+        String::from_utf8(bytes.to_vec()).unwrap(),
+    )
+}
+
+fn lines(text: &str) -> Vec<Value> {
+    text.lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// Kapitza's period map from the library: its exact system at `params`
+/// (A, ε, μ) and the forcing period.
+fn kapitza_map(params: [f64; 3]) -> (kapitza::Exact, f64) {
+    let model = &kapitza::FIXED;
+    (model.exact(&params), model.phase_period(&params).unwrap())
+}
+
+#[tokio::test]
+async fn models_and_page_are_served() {
+    let (status, kind, body) = call("GET", "/api/models", None).await;
+    assert_eq!(status, StatusCode::OK);
+    assert!(kind.starts_with("application/json"));
+    let models: Value = serde_json::from_str(&body).unwrap();
+    let names: Vec<&str> = models
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    let expected: Vec<&str> = mechlab::models::ALL.iter().map(|m| m.name).collect();
+    assert_eq!(names, expected);
+    let k = &models[names.iter().position(|n| *n == "kapitza").unwrap()];
+    let defaults: Vec<(String, f64)> = k["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            (
+                p["name"].as_str().unwrap().to_string(),
+                p["default"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        defaults,
+        [
+            ("A".to_string(), 1.5),
+            ("eps".into(), 0.1),
+            ("mu".into(), 0.0)
+        ]
+    );
+    assert_eq!(k["periodic"], json!([true, false]));
+
+    let (status, kind, page) = call("GET", "/", None).await;
+    assert_eq!(status, StatusCode::OK);
+    assert!(kind.starts_with("text/html"));
+    assert!(page.contains("<canvas id=\"plane\"") && page.contains("/studio.js"));
+    // No network: nothing is loaded from another host.
+    assert!(!page.contains("http://") && !page.contains("https://"));
+    let (_, kind, script) = call("GET", "/studio.js", None).await;
+    assert!(kind.starts_with("text/javascript") && script.contains("/api/orbit"));
+
+    let (status, _, body) = call("GET", "/api/models/kapitza/derivations", None).await;
+    assert_eq!(status, StatusCode::OK);
+    let derivations: Value = serde_json::from_str(&body).unwrap();
+    let hamiltonian = derivations
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|d| d["key"] == "hamiltonian")
+        .unwrap();
+    assert!(hamiltonian["mathml"].as_str().unwrap().starts_with("<math"));
+}
+
+/// The streamed orbit is the library's orbit of the period map, number for
+/// number, angles wrapped into [−π, π).
+#[tokio::test]
+async fn orbit_equals_the_library_period_map() {
+    let request = json!({"model": "kapitza", "params": {"A": 1.2}, "method": "taylor", "tol": 1e-10,
+        "seed": [2.5, 0.4], "periods": 300});
+    let (status, kind, body) = call("POST", "/api/orbit", Some(request)).await;
+    assert_eq!(status, StatusCode::OK);
+    assert_eq!(kind, "application/x-ndjson");
+    let lines = lines(&body);
+    let points: Vec<[f64; 2]> = lines
+        .iter()
+        .filter_map(|l| l.get("points"))
+        .flat_map(|p| serde_json::from_value::<Vec<[f64; 2]>>(p.clone()).unwrap())
+        .collect();
+    let end = &lines.last().unwrap()["end"];
+    assert_eq!(end["periods"], 300);
+    assert_eq!(end["cancelled"], false);
+
+    let (system, period) = kapitza_map([1.2, 0.1, 0.0]);
+    let mut integrator = Integrator::new(Method::Taylor { tol: 1e-10 }).unwrap();
+    let expected = orbit(
+        &mut integrator,
+        &system,
+        period,
+        &[2.5, 0.4],
+        300,
+        &[true, false],
+    )
+    .unwrap();
+    assert_eq!(points.len(), 301);
+    for (k, (got, want)) in points.iter().zip(&expected).enumerate() {
+        assert_eq!(got, want, "point {k}");
+    }
+    assert_eq!(end["f_evals"], integrator.stats.f_evals);
+}
+
+/// Each refinement of the streamed chaos map is the library's map of the
+/// same view, pixel for pixel.
+#[tokio::test]
+async fn chaos_levels_equal_the_library_map() {
+    let ranges = [[-3.0, 3.0], [-2.0, 2.5]];
+    let request = json!({"model": "kapitza", "params": {"A": 1.0}, "tol": 1e-8, "ranges": ranges,
+        "levels": [4, 9], "periods": 40});
+    let (status, _, body) = call("POST", "/api/chaos", Some(request)).await;
+    assert_eq!(status, StatusCode::OK);
+    let levels = lines(&body);
+    assert_eq!(levels.len(), 2);
+    for level in &levels {
+        let pixels = level["pixels"].as_u64().unwrap() as usize;
+        let settings = ChaosMapSettings {
+            axes: [0, 1],
+            ranges: ranges.map(|r| Some((r[0], r[1]))),
+            p_max: 1.0,
+            through: Some(vec![0.0, 0.0]),
+            pixels,
+            periods: 40,
+            method: Method::Taylor { tol: 1e-8 },
+            tiles: None,
+        };
+        let map = chaos_map("kapitza", &[1.0, 0.1, 0.0], &settings, &|| {}).unwrap();
+        let fli: Vec<Option<f64>> = serde_json::from_value(level["fli"].clone()).unwrap();
+        let expected: Vec<Option<f64>> = map
+            .fli
+            .iter()
+            .map(|v| v.is_finite().then_some(*v))
+            .collect();
+        assert_eq!(fli, expected, "{pixels}² pixels");
+        assert_eq!(level["regular_level"].as_f64().unwrap(), 40f64.ln());
+    }
+}
+
+/// Kapitza's averaged Hamiltonian H̄ = p²/2 + cos q + A² sin² q / 4 (q from
+/// the upward vertical): its unstable equilibria sit at cos q = 2/A², the
+/// separatrices are the level H̄(q*, 0), and every drawn segment end lies
+/// on its level set.
+#[tokio::test]
+async fn overlay_matches_the_averaged_hamiltonian_by_hand() {
+    let a: f64 = 1.8;
+    let request = json!({"model": "kapitza", "params": {"A": a}, "ranges": [[-3.14159, 3.14159], [-3, 3]],
+        "grid": 200, "levels": 10});
+    let (status, _, body) = call("POST", "/api/overlay", Some(request)).await;
+    assert_eq!(status, StatusCode::OK);
+    let overlay: Value = serde_json::from_str(&body).unwrap();
+    let h_bar = |q: f64, p: f64| p * p / 2.0 + q.cos() + a * a * q.sin().powi(2) / 4.0;
+    let q_star = (2.0 / (a * a)).acos();
+    let mut unstable: Vec<f64> = Vec::new();
+    let mut stable: Vec<f64> = Vec::new();
+    for e in overlay["equilibria"].as_array().unwrap() {
+        let q = wrap_angle(e["q"][0].as_f64().unwrap());
+        if e["stable"].as_bool().unwrap() {
+            stable.push(q);
+        } else {
+            unstable.push(q);
+        }
+    }
+    unstable.sort_by(f64::total_cmp);
+    stable.sort_by(f64::total_cmp);
+    assert_eq!(unstable.len(), 2, "{unstable:?}");
+    assert!(
+        (unstable[0] + q_star).abs() < 1e-8 && (unstable[1] - q_star).abs() < 1e-8,
+        "{unstable:?} against ±{q_star}"
+    );
+    // Upright (A > √2) and hanging.
+    assert!(
+        stable.iter().any(|q| q.abs() < 1e-8)
+            && stable
+                .iter()
+                .any(|q| (q.abs() - std::f64::consts::PI).abs() < 1e-8),
+        "{stable:?}"
+    );
+    let separatrix_level = h_bar(q_star, 0.0);
+    let mut separatrices = 0;
+    for level in overlay["levels"].as_array().unwrap() {
+        let value = level["value"].as_f64().unwrap();
+        if level["separatrix"].as_bool().unwrap() {
+            separatrices += 1;
+            assert!((value - separatrix_level).abs() < 1e-12);
+        }
+        for s in level["segments"].as_array().unwrap() {
+            let s: [f64; 4] = serde_json::from_value(s.clone()).unwrap();
+            for (q, p) in [(s[0], s[1]), (s[2], s[3])] {
+                // Linear interpolation on a grid of spacing h: error O(h²).
+                assert!(
+                    (h_bar(q, p) - value).abs() < 2e-3,
+                    "H̄({q}, {p}) = {} on level {value}",
+                    h_bar(q, p)
+                );
+            }
+        }
+    }
+    assert_eq!(separatrices, 2);
+}
+
+/// Every bad request gets a status and a message naming the problem; the
+/// router keeps answering.
+#[tokio::test]
+async fn bad_requests_are_named_errors() {
+    let orbit = |extra: Value| {
+        let mut request = json!({"model": "kapitza", "seed": [0.1, 0.0], "periods": 10});
+        for (k, v) in extra.as_object().unwrap() {
+            request[k] = v.clone();
+        }
+        request
+    };
+    let cases = [
+        (
+            orbit(json!({"model": "no_such_model"})),
+            StatusCode::NOT_FOUND,
+            "no model 'no_such_model'",
+        ),
+        (
+            orbit(json!({"params": {"B": 1.0}})),
+            StatusCode::BAD_REQUEST,
+            "no parameter 'B'",
+        ),
+        (
+            orbit(json!({"tol": 0.0})),
+            StatusCode::BAD_REQUEST,
+            "tolerance",
+        ),
+        (
+            orbit(json!({"method": "euler"})),
+            StatusCode::BAD_REQUEST,
+            "euler",
+        ),
+        (
+            orbit(json!({"seed": [0.1]})),
+            StatusCode::BAD_REQUEST,
+            "the seed has 1 components",
+        ),
+        (
+            orbit(json!({"periods": 0})),
+            StatusCode::BAD_REQUEST,
+            "periods must be between 1",
+        ),
+        (
+            orbit(json!({"periods": 10_000_000})),
+            StatusCode::BAD_REQUEST,
+            "periods must be between 1",
+        ),
+        (
+            orbit(json!({"axes": [1, 1]})),
+            StatusCode::BAD_REQUEST,
+            "axes",
+        ),
+        (
+            orbit(json!({"model": "painleve_klein"})),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "contact model",
+        ),
+        (
+            orbit(json!({"surprise": 1})),
+            StatusCode::BAD_REQUEST,
+            "surprise",
+        ),
+    ];
+    for (request, status, message) in cases {
+        let (got, kind, body) = call("POST", "/api/orbit", Some(request.clone())).await;
+        assert_eq!(got, status, "{request}: {body}");
+        assert!(kind.starts_with("application/json"));
+        let error: Value = serde_json::from_str(&body).unwrap();
+        assert!(
+            error["error"].as_str().unwrap().contains(message),
+            "{request}: {body}"
+        );
+    }
+    let raw = Request::builder()
+        .method("POST")
+        .uri("/api/orbit")
+        .body(Body::from("{\"model\":"))
+        .unwrap();
+    let response = router().oneshot(raw).await.unwrap();
+    assert_eq!(response.status(), StatusCode::BAD_REQUEST);
+    let chaos = json!({"model": "kapitza", "ranges": [[1.0, -1.0], [0.0, 1.0]], "levels": [8], "periods": 10});
+    let (status, _, body) = call("POST", "/api/chaos", Some(chaos)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(body.contains("range of axis 0"), "{body}");
+    let (status, _, body) = call("GET", "/api/nothing", None).await;
+    assert_eq!(status, StatusCode::NOT_FOUND);
+    assert!(body.contains("/api/nothing"));
+}
+
+/// An orbit whose listener goes away stops at once and says so; the points
+/// it handed over are the library's.
+#[test]
+fn a_dropped_orbit_stops() {
+    let request: mechlab::studio::OrbitRequest =
+        serde_json::from_value(json!({"model": "kapitza", "seed": [1.0, 0.5], "periods": 100_000}))
+            .unwrap();
+    let mut received = Vec::new();
+    let end = mechlab::studio::orbit(&request, &mut |chunk| {
+        received.extend(chunk.points);
+        false
+    })
+    .unwrap();
+    assert!(end.cancelled);
+    assert!(
+        end.periods < 100_000 && end.periods + 1 == received.len(),
+        "{end:?}, {} points",
+        received.len()
+    );
+    let (system, period) = kapitza_map([1.5, 0.1, 0.0]);
+    let mut integrator = Integrator::new(Method::Taylor { tol: 1e-10 }).unwrap();
+    let second = period_map(&mut integrator, &system, period, &[1.0, 0.5]).unwrap();
+    assert_eq!(received[1], [wrap_angle(second[0]), second[1]]);
+}
+
+mod browser {
+    //! The end-to-end test in Debian's Chromium over WebDriver (chromedriver).
+
+    use super::*;
+    use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
+    use fantoccini::{Client, ClientBuilder, Locator};
+    use std::process::{Child, Command};
+    use std::time::{Duration, Instant};
+
+    /// chromedriver, killed when the test ends (even by a failed assertion).
+    struct Driver(Child);
+    impl Drop for Driver {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+
+    fn free_port() -> u16 {
+        std::net::TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap()
+            .port()
+    }
+
+    async fn connect(port: u16) -> Client {
+        let mut capabilities = serde_json::Map::new();
+        capabilities.insert(
+            "goog:chromeOptions".into(),
+            json!({"binary": std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into()),
+                   "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1400,1000"]}),
+        );
+        let started = Instant::now();
+        loop {
+            let attempt =
+                ClientBuilder::new(hyper_util::client::legacy::connect::HttpConnector::new())
+                    .capabilities(capabilities.clone())
+                    .connect(&format!("http://127.0.0.1:{port}"))
+                    .await;
+            match attempt {
+                Ok(client) => return client,
+                Err(e) if started.elapsed() > Duration::from_secs(30) => {
+                    panic!("chromedriver: {e}")
+                }
+                Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
+            }
+        }
+    }
+
+    /// Evaluates `expression` in the page until it is true (or fails after
+    /// `seconds`).
+    async fn wait_for(client: &Client, expression: &str, seconds: u64) {
+        let started = Instant::now();
+        loop {
+            let value = client
+                .execute(&format!("return !!({expression});"), vec![])
+                .await
+                .unwrap();
+            if value == Value::Bool(true) {
+                return;
+            }
+            assert!(
+                started.elapsed() < Duration::from_secs(seconds),
+                "timed out waiting for {expression}"
+            );
+            tokio::time::sleep(Duration::from_millis(100)).await;
+        }
+    }
+
+    async fn click_at(client: &Client, element: &fantoccini::elements::Element, x: f64, y: f64) {
+        let mouse = MouseActions::new("mouse".into())
+            .then(PointerAction::MoveToElement {
+                element: element.clone(),
+                duration: None,
+                x,
+                y,
+            })
+            .then(PointerAction::Down {
+                button: MOUSE_BUTTON_LEFT,
+            })
+            .then(PointerAction::Up {
+                button: MOUSE_BUTTON_LEFT,
+            });
+        client.perform_actions(mouse).await.unwrap();
+    }
+
+    /// Seeds, counts, second points (the first iterate) and parameters of
+    /// the page's orbits.
+    async fn orbits(client: &Client) -> Vec<Value> {
+        let script = "return studio.orbits.map(o => ({seed: o.seed, count: o.points.length, first: o.points[0], \
+                      second: o.points[1], error: o.error, params: o.params, \
+                      color: studio.colorAt(...studio.pixelOf(...o.points[Math.min(10, o.points.length - 1)]))}));";
+        client
+            .execute(script, vec![])
+            .await
+            .unwrap()
+            .as_array()
+            .unwrap()
+            .clone()
+    }
+
+    /// Each orbit's second point is the library's period map of its seed at
+    /// the page's parameters, and the orbit is drawn on the canvas.
+    fn check_against_library(orbits: &[Value], periods: usize) {
+        for o in orbits {
+            assert!(o["error"].is_null(), "{o}");
+            assert_eq!(o["count"].as_u64().unwrap() as usize, periods + 1, "{o}");
+            let seed: [f64; 2] = serde_json::from_value(o["seed"].clone()).unwrap();
+            let params = ["A", "eps", "mu"].map(|k| o["params"][k].as_f64().unwrap());
+            let (system, period) = kapitza_map(params);
+            let mut integrator = Integrator::new(Method::Taylor { tol: 1e-10 }).unwrap();
+            let y1 = period_map(&mut integrator, &system, period, &seed).unwrap();
+            let first: [f64; 2] = serde_json::from_value(o["first"].clone()).unwrap();
+            let second: [f64; 2] = serde_json::from_value(o["second"].clone()).unwrap();
+            assert_eq!(first, [wrap_angle(seed[0]), seed[1]], "{o}");
+            assert_eq!(second, [wrap_angle(y1[0]), y1[1]], "{o}");
+            let color: Vec<u8> = serde_json::from_value(o["color"].clone()).unwrap();
+            assert_ne!(
+                &color[..3],
+                &[255, 255, 255],
+                "orbit not drawn at its 10th point: {o}"
+            );
+        }
+    }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    #[ignore = "needs Chromium and chromedriver (apt-get install chromium chromium-driver)"]
+    async fn browser_seeds_orbits_and_sweeps_a_parameter() {
+        let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+        let studio = format!("http://{}/", listener.local_addr().unwrap());
+        tokio::spawn(async move { axum::serve(listener, router()).await.unwrap() });
+        let port = free_port();
+        let driver =
+            std::env::var("CHROMEDRIVER").unwrap_or_else(|_| "/usr/bin/chromedriver".into());
+        let _driver = Driver(
+            Command::new(&driver)
+                .arg(format!("--port={port}"))
+                .spawn()
+                .unwrap_or_else(|e| panic!("{driver}: {e}")),
+        );
+        let client = connect(port).await;
+
+        client.goto(&studio).await.unwrap();
+        wait_for(&client, "window.studio && studio.ready", 30).await;
+        client
+            .find(Locator::Id("model"))
+            .await
+            .unwrap()
+            .select_by_value("kapitza")
+            .await
+            .unwrap();
+        wait_for(
+            &client,
+            "studio.ready && studio.model.name === 'kapitza'",
+            30,
+        )
+        .await;
+        let periods = client.find(Locator::Id("periods")).await.unwrap();
+        periods.clear().await.unwrap();
+        periods.send_keys("400").await.unwrap();
+
+        let canvas = client.find(Locator::Id("plane")).await.unwrap();
+        for (x, y) in [(-250.0, 60.0), (120.0, -140.0), (300.0, 200.0)] {
+            click_at(&client, &canvas, x, y).await;
+        }
+        wait_for(
+            &client,
+            "studio.orbits.length === 3 && studio.orbits.every(o => o.done)",
+            60,
+        )
+        .await;
+        // One more frame for the last points to be painted.
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        let before = orbits(&client).await;
+        assert_eq!(before.len(), 3);
+        check_against_library(&before, 400);
+        let seeds: Vec<&Value> = before.iter().map(|o| &o["seed"]).collect();
+        assert!(
+            seeds[0] != seeds[1] && seeds[1] != seeds[2],
+            "three different clicks: {seeds:?}"
+        );
+
+        // Move the A slider: every orbit is redrawn for the new value.
+        let slider = client.find(Locator::Id("param-A")).await.unwrap();
+        click_at(&client, &slider, 30.0, 0.0).await;
+        wait_for(&client, "studio.params.A !== 1.5 && studio.orbits.every(o => o.done && o.params.A === studio.params.A)", 60).await;
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        let after = orbits(&client).await;
+        check_against_library(&after, 400);
+        for (b, a) in before.iter().zip(&after) {
+            assert_eq!(b["seed"], a["seed"]);
+            assert_ne!(b["second"], a["second"], "A moved, the orbit did not");
+        }
+
+        let png = client.screenshot().await.unwrap();
+        let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("studio");
+        std::fs::create_dir_all(&folder).unwrap();
+        std::fs::write(folder.join("browser.png"), png).unwrap();
+        eprintln!("screenshot: {}", folder.join("browser.png").display());
+        client.close().await.unwrap();
+    }
+}
