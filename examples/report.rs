@@ -73,21 +73,7 @@ fn main() {
                 }
             }
         }
-        let derivations: Vec<(&str, &str, &str)> = mechlab::models::ALL
-            .iter()
-            .flat_map(|m| m.derivations.iter().map(move |d| (m.name, d.key, d.latex)))
-            .filter(|(_, key, _)| {
-                [
-                    "hamiltonian",
-                    "averaged_hamiltonian",
-                    "vibrational_potential",
-                    "free_force[0]",
-                    "normal_force[0]",
-                ]
-                .contains(key)
-            })
-            .collect();
-        let html = index_html(&root, &derivations);
+        let html = index_html(&root);
         let missing: Vec<String> = links(&html)
             .into_iter()
             .filter(|l| !l.starts_with('#') && !root.join(l).exists())

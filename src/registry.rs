@@ -110,6 +110,10 @@ pub trait DynamicModel: Sync {
     fn averaged_energy(&self, _params: &[f64], _y: &[f64]) -> Option<f64> {
         None
     }
+    /// The Hamiltonian averaged to second order in ε = 1/rate, where derived.
+    fn averaged2_energy(&self, _params: &[f64], _y: &[f64]) -> Option<f64> {
+        None
+    }
     /// V + V_vibr (V without a fast phase).
     fn effective_potential(&self, _params: &[f64], _q: &[f64]) -> Option<f64> {
         None

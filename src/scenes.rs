@@ -158,8 +158,12 @@ pub fn chaos_map_scene(
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
     let params = scene.parameter_values(info)?;
-    let run =
-        |settings: &ChaosMapSettings| chaos_map(info.name, &params, settings, &|| progress.inc());
+    let run = |settings: &ChaosMapSettings| {
+        chaos_map(info.name, &params, settings, &|| {
+            progress.inc();
+            true
+        })
+    };
     #[cfg(feature = "mpi")]
     if let Some(ranks) = ranks::Ranks::start(&settings)? {
         return ranks.run(&settings, &run, &|map| write_chaos_map(&scene, map));

@@ -171,7 +171,7 @@ async fn chaos_levels_equal_the_library_map() {
             method: Method::Taylor { tol: 1e-8 },
             tiles: None,
         };
-        let map = chaos_map("kapitza", &[1.0, 0.1, 0.0], &settings, &|| {}).unwrap();
+        let map = chaos_map("kapitza", &[1.0, 0.1, 0.0], &settings, &|| true).unwrap();
         let fli: Vec<Option<f64>> = serde_json::from_value(level["fli"].clone()).unwrap();
         let expected: Vec<Option<f64>> = map
             .fli
@@ -243,6 +243,17 @@ async fn overlay_matches_the_averaged_hamiltonian_by_hand() {
         }
     }
     assert_eq!(separatrices, 2);
+
+    // To second order where derived; a model in the numeric-solve form
+    // has none, and says so.
+    let second = json!({"model": "kapitza", "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 2});
+    let (status, _, body) = call("POST", "/api/overlay", Some(second)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    assert!(body.contains("second order"), "{body}");
+    let triple = json!({"model": "triple_pendulum", "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 2});
+    let (status, _, body) = call("POST", "/api/overlay", Some(triple)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(body.contains("order 2 is not derived"), "{body}");
 }
 
 /// Every bad request gets a status and a message naming the problem; the

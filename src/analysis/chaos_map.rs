@@ -180,7 +180,9 @@ fn fingerprint(text: &str) -> u64 {
 
 /// The FLI map of the model `name` with parameter values `params`
 /// (declaration order); `row_done` is called as each row is finished (from
-/// the worker threads).
+/// the worker threads) and returns whether to go on: once it says false,
+/// rows not yet started are skipped and the map ends with
+/// [`ChaosMapError::Cancelled`] (nobody is waiting for it any more).
 /// (`#[inline]`: the per-model instances are compiled in the crates that
 /// call this, not in the library on every rebuild.)
 #[inline]
@@ -188,7 +190,7 @@ pub fn chaos_map(
     name: &str,
     params: &[f64],
     settings: &ChaosMapSettings,
-    row_done: &(dyn Fn() + Sync),
+    row_done: &(dyn Fn() -> bool + Sync),
 ) -> Result<ChaosMap, ChaosMapError> {
     let work = Map {
         params,
@@ -201,7 +203,7 @@ pub fn chaos_map(
 struct Map<'a> {
     params: &'a [f64],
     settings: &'a ChaosMapSettings,
-    row_done: &'a (dyn Fn() + Sync),
+    row_done: &'a (dyn Fn() -> bool + Sync),
 }
 
 impl WithFixed for Map<'_> {
@@ -256,7 +258,11 @@ impl WithFixed for Map<'_> {
         // One row of FLI values and its f-evaluations; a fresh integrator
         // per row, so a row's values do not depend on what ran before.
         // The Taylor method runs the row in batches of LANES orbits.
+        let stopped = std::sync::atomic::AtomicBool::new(false);
         let row = |j: usize| -> Result<(Vec<f64>, u64), OdeError> {
+            if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+                return Ok((Vec::new(), 0));
+            }
             let starts: Vec<[f64; S]> = (0..pixels).map(|i| start_of(j * pixels + i)).collect();
             let (values, f_evals) = match settings.method {
                 Method::Taylor { .. } => {
@@ -298,12 +304,17 @@ impl WithFixed for Map<'_> {
                     (values, integrator.stats.f_evals)
                 }
             };
-            (self.row_done)();
+            if !(self.row_done)() {
+                stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
             Ok((values, f_evals))
         };
-        let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
+        let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), ChaosMapError> {
             let rows: Vec<(Vec<f64>, u64)> =
                 range.into_par_iter().map(row).collect::<Result<_, _>>()?;
+            if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+                return Err(ChaosMapError::Cancelled);
+            }
             Ok(rows
                 .into_iter()
                 .fold((Vec::new(), 0), |(mut all, evals), (values, e)| {
@@ -372,7 +383,7 @@ fn run_tiles(
     tiles: &Tiles,
     fingerprint: u64,
     pixels: usize,
-    rows_of: &dyn Fn(std::ops::Range<usize>) -> Result<(Vec<f64>, u64), OdeError>,
+    rows_of: &dyn Fn(std::ops::Range<usize>) -> Result<(Vec<f64>, u64), ChaosMapError>,
 ) -> Result<Option<(Vec<f64>, u64)>, ChaosMapError> {
     let rows = tiles.rows.max(1);
     let count = pixels.div_ceil(rows);

@@ -121,6 +121,9 @@ pub enum PeriodMapError {
     /// no map to return.
     #[error("the tiles asked for are written; run without `only` to merge them into the map")]
     Partial,
+    /// The caller said to stop (a page that no longer waits for the map).
+    #[error("stopped before the end: nobody waits for the map any more")]
+    Cancelled,
     #[error(transparent)]
     Tile(#[from] super::chaos_map::TileError),
     #[error(transparent)]

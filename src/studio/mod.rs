@@ -57,6 +57,8 @@ pub enum RequestProblem {
     SeedLength { got: usize, expected: usize },
     #[error("the state to pass through has {got} components; the state [q; p] has {expected}")]
     ThroughLength { got: usize, expected: usize },
+    #[error("the averaged Hamiltonian to order {0} is not derived for this model (orders: 1, and 2 for models with a fast phase in the symbolic form)")]
+    Order(usize),
     #[error("the request has a field '{0}' that this route does not know")]
     UnknownField(String),
     #[error("{what} must be finite")]
@@ -212,6 +214,10 @@ fn find_dynamic(
         known: crate::models::ALL.iter().map(|m| m.name).collect(),
     })?;
     Ok((info, model))
+}
+
+fn first_order() -> usize {
+    1
 }
 
 fn default_method() -> String {
@@ -420,7 +426,8 @@ const CHUNK_POINTS: usize = 4096;
 /// as they come (at least every 40 ms); `sink` returns false when nobody
 /// listens any more, which stops the orbit. An orbit that leaves the
 /// model's domain ends with the integrator's error after the points before.
-#[inline]
+/// (Not `#[inline]`, unlike the analyses: the per-model instances compile
+/// once, in the library, for the studio and its tests.)
 pub fn orbit(
     request: &OrbitRequest,
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
@@ -549,11 +556,13 @@ pub struct ChaosLevel {
 
 /// The FLI map of the view at each resolution of `request.levels` (rows
 /// on all cores; the Taylor method in batches), each handed to `sink` when
-/// done; `sink` returns false to stop before the next.
-#[inline]
+/// done; `sink` returns false to stop before the next, and once `listening`
+/// says false a level stops between rows (ending with
+/// `PeriodMapError::Cancelled`). (Compiled once, in the library.)
 pub fn chaos(
     request: &ChaosRequest,
     sink: &mut dyn FnMut(ChaosLevel) -> bool,
+    listening: &(dyn Fn() -> bool + Sync),
 ) -> Result<(), StudioError> {
     let (setup, ranges) = request.check()?;
     for &pixels in &request.levels {
@@ -567,7 +576,7 @@ pub fn chaos(
             method: setup.method,
             tiles: None,
         };
-        let map = chaos_map(setup.info.name, &setup.params, &settings, &|| {})?;
+        let map = chaos_map(setup.info.name, &setup.params, &settings, listening)?;
         let level = ChaosLevel {
             pixels,
             shades: map.shades,
@@ -598,6 +607,10 @@ pub struct OverlayRequest {
     pub grid: usize,
     /// Number of level sets (besides those through unstable equilibria).
     pub levels: usize,
+    /// The order of the averaged Hamiltonian drawn: 1 (H̄) or 2 (K̄ to ε²,
+    /// where derived).
+    #[serde(default = "first_order")]
+    pub order: usize,
     /// Fields no route knows (refused by name, not ignored).
     #[serde(flatten)]
     pub unknown: BTreeMap<String, serde_json::Value>,
@@ -640,15 +653,23 @@ pub fn overlay(request: &OverlayRequest) -> Result<Overlay, StudioError> {
     let count = setup.count("level sets", request.levels, 100)?;
     let model = setup.model;
     let params = &setup.params;
+    let second_order = match request.order {
+        1 => false,
+        2 if model.averaged2_energy(params, &setup.through).is_some() => true,
+        order => return Err(setup.bad(RequestProblem::Order(order))),
+    };
     let value = |x: f64, y: f64| {
         let mut state = setup.through.clone();
         state[setup.axes[0]] = x;
         state[setup.axes[1]] = y;
-        if setup.fast_phase {
-            model.averaged_energy(params, &state).unwrap_or(f64::NAN)
+        let value = if second_order {
+            model.averaged2_energy(params, &state)
+        } else if setup.fast_phase {
+            model.averaged_energy(params, &state)
         } else {
-            model.energy(params, 0.0, &state)
-        }
+            Some(model.energy(params, 0.0, &state))
+        };
+        value.unwrap_or(f64::NAN)
     };
     let field = contour::Field::sample(ranges, grid, value);
     let equilibria: Vec<EquilibriumMark> = crate::explore::equilibria(model, params)
@@ -704,10 +725,10 @@ pub fn overlay(request: &OverlayRequest) -> Result<Overlay, StudioError> {
         }
     }
     Ok(Overlay {
-        function: if setup.fast_phase {
-            "averaged Hamiltonian H̄"
-        } else {
-            "Hamiltonian H"
+        function: match (setup.fast_phase, second_order) {
+            (_, true) => "averaged Hamiltonian to second order K̄",
+            (true, false) => "averaged Hamiltonian H̄",
+            (false, false) => "Hamiltonian H",
         },
         levels,
         equilibria,

@@ -16,6 +16,7 @@
 //! goes on.
 
 use super::{ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
+use crate::analysis::period_map::PeriodMapError;
 use axum::body::{Body, Bytes};
 use axum::extract::Path;
 use axum::http::{header, StatusCode};
@@ -146,7 +147,7 @@ async fn overlay(body: Bytes) -> Result<Response, ApiError> {
 async fn orbit(body: Bytes) -> Result<Response, ApiError> {
     let request: OrbitRequest = serde_json::from_slice(&body)?;
     request.check()?;
-    Ok(stream(move |send| {
+    Ok(stream(move |send, _| {
         let end = super::orbit(&request, &mut |chunk| send(&chunk))?;
         send(&Ended { end });
         Ok(())
@@ -156,8 +157,8 @@ async fn orbit(body: Bytes) -> Result<Response, ApiError> {
 async fn chaos(body: Bytes) -> Result<Response, ApiError> {
     let request: ChaosRequest = serde_json::from_slice(&body)?;
     request.check()?;
-    Ok(stream(move |send| {
-        super::chaos(&request, &mut |level| send(&level))
+    Ok(stream(move |send, listening| {
+        super::chaos(&request, &mut |level| send(&level), listening)
     }))
 }
 
@@ -187,20 +188,26 @@ fn panic_text(panic: &Box<dyn std::any::Any + Send>) -> String {
 }
 
 /// An NDJSON answer: `work` runs on a blocking thread and sends lines with
-/// `send`, which returns false once the page has dropped the answer (then
-/// `work` should stop). An error or a panic ends the stream with an
-/// `{"error": …}` line.
+/// `send`, which returns false once the page has dropped the answer; then
+/// `listening` (callable from any thread) says false too, and `work` should
+/// stop. An error or a panic ends the stream with an `{"error": …}` line.
 fn stream(
-    work: impl FnOnce(&mut dyn FnMut(&dyn erased::Line) -> bool) -> Result<(), StudioError>
+    work: impl FnOnce(
+            &mut dyn FnMut(&dyn erased::Line) -> bool,
+            &(dyn Fn() -> bool + Sync),
+        ) -> Result<(), StudioError>
         + Send
         + 'static,
 ) -> Response {
     let (tx, rx) = tokio::sync::mpsc::channel::<Bytes>(8);
+    let probe = tx.clone();
     tokio::task::spawn_blocking(move || {
+        let listening = move || !probe.is_closed();
         let mut send = |line: &dyn erased::Line| tx.blocking_send(line.ndjson()).is_ok();
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&mut send)));
+        let outcome =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| work(&mut send, &listening)));
         let error = match outcome {
-            Ok(Ok(())) => return,
+            Ok(Ok(()) | Err(StudioError::PeriodMap(PeriodMapError::Cancelled))) => return,
             Ok(Err(e)) => ApiError::Studio(e),
             Err(panic) => ApiError::Internal(panic_text(&panic)),
         };

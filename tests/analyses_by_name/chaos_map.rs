@@ -33,7 +33,7 @@ fn kapitza_map_is_the_scene_s_map() {
         "kapitza",
         &params.values(),
         &settings([0, 1], 12, 40),
-        &|| {},
+        &|| true,
     )
     .unwrap();
     assert_eq!((map.axes[0].as_str(), map.axes[1].as_str()), ("q", "p_q"));
@@ -69,7 +69,7 @@ fn a_plane_of_a_larger_model() {
     let mut s = settings([0, 2], 3, 10);
     s.through = Some(vec![0.0, 0.1, 0.0, 0.05]);
     s.ranges = [None, Some((-1.0, 1.0))];
-    let map = chaos_map("double_pendulum", &params.values(), &s, &|| {}).unwrap();
+    let map = chaos_map("double_pendulum", &params.values(), &s, &|| true).unwrap();
     assert_eq!(map.axes, ["phi1".to_string(), "p_phi1".to_string()]);
     let system = double_pendulum::Exact { params };
     let mut integrator = Integrator::new(Method::parse("taylor", 1e-6).unwrap()).unwrap();
@@ -91,16 +91,16 @@ fn a_plane_of_a_larger_model() {
 #[test]
 fn bad_requests_are_typed_errors() {
     let kapitza = models::dynamic("kapitza").unwrap().defaults();
-    let e = chaos_map("kapitza", &kapitza, &settings([0, 2], 2, 2), &|| {}).unwrap_err();
+    let e = chaos_map("kapitza", &kapitza, &settings([0, 2], 2, 2), &|| true).unwrap_err();
     assert!(e.to_string().contains("q, p_q"), "{e}");
-    let e = chaos_map("kapitza", &kapitza, &settings([1, 1], 2, 2), &|| {}).unwrap_err();
+    let e = chaos_map("kapitza", &kapitza, &settings([1, 1], 2, 2), &|| true).unwrap_err();
     assert!(matches!(e, ChaosMapError::Request { .. }));
     let mut s = settings([0, 1], 2, 2);
     s.through = Some(vec![0.0; 3]);
-    assert!(chaos_map("kapitza", &kapitza, &s, &|| {}).is_err());
+    assert!(chaos_map("kapitza", &kapitza, &s, &|| true).is_err());
     let none = models::dynamic("painleve_klein").unwrap().defaults();
     assert!(matches!(
-        chaos_map("painleve_klein", &none, &settings([0, 1], 2, 2), &|| {}),
+        chaos_map("painleve_klein", &none, &settings([0, 1], 2, 2), &|| true),
         Err(ChaosMapError::UnknownModel(_))
     ));
 }
@@ -176,7 +176,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
         "kapitza",
         &params.values(),
         &settings([0, 1], 20, 30),
-        &|| {},
+        &|| true,
     )
     .unwrap();
     let folder = tempfile::tempdir().unwrap();
@@ -196,12 +196,14 @@ fn tiles_resume_and_merge_bit_for_bit() {
         &tiled(Some(vec![1, 6])),
         &|| {
             count();
+            true
         },
     );
     assert!(matches!(first, Err(ChaosMapError::Partial)));
     assert_eq!(rows.swap(0, std::sync::atomic::Ordering::Relaxed), 3 + 2);
     let resumed = chaos_map("kapitza", &params.values(), &tiled(None), &|| {
         count();
+        true
     })
     .unwrap();
     assert_eq!(rows.load(std::sync::atomic::Ordering::Relaxed), 20 - 5);
@@ -218,7 +220,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
     let tile = sweep.join("tile_2.bin");
     let bytes = std::fs::read(&tile).unwrap();
     std::fs::write(&tile, &bytes[..bytes.len() - 3]).unwrap();
-    let damaged = chaos_map("kapitza", &params.values(), &tiled(None), &|| {});
+    let damaged = chaos_map("kapitza", &params.values(), &tiled(None), &|| true);
     assert!(
         matches!(
             damaged,
@@ -226,7 +228,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
         ),
         "{damaged:?}"
     );
-    let missing = chaos_map("kapitza", &params.values(), &tiled(Some(vec![7])), &|| {});
+    let missing = chaos_map("kapitza", &params.values(), &tiled(Some(vec![7])), &|| true);
     assert!(
         matches!(
             missing,
@@ -237,4 +239,25 @@ fn tiles_resume_and_merge_bit_for_bit() {
         ),
         "{missing:?}"
     );
+}
+
+/// A map whose caller stops listening after a few rows ends with
+/// `Cancelled`, without computing the rows not yet started.
+#[test]
+fn a_map_nobody_waits_for_stops() {
+    let rows = std::sync::atomic::AtomicUsize::new(0);
+    let params = kapitza::Params::default();
+    let result = chaos_map(
+        "kapitza",
+        &params.values(),
+        &settings([0, 1], 64, 30),
+        &|| rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1 < 3,
+    );
+    assert!(
+        matches!(result, Err(ChaosMapError::Cancelled)),
+        "{result:?}"
+    );
+    let done = rows.load(std::sync::atomic::Ordering::Relaxed);
+    // Rows already running on the other workers finish; no new one starts.
+    assert!(done < 3 + rayon::current_num_threads(), "{done} of 64 rows");
 }

@@ -24,7 +24,7 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
             );
             let e = convergence(info.name, &params, &averaging_settings()).unwrap_err();
             assert!(matches!(e, AveragingError::UnknownModel(_)));
-            let e = chaos_map(info.name, &params, &map_settings(5), &|| {}).unwrap_err();
+            let e = chaos_map(info.name, &params, &map_settings(5), &|| true).unwrap_err();
             assert!(matches!(e, ChaosMapError::UnknownModel(_)));
             assert!(portrait(info.name, &params, &portrait_settings(1)).is_err());
             continue;
@@ -43,8 +43,8 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         }
         // The FLI is a maximum over the iterations: more periods never lower it.
         let (short, long) = (
-            chaos_map(info.name, &params, &map_settings(4), &|| {}).unwrap(),
-            chaos_map(info.name, &params, &map_settings(8), &|| {}).unwrap(),
+            chaos_map(info.name, &params, &map_settings(4), &|| true).unwrap(),
+            chaos_map(info.name, &params, &map_settings(8), &|| true).unwrap(),
         );
         assert_eq!(short.fli.len(), 9);
         // A pixel whose orbit left the model's domain (+∞: the elastic

@@ -269,6 +269,9 @@ function seedAt(x, y) {
   listOrbits();
 }
 
+// Scripting from the browser's console: studio.seed(q, p) seeds an orbit.
+studio.seed = (x, y) => seedAt(x, y);
+
 function listOrbits() {
   const list = $("orbit-list");
   list.innerHTML = "";
@@ -303,7 +306,7 @@ async function refreshOverlay() {
   if (!wanted || studio.model.kind !== "hamiltonian") { studio.overlay = null; redraw(); return; }
   try {
     studio.overlay = await postJson("/api/overlay",
-      { ...setup(), ranges: viewRanges(), grid: 160, levels: 14 }, overlayController.signal);
+      { ...setup(), ranges: viewRanges(), grid: 160, levels: 14, order: Number($("order").value) }, overlayController.signal);
     redraw();
   } catch (e) {
     if (!aborted(e)) say(`overlay: ${e.message}`);
@@ -377,6 +380,7 @@ function buildAxes(model) {
     select.value = String(studio.axes[k]);
   }
   $("axes-row").style.display = model.state.length > 2 ? "" : "none";
+  $("through").value = studio.through.join(", ");
 }
 
 function defaultView(model) {
@@ -400,6 +404,8 @@ async function chooseModel(name) {
   $("derivations-model").textContent = name;
   buildParameters(model);
   buildAxes(model);
+  $("order").disabled = !model.fast_phase;
+  $("order").value = "1";
   defaultView(model);
   say(model.kind !== "hamiltonian" ? `model '${name}' is a contact model: no phase plane here, its derivations are below`
     : model.fast_phase ? "" : `model '${name}' has no fast phase: no period map; the level sets of H and the equilibria are shown`);
@@ -525,6 +531,19 @@ function wire() {
       refreshOverlays();
     });
   }
+  $("order").addEventListener("change", refreshOverlay);
+  $("through").addEventListener("change", () => {
+    const state = $("through").value.split(",").map((v) => Number(v.trim()));
+    if (state.length !== studio.model.state.length || !state.every(Number.isFinite)) {
+      say(`the plane passes through a state of ${studio.model.state.length} numbers, comma-separated`);
+      $("through").value = studio.through.join(", ");
+      return;
+    }
+    studio.through = state;
+    say("");
+    removeOrbits(0);
+    refreshOverlays();
+  });
   $("export-png").addEventListener("click", () => canvas.toBlob((blob) => download(`studio_${studio.model.name}.png`, blob)));
   $("export-svg").addEventListener("click", exportSvg);
   $("export-csv").addEventListener("click", exportCsv);
