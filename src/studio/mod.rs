@@ -426,8 +426,9 @@ const CHUNK_POINTS: usize = 4096;
 /// as they come (at least every 40 ms); `sink` returns false when nobody
 /// listens any more, which stops the orbit. An orbit that leaves the
 /// model's domain ends with the integrator's error after the points before.
-/// (Not `#[inline]`, unlike the analyses: the per-model instances compile
-/// once, in the library, for the studio and its tests.)
+/// (`#[inline]`, as the analyses: the per-model instances compile in the
+/// studio and its tests, not in the library every scene waits for.)
+#[inline]
 pub fn orbit(
     request: &OrbitRequest,
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
@@ -558,7 +559,8 @@ pub struct ChaosLevel {
 /// on all cores; the Taylor method in batches), each handed to `sink` when
 /// done; `sink` returns false to stop before the next, and once `listening`
 /// says false a level stops between rows (ending with
-/// `PeriodMapError::Cancelled`). (Compiled once, in the library.)
+/// `PeriodMapError::Cancelled`). (`#[inline]`, as [`orbit`].)
+#[inline]
 pub fn chaos(
     request: &ChaosRequest,
     sink: &mut dyn FnMut(ChaosLevel) -> bool,
