@@ -61,8 +61,9 @@ fn batch_fli_equals_the_scalar_fli_for_every_orbit() {
         params: double_pendulum::Params::default(),
     };
     let period = 2.0 * std::f64::consts::PI / system.params.nu;
-    // Five orbits: three lanes idle.
-    let starts: Vec<[f64; 4]> = (0..5).map(spread).collect();
+    // Thirteen orbits streamed through eight lanes: lanes take new orbits
+    // as theirs end, and three idle at the end.
+    let starts: Vec<[f64; 4]> = (0..13).map(spread).collect();
     let w0 = [0.5; 4];
     let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
     let values = fast_lyapunov_indicators::<_, 4, 8>(&mut batch, &system, period, &starts, &w0, 20);
@@ -139,6 +140,68 @@ fn a_diverging_or_nan_lane_ends_alone_with_the_scalar_error() {
             }
         }
     }
+}
+
+#[test]
+fn a_stream_ends_each_orbit_with_its_scalar_segments() {
+    // Ten orbits over three segments [0, 0.2] each, every segment started
+    // from 1.5 × the last end: orbit 3 (y₀ = 3, then 11.25) blows up in
+    // its second segment, orbit 6 starts from NaN, orbit 8 is stopped after
+    // one segment; the others run on.
+    let starts: Vec<[f64; 1]> = (0..10)
+        .map(|k| match k {
+            3 => [3.0],
+            6 => [f64::NAN],
+            _ => [0.1 * k as f64 - 0.4],
+        })
+        .collect();
+    let segments = |k: usize| if k == 8 { 1 } else { 3 };
+    let mut ends: Vec<Vec<[f64; 1]>> = vec![Vec::new(); starts.len()];
+    let mut done = vec![0; starts.len()];
+    let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
+    let errors = batch.stream(&BlowUp, 0.2, &starts, |k, y| {
+        done[k] += 1;
+        ends[k].push(*y);
+        y[0] *= 1.5; // each segment starts from a changed state, as the FLI's renormalisation
+        done[k] < segments(k)
+    });
+    let mut scalar = Integrator::new(TAYLOR).unwrap();
+    for (k, start) in starts.iter().enumerate() {
+        let mut y = *start;
+        let mut expected = Ok(());
+        let mut completed = 0;
+        for segment in 0..segments(k) {
+            match scalar.advance(&BlowUp, 0.0, &y, 0.2) {
+                Ok(end) => {
+                    assert_eq!(ends[k][segment], end, "orbit {k} after segment {segment}");
+                    y = [end[0] * 1.5];
+                    completed += 1;
+                }
+                Err(e) => {
+                    expected = Err(e);
+                    break;
+                }
+            }
+        }
+        assert_eq!(
+            format!("{:?}", errors[k]),
+            format!("{:?}", expected.err()),
+            "orbit {k}"
+        );
+        assert_eq!(ends[k].len(), completed, "segments of orbit {k}");
+    }
+    assert_eq!(ends[3].len(), 1, "orbit 3 diverges in its second segment");
+    assert!(matches!(
+        errors[3],
+        Some(OdeError::NonFinite { .. } | OdeError::StepSizeUnderflow { .. })
+    ));
+    assert!(matches!(
+        errors[6],
+        Some(OdeError::NonFiniteInitialState { .. })
+    ));
+    assert_eq!(done[8], 1);
+    assert_eq!(batch.stats.steps, scalar.stats.steps);
+    assert_eq!(batch.stats.f_evals, scalar.stats.f_evals);
 }
 
 #[test]

@@ -4,7 +4,7 @@
 //! of freedom the plane is the cylinder (q, p).
 
 use super::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators, fli_shading};
-use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, LANES};
+use crate::ode::{Integrator, LaneIntegrator, Method, OdeError};
 use crate::registry::{Fixed, WithFixed};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -257,7 +257,7 @@ impl WithFixed for Map<'_> {
         };
         // One row of FLI values and its f-evaluations; a fresh integrator
         // per row, so a row's values do not depend on what ran before.
-        // The Taylor method runs the row in batches of LANES orbits.
+        // The Taylor method streams the row through its LANES lanes.
         let stopped = std::sync::atomic::AtomicBool::new(false);
         let row = |j: usize| -> Result<(Vec<f64>, u64), OdeError> {
             if stopped.load(std::sync::atomic::Ordering::Relaxed) {
@@ -267,20 +267,17 @@ impl WithFixed for Map<'_> {
             let (values, f_evals) = match settings.method {
                 Method::Taylor { .. } => {
                     let mut integrator = LaneIntegrator::new(settings.method)?;
-                    let values = starts
-                        .chunks(LANES)
-                        .flat_map(|batch| {
-                            fast_lyapunov_indicators::<_, S, T>(
-                                &mut integrator,
-                                &system,
-                                period,
-                                batch,
-                                &w0,
-                                settings.periods,
-                            )
-                        })
-                        .map(pixel_value)
-                        .collect::<Result<_, _>>()?;
+                    let values = fast_lyapunov_indicators::<_, S, T>(
+                        &mut integrator,
+                        &system,
+                        period,
+                        &starts,
+                        &w0,
+                        settings.periods,
+                    )
+                    .into_iter()
+                    .map(pixel_value)
+                    .collect::<Result<_, _>>()?;
                     (values, integrator.stats.f_evals)
                 }
                 _ => {

@@ -3,7 +3,7 @@
 
 use super::period_map::wrap_angle;
 use super::variational::Variational;
-use crate::ode::{Integrator, LaneIntegrator, OdeError, System, LANES};
+use crate::ode::{Integrator, LaneIntegrator, OdeError, System};
 use nalgebra::DMatrix;
 
 /// The full Lyapunov spectrum of the period map (exponents per period, in
@@ -75,9 +75,10 @@ pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
     Ok(fli.value)
 }
 
-/// The FLI of up to [`LANES`] orbits started at `starts`, integrated
-/// together by the batch Taylor method; each orbit's value (or error) is
-/// the one [`fast_lyapunov_indicator`] gives it with the same tolerance.
+/// The FLI of every orbit started at `starts`, integrated [`crate::ode::LANES`] at a
+/// time by the batch Taylor method (a lane whose orbit ends takes the next
+/// one); each orbit's value (or error) is the one
+/// [`fast_lyapunov_indicator`] gives it with the same tolerance.
 pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
     integrator: &mut LaneIntegrator,
     system: &S,
@@ -86,33 +87,29 @@ pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
     w0: &[f64; N],
     periods: usize,
 ) -> Vec<Result<f64, OdeError>> {
-    assert!(starts.len() <= LANES, "at most {LANES} orbits per batch");
+    if periods == 0 {
+        return vec![Ok(f64::NEG_INFINITY); starts.len()];
+    }
     let variational = Variational::<S, N, M>::new(system);
-    let mut z: [[f64; M]; LANES] = std::array::from_fn(|l| {
-        Variational::<S, N, M>::pack(starts.get(l).unwrap_or(&starts[0]), &[*w0])
+    let packed: Vec<[f64; M]> = starts
+        .iter()
+        .map(|y0| Variational::<S, N, M>::pack(y0, &[*w0]))
+        .collect();
+    let mut fli = vec![(Fli::<N, M>::new(w0), 0usize); starts.len()];
+    let errors = integrator.stream(&variational, period, &packed, |k, z| {
+        let (fli, done) = &mut fli[k];
+        fli.after_period(z);
+        *done += 1;
+        *done < periods
     });
-    let mut running: [bool; LANES] = std::array::from_fn(|l| l < starts.len());
-    let mut fli = [Fli::<N, M>::new(w0); LANES];
-    let mut results: Vec<Result<f64, OdeError>> = vec![Ok(f64::NEG_INFINITY); starts.len()];
-    for _ in 0..periods {
-        let ends = integrator.advance(&variational, 0.0, &z, running, period);
-        let integrated = running;
-        for (l, end) in ends.into_iter().enumerate().filter(|&(l, _)| integrated[l]) {
-            match end {
-                Ok(end) => {
-                    z[l] = end;
-                    fli[l].after_period(&mut z[l]);
-                }
-                Err(e) => (results[l], running[l]) = (Err(e), false),
-            }
-        }
-    }
-    for (l, result) in results.iter_mut().enumerate() {
-        if running[l] {
-            *result = Ok(fli[l].value);
-        }
-    }
-    results
+    errors
+        .into_iter()
+        .zip(fli)
+        .map(|(error, (fli, _))| match error {
+            Some(e) => Err(e),
+            None => Ok(fli.value),
+        })
+        .collect()
 }
 
 /// One orbit's FLI so far: the largest ln(‖w‖/‖w₀‖), with the logarithms

@@ -116,17 +116,19 @@ pub(super) fn step_from_exponent(exponent: f64, safety: f64) -> Option<f64> {
 
 /// The step to take from t towards t1 (`remaining` = |t1 − t| away), and
 /// whether it is the last one.
+/// `y` gives the state for the error of a non-finite step.
+#[inline(always)]
 pub(super) fn step_to_take<const N: usize>(
     step: Option<f64>,
     remaining: f64,
     t: f64,
-    y: &[f64; N],
+    y: impl FnOnce() -> [f64; N],
 ) -> Result<(f64, bool), OdeError> {
     let h = match step {
         Some(h) if h.is_finite() => h,
         // Vanishing top coefficients: the series is exact.
         None => remaining,
-        Some(_) => return Err(OdeError::NonFinite { t, y: y.to_vec() }),
+        Some(_) => return Err(OdeError::NonFinite { t, y: y().to_vec() }),
     };
     if h <= 0.0 && remaining > 0.0 {
         return Err(OdeError::StepSizeUnderflow { t, h });
@@ -196,7 +198,7 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
         }
         stats.f_evals += order as u64;
         let remaining = (t1 - t).abs();
-        let (h, last) = step_to_take(step_size(c, &y, safety), remaining, t, &y)?;
+        let (h, last) = step_to_take(step_size(c, &y, safety), remaining, t, || y)?;
         let h = h * direction;
         let y_new = horner(c, h);
         let t_new = if last {

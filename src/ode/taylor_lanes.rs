@@ -10,13 +10,10 @@
 //! they gain the SIMD width and the overlap of independent lanes, where one
 //! orbit's recurrences are a chain of dependent operations.
 
+use super::kernels::exp2;
 use super::lanes::{Lanes, LANES};
-use super::taylor::{
-    compensated_sum, horner, safety, step_exponent, step_from_exponent, step_to_take,
-};
-use super::{
-    check_finite, check_initial, order_for_tolerance, Method, OdeError, Stats, System, TaylorWork,
-};
+use super::taylor::{compensated_sum, horner, safety, step_exponent, step_to_take};
+use super::{check_initial, order_for_tolerance, Method, OdeError, Stats, System, TaylorWork};
 
 /// The result of one lane.
 pub type LaneResult<const N: usize> = Result<[f64; N], OdeError>;
@@ -62,88 +59,207 @@ impl LaneIntegrator {
         t1: f64,
     ) -> [LaneResult<N>; LANES] {
         let mut results: [LaneResult<N>; LANES] = std::array::from_fn(|l| Ok(y0[l]));
-        let mut running = active;
+        let mut run = Run::new(t0, y0);
+        run.running = active;
         for l in (0..LANES).filter(|&l| active[l]) {
             if let Err(e) = check_initial(t0, &y0[l], t1) {
-                (results[l], running[l]) = (Err(e), false);
+                (results[l], run.running[l]) = (Err(e), false);
             }
         }
         if t1 == t0 {
             return results;
         }
-        let order = order_for_tolerance(self.tol);
-        self.stats.order = self.stats.order.max(order as u64);
-        self.coefficients.resize((order + 1) * N, Lanes::default());
-        let direction = (t1 - t0).signum();
-        let safety = safety(order);
-        let mut lanes = Run {
-            t: [t0; LANES],
-            carry: [0.0; LANES],
-            y: std::array::from_fn(|i| Lanes(std::array::from_fn(|l| y0[l][i]))),
-            steps: [0; LANES],
-        };
-        while running.iter().any(|&r| r) {
-            let (c, _) = self.coefficients.as_chunks_mut::<N>();
-            if !system.taylor(Lanes(lanes.t), &lanes.y, order, &mut self.work, c) {
+        while run.running.iter().any(|&r| r) {
+            let Some(ends) = self.step_lanes(system, &mut run, t1) else {
                 return std::array::from_fn(|_| Err(OdeError::TaylorUnavailable));
-            }
-            let row_norms =
-                |row: &[Lanes; N]| row.iter().fold(Lanes::splat(0.0), |m, x| m.max(x.abs()));
-            let (y_norm, top) = (
-                row_norms(&lanes.y),
-                [row_norms(&c[order - 1]), row_norms(&c[order])],
-            );
-            // The step rule for all lanes at once (vectorised), then lane by lane.
-            let mut exponents = [0.0; LANES];
-            for (l, exponent) in exponents.iter_mut().enumerate() {
-                *exponent = step_exponent(y_norm.0[l], [top[0].0[l], top[1].0[l]], order);
-            }
-            let mut h = [0.0; LANES];
-            let mut last = [false; LANES];
-            let stepping = running;
-            for l in (0..LANES).filter(|&l| stepping[l]) {
-                self.stats.f_evals += order as u64;
-                let y = lanes.state(l);
-                let step = step_from_exponent(exponents[l], safety);
-                match step_to_take(step, (t1 - lanes.t[l]).abs(), lanes.t[l], &y) {
-                    Ok((step, is_last)) => (h[l], last[l]) = (step * direction, is_last),
-                    Err(e) => (results[l], running[l]) = (Err(e), false),
-                }
-            }
-            let y_new = horner(c, Lanes(h));
-            let stepping = running;
-            for l in (0..LANES).filter(|&l| stepping[l]) {
-                if let Some(result) = lanes.step(l, y_new, h[l], last[l], t1, self.max_steps) {
-                    (results[l], running[l]) = (result, false);
+            };
+            for (l, end) in ends.into_iter().enumerate() {
+                if let Some(result) = end {
+                    (results[l], run.running[l]) = (result, false);
                 }
             }
         }
-        self.stats.steps += lanes.steps.iter().sum::<u64>();
+        self.stats.steps += run.steps.iter().sum::<u64>();
         results
+    }
+
+    /// Integrates every orbit of `starts` over consecutive segments
+    /// [0, `t1`] (the time restarts at 0 after each, as a period map's
+    /// does), [`LANES`] orbits at a time, each lane exactly as the scalar
+    /// method (one `advance` per segment) would. After each segment
+    /// `after_segment(k, y)` may change orbit k's state and says whether it
+    /// goes on. A lane whose orbit ends takes the next orbit at once: no
+    /// lane waits for a slower one, as with [`LaneIntegrator::advance`] at
+    /// every segment's end. Returns each orbit's error, if it ended with one.
+    pub fn stream<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t1: f64,
+        starts: &[[f64; N]],
+        mut after_segment: impl FnMut(usize, &mut [f64; N]) -> bool,
+    ) -> Vec<Option<OdeError>> {
+        let mut errors: Vec<Option<OdeError>> = vec![None; starts.len()];
+        let mut orbit_of: [usize; LANES] = [0; LANES];
+        let mut queue = 0..starts.len();
+        let mut run = Run::new(0.0, &[[0.0; N]; LANES]);
+        run.running = [false; LANES];
+        // Gives lane `l` the next orbit that starts well, or leaves it idle.
+        let mut load = |run: &mut Run<N>,
+                        orbit_of: &mut [usize; LANES],
+                        l: usize,
+                        errors: &mut [Option<OdeError>]| {
+            for k in queue.by_ref() {
+                match check_initial(0.0, &starts[k], t1) {
+                    Ok(()) => {
+                        orbit_of[l] = k;
+                        run.restart(l, &starts[k]);
+                        return;
+                    }
+                    Err(e) => errors[k] = Some(e),
+                }
+            }
+            run.running[l] = false;
+        };
+        for l in 0..LANES {
+            load(&mut run, &mut orbit_of, l, &mut errors);
+        }
+        if t1 == 0.0 {
+            return errors;
+        }
+        while run.running.iter().any(|&r| r) {
+            let Some(ends) = self.step_lanes(system, &mut run, t1) else {
+                return vec![Some(OdeError::TaylorUnavailable); starts.len()];
+            };
+            for (l, end) in ends.into_iter().enumerate() {
+                let Some(result) = end else { continue };
+                self.stats.steps += run.steps[l];
+                let k = orbit_of[l];
+                let go_on = match result {
+                    Ok(mut y) => after_segment(k, &mut y).then_some(y).map(Ok),
+                    Err(e) => Some(Err(e)),
+                };
+                match go_on.map(|y| y.and_then(|y| check_initial(0.0, &y, t1).map(|()| y))) {
+                    Some(Ok(y)) => run.restart(l, &y),
+                    Some(Err(e)) => {
+                        errors[k] = Some(e);
+                        load(&mut run, &mut orbit_of, l, &mut errors);
+                    }
+                    None => load(&mut run, &mut orbit_of, l, &mut errors),
+                }
+            }
+        }
+        errors
+    }
+
+    /// One step of every running lane towards `t1`: for each lane whose run
+    /// ends with it (at t1, or with an error), how; `None` when the system
+    /// has no Taylor recurrences.
+    fn step_lanes<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        run: &mut Run<N>,
+        t1: f64,
+    ) -> Option<[Option<LaneResult<N>>; LANES]> {
+        let order = order_for_tolerance(self.tol);
+        self.stats.order = self.stats.order.max(order as u64);
+        self.coefficients.resize((order + 1) * N, Lanes::default());
+        let safety = safety(order);
+        let mut ends: [Option<LaneResult<N>>; LANES] = std::array::from_fn(|_| None);
+        let (c, _) = self.coefficients.as_chunks_mut::<N>();
+        if !system.taylor(Lanes(run.t), &run.y, order, &mut self.work, c) {
+            return None;
+        }
+        let row_norms =
+            |row: &[Lanes; N]| row.iter().fold(Lanes::splat(0.0), |m, x| m.max(x.abs()));
+        let (y_norm, top) = (
+            row_norms(&run.y),
+            [row_norms(&c[order - 1]), row_norms(&c[order])],
+        );
+        // The step rule for all lanes at once, branch-free so that it
+        // vectorises (a placeholder exponent where the series is exact,
+        // as step_from_exponent decides), then lane by lane.
+        let mut steps = [0.0; LANES];
+        let mut exact = [false; LANES];
+        for l in 0..LANES {
+            let exponent = step_exponent(y_norm.0[l], [top[0].0[l], top[1].0[l]], order);
+            exact[l] = !(exponent < f64::INFINITY);
+            steps[l] = exp2(if exact[l] { 0.0 } else { exponent }) * safety;
+        }
+        let mut h = [0.0; LANES];
+        let mut last = [false; LANES];
+        let mut stepping = run.running;
+        for l in (0..LANES).filter(|&l| run.running[l]) {
+            self.stats.f_evals += order as u64;
+            let step = (!exact[l]).then_some(steps[l]);
+            let direction = (t1 - run.t[l]).signum();
+            match step_to_take(step, (t1 - run.t[l]).abs(), run.t[l], || run.state(l)) {
+                Ok((step, is_last)) => (h[l], last[l]) = (step * direction, is_last),
+                Err(e) => (ends[l], stepping[l]) = (Some(Err(e)), false),
+            }
+        }
+        let y_new = horner(c, Lanes(h));
+        // x − x is 0 for finite x, NaN otherwise: one vector pass.
+        let mut check = Lanes::splat(0.0);
+        for row in &y_new {
+            check += *row - *row;
+        }
+        for l in (0..LANES).filter(|&l| stepping[l]) {
+            ends[l] = run.step(
+                l,
+                &y_new,
+                check.0[l] == 0.0,
+                (h[l], last[l]),
+                t1,
+                self.max_steps,
+            );
+        }
+        Some(ends)
     }
 }
 
-/// The lanes' times, Kahan carries, states and step counts.
+/// The lanes' times, Kahan carries, states, step counts (of the current
+/// run from t0) and whether each is running.
 struct Run<const N: usize> {
     t: [f64; LANES],
     carry: [f64; LANES],
     y: [Lanes; N],
     steps: [u64; LANES],
+    running: [bool; LANES],
 }
 
 impl<const N: usize> Run<N> {
+    fn new(t0: f64, y0: &[[f64; N]; LANES]) -> Run<N> {
+        Run {
+            t: [t0; LANES],
+            carry: [0.0; LANES],
+            y: std::array::from_fn(|i| Lanes(std::array::from_fn(|l| y0[l][i]))),
+            steps: [0; LANES],
+            running: [true; LANES],
+        }
+    }
+
+    /// Starts lane `l` afresh at t = 0 from `y`.
+    fn restart(&mut self, l: usize, y: &[f64; N]) {
+        for (i, x) in y.iter().enumerate() {
+            self.y[i].0[l] = *x;
+        }
+        (self.t[l], self.carry[l], self.steps[l], self.running[l]) = (0.0, 0.0, 0, true);
+    }
+
     fn state(&self, l: usize) -> [f64; N] {
         std::array::from_fn(|i| self.y[i].0[l])
     }
 
-    /// Moves lane `l` to the end of its step; its result when its run ends
-    /// there (reached t1, diverged, or out of steps).
+    /// Moves lane `l` to the end of its step (`finite`: whether its new
+    /// state is); its result when its run ends there (reached t1, diverged,
+    /// or out of steps).
+    #[inline(always)]
     fn step(
         &mut self,
         l: usize,
-        y_new: [Lanes; N],
-        h: f64,
-        last: bool,
+        y_new: &[Lanes; N],
+        finite: bool,
+        (h, last): (f64, bool),
         t1: f64,
         max_steps: u64,
     ) -> Option<LaneResult<N>> {
@@ -153,20 +269,23 @@ impl<const N: usize> Run<N> {
         } else {
             compensated_sum(t, h, &mut self.carry[l])
         };
-        let y: [f64; N] = std::array::from_fn(|i| y_new[i].0[l]);
-        if let Err(e) = check_finite(t_new, &y) {
-            return Some(Err(e));
+        if !finite {
+            let y: [f64; N] = std::array::from_fn(|i| y_new[i].0[l]);
+            return Some(Err(OdeError::NonFinite {
+                t: t_new,
+                y: y.to_vec(),
+            }));
         }
         if !last && t_new == t {
             return Some(Err(OdeError::StepSizeUnderflow { t, h }));
         }
-        for (i, x) in y.iter().enumerate() {
-            self.y[i].0[l] = *x;
+        for (i, row) in y_new.iter().enumerate() {
+            self.y[i].0[l] = row.0[l];
         }
         self.t[l] = t_new;
         self.steps[l] += 1;
         if last {
-            return Some(Ok(y));
+            return Some(Ok(self.state(l)));
         }
         (self.steps[l] >= max_steps).then_some(Err(OdeError::TooManySteps {
             t: t_new,
