@@ -399,27 +399,32 @@ pub fn seconds_at(rows: &[&Row], target: f64) -> Option<f64> {
     })
 }
 
-pub const METHODS: [&str; 7] = [
-    "rk4", "gauss4", "gauss6", "dop853", "radau5", PEER, "taylor",
+pub const METHODS: [&str; 8] = [
+    "rk4",
+    "gauss4",
+    "gauss6",
+    "dop853",
+    "radau5",
+    PEER,
+    "taylor",
+    "taylor_lanes",
 ];
 
-/// Time of dop853 over time of taylor at equal error, per smooth problem and
-/// target error (log-log interpolated along each method's runs).
-pub fn taylor_speedups(rows: &[Row]) -> BTreeMap<String, BTreeMap<String, Option<f64>>> {
+/// Time of method `slow` over time of method `fast` at equal error, per
+/// problem and target error (log-log interpolated along each method's runs).
+pub fn speedups(
+    rows: &[Row],
+    problems: &[&str],
+    (slow, fast): (&str, &str),
+) -> BTreeMap<String, BTreeMap<String, Option<f64>>> {
     let mut out = BTreeMap::new();
-    for problem in [
-        "kapitza_regular",
-        "kapitza_regular_global",
-        "kapitza_chaotic",
-        "double_pendulum",
-        "triple_pendulum",
-    ] {
+    for &problem in problems {
         let of = |method: &str| -> Vec<&Row> {
             rows.iter()
                 .filter(|r| r.problem == problem && r.method == method)
                 .collect()
         };
-        let (dop, taylor) = (of("dop853"), of("taylor"));
+        let (dop, taylor) = (of(slow), of(fast));
         let ratios = [1e-6, 1e-8, 1e-10]
             .into_iter()
             .map(|target| {

@@ -6,6 +6,9 @@
 //!     (each period started from the reference point; the global error of a
 //!     chaotic orbit only measures its exponential divergence), plus the
 //!     global error of the regular orbit after 1000 periods;
+//! (a′) an ensemble of 64 Kapitza orbits over 20 periods, the sweeps'
+//!     workload, with the batch Taylor method (`taylor_lanes`, 8 lanes
+//!     streamed) beside one orbit at a time;
 //! (b) the double pendulum on the vibrating base at ν = 100, t ∈ [0, 10];
 //! (c) the deformable rod of Study 3 sliding, ε = 0.01 and 0.001, t ∈ [0, 2].
 //! Each run is timed (repeated until it has taken `min_seconds`), and the
@@ -19,16 +22,17 @@ mod harness;
 mod performance;
 mod problems;
 
-use harness::{plot_problem, taylor_speedups, BenchError, Failure, Row, Slopes};
+use harness::{plot_problem, speedups, BenchError, Failure, Row, Slopes};
 use mechlab::models::kapitza;
 use mechlab::scene::{knob, Scene};
 use performance::{performance, Performance};
 use std::collections::BTreeMap;
 
-const PROBLEMS: [&str; 7] = [
+const PROBLEMS: [&str; 8] = [
     "kapitza_regular",
     "kapitza_regular_global",
     "kapitza_chaotic",
+    "kapitza_ensemble",
     "double_pendulum",
     "triple_pendulum",
     "rod_eps_0.01",
@@ -44,6 +48,9 @@ struct Summary<'a> {
     performance: Performance,
     /// dop853 seconds / taylor seconds at equal error (1e-6, 1e-8, 1e-10).
     taylor_speedup_over_dop853: BTreeMap<String, BTreeMap<String, Option<f64>>>,
+    /// On the ensemble: taylor (one orbit at a time) seconds / taylor_lanes
+    /// (8 lanes streamed) seconds at equal error, one core each.
+    lanes_speedup_over_taylor: BTreeMap<String, BTreeMap<String, Option<f64>>>,
 }
 
 fn bench() -> Result<(), BenchError> {
@@ -80,7 +87,23 @@ fn bench() -> Result<(), BenchError> {
     };
     let period = mechlab::studies::kapitza::period(&problems::KAPITZA);
     let ratios = performance(&system, &problems::REGULAR, period, periods, &runs.rows)?;
-    let speedups = taylor_speedups(&runs.rows);
+    let speedups = speedups(
+        &runs.rows,
+        &[
+            "kapitza_regular",
+            "kapitza_regular_global",
+            "kapitza_chaotic",
+            "kapitza_ensemble",
+            "double_pendulum",
+            "triple_pendulum",
+        ],
+        ("dop853", "taylor"),
+    );
+    let lanes = harness::speedups(
+        &runs.rows,
+        &["kapitza_ensemble"],
+        ("taylor", "taylor_lanes"),
+    );
     let header = [
         "problem",
         "method",
@@ -107,11 +130,16 @@ fn bench() -> Result<(), BenchError> {
         reference_agreement: &runs.agreements,
         performance: ratios,
         taylor_speedup_over_dop853: speedups,
+        lanes_speedup_over_taylor: lanes,
     };
     println!("performance: {}", serde_json::json!(summary.performance));
     println!(
         "dop853 time / taylor time at equal error: {}",
         serde_json::json!(summary.taylor_speedup_over_dop853)
+    );
+    println!(
+        "taylor time / taylor_lanes time at equal error: {}",
+        serde_json::json!(summary.lanes_speedup_over_taylor)
     );
     scene.write_summary(&summary)?;
     Ok(())

@@ -1,11 +1,14 @@
 //! The problems: the Kapitza period map (regular and chaotic orbits), the
 //! double and triple pendulums on a vibrating base, the sliding rod.
 
-use crate::harness::{reference_end, reference_orbit, solvers, sweep, BenchError, Failure, Row};
+use crate::harness::{
+    end_state, max_difference, reference_end, reference_orbit, solvers, sweep, timed, BenchError,
+    Failure, Row, RunError, Solver,
+};
 use mechlab::contact::{Mode, Smooth};
 use mechlab::models::painleve_klein::{self as painleve, Contacts};
 use mechlab::models::{double_pendulum as dp, kapitza, triple_pendulum};
-use mechlab::ode::{Method, System};
+use mechlab::ode::{LaneIntegrator, Method, System};
 use mechlab::studies::painleve::state_with_deformation;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -33,6 +36,7 @@ pub fn run_all(min_seconds: f64, periods: usize, budget: f64) -> Result<Runs, Be
         agreements: BTreeMap::new(),
     };
     kapitza_map(&mut runs, min_seconds, periods, budget)?;
+    kapitza_ensemble(&mut runs, min_seconds)?;
     vibrating_bases(&mut runs, min_seconds, budget)?;
     sliding_rod(&mut runs, min_seconds, budget)?;
     Ok(runs)
@@ -97,6 +101,81 @@ fn kapitza_map(
         );
     }
 
+    Ok(())
+}
+
+/// Periods of each orbit of the ensemble.
+const ENSEMBLE_PERIODS: usize = 20;
+
+/// (a′) An ensemble, the sweeps' workload: 64 Kapitza orbits from an 8×8
+/// grid over (q, p) ∈ [−3, 3] × [−2, 2], 20 periods each, one orbit at a
+/// time (`dop853`, `taylor`) and streamed through the batch lanes
+/// (`taylor_lanes`, one core). The error is the worst end state's against
+/// DOP853 at 1e-14; the time is the whole ensemble's.
+fn kapitza_ensemble(runs: &mut Runs, min_seconds: f64) -> Result<(), BenchError> {
+    const PROBLEM: &str = "kapitza_ensemble";
+    let system = kapitza::Exact { params: KAPITZA };
+    let period = TAU * KAPITZA.eps;
+    let cell = |k: usize, low: f64, width: f64| low + width * (k as f64 + 0.5) / 8.0;
+    let starts: Vec<[f64; 2]> = (0..64)
+        .map(|k| [cell(k % 8, -3.0, 6.0), cell(k / 8, -2.0, 4.0)])
+        .collect();
+    let one_by_one = |solver: Solver| -> Result<(Vec<[f64; 2]>, u64), RunError> {
+        let (mut ends, mut evals) = (Vec::new(), 0);
+        for y0 in &starts {
+            let (y, e) = end_state::<_, 2, 3>(solver, &system, y0, period, ENSEMBLE_PERIODS)?;
+            ends.push(y);
+            evals += e;
+        }
+        Ok((ends, evals))
+    };
+    let streamed = |tol: f64| -> Result<(Vec<[f64; 2]>, u64), RunError> {
+        let mut lanes = LaneIntegrator::new(Method::Taylor { tol })?;
+        let (mut ends, mut done) = (starts.clone(), vec![0; starts.len()]);
+        let errors = lanes.stream(&system, period, &starts, |k, y| {
+            (ends[k], done[k]) = (*y, done[k] + 1);
+            done[k] < ENSEMBLE_PERIODS
+        });
+        match errors.into_iter().flatten().next() {
+            Some(e) => Err(e.into()),
+            None => Ok((ends, lanes.stats.f_evals)),
+        }
+    };
+    let (reference, _) = one_by_one(Solver::Ours(Method::parse("dop853", 1e-14)?))?;
+    let worst = |ends: &[[f64; 2]]| {
+        ends.iter()
+            .zip(&reference)
+            .map(|(a, b)| max_difference(a, b))
+            .fold(0.0, f64::max)
+    };
+    for k in 3..=14 {
+        let tol = 10f64.powi(-k);
+        for method in ["dop853", "taylor", "taylor_lanes"] {
+            let run = || -> Result<(f64, u64), RunError> {
+                let (ends, evals) = match method {
+                    "taylor_lanes" => streamed(tol)?,
+                    _ => one_by_one(Solver::Ours(Method::parse(method, tol)?))?,
+                };
+                Ok((worst(&ends), evals))
+            };
+            match timed(min_seconds, run) {
+                Ok(((error, f_evals), seconds)) => runs.rows.push(Row {
+                    problem: PROBLEM,
+                    method,
+                    tol_or_step: tol,
+                    error,
+                    seconds,
+                    f_evals,
+                }),
+                Err(reason) => runs.failures.push(Failure {
+                    problem: PROBLEM,
+                    method,
+                    tol_or_step: tol,
+                    reason: reason.to_string(),
+                }),
+            }
+        }
+    }
     Ok(())
 }
 
