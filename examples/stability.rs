@@ -135,5 +135,6 @@ fn chart_settings(
         y_samples: scene.count("chart_y_samples")?,
         edge_tolerance: settings.edge_tolerance,
         method: settings.method,
+        tiles: None,
     })
 }

@@ -12,5 +12,6 @@ pub mod lyapunov;
 pub mod period_map;
 pub mod stability;
 pub mod standard_map;
+pub mod tiles;
 pub mod variational;
 pub mod vibrational_stability;

@@ -125,7 +125,7 @@ pub enum PeriodMapError {
     #[error("stopped before the end: nobody waits for the map any more")]
     Cancelled,
     #[error(transparent)]
-    Tile(#[from] super::chaos_map::TileError),
+    Tile(#[from] super::tiles::TileError),
     #[error(transparent)]
     Ode(#[from] OdeError),
 }

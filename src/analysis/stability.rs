@@ -13,6 +13,7 @@
 //! quadratic dependence is checked (else the reason is given).
 
 use super::floquet::{floquet_multipliers, monodromy, spectral_radius, stability_window};
+use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues;
 use crate::analysis::period_map::wrap_angle;
 use crate::ode::{Integrator, Method, OdeError, System};
@@ -92,6 +93,12 @@ pub enum StabilityError {
     },
     #[error("{0} parameter values for model '{1}'")]
     ParameterCount(usize, String),
+    /// Only some tiles of a chart were asked for: they are written, there
+    /// is no chart to return.
+    #[error("the tiles asked for are written; run without `only` to merge them into the chart")]
+    Partial,
+    #[error(transparent)]
+    Tile(#[from] TileError),
     #[error(transparent)]
     Ode(#[from] OdeError),
 }
@@ -668,6 +675,9 @@ pub struct ChartSettings {
     /// Each boundary is bisected to this tolerance in y.
     pub edge_tolerance: f64,
     pub method: Method,
+    /// Cut the chart into tiles of whole columns (x values), each written
+    /// to a file when done (None: one run in memory).
+    pub tiles: Option<Tiles>,
 }
 
 /// A stability chart of the exact system in two parameters (an Ince–Strutt
@@ -736,40 +746,72 @@ impl WithFixed for Chart<'_> {
             .map(|k| settings.y_max * k as f64 / settings.y_samples as f64)
             .collect();
         // Per x: the verdict at each y sample and the located boundaries.
-        type Column = Result<(Vec<bool>, Vec<f64>), OdeError>;
-        let columns: Vec<Column> = settings
-            .x_values
-            .par_iter()
-            .map(|&x| {
-                let margins: Vec<f64> = y_values
-                    .iter()
-                    .map(|&y| margin(x, y))
-                    .collect::<Result<_, _>>()?;
-                let mut edges = Vec::new();
-                for k in 1..y_values.len() {
-                    if (margins[k - 1] > 0.0) != (margins[k] > 0.0) {
-                        let (mut low, mut high) = (y_values[k - 1], y_values[k]);
-                        let stable_low = margins[k - 1] <= 0.0;
-                        while high - low > settings.edge_tolerance {
-                            let mid = 0.5 * (low + high);
-                            if (margin(x, mid)? <= 0.0) == stable_low {
-                                low = mid;
-                            } else {
-                                high = mid;
-                            }
+        let column = |x: f64| -> Result<(Vec<bool>, Vec<f64>), OdeError> {
+            let margins: Vec<f64> = y_values
+                .iter()
+                .map(|&y| margin(x, y))
+                .collect::<Result<_, _>>()?;
+            let mut edges = Vec::new();
+            for k in 1..y_values.len() {
+                if (margins[k - 1] > 0.0) != (margins[k] > 0.0) {
+                    let (mut low, mut high) = (y_values[k - 1], y_values[k]);
+                    let stable_low = margins[k - 1] <= 0.0;
+                    while high - low > settings.edge_tolerance {
+                        let mid = 0.5 * (low + high);
+                        if (margin(x, mid)? <= 0.0) == stable_low {
+                            low = mid;
+                        } else {
+                            high = mid;
                         }
-                        edges.push(0.5 * (low + high));
                     }
+                    edges.push(0.5 * (low + high));
                 }
-                Ok((margins.iter().map(|m| *m <= 0.0).collect(), edges))
-            })
-            .collect();
-        let (mut stable, mut boundaries) = (Vec::new(), Vec::new());
-        for column in columns {
-            let (s, b) = column?;
-            stable.push(s);
-            boundaries.push(b);
-        }
+            }
+            Ok((margins.iter().map(|m| *m <= 0.0).collect(), edges))
+        };
+        let samples = y_values.len();
+        let columns_of =
+            |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), StabilityError> {
+                let columns: Vec<(Vec<bool>, Vec<f64>)> = settings.x_values[range]
+                    .par_iter()
+                    .map(|&x| column(x))
+                    .collect::<Result<_, _>>()?;
+                Ok((
+                    columns
+                        .iter()
+                        .flat_map(|c| encode_column(c, samples))
+                        .collect(),
+                    0,
+                ))
+            };
+        let columns = match &settings.tiles {
+            None => columns_of(0..settings.x_values.len())?.0,
+            Some(tiles) => {
+                let key = format!(
+                    "chart {} {:?} {:?} {} {:?} {} {} {} {} {:?} {}",
+                    info.name,
+                    self.params,
+                    settings.q,
+                    settings.x,
+                    settings.x_values,
+                    settings.y,
+                    settings.y_max,
+                    settings.y_samples,
+                    settings.edge_tolerance,
+                    settings.method,
+                    tiles.rows
+                );
+                let shape = (settings.x_values.len(), 2 * samples);
+                match run_tiles(tiles, fingerprint(&key), shape, &columns_of)? {
+                    Some((values, _)) => values,
+                    None => return Err(StabilityError::Partial),
+                }
+            }
+        };
+        let (stable, boundaries) = columns
+            .chunks(2 * samples)
+            .map(|c| decode_column(c, samples))
+            .unzip();
         Ok(StabilityChart {
             model: info.name.into(),
             q: settings.q.clone(),
@@ -781,6 +823,26 @@ impl WithFixed for Chart<'_> {
             boundaries,
         })
     }
+}
+
+/// A chart column as 2·samples numbers (for tiles): the verdicts as 1 or
+/// 0, the number of boundaries, the boundaries, NaN after them (a column
+/// has fewer boundaries than samples).
+fn encode_column((stable, edges): &(Vec<bool>, Vec<f64>), samples: usize) -> Vec<f64> {
+    let mut out: Vec<f64> = stable.iter().map(|&s| f64::from(u8::from(s))).collect();
+    out.push(edges.len() as f64);
+    out.extend(edges);
+    out.resize(2 * samples, f64::NAN);
+    out
+}
+
+/// The verdicts and boundaries of a column from [`encode_column`]'s numbers.
+fn decode_column(values: &[f64], samples: usize) -> (Vec<bool>, Vec<f64>) {
+    let count = values[samples] as usize;
+    (
+        values[..samples].iter().map(|&v| v == 1.0).collect(),
+        values[samples + 1..samples + 1 + count].to_vec(),
+    )
 }
 
 impl Stability {

@@ -359,6 +359,7 @@ pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyE
         y_samples: na,
         edge_tolerance: 1e-6,
         method: s.method,
+        tiles: None,
     };
     let chart = stability_chart("kapitza", &s.params.values(), &chart_settings)?;
 

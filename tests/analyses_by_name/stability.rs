@@ -193,6 +193,7 @@ fn kapitza_chart_boundaries_are_the_exact_thresholds() {
         y_samples: 60,
         edge_tolerance: 1e-11,
         method: Method::parse("dop853", 1e-12).unwrap(),
+        tiles: None,
     };
     let chart = stability_chart("kapitza", &defaults("kapitza"), &settings).unwrap();
     for (k, &eps) in settings.x_values.iter().enumerate() {
@@ -205,4 +206,82 @@ fn kapitza_chart_boundaries_are_the_exact_thresholds() {
         assert!(!chart.stable[k][0] && chart.stable[k].iter().any(|s| *s));
     }
     assert!(chart.boundaries[1].len() >= 2, "{:?}", chart.boundaries);
+}
+
+/// Chart tiles (one column each): an interrupted run writes two of four,
+/// the resumed run computes the other two and leaves those files alone,
+/// and the merged chart equals the single run's bit for bit; a tile that
+/// does not exist is a typed error.
+#[test]
+fn chart_tiles_resume_and_merge_bit_for_bit() {
+    use mechlab::analysis::stability::{stability_chart, ChartSettings};
+    use mechlab::analysis::tiles::{TileError, Tiles};
+    let base = ChartSettings {
+        q: vec![0.0],
+        x: "eps".into(),
+        x_values: vec![0.05, 0.1, 0.2, 0.3],
+        y: "A".into(),
+        y_max: 4.0,
+        y_samples: 12,
+        edge_tolerance: 1e-6,
+        method: Method::parse("taylor", 1e-10).unwrap(),
+        tiles: None,
+    };
+    let params = defaults("kapitza");
+    let whole = stability_chart("kapitza", &params, &base).unwrap();
+    assert!(whole.boundaries.iter().all(|b| !b.is_empty()));
+    let folder = tempfile::tempdir().unwrap();
+    let tiled = |only: Option<Vec<usize>>| ChartSettings {
+        tiles: Some(Tiles {
+            folder: folder.path().to_path_buf(),
+            rows: 1,
+            only,
+        }),
+        ..base.clone()
+    };
+    let first = stability_chart("kapitza", &params, &tiled(Some(vec![1, 3])));
+    assert!(matches!(first, Err(StabilityError::Partial)), "{first:?}");
+    let sweep = std::fs::read_dir(folder.path())
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let files = || {
+        let mut names: Vec<String> = std::fs::read_dir(&sweep)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(files(), ["tile_1.bin", "tile_3.bin"]);
+    let stamp = |name: &str| {
+        std::fs::metadata(sweep.join(name))
+            .unwrap()
+            .modified()
+            .unwrap()
+    };
+    let before = [stamp("tile_1.bin"), stamp("tile_3.bin")];
+    let resumed = stability_chart("kapitza", &params, &tiled(None)).unwrap();
+    assert_eq!(files().len(), 4);
+    assert_eq!([stamp("tile_1.bin"), stamp("tile_3.bin")], before);
+    assert_eq!(resumed.stable, whole.stable);
+    let bits = |b: &[Vec<f64>]| -> Vec<Vec<u64>> {
+        b.iter()
+            .map(|c| c.iter().map(|v| v.to_bits()).collect())
+            .collect()
+    };
+    assert_eq!(bits(&resumed.boundaries), bits(&whole.boundaries));
+    let missing = stability_chart("kapitza", &params, &tiled(Some(vec![4])));
+    assert!(
+        matches!(
+            missing,
+            Err(StabilityError::Tile(TileError::NoSuchTile {
+                tile: 4,
+                count: 4
+            }))
+        ),
+        "{missing:?}"
+    );
 }
