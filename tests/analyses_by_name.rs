@@ -11,3 +11,16 @@ mod chaos_map;
 mod every_model;
 #[path = "analyses_by_name/stability.rs"]
 mod stability;
+
+/// The one sweep folder (named by its fingerprint) that a tiled run wrote
+/// under `root`.
+fn sweep_folder(root: &std::path::Path) -> std::path::PathBuf {
+    let mut folders = std::fs::read_dir(root).unwrap();
+    let sweep = folders.next().unwrap().unwrap().path();
+    assert!(
+        folders.next().is_none(),
+        "one sweep under {}",
+        root.display()
+    );
+    sweep
+}

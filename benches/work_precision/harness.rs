@@ -411,7 +411,8 @@ pub const METHODS: [&str; 8] = [
 ];
 
 /// Time of method `slow` over time of method `fast` at equal error, per
-/// problem and target error (log-log interpolated along each method's runs).
+/// problem with runs of both and target error (log-log interpolated along
+/// each method's runs).
 pub fn speedups(
     rows: &[Row],
     problems: &[&str],
@@ -425,6 +426,9 @@ pub fn speedups(
                 .collect()
         };
         let (dop, taylor) = (of(slow), of(fast));
+        if dop.is_empty() || taylor.is_empty() {
+            continue;
+        }
         let ratios = [1e-6, 1e-8, 1e-10]
             .into_iter()
             .map(|target| {

@@ -87,23 +87,8 @@ fn bench() -> Result<(), BenchError> {
     };
     let period = mechlab::studies::kapitza::period(&problems::KAPITZA);
     let ratios = performance(&system, &problems::REGULAR, period, periods, &runs.rows)?;
-    let speedups = speedups(
-        &runs.rows,
-        &[
-            "kapitza_regular",
-            "kapitza_regular_global",
-            "kapitza_chaotic",
-            "kapitza_ensemble",
-            "double_pendulum",
-            "triple_pendulum",
-        ],
-        ("dop853", "taylor"),
-    );
-    let lanes = harness::speedups(
-        &runs.rows,
-        &["kapitza_ensemble"],
-        ("taylor", "taylor_lanes"),
-    );
+    let taylor_over_dop853 = speedups(&runs.rows, &PROBLEMS, ("dop853", "taylor"));
+    let lanes_over_taylor = speedups(&runs.rows, &PROBLEMS, ("taylor", "taylor_lanes"));
     let header = [
         "problem",
         "method",
@@ -129,8 +114,8 @@ fn bench() -> Result<(), BenchError> {
         slopes_error_vs_f_evals: slopes,
         reference_agreement: &runs.agreements,
         performance: ratios,
-        taylor_speedup_over_dop853: speedups,
-        lanes_speedup_over_taylor: lanes,
+        taylor_speedup_over_dop853: taylor_over_dop853,
+        lanes_speedup_over_taylor: lanes_over_taylor,
     };
     println!("performance: {}", serde_json::json!(summary.performance));
     println!(

@@ -109,9 +109,13 @@ pub(super) fn step_exponent(y_norm: f64, top_norms: [f64; 2], p: usize) -> f64 {
 }
 
 /// ρ·safety from log2 ρ; `None` for log2 ρ = +∞ (the series is exact).
+/// Branch-free (a placeholder exponent where the series is exact), so that
+/// the batch method computes it for all lanes at once.
 #[inline(always)]
 pub(super) fn step_from_exponent(exponent: f64, safety: f64) -> Option<f64> {
-    (exponent < f64::INFINITY).then(|| super::kernels::exp2(exponent) * safety)
+    let exact = !(exponent < f64::INFINITY);
+    let step = super::kernels::exp2(if exact { 0.0 } else { exponent }) * safety;
+    (!exact).then_some(step)
 }
 
 /// The step to take from t towards t1 (`remaining` = |t1 − t| away), and

@@ -10,9 +10,10 @@
 //! they gain the SIMD width and the overlap of independent lanes, where one
 //! orbit's recurrences are a chain of dependent operations.
 
-use super::kernels::exp2;
 use super::lanes::{Lanes, LANES};
-use super::taylor::{compensated_sum, horner, safety, step_exponent, step_to_take};
+use super::taylor::{
+    compensated_sum, horner, safety, step_exponent, step_from_exponent, step_to_take,
+};
 use super::{check_initial, order_for_tolerance, Method, OdeError, Stats, System, TaylorWork};
 
 /// The result of one lane.
@@ -134,11 +135,14 @@ impl LaneIntegrator {
                 let Some(result) = end else { continue };
                 self.stats.steps += run.steps[l];
                 let k = orbit_of[l];
-                let go_on = match result {
-                    Ok(mut y) => after_segment(k, &mut y).then_some(y).map(Ok),
+                // Its next segment, or why it ends (None: it is done).
+                let next = match result {
+                    Ok(mut y) => {
+                        after_segment(k, &mut y).then(|| check_initial(0.0, &y, t1).map(|()| y))
+                    }
                     Err(e) => Some(Err(e)),
                 };
-                match go_on.map(|y| y.and_then(|y| check_initial(0.0, &y, t1).map(|()| y))) {
+                match next {
                     Some(Ok(y)) => run.restart(l, &y),
                     Some(Err(e)) => {
                         errors[k] = Some(e);
@@ -175,24 +179,19 @@ impl LaneIntegrator {
             row_norms(&run.y),
             [row_norms(&c[order - 1]), row_norms(&c[order])],
         );
-        // The step rule for all lanes at once, branch-free so that it
-        // vectorises (a placeholder exponent where the series is exact,
-        // as step_from_exponent decides), then lane by lane.
-        let mut steps = [0.0; LANES];
-        let mut exact = [false; LANES];
-        for l in 0..LANES {
+        // The step rule for all lanes at once (vectorised), then lane by lane.
+        let mut steps = [None; LANES];
+        for (l, step) in steps.iter_mut().enumerate() {
             let exponent = step_exponent(y_norm.0[l], [top[0].0[l], top[1].0[l]], order);
-            exact[l] = !(exponent < f64::INFINITY);
-            steps[l] = exp2(if exact[l] { 0.0 } else { exponent }) * safety;
+            *step = step_from_exponent(exponent, safety);
         }
         let mut h = [0.0; LANES];
         let mut last = [false; LANES];
         let mut stepping = run.running;
         for l in (0..LANES).filter(|&l| run.running[l]) {
             self.stats.f_evals += order as u64;
-            let step = (!exact[l]).then_some(steps[l]);
             let direction = (t1 - run.t[l]).signum();
-            match step_to_take(step, (t1 - run.t[l]).abs(), run.t[l], || run.state(l)) {
+            match step_to_take(steps[l], (t1 - run.t[l]).abs(), run.t[l], || run.state(l)) {
                 Ok((step, is_last)) => (h[l], last[l]) = (step * direction, is_last),
                 Err(e) => (ends[l], stepping[l]) = (Some(Err(e)), false),
             }

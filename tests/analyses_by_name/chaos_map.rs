@@ -211,12 +211,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
     assert_eq!(bits(&resumed.fli), bits(&whole.fli));
     assert_eq!(resumed.f_evals, whole.f_evals);
 
-    let sweep = std::fs::read_dir(folder.path())
-        .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
+    let sweep = crate::sweep_folder(folder.path());
     let tile = sweep.join("tile_2.bin");
     let bytes = std::fs::read(&tile).unwrap();
     std::fs::write(&tile, &bytes[..bytes.len() - 3]).unwrap();

@@ -241,12 +241,7 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
     };
     let first = stability_chart("kapitza", &params, &tiled(Some(vec![1, 3])));
     assert!(matches!(first, Err(StabilityError::Partial)), "{first:?}");
-    let sweep = std::fs::read_dir(folder.path())
-        .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
+    let sweep = crate::sweep_folder(folder.path());
     let files = || {
         let mut names: Vec<String> = std::fs::read_dir(&sweep)
             .unwrap()
