@@ -30,6 +30,8 @@ mod emit;
 mod generate;
 #[path = "build/latex.rs"]
 mod latex;
+#[path = "build/lie.rs"]
+mod lie;
 #[path = "build/numeric.rs"]
 mod numeric;
 #[path = "build/simplify.rs"]

@@ -95,6 +95,12 @@ pub struct NumericForm {
     /// mean(h_s), so that b̄ = Σ m_s g_s.
     pub mode_means: Vec<f64>,
     pub averaged_momentum_rates: Vec<String>,
+    /// (a, b) of each mode's h_s = sin(θ)^a cos(θ)^b.
+    pub mode_exponents: Vec<(i64, i64)>,
+    /// The Fourier series of V(q, θ) in the phase, harmonic by harmonic.
+    pub potential_series: Vec<(crate::lie::Harmonic, String)>,
+    /// P̄ = mean of the forces over the phase, in q and the velocities.
+    pub mean_forces: Vec<String>,
 }
 
 /// A derivation failure, with the model quantity it concerns.
@@ -1038,6 +1044,9 @@ fn numeric_form(
         mode_products: Vec::new(),
         mode_means: Vec::new(),
         averaged_momentum_rates: Vec::new(),
+        mode_exponents: Vec::new(),
+        potential_series: Vec::new(),
+        mean_forces: Vec::new(),
     };
     let mean_potential = match &phase {
         Some(th) => {
@@ -1089,6 +1098,7 @@ fn numeric_form(
                 let (numerator, denominator) = monomial_mean(a, b);
                 numerator as f64 / denominator as f64
             };
+            form.mode_exponents = modes.iter().map(|(k, _)| *k).collect();
             form.mode_means = modes.iter().map(|((a, b), _)| mean(*a, *b)).collect();
             form.mode_products = modes
                 .iter()
@@ -1102,8 +1112,31 @@ fn numeric_form(
                     reduced = reduced + &mass[i][j] * var(&qd[i]) * var(&qd[j]) / num(2);
                 }
             }
+            for (h, coefficient) in crate::deprit::fourier(&potential, th)? {
+                let (label, what) = match h {
+                    crate::lie::Harmonic::Cos(0) => (
+                        "cos0".to_string(),
+                        format!("the mean of V(q, {th}) over {th}"),
+                    ),
+                    crate::lie::Harmonic::Cos(k) => (
+                        format!("cos{k}"),
+                        format!("the coefficient of cos({k}{th}) in V(q, {th})"),
+                    ),
+                    crate::lie::Harmonic::Sin(k) => (
+                        format!("sin{k}"),
+                        format!("the coefficient of sin({k}{th}) in V(q, {th})"),
+                    ),
+                };
+                let text = rec.record(
+                    format!("potential_harmonics[{label}]"),
+                    format!("{what}, for second-order averaging"),
+                    &coefficient.expand(),
+                )?;
+                form.potential_series.push((h, text));
+            }
             for i in 0..n {
                 let force = phase_mean(&forces[i], th)?;
+                form.mean_forces.push(force.to_string());
                 let rate_i = (reduced.derivative(symbol!(q[i].as_str())) + force).expand();
                 form.averaged_momentum_rates.push(rec.record(
                     format!("averaged_momentum_rates[{i}]"),

@@ -88,6 +88,11 @@ pub struct Emitter {
     solve_derivatives: HashMap<(usize, String), Option<usize>>,
     /// Factorised matrices already bound, by their entries.
     factors: HashMap<Vec<Vec<usize>>, String>,
+    /// A conversion (e.g. `crate::ode::HyperDual::from`) around every entry
+    /// of the arrays handed to the solves, for code over a number type
+    /// other than f64: there, parameter expressions stay f64 while the
+    /// state's are of that type, and an array needs one type.
+    pub lift: Option<&'static str>,
 }
 
 fn literal(value: f64) -> String {
@@ -738,7 +743,8 @@ impl Emitter {
                 let rows: Vec<String> = matrix
                     .iter()
                     .map(|row| {
-                        let cells: Vec<String> = row.iter().map(|&a| self.text(a)).collect();
+                        let cells: Vec<String> =
+                            row.iter().map(|&a| self.lifted(self.text(a))).collect();
                         format!("[{}]", cells.join(", "))
                     })
                     .collect();
@@ -760,7 +766,7 @@ impl Emitter {
                     })
                     .collect(),
             };
-            let rhs: Vec<String> = column.iter().map(|&r| self.text(r)).collect();
+            let rhs: Vec<String> = column.iter().map(|&r| self.lifted(self.text(r))).collect();
             self.lines.push(format!(
                 "let [{}] = {factor}.solve([{}]);",
                 outputs.join(", "),
@@ -774,6 +780,14 @@ impl Emitter {
                 });
                 self.bound.insert(node, name);
             }
+        }
+    }
+
+    /// `text` converted by [`Emitter::lift`], if any.
+    pub fn lifted(&self, text: String) -> String {
+        match self.lift {
+            Some(f) => format!("{f}({text})"),
+            None => text,
         }
     }
 

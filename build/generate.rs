@@ -63,6 +63,9 @@ pub enum Inputs {
     State,
     /// The state of the autonomous averaged system.
     AveragedState,
+    /// That state as hyper-dual numbers (`crate::ode::HyperDual`), for
+    /// derivatives at run time.
+    DualAveragedState,
     /// `y = [s, s']` of a contact model (sliding coordinates, velocities).
     ContactState,
 }
@@ -141,14 +144,16 @@ impl Context<'_> {
                 prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
                 format!("y: &[f64; {}], params: &Params", 2 * n)
             }
-            Inputs::State | Inputs::AveragedState => {
+            Inputs::State | Inputs::AveragedState | Inputs::DualAveragedState => {
                 let mut names = self.coordinates();
                 names.extend(self.momenta());
                 prelude.push(format!("let [{}] = *y;", names.join(", ")));
-                if matches!(inputs, Inputs::State) {
-                    format!("{time}: f64, y: &[f64; {}], params: &Params", 2 * n)
-                } else {
-                    format!("y: &[f64; {}], params: &Params", 2 * n)
+                match inputs {
+                    Inputs::State => format!("{time}: f64, y: &[f64; {}], params: &Params", 2 * n),
+                    Inputs::DualAveragedState => {
+                        format!("y: &[crate::ode::HyperDual; {}], params: &Params", 2 * n)
+                    }
+                    _ => format!("y: &[f64; {}], params: &Params", 2 * n),
                 }
             }
         };
@@ -185,6 +190,10 @@ impl Context<'_> {
     ) -> Result<Function, String> {
         let (args, mut body) = self.signature_and_prelude(inputs);
         let mut emitter = Emitter::default();
+        if matches!(inputs, Inputs::DualAveragedState) {
+            emitter.lift = Some("crate::ode::HyperDual::from");
+        }
+        let result = emitter.lifted(result);
         for step in steps {
             emitter.apply(step).map_err(|e| format!("{name}: {e}"))?;
         }
@@ -337,7 +346,13 @@ pub fn render(
     );
     context.insert("momenta", &cx.momenta());
     context.insert("has_phase", &model.fast_phase.is_some());
-    context.insert("has_second_order", &derivation.second_order.is_some());
+    // Every model with a fast phase: in closed form, or (numeric solves)
+    // with the series' coefficients in the DAG.
+    context.insert(
+        "has_second_order",
+        &(derivation.second_order.is_some()
+            || (derivation.numeric.is_some() && model.fast_phase.is_some())),
+    );
     context.insert(
         "phase",
         &model
@@ -537,7 +552,11 @@ fn symbolic_functions(
     }
 
     if let Some(second) = &derivation.second_order {
-        functions.extend(second_order_functions(cx, second)?);
+        functions.extend(second_order_functions(
+            cx,
+            second,
+            &SecondOrderSteps::default(),
+        )?);
     }
     let taylor_functions = taylor_functions(cx, derivation, &velocity_stage)?;
     Ok((functions, taylor_functions))
@@ -760,12 +779,30 @@ pub fn render_registry(
         .map_err(|e| format!("template registry.rs.tera: {e:?}"))
 }
 
+/// The steps that define the names the texts of a
+/// [`crate::deprit::SecondOrderForm`] use (none in closed form; the solves
+/// and brackets of the numeric-solve form), and how K̄ is differentiated.
+#[derive(Default)]
+pub struct SecondOrderSteps {
+    /// Before K̄.
+    pub hamiltonian: Vec<Step>,
+    /// After K̄ and before the forces P̄.
+    pub forces: Vec<Step>,
+    /// Before εχ₁.
+    pub generator: Vec<Step>,
+    /// K̄'s gradient and Hessian at run time, by hyper-dual numbers through
+    /// `averaged2_hamiltonian_dual`, instead of forward mode through the
+    /// DAG at build time: where K̄ already holds second derivatives of
+    /// solves, the DAG's third and fourth would multiply the code's size.
+    pub run_time_derivatives: bool,
+}
+
 /// The second-order averaged system: K̄ = H̄ + εK̄₁ + ε²K̄₂ (ε = 1/rate), its
-/// field, its Hessian in the state and the first-order map's shift, the
-/// derivatives by forward mode through the DAG.
-fn second_order_functions(
+/// field, its Hessian in the state and the first-order map's shift.
+pub fn second_order_functions(
     cx: &Context,
     second: &crate::deprit::SecondOrderForm,
+    before: &SecondOrderSteps,
 ) -> Result<Vec<Function>, String> {
     let q = cx.coordinates();
     let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
@@ -796,52 +833,106 @@ fn second_order_functions(
             .map(|(i, f)| (format!("force__{i}"), f.clone()))
             .collect(),
     );
-    let hessian = Step::Derivatives(
-        (0..m)
-            .flat_map(|i| (0..m).map(move |j| (i, j)))
-            .map(|(i, j)| {
-                (
-                    format!("k__{i}_{j}"),
-                    "k__".to_string(),
-                    vec![state[i].clone(), state[j].clone()],
-                )
-            })
-            .collect(),
-    );
-    let (_, hessian_result) = matrix("k", &vec![vec![String::new(); m]; m]);
     let generator = Step::Values(vec![("chi__".into(), second.generator.clone())]);
-    Ok(vec![
-        cx.function_steps(
-            "averaged2_hamiltonian",
-            "Averaged Hamiltonian to second order, K̄ = H̄ + εK̄₁ + ε²K̄₂ with ε = 1/rate.",
-            Inputs::AveragedState,
-            "f64".into(),
-            std::slice::from_ref(&k_bar),
+    let with = |prelude: &[Step], steps: &[Step]| -> Vec<Step> {
+        prelude.iter().chain(steps).cloned().collect()
+    };
+    let k_steps = with(&before.hamiltonian, std::slice::from_ref(&k_bar));
+    let doc_k = "Averaged Hamiltonian to second order, K̄ = H̄ + εK̄₁ + ε²K̄₂ with ε = 1/rate.";
+    let doc_rhs = "Second-order averaged equations: q' = ∂K̄/∂p, p' = −∂K̄/∂q + P̄.";
+    let doc_hessian =
+        "Hessian ∂²K̄/∂y² of the second-order averaged Hamiltonian in the state y = [q; p].";
+    let mut functions = vec![cx.function_steps(
+        "averaged2_hamiltonian",
+        doc_k,
+        Inputs::AveragedState,
+        "f64".into(),
+        &k_steps,
+        "k__".into(),
+    )?];
+    if before.run_time_derivatives {
+        functions.push(cx.function_steps(
+            "averaged2_hamiltonian_dual",
+            "K̄ over hyper-dual numbers: its gradient and Hessian at run time (`crate::ode::hyperdual`).",
+            Inputs::DualAveragedState,
+            "crate::ode::HyperDual".into(),
+            &k_steps,
             "k__".into(),
-        )?,
-        cx.function_steps(
+        )?);
+        let dual_k = "|y| averaged2_hamiltonian_dual(y, params)";
+        let mut rhs = cx.function_steps(
             "averaged2_rhs",
-            "Second-order averaged equations: q' = ∂K̄/∂p, p' = −∂K̄/∂q + P̄.",
+            doc_rhs,
             Inputs::AveragedState,
             format!("[f64; {m}]"),
-            &[k_bar.clone(), forces, gradient("k__", "dk")],
+            &with(&before.forces, &[forces]),
             symplectic("dk", &|i| format!(" + force__{i}")),
-        )?,
-        cx.function_steps(
+        )?;
+        let names: Vec<String> = (0..m).map(|i| format!("dk__{i}")).collect();
+        // Before the prelude, whose coordinates may shadow `y`.
+        rhs.body.insert(
+            0,
+            format!(
+                "let [{}] = crate::ode::hyperdual::gradient({dual_k}, y);",
+                names.join(", ")
+            ),
+        );
+        functions.push(rhs);
+        // Before the prelude, whose coordinates may shadow `y`.
+        let mut hessian = cx.function_steps(
             "averaged2_hessian",
-            "Hessian ∂²K̄/∂y² of the second-order averaged Hamiltonian in the state y = [q; p].",
+            doc_hessian,
             Inputs::AveragedState,
             format!("[[f64; {m}]; {m}]"),
-            &[k_bar, hessian],
-            hessian_result,
-        )?,
-        cx.function_steps(
-            "averaged2_shift",
-            "J∇(εχ₁) at (y′, θ(t)): the exact state is y = y′ + shift to first order in ε.",
-            Inputs::State,
+            &[],
+            "hessian__".into(),
+        )?;
+        hessian.body.insert(
+            0,
+            format!("let hessian__ = crate::ode::hyperdual::hessian({dual_k}, y);"),
+        );
+        functions.push(hessian);
+    } else {
+        let mut field = k_steps.clone();
+        field.extend(before.forces.iter().cloned());
+        field.extend([forces, gradient("k__", "dk")]);
+        functions.push(cx.function_steps(
+            "averaged2_rhs",
+            doc_rhs,
+            Inputs::AveragedState,
             format!("[f64; {m}]"),
-            &[generator, gradient("chi__", "dchi")],
-            symplectic("dchi", &|_| String::new()),
-        )?,
-    ])
+            &field,
+            symplectic("dk", &|i| format!(" + force__{i}")),
+        )?);
+        let hessian = Step::Derivatives(
+            (0..m)
+                .flat_map(|i| (0..m).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    (
+                        format!("k__{i}_{j}"),
+                        "k__".to_string(),
+                        vec![state[i].clone(), state[j].clone()],
+                    )
+                })
+                .collect(),
+        );
+        let (_, hessian_result) = matrix("k", &vec![vec![String::new(); m]; m]);
+        functions.push(cx.function_steps(
+            "averaged2_hessian",
+            doc_hessian,
+            Inputs::AveragedState,
+            format!("[[f64; {m}]; {m}]"),
+            &with(&before.hamiltonian, &[k_bar, hessian]),
+            hessian_result,
+        )?);
+    }
+    functions.push(cx.function_steps(
+        "averaged2_shift",
+        "J∇(εχ₁) at (y′, θ(t)): the exact state is y = y′ + shift to first order in ε.",
+        Inputs::State,
+        format!("[f64; {m}]"),
+        &with(&before.generator, &[generator, gradient("chi__", "dchi")]),
+        symplectic("dchi", &|_| String::new()),
+    )?);
+    Ok(functions)
 }

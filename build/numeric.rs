@@ -338,13 +338,14 @@ pub fn functions(
         &mut functions,
     )?;
     let averaged = match cx.model.fast_phase {
-        Some(_) => Some(averaged_functions(
-            cx,
-            derivation,
-            form,
-            &state,
-            &mut functions,
-        )?),
+        Some(_) => {
+            let field = averaged_functions(cx, derivation, form, &state, &mut functions)?;
+            let (second, steps) = second_order(cx, derivation, form);
+            functions.extend(crate::generate::second_order_functions(
+                cx, &second, &steps,
+            )?);
+            Some(field)
+        }
         None => None,
     };
     let taylor = taylor_set(
@@ -434,4 +435,206 @@ fn averaged_functions(
         functions,
     )?;
     Ok((averaged, outputs))
+}
+
+/// Coefficients of the Lie series as expressions over named outputs of the
+/// emitter's DAG. A bracket names its operands and their first derivatives
+/// in every state variable (forward mode through the solves, see
+/// [`crate::emit::Emitter::derivative`]): nothing is expanded, and nested
+/// brackets differentiate the earlier derivatives through their
+/// definitions.
+struct DagCoefficients {
+    /// [q, p]: the first half coordinates, the second momenta.
+    state: Vec<String>,
+    steps: Vec<Step>,
+    /// Expression text → the name it was given.
+    named: std::collections::HashMap<String, String>,
+}
+
+impl DagCoefficients {
+    /// The name of `text` (a new output with its derivatives on first use).
+    fn name(&mut self, text: &str) -> String {
+        if let Some(name) = self.named.get(text) {
+            return name.clone();
+        }
+        let name = format!("lie{}__", self.named.len());
+        self.steps
+            .push(Step::Values(vec![(name.clone(), text.to_string())]));
+        self.steps.push(Step::Derivatives(
+            self.state
+                .iter()
+                .enumerate()
+                .map(|(k, v)| (format!("{name}d{k}"), name.clone(), vec![v.clone()]))
+                .collect(),
+        ));
+        self.named.insert(text.to_string(), name.clone());
+        name
+    }
+}
+
+impl crate::lie::Coefficients for DagCoefficients {
+    type C = String;
+    fn zero(&mut self) -> String {
+        "0".into()
+    }
+    fn add(&mut self, a: &String, b: &String) -> String {
+        match (a.as_str(), b.as_str()) {
+            ("0", _) => b.clone(),
+            (_, "0") => a.clone(),
+            _ => format!("{a}+{b}"),
+        }
+    }
+    fn scale(&mut self, c: &String, numerator: i64, denominator: i64) -> String {
+        if c == "0" || numerator == 0 {
+            return "0".into();
+        }
+        format!("({numerator}/{denominator})*({c})")
+    }
+    fn bracket(&mut self, f: &String, g: &String) -> String {
+        if f == "0" || g == "0" {
+            return "0".into();
+        }
+        let (f, g) = (self.name(f), self.name(g));
+        let n = self.state.len() / 2;
+        let terms: Vec<String> = (0..n)
+            .map(|i| format!("{f}d{i}*{g}d{}-{f}d{}*{g}d{i}", n + i, n + i))
+            .collect();
+        format!("({})", terms.join("+"))
+    }
+}
+
+/// The second-order averaged system of a numeric-solve model: the Lie
+/// series of `build/lie.rs` with coefficients in the DAG. With y = A⁻¹p,
+/// x_s = A⁻¹g_s (one factorisation) and b = Σ h_s(θ) g_s,
+/// H = ½ pᵀy − Σ h_s g_s·y + ½ Σ h_s h_t g_s·x_t + V(q, θ), whose Fourier
+/// series in θ follows from the products h_s h_t (monomials in sin θ,
+/// cos θ).
+pub fn second_order(
+    cx: &Context,
+    derivation: &Derivation,
+    form: &NumericForm,
+) -> (
+    crate::deprit::SecondOrderForm,
+    crate::generate::SecondOrderSteps,
+) {
+    use crate::lie::{add_to, monomial, Harmonic, Series};
+    let n = cx.n();
+    let momenta = cx.momenta();
+    let modes = form.modes.len();
+    let mut values = upper("mass", &derivation.mass_matrix);
+    for (s, mode) in form.modes.iter().enumerate() {
+        values.extend(
+            mode.iter()
+                .enumerate()
+                .map(|(i, g)| (format!("mode{s}__{i}"), g.clone())),
+        );
+    }
+    let mut columns = vec![momenta.clone()];
+    let mut solved: Vec<Vec<String>> = vec![(0..n).map(|i| format!("inverse_p__{i}")).collect()];
+    for s in 0..modes {
+        columns.push((0..n).map(|i| format!("mode{s}__{i}")).collect());
+        solved.push((0..n).map(|i| format!("solved{s}__{i}")).collect());
+    }
+    let mode = |s: usize| -> Vec<String> { (0..n).map(|i| format!("mode{s}__{i}")).collect() };
+    let mut scalars = vec![("kinetic__".to_string(), dot(&momenta, &solved[0]))];
+    for s in 0..modes {
+        scalars.push((format!("coupling{s}__"), dot(&mode(s), &solved[0])));
+        for t in s..modes {
+            scalars.push((format!("vibration{s}_{t}__"), dot(&mode(s), &solved[1 + t])));
+        }
+    }
+    let base = vec![
+        Step::Values(values),
+        Step::Solve {
+            matrix: names("mass", n),
+            columns,
+            names: solved,
+        },
+        Step::Values(scalars),
+    ];
+    let mut state = cx.coordinates();
+    state.extend(momenta.iter().cloned());
+    let mut alg = DagCoefficients {
+        state,
+        steps: Vec::new(),
+        named: Default::default(),
+    };
+    let mut series: Series<String> = Series::new();
+    add_to(
+        &mut alg,
+        &mut series,
+        Harmonic::Cos(0),
+        "kinetic__/2".into(),
+    );
+    for (s, &(a, b)) in form.mode_exponents.iter().enumerate() {
+        for (h, numerator, denominator) in monomial(a, b) {
+            let term = format!("({}/{denominator})*coupling{s}__", -numerator);
+            add_to(&mut alg, &mut series, h, term);
+        }
+        for (t, &(c, d)) in form.mode_exponents.iter().enumerate() {
+            let (low, high) = (s.min(t), s.max(t));
+            for (h, numerator, denominator) in monomial(a + c, b + d) {
+                let term = format!("({numerator}/{})*vibration{low}_{high}__", 2 * denominator);
+                add_to(&mut alg, &mut series, h, term);
+            }
+        }
+    }
+    for (h, coefficient) in &form.potential_series {
+        add_to(&mut alg, &mut series, *h, format!("({coefficient})"));
+    }
+    let terms = crate::lie::second_order(&mut alg, &series);
+    let mean = crate::lie::mean(&mut alg, &series);
+    let phase = cx.model.fast_phase.as_ref().map_or("", |f| f.name.as_str());
+    let generator: Vec<String> = terms
+        .generator
+        .iter()
+        .map(|(h, c)| match h {
+            Harmonic::Cos(0) => format!("({c})"),
+            Harmonic::Cos(k) => format!("({c})*cos({k}*{phase})"),
+            Harmonic::Sin(k) => format!("({c})*sin({k}*{phase})"),
+        })
+        .collect();
+    let eps = format!("(1/({}))", derivation.phase_rate);
+    let residuals: Vec<(String, String)> = (0..n)
+        .map(|i| {
+            (
+                format!("residual_mean__{i}"),
+                format!("{}-({})", momenta[i], form.mean_linear_term[i]),
+            )
+        })
+        .collect();
+    let frictionless = form.mean_forces.iter().all(|f| f == "0");
+    let velocities = match frictionless {
+        true => Vec::new(),
+        false => vec![
+            Step::Values(upper("mass", &derivation.mass_matrix)),
+            Step::Values(residuals),
+            Step::Solve {
+                matrix: names("mass", n),
+                columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
+                names: vec![cx.velocities()],
+            },
+        ],
+    };
+    let mut hamiltonian = base.clone();
+    hamiltonian.extend(alg.steps);
+    (
+        crate::deprit::SecondOrderForm {
+            hamiltonian: format!(
+                "({mean}) + {eps}*({}) + {eps}^2*({})",
+                terms.first, terms.second
+            ),
+            forces: form.mean_forces.clone(),
+            generator: match generator.is_empty() {
+                true => "0".into(),
+                false => format!("{eps}*({})", generator.join("+")),
+            },
+        },
+        crate::generate::SecondOrderSteps {
+            hamiltonian,
+            forces: velocities,
+            generator: base,
+            run_time_derivatives: true,
+        },
+    )
 }

@@ -101,6 +101,30 @@ fn numeric_and_symbolic_forms_agree_on_the_double_pendulum() {
                 vec![double_pendulum_numeric::vibrational_potential(&q, &numeric)],
                 "vibrational_potential",
             ),
+            // Second-order averaging: K̄ expanded by Symbolica, its
+            // derivatives forward mode in the DAG, against the Lie series
+            // in the DAG with the solves and K̄'s derivatives by hyper-dual
+            // numbers at run time.
+            (
+                vec![double_pendulum::averaged2_hamiltonian(&y, &symbolic)],
+                vec![double_pendulum_numeric::averaged2_hamiltonian(&y, &numeric)],
+                "averaged2_hamiltonian",
+            ),
+            (
+                double_pendulum::averaged2_rhs(&y, &symbolic).to_vec(),
+                double_pendulum_numeric::averaged2_rhs(&y, &numeric).to_vec(),
+                "averaged2_rhs",
+            ),
+            (
+                flat(&double_pendulum::averaged2_hessian(&y, &symbolic)),
+                flat(&double_pendulum_numeric::averaged2_hessian(&y, &numeric)),
+                "averaged2_hessian",
+            ),
+            (
+                double_pendulum::averaged2_shift(t, &y, &symbolic).to_vec(),
+                double_pendulum_numeric::averaged2_shift(t, &y, &numeric).to_vec(),
+                "averaged2_shift",
+            ),
         ];
         for (a, b, name) in pairs {
             for (x, z) in a.iter().zip(&b) {

@@ -160,6 +160,37 @@ fn double_pendulum_second_order_threshold_meets_the_exact_edge() {
     );
 }
 
+/// The triple and quadruple chains (numeric solves: K̄ from the Lie series
+/// in the DAG) at ν = 100: the second-order threshold of the upright chain
+/// is far closer to the exact (Floquet) edge than a* is.
+#[test]
+fn chains_second_order_thresholds_meet_the_exact_edges() {
+    use mechlab::models::{quadruple_pendulum as quadruple, triple_pendulum as triple};
+    let triple = triple::Params {
+        nu: 100.0,
+        ..Default::default()
+    };
+    let quadruple = quadruple::Params {
+        nu: 100.0,
+        ..Default::default()
+    };
+    for (model, params, a_max) in [
+        ("triple_pendulum", triple.values(), 12.0),
+        ("quadruple_pendulum", quadruple.values(), 20.0),
+    ] {
+        let (exact, first, second) = thresholds(model, &params, "a", a_max);
+        eprintln!(
+            "{model}: exact − first {:e}, exact − second {:e}",
+            exact - first,
+            exact - second
+        );
+        assert!(
+            (exact - second).abs() * 50.0 < (exact - first).abs(),
+            "{model}: exact {exact}, first {first}, second {second}"
+        );
+    }
+}
+
 /// Theorem 2 one order higher: the exact run against the second-order
 /// averaged run from the transformed state (mapped back) deviates like
 /// 1/ν², where the first-order comparison deviates like 1/ν.
@@ -205,10 +236,10 @@ fn second_order_trajectories_deviate_like_one_over_nu_squared() {
     );
 }
 
-/// A model in the numeric-solve form has no second-order system: a typed
-/// error, not a panic.
+/// Averaging is derived to second order: asking for the third is a typed
+/// error naming the model and the order, not a panic.
 #[test]
-fn second_order_is_an_error_where_it_is_not_derived() {
+fn an_order_not_derived_is_an_error() {
     use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
     let params = mechlab::models::triple_pendulum::Params::default();
     let settings = ConvergenceSettings {
@@ -217,14 +248,14 @@ fn second_order_is_an_error_where_it_is_not_derived() {
         y0: None,
         t_obs: 1.0,
         method: Method::parse("dop853", 1e-10).unwrap(),
-        order: 2,
+        order: 3,
     };
     let error = convergence("triple_pendulum", &params.values(), &settings).unwrap_err();
-    assert!(matches!(error, AveragingError::Order(_, 2)), "{error}");
+    assert!(matches!(error, AveragingError::Order(_, 3)), "{error}");
 }
 
-/// Every model file with a second-order system: its trajectories deviate
-/// like 1/ν² from the exact ones (a wrong K̄₁, such as the circular
+/// Every model file with a fast phase has a second-order system, and its
+/// trajectories deviate like 1/ν² from the exact ones (a wrong K̄₁, such as the circular
 /// pivot's A²p/2, or a wrong map would leave −1).
 #[test]
 fn every_second_order_model_converges_like_one_over_nu_squared() {
@@ -263,5 +294,9 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             Err(e) => panic!("{}: {e}", info.name),
         }
     }
-    assert!(checked.len() >= 6, "{checked:?}");
+    // Every model with a fast phase, the chains (numeric solves) included.
+    for name in ["kapitza", "double_pendulum", "triple_pendulum", "quadruple_pendulum"] {
+        assert!(checked.contains(&name), "{name} not checked: {checked:?}");
+    }
+    assert!(checked.len() >= 8, "{checked:?}");
 }

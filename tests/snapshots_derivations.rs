@@ -81,3 +81,28 @@ fn latex_uses_greek_letters_and_subscripts() {
         "{rates}"
     );
 }
+
+/// The chains solve for A⁻¹ at run time, so their K̄₂ has no closed form to
+/// pin: their second-order Hessian at the upright chain (defaults, ν = 100)
+/// is pinned instead, to nine digits, in a snapshot.
+#[test]
+fn chains_second_order_hessians_are_pinned() {
+    use mechlab::models::{quadruple_pendulum as quadruple, triple_pendulum as triple};
+    fn rows<const S: usize>(h: [[f64; S]; S]) -> String {
+        let scale = h.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
+        // Round-off below 1e-12 of the largest entry prints as zero.
+        let cell = |x: f64| if x.abs() < 1e-12 * scale { 0.0 } else { x };
+        h.iter()
+            .map(|row| {
+                let cells: Vec<String> =
+                    row.iter().map(|&x| format!("{:+.9e}", cell(x))).collect();
+                cells.join(" ")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+    let triple = triple::averaged2_hessian(&[0.0; 6], &triple::Params::default());
+    insta::assert_snapshot!("triple_pendulum__averaged2_hessian_upright", rows(triple));
+    let quadruple = quadruple::averaged2_hessian(&[0.0; 8], &quadruple::Params::default());
+    insta::assert_snapshot!("quadruple_pendulum__averaged2_hessian_upright", rows(quadruple));
+}

@@ -244,16 +244,18 @@ async fn overlay_matches_the_averaged_hamiltonian_by_hand() {
     }
     assert_eq!(separatrices, 2);
 
-    // To second order where derived; a model in the numeric-solve form
-    // has none, and says so.
-    let second = json!({"model": "kapitza", "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 2});
-    let (status, _, body) = call("POST", "/api/overlay", Some(second)).await;
-    assert_eq!(status, StatusCode::OK, "{body}");
-    assert!(body.contains("second order"), "{body}");
-    let triple = json!({"model": "triple_pendulum", "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 2});
-    let (status, _, body) = call("POST", "/api/overlay", Some(triple)).await;
+    // To second order for every model with a fast phase, the numeric-solve
+    // form included; an order that is not derived is refused by name.
+    for model in ["kapitza", "triple_pendulum"] {
+        let second = json!({"model": model, "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 2});
+        let (status, _, body) = call("POST", "/api/overlay", Some(second)).await;
+        assert_eq!(status, StatusCode::OK, "{body}");
+        assert!(body.contains("second order"), "{body}");
+    }
+    let third = json!({"model": "triple_pendulum", "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 3});
+    let (status, _, body) = call("POST", "/api/overlay", Some(third)).await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
-    assert!(body.contains("order 2 is not derived"), "{body}");
+    assert!(body.contains("order 3 is not derived"), "{body}");
 }
 
 /// Every bad request gets a status and a message naming the problem; the

@@ -184,7 +184,7 @@ pub enum AveragingError {
         got: usize,
         expected: usize,
     },
-    #[error("model '{0}': the averaged system of order {1} is not derived (order 1 always is; order 2 for models in the symbolic form, not the numeric-solve form)")]
+    #[error("model '{0}': the averaged system of order {1} is not derived (orders 1 and 2 are, for every model with a fast phase)")]
     Order(String, usize),
     #[error(transparent)]
     Ode(#[from] OdeError),

@@ -9,6 +9,7 @@
 mod dop853;
 mod events;
 mod gauss;
+pub mod hyperdual;
 pub mod kernels;
 mod lanes;
 mod radau5;
@@ -18,6 +19,7 @@ pub mod taylor;
 mod taylor_lanes;
 
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
+pub use hyperdual::HyperDual;
 pub use lanes::{Lanes, LANES};
 pub use series::Scalar;
 pub use taylor::{order_for_tolerance, TaylorWork};
