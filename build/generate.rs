@@ -346,12 +346,11 @@ pub fn render(
     );
     context.insert("momenta", &cx.momenta());
     context.insert("has_phase", &model.fast_phase.is_some());
-    // Every model with a fast phase: in closed form, or (numeric solves)
-    // with the series' coefficients in the DAG.
+    // Every model with a fast phase: in closed form, or (numeric solves,
+    // up to `numeric::SECOND_ORDER_MAX_DOF`) with the series in the DAG.
     context.insert(
         "has_second_order",
-        &(derivation.second_order.is_some()
-            || (derivation.numeric.is_some() && model.fast_phase.is_some())),
+        &(derivation.second_order.is_some() || crate::numeric::has_second_order(derivation, model)),
     );
     context.insert(
         "phase",
@@ -842,15 +841,24 @@ pub fn second_order_functions(
     let doc_rhs = "Second-order averaged equations: q' = ∂K̄/∂p, p' = −∂K̄/∂q + P̄.";
     let doc_hessian =
         "Hessian ∂²K̄/∂y² of the second-order averaged Hamiltonian in the state y = [q; p].";
-    let mut functions = vec![cx.function_steps(
-        "averaged2_hamiltonian",
-        doc_k,
-        Inputs::AveragedState,
-        "f64".into(),
-        &k_steps,
-        "k__".into(),
-    )?];
+    let mut functions = Vec::new();
     if before.run_time_derivatives {
+        // K̄ itself as the value part of the hyper-dual one: one copy of
+        // the code, the largest function of these models.
+        let mut k = cx.function_steps(
+            "averaged2_hamiltonian",
+            doc_k,
+            Inputs::AveragedState,
+            "f64".into(),
+            &[],
+            "k__".into(),
+        )?;
+        k.body.insert(
+            0,
+            "let k__ = averaged2_hamiltonian_dual(&y.map(crate::ode::HyperDual::from), params).re;"
+                .into(),
+        );
+        functions.push(k);
         functions.push(cx.function_steps(
             "averaged2_hamiltonian_dual",
             "K̄ over hyper-dual numbers: its gradient and Hessian at run time (`crate::ode::hyperdual`).",
@@ -893,6 +901,14 @@ pub fn second_order_functions(
         );
         functions.push(hessian);
     } else {
+        functions.push(cx.function_steps(
+            "averaged2_hamiltonian",
+            doc_k,
+            Inputs::AveragedState,
+            "f64".into(),
+            &k_steps,
+            "k__".into(),
+        )?);
         let mut field = k_steps.clone();
         field.extend(before.forces.iter().cloned());
         field.extend([forces, gradient("k__", "dk")]);

@@ -51,12 +51,8 @@ fn dot(x: &[String], y: &[String]) -> String {
     format!("({})", terms.join("+"))
 }
 
-/// Steps of x_t = A⁻¹g_t for every mode g_t of b over the phase (as
-/// `solved{t}__{i}`) and V_vibr = ½ Σ M_st g_s·x_t (as `v_vibr__`), from
-/// the coordinates alone. (Generated names contain `__`, which no name of a
-/// model file may: they never shadow a parameter.)
-fn vibrational_steps(derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
-    let n = derivation.dof;
+/// A's upper triangle (`mass__i_j`) and the modes g_s of b (`mode{s}__{i}`).
+fn mass_and_modes(derivation: &Derivation, form: &NumericForm) -> Vec<(String, String)> {
     let mut values = upper("mass", &derivation.mass_matrix);
     for (s, mode) in form.modes.iter().enumerate() {
         values.extend(
@@ -65,6 +61,16 @@ fn vibrational_steps(derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
                 .map(|(i, g)| (format!("mode{s}__{i}"), g.clone())),
         );
     }
+    values
+}
+
+/// Steps of x_t = A⁻¹g_t for every mode g_t of b over the phase (as
+/// `solved{t}__{i}`) and V_vibr = ½ Σ M_st g_s·x_t (as `v_vibr__`), from
+/// the coordinates alone. (Generated names contain `__`, which no name of a
+/// model file may: they never shadow a parameter.)
+fn vibrational_steps(derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
+    let n = derivation.dof;
+    let values = mass_and_modes(derivation, form);
     let mut steps = vec![Step::Values(values)];
     if !form.modes.is_empty() {
         steps.push(Step::Solve {
@@ -340,10 +346,12 @@ pub fn functions(
     let averaged = match cx.model.fast_phase {
         Some(_) => {
             let field = averaged_functions(cx, derivation, form, &state, &mut functions)?;
-            let (second, steps) = second_order(cx, derivation, form);
-            functions.extend(crate::generate::second_order_functions(
-                cx, &second, &steps,
-            )?);
+            if has_second_order(derivation, cx.model) {
+                let (second, steps) = second_order(cx, derivation, form);
+                functions.extend(crate::generate::second_order_functions(
+                    cx, &second, &steps,
+                )?);
+            }
             Some(field)
         }
         None => None,
@@ -437,6 +445,19 @@ fn averaged_functions(
     Ok((averaged, outputs))
 }
 
+/// The largest numeric-solve model averaged to second order. K̄₂ holds
+/// second derivatives of the solves in every pair of coordinates, so its
+/// code grows like n⁴: 1 200 lines for 4 degrees of freedom, 8 300 for 6,
+/// which made the library's build 8 minutes longer.
+pub const SECOND_ORDER_MAX_DOF: usize = 4;
+
+/// Whether a numeric-solve model gets the second-order averaged system.
+pub fn has_second_order(derivation: &Derivation, model: &crate::model::Model) -> bool {
+    derivation.numeric.is_some()
+        && model.fast_phase.is_some()
+        && derivation.dof <= SECOND_ORDER_MAX_DOF
+}
+
 /// Coefficients of the Lie series as expressions over named outputs of the
 /// emitter's DAG. A bracket names its operands and their first derivatives
 /// in every state variable (forward mode through the solves, see
@@ -521,14 +542,7 @@ pub fn second_order(
     let n = cx.n();
     let momenta = cx.momenta();
     let modes = form.modes.len();
-    let mut values = upper("mass", &derivation.mass_matrix);
-    for (s, mode) in form.modes.iter().enumerate() {
-        values.extend(
-            mode.iter()
-                .enumerate()
-                .map(|(i, g)| (format!("mode{s}__{i}"), g.clone())),
-        );
-    }
+    let values = mass_and_modes(derivation, form);
     let mut columns = vec![momenta.clone()];
     let mut solved: Vec<Vec<String>> = vec![(0..n).map(|i| format!("inverse_p__{i}")).collect()];
     for s in 0..modes {

@@ -10,9 +10,11 @@
 //! `cargo run --release --example stability -- --set model=triple_pendulum`
 //! `cargo run --release --example stability -- --set chart=eps,A --set chart_y_max=12`
 
-use mechlab::analysis::stability::{stability, stability_chart, ChartSettings, Settings};
+use mechlab::analysis::stability::{
+    stability, stability_chart, ChartSettings, Settings, StabilityError,
+};
 use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
-use mechlab::scenes::{method_from, method_knobs, model_from_args};
+use mechlab::scenes::{method_from, method_knobs, model_from_args, tiles_from};
 
 fn main() {
     run(|| {
@@ -31,6 +33,8 @@ fn main() {
             knob("chart_x", "0.02,0.5,40", "first, last value and count of x"),
             knob("chart_y_max", "12", "y is sampled on (0, chart_y_max]"),
             knob("chart_y_samples", "120", "samples of y that bracket the boundaries"),
+            knob("chart_tile_columns", "4", "chart columns per tile, each written to out/stability.tiles/ when done so a rerun resumes (0: no tiles)"),
+            knob("chart_only_tiles", "all", "compute only these chart tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the chart"),
         ];
         knobs.extend(parameter_knobs(info, &[]));
         let scene = Scene::from_args(
@@ -73,11 +77,15 @@ fn main() {
             scene.save_figure(&figure, "spectral_radius.png")?;
         }
         if scene.text("chart") != "none" {
-            let chart = stability_chart(
-                info.name,
-                &params,
-                &chart_settings(&scene, &settings, info.coordinates.len())?,
-            )?;
+            let chart_settings = chart_settings(&scene, &settings, info.coordinates.len())?;
+            let chart = match stability_chart(info.name, &params, &chart_settings) {
+                // A job of an array: its tiles are written, the last run draws.
+                Err(StabilityError::Partial) => {
+                    eprintln!("chart tiles {} written", scene.text("chart_only_tiles"));
+                    return Ok(());
+                }
+                chart => chart?,
+            };
             let rows = chart
                 .boundaries
                 .iter()
@@ -135,6 +143,6 @@ fn chart_settings(
         y_samples: scene.count("chart_y_samples")?,
         edge_tolerance: settings.edge_tolerance,
         method: settings.method,
-        tiles: None,
+        tiles: tiles_from(scene, ["chart_tile_columns", "chart_only_tiles"])?,
     })
 }

@@ -154,7 +154,7 @@ pub fn chaos_map_scene(
         pixels: scene.count("pixels")?,
         periods: scene.count("periods")?,
         method: method_from(&scene)?,
-        tiles: tiles_from(&scene)?,
+        tiles: tiles_from(&scene, ["tile_rows", "only_tiles"])?,
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
     let params = scene.parameter_values(info)?;
@@ -271,33 +271,38 @@ mod ranks {
     }
 }
 
-/// The tiles of the `tile_rows` and `only_tiles` knobs, in
+/// The tiles of the knobs `size` (rows or columns per tile, 0 for none)
+/// and `only` (`all`, or the indices of a job's tiles), in
 /// `out/<scene>.tiles/` beside the scene's output folder.
-fn tiles_from(scene: &Scene) -> Result<Option<crate::analysis::chaos_map::Tiles>, SceneError> {
-    if scene.number("tile_rows")? == 0.0 {
+pub fn tiles_from(
+    scene: &Scene,
+    [size, only]: [&str; 2],
+) -> Result<Option<crate::analysis::tiles::Tiles>, SceneError> {
+    if scene.number(size)? == 0.0 {
         return Ok(None);
     }
-    let only = match scene.text("only_tiles") {
+    let only_name = only;
+    let only = match scene.text(only_name) {
         "all" => None,
         _ => Some(
             scene
-                .numbers("only_tiles")?
+                .numbers(only_name)?
                 .iter()
                 .map(|k| {
                     (*k >= 0.0 && k.fract() == 0.0)
                         .then_some(*k as usize)
                         .ok_or_else(|| SceneError::BadValue {
-                            name: "only_tiles".into(),
-                            value: scene.text("only_tiles").into(),
+                            name: only_name.into(),
+                            value: scene.text(only_name).into(),
                             reason: "tile indices are whole numbers from 0".into(),
                         })
                 })
                 .collect::<Result<_, _>>()?,
         ),
     };
-    Ok(Some(crate::analysis::chaos_map::Tiles {
+    Ok(Some(crate::analysis::tiles::Tiles {
         folder: scene.out.with_extension("tiles"),
-        rows: scene.count("tile_rows")?,
+        rows: scene.count(size)?,
         only,
     }))
 }

@@ -295,7 +295,12 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
         }
     }
     // Every model with a fast phase, the chains (numeric solves) included.
-    for name in ["kapitza", "double_pendulum", "triple_pendulum", "quadruple_pendulum"] {
+    for name in [
+        "kapitza",
+        "double_pendulum",
+        "triple_pendulum",
+        "quadruple_pendulum",
+    ] {
         assert!(checked.contains(&name), "{name} not checked: {checked:?}");
     }
     assert!(checked.len() >= 8, "{checked:?}");

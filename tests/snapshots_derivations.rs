@@ -94,8 +94,7 @@ fn chains_second_order_hessians_are_pinned() {
         let cell = |x: f64| if x.abs() < 1e-12 * scale { 0.0 } else { x };
         h.iter()
             .map(|row| {
-                let cells: Vec<String> =
-                    row.iter().map(|&x| format!("{:+.9e}", cell(x))).collect();
+                let cells: Vec<String> = row.iter().map(|&x| format!("{:+.9e}", cell(x))).collect();
                 cells.join(" ")
             })
             .collect::<Vec<_>>()
@@ -104,5 +103,8 @@ fn chains_second_order_hessians_are_pinned() {
     let triple = triple::averaged2_hessian(&[0.0; 6], &triple::Params::default());
     insta::assert_snapshot!("triple_pendulum__averaged2_hessian_upright", rows(triple));
     let quadruple = quadruple::averaged2_hessian(&[0.0; 8], &quadruple::Params::default());
-    insta::assert_snapshot!("quadruple_pendulum__averaged2_hessian_upright", rows(quadruple));
+    insta::assert_snapshot!(
+        "quadruple_pendulum__averaged2_hessian_upright",
+        rows(quadruple)
+    );
 }

@@ -184,7 +184,7 @@ pub enum AveragingError {
         got: usize,
         expected: usize,
     },
-    #[error("model '{0}': the averaged system of order {1} is not derived (orders 1 and 2 are, for every model with a fast phase)")]
+    #[error("model '{0}': the averaged system of order {1} is not derived (order 1 is for every model with a fast phase, order 2 too except for models with a numeric solve of more than 4 degrees of freedom, whose code would grow like n⁴)")]
     Order(String, usize),
     #[error(transparent)]
     Ode(#[from] OdeError),

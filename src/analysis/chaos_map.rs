@@ -239,7 +239,7 @@ impl WithFixed for Map<'_> {
                     settings.method,
                     tiles.rows
                 );
-                match run_tiles(tiles, fingerprint(&key), (pixels, pixels), &rows_of)? {
+                match run_tiles(tiles, fingerprint(&key), (pixels, pixels, "rows"), &rows_of)? {
                     Some(map) => map,
                     None => return Err(ChaosMapError::Partial),
                 }

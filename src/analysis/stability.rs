@@ -801,7 +801,7 @@ impl WithFixed for Chart<'_> {
                     settings.method,
                     tiles.rows
                 );
-                let shape = (settings.x_values.len(), 2 * samples);
+                let shape = (settings.x_values.len(), 2 * samples, "columns");
                 match run_tiles(tiles, fingerprint(&key), shape, &columns_of)? {
                     Some((values, _)) => values,
                     None => return Err(StabilityError::Partial),

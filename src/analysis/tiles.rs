@@ -106,10 +106,11 @@ pub(crate) fn fingerprint(text: &str) -> u64 {
 /// `row_count` rows of `row_len` values each (`rows_of` computes a range of
 /// rows: their values and f-evaluations), then merges every tile into the
 /// sweep's values and f-evaluations; None if only some tiles were asked for.
+/// `unit` names a row in the progress lines ("rows", "columns").
 pub(crate) fn run_tiles<E: From<TileError>>(
     tiles: &Tiles,
     fingerprint: u64,
-    (row_count, row_len): (usize, usize),
+    (row_count, row_len, unit): (usize, usize, &str),
     rows_of: &dyn Fn(std::ops::Range<usize>) -> Result<(Vec<f64>, u64), E>,
 ) -> Result<Option<(Vec<f64>, u64)>, E> {
     let rows = tiles.rows.max(1);
@@ -140,7 +141,7 @@ pub(crate) fn run_tiles<E: From<TileError>>(
             None => {
                 let (values, evals) = rows_of(span(k))?;
                 write_tile(&path(k), fingerprint, evals, &values).map_err(E::from)?;
-                eprintln!("tile {}/{count} done ({} rows)", k + 1, span(k).len());
+                eprintln!("tile {}/{count} done ({} {unit})", k + 1, span(k).len());
                 (evals, values)
             }
         };

@@ -57,7 +57,7 @@ pub enum RequestProblem {
     SeedLength { got: usize, expected: usize },
     #[error("the state to pass through has {got} components; the state [q; p] has {expected}")]
     ThroughLength { got: usize, expected: usize },
-    #[error("the averaged Hamiltonian to order {0} is not derived for this model (orders: 1, and 2 for models with a fast phase)")]
+    #[error("the averaged Hamiltonian to order {0} is not derived for this model (orders: 1, and 2 for models with a fast phase, except numeric-solve models of more than 4 degrees of freedom)")]
     Order(usize),
     #[error("the request has a field '{0}' that this route does not know")]
     UnknownField(String),
