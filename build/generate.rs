@@ -796,6 +796,13 @@ pub struct SecondOrderSteps {
     pub run_time_derivatives: bool,
 }
 
+/// `f` with `line` first, before the prelude (whose coordinates may shadow
+/// the argument `y` the line reads).
+fn first_line(mut f: Function, line: String) -> Function {
+    f.body.insert(0, line);
+    f
+}
+
 /// The second-order averaged system: K̄ = H̄ + εK̄₁ + ε²K̄₂ (ε = 1/rate), its
 /// field, its Hessian in the state and the first-order map's shift.
 pub fn second_order_functions(
@@ -845,7 +852,7 @@ pub fn second_order_functions(
     if before.run_time_derivatives {
         // K̄ itself as the value part of the hyper-dual one: one copy of
         // the code, the largest function of these models.
-        let mut k = cx.function_steps(
+        let k = cx.function_steps(
             "averaged2_hamiltonian",
             doc_k,
             Inputs::AveragedState,
@@ -853,12 +860,11 @@ pub fn second_order_functions(
             &[],
             "k__".into(),
         )?;
-        k.body.insert(
-            0,
+        functions.push(first_line(
+            k,
             "let k__ = averaged2_hamiltonian_dual(&y.map(crate::ode::HyperDual::from), params).re;"
                 .into(),
-        );
-        functions.push(k);
+        ));
         functions.push(cx.function_steps(
             "averaged2_hamiltonian_dual",
             "K̄ over hyper-dual numbers: its gradient and Hessian at run time (`crate::ode::hyperdual`).",
@@ -868,7 +874,7 @@ pub fn second_order_functions(
             "k__".into(),
         )?);
         let dual_k = "|y| averaged2_hamiltonian_dual(y, params)";
-        let mut rhs = cx.function_steps(
+        let rhs = cx.function_steps(
             "averaged2_rhs",
             doc_rhs,
             Inputs::AveragedState,
@@ -877,17 +883,14 @@ pub fn second_order_functions(
             symplectic("dk", &|i| format!(" + force__{i}")),
         )?;
         let names: Vec<String> = (0..m).map(|i| format!("dk__{i}")).collect();
-        // Before the prelude, whose coordinates may shadow `y`.
-        rhs.body.insert(
-            0,
+        functions.push(first_line(
+            rhs,
             format!(
                 "let [{}] = crate::ode::hyperdual::gradient({dual_k}, y);",
                 names.join(", ")
             ),
-        );
-        functions.push(rhs);
-        // Before the prelude, whose coordinates may shadow `y`.
-        let mut hessian = cx.function_steps(
+        ));
+        let hessian = cx.function_steps(
             "averaged2_hessian",
             doc_hessian,
             Inputs::AveragedState,
@@ -895,11 +898,10 @@ pub fn second_order_functions(
             &[],
             "hessian__".into(),
         )?;
-        hessian.body.insert(
-            0,
+        functions.push(first_line(
+            hessian,
             format!("let hessian__ = crate::ode::hyperdual::hessian({dual_k}, y);"),
-        );
-        functions.push(hessian);
+        ));
     } else {
         functions.push(cx.function_steps(
             "averaged2_hamiltonian",

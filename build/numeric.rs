@@ -617,10 +617,12 @@ pub fn second_order(
             )
         })
         .collect();
+    // The forces P̄ read the velocities q' = A⁻¹(p − b̄), if there are any.
     let frictionless = form.mean_forces.iter().all(|f| f == "0");
-    let velocities = match frictionless {
-        true => Vec::new(),
-        false => vec![
+    let velocities = if frictionless {
+        Vec::new()
+    } else {
+        vec![
             Step::Values(upper("mass", &derivation.mass_matrix)),
             Step::Values(residuals),
             Step::Solve {
@@ -628,7 +630,7 @@ pub fn second_order(
                 columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
                 names: vec![cx.velocities()],
             },
-        ],
+        ]
     };
     let mut hamiltonian = base.clone();
     hamiltonian.extend(alg.steps);
