@@ -358,11 +358,28 @@ impl Emitter {
                 format!("{} * {}", atom(*a), atom(*a))
             }
             Node::Powi(a, -1) => format!("1.0 / {}", atom(*a)),
-            Node::Powi(a, k) => format!("{}.powi({k})", atom(*a)),
-            Node::Sqrt(a) => format!("{}.sqrt()", atom(*a)),
-            Node::Powf(a, b) => format!("{}.powf({})", atom(*a), t(*b)),
-            Node::Call(f, a) => format!("{}.{f}()", atom(*a)),
+            Node::Powi(a, k) => format!("{}.powi({k})", self.receiver(*a)),
+            Node::Sqrt(a) => format!("{}.sqrt()", self.receiver(*a)),
+            Node::Powf(a, b) => format!("{}.powf({})", self.receiver(*a), t(*b)),
+            Node::Call(f, a) => format!("{}.{f}()", self.receiver(*a)),
             Node::Solution { .. } => unreachable!("solutions are bound before use"),
+        }
+    }
+
+    /// The receiver of a method call: a literal typed as f64 (`2.0.sqrt()`
+    /// does not compile: its float type is ambiguous), a sum parenthesised.
+    fn receiver(&self, j: usize) -> String {
+        match &self.nodes[j] {
+            Node::Lit(l) if !self.bound.contains_key(&j) => match l.strip_prefix('-') {
+                Some(magnitude) => format!("(-{magnitude}_f64)"),
+                None => format!("{l}_f64"),
+            },
+            _ if self.bound.contains_key(&j)
+                || matches!(self.nodes[j], Node::Var(_) | Node::Call(..) | Node::Sqrt(_)) =>
+            {
+                self.text(j)
+            }
+            _ => format!("({})", self.text(j)),
         }
     }
 
@@ -803,12 +820,15 @@ impl Emitter {
                     let (s, c) = if f == "sin" { (i, j) } else { (j, i) };
                     let (sn, cn) = (self.name_for(s), self.name_for(c));
                     let arg = self.text(a);
-                    let arg =
-                        if self.bound.contains_key(&a) || matches!(self.nodes[a], Node::Var(_)) {
+                    let arg = match self.nodes[a] {
+                        Node::Lit(_) => self.receiver(a),
+                        _ if self.bound.contains_key(&a)
+                            || matches!(self.nodes[a], Node::Var(_)) =>
+                        {
                             arg
-                        } else {
-                            format!("({arg})")
-                        };
+                        }
+                        _ => format!("({arg})"),
+                    };
                     self.lines
                         .push(format!("let ({sn}, {cn}) = {arg}.sin_cos();"));
                     self.bound.insert(s, sn);

@@ -119,7 +119,14 @@ impl Context<'_> {
             .iter()
             .map(|p| p.name.clone())
             .collect();
-        let params_line = format!("let &Params {{ {} }} = params;", params.join(", "));
+        let params_line = format!(
+            "let &Params {{ {} }} = params;",
+            if params.is_empty() {
+                "..".to_string()
+            } else {
+                params.join(", ")
+            }
+        );
         let phase_line = self
             .model
             .fast_phase

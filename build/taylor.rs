@@ -257,10 +257,12 @@ impl Lowering<'_> {
             }
             Node::Powf(a, b) => {
                 let (a, b) = (self.lower(a)?, self.lower(b)?);
-                if self.classes[b] == Class::Constant {
+                if let Op::Literal(_) = self.ops[b] {
                     self.intern(Op::Power(a, b))
                 } else {
-                    // u^v = exp(v ln u) for a varying exponent.
+                    // u^v = exp(v ln u) for an exponent that is not a
+                    // number (powers take an f64 exponent; a parameter is
+                    // a `Num`, a lane's own in a batch).
                     let ln = self.intern(Op::Ln(a));
                     let product = self.intern(Op::Mul(b, ln));
                     self.intern(Op::Exp(product))
@@ -465,8 +467,12 @@ impl Lowering<'_> {
                     self.intern(Op::Div(x, two_w))
                 }),
                 Op::Power(a, alpha) => self.derivative(a, dim, t, memo).map(|x| {
-                    let one = self.literal("1.0");
-                    let lowered = self.intern(Op::Sub(alpha, one));
+                    // The exponent is a literal (see `lower`), and so is α − 1.
+                    let Op::Literal(value) = &self.ops[alpha] else {
+                        unreachable!("powers have literal exponents")
+                    };
+                    let value: f64 = value.parse().expect("a literal is a number");
+                    let lowered = self.literal(&format!("{:?}", value - 1.0));
                     let power = self.intern(Op::Power(a, lowered));
                     let slope = self.multiply(alpha, power);
                     self.multiply(slope, x)
@@ -600,7 +606,14 @@ pub fn recurrences(
             None => format!("{p}: _"),
         })
         .collect();
-    let params_line = format!("let &Params {{ {} }} = params;", fields.join(", "));
+    let params_line = format!(
+        "let &Params {{ {} }} = params;",
+        if fields.is_empty() {
+            "..".to_string()
+        } else {
+            fields.join(", ")
+        }
+    );
     Ok(Writer {
         ops: &lowering.ops,
         classes: &lowering.classes,
@@ -749,16 +762,6 @@ impl Writer<'_> {
         }
     }
 
-    /// [`Writer::value`], as the recurrences' number type `Num` where
-    /// `varying` (a constant among varying entries of one array).
-    fn value_as(&self, k: usize, varying: bool) -> String {
-        if varying && self.constant(k) {
-            format!("Num::from({})", self.value(k))
-        } else {
-            self.value(k)
-        }
-    }
-
     /// Order-n coefficient of a varying node.
     fn at(&self, k: usize, n: &str) -> String {
         format!("{}[{n}]", self.names[k])
@@ -773,32 +776,49 @@ impl Writer<'_> {
             Op::State(i) => format!("y[{i}]"),
             Op::Time => self.time.to_string(),
             Op::Phase(r) => format!("{} * {}", self.time, v(*r)),
-            Op::Neg(a) => format!("-{}", v(*a)),
+            Op::Neg(a) => format!("-{}", self.value_num(*a)),
             Op::Add(a, b) => self.binary(*a, "+", *b),
             Op::Sub(a, b) => self.binary(*a, "-", *b),
             Op::Mul(a, b) => self.binary(*a, "*", *b),
             Op::Div(a, b) => self.binary(*a, "/", *b),
-            Op::Square(a) => format!("{} * {}", v(*a), v(*a)),
-            Op::Sqrt(a) => format!("{}.sqrt()", v(*a)),
-            Op::Power(a, b) => format!("{}.powf({})", v(*a), v(*b)),
-            Op::Exp(a) => format!("{}.exp()", v(*a)),
-            Op::Ln(a) => format!("{}.ln()", v(*a)),
-            Op::Sin(a) => format!("{}.sin()", v(*a)),
-            Op::Cos(a) => format!("{}.cos()", v(*a)),
+            Op::Square(a) => format!("{} * {}", self.value_num(*a), v(*a)),
+            Op::Sqrt(a) => format!("{}.sqrt()", self.value_num(*a)),
+            Op::Power(a, b) => format!("{}.powf({})", self.value_num(*a), v(*b)),
+            Op::Exp(a) => format!("{}.exp()", self.value_num(*a)),
+            Op::Ln(a) => format!("{}.ln()", self.value_num(*a)),
+            Op::Sin(a) => format!("{}.sin()", self.value_num(*a)),
+            Op::Cos(a) => format!("{}.cos()", self.value_num(*a)),
             Op::Solution { .. } => unreachable!("solutions are computed by `solve_lines`"),
         }
     }
 
-    /// `a op b` from the children's values. The recurrences' number type
-    /// `Num` takes f64 on the right only: a constant left of a varying
-    /// node is swapped to the right of + and × (the same rounding), and
-    /// made a `Num` before − and /.
+    /// `a op b` from the children's values. Parameters are of the
+    /// recurrences' number type `Num` (a batch may give each lane its own),
+    /// literals are f64, and `Num` takes f64 on the right only: a literal
+    /// left of a `Num` is swapped to the right of + and × (the same
+    /// rounding), and made a `Num` before − and / or another literal.
     fn binary(&self, a: usize, op: &str, b: usize) -> String {
         let (x, y) = (self.value(a), self.value(b));
-        match (self.constant(a) && !self.constant(b), op) {
-            (true, "+" | "*") => format!("{y} {op} {x}"),
-            (true, _) => format!("Num::from({x}) {op} {y}"),
-            (false, _) => format!("{x} {op} {y}"),
+        match (self.is_literal(a), self.is_literal(b), op) {
+            (true, false, "+" | "*") => format!("{y} {op} {x}"),
+            (true, _, _) => format!("Num::from({x}) {op} {y}"),
+            (false, _, _) => format!("{x} {op} {y}"),
+        }
+    }
+
+    /// Whether node k is a literal (f64; every other node is a `Num`).
+    fn is_literal(&self, k: usize) -> bool {
+        matches!(self.ops[k], Op::Literal(_))
+    }
+
+    /// [`Writer::value`] as the recurrences' number type `Num`: a literal
+    /// wrapped (for a method call on it, or among `Num` entries of one
+    /// array; parameters are `Num` already).
+    fn value_num(&self, k: usize) -> String {
+        if self.is_literal(k) {
+            format!("Num::from({})", self.value(k))
+        } else {
+            self.value(k)
         }
     }
 
@@ -832,12 +852,11 @@ impl Writer<'_> {
 
     /// `let factor = Cholesky::new(A at order 0);`
     fn factor_line(&self, s: &Solve) -> String {
-        let varying = !self.constant_matrix(s);
         let rows: Vec<String> = s
             .matrix
             .iter()
             .map(|row| {
-                let cells: Vec<String> = row.iter().map(|&a| self.value_as(a, varying)).collect();
+                let cells: Vec<String> = row.iter().map(|&a| self.value_num(a)).collect();
                 format!("[{}]", cells.join(", "))
             })
             .collect();
@@ -857,10 +876,7 @@ impl Writer<'_> {
             self.declare_factor(s, lines);
         }
         for (column, solutions) in s.columns.iter().zip(&s.solutions) {
-            let rhs: Vec<String> = column
-                .iter()
-                .map(|&r| self.value_as(r, !constant))
-                .collect();
+            let rhs: Vec<String> = column.iter().map(|&r| self.value_num(r)).collect();
             let targets: Vec<String> = solutions
                 .iter()
                 .map(|&x| {
@@ -936,8 +952,8 @@ impl Writer<'_> {
     fn slope(&self, k: usize) -> String {
         let s = |c: usize| -> Option<String> { (!self.constant(c)).then(|| self.at(c, "1")) };
         match self.ops[k] {
-            Op::Time => "1.0".into(),
-            Op::Phase(r) => self.value(r),
+            Op::Time => "Num::from(1.0)".into(),
+            Op::Phase(r) => self.value_num(r),
             Op::Neg(a) => format!("-{}", self.at(a, "1")),
             Op::Add(a, b) | Op::Sub(a, b) => match (s(a), s(b), &self.ops[k]) {
                 (Some(x), Some(y), Op::Add(..)) => format!("{x} + {y}"),
@@ -1160,7 +1176,7 @@ impl Writer<'_> {
                 .map(|&r| {
                     if self.constant(r) {
                         if n == "0" {
-                            format!("Num::from({}){scale}", self.value(r))
+                            format!("{}{scale}", self.value_num(r))
                         } else {
                             "Num::from(0.0)".into()
                         }
@@ -1221,7 +1237,7 @@ impl Writer<'_> {
             _ => lines.push(format!("{w}[0] = {};", self.scalar(k))),
         }
         if self.classes[k] == Class::Linear {
-            lines.push(format!("{w}[1] = Num::from({});", self.slope(k)));
+            lines.push(format!("{w}[1] = {};", self.slope(k)));
             if self.read_as_series(k) {
                 lines.push(format!("{w}[2..=order].fill(Num::from(0.0));"));
             }

@@ -4,10 +4,11 @@
 //! end with the scalar error without disturbing the others, and only the
 //! Taylor method has a batch mode.
 
+use mechlab::analysis::floquet::{monodromies, monodromy};
 use mechlab::analysis::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators};
 use mechlab::models::{double_pendulum, kapitza, triple_pendulum};
 use mechlab::ode::{
-    Integrator, LaneIntegrator, Lanes, Method, OdeError, Scalar, System, TaylorWork, LANES,
+    Integrator, LaneIntegrator, Lanes, Method, OdeError, Orbit, Scalar, System, TaylorWork, LANES,
 };
 
 const TAYLOR: Method = Method::Taylor { tol: 1e-10 };
@@ -159,7 +160,7 @@ fn a_stream_ends_each_orbit_with_its_scalar_segments() {
     let mut ends: Vec<Vec<[f64; 1]>> = vec![Vec::new(); starts.len()];
     let mut done = vec![0; starts.len()];
     let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
-    let errors = batch.stream(&BlowUp, 0.2, &starts, |k, y| {
+    let errors = batch.stream(&Orbit::of_one_system(&BlowUp, 0.2, &starts), |k, y| {
         done[k] += 1;
         ends[k].push(*y);
         y[0] *= 1.5; // each segment starts from a changed state, as the FLI's renormalisation
@@ -202,6 +203,155 @@ fn a_stream_ends_each_orbit_with_its_scalar_segments() {
     assert_eq!(done[8], 1);
     assert_eq!(batch.stats.steps, scalar.stats.steps);
     assert_eq!(batch.stats.f_evals, scalar.stats.f_evals);
+}
+
+/// Lanes with their own parameters and ends (a sweep over parameters):
+/// Kapitza at 13 points (A, ε) streamed through 8 lanes, each to its own
+/// period, and the triple pendulum at 9 (masses, lengths: a Cholesky
+/// factor per lane), each equal to its scalar run bit for bit; a lane
+/// whose orbit has length 0 returns its start, one from NaN its error.
+#[test]
+fn lanes_with_their_own_parameters_equal_scalar_runs() {
+    let kapitza: Vec<kapitza::Exact> = (0..13)
+        .map(|k| kapitza::Exact {
+            params: kapitza::Params {
+                A: 0.5 + 0.3 * k as f64,
+                eps: 0.05 + 0.02 * k as f64,
+                mu: 0.01 * k as f64,
+            },
+        })
+        .collect();
+    let orbits: Vec<Orbit<_, 2>> = kapitza
+        .iter()
+        .enumerate()
+        .map(|(k, system)| Orbit {
+            system,
+            start: spread(k),
+            end: match k {
+                4 => 0.0,
+                _ => 2.0 * std::f64::consts::PI * system.params.eps,
+            },
+        })
+        .collect();
+    assert_streams_equal_scalar(&orbits);
+    let triple: Vec<triple_pendulum::Exact> = (0..9)
+        .map(|k| {
+            let mut params = triple_pendulum::Params::default();
+            params.m2 = 0.5 + 0.2 * k as f64;
+            params.l3 = 1.5 - 0.1 * k as f64;
+            triple_pendulum::Exact { params }
+        })
+        .collect();
+    let orbits: Vec<Orbit<_, 6>> = triple
+        .iter()
+        .enumerate()
+        .map(|(k, system)| Orbit {
+            system,
+            start: if k == 6 { [f64::NAN; 6] } else { spread(k) },
+            end: 0.2 + 0.01 * k as f64,
+        })
+        .collect();
+    assert_streams_equal_scalar(&orbits);
+}
+
+/// Each orbit streamed for one segment against its scalar run.
+fn assert_streams_equal_scalar<S: System<N>, const N: usize>(orbits: &[Orbit<'_, S, N>]) {
+    let mut ends: Vec<[f64; N]> = orbits.iter().map(|o| o.start).collect();
+    let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
+    let errors = batch.stream(orbits, |k, y| {
+        ends[k] = *y;
+        false
+    });
+    let mut scalar = Integrator::new(TAYLOR).unwrap();
+    for (k, orbit) in orbits.iter().enumerate() {
+        let expected = scalar.advance(orbit.system, 0.0, &orbit.start, orbit.end);
+        let streamed = match &errors[k] {
+            Some(e) => Err(e.clone()),
+            None => Ok(ends[k]),
+        };
+        // Debug text: NaN ≠ NaN, but the errors must read the same.
+        assert_eq!(
+            format!("{streamed:?}"),
+            format!("{expected:?}"),
+            "orbit {k}"
+        );
+    }
+    assert_eq!(batch.stats.steps, scalar.stats.steps);
+    assert_eq!(batch.stats.f_evals, scalar.stats.f_evals);
+}
+
+/// The monodromy matrices of a sweep over (A, ε) in lanes, each over its
+/// own period, equal the scalar ones bit for bit.
+#[test]
+fn monodromies_in_lanes_equal_the_scalar_ones() {
+    let problems: Vec<(kapitza::Exact, f64, [f64; 2])> = (0..11)
+        .map(|k| {
+            let params = kapitza::Params {
+                A: 1.0 + 0.25 * k as f64,
+                eps: 0.1 + 0.01 * k as f64,
+                mu: 0.0,
+            };
+            let period = 2.0 * std::f64::consts::PI * params.eps;
+            (kapitza::Exact { params }, period, [0.0, 0.0])
+        })
+        .collect();
+    let batch = monodromies::<_, 2, 6>(TAYLOR, &problems);
+    for ((system, period, y0), result) in problems.iter().zip(batch) {
+        let mut scalar = Integrator::new(TAYLOR).unwrap();
+        let expected = monodromy::<_, 2, 6>(&mut scalar, system, *period, y0);
+        assert_eq!(result, expected, "{:?}", system.params);
+    }
+}
+
+/// Models whose recurrences compute with literals only (no parameters:
+/// an empty `Params`, gravity √2 as a power of numbers) or take a
+/// parameter as an exponent (through exp(α ln u), in a batch with each
+/// lane's own α): the closed forms hold, and lanes equal scalar runs.
+#[test]
+fn models_without_parameters_or_with_a_parameter_exponent() {
+    use mechlab::test_models::{bare_pendulum, power_law_oscillator};
+    // H = p²/2 − √2 cos q is conserved.
+    let bare = bare_pendulum::Exact {
+        params: bare_pendulum::Params::default(),
+    };
+    let energy = |y: &[f64; 2]| y[1] * y[1] / 2.0 - 2f64.sqrt() * y[0].cos();
+    let y0 = [1.0, 0.5];
+    let y1 = Integrator::new(TAYLOR)
+        .unwrap()
+        .advance(&bare, 0.0, &y0, 10.0)
+        .unwrap();
+    assert!((energy(&y1) - energy(&y0)).abs() < 1e-11, "{y1:?}");
+    // α = 1: V = 1 + x², x(t) = x₀ cos √2t + (p₀/√2) sin √2t.
+    let oscillators: Vec<power_law_oscillator::Exact> =
+        [0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 1.0, 0.75, 1.25]
+            .map(|alpha| power_law_oscillator::Exact {
+                params: power_law_oscillator::Params { alpha },
+            })
+            .to_vec();
+    let orbits: Vec<Orbit<_, 2>> = oscillators
+        .iter()
+        .enumerate()
+        .map(|(k, system)| Orbit {
+            system,
+            start: [0.3 + 0.1 * k as f64, -0.2],
+            end: 3.0,
+        })
+        .collect();
+    assert_streams_equal_scalar(&orbits);
+    let [x0, p0] = orbits[1].start;
+    let w = 2f64.sqrt();
+    let y = Integrator::new(TAYLOR)
+        .unwrap()
+        .advance(&oscillators[1], 0.0, &orbits[1].start, 3.0)
+        .unwrap();
+    let exact = [
+        x0 * (w * 3.0).cos() + p0 / w * (w * 3.0).sin(),
+        -x0 * w * (w * 3.0).sin() + p0 * (w * 3.0).cos(),
+    ];
+    assert!(
+        (y[0] - exact[0]).abs() < 1e-10 && (y[1] - exact[1]).abs() < 1e-10,
+        "{y:?} vs {exact:?}"
+    );
 }
 
 #[test]

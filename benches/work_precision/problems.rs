@@ -8,7 +8,7 @@ use crate::harness::{
 use mechlab::contact::{Mode, Smooth};
 use mechlab::models::painleve_klein::{self as painleve, Contacts};
 use mechlab::models::{double_pendulum as dp, kapitza, triple_pendulum};
-use mechlab::ode::{LaneIntegrator, Method, System};
+use mechlab::ode::{LaneIntegrator, Method, Orbit, System};
 use mechlab::studies::painleve::state_with_deformation;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -132,7 +132,8 @@ fn kapitza_ensemble(runs: &mut Runs, min_seconds: f64) -> Result<(), BenchError>
     let streamed = |tol: f64| -> Result<(Vec<[f64; 2]>, u64), RunError> {
         let mut lanes = LaneIntegrator::new(Method::Taylor { tol })?;
         let (mut ends, mut done) = (starts.clone(), vec![0; starts.len()]);
-        let errors = lanes.stream(&system, period, &starts, |k, y| {
+        let orbits = Orbit::of_one_system(&system, period, &starts);
+        let errors = lanes.stream(&orbits, |k, y| {
             (ends[k], done[k]) = (*y, done[k] + 1);
             done[k] < ENSEMBLE_PERIODS
         });

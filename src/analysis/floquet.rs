@@ -1,7 +1,7 @@
 //! Monodromy matrices and Floquet multipliers of periodic motions.
 
 use super::variational::Variational;
-use crate::ode::{Integrator, OdeError, System};
+use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, Orbit, System};
 use nalgebra::DMatrix;
 
 /// The state after one period and the monodromy matrix ∂y(T)/∂y(0)
@@ -13,22 +13,82 @@ pub fn monodromy<S: System<N>, const N: usize, const M: usize>(
     y0: &[f64; N],
 ) -> Result<([f64; N], [[f64; N]; N]), OdeError> {
     assert_eq!(M, N + N * N, "monodromy needs M = N + N²");
-    let identity: Vec<[f64; N]> = (0..N)
-        .map(|k| std::array::from_fn(|i| f64::from(u8::from(i == k))))
-        .collect();
     let variational = Variational::<S, N, M>::new(system);
-    let z0 = Variational::<S, N, M>::pack(y0, &identity);
+    let z0 = Variational::<S, N, M>::pack(y0, &identity::<N>());
     let z = integrator.advance(&variational, 0.0, &z0, period)?;
+    Ok(split::<S, N, M>(&z))
+}
+
+/// The end state and monodromy matrix of each problem (system, period,
+/// start) of a sweep, as [`monodromy`] gives them: for `taylor` through the
+/// lanes of the batch Taylor method, each lane with its own system (its own
+/// parameters) and period and equal to its scalar run bit for bit; one at a
+/// time for the other methods.
+pub fn monodromies<S: System<N>, const N: usize, const M: usize>(
+    method: Method,
+    problems: &[(S, f64, [f64; N])],
+) -> Vec<Result<([f64; N], [[f64; N]; N]), OdeError>> {
+    assert_eq!(M, N + N * N, "monodromy needs M = N + N²");
+    let Method::Taylor { .. } = method else {
+        // A fresh integrator each: DOP853 would start from the last step size.
+        return problems
+            .iter()
+            .map(|(system, period, y0)| {
+                let mut integrator = Integrator::new(method)?;
+                monodromy::<S, N, M>(&mut integrator, system, *period, y0)
+            })
+            .collect();
+    };
+    let mut lanes = match LaneIntegrator::new(method) {
+        Ok(lanes) => lanes,
+        Err(e) => return vec![Err(e); problems.len()],
+    };
+    let variational: Vec<Variational<S, N, M>> = problems
+        .iter()
+        .map(|(system, _, _)| Variational::new(system))
+        .collect();
+    let orbits: Vec<Orbit<_, M>> = problems
+        .iter()
+        .zip(&variational)
+        .map(|((_, period, y0), system)| Orbit {
+            system,
+            start: Variational::<S, N, M>::pack(y0, &identity::<N>()),
+            end: *period,
+        })
+        .collect();
+    let mut ends: Vec<[f64; M]> = orbits.iter().map(|o| o.start).collect();
+    let errors = lanes.stream(&orbits, |k, z| {
+        ends[k] = *z;
+        false
+    });
+    errors
+        .into_iter()
+        .zip(ends)
+        .map(|(error, z)| match error {
+            Some(e) => Err(e),
+            None => Ok(split::<S, N, M>(&z)),
+        })
+        .collect()
+}
+
+/// The columns of the N×N identity matrix.
+fn identity<const N: usize>() -> Vec<[f64; N]> {
+    (0..N)
+        .map(|k| std::array::from_fn(|i| f64::from(u8::from(i == k))))
+        .collect()
+}
+
+/// The state and the matrix of tangent vectors (as columns) of a
+/// variational state [y; Φ].
+fn split<S: System<N>, const N: usize, const M: usize>(z: &[f64; M]) -> ([f64; N], [[f64; N]; N]) {
     let mut m = [[0.0; N]; N];
-    for (k, column) in (0..N)
-        .map(|k| Variational::<S, N, M>::tangent(&z, k))
-        .enumerate()
-    {
+    for k in 0..N {
+        let column = Variational::<S, N, M>::tangent(z, k);
         for i in 0..N {
             m[i][k] = column[i];
         }
     }
-    Ok((Variational::<S, N, M>::state(&z), m))
+    (Variational::<S, N, M>::state(z), m)
 }
 
 /// Eigenvalues of a monodromy matrix, as (re, im), sorted by decreasing modulus.
@@ -101,25 +161,65 @@ pub fn first_stability_onset<E>(
     samples: usize,
     tolerance: f64,
 ) -> Result<Option<f64>, E> {
-    let mut previous = (lo, margin(lo)?);
-    for i in 1..=samples {
-        let a = lo + (hi - lo) * i as f64 / samples as f64;
-        let g = margin(a)?;
-        if previous.1 > 0.0 && g <= 0.0 {
-            let (mut left, mut right) = (previous.0, a);
-            while right - left > tolerance {
-                let mid = 0.5 * (left + right);
-                if margin(mid)? > 0.0 {
-                    left = mid;
-                } else {
-                    right = mid;
-                }
+    let margins = |values: &[f64]| values.iter().map(|&a| margin(a)).collect();
+    first_onset_in_batches(&margins, 1, lo, hi, samples, tolerance)
+}
+
+/// [`first_stability_onset`] with `margins` evaluating up to `width`
+/// values at once (the lanes of the batch Taylor method,
+/// [`Method::batch_width`]): the samples are taken `width` at a time, and
+/// each narrowing step cuts the bracket into width + 1 parts. Width 1 is
+/// the bisection, step for step.
+pub fn first_onset_in_batches<E>(
+    margins: &dyn Fn(&[f64]) -> Result<Vec<f64>, E>,
+    width: usize,
+    lo: f64,
+    hi: f64,
+    samples: usize,
+    tolerance: f64,
+) -> Result<Option<f64>, E> {
+    let width = width.max(1);
+    let mut previous = (lo, margins(&[lo])?[0]);
+    for first in (1..=samples).step_by(width) {
+        let values: Vec<f64> = (first..=(first + width - 1).min(samples))
+            .map(|i| lo + (hi - lo) * i as f64 / samples as f64)
+            .collect();
+        for (a, g) in values.iter().copied().zip(margins(&values)?) {
+            if previous.1 > 0.0 && g <= 0.0 {
+                return narrow(margins, width, previous.0, a, tolerance).map(Some);
             }
-            return Ok(Some(0.5 * (left + right)));
+            previous = (a, g);
         }
-        previous = (a, g);
     }
     Ok(None)
+}
+
+/// The middle of a bracket [left, right] (margin > 0 at left, ≤ 0 at right)
+/// narrowed to `tolerance` by `width` points per step: the first of them
+/// with margin ≤ 0 and the one before it bound the next bracket.
+fn narrow<E>(
+    margins: &dyn Fn(&[f64]) -> Result<Vec<f64>, E>,
+    width: usize,
+    mut left: f64,
+    mut right: f64,
+    tolerance: f64,
+) -> Result<f64, E> {
+    while right - left > tolerance {
+        let points: Vec<f64> = if width == 1 {
+            vec![0.5 * (left + right)]
+        } else {
+            (1..=width)
+                .map(|j| left + (right - left) * j as f64 / (width + 1) as f64)
+                .collect()
+        };
+        let values = margins(&points)?;
+        match values.iter().position(|&g| g <= 0.0) {
+            Some(0) => right = points[0],
+            Some(j) => (left, right) = (points[j - 1], points[j]),
+            None => left = points[width - 1],
+        }
+    }
+    Ok(0.5 * (left + right))
 }
 
 /// The first interval of a parameter in (lo, hi] on which `margin` ≤ 0
@@ -133,11 +233,27 @@ pub fn stability_window<E>(
     samples: usize,
     tolerance: f64,
 ) -> Result<Option<(f64, Option<f64>)>, E> {
-    let Some(low) = first_stability_onset(margin, lo, hi, samples, tolerance)? else {
+    let margins = |values: &[f64]| values.iter().map(|&a| margin(a)).collect();
+    window_in_batches(&margins, 1, lo, hi, samples, tolerance)
+}
+
+/// [`stability_window`] with `margins` evaluating up to `width` values at
+/// once, as [`first_onset_in_batches`].
+pub fn window_in_batches<E>(
+    margins: &dyn Fn(&[f64]) -> Result<Vec<f64>, E>,
+    width: usize,
+    lo: f64,
+    hi: f64,
+    samples: usize,
+    tolerance: f64,
+) -> Result<Option<(f64, Option<f64>)>, E> {
+    let Some(low) = first_onset_in_batches(margins, width, lo, hi, samples, tolerance)? else {
         return Ok(None);
     };
     let rest = ((hi - low) / (hi - lo) * samples as f64).ceil().max(1.0) as usize;
-    let flipped = |a: f64| margin(a).map(|m| -m);
-    let high = first_stability_onset(&flipped, low + tolerance, hi, rest, tolerance)?;
+    let flipped = |values: &[f64]| -> Result<Vec<f64>, E> {
+        Ok(margins(values)?.into_iter().map(|m| -m).collect())
+    };
+    let high = first_onset_in_batches(&flipped, width, low + tolerance, hi, rest, tolerance)?;
     Ok(Some((low, high)))
 }

@@ -3,7 +3,7 @@
 
 use super::period_map::wrap_angle;
 use super::variational::Variational;
-use crate::ode::{Integrator, LaneIntegrator, OdeError, System};
+use crate::ode::{Integrator, LaneIntegrator, OdeError, Orbit, System};
 use nalgebra::DMatrix;
 
 /// The full Lyapunov spectrum of the period map (exponents per period, in
@@ -95,8 +95,9 @@ pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
         .iter()
         .map(|y0| Variational::<S, N, M>::pack(y0, &[*w0]))
         .collect();
+    let orbits = Orbit::of_one_system(&variational, period, &packed);
     let mut fli = vec![(Fli::<N, M>::new(w0), 0usize); starts.len()];
-    let errors = integrator.stream(&variational, period, &packed, |k, z| {
+    let errors = integrator.stream(&orbits, |k, z| {
         let (fli, done) = &mut fli[k];
         fli.after_period(z);
         *done += 1;

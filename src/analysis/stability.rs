@@ -12,11 +12,11 @@
 //! generated Hessian is evaluated at a = 0, 1, 2 to find C and K, and the
 //! quadratic dependence is checked (else the reason is given).
 
-use super::floquet::{floquet_multipliers, monodromy, spectral_radius, stability_window};
+use super::floquet::{floquet_multipliers, monodromies, spectral_radius, window_in_batches};
 use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues;
 use crate::analysis::period_map::wrap_angle;
-use crate::ode::{Integrator, Method, OdeError, System};
+use crate::ode::{Method, OdeError, System};
 use crate::registry::{Fixed, WithFixed};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -558,8 +558,10 @@ fn second_order_threshold<
 const STABLE_SLACK: f64 = 1e-6;
 
 /// The spectral radius of the exact system's monodromy matrix over one
-/// period of the phase from `y0`, at parameter values `params`.
-fn spectral_radius_at<
+/// period of the phase from `y0`, at each parameter point of `points` (a
+/// sweep): on all cores, in batches of the method's width (the lanes of the
+/// batch Taylor method; each as its own scalar run, bit for bit).
+fn spectral_radii_at<
     F: Fixed<D, S, T, V>,
     const D: usize,
     const S: usize,
@@ -567,14 +569,35 @@ fn spectral_radius_at<
     const V: usize,
 >(
     model: &F,
-    params: &[f64],
+    points: &[Vec<f64>],
     y0: &[f64; S],
     method: Method,
-) -> Result<f64, OdeError> {
-    let period = model.phase_period(params).unwrap_or(f64::NAN);
-    let mut integrator = Integrator::new(method)?;
-    let (_, m) = monodromy::<_, S, V>(&mut integrator, &model.exact(params), period, y0)?;
-    Ok(spectral_radius(&floquet_multipliers(&m)))
+) -> Result<Vec<f64>, OdeError> {
+    use rayon::prelude::*;
+    // Whole batches, about four tasks per thread.
+    let width = method.batch_width();
+    let task = points
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
+        .next_multiple_of(width)
+        .max(width);
+    let radii: Vec<Vec<f64>> = points
+        .par_chunks(task)
+        .map(|chunk| {
+            let problems: Vec<_> = chunk
+                .iter()
+                .map(|p| {
+                    let period = model.phase_period(p).unwrap_or(f64::NAN);
+                    (model.exact(p), period, *y0)
+                })
+                .collect();
+            monodromies::<_, S, V>(method, &problems)
+                .into_iter()
+                .map(|result| result.map(|(_, m)| spectral_radius(&floquet_multipliers(&m))))
+                .collect()
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(radii.concat())
 }
 
 /// The parameters by name of a model with a fast phase, or why it cannot be
@@ -638,13 +661,16 @@ fn exact_window<
     }
     let a_max = settings.a_max.unwrap_or(3.0 * a_star);
     let curve = RefCell::new(Vec::new());
-    let margin = |a: f64| -> Result<f64, OdeError> {
-        let radius = spectral_radius_at(model, &with(a), &y0, settings.method)?;
-        curve.borrow_mut().push([a, radius]);
-        Ok(radius - 1.0 - STABLE_SLACK)
+    let margins = |amplitudes: &[f64]| -> Result<Vec<f64>, OdeError> {
+        let points: Vec<Vec<f64>> = amplitudes.iter().map(|&a| with(a)).collect();
+        let radii = spectral_radii_at(model, &points, &y0, settings.method)?;
+        let mut curve = curve.borrow_mut();
+        curve.extend(amplitudes.iter().zip(&radii).map(|(&a, &r)| [a, r]));
+        Ok(radii.iter().map(|r| r - 1.0 - STABLE_SLACK).collect())
     };
-    let window = stability_window(
-        &margin,
+    let window = window_in_batches(
+        &margins,
+        settings.method.batch_width(),
         0.0,
         a_max,
         settings.samples,
@@ -721,7 +747,6 @@ impl WithFixed for Chart<'_> {
         self,
         model: &'static F,
     ) -> Self::Output {
-        use rayon::prelude::*;
         let info = model.info();
         let settings = self.settings;
         vibrating_model(model, self.params)?;
@@ -736,46 +761,26 @@ impl WithFixed for Chart<'_> {
             )
         })?;
         let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
-        let margin = |x: f64, y: f64| -> Result<f64, OdeError> {
-            let mut p = self.params.to_vec();
-            p[ix] = x;
-            p[iy] = y;
-            Ok(spectral_radius_at(model, &p, &y0, settings.method)? - 1.0 - STABLE_SLACK)
+        let margins = |xy: &[(f64, f64)]| -> Result<Vec<f64>, OdeError> {
+            let points: Vec<Vec<f64>> = xy
+                .iter()
+                .map(|&(x, y)| {
+                    let mut p = self.params.to_vec();
+                    (p[ix], p[iy]) = (x, y);
+                    p
+                })
+                .collect();
+            let radii = spectral_radii_at(model, &points, &y0, settings.method)?;
+            Ok(radii.iter().map(|r| r - 1.0 - STABLE_SLACK).collect())
         };
         let y_values: Vec<f64> = (1..=settings.y_samples)
             .map(|k| settings.y_max * k as f64 / settings.y_samples as f64)
             .collect();
-        // Per x: the verdict at each y sample and the located boundaries.
-        let column = |x: f64| -> Result<(Vec<bool>, Vec<f64>), OdeError> {
-            let margins: Vec<f64> = y_values
-                .iter()
-                .map(|&y| margin(x, y))
-                .collect::<Result<_, _>>()?;
-            let mut edges = Vec::new();
-            for k in 1..y_values.len() {
-                if (margins[k - 1] > 0.0) != (margins[k] > 0.0) {
-                    let (mut low, mut high) = (y_values[k - 1], y_values[k]);
-                    let stable_low = margins[k - 1] <= 0.0;
-                    while high - low > settings.edge_tolerance {
-                        let mid = 0.5 * (low + high);
-                        if (margin(x, mid)? <= 0.0) == stable_low {
-                            low = mid;
-                        } else {
-                            high = mid;
-                        }
-                    }
-                    edges.push(0.5 * (low + high));
-                }
-            }
-            Ok((margins.iter().map(|m| *m <= 0.0).collect(), edges))
-        };
         let samples = y_values.len();
         let columns_of =
             |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), StabilityError> {
-                let columns: Vec<(Vec<bool>, Vec<f64>)> = settings.x_values[range]
-                    .par_iter()
-                    .map(|&x| column(x))
-                    .collect::<Result<_, _>>()?;
+                let xs = &settings.x_values[range];
+                let columns = chart_columns(xs, &y_values, settings.edge_tolerance, &margins)?;
                 Ok((
                     columns
                         .iter()
@@ -823,6 +828,78 @@ impl WithFixed for Chart<'_> {
             boundaries,
         })
     }
+}
+
+/// The verdict at every y of `ys` and the boundaries between them, of each
+/// column x of `xs`: every (x, y) margin of the columns in one sweep, then
+/// every boundary bisected to `tolerance`, all in lockstep, one sweep per
+/// step (each boundary takes the steps it would alone).
+fn chart_columns(
+    xs: &[f64],
+    ys: &[f64],
+    tolerance: f64,
+    margins: &dyn Fn(&[(f64, f64)]) -> Result<Vec<f64>, OdeError>,
+) -> Result<Vec<(Vec<bool>, Vec<f64>)>, OdeError> {
+    let grid: Vec<(f64, f64)> = xs
+        .iter()
+        .flat_map(|&x| ys.iter().map(move |&y| (x, y)))
+        .collect();
+    let sampled = margins(&grid)?;
+    let mut brackets = Vec::new();
+    for (column, m) in sampled.chunks(ys.len()).enumerate() {
+        for k in 1..ys.len() {
+            if (m[k - 1] > 0.0) != (m[k] > 0.0) {
+                let (low, high, stable_low) = (ys[k - 1], ys[k], m[k - 1] <= 0.0);
+                brackets.push(Bracket {
+                    column,
+                    low,
+                    high,
+                    stable_low,
+                });
+            }
+        }
+    }
+    loop {
+        let open: Vec<&mut Bracket> = brackets
+            .iter_mut()
+            .filter(|b| b.high - b.low > tolerance)
+            .collect();
+        if open.is_empty() {
+            break;
+        }
+        let middles: Vec<(f64, f64)> = open
+            .iter()
+            .map(|b| (xs[b.column], 0.5 * (b.low + b.high)))
+            .collect();
+        for ((b, (_, mid)), m) in open.into_iter().zip(&middles).zip(margins(&middles)?) {
+            if (m <= 0.0) == b.stable_low {
+                b.low = *mid;
+            } else {
+                b.high = *mid;
+            }
+        }
+    }
+    Ok(sampled
+        .chunks(ys.len())
+        .enumerate()
+        .map(|(column, m)| {
+            let edges = brackets
+                .iter()
+                .filter(|b| b.column == column)
+                .map(|b| 0.5 * (b.low + b.high))
+                .collect();
+            (m.iter().map(|m| *m <= 0.0).collect(), edges)
+        })
+        .collect())
+}
+
+/// A boundary of a chart column being bisected: y in [low, high].
+struct Bracket {
+    column: usize,
+    low: f64,
+    high: f64,
+    /// Whether the chart is stable at `low`.
+    stable_low: bool,
 }
 
 /// A chart column as 2·samples numbers (for tiles): the verdicts as 1 or

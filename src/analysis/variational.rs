@@ -3,7 +3,7 @@
 //! The state length M = N + N·K must be given explicitly (stable Rust has no
 //! arithmetic on const generics); [`Variational::new`] checks it.
 
-use crate::ode::{Scalar, System, TaylorWork};
+use crate::ode::{Lanes, Scalar, System, TaylorWork, LANES};
 
 /// The system and K tangent vectors: M = N + N·K.
 pub struct Variational<'a, S, const N: usize, const M: usize> {
@@ -76,5 +76,22 @@ impl<S: System<N>, const N: usize, const M: usize> System<M> for Variational<'_,
     ) -> bool {
         self.system
             .taylor_variational(t, z, order, work, out.as_flattened_mut())
+    }
+    fn taylor_lanes(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        z: &[Lanes; M],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [[Lanes; M]],
+    ) -> bool {
+        S::taylor_variational_lanes(
+            lanes.map(|v| v.system),
+            t,
+            z,
+            order,
+            work,
+            out.as_flattened_mut(),
+        )
     }
 }

@@ -23,7 +23,7 @@ pub use hyperdual::HyperDual;
 pub use lanes::{Lanes, LANES};
 pub use series::Scalar;
 pub use taylor::{order_for_tolerance, TaylorWork};
-pub use taylor_lanes::{LaneIntegrator, LaneResult};
+pub use taylor_lanes::{LaneIntegrator, LaneResult, Orbit};
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
 pub trait System<const N: usize> {
@@ -60,6 +60,40 @@ pub trait System<const N: usize> {
     ) -> bool {
         false
     }
+    /// [`System::taylor`] for a batch whose lane l follows the system
+    /// `lanes[l]`, one of this kind with its own parameters (a sweep over
+    /// parameters). Generated models give each lane its parameters; by
+    /// default a batch needs one system in every lane.
+    fn taylor_lanes(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        y: &[Lanes; N],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [[Lanes; N]],
+    ) -> bool {
+        one_system(lanes).is_some_and(|s| s.taylor(t, y, order, work, out))
+    }
+    /// [`System::taylor_variational`] for a batch whose lane l follows
+    /// `lanes[l]`, as [`System::taylor_lanes`].
+    fn taylor_variational_lanes(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        z: &[Lanes],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [Lanes],
+    ) -> bool {
+        one_system(lanes).is_some_and(|s| s.taylor_variational(t, z, order, work, out))
+    }
+}
+
+/// The system of a batch whose lanes all follow one, if they do.
+fn one_system<S: ?Sized>(lanes: [&S; LANES]) -> Option<&S> {
+    lanes
+        .iter()
+        .all(|s| std::ptr::eq(*s, lanes[0]))
+        .then_some(lanes[0])
 }
 
 /// One accepted step, as an integrator hands it to observers and to event
@@ -168,6 +202,15 @@ impl Method {
             Method::Gauss { stages, .. } => 2 * stages,
             Method::Radau5 { .. } => 5,
             Method::Taylor { tol } => order_for_tolerance(*tol),
+        }
+    }
+
+    /// How many independent orbits the method integrates at once: the
+    /// lanes of the batch Taylor method, one for the others.
+    pub fn batch_width(&self) -> usize {
+        match self {
+            Method::Taylor { .. } => LANES,
+            _ => 1,
         }
     }
 

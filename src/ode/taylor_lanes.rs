@@ -19,6 +19,33 @@ use super::{check_initial, order_for_tolerance, Method, OdeError, Stats, System,
 /// The result of one lane.
 pub type LaneResult<const N: usize> = Result<[f64; N], OdeError>;
 
+/// One orbit of a sweep: the system it follows (a generated model's has its
+/// own parameters, so one batch can sweep them), its state at t = 0 and the
+/// end of its segments [0, end].
+#[derive(Debug)]
+pub struct Orbit<'a, S, const N: usize> {
+    pub system: &'a S,
+    pub start: [f64; N],
+    pub end: f64,
+}
+
+impl<S, const N: usize> Clone for Orbit<'_, S, N> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S, const N: usize> Copy for Orbit<'_, S, N> {}
+
+impl<'a, S, const N: usize> Orbit<'a, S, N> {
+    /// Orbits of one system, one from each start, with segments [0, end].
+    pub fn of_one_system(system: &'a S, end: f64, starts: &[[f64; N]]) -> Vec<Self> {
+        starts
+            .iter()
+            .map(|&start| Orbit { system, start, end })
+            .collect()
+    }
+}
+
 /// The batch Taylor integrator: the method's tolerance, its workspace and the
 /// run's statistics, summed over lanes (`steps` and `f_evals` count each
 /// lane's steps, as the scalar runs would).
@@ -60,7 +87,7 @@ impl LaneIntegrator {
         t1: f64,
     ) -> [LaneResult<N>; LANES] {
         let mut results: [LaneResult<N>; LANES] = std::array::from_fn(|l| Ok(y0[l]));
-        let mut run = Run::new(t0, y0);
+        let mut run = Run::new(t0, y0, t1);
         run.running = active;
         for l in (0..LANES).filter(|&l| active[l]) {
             if let Err(e) = check_initial(t0, &y0[l], t1) {
@@ -71,7 +98,7 @@ impl LaneIntegrator {
             return results;
         }
         while run.running.iter().any(|&r| r) {
-            let Some(ends) = self.step_lanes(system, &mut run, t1) else {
+            let Some(ends) = self.step_lanes([system; LANES], &mut run) else {
                 return std::array::from_fn(|_| Err(OdeError::TaylorUnavailable));
             };
             for (l, end) in ends.into_iter().enumerate() {
@@ -84,36 +111,41 @@ impl LaneIntegrator {
         results
     }
 
-    /// Integrates every orbit of `starts` over consecutive segments
-    /// [0, `t1`] (the time restarts at 0 after each, as a period map's
-    /// does), [`LANES`] orbits at a time, each lane exactly as the scalar
-    /// method (one `advance` per segment) would. After each segment
+    /// Integrates every orbit over consecutive segments [0, its end] (the
+    /// time restarts at 0 after each, as a period map's does), [`LANES`]
+    /// orbits at a time, each lane exactly as the scalar method (one
+    /// `advance` per segment) would. After each segment
     /// `after_segment(k, y)` may change orbit k's state and says whether it
     /// goes on. A lane whose orbit ends takes the next orbit at once: no
     /// lane waits for a slower one, as with [`LaneIntegrator::advance`] at
     /// every segment's end. Returns each orbit's error, if it ended with one.
-    pub fn stream<S: System<N>, const N: usize>(
+    pub fn stream<'a, S: System<N>, const N: usize>(
         &mut self,
-        system: &S,
-        t1: f64,
-        starts: &[[f64; N]],
+        orbits: &[Orbit<'a, S, N>],
         mut after_segment: impl FnMut(usize, &mut [f64; N]) -> bool,
     ) -> Vec<Option<OdeError>> {
-        let mut errors: Vec<Option<OdeError>> = vec![None; starts.len()];
+        let mut errors: Vec<Option<OdeError>> = vec![None; orbits.len()];
+        let Some(first) = orbits.first() else {
+            return errors;
+        };
+        let mut systems = [first.system; LANES];
         let mut orbit_of: [usize; LANES] = [0; LANES];
-        let mut queue = 0..starts.len();
-        let mut run = Run::new(0.0, &[[0.0; N]; LANES]);
+        let mut queue = 0..orbits.len();
+        let mut run = Run::new(0.0, &[[0.0; N]; LANES], 0.0);
         run.running = [false; LANES];
         // Gives lane `l` the next orbit that starts well, or leaves it idle.
         let mut load = |run: &mut Run<N>,
+                        systems: &mut [&'a S; LANES],
                         orbit_of: &mut [usize; LANES],
                         l: usize,
                         errors: &mut [Option<OdeError>]| {
             for k in queue.by_ref() {
-                match check_initial(0.0, &starts[k], t1) {
+                let orbit = &orbits[k];
+                match check_initial(0.0, &orbit.start, orbit.end) {
+                    Ok(()) if orbit.end == 0.0 => {}
                     Ok(()) => {
-                        orbit_of[l] = k;
-                        run.restart(l, &starts[k]);
+                        (orbit_of[l], systems[l], run.end[l]) = (k, orbit.system, orbit.end);
+                        run.restart(l, &orbit.start);
                         return;
                     }
                     Err(e) => errors[k] = Some(e),
@@ -122,14 +154,11 @@ impl LaneIntegrator {
             run.running[l] = false;
         };
         for l in 0..LANES {
-            load(&mut run, &mut orbit_of, l, &mut errors);
-        }
-        if t1 == 0.0 {
-            return errors;
+            load(&mut run, &mut systems, &mut orbit_of, l, &mut errors);
         }
         while run.running.iter().any(|&r| r) {
-            let Some(ends) = self.step_lanes(system, &mut run, t1) else {
-                return vec![Some(OdeError::TaylorUnavailable); starts.len()];
+            let Some(ends) = self.step_lanes(systems, &mut run) else {
+                return vec![Some(OdeError::TaylorUnavailable); orbits.len()];
             };
             for (l, end) in ends.into_iter().enumerate() {
                 let Some(result) = end else { continue };
@@ -137,32 +166,31 @@ impl LaneIntegrator {
                 let k = orbit_of[l];
                 // Its next segment, or why it ends (None: it is done).
                 let next = match result {
-                    Ok(mut y) => {
-                        after_segment(k, &mut y).then(|| check_initial(0.0, &y, t1).map(|()| y))
-                    }
+                    Ok(mut y) => after_segment(k, &mut y)
+                        .then(|| check_initial(0.0, &y, run.end[l]).map(|()| y)),
                     Err(e) => Some(Err(e)),
                 };
                 match next {
                     Some(Ok(y)) => run.restart(l, &y),
                     Some(Err(e)) => {
                         errors[k] = Some(e);
-                        load(&mut run, &mut orbit_of, l, &mut errors);
+                        load(&mut run, &mut systems, &mut orbit_of, l, &mut errors);
                     }
-                    None => load(&mut run, &mut orbit_of, l, &mut errors),
+                    None => load(&mut run, &mut systems, &mut orbit_of, l, &mut errors),
                 }
             }
         }
         errors
     }
 
-    /// One step of every running lane towards `t1`: for each lane whose run
-    /// ends with it (at t1, or with an error), how; `None` when the system
-    /// has no Taylor recurrences.
+    /// One step of every running lane, lane l of the system `systems[l]`,
+    /// towards its end: for each lane whose run ends with it (at its end, or
+    /// with an error), how; `None` when the system has no Taylor
+    /// recurrences (for these lanes).
     fn step_lanes<S: System<N>, const N: usize>(
         &mut self,
-        system: &S,
+        systems: [&S; LANES],
         run: &mut Run<N>,
-        t1: f64,
     ) -> Option<[Option<LaneResult<N>>; LANES]> {
         let order = order_for_tolerance(self.tol);
         self.stats.order = self.stats.order.max(order as u64);
@@ -170,7 +198,7 @@ impl LaneIntegrator {
         let safety = safety(order);
         let mut ends: [Option<LaneResult<N>>; LANES] = std::array::from_fn(|_| None);
         let (c, _) = self.coefficients.as_chunks_mut::<N>();
-        if !system.taylor(Lanes(run.t), &run.y, order, &mut self.work, c) {
+        if !S::taylor_lanes(systems, Lanes(run.t), &run.y, order, &mut self.work, c) {
             return None;
         }
         let row_norms =
@@ -190,8 +218,9 @@ impl LaneIntegrator {
         let mut stepping = run.running;
         for l in (0..LANES).filter(|&l| run.running[l]) {
             self.stats.f_evals += order as u64;
-            let direction = (t1 - run.t[l]).signum();
-            match step_to_take(steps[l], (t1 - run.t[l]).abs(), run.t[l], || run.state(l)) {
+            let (t, t1) = (run.t[l], run.end[l]);
+            let direction = (t1 - t).signum();
+            match step_to_take(steps[l], (t1 - t).abs(), t, || run.state(l)) {
                 Ok((step, is_last)) => (h[l], last[l]) = (step * direction, is_last),
                 Err(e) => (ends[l], stepping[l]) = (Some(Err(e)), false),
             }
@@ -208,7 +237,6 @@ impl LaneIntegrator {
                 &y_new,
                 check.0[l] == 0.0,
                 (h[l], last[l]),
-                t1,
                 self.max_steps,
             );
         }
@@ -216,10 +244,11 @@ impl LaneIntegrator {
     }
 }
 
-/// The lanes' times, Kahan carries, states, step counts (of the current
-/// run from t0) and whether each is running.
+/// The lanes' times, ends, Kahan carries, states, step counts (of the
+/// current run from t0) and whether each is running.
 struct Run<const N: usize> {
     t: [f64; LANES],
+    end: [f64; LANES],
     carry: [f64; LANES],
     y: [Lanes; N],
     steps: [u64; LANES],
@@ -227,9 +256,10 @@ struct Run<const N: usize> {
 }
 
 impl<const N: usize> Run<N> {
-    fn new(t0: f64, y0: &[[f64; N]; LANES]) -> Run<N> {
+    fn new(t0: f64, y0: &[[f64; N]; LANES], t1: f64) -> Run<N> {
         Run {
             t: [t0; LANES],
+            end: [t1; LANES],
             carry: [0.0; LANES],
             y: std::array::from_fn(|i| Lanes(std::array::from_fn(|l| y0[l][i]))),
             steps: [0; LANES],
@@ -259,12 +289,11 @@ impl<const N: usize> Run<N> {
         y_new: &[Lanes; N],
         finite: bool,
         (h, last): (f64, bool),
-        t1: f64,
         max_steps: u64,
     ) -> Option<LaneResult<N>> {
         let t = self.t[l];
         let t_new = if last {
-            t1
+            self.end[l]
         } else {
             compensated_sum(t, h, &mut self.carry[l])
         };

@@ -208,6 +208,88 @@ fn kapitza_chart_boundaries_are_the_exact_thresholds() {
     assert!(chart.boundaries[1].len() >= 2, "{:?}", chart.boundaries);
 }
 
+/// A chart in the lanes of the batch Taylor method (each (ε, A) point with
+/// its own parameters and period, every boundary bisected in lockstep)
+/// equals, bit for bit, the chart of one scalar monodromy matrix at a time
+/// with one bisection per boundary, written out here.
+#[test]
+fn chart_in_lanes_equals_the_scalar_chart_bit_for_bit() {
+    use mechlab::analysis::floquet::{floquet_multipliers, spectral_radius};
+    use mechlab::analysis::stability::{stability_chart, ChartSettings};
+    let method = Method::parse("taylor", 1e-10).unwrap();
+    let settings = ChartSettings {
+        q: vec![0.0],
+        x: "eps".into(),
+        x_values: vec![0.05, 0.15, 0.3],
+        y: "A".into(),
+        y_max: 6.0,
+        y_samples: 15,
+        edge_tolerance: 1e-9,
+        method,
+        tiles: None,
+    };
+    let chart = stability_chart("kapitza", &defaults("kapitza"), &settings).unwrap();
+    let margin = |eps: f64, a: f64| {
+        let system = kapitza::Exact {
+            params: kapitza::Params { A: a, eps, mu: 0.0 },
+        };
+        let mut integrator = Integrator::new(method).unwrap();
+        let (_, m) =
+            monodromy::<_, 2, 6>(&mut integrator, &system, 2.0 * PI * eps, &[0.0, 0.0]).unwrap();
+        spectral_radius(&floquet_multipliers(&m)) - 1.0 - 1e-6
+    };
+    for (k, &eps) in settings.x_values.iter().enumerate() {
+        let margins: Vec<f64> = chart.y_values.iter().map(|&a| margin(eps, a)).collect();
+        let stable: Vec<bool> = margins.iter().map(|m| *m <= 0.0).collect();
+        assert_eq!(chart.stable[k], stable, "ε = {eps}");
+        let mut edges = Vec::new();
+        for j in 1..margins.len() {
+            if (margins[j - 1] > 0.0) == (margins[j] > 0.0) {
+                continue;
+            }
+            let (mut low, mut high) = (chart.y_values[j - 1], chart.y_values[j]);
+            while high - low > settings.edge_tolerance {
+                let mid = 0.5 * (low + high);
+                if (margin(eps, mid) <= 0.0) == stable[j - 1] {
+                    low = mid;
+                } else {
+                    high = mid;
+                }
+            }
+            edges.push((0.5 * (low + high)).to_bits());
+        }
+        let found: Vec<u64> = chart.boundaries[k].iter().map(|b| b.to_bits()).collect();
+        assert_eq!(found, edges, "ε = {eps}");
+        assert!(!edges.is_empty());
+    }
+}
+
+/// The window search in batches of 8 (the Taylor lanes: 9 parts a step)
+/// finds Kapitza's exact lower edge within its tolerance of the Jury
+/// criterion's (bisected with DOP853); width 1 is the bisection itself.
+#[test]
+fn window_in_lanes_finds_the_exact_edge() {
+    let mut taylor = settings("A");
+    taylor.method = Method::parse("taylor", 1e-12).unwrap();
+    let result = stability("kapitza", &defaults("kapitza"), &taylor).unwrap();
+    let [low, _] = at(&result.equilibria, &[0.0]).exact_window.unwrap();
+    let reference = jury_threshold(0.1, 4.0);
+    assert!(
+        (low.unwrap() - reference).abs() < 1e-9,
+        "{low:?} vs {reference}"
+    );
+    // A closed form: cos a first becomes ≤ 0 at π/2.
+    use mechlab::analysis::floquet::first_onset_in_batches;
+    let cosines = |a: &[f64]| -> Result<Vec<f64>, ()> { Ok(a.iter().map(|a| a.cos()).collect()) };
+    let onset = |width| first_onset_in_batches(&cosines, width, 0.0, 4.0, 10, 1e-12);
+    for width in [1, 3, 8] {
+        let found = onset(width).unwrap().unwrap();
+        assert!((found - PI / 2.0).abs() < 1e-12, "width {width}: {found}");
+    }
+    let bisected = first_stability_onset(&|a: f64| Ok::<_, ()>(a.cos()), 0.0, 4.0, 10, 1e-12);
+    assert_eq!(onset(1), bisected);
+}
+
 /// Chart tiles (one column each): an interrupted run writes two of four,
 /// the resumed run computes the other two and leaves those files alone,
 /// and the merged chart equals the single run's bit for bit; a tile that
