@@ -295,12 +295,15 @@ fn monodromies_in_lanes_equal_the_scalar_ones() {
             (kapitza::Exact { params }, period, [0.0, 0.0])
         })
         .collect();
-    let batch = monodromies::<_, 2, 6>(TAYLOR, &problems);
+    let (batch, stats) = monodromies::<_, 2, 6>(TAYLOR, &problems);
+    let mut f_evals = 0;
     for ((system, period, y0), result) in problems.iter().zip(batch) {
         let mut scalar = Integrator::new(TAYLOR).unwrap();
         let expected = monodromy::<_, 2, 6>(&mut scalar, system, *period, y0);
         assert_eq!(result, expected, "{:?}", system.params);
+        f_evals += scalar.stats.f_evals;
     }
+    assert_eq!(stats.f_evals, f_evals);
 }
 
 /// Models whose recurrences compute with literals only (no parameters:

@@ -9,6 +9,9 @@
 //! (a′) an ensemble of 64 Kapitza orbits over 20 periods, the sweeps'
 //!     workload, with the batch Taylor method (`taylor_lanes`, 8 lanes
 //!     streamed) beside one orbit at a time;
+//! (a″) the monodromy matrices of the triple pendulum over 32 points
+//!     (ν, a), the stability charts' workload, with each lane's own
+//!     parameters (`taylor_lanes`) beside one matrix at a time;
 //! (b) the double pendulum on the vibrating base at ν = 100, t ∈ [0, 10];
 //! (c) the deformable rod of Study 3 sliding, ε = 0.01 and 0.001, t ∈ [0, 2].
 //! Each run is timed (repeated until it has taken `min_seconds`), and the
@@ -28,11 +31,12 @@ use mechlab::scene::{knob, Scene};
 use performance::{performance, Performance};
 use std::collections::BTreeMap;
 
-const PROBLEMS: [&str; 8] = [
+const PROBLEMS: [&str; 9] = [
     "kapitza_regular",
     "kapitza_regular_global",
     "kapitza_chaotic",
     "kapitza_ensemble",
+    "triple_monodromy_sweep",
     "double_pendulum",
     "triple_pendulum",
     "rod_eps_0.01",
@@ -48,8 +52,9 @@ struct Summary<'a> {
     performance: Performance,
     /// dop853 seconds / taylor seconds at equal error (1e-6, 1e-8, 1e-10).
     taylor_speedup_over_dop853: BTreeMap<String, BTreeMap<String, Option<f64>>>,
-    /// On the ensemble: taylor (one orbit at a time) seconds / taylor_lanes
-    /// (8 lanes streamed) seconds at equal error, one core each.
+    /// On the ensemble and the monodromy sweep: taylor (one orbit at a
+    /// time) seconds / taylor_lanes (8 lanes streamed) seconds at equal
+    /// error, one core each.
     lanes_speedup_over_taylor: BTreeMap<String, BTreeMap<String, Option<f64>>>,
 }
 

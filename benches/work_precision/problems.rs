@@ -5,10 +5,11 @@ use crate::harness::{
     end_state, max_difference, reference_end, reference_orbit, solvers, sweep, timed, BenchError,
     Failure, Row, RunError, Solver,
 };
+use mechlab::analysis::floquet::{monodromies, monodromy};
 use mechlab::contact::{Mode, Smooth};
 use mechlab::models::painleve_klein::{self as painleve, Contacts};
 use mechlab::models::{double_pendulum as dp, kapitza, triple_pendulum};
-use mechlab::ode::{LaneIntegrator, Method, Orbit, System};
+use mechlab::ode::{Integrator, LaneIntegrator, Method, Orbit, System};
 use mechlab::studies::painleve::state_with_deformation;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -37,6 +38,7 @@ pub fn run_all(min_seconds: f64, periods: usize, budget: f64) -> Result<Runs, Be
     };
     kapitza_map(&mut runs, min_seconds, periods, budget)?;
     kapitza_ensemble(&mut runs, min_seconds)?;
+    triple_monodromy_sweep(&mut runs, min_seconds)?;
     vibrating_bases(&mut runs, min_seconds, budget)?;
     sliding_rod(&mut runs, min_seconds, budget)?;
     Ok(runs)
@@ -149,19 +151,31 @@ fn kapitza_ensemble(runs: &mut Runs, min_seconds: f64) -> Result<(), BenchError>
             .map(|(a, b)| max_difference(a, b))
             .fold(0.0, f64::max)
     };
+    lanes_rows(runs, PROBLEM, min_seconds, |method, tol| {
+        let (ends, evals) = match method {
+            "taylor_lanes" => streamed(tol)?,
+            _ => one_by_one(Solver::Ours(Method::parse(method, tol)?))?,
+        };
+        Ok((worst(&ends), evals))
+    });
+    Ok(())
+}
+
+/// The rows of a problem for `dop853`, `taylor` and `taylor_lanes` at the
+/// tolerances 1e-3 … 1e-14: `run(method, tol)` gives the error and the
+/// f-evaluations of one run, [`timed`] its time.
+fn lanes_rows(
+    runs: &mut Runs,
+    problem: &'static str,
+    min_seconds: f64,
+    run: impl Fn(&'static str, f64) -> Result<(f64, u64), RunError>,
+) {
     for k in 3..=14 {
         let tol = 10f64.powi(-k);
         for method in ["dop853", "taylor", "taylor_lanes"] {
-            let run = || -> Result<(f64, u64), RunError> {
-                let (ends, evals) = match method {
-                    "taylor_lanes" => streamed(tol)?,
-                    _ => one_by_one(Solver::Ours(Method::parse(method, tol)?))?,
-                };
-                Ok((worst(&ends), evals))
-            };
-            match timed(min_seconds, run) {
+            match timed(min_seconds, || run(method, tol)) {
                 Ok(((error, f_evals), seconds)) => runs.rows.push(Row {
-                    problem: PROBLEM,
+                    problem,
                     method,
                     tol_or_step: tol,
                     error,
@@ -169,7 +183,7 @@ fn kapitza_ensemble(runs: &mut Runs, min_seconds: f64) -> Result<(), BenchError>
                     f_evals,
                 }),
                 Err(reason) => runs.failures.push(Failure {
-                    problem: PROBLEM,
+                    problem,
                     method,
                     tol_or_step: tol,
                     reason: reason.to_string(),
@@ -177,6 +191,59 @@ fn kapitza_ensemble(runs: &mut Runs, min_seconds: f64) -> Result<(), BenchError>
             }
         }
     }
+}
+
+/// (a″) A sweep over parameters, the stability charts' workload: the
+/// monodromy matrices of the triple pendulum's upright over one base
+/// period at 32 points (ν, a) of a 4 × 8 grid, each with its own period,
+/// one at a time (`dop853`, `taylor`) and through the batch lanes with
+/// each lane's own parameters (`taylor_lanes`, one core). The error is the
+/// worst matrix entry's against DOP853 at 1e-14; the time is the sweep's.
+fn triple_monodromy_sweep(runs: &mut Runs, min_seconds: f64) -> Result<(), BenchError> {
+    const PROBLEM: &str = "triple_monodromy_sweep";
+    let problems: Vec<(triple_pendulum::Exact, f64, [f64; 6])> = (0..32)
+        .map(|k| {
+            let params = triple_pendulum::Params {
+                nu: 50.0 + 25.0 * (k % 4) as f64,
+                a: 1.0 + 0.25 * (k / 4) as f64,
+                ..Default::default()
+            };
+            (triple_pendulum::Exact { params }, TAU / params.nu, [0.0; 6])
+        })
+        .collect();
+    type Matrices = Vec<[[f64; 6]; 6]>;
+    let one_by_one = |method: Method| -> Result<(Matrices, u64), RunError> {
+        let (mut matrices, mut f_evals) = (Vec::new(), 0);
+        for (system, period, y0) in &problems {
+            let mut integrator = Integrator::new(method)?;
+            matrices.push(monodromy::<_, 6, 42>(&mut integrator, system, *period, y0)?.1);
+            f_evals += integrator.stats.f_evals;
+        }
+        Ok((matrices, f_evals))
+    };
+    let in_lanes = |tol: f64| -> Result<(Matrices, u64), RunError> {
+        let (results, stats) = monodromies::<_, 6, 42>(Method::Taylor { tol }, &problems);
+        let matrices = results
+            .into_iter()
+            .map(|r| r.map(|(_, m)| m))
+            .collect::<Result<_, _>>()?;
+        Ok((matrices, stats.f_evals))
+    };
+    let (reference, _) = one_by_one(Method::parse("dop853", 1e-14)?)?;
+    let worst = |matrices: &Matrices| {
+        matrices
+            .iter()
+            .zip(&reference)
+            .flat_map(|(m, r)| m.iter().zip(r).map(|(a, b)| max_difference(a, b)))
+            .fold(0.0, f64::max)
+    };
+    lanes_rows(runs, PROBLEM, min_seconds, |method, tol| {
+        let (matrices, f_evals) = match method {
+            "taylor_lanes" => in_lanes(tol)?,
+            _ => one_by_one(Method::parse(method, tol)?)?,
+        };
+        Ok((worst(&matrices), f_evals))
+    });
     Ok(())
 }
 

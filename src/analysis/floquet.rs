@@ -1,7 +1,7 @@
 //! Monodromy matrices and Floquet multipliers of periodic motions.
 
 use super::variational::Variational;
-use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, Orbit, System};
+use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, Orbit, Stats, System};
 use nalgebra::DMatrix;
 
 /// The state after one period and the monodromy matrix ∂y(T)/∂y(0)
@@ -20,28 +20,32 @@ pub fn monodromy<S: System<N>, const N: usize, const M: usize>(
 }
 
 /// The end state and monodromy matrix of each problem (system, period,
-/// start) of a sweep, as [`monodromy`] gives them: for `taylor` through the
-/// lanes of the batch Taylor method, each lane with its own system (its own
-/// parameters) and period and equal to its scalar run bit for bit; one at a
-/// time for the other methods.
+/// start) of a sweep, as [`monodromy`] gives them, and the sweep's
+/// statistics: for `taylor` through the lanes of the batch Taylor method,
+/// each lane with its own system (its own parameters) and period and equal
+/// to its scalar run bit for bit; one at a time for the other methods.
 pub fn monodromies<S: System<N>, const N: usize, const M: usize>(
     method: Method,
     problems: &[(S, f64, [f64; N])],
-) -> Vec<Result<([f64; N], [[f64; N]; N]), OdeError>> {
+) -> (Vec<Result<([f64; N], [[f64; N]; N]), OdeError>>, Stats) {
     assert_eq!(M, N + N * N, "monodromy needs M = N + N²");
+    let mut stats = Stats::default();
     let Method::Taylor { .. } = method else {
         // A fresh integrator each: DOP853 would start from the last step size.
-        return problems
+        let results = problems
             .iter()
             .map(|(system, period, y0)| {
                 let mut integrator = Integrator::new(method)?;
-                monodromy::<S, N, M>(&mut integrator, system, *period, y0)
+                let result = monodromy::<S, N, M>(&mut integrator, system, *period, y0);
+                stats += integrator.stats;
+                result
             })
             .collect();
+        return (results, stats);
     };
     let mut lanes = match LaneIntegrator::new(method) {
         Ok(lanes) => lanes,
-        Err(e) => return vec![Err(e); problems.len()],
+        Err(e) => return (vec![Err(e); problems.len()], stats),
     };
     let variational: Vec<Variational<S, N, M>> = problems
         .iter()
@@ -61,14 +65,15 @@ pub fn monodromies<S: System<N>, const N: usize, const M: usize>(
         ends[k] = *z;
         false
     });
-    errors
+    let results = errors
         .into_iter()
         .zip(ends)
         .map(|(error, z)| match error {
             Some(e) => Err(e),
             None => Ok(split::<S, N, M>(&z)),
         })
-        .collect()
+        .collect();
+    (results, lanes.stats)
 }
 
 /// The columns of the N×N identity matrix.

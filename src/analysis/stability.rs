@@ -592,6 +592,7 @@ fn spectral_radii_at<
                 })
                 .collect();
             monodromies::<_, S, V>(method, &problems)
+                .0
                 .into_iter()
                 .map(|result| result.map(|(_, m)| spectral_radius(&floquet_multipliers(&m))))
                 .collect()
