@@ -29,6 +29,7 @@ pub struct Orbit<'a, S, const N: usize> {
     pub end: f64,
 }
 
+// By hand: a derive would ask `S: Copy`, and an orbit only borrows its system.
 impl<S, const N: usize> Clone for Orbit<'_, S, N> {
     fn clone(&self) -> Self {
         *self
@@ -142,6 +143,8 @@ impl LaneIntegrator {
             for k in queue.by_ref() {
                 let orbit = &orbits[k];
                 match check_initial(0.0, &orbit.start, orbit.end) {
+                    // No segment to run: it ends where it starts, as the
+                    // scalar `advance` over [0, 0] returns its start.
                     Ok(()) if orbit.end == 0.0 => {}
                     Ok(()) => {
                         (orbit_of[l], systems[l], run.end[l]) = (k, orbit.system, orbit.end);
