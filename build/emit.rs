@@ -95,6 +95,18 @@ pub struct Emitter {
     pub lift: Option<&'static str>,
 }
 
+/// `let &Params { fields } = params;`, the prelude of a generated function
+/// (`..` for a model without parameters, whose `Params` holds only a marker
+/// of its number type).
+pub fn params_line(fields: &[String]) -> String {
+    let fields = if fields.is_empty() {
+        "..".to_string()
+    } else {
+        fields.join(", ")
+    };
+    format!("let &Params {{ {fields} }} = params;")
+}
+
 fn literal(value: f64) -> String {
     let s = format!("{value:?}");
     if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
@@ -319,26 +331,10 @@ impl Emitter {
             return name.clone();
         }
         let t = |j: usize| self.text(j);
-        let atom = |j: usize| {
-            let s = self.text(j);
-            if self.bound.contains_key(&j)
-                || matches!(self.nodes[j], Node::Var(_) | Node::Call(..) | Node::Sqrt(_))
-            {
-                s
-            } else if let Node::Lit(l) = &self.nodes[j] {
-                if l.starts_with('-') {
-                    format!("({s})")
-                } else {
-                    s
-                }
-            } else {
-                format!("({s})")
-            }
-        };
         match &self.nodes[i] {
             Node::Lit(l) => l.clone(),
             Node::Var(v) => v.clone(),
-            Node::Neg(a) => format!("-{}", atom(*a)),
+            Node::Neg(a) => format!("-{}", self.atom(*a)),
             Node::Add(a, b) => format!("{} + {}", t(*a), t(*b)),
             Node::Sub(a, b) => {
                 let right = match self.nodes[*b] {
@@ -350,14 +346,14 @@ impl Emitter {
                 format!("{} - {}", t(*a), right)
             }
             Node::Mul(a, b) => format!("{} * {}", self.factor(*a), self.factor(*b)),
-            Node::Div(a, b) => format!("{} / {}", self.factor(*a), atom(*b)),
+            Node::Div(a, b) => format!("{} / {}", self.factor(*a), self.atom(*b)),
             Node::Powi(a, 1) => t(*a),
             Node::Powi(a, 2)
                 if self.bound.contains_key(a) || matches!(self.nodes[*a], Node::Var(_)) =>
             {
-                format!("{} * {}", atom(*a), atom(*a))
+                format!("{} * {}", self.atom(*a), self.atom(*a))
             }
-            Node::Powi(a, -1) => format!("1.0 / {}", atom(*a)),
+            Node::Powi(a, -1) => format!("1.0 / {}", self.atom(*a)),
             Node::Powi(a, k) => format!("{}.powi({k})", self.receiver(*a)),
             Node::Sqrt(a) => format!("{}.sqrt()", self.receiver(*a)),
             Node::Powf(a, b) => format!("{}.powf({})", self.receiver(*a), t(*b)),
@@ -366,20 +362,33 @@ impl Emitter {
         }
     }
 
-    /// The receiver of a method call: a literal typed as f64 (`2.0.sqrt()`
-    /// does not compile: its float type is ambiguous), a sum parenthesised.
+    /// Node j as an operand that binds tighter than any operator: names,
+    /// calls and positive literals as they are, anything else parenthesised.
+    fn atom(&self, j: usize) -> String {
+        let s = self.text(j);
+        let bare = self.bound.contains_key(&j)
+            || match &self.nodes[j] {
+                Node::Var(_) | Node::Call(..) | Node::Sqrt(_) => true,
+                Node::Lit(l) => !l.starts_with('-'),
+                _ => false,
+            };
+        if bare {
+            s
+        } else {
+            format!("({s})")
+        }
+    }
+
+    /// The receiver of a method call: an [`Emitter::atom`], with a literal
+    /// typed as f64 (`2.0.sqrt()` does not compile: its float type is
+    /// ambiguous).
     fn receiver(&self, j: usize) -> String {
         match &self.nodes[j] {
             Node::Lit(l) if !self.bound.contains_key(&j) => match l.strip_prefix('-') {
                 Some(magnitude) => format!("(-{magnitude}_f64)"),
                 None => format!("{l}_f64"),
             },
-            _ if self.bound.contains_key(&j)
-                || matches!(self.nodes[j], Node::Var(_) | Node::Call(..) | Node::Sqrt(_)) =>
-            {
-                self.text(j)
-            }
-            _ => format!("({})", self.text(j)),
+            _ => self.atom(j),
         }
     }
 
@@ -819,16 +828,7 @@ impl Emitter {
                 if reachable[j] && !self.bound.contains_key(&j) {
                     let (s, c) = if f == "sin" { (i, j) } else { (j, i) };
                     let (sn, cn) = (self.name_for(s), self.name_for(c));
-                    let arg = self.text(a);
-                    let arg = match self.nodes[a] {
-                        Node::Lit(_) => self.receiver(a),
-                        _ if self.bound.contains_key(&a)
-                            || matches!(self.nodes[a], Node::Var(_)) =>
-                        {
-                            arg
-                        }
-                        _ => format!("({arg})"),
-                    };
+                    let arg = self.receiver(a);
                     self.lines
                         .push(format!("let ({sn}, {cn}) = {arg}.sin_cos();"));
                     self.bound.insert(s, sn);

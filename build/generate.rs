@@ -3,7 +3,7 @@
 
 use crate::contacts::ContactDerivation;
 use crate::derive::{momentum_name, Derivation, Derived};
-use crate::emit::{Emitter, Step};
+use crate::emit::{params_line, Emitter, Step};
 use crate::model::Model;
 use crate::taylor::{recurrences, Signature};
 use serde::Serialize;
@@ -119,14 +119,7 @@ impl Context<'_> {
             .iter()
             .map(|p| p.name.clone())
             .collect();
-        let params_line = format!(
-            "let &Params {{ {} }} = params;",
-            if params.is_empty() {
-                "..".to_string()
-            } else {
-                params.join(", ")
-            }
-        );
+        let params_line = params_line(&params);
         let phase_line = self
             .model
             .fast_phase

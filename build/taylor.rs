@@ -15,7 +15,7 @@
 //! recurrence divides by u^[0] and fails at u = 0). The emitted function
 //! calls the kernels of `mechlab::ode::series`.
 
-use crate::emit::{Dag, Node};
+use crate::emit::{params_line, Dag, Node};
 use std::collections::HashMap;
 
 /// How a node varies over a step.
@@ -606,14 +606,7 @@ pub fn recurrences(
             None => format!("{p}: _"),
         })
         .collect();
-    let params_line = format!(
-        "let &Params {{ {} }} = params;",
-        if fields.is_empty() {
-            "..".to_string()
-        } else {
-            fields.join(", ")
-        }
-    );
+    let params_line = params_line(&fields);
     Ok(Writer {
         ops: &lowering.ops,
         classes: &lowering.classes,
