@@ -93,6 +93,10 @@ pub enum StabilityError {
     },
     #[error("{0} parameter values for model '{1}'")]
     ParameterCount(usize, String),
+    /// A chart of an equilibrium that the vibration moves: (q, 0) is no
+    /// periodic solution, so it has no monodromy matrix.
+    #[error("(q = {q:?}, p = 0) is not a solution of the exact system of model '{model}': the vibration moves it, so it has no stability chart (`stability` lists the equilibria the vibration keeps)")]
+    MovedByVibration { model: String, q: Vec<f64> },
     /// Only some tiles of a chart were asked for: they are written, there
     /// is no chart to return.
     #[error("the tiles asked for are written; run without `only` to merge them into the chart")]
@@ -648,14 +652,7 @@ fn exact_window<
         p[amplitude] = a;
         p
     };
-    let probe = with(a_star.max(params[amplitude]));
-    let period = model.phase_period(&probe).unwrap_or(f64::NAN);
-    let exact = model.exact(&probe);
-    let moving = (0..8).any(|k| {
-        let f = exact.rhs(period * k as f64 / 8.0, &y0);
-        f.iter().map(|x| x.abs()).fold(0.0, f64::max) > 1e-9
-    });
-    if moving {
+    if moved_by_vibration(model, &with(a_star.max(params[amplitude])), &y0) {
         out.exact_reason =
             Some("(q, 0) is not a solution of the exact system: the vibration moves it".into());
         return Ok(());
@@ -685,6 +682,27 @@ fn exact_window<
     curve.sort_by(|x, y| x[0].total_cmp(&y[0]));
     out.spectral_radius = curve;
     Ok(())
+}
+
+/// Whether the exact system at parameter values `params` moves the state
+/// `y0`: its field, at eight phases of a period, is not zero.
+fn moved_by_vibration<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    y0: &[f64; S],
+) -> bool {
+    let period = model.phase_period(params).unwrap_or(f64::NAN);
+    let exact = model.exact(params);
+    (0..8).any(|k| {
+        let f = exact.rhs(period * k as f64 / 8.0, y0);
+        f.iter().map(|x| x.abs()).fold(0.0, f64::max) > 1e-9
+    })
 }
 
 /// What [`stability_chart`] computes.
@@ -762,6 +780,16 @@ impl WithFixed for Chart<'_> {
             )
         })?;
         let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+        // Probed at the chart's corner of the largest y (the amplitude).
+        let mut corner = self.params.to_vec();
+        corner[ix] = settings.x_values.last().copied().unwrap_or(corner[ix]);
+        corner[iy] = settings.y_max;
+        if moved_by_vibration(model, &corner, &y0) {
+            return Err(StabilityError::MovedByVibration {
+                model: info.name.into(),
+                q: settings.q.clone(),
+            });
+        }
         let margins = |xy: &[(f64, f64)]| -> Result<Vec<f64>, OdeError> {
             let points: Vec<Vec<f64>> = xy
                 .iter()

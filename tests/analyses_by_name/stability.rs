@@ -208,6 +208,33 @@ fn kapitza_chart_boundaries_are_the_exact_thresholds() {
     assert!(chart.boundaries[1].len() >= 2, "{:?}", chart.boundaries);
 }
 
+/// A chart of a point the vibration moves (the elastic pendulum upright:
+/// its vertical shaking stretches the spring) has no monodromy matrix to
+/// chart: a typed error naming the model and the point, where it was a
+/// divergence at the spring's singular length r = 0.
+#[test]
+fn a_chart_of_a_point_the_vibration_moves_is_refused() {
+    use mechlab::analysis::stability::{stability_chart, ChartSettings};
+    let settings = ChartSettings {
+        q: vec![0.9, 0.0],
+        x: "nu".into(),
+        x_values: vec![5.0, 40.0],
+        y: "a".into(),
+        y_max: 4.0,
+        y_samples: 8,
+        edge_tolerance: 1e-6,
+        method: Method::parse("taylor", 1e-10).unwrap(),
+        tiles: None,
+    };
+    let e =
+        stability_chart("elastic_pendulum", &defaults("elastic_pendulum"), &settings).unwrap_err();
+    assert!(
+        matches!(&e, StabilityError::MovedByVibration { model, q } if model == "elastic_pendulum" && *q == [0.9, 0.0]),
+        "{e}"
+    );
+    assert!(e.to_string().contains("the vibration moves it"), "{e}");
+}
+
 /// A chart in the lanes of the batch Taylor method (each (ε, A) point with
 /// its own parameters and period, every boundary bisected in lockstep)
 /// equals, bit for bit, the chart of one scalar monodromy matrix at a time
