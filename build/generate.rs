@@ -39,6 +39,28 @@ struct Param {
     name: String,
     default: String,
     description: String,
+    /// The parameter's range as a Rust expression of `crate::model::Range`.
+    range: String,
+}
+
+/// A range as Rust source.
+fn range_literal(range: &crate::model::Range) -> String {
+    let end = |x: f64| {
+        if x == f64::INFINITY {
+            "f64::INFINITY".to_string()
+        } else if x == f64::NEG_INFINITY {
+            "f64::NEG_INFINITY".to_string()
+        } else {
+            format!("{x:?}")
+        }
+    };
+    format!(
+        "crate::model::Range {{ min: {}, max: {}, min_open: {}, max_open: {} }}",
+        end(range.min),
+        end(range.max),
+        range.min_open,
+        range.max_open
+    )
 }
 
 #[derive(Serialize)]
@@ -362,6 +384,7 @@ pub fn render(
     );
     context.insert("functions", &functions);
     context.insert("taylor_functions", &taylor_functions);
+    context.insert("dyn_systems", &dyn_systems(model, derivation));
     context.insert(
         "operation_counts",
         &derivation
@@ -644,6 +667,7 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
             name: p.name.clone(),
             default: format!("{:?}", p.default),
             description: format!("{:?}", p.description),
+            range: range_literal(&p.range),
         })
         .collect();
     let derived: Vec<DerivedEntry> = derived
@@ -776,6 +800,22 @@ pub fn render_registry(
     context.insert("users_models", &users_models);
     tera.render("registry.rs.tera", &context)
         .map_err(|e| format!("template registry.rs.tera: {e:?}"))
+}
+
+/// The systems a Hamiltonian model puts behind trait objects for the
+/// analyses by name: (marker type, system type) pairs.
+fn dyn_systems(model: &Model, derivation: &Derivation) -> Vec<std::collections::BTreeMap<&'static str, &'static str>> {
+    let mut kinds = vec![("ExactDyn", "Exact")];
+    if model.fast_phase.is_some() {
+        kinds.push(("AveragedDyn", "Averaged"));
+    }
+    if derivation.second_order.is_some() || crate::numeric::has_second_order(derivation, model) {
+        kinds.push(("Averaged2Dyn", "Averaged2"));
+    }
+    kinds
+        .into_iter()
+        .map(|(kind, system)| [("type", kind), ("system", system)].into_iter().collect())
+        .collect()
 }
 
 /// The steps that define the names the texts of a

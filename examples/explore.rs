@@ -9,22 +9,14 @@
 //! `cargo run --release --example explore -- --set model=elastic_pendulum --set k=20`
 
 use mechlab::explore::{explore, Settings};
-use mechlab::models;
 use mechlab::ode::Method;
 use mechlab::registry::Kind;
-use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
+use mechlab::scene::{knob, parameter_knobs, run, Scene};
 
 fn main() {
     run(|| {
         let name = Scene::peek("model").unwrap_or_else(|| "kapitza".into());
-        let model = models::dynamic(&name).ok_or_else(|| {
-            let known: Vec<&str> = models::ALL.iter().map(|m| m.name).collect();
-            SceneError::BadValue {
-                name: "model".into(),
-                value: name.clone(),
-                reason: format!("no such model (known: {})", known.join(", ")),
-            }
-        })?;
+        let model = mechlab::registry::model(&name)?.dynamic;
         let info = model.info();
         let mut knobs = vec![
             knob("model", "kapitza", "the model (a file models/<name>.toml)"),

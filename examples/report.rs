@@ -4,7 +4,7 @@
 //! numbers and a line on what it shows, and the LaTeX of the derivations.
 //! Static, no network: open it from the disk.
 
-use mechlab::report::{index_html, links, SECTIONS};
+use mechlab::report::{index_html, links, scene_command, SECTIONS};
 use mechlab::scene::{knob, run, write_atomic, Scene, SceneError};
 use std::path::PathBuf;
 use std::process::Command;
@@ -42,23 +42,9 @@ fn main() {
             let present = root.join(name).join("summary.json").exists();
             if mode == "all" || (mode == "missing" && !present) {
                 eprintln!("running {name} …");
-                // The benchmark among them runs through `cargo bench`.
-                let target = if name == "work_precision" {
-                    ["bench", "--bench"]
-                } else {
-                    ["run", "--example"]
-                };
                 let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
                 let status = Command::new(cargo)
-                    .args([
-                        target[0],
-                        "--release",
-                        "--quiet",
-                        target[1],
-                        name,
-                        "--",
-                        "--out",
-                    ])
+                    .args(scene_command(name))
                     .arg(root.join(name))
                     .status()
                     .map_err(|source| SceneError::Spawn {

@@ -60,6 +60,8 @@ pub enum ExploreError {
     Ode(#[from] OdeError),
     #[error(transparent)]
     Contact(#[from] ContactError),
+    #[error(transparent)]
+    UnknownModel(#[from] crate::registry::UnknownModel),
     /// A state of the wrong length or an unsupported size.
     #[error("{0}")]
     Shape(String),
@@ -114,9 +116,6 @@ fn to_array<const N: usize>(v: &[f64]) -> [f64; N] {
 }
 
 /// Runs everything the explorer shows for `model` from `y0`.
-/// (`#[inline]`: the per-model instances are compiled in the crates that
-/// call this, not in the library on every rebuild.)
-#[inline]
 pub fn explore(
     model: &dyn DynamicModel,
     params: &[f64],
@@ -143,7 +142,7 @@ pub fn explore(
     };
     match (model.kind(), expected) {
         (Kind::Hamiltonian { .. }, _) => {
-            crate::models::with_fixed(name, runs).unwrap_or_else(|| {
+            crate::registry::with_fixed(name, runs)?.unwrap_or_else(|| {
                 Err(ExploreError::Shape(format!(
                     "'{name}' is not a generated Hamiltonian model"
                 )))

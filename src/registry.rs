@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use crate::ode::{DynSystem, ErasedSystem};
+
 /// One derived expression in its readable form (checked at build time
 /// against Symbolica's result), as text and LaTeX.
 #[derive(Clone, Copy, Debug)]
@@ -27,6 +29,8 @@ pub struct ModelInfo {
     /// Defaults of the model file, as text.
     pub parameter_defaults: &'static [&'static str],
     pub parameter_descriptions: &'static [&'static str],
+    /// The values each parameter may take.
+    pub parameter_ranges: &'static [crate::model::Range],
     /// The parameter that scales the vibration, if the model file names one
     /// (`[fast_phase] amplitude`).
     pub amplitude: Option<&'static str>,
@@ -60,6 +64,26 @@ impl ModelInfo {
             ));
         }
         Ok(axes.map(|a| names[a].to_string()))
+    }
+
+    /// `value` for the parameter `name`, or why it cannot be: an unknown
+    /// name, a value that is not finite or outside the parameter's range.
+    pub fn check_parameter(&self, name: &str, value: f64) -> Result<(), ParameterError> {
+        let Some(i) = self.parameter_names.iter().position(|n| *n == name) else {
+            return Err(ParameterError::Unknown {
+                model: self.name,
+                name: name.to_string(),
+                known: self.parameter_names,
+            });
+        };
+        if !value.is_finite() {
+            return Err(ParameterError::NotFinite { model: self.name, name: name.to_string(), value });
+        }
+        let range = self.parameter_ranges[i];
+        if !range.contains(value) {
+            return Err(ParameterError::OutOfRange { model: self.name, name: name.to_string(), value, range });
+        }
+        Ok(())
     }
 
     /// Parameter values in declaration order as name → value; None if there
@@ -149,6 +173,12 @@ pub enum ParameterError {
         name: String,
         value: f64,
     },
+    OutOfRange {
+        model: &'static str,
+        name: String,
+        value: f64,
+        range: crate::model::Range,
+    },
 }
 
 impl fmt::Display for ParameterError {
@@ -159,6 +189,12 @@ impl fmt::Display for ParameterError {
                     f,
                     "model '{model}' has no parameter '{name}' (known: {})",
                     known.join(", ")
+                )
+            }
+            ParameterError::OutOfRange { model, name, value, range } => {
+                write!(
+                    f,
+                    "parameter '{name}' of model '{model}' must lie in {range} (its model file's range), got {value}"
                 )
             }
             ParameterError::NotFinite { model, name, value } => {
@@ -176,9 +212,10 @@ impl std::error::Error for ParameterError {}
 /// A generated Hamiltonian model at its own sizes: D degrees of freedom, a
 /// state of S = 2D, T = 2S for the state with one tangent vector and
 /// V = S + S² with a full set (stable Rust cannot compute them from D, so
-/// the generated registry states all four). Analyses written once over this trait are
-/// monomorphised per model by [`crate::models::with_fixed`], so they run at
-/// the speed of code written for that model.
+/// [`with_fixed`] states all four). Analyses are written once over this
+/// trait; its one implementation, [`Erased`], reaches the model's compiled
+/// code through a trait object, so they are compiled once per size and not
+/// again when a model file changes.
 pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     Sync + 'static
 {
@@ -212,6 +249,130 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     fn effective_potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
 }
 
+/// What a generated Hamiltonian model gives at its own sizes, as a trait
+/// object (the model's module implements it; [`Erased`] adapts it to
+/// [`Fixed`]). Parameters are values in declaration order.
+pub trait SizedModel<const D: usize, const S: usize>: Sync {
+    fn info(&self) -> &'static ModelInfo;
+    /// Which coordinates are angles.
+    fn periodic(&self) -> [bool; D];
+    fn exact(&self) -> &'static dyn DynSystem<S>;
+    /// None without a fast phase.
+    fn averaged(&self) -> Option<&'static dyn DynSystem<S>>;
+    /// None where the second order is not derived.
+    fn averaged2(&self) -> Option<&'static dyn DynSystem<S>>;
+    fn phase_period(&self, params: &[f64]) -> Option<f64>;
+    fn averaged2_hessian(&self, params: &[f64], y: &[f64; S]) -> Option<[[f64; S]; S]>;
+    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64; S]) -> Option<[f64; S]>;
+    fn mass_matrix(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
+    fn potential_gradient(&self, params: &[f64], q: &[f64; D]) -> [f64; D];
+    fn potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
+    fn effective_potential(&self, params: &[f64], q: &[f64; D]) -> f64;
+    fn effective_potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
+}
+
+/// A [`SizedModel`] as a [`Fixed`] model: the one type the analyses are
+/// compiled for at each size.
+pub struct Erased<const D: usize, const S: usize, const T: usize, const V: usize>(
+    pub &'static dyn SizedModel<D, S>,
+);
+
+impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S, T, V>
+    for Erased<D, S, T, V>
+{
+    type Exact = ErasedSystem<S>;
+    type Averaged = ErasedSystem<S>;
+    type Averaged2 = ErasedSystem<S>;
+    fn info(&self) -> &'static ModelInfo {
+        self.0.info()
+    }
+    fn has_fast_phase(&self) -> bool {
+        self.0.averaged().is_some()
+    }
+    fn periodic(&self) -> [bool; D] {
+        self.0.periodic()
+    }
+    fn exact(&self, params: &[f64]) -> ErasedSystem<S> {
+        ErasedSystem { system: self.0.exact(), params: params.to_vec() }
+    }
+    fn averaged(&self, params: &[f64]) -> Option<ErasedSystem<S>> {
+        let system = self.0.averaged()?;
+        Some(ErasedSystem { system, params: params.to_vec() })
+    }
+    fn phase_period(&self, params: &[f64]) -> Option<f64> {
+        self.0.phase_period(params)
+    }
+    fn averaged2(&self, params: &[f64]) -> Option<ErasedSystem<S>> {
+        let system = self.0.averaged2()?;
+        Some(ErasedSystem { system, params: params.to_vec() })
+    }
+    fn averaged2_hessian(&self, params: &[f64], y: &[f64; S]) -> Option<[[f64; S]; S]> {
+        self.0.averaged2_hessian(params, y)
+    }
+    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64; S]) -> Option<[f64; S]> {
+        self.0.averaged2_shift(params, t, y)
+    }
+    fn mass_matrix(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D] {
+        self.0.mass_matrix(params, q)
+    }
+    fn potential_gradient(&self, params: &[f64], q: &[f64; D]) -> [f64; D] {
+        self.0.potential_gradient(params, q)
+    }
+    fn potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D] {
+        self.0.potential_hessian(params, q)
+    }
+    fn effective_potential(&self, params: &[f64], q: &[f64; D]) -> f64 {
+        self.0.effective_potential(params, q)
+    }
+    fn effective_potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D] {
+        self.0.effective_potential_hessian(params, q)
+    }
+}
+
+/// A Hamiltonian model at its own size, for [`with_fixed`]: one variant per
+/// number of degrees of freedom a model file may have (1 to 8).
+#[derive(Clone, Copy)]
+pub enum Sized {
+    Dof1(&'static Erased<1, 2, 4, 6>),
+    Dof2(&'static Erased<2, 4, 8, 20>),
+    Dof3(&'static Erased<3, 6, 12, 42>),
+    Dof4(&'static Erased<4, 8, 16, 72>),
+    Dof5(&'static Erased<5, 10, 20, 110>),
+    Dof6(&'static Erased<6, 12, 24, 156>),
+    Dof7(&'static Erased<7, 14, 28, 210>),
+    Dof8(&'static Erased<8, 16, 32, 272>),
+}
+
+/// One generated model: what it is, its dynamically sized interface, and
+/// for Hamiltonian models the same at its own sizes.
+#[derive(Clone, Copy)]
+pub struct Model {
+    pub info: &'static ModelInfo,
+    pub dynamic: &'static dyn DynamicModel,
+    /// None for a contact model.
+    pub sized: Option<Sized>,
+}
+
+/// A model name that no model file has.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("no model named '{name}' (known: {})", known.join(", "))]
+pub struct UnknownModel {
+    pub name: String,
+    pub known: Vec<&'static str>,
+}
+
+/// The model named `name` among the users' models.
+pub fn model(name: &str) -> Result<&'static Model, UnknownModel> {
+    crate::models::MODELS
+        .iter()
+        .copied()
+        .find(|m| m.info.name == name)
+        .ok_or_else(|| UnknownModel {
+            name: name.to_string(),
+            known: crate::models::MODELS.iter().map(|m| m.info.name).collect(),
+        })
+}
+
 /// Work to run on one model at its own sizes (see [`Fixed`]).
 pub trait WithFixed {
     type Output;
@@ -219,6 +380,22 @@ pub trait WithFixed {
         self,
         model: &'static F,
     ) -> Self::Output;
+}
+
+/// Runs `work` on the Hamiltonian model `name` at its own sizes: an unknown
+/// name is an error, a contact model gives None. The analyses are compiled
+/// once per size, whatever the models are.
+pub fn with_fixed<W: WithFixed>(name: &str, work: W) -> Result<Option<W::Output>, UnknownModel> {
+    Ok(model(name)?.sized.map(|sized| match sized {
+        Sized::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
+        Sized::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
+        Sized::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
+        Sized::Dof4(m) => work.run::<_, 4, 8, 16, 72>(m),
+        Sized::Dof5(m) => work.run::<_, 5, 10, 20, 110>(m),
+        Sized::Dof6(m) => work.run::<_, 6, 12, 24, 156>(m),
+        Sized::Dof7(m) => work.run::<_, 7, 14, 28, 210>(m),
+        Sized::Dof8(m) => work.run::<_, 8, 16, 32, 272>(m),
+    }))
 }
 
 /// A name of a model file in the notation of the figures: Greek names as

@@ -216,3 +216,15 @@ pub fn links(html: &str) -> Vec<String> {
     }
     out
 }
+
+/// The cargo arguments that run the scene `name` in release mode, up to
+/// its output folder (which follows): a scene is an example, the
+/// work–precision benchmark runs through `cargo bench`, whose profile is
+/// already the optimised one (cargo refuses `bench --release`).
+pub fn scene_command(name: &str) -> Vec<&str> {
+    if name == "work_precision" {
+        vec!["bench", "--quiet", "--bench", name, "--", "--out"]
+    } else {
+        vec!["run", "--release", "--quiet", "--example", name, "--", "--out"]
+    }
+}

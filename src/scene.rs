@@ -77,6 +77,8 @@ pub enum SceneError {
     #[error(transparent)]
     Parameter(#[from] crate::registry::ParameterError),
     #[error(transparent)]
+    UnknownModel(#[from] crate::registry::UnknownModel),
+    #[error(transparent)]
     Study(#[from] crate::studies::StudyError),
     #[error(transparent)]
     Explore(#[from] crate::explore::ExploreError),
@@ -219,7 +221,11 @@ impl Scene {
     ) -> Result<Vec<f64>, SceneError> {
         info.parameter_names
             .iter()
-            .map(|n| self.number(n))
+            .map(|n| {
+                let value = self.number(n)?;
+                info.check_parameter(n, value)?;
+                Ok(value)
+            })
             .collect()
     }
 

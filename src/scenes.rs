@@ -1,11 +1,6 @@
 //! The bodies of the generic scenes, shared by the scene of that name and
 //! the study scenes that are its presets (the same knobs with other
 //! defaults, the same files): knobs → one library call → figures.
-//!
-//! The scene bodies and the analyses they call are `#[inline]`: their
-//! per-model instances (one per model of `models/`, through
-//! `models::with_fixed`) are compiled in the scene that runs them, not in
-//! the library on every rebuild.
 
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::ode::Method;
@@ -16,18 +11,7 @@ use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError};
 /// listing the known ones.
 pub fn model_from_args(default: &str) -> Result<&'static ModelInfo, SceneError> {
     let name = Scene::peek("model").unwrap_or_else(|| default.into());
-    crate::registry::find(&name).ok_or_else(|| SceneError::BadValue {
-        name: "model".into(),
-        value: name.clone(),
-        reason: format!(
-            "no such model (known: {})",
-            crate::models::ALL
-                .iter()
-                .map(|m| m.name)
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    })
+    Ok(crate::registry::model(&name)?.info)
 }
 
 /// A preset's defaults: its value of a knob, or the generic scene's.
@@ -111,7 +95,6 @@ pub fn method_from(scene: &Scene) -> Result<Method, SceneError> {
 /// The `chaos_map` scene: the FLI map of any model's period map on a plane
 /// of two state components. `overrides` are the preset's defaults (model
 /// and its parameters, knobs).
-#[inline]
 pub fn chaos_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
@@ -311,7 +294,6 @@ pub fn tiles_from(
 /// the exact and averaged runs from the same state against the phase's
 /// frequency, with the fitted slopes, and ν × deviation. `values` takes a
 /// list, `auto`, or `geometric:first,last,count`.
-#[inline]
 pub fn averaging_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
@@ -501,7 +483,6 @@ fn averaging_figure(
 /// fast phase on the cylinder (q, p), or on a plane of two state
 /// components. Seeds: `--set seeds=…` (states separated by `;`) or a line
 /// of `count` seeds along the first axis.
-#[inline]
 pub fn period_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],

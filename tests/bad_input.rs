@@ -63,7 +63,13 @@ proptest! {
     ) {
         let text = mutate(SHIPPED[which], &edits);
         match Model::parse("models/mutated.toml", &text) {
-            Ok(_) => {}
+            // A mutation that still parses is a model in full: coordinates,
+            // and parsing is a function of the text.
+            Ok(model) => {
+                prop_assert!(!model.coordinates.is_empty());
+                let again = Model::parse("models/mutated.toml", &text).unwrap();
+                prop_assert_eq!(format!("{model:?}"), format!("{again:?}"));
+            }
             Err(e) => prop_assert!(e.to_string().starts_with("models/mutated.toml: key `")),
         }
     }
@@ -79,11 +85,22 @@ proptest! {
     ) {
         let knobs = [knob("tol", "1e-10", "tolerance"), knob("a", "1", "amplitude")];
         if let Ok(scene) = Scene::parse("random", &knobs, &args) {
-            // Values that parse are numbers or typed errors, never panics.
-            let _ = scene.positive("tol");
-            let _ = scene.number("a");
-            let _ = scene.numbers("a");
-            let _ = scene.count("a");
+            // Values that parse keep their contracts; the others are typed
+            // errors naming the knob, never panics.
+            match scene.positive("tol") {
+                Ok(tol) => prop_assert!(tol > 0.0 && tol.is_finite()),
+                Err(e) => prop_assert!(e.to_string().contains("--set tol="), "{}", e),
+            }
+            match scene.number("a") {
+                Ok(a) => prop_assert!(a.is_finite()),
+                Err(e) => prop_assert!(e.to_string().contains("--set a="), "{}", e),
+            }
+            if let Ok(values) = scene.numbers("a") {
+                prop_assert!(!values.is_empty() && values.iter().all(|v| v.is_finite()));
+            }
+            if let Ok(count) = scene.count("a") {
+                prop_assert!(count > 0);
+            }
         }
     }
 }

@@ -18,7 +18,7 @@ fn settings() -> Settings {
 #[test]
 fn every_model_can_be_explored() {
     for info in models::ALL {
-        let model = models::dynamic(info.name).expect("every model is listed");
+        let model = mechlab::registry::model(info.name).expect("every model is listed").dynamic;
         let (n, phase) = match model.kind() {
             Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
             Kind::Contacts { count } => (count, false),
@@ -42,7 +42,7 @@ fn every_model_can_be_explored() {
 
 #[test]
 fn a_state_of_the_wrong_length_is_an_error() {
-    let model = models::dynamic("kapitza").unwrap();
+    let model = mechlab::registry::model("kapitza").unwrap().dynamic;
     assert!(explore(model, &model.defaults(), &[0.1, 0.0, 0.0], &settings()).is_err());
 }
 
@@ -50,7 +50,7 @@ fn a_state_of_the_wrong_length_is_an_error() {
 /// (V'' = A²/2 − 1) and π (V'' = 1 + A²/2) and maxima at cos q = 2/A².
 #[test]
 fn kapitza_equilibria_match_the_closed_form() {
-    let model = models::dynamic("kapitza").unwrap();
+    let model = mechlab::registry::model("kapitza").unwrap().dynamic;
     let a: f64 = 1.5;
     let mut params = model.defaults();
     params[0] = a;
@@ -74,7 +74,7 @@ fn kapitza_equilibria_match_the_closed_form() {
 #[test]
 fn explore_runs_with_taylor() {
     for name in ["kapitza", "triple_pendulum"] {
-        let model = models::dynamic(name).unwrap();
+        let model = mechlab::registry::model(name).unwrap().dynamic;
         let n = match model.kind() {
             Kind::Hamiltonian { dof, .. } => dof,
             Kind::Contacts { .. } => unreachable!(),

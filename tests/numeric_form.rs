@@ -146,9 +146,9 @@ fn flat<const N: usize>(m: &[[f64; N]; N]) -> Vec<f64> {
 #[test]
 fn every_model_follows_hamiltons_equations_of_its_hamiltonians() {
     let mut rng = Rng(0x2545_f491_4f6c_dd1d);
-    let models: Vec<&dyn DynamicModel> = mechlab::models::ALL
+    let models: Vec<&dyn DynamicModel> = mechlab::models::MODELS
         .iter()
-        .filter_map(|info| mechlab::models::dynamic(info.name))
+        .map(|m| m.dynamic)
         .chain([
             &double_pendulum_numeric::DYNAMIC as &dyn DynamicModel,
             &spring_double_pendulum::DYNAMIC,

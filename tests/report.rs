@@ -49,3 +49,26 @@ fn every_link_of_the_report_exists() {
         .unwrap();
     assert!(html.contains(&mechlab::mathml::mathml(hamiltonian.latex, true)));
 }
+
+/// The report runs each missing scene through cargo: the examples in
+/// release mode, the work–precision benchmark through `cargo bench`,
+/// which refuses `--release` (a fresh clone has no `out/work_precision`,
+/// so the report ran `cargo bench --release` and failed).
+#[test]
+fn the_report_runs_scenes_with_arguments_cargo_accepts() {
+    use mechlab::report::scene_command;
+    let bench = scene_command("work_precision");
+    assert_eq!(&bench[..3], &["bench", "--quiet", "--bench"]);
+    assert!(!bench.contains(&"--release"));
+    assert_eq!(bench.last(), Some(&"--out"));
+    let example = scene_command("kapitza_period_map");
+    assert_eq!(
+        example,
+        ["run", "--release", "--quiet", "--example", "kapitza_period_map", "--", "--out"]
+    );
+    for section in SECTIONS {
+        let args = scene_command(section.scene);
+        assert!(args.contains(&section.scene), "{}", section.scene);
+        assert!(!(args[0] == "bench" && args.contains(&"--release")));
+    }
+}

@@ -289,7 +289,7 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             Err(
                 AveragingError::Order(..)
                 | AveragingError::NoFastPhase(_)
-                | AveragingError::UnknownModel(_),
+                | AveragingError::ContactModel(_),
             ) => {}
             Err(e) => panic!("{}: {e}", info.name),
         }

@@ -13,7 +13,6 @@ use mechlab::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use mechlab::analysis::period_map::{orbit, period_map, wrap_angle};
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
-use mechlab::registry::Fixed;
 use mechlab::studio::server::router;
 use serde_json::{json, Value};
 use tower::ServiceExt;
@@ -50,8 +49,8 @@ fn lines(text: &str) -> Vec<Value> {
 /// Kapitza's period map from the library: its exact system at `params`
 /// (A, ε, μ) and the forcing period.
 fn kapitza_map(params: [f64; 3]) -> (kapitza::Exact, f64) {
-    let model = &kapitza::FIXED;
-    (model.exact(&params), model.phase_period(&params).unwrap())
+    let exact = kapitza::Exact { params: kapitza::Params::from_values(&params) };
+    (exact, 2.0 * std::f64::consts::PI * params[1])
 }
 
 #[tokio::test]
@@ -273,7 +272,7 @@ async fn bad_requests_are_named_errors() {
         (
             orbit(json!({"model": "no_such_model"})),
             StatusCode::NOT_FOUND,
-            "no model 'no_such_model'",
+            "no model named 'no_such_model'",
         ),
         (
             orbit(json!({"params": {"B": 1.0}})),

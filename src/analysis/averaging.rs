@@ -172,8 +172,10 @@ pub struct AveragingConvergence {
 /// Why [`convergence`] cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum AveragingError {
-    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
-    UnknownModel(String),
+    #[error(transparent)]
+    UnknownModel(#[from] crate::registry::UnknownModel),
+    #[error("'{0}' is a contact model: it has no period map or averaged system")]
+    ContactModel(String),
     #[error("model '{0}' has no fast phase: there is no averaged system")]
     NoFastPhase(String),
     #[error("model '{model}': {reason}")]
@@ -228,16 +230,13 @@ pub fn second_order_deviation<
 
 /// Runs [`AveragingConvergence`] on the model `name` with parameter values
 /// `params` (declaration order).
-/// (`#[inline]`: the per-model instances are compiled in the crates that
-/// call this, not in the library on every rebuild.)
-#[inline]
 pub fn convergence(
     name: &str,
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
-    crate::models::with_fixed(name, Sweep { params, settings })
-        .ok_or_else(|| AveragingError::UnknownModel(name.to_string()))?
+    crate::registry::with_fixed(name, Sweep { params, settings })?
+        .ok_or_else(|| AveragingError::ContactModel(name.into()))?
 }
 
 struct Sweep<'a> {

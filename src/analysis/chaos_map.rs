@@ -87,9 +87,6 @@ pub use super::period_map::PeriodMapError as ChaosMapError;
 /// the worker threads) and returns whether to go on: once it says false,
 /// rows not yet started are skipped and the map ends with
 /// [`ChaosMapError::Cancelled`] (nobody is waiting for it any more).
-/// (`#[inline]`: the per-model instances are compiled in the crates that
-/// call this, not in the library on every rebuild.)
-#[inline]
 pub fn chaos_map(
     name: &str,
     params: &[f64],
@@ -101,7 +98,8 @@ pub fn chaos_map(
         settings,
         row_done,
     };
-    crate::models::with_fixed(name, work).ok_or_else(|| ChaosMapError::UnknownModel(name.into()))?
+    crate::registry::with_fixed(name, work)?
+        .ok_or_else(|| ChaosMapError::ContactModel(name.into()))?
 }
 
 struct Map<'a> {

@@ -111,8 +111,10 @@ pub struct Portrait {
 /// Why an analysis of the period map ([`portrait`], the chaos map) cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum PeriodMapError {
-    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
-    UnknownModel(String),
+    #[error(transparent)]
+    UnknownModel(#[from] crate::registry::UnknownModel),
+    #[error("'{0}' is a contact model: it has no period map or averaged system")]
+    ContactModel(String),
     #[error("model '{0}' has no fast phase: it has no period map")]
     NoFastPhase(String),
     #[error("model '{model}': {reason}")]
@@ -131,16 +133,13 @@ pub enum PeriodMapError {
 }
 
 /// The orbits of the model `name` with parameter values `params`.
-/// (`#[inline]`: the per-model instances are compiled in the crates that
-/// call this, not in the library on every rebuild.)
-#[inline]
 pub fn portrait(
     name: &str,
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    crate::models::with_fixed(name, Portraits { params, settings })
-        .ok_or_else(|| PeriodMapError::UnknownModel(name.into()))?
+    crate::registry::with_fixed(name, Portraits { params, settings })?
+        .ok_or_else(|| PeriodMapError::ContactModel(name.into()))?
 }
 
 struct Portraits<'a> {

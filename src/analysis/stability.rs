@@ -79,8 +79,10 @@ pub struct Stability {
 /// Why the analysis cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum StabilityError {
-    #[error("'{0}' is not a Hamiltonian model of models/ (a contact model has no period map or averaged system)")]
-    UnknownModel(String),
+    #[error(transparent)]
+    UnknownModel(#[from] crate::registry::UnknownModel),
+    #[error("'{0}' is a contact model: it has no period map or averaged system")]
+    ContactModel(String),
     #[error("model '{0}' has no fast phase: there is no vibration to stabilise by")]
     NoFastPhase(String),
     #[error(
@@ -109,16 +111,13 @@ pub enum StabilityError {
 
 /// Runs the analysis on the model `name` with parameter values `params`
 /// (declaration order).
-/// (`#[inline]`: the per-model instances are compiled in the crates that
-/// call this, not in the library on every rebuild.)
-#[inline]
 pub fn stability(
     name: &str,
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
-    crate::models::with_fixed(name, Analysis { params, settings })
-        .ok_or_else(|| StabilityError::UnknownModel(name.to_string()))?
+    crate::registry::with_fixed(name, Analysis { params, settings })?
+        .ok_or_else(|| StabilityError::ContactModel(name.into()))?
 }
 
 struct Analysis<'a> {
@@ -176,22 +175,21 @@ fn parameter_index(info: &crate::registry::ModelInfo, name: &str) -> Result<usiz
 
 /// The averaged analysis at one equilibrium `q` of the system without
 /// vibration (roots, a*, the second-order threshold; no exact window).
-#[inline]
 pub fn averaged_stability(
     name: &str,
     params: &[f64],
     amplitude: &str,
     q: &[f64],
 ) -> Result<EquilibriumStability, StabilityError> {
-    crate::models::with_fixed(
+    crate::registry::with_fixed(
         name,
         AtEquilibrium {
             params,
             amplitude,
             q,
         },
-    )
-    .ok_or_else(|| StabilityError::UnknownModel(name.to_string()))?
+    )?
+        .ok_or_else(|| StabilityError::ContactModel(name.into()))?
 }
 
 struct AtEquilibrium<'a> {
@@ -743,16 +741,13 @@ pub struct StabilityChart {
 }
 
 /// The stability chart of the model `name` (see [`StabilityChart`]).
-/// (`#[inline]`: the per-model instances are compiled in the crates that
-/// call this, not in the library on every rebuild.)
-#[inline]
 pub fn stability_chart(
     name: &str,
     params: &[f64],
     settings: &ChartSettings,
 ) -> Result<StabilityChart, StabilityError> {
-    crate::models::with_fixed(name, Chart { params, settings })
-        .ok_or_else(|| StabilityError::UnknownModel(name.to_string()))?
+    crate::registry::with_fixed(name, Chart { params, settings })?
+        .ok_or_else(|| StabilityError::ContactModel(name.into()))?
 }
 
 struct Chart<'a> {

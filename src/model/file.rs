@@ -111,6 +111,8 @@ pub struct ParameterSpec {
     pub description: String,
     /// LaTeX of the name, when the default does not fit.
     pub latex: Option<String>,
+    /// The values it may take, as an interval: `"(0, inf)"`, `"[0, 1]"`.
+    pub range: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -153,6 +155,84 @@ pub struct Coordinate {
     pub latex: Option<String>,
 }
 
+/// The values a parameter may take: an interval whose ends are open or
+/// closed, written `"(0, inf)"` or `"[0, 1]"` in a model file. Scenes and
+/// the studio refuse a value outside it with an error naming both, so a
+/// negative ε never becomes a negative period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+    pub min_open: bool,
+    pub max_open: bool,
+}
+
+impl Range {
+    /// Every real number.
+    pub const ALL: Range = Range {
+        min: f64::NEG_INFINITY,
+        max: f64::INFINITY,
+        min_open: true,
+        max_open: true,
+    };
+
+    /// Reads `(a, b)`, `[a, b]`, `(a, b]` or `[a, b)`, with `inf` and
+    /// `-inf` for unbounded ends; the reason when it cannot.
+    pub fn parse(text: &str) -> Result<Range, String> {
+        let text = text.trim();
+        let bad = || format!("'{text}' is not an interval such as \"(0, inf)\" or \"[0, 1]\"");
+        let (min_open, rest) = match text.chars().next() {
+            Some('(') => (true, &text[1..]),
+            Some('[') => (false, &text[1..]),
+            _ => return Err(bad()),
+        };
+        let (max_open, inner) = match rest.chars().last() {
+            Some(')') => (true, &rest[..rest.len() - 1]),
+            Some(']') => (false, &rest[..rest.len() - 1]),
+            _ => return Err(bad()),
+        };
+        let (a, b) = inner.split_once(',').ok_or_else(bad)?;
+        let number = |x: &str| -> Result<f64, String> {
+            match x.trim() {
+                "inf" | "+inf" => Ok(f64::INFINITY),
+                "-inf" => Ok(f64::NEG_INFINITY),
+                x => x.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(bad),
+            }
+        };
+        let range = Range { min: number(a)?, max: number(b)?, min_open, max_open };
+        if range.min >= range.max {
+            return Err(format!("'{text}' is empty: its lower end must be below its upper end"));
+        }
+        Ok(range)
+    }
+
+    pub fn contains(&self, x: f64) -> bool {
+        let above = if self.min_open { x > self.min } else { x >= self.min };
+        let below = if self.max_open { x < self.max } else { x <= self.max };
+        above && below
+    }
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let end = |x: f64| {
+            if x.is_infinite() {
+                if x > 0.0 { "inf".to_string() } else { "-inf".to_string() }
+            } else {
+                x.to_string()
+            }
+        };
+        write!(
+            f,
+            "{}{}, {}{}",
+            if self.min_open { '(' } else { '[' },
+            end(self.min),
+            end(self.max),
+            if self.max_open { ')' } else { ']' }
+        )
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct Parameter {
     pub name: String,
@@ -160,6 +240,8 @@ pub struct Parameter {
     pub description: String,
     /// Explicit LaTeX name, if the model file gives one.
     pub latex: Option<String>,
+    /// The values it may take (all reals unless the file says otherwise).
+    pub range: Range,
 }
 
 /// The fast phase θ with dθ/dt = rate(parameters); the model is 2π-periodic in θ.
@@ -372,6 +454,15 @@ impl ModelFile {
                     format!("default of '{}' is not finite", p.name),
                 ));
             }
+            if let Some(text) = &p.range {
+                let range = Range::parse(text).map_err(|reason| err(&format!("parameters[{i}].range"), reason))?;
+                if !range.contains(p.default) {
+                    return Err(err(
+                        &format!("parameters[{i}].default"),
+                        format!("the default {} of '{}' is outside its range {range}", p.default, p.name),
+                    ));
+                }
+            }
         }
         if let Some(phase) = &self.fast_phase {
             declare("fast_phase.name", &phase.name)?;
@@ -549,6 +640,11 @@ impl ModelFile {
                 .parameters
                 .into_iter()
                 .map(|p| Parameter {
+                    range: p
+                        .range
+                        .as_deref()
+                        .map_or(Ok(Range::ALL), Range::parse)
+                        .expect("checked above"),
                     name: p.name,
                     default: p.default,
                     description: p.description,

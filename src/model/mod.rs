@@ -5,4 +5,4 @@ pub mod expr;
 pub mod file;
 
 pub use expr::Expr;
-pub use file::{Contact, Inverse, Model, ModelError, MAX_DOF, SYMBOLIC_INVERSE_MAX_DOF};
+pub use file::{Contact, Inverse, Model, ModelError, Range, MAX_DOF, SYMBOLIC_INVERSE_MAX_DOF};

@@ -6,7 +6,9 @@
 //! only) call the scalar ones lane by lane.
 
 use super::kernels;
+use super::erased::DynSystem;
 use super::series::Scalar;
+use super::TaylorWork;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 /// Orbits per batch: eight f64 fill one AVX-512 register or two AVX ones.
@@ -149,5 +151,27 @@ impl Scalar for Lanes {
     #[inline(always)]
     fn positive_sqrt(self) -> Lanes {
         self.map(<f64 as Scalar>::positive_sqrt)
+    }
+    fn dyn_taylor<const N: usize>(
+        system: &dyn DynSystem<N>,
+        params: [&[f64]; LANES],
+        t: Lanes,
+        y: &[Lanes; N],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [[Lanes; N]],
+    ) -> bool {
+        system.taylor_lanes(params, t, y, order, work, out)
+    }
+    fn dyn_taylor_variational<const N: usize>(
+        system: &dyn DynSystem<N>,
+        params: [&[f64]; LANES],
+        t: Lanes,
+        z: &[Lanes],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [Lanes],
+    ) -> bool {
+        system.taylor_variational_lanes(params, t, z, order, work, out)
     }
 }

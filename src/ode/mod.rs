@@ -7,6 +7,7 @@
 //! States are `[f64; N]`: no allocation per step.
 
 mod dop853;
+mod erased;
 mod events;
 mod gauss;
 pub mod hyperdual;
@@ -18,6 +19,7 @@ pub mod series;
 pub mod taylor;
 mod taylor_lanes;
 
+pub use erased::{DynSystem, ErasedSystem};
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
 pub use hyperdual::HyperDual;
 pub use lanes::{Lanes, LANES};

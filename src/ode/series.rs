@@ -16,6 +16,9 @@
 
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
+use super::erased::DynSystem;
+use super::{TaylorWork, LANES};
+
 /// What the recurrences compute with: `f64`, or a batch of f64 lanes.
 /// Arithmetic with f64 is on the right only (`x * A`, `Num::from(2.0) - x`):
 /// a bound `f64: Mul<Num>` would shadow `f64: Mul<f64>` in the generated
@@ -46,6 +49,36 @@ pub trait Scalar:
     fn recip(self) -> Self;
     /// √x where x > 0, NaN elsewhere (a Cholesky pivot).
     fn positive_sqrt(self) -> Self;
+    /// Runs the recurrences of a system behind a trait object in this
+    /// number type (lane l with `params[l]`): a generic method cannot be
+    /// called through a trait object, so each number type picks the one its
+    /// model compiled, f64 the scalar recurrences and [`Lanes`](super::Lanes)
+    /// the batch; others have none (false).
+    #[allow(clippy::too_many_arguments)]
+    fn dyn_taylor<const N: usize>(
+        _system: &dyn DynSystem<N>,
+        _params: [&[f64]; LANES],
+        _t: Self,
+        _y: &[Self; N],
+        _order: usize,
+        _work: &mut TaylorWork<Self>,
+        _out: &mut [[Self; N]],
+    ) -> bool {
+        false
+    }
+    /// [`Scalar::dyn_taylor`] for the system with tangent vectors.
+    #[allow(clippy::too_many_arguments)]
+    fn dyn_taylor_variational<const N: usize>(
+        _system: &dyn DynSystem<N>,
+        _params: [&[f64]; LANES],
+        _t: Self,
+        _z: &[Self],
+        _order: usize,
+        _work: &mut TaylorWork<Self>,
+        _out: &mut [Self],
+    ) -> bool {
+        false
+    }
 }
 
 impl Scalar for f64 {
@@ -88,6 +121,28 @@ impl Scalar for f64 {
         } else {
             f64::NAN
         }
+    }
+    fn dyn_taylor<const N: usize>(
+        system: &dyn DynSystem<N>,
+        params: [&[f64]; LANES],
+        t: f64,
+        y: &[f64; N],
+        order: usize,
+        work: &mut TaylorWork<f64>,
+        out: &mut [[f64; N]],
+    ) -> bool {
+        system.taylor(params[0], t, y, order, work, out)
+    }
+    fn dyn_taylor_variational<const N: usize>(
+        system: &dyn DynSystem<N>,
+        params: [&[f64]; LANES],
+        t: f64,
+        z: &[f64],
+        order: usize,
+        work: &mut TaylorWork<f64>,
+        out: &mut [f64],
+    ) -> bool {
+        system.taylor_variational(params[0], t, z, order, work, out)
     }
 }
 

@@ -105,7 +105,6 @@ pub fn threshold_formula(phi: (f64, f64)) -> Option<(String, String)> {
 
 /// Spectral radius of the exact system's monodromy matrix at an equilibrium
 /// (a 2π/ν-periodic solution for every a), with its multipliers.
-#[inline]
 pub fn exact_multipliers(
     params: &Params,
     phi: (f64, f64),
@@ -123,7 +122,6 @@ pub fn exact_multipliers(
 /// equilibrium is stable (all multipliers within 1 + 1e-6 of the unit
 /// circle): its lower edge close to a* for large ν, its upper edge where
 /// parametric resonance destabilises it again (None if beyond a_max).
-#[inline]
 pub fn exact_stability_window(
     params: &Params,
     phi: (f64, f64),
@@ -205,7 +203,6 @@ pub struct AveragingCases {
     pub cases: Vec<AveragingCase>,
 }
 
-#[inline]
 pub fn averaging_cases(s: &AveragingSettings) -> Result<AveragingCases, StudyError> {
     let grid = time_grid(s.t_end, 2.0 * PI / s.params.nu, 16, 2000);
     let mut cases = Vec::new();
@@ -467,7 +464,6 @@ fn limiting_run(
 /// For every equilibrium: the roots of det(C − λA) = 0, stability without
 /// vibration, a* (number and closed formula), the exact window at ν, long
 /// limiting runs either side of a*, and the exact spectral radius against a.
-#[inline]
 pub fn stabilization_study(
     s: &StabilizationSettings,
     progress: &(dyn Fn(usize) + Sync),
@@ -701,7 +697,6 @@ pub struct Friction {
     pub t_end: f64,
 }
 
-#[inline]
 pub fn friction(s: &FrictionSettings) -> Result<Friction, StudyError> {
     let (params, phi) = (s.params, s.equilibrium);
     let y_eq = [phi.0, phi.1, 0.0, 0.0];

@@ -65,7 +65,6 @@ pub struct Portrait {
 }
 
 /// The portrait at `params`: `seeds` orbits of `periods` periods, on all cores.
-#[inline]
 pub fn portrait(
     params: Params,
     seeds: usize,
@@ -168,7 +167,6 @@ pub struct SingleOrbit {
 }
 
 /// The orbit from `y0`, timed `repeat` times (the fastest run is reported).
-#[inline]
 pub fn single_orbit(
     params: Params,
     y0: [f64; 2],
@@ -229,7 +227,6 @@ impl SingleOrbit {
 /// The exact A* at which the upper position becomes stable (the lower edge
 /// of its window in (0, 4]) and the second-order averaged threshold, both
 /// from the generic `stability`.
-#[inline]
 pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<AStar, StudyError> {
     let settings = Settings {
         amplitude: "A".into(),
@@ -299,9 +296,6 @@ pub type Orbits = Vec<Vec<[f64; 2]>>;
 /// Starts of the orbits near the upper position.
 const NEAR_UPPER: [[f64; 2]; 4] = [[0.05, 0.0], [0.15, 0.0], [0.3, 0.0], [0.0, 0.25]];
 
-/// (`#[inline]`, as the generic analyses it calls: their per-model
-/// instances compile in the caller, not in the library.)
-#[inline]
 pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyError> {
     check(&s.params)?;
     let Params { A: a, eps, mu } = s.params;
@@ -519,7 +513,6 @@ pub struct AttractorSettings {
 /// (their sum is −μT) and its box-counting dimension (box sides 1/4 …
 /// 1/256 of the extent; the fit leaves out the coarsest and the finest,
 /// which 10⁵ points cannot fill).
-#[inline]
 pub fn attractor(s: &AttractorSettings) -> Result<Attractor, StudyError> {
     check(&s.params)?;
     let system = Exact { params: s.params };

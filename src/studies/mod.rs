@@ -1,10 +1,6 @@
 //! The runs of the three studies' scenes, each returning a typed result
 //! (the scene's summary, with the data its figures are drawn from), and the
 //! closed forms derived by hand that the generated code is tested against.
-//!
-//! The runs are `#[inline]`: their integrator instances compile in the
-//! scenes and tests that call them, not in the library, which is rebuilt
-//! whenever a model file is added.
 
 pub mod double_pendulum;
 pub mod kapitza;

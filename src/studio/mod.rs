@@ -28,11 +28,8 @@ pub const MAX_GRID: usize = 400;
 /// Why the studio cannot answer a request. Each names what was wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum StudioError {
-    #[error("no model '{name}' in models/ (known: {})", known.join(", "))]
-    UnknownModel {
-        name: String,
-        known: Vec<&'static str>,
-    },
+    #[error(transparent)]
+    UnknownModel(#[from] crate::registry::UnknownModel),
     #[error("model '{0}' is a contact model: it has no Hamiltonian phase plane (its derivations are shown)")]
     ContactModel(String),
     #[error("model '{0}' has no fast phase: it has no period map (its derivations and equilibria are shown)")]
@@ -106,9 +103,9 @@ pub struct ModelSummary {
 
 /// Every model of `models/`, in file-name order.
 pub fn models() -> Vec<ModelSummary> {
-    crate::models::ALL
+    crate::models::MODELS
         .iter()
-        .filter_map(|info| crate::models::dynamic(info.name).map(|m| summary(info, m)))
+        .map(|m| summary(m.info, m.dynamic))
         .collect()
 }
 
@@ -199,21 +196,14 @@ pub fn derivations(name: &str) -> Result<Vec<Derivation>, StudioError> {
 }
 
 fn find(name: &str) -> Result<&'static ModelInfo, StudioError> {
-    crate::registry::find(name).ok_or_else(|| StudioError::UnknownModel {
-        name: name.into(),
-        known: crate::models::ALL.iter().map(|m| m.name).collect(),
-    })
+    Ok(crate::registry::model(name)?.info)
 }
 
 fn find_dynamic(
     name: &str,
 ) -> Result<(&'static ModelInfo, &'static dyn DynamicModel), StudioError> {
-    let info = find(name)?;
-    let model = crate::models::dynamic(info.name).ok_or_else(|| StudioError::UnknownModel {
-        name: name.into(),
-        known: crate::models::ALL.iter().map(|m| m.name).collect(),
-    })?;
-    Ok((info, model))
+    let model = crate::registry::model(name)?;
+    Ok((model.info, model.dynamic))
 }
 
 fn first_order() -> usize {
@@ -283,24 +273,9 @@ impl Setup {
         };
         let mut params = model.defaults();
         for (name, &value) in &self.params {
-            let k = info
-                .parameter_names
-                .iter()
-                .position(|n| n == name)
-                .ok_or_else(|| ParameterError::Unknown {
-                    model: info.name,
-                    name: name.clone(),
-                    known: info.parameter_names,
-                })?;
-            if !value.is_finite() {
-                return Err(ParameterError::NotFinite {
-                    model: info.name,
-                    name: name.clone(),
-                    value,
-                }
-                .into());
-            }
-            params[k] = value;
+            info.check_parameter(name, value)?;
+            let k = info.parameter_names.iter().position(|n| n == name);
+            params[k.expect("check_parameter knows every name")] = value;
         }
         let method = Method::parse(&self.method, self.tol)?;
         method.validate()?;
@@ -426,9 +401,6 @@ const CHUNK_POINTS: usize = 4096;
 /// as they come (at least every 40 ms); `sink` returns false when nobody
 /// listens any more, which stops the orbit. An orbit that leaves the
 /// model's domain ends with the integrator's error after the points before.
-/// (`#[inline]`, as the analyses: the per-model instances compile in the
-/// studio and its tests, not in the library every scene waits for.)
-#[inline]
 pub fn orbit(
     request: &OrbitRequest,
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
@@ -440,7 +412,7 @@ pub fn orbit(
         periods: request.periods,
         sink,
     };
-    crate::models::with_fixed(setup.info.name, work)
+    crate::registry::with_fixed(setup.info.name, work)?
         .ok_or_else(|| StudioError::ContactModel(setup.info.name.into()))?
 }
 
@@ -559,8 +531,7 @@ pub struct ChaosLevel {
 /// on all cores; the Taylor method in batches), each handed to `sink` when
 /// done; `sink` returns false to stop before the next, and once `listening`
 /// says false a level stops between rows (ending with
-/// `PeriodMapError::Cancelled`). (`#[inline]`, as [`orbit`].)
-#[inline]
+/// `PeriodMapError::Cancelled`).
 pub fn chaos(
     request: &ChaosRequest,
     sink: &mut dyn FnMut(ChaosLevel) -> bool,

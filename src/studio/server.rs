@@ -58,7 +58,7 @@ pub enum ApiError {
 impl ApiError {
     fn status(&self) -> StatusCode {
         match self {
-            ApiError::Studio(StudioError::UnknownModel { .. }) | ApiError::NotFound(_) => {
+            ApiError::Studio(StudioError::UnknownModel(_)) | ApiError::NotFound(_) => {
                 StatusCode::NOT_FOUND
             }
             ApiError::Studio(StudioError::ContactModel(_) | StudioError::NoFastPhase(_)) => {

@@ -2,7 +2,6 @@
 //! averaged runs from the same state falls like 1/ν.
 
 use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
-use mechlab::models;
 use mechlab::ode::Method;
 
 fn settings(parameter: Option<&str>, values: &[f64]) -> ConvergenceSettings {
@@ -17,7 +16,7 @@ fn settings(parameter: Option<&str>, values: &[f64]) -> ConvergenceSettings {
 }
 
 fn defaults(name: &str) -> Vec<f64> {
-    models::dynamic(name).unwrap().defaults()
+    mechlab::registry::model(name).unwrap().dynamic.defaults()
 }
 
 #[test]
@@ -77,7 +76,7 @@ fn bad_requests_are_typed_errors() {
         &settings(None, &[1.0]),
     )
     .unwrap_err();
-    assert!(matches!(e, AveragingError::UnknownModel(_)), "{e}");
+    assert!(matches!(e, AveragingError::ContactModel(_)), "{e}");
     let e = convergence(
         "kapitza",
         &defaults("kapitza"),

@@ -19,7 +19,7 @@ fn settings(amplitude: &str) -> Settings {
 }
 
 fn defaults(name: &str) -> Vec<f64> {
-    models::dynamic(name).unwrap().defaults()
+    mechlab::registry::model(name).unwrap().dynamic.defaults()
 }
 
 fn at<'a>(result: &'a [EquilibriumStability], q: &[f64]) -> &'a EquilibriumStability {
@@ -166,7 +166,7 @@ fn bad_requests_are_typed_errors() {
         &settings("mu1"),
     )
     .unwrap_err();
-    assert!(matches!(e, StabilityError::UnknownModel(_)), "{e}");
+    assert!(matches!(e, StabilityError::ContactModel(_)), "{e}");
     let e = stability("kapitza", &defaults("kapitza"), &settings("B")).unwrap_err();
     assert!(
         e.to_string().contains("no parameter 'B'") && e.to_string().contains("A, eps, mu"),
@@ -174,6 +174,7 @@ fn bad_requests_are_typed_errors() {
     );
     let e = stability("no_such_model", &[], &settings("A")).unwrap_err();
     assert!(matches!(e, StabilityError::UnknownModel(_)));
+    assert!(e.to_string().contains("no model named 'no_such_model'") && e.to_string().contains("kapitza"), "{e}");
     let e = stability("kapitza", &[1.0], &settings("A")).unwrap_err();
     assert!(matches!(e, StabilityError::ParameterCount(1, _)));
 }

@@ -74,7 +74,6 @@ fn trajectories(
 /// An example of each class (σ = 1), then the given parameters with `sigma`;
 /// each drawn without damping and with the rod's ν, trajectories of
 /// `t_end` (in units of ε) from `starts`² points.
-#[inline]
 pub fn deformation(
     params: &Params,
     sigma: f64,

@@ -48,7 +48,6 @@ fn graph(q: &Reduced, sigma: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
 /// The classes with their examples (each checked to be of its class), the
 /// region of each in the (μ1*, μ2*) plane for σo = ±1, and the roots for
 /// `params` with σ = ±1.
-#[inline]
 pub fn phi_graphs(params: &Params, region_pixels: usize) -> PhiGraphs {
     let q = reduced(params);
     let examples = (0..GRAPH_CLASSES.len())

@@ -59,7 +59,6 @@ pub struct Impact {
 }
 
 /// Runs every case to `t_end` (or rest).
-#[inline]
 pub fn impact(s: &ImpactSettings) -> Result<Impact, StudyError> {
     let times: Vec<f64> = (0..=s.samples)
         .map(|i| s.t_end * i as f64 / s.samples as f64)

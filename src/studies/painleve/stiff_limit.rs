@@ -64,7 +64,6 @@ fn start(base: &Params, x2_ref: f64, eps: f64) -> [f64; 4] {
     [0.0, x2, 10.0, 10.0]
 }
 
-#[inline]
 pub fn stiff_limit(s: &StiffLimitSettings) -> Result<StiffLimit, StudyError> {
     let base = Params::default();
     let q = reduced(&base);
