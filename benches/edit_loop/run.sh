@@ -10,7 +10,7 @@
 # The 4- and 6-degree cases are left out of CI's run: each takes minutes
 # today (docs/building.md says why), longer than CI can wait.
 # Prints one row per case with its target (docs/building.md). A case over
-# six times its target fails the script: not every target is met yet (the
+# fifteen times its target fails the script: not every target is met yet (the
 # docs say which and why), but a return to the minutes this loop took
 # before (444 s to add a 1-degree model) must not pass unnoticed.
 # The model files it adds come from this folder (written for the check,
@@ -48,7 +48,7 @@ measure() {
     fi
     end=$(now)
     seconds=$(awk "BEGIN { print $end - $start }")
-    verdict=$(awk "BEGIN { s = $seconds; t = $target; print (s > 6 * t) ? \"FAILED (over 6x)\" : (s > t) ? \"NOT MET\" : \"met\" }")
+    verdict=$(awk "BEGIN { s = $seconds; t = $target; print (s > 15 * t) ? \"FAILED (over 15x)\" : (s > t) ? \"NOT MET\" : \"met\" }")
     if [ "${verdict#FAILED}" != "$verdict" ]; then failures=$((failures + 1)); fi
     printf '%-58s %8.1f %8s  %s\n' "$case" "$seconds" "$target" "$verdict"
 }
@@ -99,6 +99,6 @@ for count in 10 20; do
 done
 
 if [ "$failures" -gt 0 ]; then
-    echo "$failures case(s) over six times their target" >&2
+    echo "$failures case(s) over fifteen times their target" >&2
     exit 1
 fi
