@@ -804,7 +804,10 @@ pub fn render_registry(
 
 /// The systems a Hamiltonian model puts behind trait objects for the
 /// analyses by name: (marker type, system type) pairs.
-fn dyn_systems(model: &Model, derivation: &Derivation) -> Vec<std::collections::BTreeMap<&'static str, &'static str>> {
+fn dyn_systems(
+    model: &Model,
+    derivation: &Derivation,
+) -> Vec<std::collections::BTreeMap<&'static str, &'static str>> {
     let mut kinds = vec![("ExactDyn", "Exact")];
     if model.fast_phase.is_some() {
         kinds.push(("AveragedDyn", "Averaged"));

@@ -77,11 +77,20 @@ impl ModelInfo {
             });
         };
         if !value.is_finite() {
-            return Err(ParameterError::NotFinite { model: self.name, name: name.to_string(), value });
+            return Err(ParameterError::NotFinite {
+                model: self.name,
+                name: name.to_string(),
+                value,
+            });
         }
         let range = self.parameter_ranges[i];
         if !range.contains(value) {
-            return Err(ParameterError::OutOfRange { model: self.name, name: name.to_string(), value, range });
+            return Err(ParameterError::OutOfRange {
+                model: self.name,
+                name: name.to_string(),
+                value,
+                range,
+            });
         }
         Ok(())
     }
@@ -191,7 +200,12 @@ impl fmt::Display for ParameterError {
                     known.join(", ")
                 )
             }
-            ParameterError::OutOfRange { model, name, value, range } => {
+            ParameterError::OutOfRange {
+                model,
+                name,
+                value,
+                range,
+            } => {
                 write!(
                     f,
                     "parameter '{name}' of model '{model}' must lie in {range} (its model file's range), got {value}"
@@ -293,18 +307,27 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
         self.0.periodic()
     }
     fn exact(&self, params: &[f64]) -> ErasedSystem<S> {
-        ErasedSystem { system: self.0.exact(), params: params.to_vec() }
+        ErasedSystem {
+            system: self.0.exact(),
+            params: params.to_vec(),
+        }
     }
     fn averaged(&self, params: &[f64]) -> Option<ErasedSystem<S>> {
         let system = self.0.averaged()?;
-        Some(ErasedSystem { system, params: params.to_vec() })
+        Some(ErasedSystem {
+            system,
+            params: params.to_vec(),
+        })
     }
     fn phase_period(&self, params: &[f64]) -> Option<f64> {
         self.0.phase_period(params)
     }
     fn averaged2(&self, params: &[f64]) -> Option<ErasedSystem<S>> {
         let system = self.0.averaged2()?;
-        Some(ErasedSystem { system, params: params.to_vec() })
+        Some(ErasedSystem {
+            system,
+            params: params.to_vec(),
+        })
     }
     fn averaged2_hessian(&self, params: &[f64], y: &[f64; S]) -> Option<[[f64; S]; S]> {
         self.0.averaged2_hessian(params, y)

@@ -225,6 +225,14 @@ pub fn scene_command(name: &str) -> Vec<&str> {
     if name == "work_precision" {
         vec!["bench", "--quiet", "--bench", name, "--", "--out"]
     } else {
-        vec!["run", "--release", "--quiet", "--example", name, "--", "--out"]
+        vec![
+            "run",
+            "--release",
+            "--quiet",
+            "--example",
+            name,
+            "--",
+            "--out",
+        ]
     }
 }

@@ -18,7 +18,9 @@ fn settings() -> Settings {
 #[test]
 fn every_model_can_be_explored() {
     for info in models::ALL {
-        let model = mechlab::registry::model(info.name).expect("every model is listed").dynamic;
+        let model = mechlab::registry::model(info.name)
+            .expect("every model is listed")
+            .dynamic;
         let (n, phase) = match model.kind() {
             Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
             Kind::Contacts { count } => (count, false),

@@ -334,21 +334,43 @@ fn oversized_and_deeply_nested_models_are_errors() {
 fn parameter_ranges() {
     use mechlab::model::Range;
     let with = |range: &str, default: &str| {
-        GOOD.replace("default = 1.0", &format!("default = {default}\nrange = \"{range}\""))
+        GOOD.replace(
+            "default = 1.0",
+            &format!("default = {default}\nrange = \"{range}\""),
+        )
     };
     let model = Model::parse("models/toy.toml", &with("(0, inf)", "1.0")).unwrap();
     let range = model.parameters[0].range;
-    assert_eq!((range.min, range.max, range.min_open, range.max_open), (0.0, f64::INFINITY, true, true));
+    assert_eq!(
+        (range.min, range.max, range.min_open, range.max_open),
+        (0.0, f64::INFINITY, true, true)
+    );
     assert!(range.contains(1e-300) && !range.contains(0.0) && !range.contains(-1.0));
     let closed = Range::parse("[-1, 2]").unwrap();
     assert!(closed.contains(-1.0) && closed.contains(2.0) && !closed.contains(2.0 + 1e-15));
     assert_eq!(closed.to_string(), "[-1, 2]");
     assert_eq!(Range::ALL.to_string(), "(-inf, inf)");
-    assert_error(&with("(0, inf)", "-0.5"), "parameters[0].default", "outside its range (0, inf)");
-    assert_error(&with("[0, 1)", "1.0"), "parameters[0].default", "outside its range [0, 1)");
-    assert_error(&with("0, 1", "1.0"), "parameters[0].range", "is not an interval");
+    assert_error(
+        &with("(0, inf)", "-0.5"),
+        "parameters[0].default",
+        "outside its range (0, inf)",
+    );
+    assert_error(
+        &with("[0, 1)", "1.0"),
+        "parameters[0].default",
+        "outside its range [0, 1)",
+    );
+    assert_error(
+        &with("0, 1", "1.0"),
+        "parameters[0].range",
+        "is not an interval",
+    );
     assert_error(&with("(2, 1)", "1.0"), "parameters[0].range", "is empty");
-    assert_error(&with("(0, nan)", "1.0"), "parameters[0].range", "is not an interval");
+    assert_error(
+        &with("(0, nan)", "1.0"),
+        "parameters[0].range",
+        "is not an interval",
+    );
 }
 
 /// A negative ε gave the generic scenes a negative period: the shipped
@@ -361,7 +383,10 @@ fn a_scene_refuses_a_parameter_outside_its_range() {
     let args = |eps: &str| vec!["--set".to_string(), format!("eps={eps}")];
     let scene = Scene::parse("stability", &knobs, &args("-0.1")).unwrap();
     let e = scene.parameter_values(info).unwrap_err().to_string();
-    assert!(e.contains("'eps'") && e.contains("(0, inf)") && e.contains("-0.1"), "{e}");
+    assert!(
+        e.contains("'eps'") && e.contains("(0, inf)") && e.contains("-0.1"),
+        "{e}"
+    );
     let scene = Scene::parse("stability", &knobs, &args("0.05")).unwrap();
     assert_eq!(scene.parameter_values(info).unwrap()[1], 0.05);
     // Params::set keeps the same rule.

@@ -64,7 +64,15 @@ fn the_report_runs_scenes_with_arguments_cargo_accepts() {
     let example = scene_command("kapitza_period_map");
     assert_eq!(
         example,
-        ["run", "--release", "--quiet", "--example", "kapitza_period_map", "--", "--out"]
+        [
+            "run",
+            "--release",
+            "--quiet",
+            "--example",
+            "kapitza_period_map",
+            "--",
+            "--out"
+        ]
     );
     for section in SECTIONS {
         let args = scene_command(section.scene);

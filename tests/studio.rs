@@ -49,7 +49,9 @@ fn lines(text: &str) -> Vec<Value> {
 /// Kapitza's period map from the library: its exact system at `params`
 /// (A, ε, μ) and the forcing period.
 fn kapitza_map(params: [f64; 3]) -> (kapitza::Exact, f64) {
-    let exact = kapitza::Exact { params: kapitza::Params::from_values(&params) };
+    let exact = kapitza::Exact {
+        params: kapitza::Params::from_values(&params),
+    };
     (exact, 2.0 * std::f64::consts::PI * params[1])
 }
 

@@ -189,7 +189,7 @@ pub fn averaged_stability(
             q,
         },
     )?
-        .ok_or_else(|| StabilityError::ContactModel(name.into()))?
+    .ok_or_else(|| StabilityError::ContactModel(name.into()))?
 }
 
 struct AtEquilibrium<'a> {

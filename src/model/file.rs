@@ -196,19 +196,38 @@ impl Range {
             match x.trim() {
                 "inf" | "+inf" => Ok(f64::INFINITY),
                 "-inf" => Ok(f64::NEG_INFINITY),
-                x => x.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(bad),
+                x => x
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(bad),
             }
         };
-        let range = Range { min: number(a)?, max: number(b)?, min_open, max_open };
+        let range = Range {
+            min: number(a)?,
+            max: number(b)?,
+            min_open,
+            max_open,
+        };
         if range.min >= range.max {
-            return Err(format!("'{text}' is empty: its lower end must be below its upper end"));
+            return Err(format!(
+                "'{text}' is empty: its lower end must be below its upper end"
+            ));
         }
         Ok(range)
     }
 
     pub fn contains(&self, x: f64) -> bool {
-        let above = if self.min_open { x > self.min } else { x >= self.min };
-        let below = if self.max_open { x < self.max } else { x <= self.max };
+        let above = if self.min_open {
+            x > self.min
+        } else {
+            x >= self.min
+        };
+        let below = if self.max_open {
+            x < self.max
+        } else {
+            x <= self.max
+        };
         above && below
     }
 }
@@ -217,7 +236,11 @@ impl fmt::Display for Range {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let end = |x: f64| {
             if x.is_infinite() {
-                if x > 0.0 { "inf".to_string() } else { "-inf".to_string() }
+                if x > 0.0 {
+                    "inf".to_string()
+                } else {
+                    "-inf".to_string()
+                }
             } else {
                 x.to_string()
             }
@@ -455,11 +478,15 @@ impl ModelFile {
                 ));
             }
             if let Some(text) = &p.range {
-                let range = Range::parse(text).map_err(|reason| err(&format!("parameters[{i}].range"), reason))?;
+                let range = Range::parse(text)
+                    .map_err(|reason| err(&format!("parameters[{i}].range"), reason))?;
                 if !range.contains(p.default) {
                     return Err(err(
                         &format!("parameters[{i}].default"),
-                        format!("the default {} of '{}' is outside its range {range}", p.default, p.name),
+                        format!(
+                            "the default {} of '{}' is outside its range {range}",
+                            p.default, p.name
+                        ),
                     ));
                 }
             }

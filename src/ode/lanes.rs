@@ -5,8 +5,8 @@
 //! nightly features. The transcendental functions (at order 0 of a step
 //! only) call the scalar ones lane by lane.
 
-use super::kernels;
 use super::erased::DynSystem;
+use super::kernels;
 use super::series::Scalar;
 use super::TaylorWork;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};

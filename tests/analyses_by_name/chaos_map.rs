@@ -90,7 +90,10 @@ fn a_plane_of_a_larger_model() {
 
 #[test]
 fn bad_requests_are_typed_errors() {
-    let kapitza = mechlab::registry::model("kapitza").unwrap().dynamic.defaults();
+    let kapitza = mechlab::registry::model("kapitza")
+        .unwrap()
+        .dynamic
+        .defaults();
     let e = chaos_map("kapitza", &kapitza, &settings([0, 2], 2, 2), &|| true).unwrap_err();
     assert!(e.to_string().contains("q, p_q"), "{e}");
     let e = chaos_map("kapitza", &kapitza, &settings([1, 1], 2, 2), &|| true).unwrap_err();
@@ -98,7 +101,10 @@ fn bad_requests_are_typed_errors() {
     let mut s = settings([0, 1], 2, 2);
     s.through = Some(vec![0.0; 3]);
     assert!(chaos_map("kapitza", &kapitza, &s, &|| true).is_err());
-    let none = mechlab::registry::model("painleve_klein").unwrap().dynamic.defaults();
+    let none = mechlab::registry::model("painleve_klein")
+        .unwrap()
+        .dynamic
+        .defaults();
     assert!(matches!(
         chaos_map("painleve_klein", &none, &settings([0, 1], 2, 2), &|| true),
         Err(ChaosMapError::ContactModel(_))

@@ -33,11 +33,23 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         // average: each analysis says so.
         if !fast_phase {
             let e = stability(info.name, &params, &stability_settings("x")).unwrap_err();
-            assert!(matches!(e, StabilityError::NoFastPhase(_)), "{}: {e}", info.name);
+            assert!(
+                matches!(e, StabilityError::NoFastPhase(_)),
+                "{}: {e}",
+                info.name
+            );
             let e = convergence(info.name, &params, &averaging_settings()).unwrap_err();
-            assert!(matches!(e, AveragingError::NoFastPhase(_)), "{}: {e}", info.name);
+            assert!(
+                matches!(e, AveragingError::NoFastPhase(_)),
+                "{}: {e}",
+                info.name
+            );
             let e = chaos_map(info.name, &params, &map_settings(4), &|| true).unwrap_err();
-            assert!(matches!(e, ChaosMapError::NoFastPhase(_)), "{}: {e}", info.name);
+            assert!(
+                matches!(e, ChaosMapError::NoFastPhase(_)),
+                "{}: {e}",
+                info.name
+            );
             continue;
         }
         // The amplitude is optional in a model file: without one, the

@@ -174,7 +174,11 @@ fn bad_requests_are_typed_errors() {
     );
     let e = stability("no_such_model", &[], &settings("A")).unwrap_err();
     assert!(matches!(e, StabilityError::UnknownModel(_)));
-    assert!(e.to_string().contains("no model named 'no_such_model'") && e.to_string().contains("kapitza"), "{e}");
+    assert!(
+        e.to_string().contains("no model named 'no_such_model'")
+            && e.to_string().contains("kapitza"),
+        "{e}"
+    );
     let e = stability("kapitza", &[1.0], &settings("A")).unwrap_err();
     assert!(matches!(e, StabilityError::ParameterCount(1, _)));
 }
