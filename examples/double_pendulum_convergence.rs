@@ -6,6 +6,7 @@
 fn main() {
     mechlab::scene::run(|| {
         mechlab::scenes::averaging_scene(
+            mechlab::models::MODELS,
             "double_pendulum_convergence",
             &[
                 ("model", "double_pendulum"),

@@ -16,7 +16,8 @@ use mechlab::scene::{knob, parameter_knobs, run, Scene};
 fn main() {
     run(|| {
         let name = Scene::peek("model").unwrap_or_else(|| "kapitza".into());
-        let model = mechlab::registry::model(&name)?.dynamic;
+        let handle = mechlab::models::by_name(&name)?;
+        let model = handle.dynamic;
         let info = model.info();
         let mut knobs = vec![
             knob("model", "kapitza", "the model (a file models/<name>.toml)"),
@@ -55,7 +56,7 @@ fn main() {
             samples: scene.count("samples")?,
             periods: scene.count("periods")?,
         };
-        let result = explore(model, &params, &y0, &settings)?;
+        let result = explore(handle, &params, &y0, &settings)?;
 
         let figure = mechlab::explore::figure(&result, model, settings.t_end);
         scene.save_figure(&figure, "explore.png")?;

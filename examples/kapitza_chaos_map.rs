@@ -5,6 +5,10 @@
 
 fn main() {
     mechlab::scene::run(|| {
-        mechlab::scenes::chaos_map_scene("kapitza_chaos_map", &[("model", "kapitza"), ("A", "1")])
+        mechlab::scenes::chaos_map_scene(
+            mechlab::models::MODELS,
+            "kapitza_chaos_map",
+            &[("model", "kapitza"), ("A", "1")],
+        )
     });
 }

@@ -1,8 +1,7 @@
 //! Scene `model_report`: prints the derivations of a model (deliverables 1.1,
 //! 2.1) and writes them as Markdown with LaTeX.
 
-use mechlab::registry;
-use mechlab::scene::{knob, run, Scene, SceneError};
+use mechlab::scene::{knob, run, Scene};
 
 fn main() {
     run(|| {
@@ -12,14 +11,7 @@ fn main() {
             &[knob("model", "kapitza", "model name (a file models/<name>.toml)")],
         )?;
         let name = scene.text("model").to_string();
-        let model = registry::find(&name).ok_or_else(|| {
-            let known: Vec<&str> = mechlab::models::ALL.iter().map(|m| m.name).collect();
-            SceneError::BadValue {
-                name: "model".into(),
-                value: name.clone(),
-                reason: format!("no such model (known: {})", known.join(", ")),
-            }
-        })?;
+        let model = mechlab::models::by_name(&name)?.info;
         let mut markdown = format!(
             "# Model `{}`\n\nFrom `{}`:\n\n```toml\n{}```\n\n",
             model.name, model.source_file, model.source

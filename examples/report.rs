@@ -59,7 +59,7 @@ fn main() {
                 }
             }
         }
-        let html = index_html(&root);
+        let html = index_html(mechlab::models::MODELS, &root);
         let missing: Vec<String> = links(&html)
             .into_iter()
             .filter(|l| !l.starts_with('#') && !root.join(l).exists())

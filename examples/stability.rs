@@ -18,7 +18,8 @@ use mechlab::scenes::{method_from, method_knobs, model_from_args, tiles_from};
 
 fn main() {
     run(|| {
-        let info = model_from_args("kapitza")?;
+        let model = model_from_args(mechlab::models::MODELS, "kapitza")?;
+        let info = model.info;
         let [method, tol] = method_knobs("dop853", "1e-10");
         let mut knobs = vec![
             knob("model", "kapitza", "the model (a file models/<name>.toml) with a fast phase"),
@@ -52,7 +53,7 @@ fn main() {
             edge_tolerance: scene.positive("edge_tolerance")?,
             method: method_from(&scene)?,
         };
-        let result = stability(info.name, &params, &settings)?;
+        let result = stability(model, &params, &settings)?;
         for q in &result.moved_by_vibration {
             eprintln!("q = {q:?}: an equilibrium without vibration that the vibration moves");
         }
@@ -78,7 +79,7 @@ fn main() {
         }
         if scene.text("chart") != "none" {
             let chart_settings = chart_settings(&scene, &settings, info.coordinates.len())?;
-            let chart = match stability_chart(info.name, &params, &chart_settings) {
+            let chart = match stability_chart(model, &params, &chart_settings) {
                 // A job of an array: its tiles are written, the last run draws.
                 Err(StabilityError::Partial) => {
                     eprintln!("chart tiles {} written", scene.text("chart_only_tiles"));

@@ -26,7 +26,7 @@ fn main() {
             value: port.to_string(),
             reason: "a port is at most 65535".into(),
         })?;
-        mechlab::studio::server::run(port)?;
+        mechlab::studio::server::run(mechlab::models::MODELS, port)?;
         Ok(())
     });
 }

@@ -1,11 +1,14 @@
 //! mechlab: Lagrangians of small mechanical systems → symbolic derivations at
 //! build time → fast, verified simulations and figures.
 //!
-//! Pipeline: `models/*.toml` → `build.rs` (Symbolica, build time only) →
-//! generated modules in [`models`] → runtime: [`ode`] (integrators),
-//! [`analysis`] (period map, Floquet, Lyapunov, averaging), [`studies`]
-//! (closed forms and runs shared by the scenes of a study), [`plot`] →
-//! `examples/` (scenes).
+//! The workspace follows the data flow: `models/*.toml` (read by
+//! `mechlab-model`) → `build.rs` (runs `mechlab-derive`, with Symbolica,
+//! build time only) → the generated modules in [`models`] (this crate) →
+//! `mechlab-runtime`: [`ode`] (integrators), [`analysis`] (period map,
+//! Floquet, Lyapunov, averaging), [`scene`], [`studio`], [`plot`] →
+//! `examples/` (scenes). This crate holds only what depends on the models:
+//! the generated modules and the three [`studies`]; it re-exports the
+//! runtime, so `mechlab::ode` is `mechlab_runtime::ode`.
 //!
 //! ```
 //! use mechlab::models::kapitza;
@@ -22,19 +25,12 @@
 //! assert_eq!(integrator.stats.steps, 2000);
 //! ```
 
-pub mod analysis;
-pub mod contact;
-pub mod explore;
-pub mod linalg;
-pub mod mathml;
-pub mod model;
+pub use mechlab_runtime::{
+    analysis, contact, explore, linalg, mathml, model, ode, plot, registry, report, scene, scenes,
+    studio,
+};
+
 pub mod models;
-pub mod ode;
-pub mod plot;
-pub mod registry;
-pub mod report;
-pub mod scene;
-pub mod scenes;
 pub mod studies;
-pub mod studio;
 pub mod test_models;
+

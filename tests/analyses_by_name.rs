@@ -3,6 +3,9 @@
 //! is instantiated for every model of `models/`, and one binary compiles
 //! those instances once rather than once per file.
 
+mod common;
+use common::model_of;
+
 #[path = "analyses_by_name/averaging.rs"]
 mod averaging;
 #[path = "analyses_by_name/chaos_map.rs"]

@@ -18,9 +18,8 @@ fn settings() -> Settings {
 #[test]
 fn every_model_can_be_explored() {
     for info in models::ALL {
-        let model = mechlab::registry::model(info.name)
-            .expect("every model is listed")
-            .dynamic;
+        let handle = mechlab::models::by_name(info.name).expect("every model is listed");
+        let model = handle.dynamic;
         let (n, phase) = match model.kind() {
             Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
             Kind::Contacts { count } => (count, false),
@@ -29,7 +28,7 @@ fn every_model_can_be_explored() {
             .map(|i| 0.3 - 0.5 * i as f64)
             .chain((0..n).map(|_| 0.5))
             .collect();
-        let result = explore(model, &model.defaults(), &y0, &settings())
+        let result = explore(handle, &model.defaults(), &y0, &settings())
             .unwrap_or_else(|e| panic!("{}: {e}", info.name));
         assert!(
             result.exact.iter().flatten().all(|x| x.is_finite()),
@@ -44,15 +43,16 @@ fn every_model_can_be_explored() {
 
 #[test]
 fn a_state_of_the_wrong_length_is_an_error() {
-    let model = mechlab::registry::model("kapitza").unwrap().dynamic;
-    assert!(explore(model, &model.defaults(), &[0.1, 0.0, 0.0], &settings()).is_err());
+    let handle = mechlab::models::by_name("kapitza").unwrap();
+    let defaults = handle.dynamic.defaults();
+    assert!(explore(handle, &defaults, &[0.1, 0.0, 0.0], &settings()).is_err());
 }
 
 /// Kapitza at A = 1.5: V + V_vibr = cos q + (A²/4) sin²q has minima at 0
 /// (V'' = A²/2 − 1) and π (V'' = 1 + A²/2) and maxima at cos q = 2/A².
 #[test]
 fn kapitza_equilibria_match_the_closed_form() {
-    let model = mechlab::registry::model("kapitza").unwrap().dynamic;
+    let model = mechlab::models::by_name("kapitza").unwrap().dynamic;
     let a: f64 = 1.5;
     let mut params = model.defaults();
     params[0] = a;
@@ -76,7 +76,8 @@ fn kapitza_equilibria_match_the_closed_form() {
 #[test]
 fn explore_runs_with_taylor() {
     for name in ["kapitza", "triple_pendulum"] {
-        let model = mechlab::registry::model(name).unwrap().dynamic;
+        let handle = mechlab::models::by_name(name).unwrap();
+        let model = handle.dynamic;
         let n = match model.kind() {
             Kind::Hamiltonian { dof, .. } => dof,
             Kind::Contacts { .. } => unreachable!(),
@@ -87,7 +88,7 @@ fn explore_runs_with_taylor() {
                 method: Method::parse(method, tol).unwrap(),
                 ..settings()
             };
-            explore(model, &model.defaults(), &y0, &settings).unwrap()
+            explore(handle, &model.defaults(), &y0, &settings).unwrap()
         };
         let (taylor, dop) = (run("taylor", 1e-13), run("dop853", 1e-13));
         let last = |runs: &Vec<Vec<f64>>| runs.last().unwrap().clone();

@@ -378,7 +378,7 @@ fn parameter_ranges() {
 #[test]
 fn a_scene_refuses_a_parameter_outside_its_range() {
     use mechlab::scene::{parameter_knobs, Scene};
-    let info = mechlab::registry::model("kapitza").unwrap().info;
+    let info = mechlab::models::by_name("kapitza").unwrap().info;
     let knobs = parameter_knobs(info, &[]);
     let args = |eps: &str| vec!["--set".to_string(), format!("eps={eps}")];
     let scene = Scene::parse("stability", &knobs, &args("-0.1")).unwrap();

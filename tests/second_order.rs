@@ -2,6 +2,8 @@
 //! closed form derived by hand, the thresholds against the Mathieu series
 //! and the exact (Floquet) edges, and their order in ε.
 
+mod common;
+use common::model_of;
 use mechlab::analysis::stability::{stability, Settings};
 use mechlab::models::{double_pendulum as dp, kapitza};
 use mechlab::ode::Method;
@@ -17,7 +19,7 @@ fn thresholds(model: &str, params: &[f64], amplitude: &str, a_max: f64) -> (f64,
         edge_tolerance: 1e-12,
         method: Method::parse("dop853", 1e-13).unwrap(),
     };
-    let result = stability(model, params, &settings).unwrap();
+    let result = stability(model_of(model), params, &settings).unwrap();
     let upright = result
         .equilibria
         .iter()
@@ -207,7 +209,7 @@ fn second_order_trajectories_deviate_like_one_over_nu_squared() {
             method: Method::parse("dop853", 1e-12).unwrap(),
             order,
         };
-        let result = convergence("double_pendulum", &params.values(), &settings).unwrap();
+        let result = convergence(model_of("double_pendulum"), &params.values(), &settings).unwrap();
         for slope in &result.slope {
             assert!(
                 (slope - expected).abs() < 0.1,
@@ -228,7 +230,7 @@ fn second_order_trajectories_deviate_like_one_over_nu_squared() {
         method: Method::parse("dop853", 1e-12).unwrap(),
         order: 2,
     };
-    let result = convergence("kapitza", &kapitza.values(), &settings).unwrap();
+    let result = convergence(model_of("kapitza"), &kapitza.values(), &settings).unwrap();
     assert!(
         (result.slope[0] + 2.0).abs() < 0.1,
         "Kapitza: slope {}",
@@ -250,7 +252,7 @@ fn an_order_not_derived_is_an_error() {
         method: Method::parse("dop853", 1e-10).unwrap(),
         order: 3,
     };
-    let error = convergence("triple_pendulum", &params.values(), &settings).unwrap_err();
+    let error = convergence(model_of("triple_pendulum"), &params.values(), &settings).unwrap_err();
     assert!(matches!(error, AveragingError::Order(_, 3)), "{error}");
 }
 
@@ -275,7 +277,7 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             .iter()
             .map(|d| d.parse().unwrap())
             .collect();
-        match convergence(info.name, &defaults, &settings) {
+        match convergence(model_of(info.name), &defaults, &settings) {
             Ok(result) => {
                 for (c, slope) in result.coordinates.iter().zip(&result.slope) {
                     assert!(

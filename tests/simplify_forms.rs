@@ -1,13 +1,11 @@
-//! The readable-forms stage of the build (`build/simplify.rs`), tested
-//! directly: it is plain Rust (no Symbolica), compiled here from the same
-//! file that `build.rs` uses.
+//! The readable-forms stage of the derivation
+//! (`crates/derive/src/simplify.rs`), tested directly: it is plain Rust (no
+//! Symbolica, so a test may run it), compiled here from the same file.
 
-#[allow(dead_code, unused_imports)]
-#[path = "../src/model/mod.rs"]
-mod model;
+use mechlab::model;
 
 #[allow(dead_code)]
-#[path = "../build/simplify.rs"]
+#[path = "../crates/derive/src/simplify.rs"]
 mod simplify;
 
 use model::Expr;

@@ -6,6 +6,8 @@
 //! `cargo test --release --test studio -- --ignored browser` runs the
 //! browser test (needs `apt-get install chromium chromium-driver`).
 
+mod common;
+use common::model_of;
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
 use http_body_util::BodyExt;
@@ -25,7 +27,7 @@ async fn call(method: &str, uri: &str, body: Option<Value>) -> (StatusCode, Stri
         .header("content-type", "application/json")
         .body(body.map_or_else(Body::empty, |b| Body::from(b.to_string())))
         .unwrap();
-    let response = router().oneshot(request).await.unwrap();
+    let response = router(mechlab::models::MODELS).oneshot(request).await.unwrap();
     let status = response.status();
     let content_type = response
         .headers()
@@ -172,7 +174,7 @@ async fn chaos_levels_equal_the_library_map() {
             method: Method::Taylor { tol: 1e-8 },
             tiles: None,
         };
-        let map = chaos_map("kapitza", &[1.0, 0.1, 0.0], &settings, &|| true).unwrap();
+        let map = chaos_map(model_of("kapitza"), &[1.0, 0.1, 0.0], &settings, &|| true).unwrap();
         let fli: Vec<Option<f64>> = serde_json::from_value(level["fli"].clone()).unwrap();
         let expected: Vec<Option<f64>> = map
             .fli
@@ -337,7 +339,7 @@ async fn bad_requests_are_named_errors() {
         .uri("/api/orbit")
         .body(Body::from("{\"model\":"))
         .unwrap();
-    let response = router().oneshot(raw).await.unwrap();
+    let response = router(mechlab::models::MODELS).oneshot(raw).await.unwrap();
     assert_eq!(response.status(), StatusCode::BAD_REQUEST);
     let chaos = json!({"model": "kapitza", "ranges": [[1.0, -1.0], [0.0, 1.0]], "levels": [8], "periods": 10});
     let (status, _, body) = call("POST", "/api/chaos", Some(chaos)).await;
@@ -356,7 +358,7 @@ fn a_dropped_orbit_stops() {
         serde_json::from_value(json!({"model": "kapitza", "seed": [1.0, 0.5], "periods": 100_000}))
             .unwrap();
     let mut received = Vec::new();
-    let end = mechlab::studio::orbit(&request, &mut |chunk| {
+    let end = mechlab::studio::orbit(mechlab::models::MODELS, &request, &mut |chunk| {
         received.extend(chunk.points);
         false
     })
@@ -504,7 +506,7 @@ mod browser {
     async fn browser_seeds_orbits_and_sweeps_a_parameter() {
         let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
         let studio = format!("http://{}/", listener.local_addr().unwrap());
-        tokio::spawn(async move { axum::serve(listener, router()).await.unwrap() });
+        tokio::spawn(async move { axum::serve(listener, router(mechlab::models::MODELS)).await.unwrap() });
         let port = free_port();
         let driver =
             std::env::var("CHROMEDRIVER").unwrap_or_else(|_| "/usr/bin/chromedriver".into());

@@ -498,7 +498,7 @@ pub fn stabilization_study(
                 entry.exact_window = exact_stability_window(&params, *phi, a_max, 240, tol)?;
                 entry.a_star = Some(a_star);
                 entry.a_star_second_order = crate::analysis::stability::averaged_stability(
-                    "double_pendulum",
+                    &model::MODEL,
                     &params.values(),
                     "a",
                     &[phi.0, phi.1],

@@ -236,7 +236,7 @@ pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<AStar, St
         method,
     };
     let params = Params { A: SQRT_2, eps, mu };
-    let result = stability("kapitza", &params.values(), &settings)?;
+    let result = stability(&kapitza::MODEL, &params.values(), &settings)?;
     let upper = result.equilibria.iter().find(|e| e.q[0].abs() < 1e-9);
     Ok(AStar {
         eps,
@@ -355,7 +355,7 @@ pub fn upper_position(s: &UpperPositionSettings) -> Result<UpperPosition, StudyE
         method: s.method,
         tiles: None,
     };
-    let chart = stability_chart("kapitza", &s.params.values(), &chart_settings)?;
+    let chart = stability_chart(&kapitza::MODEL, &s.params.values(), &chart_settings)?;
 
     let a_star_by_eps = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3]
         .par_iter()

@@ -1,6 +1,7 @@
 //! Theorem 2 on any model by name: the deviation between the exact and the
 //! averaged runs from the same state falls like 1/ν.
 
+use crate::model_of;
 use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
 use mechlab::ode::Method;
 
@@ -16,14 +17,14 @@ fn settings(parameter: Option<&str>, values: &[f64]) -> ConvergenceSettings {
 }
 
 fn defaults(name: &str) -> Vec<f64> {
-    mechlab::registry::model(name).unwrap().dynamic.defaults()
+    mechlab::models::by_name(name).unwrap().dynamic.defaults()
 }
 
 #[test]
 fn deviation_falls_like_one_over_the_frequency() {
     let values = [200.0, 400.0, 800.0, 1600.0];
     for name in ["double_pendulum", "triple_pendulum"] {
-        let result = convergence(name, &defaults(name), &settings(None, &values)).unwrap();
+        let result = convergence(model_of(name), &defaults(name), &settings(None, &values)).unwrap();
         assert_eq!(result.parameter, "nu", "the rate of `{name}` is ν");
         for (f, v) in result.frequencies.iter().zip(values) {
             assert!((f - v).abs() < 1e-9 * v, "{f} vs {v}");
@@ -52,13 +53,13 @@ fn deviation_falls_like_one_over_the_frequency() {
     // values, ν runs over 4…64 times the default frequency 1/ε = 10.
     let mut auto = settings(None, &[]);
     auto.values = None;
-    let result = convergence("kapitza", &defaults("kapitza"), &auto).unwrap();
+    let result = convergence(model_of("kapitza"), &defaults("kapitza"), &auto).unwrap();
     assert!(
         (result.values[0] - 0.025).abs() < 1e-15 && (result.frequencies[4] - 640.0).abs() < 1e-9
     );
     assert!((result.slope[0] + 1.0).abs() < 0.15, "{:?}", result.slope);
     let result = convergence(
-        "kapitza",
+        model_of("kapitza"),
         &defaults("kapitza"),
         &settings(None, &[0.02, 0.01, 0.005]),
     )
@@ -71,21 +72,21 @@ fn deviation_falls_like_one_over_the_frequency() {
 #[test]
 fn bad_requests_are_typed_errors() {
     let e = convergence(
-        "painleve_klein",
+        model_of("painleve_klein"),
         &defaults("painleve_klein"),
         &settings(None, &[1.0]),
     )
     .unwrap_err();
     assert!(matches!(e, AveragingError::ContactModel(_)), "{e}");
     let e = convergence(
-        "kapitza",
+        model_of("kapitza"),
         &defaults("kapitza"),
         &settings(Some("nu"), &[1.0]),
     )
     .unwrap_err();
     assert!(e.to_string().contains("no parameter 'nu'"), "{e}");
     let e = convergence(
-        "kapitza",
+        model_of("kapitza"),
         &defaults("kapitza"),
         &settings(Some("A"), &[1.0, 2.0]),
     )
@@ -96,7 +97,7 @@ fn bad_requests_are_typed_errors() {
     );
     let mut bad_state = settings(None, &[100.0]);
     bad_state.y0 = Some(vec![0.1, 0.0]);
-    let e = convergence("double_pendulum", &defaults("double_pendulum"), &bad_state).unwrap_err();
+    let e = convergence(model_of("double_pendulum"), &defaults("double_pendulum"), &bad_state).unwrap_err();
     assert!(
         matches!(
             e,

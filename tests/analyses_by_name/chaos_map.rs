@@ -1,6 +1,7 @@
 //! The FLI chaos map of any model by name against the direct computation
 //! of `kapitza_chaos_map` and of a plane of the double pendulum.
 
+use crate::model_of;
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings, TileError, Tiles};
 use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
 use mechlab::models::{double_pendulum, kapitza};
@@ -30,7 +31,7 @@ fn kapitza_map_is_the_scene_s_map() {
         mu: 0.0,
     };
     let map = chaos_map(
-        "kapitza",
+        model_of("kapitza"),
         &params.values(),
         &settings([0, 1], 12, 40),
         &|| true,
@@ -69,7 +70,7 @@ fn a_plane_of_a_larger_model() {
     let mut s = settings([0, 2], 3, 10);
     s.through = Some(vec![0.0, 0.1, 0.0, 0.05]);
     s.ranges = [None, Some((-1.0, 1.0))];
-    let map = chaos_map("double_pendulum", &params.values(), &s, &|| true).unwrap();
+    let map = chaos_map(model_of("double_pendulum"), &params.values(), &s, &|| true).unwrap();
     assert_eq!(map.axes, ["phi1".to_string(), "p_phi1".to_string()]);
     let system = double_pendulum::Exact { params };
     let mut integrator = Integrator::new(Method::parse("taylor", 1e-6).unwrap()).unwrap();
@@ -90,23 +91,23 @@ fn a_plane_of_a_larger_model() {
 
 #[test]
 fn bad_requests_are_typed_errors() {
-    let kapitza = mechlab::registry::model("kapitza")
+    let kapitza = mechlab::models::by_name("kapitza")
         .unwrap()
         .dynamic
         .defaults();
-    let e = chaos_map("kapitza", &kapitza, &settings([0, 2], 2, 2), &|| true).unwrap_err();
+    let e = chaos_map(model_of("kapitza"), &kapitza, &settings([0, 2], 2, 2), &|| true).unwrap_err();
     assert!(e.to_string().contains("q, p_q"), "{e}");
-    let e = chaos_map("kapitza", &kapitza, &settings([1, 1], 2, 2), &|| true).unwrap_err();
+    let e = chaos_map(model_of("kapitza"), &kapitza, &settings([1, 1], 2, 2), &|| true).unwrap_err();
     assert!(matches!(e, ChaosMapError::Request { .. }));
     let mut s = settings([0, 1], 2, 2);
     s.through = Some(vec![0.0; 3]);
-    assert!(chaos_map("kapitza", &kapitza, &s, &|| true).is_err());
-    let none = mechlab::registry::model("painleve_klein")
+    assert!(chaos_map(model_of("kapitza"), &kapitza, &s, &|| true).is_err());
+    let none = mechlab::models::by_name("painleve_klein")
         .unwrap()
         .dynamic
         .defaults();
     assert!(matches!(
-        chaos_map("painleve_klein", &none, &settings([0, 1], 2, 2), &|| true),
+        chaos_map(model_of("painleve_klein"), &none, &settings([0, 1], 2, 2), &|| true),
         Err(ChaosMapError::ContactModel(_))
     ));
 }
@@ -149,7 +150,7 @@ fn portraits_are_the_period_map_iterated() {
         periods: 50,
         method: Method::parse("taylor", 1e-12).unwrap(),
     };
-    let result = portrait("kapitza", &params.values(), &settings).unwrap();
+    let result = portrait(model_of("kapitza"), &params.values(), &settings).unwrap();
     let mut integrator = Integrator::new(settings.method).unwrap();
     for (k, seed) in [[0.3, 0.0], [2.0, 0.5]].iter().enumerate() {
         let direct = orbit(
@@ -179,7 +180,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
         mu: 0.0,
     };
     let whole = chaos_map(
-        "kapitza",
+        model_of("kapitza"),
         &params.values(),
         &settings([0, 1], 20, 30),
         &|| true,
@@ -197,7 +198,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
     let rows = std::sync::atomic::AtomicUsize::new(0);
     let count = || rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let first = chaos_map(
-        "kapitza",
+        model_of("kapitza"),
         &params.values(),
         &tiled(Some(vec![1, 6])),
         &|| {
@@ -207,7 +208,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
     );
     assert!(matches!(first, Err(ChaosMapError::Partial)));
     assert_eq!(rows.swap(0, std::sync::atomic::Ordering::Relaxed), 3 + 2);
-    let resumed = chaos_map("kapitza", &params.values(), &tiled(None), &|| {
+    let resumed = chaos_map(model_of("kapitza"), &params.values(), &tiled(None), &|| {
         count();
         true
     })
@@ -221,7 +222,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
     let tile = sweep.join("tile_2.bin");
     let bytes = std::fs::read(&tile).unwrap();
     std::fs::write(&tile, &bytes[..bytes.len() - 3]).unwrap();
-    let damaged = chaos_map("kapitza", &params.values(), &tiled(None), &|| true);
+    let damaged = chaos_map(model_of("kapitza"), &params.values(), &tiled(None), &|| true);
     assert!(
         matches!(
             damaged,
@@ -229,7 +230,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
         ),
         "{damaged:?}"
     );
-    let missing = chaos_map("kapitza", &params.values(), &tiled(Some(vec![7])), &|| true);
+    let missing = chaos_map(model_of("kapitza"), &params.values(), &tiled(Some(vec![7])), &|| true);
     assert!(
         matches!(
             missing,
@@ -249,7 +250,7 @@ fn a_map_nobody_waits_for_stops() {
     let rows = std::sync::atomic::AtomicUsize::new(0);
     let params = kapitza::Params::default();
     let result = chaos_map(
-        "kapitza",
+        model_of("kapitza"),
         &params.values(),
         &settings([0, 1], 64, 30),
         &|| rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1 < 3,

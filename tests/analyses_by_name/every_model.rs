@@ -1,6 +1,7 @@
 //! Every generic analysis on every model file in `models/`: a result with
 //! properties that hold for any model, or a typed refusal with its reason.
 
+use crate::model_of;
 use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings};
 use mechlab::analysis::period_map::{portrait, PortraitSettings};
@@ -14,37 +15,37 @@ use std::f64::consts::PI;
 #[test]
 fn every_analysis_runs_on_every_model_or_says_why_not() {
     for info in models::ALL {
-        let model = mechlab::registry::model(info.name).unwrap().dynamic;
+        let model = mechlab::models::by_name(info.name).unwrap().dynamic;
         let params = model.defaults();
         let Kind::Hamiltonian { dof: n, fast_phase } = model.kind() else {
-            let e = stability(info.name, &params, &stability_settings("mu1")).unwrap_err();
+            let e = stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err();
             assert!(
                 matches!(e, StabilityError::ContactModel(_))
                     && e.to_string().contains("contact model")
             );
-            let e = convergence(info.name, &params, &averaging_settings()).unwrap_err();
+            let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
             assert!(matches!(e, AveragingError::ContactModel(_)));
-            let e = chaos_map(info.name, &params, &map_settings(5), &|| true).unwrap_err();
+            let e = chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err();
             assert!(matches!(e, ChaosMapError::ContactModel(_)));
-            assert!(portrait(info.name, &params, &portrait_settings(1)).is_err());
+            assert!(portrait(model_of(info.name), &params, &portrait_settings(1)).is_err());
             continue;
         };
         // A model without a fast phase has no period map and nothing to
         // average: each analysis says so.
         if !fast_phase {
-            let e = stability(info.name, &params, &stability_settings("x")).unwrap_err();
+            let e = stability(model_of(info.name), &params, &stability_settings("x")).unwrap_err();
             assert!(
                 matches!(e, StabilityError::NoFastPhase(_)),
                 "{}: {e}",
                 info.name
             );
-            let e = convergence(info.name, &params, &averaging_settings()).unwrap_err();
+            let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
             assert!(
                 matches!(e, AveragingError::NoFastPhase(_)),
                 "{}: {e}",
                 info.name
             );
-            let e = chaos_map(info.name, &params, &map_settings(4), &|| true).unwrap_err();
+            let e = chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap_err();
             assert!(
                 matches!(e, ChaosMapError::NoFastPhase(_)),
                 "{}: {e}",
@@ -57,7 +58,7 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         match info.amplitude {
             Some(amplitude) => check_stability(info.name, &params, amplitude, n),
             None => {
-                let e = stability(info.name, &params, &stability_settings("")).unwrap_err();
+                let e = stability(model_of(info.name), &params, &stability_settings("")).unwrap_err();
                 assert!(
                     matches!(e, StabilityError::UnknownAmplitude { .. }),
                     "{}: {e}",
@@ -65,7 +66,7 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
                 );
             }
         }
-        let result = convergence(info.name, &params, &averaging_settings()).unwrap();
+        let result = convergence(model_of(info.name), &params, &averaging_settings()).unwrap();
         for (c, slope) in result.coordinates.iter().zip(&result.slope) {
             assert!(
                 (slope + 1.0).abs() < 0.2,
@@ -75,8 +76,8 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         }
         // The FLI is a maximum over the iterations: more periods never lower it.
         let (short, long) = (
-            chaos_map(info.name, &params, &map_settings(4), &|| true).unwrap(),
-            chaos_map(info.name, &params, &map_settings(8), &|| true).unwrap(),
+            chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap(),
+            chaos_map(model_of(info.name), &params, &map_settings(8), &|| true).unwrap(),
         );
         assert_eq!(short.fli.len(), 9);
         // A pixel whose orbit left the model's domain (+∞: the elastic
@@ -93,7 +94,7 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
             short.fli.iter().filter(|f| f.is_infinite()).count()
         );
         // Orbits start at their seeds; angles stay in [−π, π).
-        let orbits = portrait(info.name, &params, &portrait_settings(n)).unwrap();
+        let orbits = portrait(model_of(info.name), &params, &portrait_settings(n)).unwrap();
         let periodic = model.periodic();
         for (seed, orbit) in orbits.seeds.iter().zip(&orbits.orbits) {
             if orbit.is_empty() {
@@ -118,8 +119,8 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
 /// there is a threshold C + a²K is positive definite just above a* and not
 /// just below.
 fn check_stability(name: &str, params: &[f64], amplitude: &str, n: usize) {
-    let model = mechlab::registry::model(name).unwrap().dynamic;
-    let result = stability(name, params, &stability_settings(amplitude)).unwrap();
+    let model = mechlab::models::by_name(name).unwrap().dynamic;
+    let result = stability(model_of(name), params, &stability_settings(amplitude)).unwrap();
     let k = model
         .info()
         .parameter_names

@@ -1,6 +1,7 @@
 //! The `stability` analysis on any model by name, against the closed forms
 //! and the study-specific computations it generalises.
 
+use crate::model_of;
 use mechlab::analysis::floquet::{first_stability_onset, jury_margin, monodromy};
 use mechlab::analysis::stability::{stability, EquilibriumStability, Settings, StabilityError};
 use mechlab::models::{self, kapitza};
@@ -19,7 +20,7 @@ fn settings(amplitude: &str) -> Settings {
 }
 
 fn defaults(name: &str) -> Vec<f64> {
-    mechlab::registry::model(name).unwrap().dynamic.defaults()
+    mechlab::models::by_name(name).unwrap().dynamic.defaults()
 }
 
 fn at<'a>(result: &'a [EquilibriumStability], q: &[f64]) -> &'a EquilibriumStability {
@@ -56,7 +57,7 @@ fn jury_threshold(eps: f64, a_max: f64) -> f64 {
 /// monodromy matrix (as `kapitza_stability` finds A*), to 1e-9.
 #[test]
 fn kapitza_threshold_and_exact_edge() {
-    let result = stability("kapitza", &defaults("kapitza"), &settings("A")).unwrap();
+    let result = stability(model_of("kapitza"), &defaults("kapitza"), &settings("A")).unwrap();
     assert_eq!(result.equilibria.len(), 2, "{result:#?}");
     let upright = at(&result.equilibria, &[0.0]);
     assert!(!upright.stable_without_vibration);
@@ -87,7 +88,7 @@ fn kapitza_threshold_and_exact_edge() {
 #[test]
 fn double_pendulum_thresholds_are_the_closed_forms() {
     let params = defaults("double_pendulum");
-    let result = stability("double_pendulum", &params, &settings("a")).unwrap();
+    let result = stability(model_of("double_pendulum"), &params, &settings("a")).unwrap();
     assert_eq!(result.equilibria.len(), 4);
     let p = models::double_pendulum::Params::from_values(&params);
     for phi in study::EQUILIBRIA {
@@ -126,7 +127,7 @@ fn chain_thresholds_match_the_normal_modes() {
         let mut fast = settings("a");
         fast.samples = 8;
         fast.edge_tolerance = 1e-6;
-        let result = stability(name, &defaults(name), &fast).unwrap();
+        let result = stability(model_of(name), &defaults(name), &fast).unwrap();
         let upright = at(&result.equilibria, &vec![0.0; result.equilibria[0].q.len()]);
         assert!(
             (upright.a_star.unwrap() - expected).abs() < 1e-9,
@@ -145,7 +146,7 @@ fn chain_thresholds_match_the_normal_modes() {
 #[test]
 fn an_isotropic_vibration_has_no_threshold() {
     let result = stability(
-        "circle_pendulum",
+        model_of("circle_pendulum"),
         &defaults("circle_pendulum"),
         &settings("A"),
     )
@@ -161,25 +162,24 @@ fn an_isotropic_vibration_has_no_threshold() {
 #[test]
 fn bad_requests_are_typed_errors() {
     let e = stability(
-        "painleve_klein",
+        model_of("painleve_klein"),
         &defaults("painleve_klein"),
         &settings("mu1"),
     )
     .unwrap_err();
     assert!(matches!(e, StabilityError::ContactModel(_)), "{e}");
-    let e = stability("kapitza", &defaults("kapitza"), &settings("B")).unwrap_err();
+    let e = stability(model_of("kapitza"), &defaults("kapitza"), &settings("B")).unwrap_err();
     assert!(
         e.to_string().contains("no parameter 'B'") && e.to_string().contains("A, eps, mu"),
         "{e}"
     );
-    let e = stability("no_such_model", &[], &settings("A")).unwrap_err();
-    assert!(matches!(e, StabilityError::UnknownModel(_)));
+    let e = models::by_name("no_such_model").unwrap_err();
     assert!(
         e.to_string().contains("no model named 'no_such_model'")
             && e.to_string().contains("kapitza"),
         "{e}"
     );
-    let e = stability("kapitza", &[1.0], &settings("A")).unwrap_err();
+    let e = stability(model_of("kapitza"), &[1.0], &settings("A")).unwrap_err();
     assert!(matches!(e, StabilityError::ParameterCount(1, _)));
 }
 
@@ -200,7 +200,7 @@ fn kapitza_chart_boundaries_are_the_exact_thresholds() {
         method: Method::parse("dop853", 1e-12).unwrap(),
         tiles: None,
     };
-    let chart = stability_chart("kapitza", &defaults("kapitza"), &settings).unwrap();
+    let chart = stability_chart(model_of("kapitza"), &defaults("kapitza"), &settings).unwrap();
     for (k, &eps) in settings.x_values.iter().enumerate() {
         let reference = jury_threshold(eps, 6.0);
         let first = chart.boundaries[k][0];
@@ -232,7 +232,7 @@ fn a_chart_of_a_point_the_vibration_moves_is_refused() {
         tiles: None,
     };
     let e =
-        stability_chart("elastic_pendulum", &defaults("elastic_pendulum"), &settings).unwrap_err();
+        stability_chart(model_of("elastic_pendulum"), &defaults("elastic_pendulum"), &settings).unwrap_err();
     assert!(
         matches!(&e, StabilityError::MovedByVibration { model, q } if model == "elastic_pendulum" && *q == [0.9, 0.0]),
         "{e}"
@@ -260,7 +260,7 @@ fn chart_in_lanes_equals_the_scalar_chart_bit_for_bit() {
         method,
         tiles: None,
     };
-    let chart = stability_chart("kapitza", &defaults("kapitza"), &settings).unwrap();
+    let chart = stability_chart(model_of("kapitza"), &defaults("kapitza"), &settings).unwrap();
     let margin = |eps: f64, a: f64| {
         let system = kapitza::Exact {
             params: kapitza::Params { A: a, eps, mu: 0.0 },
@@ -303,7 +303,7 @@ fn chart_in_lanes_equals_the_scalar_chart_bit_for_bit() {
 fn window_in_lanes_finds_the_exact_edge() {
     let mut taylor = settings("A");
     taylor.method = Method::parse("taylor", 1e-12).unwrap();
-    let result = stability("kapitza", &defaults("kapitza"), &taylor).unwrap();
+    let result = stability(model_of("kapitza"), &defaults("kapitza"), &taylor).unwrap();
     let [low, _] = at(&result.equilibria, &[0.0]).exact_window.unwrap();
     let reference = jury_threshold(0.1, 4.0);
     assert!(
@@ -342,7 +342,7 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
         tiles: None,
     };
     let params = defaults("kapitza");
-    let whole = stability_chart("kapitza", &params, &base).unwrap();
+    let whole = stability_chart(model_of("kapitza"), &params, &base).unwrap();
     assert!(whole.boundaries.iter().all(|b| !b.is_empty()));
     let folder = tempfile::tempdir().unwrap();
     let tiled = |only: Option<Vec<usize>>| ChartSettings {
@@ -353,7 +353,7 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
         }),
         ..base.clone()
     };
-    let first = stability_chart("kapitza", &params, &tiled(Some(vec![1, 3])));
+    let first = stability_chart(model_of("kapitza"), &params, &tiled(Some(vec![1, 3])));
     assert!(matches!(first, Err(StabilityError::Partial)), "{first:?}");
     let sweep = crate::sweep_folder(folder.path());
     let files = || {
@@ -372,7 +372,7 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
             .unwrap()
     };
     let before = [stamp("tile_1.bin"), stamp("tile_3.bin")];
-    let resumed = stability_chart("kapitza", &params, &tiled(None)).unwrap();
+    let resumed = stability_chart(model_of("kapitza"), &params, &tiled(None)).unwrap();
     assert_eq!(files().len(), 4);
     assert_eq!([stamp("tile_1.bin"), stamp("tile_3.bin")], before);
     assert_eq!(resumed.stable, whole.stable);
@@ -382,7 +382,7 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
             .collect()
     };
     assert_eq!(bits(&resumed.boundaries), bits(&whole.boundaries));
-    let missing = stability_chart("kapitza", &params, &tiled(Some(vec![4])));
+    let missing = stability_chart(model_of("kapitza"), &params, &tiled(Some(vec![4])));
     assert!(
         matches!(
             missing,

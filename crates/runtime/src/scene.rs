@@ -79,7 +79,7 @@ pub enum SceneError {
     #[error(transparent)]
     UnknownModel(#[from] crate::registry::UnknownModel),
     #[error(transparent)]
-    Study(#[from] crate::studies::StudyError),
+    Study(#[from] crate::study::StudyError),
     #[error(transparent)]
     Explore(#[from] crate::explore::ExploreError),
     #[error(transparent)]

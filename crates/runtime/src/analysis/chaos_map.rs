@@ -7,7 +7,7 @@ use super::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators, fli_sha
 use super::tiles::{fingerprint, run_tiles};
 pub use super::tiles::{TileError, Tiles};
 use crate::ode::{Integrator, LaneIntegrator, Method, OdeError};
-use crate::registry::{Fixed, WithFixed};
+use crate::registry::{Fixed, Model, WithFixed};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -82,13 +82,13 @@ fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64)
 /// Why [`chaos_map`] cannot run: the errors of the period map's analyses.
 pub use super::period_map::PeriodMapError as ChaosMapError;
 
-/// The FLI map of the model `name` with parameter values `params`
+/// The FLI map of `model` with parameter values `params`
 /// (declaration order); `row_done` is called as each row is finished (from
 /// the worker threads) and returns whether to go on: once it says false,
 /// rows not yet started are skipped and the map ends with
 /// [`ChaosMapError::Cancelled`] (nobody is waiting for it any more).
 pub fn chaos_map(
-    name: &str,
+    model: &Model,
     params: &[f64],
     settings: &ChaosMapSettings,
     row_done: &(dyn Fn() -> bool + Sync),
@@ -98,8 +98,8 @@ pub fn chaos_map(
         settings,
         row_done,
     };
-    crate::registry::with_fixed(name, work)?
-        .ok_or_else(|| ChaosMapError::ContactModel(name.into()))?
+    crate::registry::with_fixed(model, work)
+        .ok_or_else(|| ChaosMapError::ContactModel(model.info.name.into()))?
 }
 
 struct Map<'a> {

@@ -8,6 +8,7 @@
 
 use super::fit::{log_log, LineFit};
 use crate::ode::{Integrator, Method, OdeError, System};
+use crate::registry::Model;
 use rayon::prelude::*;
 
 /// Both systems on one time grid, from the same initial state.
@@ -172,8 +173,6 @@ pub struct AveragingConvergence {
 /// Why [`convergence`] cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum AveragingError {
-    #[error(transparent)]
-    UnknownModel(#[from] crate::registry::UnknownModel),
     #[error("'{0}' is a contact model: it has no period map or averaged system")]
     ContactModel(String),
     #[error("model '{0}' has no fast phase: there is no averaged system")]
@@ -228,15 +227,15 @@ pub fn second_order_deviation<
     Some(run())
 }
 
-/// Runs [`AveragingConvergence`] on the model `name` with parameter values
+/// Runs [`AveragingConvergence`] on `model` with parameter values
 /// `params` (declaration order).
 pub fn convergence(
-    name: &str,
+    model: &Model,
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
-    crate::registry::with_fixed(name, Sweep { params, settings })?
-        .ok_or_else(|| AveragingError::ContactModel(name.into()))?
+    crate::registry::with_fixed(model, Sweep { params, settings })
+        .ok_or_else(|| AveragingError::ContactModel(model.info.name.into()))?
 }
 
 struct Sweep<'a> {

@@ -12,7 +12,7 @@ pub mod server;
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::analysis::period_map::{period_map, wrap_angle, PeriodMapError};
 use crate::ode::{Integrator, Method, OdeError};
-use crate::registry::{DynamicModel, Fixed, Kind, ModelInfo, ParameterError, WithFixed};
+use crate::registry::{Catalog, DynamicModel, Fixed, Kind, Model, ModelInfo, ParameterError, WithFixed};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -101,9 +101,9 @@ pub struct ModelSummary {
     pub default_ranges: [[f64; 2]; 2],
 }
 
-/// Every model of `models/`, in file-name order.
-pub fn models() -> Vec<ModelSummary> {
-    crate::models::MODELS
+/// Every model of `catalog`, in its order.
+pub fn models(catalog: Catalog) -> Vec<ModelSummary> {
+    catalog
         .iter()
         .map(|m| summary(m.info, m.dynamic))
         .collect()
@@ -164,8 +164,8 @@ pub struct Derivation {
 
 /// The derivations a student reads first: L, H, the averaged H to each
 /// order, V_vibr and the effective potential, the equations of motion.
-pub fn derivations(name: &str) -> Result<Vec<Derivation>, StudioError> {
-    let info = find(name)?;
+pub fn derivations(catalog: Catalog, name: &str) -> Result<Vec<Derivation>, StudioError> {
+    let info = crate::registry::lookup(catalog, name)?.info;
     const SHOWN: [&str; 8] = [
         "lagrangian",
         "hamiltonian",
@@ -193,17 +193,6 @@ pub fn derivations(name: &str) -> Result<Vec<Derivation>, StudioError> {
             mathml: crate::mathml::mathml(d.latex, true),
         })
         .collect())
-}
-
-fn find(name: &str) -> Result<&'static ModelInfo, StudioError> {
-    Ok(crate::registry::model(name)?.info)
-}
-
-fn find_dynamic(
-    name: &str,
-) -> Result<(&'static ModelInfo, &'static dyn DynamicModel), StudioError> {
-    let model = crate::registry::model(name)?;
-    Ok((model.info, model.dynamic))
 }
 
 fn first_order() -> usize {
@@ -239,6 +228,7 @@ pub struct Setup {
 /// A [`Setup`] checked against its model.
 #[derive(Clone)]
 pub struct Resolved {
+    pub handle: &'static Model,
     pub info: &'static ModelInfo,
     pub model: &'static dyn DynamicModel,
     pub dof: usize,
@@ -254,9 +244,11 @@ impl Setup {
     /// fields that no route knows.
     pub fn resolve(
         &self,
+        catalog: Catalog,
         unknown: &BTreeMap<String, serde_json::Value>,
     ) -> Result<Resolved, StudioError> {
-        let (info, model) = find_dynamic(&self.model)?;
+        let handle = crate::registry::lookup(catalog, &self.model)?;
+        let (info, model) = (handle.info, handle.dynamic);
         if let Some(field) = unknown.keys().next() {
             return Err(StudioError::BadRequest {
                 model: info.name.into(),
@@ -297,6 +289,7 @@ impl Setup {
             }));
         }
         Ok(Resolved {
+            handle,
             info,
             model,
             dof,
@@ -358,8 +351,8 @@ pub struct OrbitRequest {
 impl OrbitRequest {
     /// The request checked: its model has a period map, the seed is a
     /// finite state of the right size, the periods are within bounds.
-    pub fn check(&self) -> Result<Resolved, StudioError> {
-        let setup = self.setup.resolve(&self.unknown)?;
+    pub fn check(&self, catalog: Catalog) -> Result<Resolved, StudioError> {
+        let setup = self.setup.resolve(catalog, &self.unknown)?;
         setup.needs_period_map()?;
         setup.count("periods", self.periods, MAX_PERIODS)?;
         if self.seed.len() != 2 * setup.dof {
@@ -402,17 +395,18 @@ const CHUNK_POINTS: usize = 4096;
 /// listens any more, which stops the orbit. An orbit that leaves the
 /// model's domain ends with the integrator's error after the points before.
 pub fn orbit(
+    catalog: Catalog,
     request: &OrbitRequest,
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
 ) -> Result<OrbitEnd, StudioError> {
-    let setup = request.check()?;
+    let setup = request.check(catalog)?;
     let work = OrbitWork {
         setup: &setup,
         seed: &request.seed,
         periods: request.periods,
         sink,
     };
-    crate::registry::with_fixed(setup.info.name, work)?
+    crate::registry::with_fixed(setup.handle, work)
         .ok_or_else(|| StudioError::ContactModel(setup.info.name.into()))?
 }
 
@@ -500,8 +494,8 @@ pub struct ChaosRequest {
 
 impl ChaosRequest {
     /// The request checked, with the view's ranges.
-    pub fn check(&self) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
-        let setup = self.setup.resolve(&self.unknown)?;
+    pub fn check(&self, catalog: Catalog) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
+        let setup = self.setup.resolve(catalog, &self.unknown)?;
         setup.needs_period_map()?;
         let ranges = setup.ranges(&self.ranges)?;
         setup.count("periods", self.periods, MAX_CHAOS_PERIODS)?;
@@ -533,11 +527,12 @@ pub struct ChaosLevel {
 /// says false a level stops between rows (ending with
 /// `PeriodMapError::Cancelled`).
 pub fn chaos(
+    catalog: Catalog,
     request: &ChaosRequest,
     sink: &mut dyn FnMut(ChaosLevel) -> bool,
     listening: &(dyn Fn() -> bool + Sync),
 ) -> Result<(), StudioError> {
-    let (setup, ranges) = request.check()?;
+    let (setup, ranges) = request.check(catalog)?;
     for &pixels in &request.levels {
         let settings = ChaosMapSettings {
             axes: setup.axes,
@@ -549,7 +544,7 @@ pub fn chaos(
             method: setup.method,
             tiles: None,
         };
-        let map = chaos_map(setup.info.name, &setup.params, &settings, listening)?;
+        let map = chaos_map(setup.handle, &setup.params, &settings, listening)?;
         let level = ChaosLevel {
             pixels,
             shades: map.shades,
@@ -619,8 +614,8 @@ pub struct Overlay {
 }
 
 /// The level sets and equilibria of a view.
-pub fn overlay(request: &OverlayRequest) -> Result<Overlay, StudioError> {
-    let setup = request.setup.resolve(&request.unknown)?;
+pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, StudioError> {
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
     let ranges = setup.ranges(&request.ranges)?;
     let grid = setup.count("grid points per side", request.grid, MAX_GRID)?;
     let count = setup.count("level sets", request.levels, 100)?;

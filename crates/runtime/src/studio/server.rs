@@ -16,9 +16,10 @@
 //! goes on.
 
 use super::{ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
+use crate::registry::Catalog;
 use crate::analysis::period_map::PeriodMapError;
 use axum::body::{Body, Bytes};
-use axum::extract::Path;
+use axum::extract::{Path, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
@@ -84,8 +85,8 @@ impl IntoResponse for ApiError {
     }
 }
 
-/// The studio's routes.
-pub fn router() -> Router {
+/// The studio's routes, serving the models of `catalog`.
+pub fn router(catalog: Catalog) -> Router {
     Router::new()
         .route(
             "/",
@@ -99,12 +100,16 @@ pub fn router() -> Router {
             "/studio.css",
             get(|| async { asset("text/css; charset=utf-8", STYLE) }),
         )
-        .route("/api/models", get(|| async { axum::Json(super::models()) }))
+        .route(
+            "/api/models",
+            get(move || async move { axum::Json(super::models(catalog)) }),
+        )
         .route("/api/models/{name}/derivations", get(derivations))
         .route("/api/orbit", post(orbit))
         .route("/api/chaos", post(chaos))
         .route("/api/overlay", post(overlay))
         .fallback(|uri: axum::http::Uri| async move { ApiError::NotFound(uri.to_string()) })
+        .with_state(catalog)
 }
 
 fn asset(content_type: &'static str, text: &'static str) -> Response {
@@ -113,7 +118,7 @@ fn asset(content_type: &'static str, text: &'static str) -> Response {
 
 /// Serves the studio on 127.0.0.1:`port` (0: any free port) until Ctrl-C,
 /// printing its address once listening.
-pub fn run(port: u16) -> Result<(), ServeError> {
+pub fn run(catalog: Catalog, port: u16) -> Result<(), ServeError> {
     let runtime = tokio::runtime::Runtime::new()?;
     runtime.block_on(async {
         let addr = SocketAddr::from(([127, 0, 0, 1], port));
@@ -124,7 +129,7 @@ pub fn run(port: u16) -> Result<(), ServeError> {
             "studio: http://{}/  (Ctrl-C stops it)",
             listener.local_addr()?
         );
-        axum::serve(listener, router())
+        axum::serve(listener, router(catalog))
             .with_graceful_shutdown(async {
                 // Without a signal handler the server runs until killed.
                 let _ = tokio::signal::ctrl_c().await;
@@ -134,31 +139,35 @@ pub fn run(port: u16) -> Result<(), ServeError> {
     })
 }
 
-async fn derivations(Path(name): Path<String>) -> Result<Response, ApiError> {
-    Ok(axum::Json(super::derivations(&name)?).into_response())
+async fn derivations(
+    State(catalog): State<Catalog>,
+    Path(name): Path<String>,
+) -> Result<Response, ApiError> {
+    Ok(axum::Json(super::derivations(catalog, &name)?).into_response())
 }
 
-async fn overlay(body: Bytes) -> Result<Response, ApiError> {
+async fn overlay(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
     let request: OverlayRequest = serde_json::from_slice(&body)?;
-    let answer = blocking(move || super::overlay(&request).map_err(ApiError::from)).await?;
+    let answer =
+        blocking(move || super::overlay(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 
-async fn orbit(body: Bytes) -> Result<Response, ApiError> {
+async fn orbit(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
     let request: OrbitRequest = serde_json::from_slice(&body)?;
-    request.check()?;
+    request.check(catalog)?;
     Ok(stream(move |send, _| {
-        let end = super::orbit(&request, &mut |chunk| send(&chunk))?;
+        let end = super::orbit(catalog, &request, &mut |chunk| send(&chunk))?;
         send(&Ended { end });
         Ok(())
     }))
 }
 
-async fn chaos(body: Bytes) -> Result<Response, ApiError> {
+async fn chaos(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
     let request: ChaosRequest = serde_json::from_slice(&body)?;
-    request.check()?;
+    request.check(catalog)?;
     Ok(stream(move |send, listening| {
-        super::chaos(&request, &mut |level| send(&level), listening)
+        super::chaos(catalog, &request, &mut |level| send(&level), listening)
     }))
 }
 

@@ -4,6 +4,7 @@
 //! behind it as formulas (MathML, which browsers draw natively). No
 //! network, no script: the figures are linked files.
 
+use crate::registry::Catalog;
 use serde_json::Value;
 use std::path::Path;
 
@@ -114,8 +115,8 @@ pub fn escape(s: &str) -> String {
 }
 
 /// The formulas of `keys` of the model `name`, each with what it is.
-fn formulas(name: &str, keys: &[&str]) -> String {
-    let Some(model) = crate::registry::find(name) else {
+fn formulas(catalog: Catalog, name: &str, keys: &[&str]) -> String {
+    let Ok(model) = crate::registry::lookup(catalog, name).map(|m| m.info) else {
         return String::new();
     };
     let mut html = String::new();
@@ -132,11 +133,11 @@ fn formulas(name: &str, keys: &[&str]) -> String {
     html
 }
 
-/// The report over the scene outputs under `out` (one folder per scene):
+/// The report (on the models of `catalog`) over the scene outputs under `out` (one folder per scene):
 /// each section's figure beside its derivations, its numbers, and at the
 /// end the main derivations of every model. Sections whose outputs are
 /// missing say so and link nothing.
-pub fn index_html(out: &Path) -> String {
+pub fn index_html(catalog: Catalog, out: &Path) -> String {
     let mut html = String::from(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>mechlab report</title>\n<style>body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em}img{max-width:100%;border:1px solid #ddd}.row{display:flex;gap:1em;align-items:flex-start}.row>a{flex:3}.row>.formulas{flex:2}.formula{border-left:3px solid #dde;padding:0 0.5em;margin:0.4em 0}.formula small{color:#555}math{font-size:1.1em}table{border-collapse:collapse}td{border:1px solid #ddd;padding:2px 6px;vertical-align:top}</style></head><body>\n<h1>mechlab: the studies</h1>\n<p>Every section is one deliverable: its figure beside the derivations behind it, the key numbers from the scene's <code>summary.json</code>, and what it shows. Regenerate with <code>cargo run --release --example report</code>; explore interactively with <code>cargo run --release --example studio</code>.</p>\n",
     );
@@ -151,17 +152,17 @@ pub fn index_html(out: &Path) -> String {
     }
     html += "<li><a href=\"#derivations\">Derivations</a></li>\n</ul>\n";
     for s in SECTIONS {
-        html += &section(out, s);
+        html += &section(catalog, out, s);
     }
     html += "<h2 id=\"derivations\">Derivations</h2>\n<p>The main derived expressions of every model, in their readable forms (each checked against the computer algebra's result at build time).</p>\n";
-    for model in crate::models::ALL {
-        html += &formulas(model.name, DERIVATION_KEYS);
+    for model in catalog {
+        html += &formulas(catalog, model.info.name, DERIVATION_KEYS);
     }
     html += "</body></html>\n";
     html
 }
 
-fn section(out: &Path, s: &Section) -> String {
+fn section(catalog: Catalog, out: &Path, s: &Section) -> String {
     let mut html = format!("<h2 id=\"{}\">{} {}</h2>\n", s.id, s.id, escape(s.title));
     let figure = out.join(s.scene).join(s.figure);
     let summary_path = out.join(s.scene).join("summary.json");
@@ -179,7 +180,7 @@ fn section(out: &Path, s: &Section) -> String {
         "<p>{}</p>\n<div class=\"row\"><a href=\"{scene}/{fig}\"><img src=\"{scene}/{fig}\" alt=\"{}\"></a><div class=\"formulas\">{}</div></div>\n",
         escape(s.shows),
         escape(s.title),
-        formulas(s.formulas.0, s.formulas.1),
+        formulas(catalog, s.formulas.0, s.formulas.1),
         scene = s.scene,
         fig = s.figure
     );

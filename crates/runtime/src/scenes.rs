@@ -4,14 +4,14 @@
 
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::ode::Method;
-use crate::registry::ModelInfo;
+use crate::registry::{Catalog, Model};
 use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError};
 
-/// The model named by `--set model=…` (or `default`), with a clear error
-/// listing the known ones.
-pub fn model_from_args(default: &str) -> Result<&'static ModelInfo, SceneError> {
+/// The model of `catalog` named by `--set model=…` (or `default`), with a
+/// clear error listing the known ones.
+pub fn model_from_args(catalog: Catalog, default: &str) -> Result<&'static Model, SceneError> {
     let name = Scene::peek("model").unwrap_or_else(|| default.into());
-    Ok(crate::registry::model(&name)?.info)
+    Ok(crate::registry::lookup(catalog, &name)?)
 }
 
 /// A preset's defaults: its value of a knob, or the generic scene's.
@@ -45,15 +45,17 @@ fn axes_from(scene: &Scene) -> Result<[usize; 2], SceneError> {
 /// one), then every parameter of the chosen model — and the parsed scene.
 /// `defaults` are the generic scene's (model, method, tolerance).
 fn generic_scene(
+    catalog: Catalog,
     scene_name: &'static str,
     about: &str,
     overrides: &[(&'static str, &'static str)],
     (model, method, tol): (&'static str, &'static str, &'static str),
     own: &[(&'static str, &'static str, &'static str)],
-) -> Result<(&'static ModelInfo, Scene), SceneError> {
+) -> Result<(&'static Model, Scene), SceneError> {
     let defaults = Defaults(overrides);
     let model = defaults.get("model", model);
-    let info = model_from_args(model)?;
+    let handle = model_from_args(catalog, model)?;
+    let info = handle.info;
     let mut knobs = vec![knob(
         "model",
         model,
@@ -68,7 +70,7 @@ fn generic_scene(
         defaults.get("tol", tol),
     ));
     knobs.extend(parameter_knobs(info, overrides));
-    Ok((info, Scene::from_args(scene_name, about, &knobs)?))
+    Ok((handle, Scene::from_args(scene_name, about, &knobs)?))
 }
 
 /// `method` and `tol` knobs with these defaults.
@@ -96,10 +98,12 @@ pub fn method_from(scene: &Scene) -> Result<Method, SceneError> {
 /// of two state components. `overrides` are the preset's defaults (model
 /// and its parameters, knobs).
 pub fn chaos_map_scene(
+    catalog: Catalog,
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    let (info, scene) = generic_scene(
+    let (model, scene) = generic_scene(
+        catalog,
         scene_name,
         "FLI chaos map of the period map of any model",
         overrides,
@@ -126,6 +130,7 @@ pub fn chaos_map_scene(
             ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the map"),
         ],
     )?;
+    let info = model.info;
     let axes = axes_from(&scene)?;
     let settings = ChaosMapSettings {
         axes,
@@ -142,7 +147,7 @@ pub fn chaos_map_scene(
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
     let params = scene.parameter_values(info)?;
     let run = |settings: &ChaosMapSettings| {
-        chaos_map(info.name, &params, settings, &|| {
+        chaos_map(model, &params, settings, &|| {
             progress.inc();
             true
         })
@@ -295,11 +300,13 @@ pub fn tiles_from(
 /// frequency, with the fitted slopes, and ν × deviation. `values` takes a
 /// list, `auto`, or `geometric:first,last,count`.
 pub fn averaging_scene(
+    catalog: Catalog,
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use crate::analysis::averaging::{convergence, ConvergenceSettings};
-    let (info, scene) = generic_scene(
+    let (model, scene) = generic_scene(
+        catalog,
         scene_name,
         "exact against averaged: the deviation against the frequency",
         overrides,
@@ -312,6 +319,7 @@ pub fn averaging_scene(
             ("order", "1", "1: the averaged system from the same state; 2: the system averaged to second order, from the transformed state and mapped back"),
         ],
     )?;
+    let info = model.info;
     let settings = ConvergenceSettings {
         parameter: (scene.text("parameter") != "auto").then(|| scene.text("parameter").to_string()),
         values: values_from(&scene)?,
@@ -322,7 +330,7 @@ pub fn averaging_scene(
         method: method_from(&scene)?,
         order: scene.count("order")?,
     };
-    let result = convergence(info.name, &scene.parameter_values(info)?, &settings)?;
+    let result = convergence(model, &scene.parameter_values(info)?, &settings)?;
     for (c, s) in result.coordinates.iter().zip(&result.slope) {
         eprintln!("{c}: max deviation ∝ ν^{s:.4}");
     }
@@ -484,11 +492,13 @@ fn averaging_figure(
 /// components. Seeds: `--set seeds=…` (states separated by `;`) or a line
 /// of `count` seeds along the first axis.
 pub fn period_map_scene(
+    catalog: Catalog,
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use crate::analysis::period_map::{portrait, PortraitSettings};
-    let (info, scene) = generic_scene(
+    let (model, scene) = generic_scene(
+        catalog,
         scene_name,
         "orbits of the period map of any model",
         overrides,
@@ -501,6 +511,7 @@ pub fn period_map_scene(
             ("periods", "500", "periods per orbit"),
         ],
     )?;
+    let info = model.info;
     let axes = axes_from(&scene)?;
     let seeds = match scene.text("seeds") {
         "line" => None,
@@ -527,7 +538,7 @@ pub fn period_map_scene(
         periods: scene.count("periods")?,
         method: method_from(&scene)?,
     };
-    let result = portrait(info.name, &scene.parameter_values(info)?, &settings)?;
+    let result = portrait(model, &scene.parameter_values(info)?, &settings)?;
     for (k, reason) in &result.failed {
         eprintln!("orbit {k} stopped: {reason}");
     }

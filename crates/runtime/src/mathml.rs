@@ -80,33 +80,3 @@ fn balanced_group_len(s: &str) -> Option<usize> {
     }
     None
 }
-
-#[cfg(test)]
-mod tests {
-    /// A fraction, powers (of a function name too) and a Greek letter become
-    /// MathML elements; a relation is escaped.
-    #[test]
-    fn formulas_become_mathml() {
-        let html = super::mathml(r"\frac{p^2}{2} + A^2 \sin^2\theta < 1", true);
-        assert!(
-            html.starts_with("<math") && html.contains("display=\"block\""),
-            "{html}"
-        );
-        assert!(
-            html.contains("<mfrac>") && html.contains("<msup>") && html.contains("θ"),
-            "{html}"
-        );
-        assert!(
-            html.contains("<msup><mrow><mi>sin</mi></mrow><mn>2</mn></msup>"),
-            "{html}"
-        );
-        assert_eq!(
-            super::powers_of_functions(r"A^2\sin^{2}{q} + \cos q"),
-            r"A^2{\sin}^{2}\,{q} + \cos q"
-        );
-        assert!(
-            html.contains("<mo>&lt;</mo>") && !html.contains("<mo><"),
-            "{html}"
-        );
-    }
-}

@@ -1,6 +1,7 @@
 //! The period map of a T-periodic system and its orbits.
 
 use crate::ode::{Integrator, Method, OdeError, Stats, System};
+use crate::registry::Model;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -111,8 +112,6 @@ pub struct Portrait {
 /// Why an analysis of the period map ([`portrait`], the chaos map) cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum PeriodMapError {
-    #[error(transparent)]
-    UnknownModel(#[from] crate::registry::UnknownModel),
     #[error("'{0}' is a contact model: it has no period map or averaged system")]
     ContactModel(String),
     #[error("model '{0}' has no fast phase: it has no period map")]
@@ -132,14 +131,14 @@ pub enum PeriodMapError {
     Ode(#[from] OdeError),
 }
 
-/// The orbits of the model `name` with parameter values `params`.
+/// The orbits of `model` with parameter values `params`.
 pub fn portrait(
-    name: &str,
+    model: &Model,
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    crate::registry::with_fixed(name, Portraits { params, settings })?
-        .ok_or_else(|| PeriodMapError::ContactModel(name.into()))?
+    crate::registry::with_fixed(model, Portraits { params, settings })
+        .ok_or_else(|| PeriodMapError::ContactModel(model.info.name.into()))?
 }
 
 struct Portraits<'a> {

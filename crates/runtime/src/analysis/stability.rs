@@ -17,7 +17,7 @@ use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues;
 use crate::analysis::period_map::wrap_angle;
 use crate::ode::{Method, OdeError, System};
-use crate::registry::{Fixed, WithFixed};
+use crate::registry::{Fixed, Model, WithFixed};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::cell::RefCell;
@@ -68,6 +68,9 @@ pub struct EquilibriumStability {
 #[derive(Clone, Debug, Serialize)]
 pub struct Stability {
     pub model: String,
+    /// The model's coordinates, for the figure's titles.
+    #[serde(skip)]
+    pub coordinates: &'static [&'static str],
     pub amplitude: String,
     pub params: BTreeMap<String, f64>,
     pub equilibria: Vec<EquilibriumStability>,
@@ -79,8 +82,6 @@ pub struct Stability {
 /// Why the analysis cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum StabilityError {
-    #[error(transparent)]
-    UnknownModel(#[from] crate::registry::UnknownModel),
     #[error("'{0}' is a contact model: it has no period map or averaged system")]
     ContactModel(String),
     #[error("model '{0}' has no fast phase: there is no vibration to stabilise by")]
@@ -109,15 +110,15 @@ pub enum StabilityError {
     Ode(#[from] OdeError),
 }
 
-/// Runs the analysis on the model `name` with parameter values `params`
+/// Runs the analysis on `model` with parameter values `params`
 /// (declaration order).
 pub fn stability(
-    name: &str,
+    model: &Model,
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
-    crate::registry::with_fixed(name, Analysis { params, settings })?
-        .ok_or_else(|| StabilityError::ContactModel(name.into()))?
+    crate::registry::with_fixed(model, Analysis { params, settings })
+        .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
 }
 
 struct Analysis<'a> {
@@ -136,6 +137,7 @@ impl WithFixed for Analysis<'_> {
         let amplitude = parameter_index(info, &self.settings.amplitude)?;
         let mut result = Stability {
             model: info.name.into(),
+            coordinates: info.coordinates,
             amplitude: self.settings.amplitude.clone(),
             params,
             equilibria: Vec::new(),
@@ -176,20 +178,20 @@ fn parameter_index(info: &crate::registry::ModelInfo, name: &str) -> Result<usiz
 /// The averaged analysis at one equilibrium `q` of the system without
 /// vibration (roots, a*, the second-order threshold; no exact window).
 pub fn averaged_stability(
-    name: &str,
+    model: &Model,
     params: &[f64],
     amplitude: &str,
     q: &[f64],
 ) -> Result<EquilibriumStability, StabilityError> {
     crate::registry::with_fixed(
-        name,
+        model,
         AtEquilibrium {
             params,
             amplitude,
             q,
         },
-    )?
-    .ok_or_else(|| StabilityError::ContactModel(name.into()))?
+    )
+    .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
 }
 
 struct AtEquilibrium<'a> {
@@ -740,14 +742,14 @@ pub struct StabilityChart {
     pub boundaries: Vec<Vec<f64>>,
 }
 
-/// The stability chart of the model `name` (see [`StabilityChart`]).
+/// The stability chart of `model` (see [`StabilityChart`]).
 pub fn stability_chart(
-    name: &str,
+    model: &Model,
     params: &[f64],
     settings: &ChartSettings,
 ) -> Result<StabilityChart, StabilityError> {
-    crate::registry::with_fixed(name, Chart { params, settings })?
-        .ok_or_else(|| StabilityError::ContactModel(name.into()))?
+    crate::registry::with_fixed(model, Chart { params, settings })
+        .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
 }
 
 struct Chart<'a> {
@@ -961,12 +963,11 @@ impl Stability {
         if drawn.is_empty() {
             return None;
         }
-        let info = crate::registry::find(&self.model)?;
         let amplitude = display_name(&self.amplitude);
         let titles: Vec<String> = drawn
             .iter()
             .map(|e| {
-                let at: Vec<String> = info
+                let at: Vec<String> = self
                     .coordinates
                     .iter()
                     .zip(&e.q)

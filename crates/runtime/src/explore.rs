@@ -12,7 +12,7 @@
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Integrator, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
-use crate::registry::{display_name, DynamicModel, Fixed, Kind, ModelInfo, WithFixed};
+use crate::registry::{display_name, DynamicModel, Fixed, Kind, Model, ModelInfo, WithFixed};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -60,8 +60,6 @@ pub enum ExploreError {
     Ode(#[from] OdeError),
     #[error(transparent)]
     Contact(#[from] ContactError),
-    #[error(transparent)]
-    UnknownModel(#[from] crate::registry::UnknownModel),
     /// A state of the wrong length or an unsupported size.
     #[error("{0}")]
     Shape(String),
@@ -117,11 +115,12 @@ fn to_array<const N: usize>(v: &[f64]) -> [f64; N] {
 
 /// Runs everything the explorer shows for `model` from `y0`.
 pub fn explore(
-    model: &dyn DynamicModel,
+    handle: &Model,
     params: &[f64],
     y0: &[f64],
     settings: &Settings,
 ) -> Result<Exploration, ExploreError> {
+    let model = handle.dynamic;
     let expected = match model.kind() {
         Kind::Hamiltonian { dof, .. } => 2 * dof,
         Kind::Contacts { count } => 2 * count,
@@ -142,7 +141,7 @@ pub fn explore(
     };
     match (model.kind(), expected) {
         (Kind::Hamiltonian { .. }, _) => {
-            crate::registry::with_fixed(name, runs)?.unwrap_or_else(|| {
+            crate::registry::with_fixed(handle, runs).unwrap_or_else(|| {
                 Err(ExploreError::Shape(format!(
                     "'{name}' is not a generated Hamiltonian model"
                 )))

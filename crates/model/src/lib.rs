@@ -1,5 +1,5 @@
 //! Model files: the expression language and the validated model description.
-//! Compiled both into the library and into `build.rs` (via `#[path]`).
+//! Shared by the derivation (`mechlab-derive`, at build time) and the runtime.
 
 pub mod expr;
 pub mod file;

@@ -108,11 +108,6 @@ impl ModelInfo {
     }
 }
 
-/// Finds a model by name.
-pub fn find(name: &str) -> Option<&'static ModelInfo> {
-    crate::models::ALL.iter().find(|m| m.name == name)
-}
-
 /// How a model moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
@@ -376,6 +371,15 @@ pub struct Model {
     pub sized: Option<Sized>,
 }
 
+impl fmt::Debug for Model {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Model")
+            .field("name", &self.info.name)
+            .field("kind", &self.dynamic.kind())
+            .finish()
+    }
+}
+
 /// A model name that no model file has.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("no model named '{name}' (known: {})", known.join(", "))]
@@ -384,15 +388,20 @@ pub struct UnknownModel {
     pub known: Vec<&'static str>,
 }
 
-/// The model named `name` among the users' models.
-pub fn model(name: &str) -> Result<&'static Model, UnknownModel> {
-    crate::models::MODELS
+/// The models a program knows by name: the `mechlab` package's
+/// `models::MODELS` (generated from `models/`), handed to the parts of the
+/// runtime that list or look up models (scenes, the studio, reports).
+pub type Catalog = &'static [&'static Model];
+
+/// The model named `name` in `catalog`.
+pub fn lookup(catalog: Catalog, name: &str) -> Result<&'static Model, UnknownModel> {
+    catalog
         .iter()
         .copied()
         .find(|m| m.info.name == name)
         .ok_or_else(|| UnknownModel {
             name: name.to_string(),
-            known: crate::models::MODELS.iter().map(|m| m.info.name).collect(),
+            known: catalog.iter().map(|m| m.info.name).collect(),
         })
 }
 
@@ -405,11 +414,11 @@ pub trait WithFixed {
     ) -> Self::Output;
 }
 
-/// Runs `work` on the Hamiltonian model `name` at its own sizes: an unknown
-/// name is an error, a contact model gives None. The analyses are compiled
-/// once per size, whatever the models are.
-pub fn with_fixed<W: WithFixed>(name: &str, work: W) -> Result<Option<W::Output>, UnknownModel> {
-    Ok(model(name)?.sized.map(|sized| match sized {
+/// Runs `work` on a Hamiltonian model at its own sizes (None for a
+/// contact model). The analyses are compiled once per size, whatever the
+/// models are.
+pub fn with_fixed<W: WithFixed>(model: &Model, work: W) -> Option<W::Output> {
+    model.sized.map(|sized| match sized {
         Sized::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
         Sized::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
         Sized::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
@@ -418,7 +427,7 @@ pub fn with_fixed<W: WithFixed>(name: &str, work: W) -> Result<Option<W::Output>
         Sized::Dof6(m) => work.run::<_, 6, 12, 24, 156>(m),
         Sized::Dof7(m) => work.run::<_, 7, 14, 28, 210>(m),
         Sized::Dof8(m) => work.run::<_, 8, 16, 32, 272>(m),
-    }))
+    })
 }
 
 /// A name of a model file in the notation of the figures: Greek names as

@@ -1,0 +1,256 @@
+//! The derivation: model files → Symbolica → generated Rust modules.
+//!
+//! Used by the workspace's `build.rs` only (Symbolica's restricted mode
+//! allows one thread of one process: never from a test, an example or the
+//! runtime). Reading and validation of the files live in `mechlab-model`,
+//! derivations in `derive.rs` (`contacts.rs` for rough guides), readable
+//! forms in `simplify.rs` and `latex.rs`, common subexpression elimination
+//! in `emit.rs`, Taylor recurrences in `taylor.rs`, the averaging series in
+//! `lie.rs` (`deprit.rs` closed form, `numeric.rs` through run-time solves),
+//! module assembly in `generate.rs`, layout in the workspace's `templates/`.
+//!
+//! Each model's generated module is cached under a hash of its file and of
+//! the derivation code, so editing or adding one model file derives that
+//! model only.
+
+use mechlab_model as model;
+
+mod contacts;
+mod deprit;
+mod derive;
+mod emit;
+mod generate;
+mod latex;
+mod lie;
+mod numeric;
+mod simplify;
+mod taylor;
+
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// What the build script watches (relative to the workspace root): the
+/// model folders and the templates. The derivation code is a dependency of
+/// the build script, so cargo reruns it when that changes.
+pub const WATCHED: [&str; 3] = ["templates", "models", "test_models"];
+
+/// Model folders: the users' models (`mechlab::models`) and the models only
+/// tests and benchmarks use (`mechlab::test_models`).
+const MODEL_DIRS: [(&str, &str); 2] = [("models", "mod.rs"), ("test_models", "test_models.rs")];
+
+/// Stack of the derivation thread: the recursion of expression trees is as
+/// deep as the longest sum, and a model near the size limit needs far more
+/// than the main thread's 8 MiB. Only the pages used are ever committed.
+const STACK_BYTES: usize = 1 << 30;
+
+fn fail(message: String) -> ! {
+    eprintln!("error: {message}");
+    std::process::exit(1);
+}
+
+/// Derives every model of the workspace's model folders into
+/// `OUT_DIR/generated` and prints cargo's rerun rules. Run from `build.rs`
+/// (the current directory is the workspace root); any failure ends the
+/// build with a message that names the model file and the reason.
+pub fn build_models() {
+    for watched in WATCHED {
+        println!("cargo:rerun-if-changed={watched}");
+    }
+    println!("cargo:rerun-if-changed=build.rs");
+    let worker = std::thread::Builder::new()
+        .name("derivations".into())
+        .stack_size(STACK_BYTES)
+        .spawn(run)
+        .unwrap_or_else(|e| fail(format!("cannot start the derivation thread: {e}")));
+    if worker.join().is_err() {
+        fail("the derivation thread panicked (see above)".into());
+    }
+}
+
+fn run() {
+    let out_dir = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let generated = out_dir.join("generated");
+    let cache = out_dir.join("cache");
+    for dir in [&generated, &cache] {
+        std::fs::create_dir_all(dir)
+            .unwrap_or_else(|e| fail(format!("cannot create {}: {e}", dir.display())));
+    }
+    let tera =
+        tera::Tera::new("templates/*.tera").unwrap_or_else(|e| fail(format!("templates: {e:?}")));
+    let code_version = code_version();
+
+    let mut timings = String::from("model\tseconds\tcached\n");
+    let mut names = std::collections::BTreeSet::new();
+    for (dir, registry_file) in MODEL_DIRS {
+        let mut models = Vec::new();
+        for path in model_files(dir) {
+            let started = Instant::now();
+            let (model, hit) = build_model(&path, &tera, &cache, &generated, code_version);
+            if !names.insert(model.name.clone()) {
+                fail(format!(
+                    "{}: key `name`: '{}' is also the name of another model",
+                    path.display(),
+                    model.name
+                ));
+            }
+            timings.push_str(&format!(
+                "{}\t{:.2}\t{hit}\n",
+                model.name,
+                started.elapsed().as_secs_f64()
+            ));
+            models.push(model);
+        }
+        let registry =
+            generate::render_registry(&tera, &models, dir == "models").unwrap_or_else(|e| fail(e));
+        write_formatted(&generated.join(registry_file), &registry);
+    }
+    let _ = std::fs::write(out_dir.join("derivation_times.tsv"), timings);
+}
+
+/// The model files of a folder, sorted (none if the folder is absent).
+fn model_files(dir: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = match std::fs::read_dir(dir) {
+        Ok(entries) => entries
+            .filter_map(|entry| entry.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => fail(format!("cannot read {dir}/: {e}")),
+    };
+    files.sort();
+    files
+}
+
+/// Reads one model file and puts its generated module in `generated`,
+/// from the cache when the file and the derivation code are unchanged.
+/// Returns the model and whether the cache had it.
+fn build_model(
+    path: &Path,
+    tera: &tera::Tera,
+    cache: &Path,
+    generated: &Path,
+    code_version: u64,
+) -> (model::Model, bool) {
+    let file = path.to_string_lossy().replace('\\', "/");
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| fail(format!("{file}: {e}")));
+    let model = model::Model::parse(&file, &text).unwrap_or_else(|e| fail(e.to_string()));
+    let expected = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    if model.name != expected {
+        fail(format!(
+            "{file}: key `name`: '{}' must equal the file name '{expected}'",
+            model.name
+        ));
+    }
+    let cached = cache.join(format!(
+        "{}-{:016x}.rs",
+        model.name,
+        key(&text, code_version)
+    ));
+    let hit = cached.is_file();
+    if !hit {
+        let derivation = std::panic::AssertUnwindSafe(|| generate_model(tera, &model, &file));
+        let code = std::panic::catch_unwind(derivation).unwrap_or_else(|_| {
+            fail(format!(
+                "{file}: the derivation stopped on an internal error (above); please report it with this model file"
+            ))
+        });
+        // Written beside and renamed: an interrupted build never leaves a
+        // half-written module under a valid key.
+        let partial = cached.with_extension("partial");
+        write_formatted(&partial, &code);
+        std::fs::rename(&partial, &cached)
+            .unwrap_or_else(|e| fail(format!("cannot write {}: {e}", cached.display())));
+        prune_cache(cache, &model.name, &cached);
+    }
+    std::fs::copy(&cached, generated.join(format!("{}.rs", model.name)))
+        .unwrap_or_else(|e| fail(format!("cannot copy {}: {e}", cached.display())));
+    (model, hit)
+}
+
+/// Removes the model's other cached versions (earlier texts or code).
+fn prune_cache(cache: &Path, name: &str, keep: &Path) {
+    let prefix = format!("{name}-");
+    let Ok(entries) = std::fs::read_dir(cache) else {
+        return;
+    };
+    for entry in entries.filter_map(|e| e.ok()) {
+        let path = entry.path();
+        let stale = path != keep
+            && entry
+                .file_name()
+                .to_string_lossy()
+                .strip_prefix(&prefix)
+                .is_some_and(|rest| {
+                    rest.len() == "0123456789abcdef.rs".len() && rest.ends_with(".rs")
+                });
+        if stale {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
+/// Derives one model and renders its module; errors name the file.
+fn generate_model(tera: &tera::Tera, model: &model::Model, file: &str) -> String {
+    let derive_failure =
+        |e: derive::DeriveError| -> ! { fail(format!("{file}: key `{}`: {}", e.key, e.reason)) };
+    if model.contacts.is_empty() {
+        let derivation = derive::derive(model).unwrap_or_else(|e| derive_failure(e));
+        generate::render(tera, model, &derivation, file)
+    } else {
+        let derivation = contacts::derive(model).unwrap_or_else(|e| derive_failure(e));
+        generate::render_contacts(tera, model, &derivation, file)
+    }
+    .unwrap_or_else(|e| fail(format!("{file}: {e}")))
+}
+
+/// A hash of the derivation code and templates (not the model files):
+/// part of every cache key, so a change to the pipeline derives every
+/// model again.
+fn code_version() -> u64 {
+    let derivation_code = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut paths = Vec::new();
+    let mut pending: Vec<PathBuf> = vec![
+        PathBuf::from("templates"),
+        derivation_code.join("src"),
+        derivation_code.join("../model/src"),
+    ];
+    while let Some(path) = pending.pop() {
+        if path.is_dir() {
+            if let Ok(entries) = std::fs::read_dir(&path) {
+                pending.extend(entries.filter_map(|e| e.ok().map(|e| e.path())));
+            }
+        } else {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for path in paths {
+        std::fs::read(&path).unwrap_or_default().hash(&mut hasher);
+    }
+    hasher.finish()
+}
+
+fn key(text: &str, code_version: u64) -> u64 {
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    text.hash(&mut hasher);
+    code_version.hash(&mut hasher);
+    hasher.finish()
+}
+
+/// Writes Rust source and formats it with rustfmt when it is available.
+fn write_formatted(path: &Path, code: &str) {
+    std::fs::write(path, code)
+        .unwrap_or_else(|e| fail(format!("cannot write {}: {e}", path.display())));
+    let rustfmt = std::env::var("RUSTFMT").unwrap_or_else(|_| "rustfmt".into());
+    // Formatting is for readers only; unformatted code compiles the same.
+    let _ = Command::new(rustfmt)
+        .args(["--edition", "2021"])
+        .arg(path)
+        .status();
+}

@@ -1,0 +1,110 @@
+//! Unit-level checks of runtime pieces that need no model: hyper-dual
+//! derivatives, formulas as MathML, the studio's level sets. (The runtime
+//! crate's own test target is not built by `cargo test`, so they live here.)
+
+use mechlab::ode::hyperdual::{gradient, hessian};
+use mechlab::ode::Scalar;
+use mechlab::studio::contour::Field;
+
+/// f(x, y) = sin(x)·y³/(1 + x²) + √(exp(x y)) against its hand-derived
+/// gradient and Hessian.
+#[test]
+fn gradient_and_hessian_match_closed_forms() {
+    fn f<T: Scalar>(v: &[T; 2]) -> T {
+        let (x, y) = (v[0], v[1]);
+        x.sin() * y * y * y / (x * x + 1.0) + (x * y).exp().sqrt()
+    }
+    let (x, y) = (0.7, -1.3);
+    let d = 1.0 + x * x;
+    let e = (x * y / 2.0).exp();
+    let s = x.sin() / d;
+    let s_x = x.cos() / d - 2.0 * x * x.sin() / (d * d);
+    let s_xx = -x.sin() / d - 4.0 * x * x.cos() / (d * d)
+        + x.sin() * (8.0 * x * x / (d * d * d) - 2.0 / (d * d));
+    let grad = gradient(f, &[x, y]);
+    let expected = [s_x * y.powi(3) + y / 2.0 * e, 3.0 * s * y * y + x / 2.0 * e];
+    let hess = hessian(f, &[x, y]);
+    let expected_h = [
+        [
+            s_xx * y.powi(3) + y * y / 4.0 * e,
+            3.0 * s_x * y * y + (0.5 + x * y / 4.0) * e,
+        ],
+        [
+            3.0 * s_x * y * y + (0.5 + x * y / 4.0) * e,
+            6.0 * s * y + x * x / 4.0 * e,
+        ],
+    ];
+    for i in 0..2 {
+        assert!(
+            (grad[i] - expected[i]).abs() < 1e-13,
+            "{grad:?} {expected:?}"
+        );
+        for j in 0..2 {
+            assert!(
+                (hess[i][j] - expected_h[i][j]).abs() < 1e-12,
+                "{hess:?} {expected_h:?}"
+            );
+        }
+    }
+}
+
+/// A fraction, powers (of a function name too) and a Greek letter become
+/// MathML elements; a relation is escaped.
+#[test]
+fn formulas_become_mathml() {
+    let html = mechlab::mathml::mathml(r"\frac{p^2}{2} + A^2 \sin^2\theta < 1", true);
+    assert!(
+        html.starts_with("<math") && html.contains("display=\"block\""),
+        "{html}"
+    );
+    assert!(
+        html.contains("<mfrac>") && html.contains("<msup>") && html.contains("θ"),
+        "{html}"
+    );
+    assert!(
+        html.contains("<msup><mrow><mi>sin</mi></mrow><mn>2</mn></msup>"),
+        "{html}"
+    );
+    assert!(
+        html.contains("<mo>&lt;</mo>") && !html.contains("<mo><"),
+        "{html}"
+    );
+}
+
+/// Every segment end of the level set x² + y² = r² lies on the circle
+/// to the grid's interpolation error, and the segments add up to its
+/// length.
+#[test]
+fn circle() {
+    let field = Field::sample([(-2.0, 2.0), (-2.0, 2.0)], 101, |x, y| x * x + y * y);
+    let r: f64 = 1.3;
+    let segments = field.segments(r * r);
+    let h = 4.0 / 100.0;
+    let mut length = 0.0;
+    for s in &segments {
+        for (x, y) in [(s[0], s[1]), (s[2], s[3])] {
+            assert!(((x * x + y * y).sqrt() - r).abs() < h * h, "({x}, {y})");
+        }
+        length += ((s[2] - s[0]).powi(2) + (s[3] - s[1]).powi(2)).sqrt();
+    }
+    assert!(
+        (length - 2.0 * std::f64::consts::PI * r).abs() < 1e-3 * r,
+        "{length}"
+    );
+}
+
+/// A saddle x·y = 0 gives the two axes, and levels at quantiles are sorted.
+#[test]
+fn saddle_and_quantiles() {
+    let field = Field::sample([(-1.0, 1.0), (-1.0, 1.0)], 20, |x, y| x * y);
+    for s in field.segments(1e-3) {
+        assert!(
+            s[0] * s[1] > 0.0 && s[2] * s[3] > 0.0,
+            "{s:?} crosses into the wrong quadrant"
+        );
+    }
+    let levels = field.quantiles(9);
+    assert!(levels.windows(2).all(|w| w[0] < w[1]));
+    assert!(levels[0] < 0.0 && levels[8] > 0.0);
+}
+
