@@ -1,7 +1,7 @@
-//! Build script: model files (`models/`, `test_models/`) → derivations
+//! Build script: the model files of `models/` → derivations
 //! (`mechlab-derive`, with Symbolica, build time only) → generated Rust in
-//! `OUT_DIR/generated`, included by `src/models.rs` and `src/test_models.rs`.
+//! `OUT_DIR/generated`, included by `src/models.rs`.
 
 fn main() {
-    mechlab_derive::build_models();
+    mechlab_derive::build_models(".", "models");
 }

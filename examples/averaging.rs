@@ -8,5 +8,7 @@
 //! `cargo run --release --example averaging -- --set model=triple_pendulum`
 
 fn main() {
-    mechlab::scene::run(|| mechlab::scenes::averaging_scene(mechlab::models::MODELS, "averaging", &[]));
+    mechlab::scene::run(|| {
+        mechlab::scenes::averaging_scene(mechlab::models::MODELS, "averaging", &[])
+    });
 }

@@ -5,5 +5,7 @@
 //! `cargo run --release --example chaos_map -- --set model=double_pendulum --set axes=0,2 --set pixels=120`
 
 fn main() {
-    mechlab::scene::run(|| mechlab::scenes::chaos_map_scene(mechlab::models::MODELS, "chaos_map", &[]));
+    mechlab::scene::run(|| {
+        mechlab::scenes::chaos_map_scene(mechlab::models::MODELS, "chaos_map", &[])
+    });
 }

@@ -5,5 +5,7 @@
 //! `cargo run --release --example period_map -- --set model=double_pendulum --set axes=0,2 --set seeds="0.1,0,0,0;0.5,0.2,0,0"`
 
 fn main() {
-    mechlab::scene::run(|| mechlab::scenes::period_map_scene(mechlab::models::MODELS, "period_map", &[]));
+    mechlab::scene::run(|| {
+        mechlab::scenes::period_map_scene(mechlab::models::MODELS, "period_map", &[])
+    });
 }

@@ -32,5 +32,3 @@ pub use mechlab_runtime::{
 
 pub mod models;
 pub mod studies;
-pub mod test_models;
-

@@ -7,6 +7,8 @@ include!(concat!(env!("OUT_DIR"), "/generated/mod.rs"));
 
 /// The model named `name` (a file `models/<name>.toml`), or an error that
 /// lists the known ones: the handle every analysis takes.
-pub fn by_name(name: &str) -> Result<&'static crate::registry::Model, crate::registry::UnknownModel> {
+pub fn by_name(
+    name: &str,
+) -> Result<&'static crate::registry::Model, crate::registry::UnknownModel> {
     crate::registry::lookup(MODELS, name)
 }

@@ -12,7 +12,7 @@ use mechlab::analysis::floquet::monodromy;
 use mechlab::models::{double_pendulum, quadruple_pendulum, triple_pendulum};
 use mechlab::ode::{Integrator, Method, System};
 use mechlab::registry::{DynamicModel, Kind};
-use mechlab::test_models::{
+use mechlab_test_models::{
     awkward_names, awkward_names_numeric, double_pendulum_numeric, spring_double_pendulum,
 };
 use nalgebra::DMatrix;

@@ -41,7 +41,9 @@ fn every_link_of_the_report_exists() {
     let first = &html[html.find("id=\"1.2-1.4\"").unwrap()..html.find("id=\"1.5-1.6\"").unwrap()];
     assert!(first.contains("<img") && first.contains("<math"), "{first}");
     assert!(!html.contains("<pre>"));
-    let hamiltonian = mechlab::models::by_name("kapitza").ok().map(|m| m.info)
+    let hamiltonian = mechlab::models::by_name("kapitza")
+        .ok()
+        .map(|m| m.info)
         .unwrap()
         .derivations
         .iter()

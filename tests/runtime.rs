@@ -107,4 +107,3 @@ fn saddle_and_quantiles() {
     assert!(levels.windows(2).all(|w| w[0] < w[1]));
     assert!(levels[0] < 0.0 && levels[8] > 0.0);
 }
-

@@ -30,7 +30,10 @@ fn every_derived_expression_is_pinned() {
 }
 
 fn derived(model: &str, key: &str) -> &'static mechlab::registry::DerivedExpression {
-    let info = mechlab::models::by_name(model).ok().map(|m| m.info).expect("model exists");
+    let info = mechlab::models::by_name(model)
+        .ok()
+        .map(|m| m.info)
+        .expect("model exists");
     info.derivations
         .iter()
         .find(|d| d.key == key)

@@ -7,9 +7,9 @@
 //! browser test (needs `apt-get install chromium chromium-driver`).
 
 mod common;
-use common::model_of;
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
+use common::model_of;
 use http_body_util::BodyExt;
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use mechlab::analysis::period_map::{orbit, period_map, wrap_angle};
@@ -27,7 +27,10 @@ async fn call(method: &str, uri: &str, body: Option<Value>) -> (StatusCode, Stri
         .header("content-type", "application/json")
         .body(body.map_or_else(Body::empty, |b| Body::from(b.to_string())))
         .unwrap();
-    let response = router(mechlab::models::MODELS).oneshot(request).await.unwrap();
+    let response = router(mechlab::models::MODELS)
+        .oneshot(request)
+        .await
+        .unwrap();
     let status = response.status();
     let content_type = response
         .headers()
@@ -506,7 +509,11 @@ mod browser {
     async fn browser_seeds_orbits_and_sweeps_a_parameter() {
         let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
         let studio = format!("http://{}/", listener.local_addr().unwrap());
-        tokio::spawn(async move { axum::serve(listener, router(mechlab::models::MODELS)).await.unwrap() });
+        tokio::spawn(async move {
+            axum::serve(listener, router(mechlab::models::MODELS))
+                .await
+                .unwrap()
+        });
         let port = free_port();
         let driver =
             std::env::var("CHROMEDRIVER").unwrap_or_else(|_| "/usr/bin/chromedriver".into());

@@ -312,7 +312,7 @@ fn monodromies_in_lanes_equal_the_scalar_ones() {
 /// lane's own α): the closed forms hold, and lanes equal scalar runs.
 #[test]
 fn models_without_parameters_or_with_a_parameter_exponent() {
-    use mechlab::test_models::{bare_pendulum, power_law_oscillator};
+    use mechlab_test_models::{bare_pendulum, power_law_oscillator};
     // H = p²/2 − √2 cos q is conserved.
     let bare = bare_pendulum::Exact {
         params: bare_pendulum::Params::default(),

@@ -24,7 +24,8 @@ fn defaults(name: &str) -> Vec<f64> {
 fn deviation_falls_like_one_over_the_frequency() {
     let values = [200.0, 400.0, 800.0, 1600.0];
     for name in ["double_pendulum", "triple_pendulum"] {
-        let result = convergence(model_of(name), &defaults(name), &settings(None, &values)).unwrap();
+        let result =
+            convergence(model_of(name), &defaults(name), &settings(None, &values)).unwrap();
         assert_eq!(result.parameter, "nu", "the rate of `{name}` is ν");
         for (f, v) in result.frequencies.iter().zip(values) {
             assert!((f - v).abs() < 1e-9 * v, "{f} vs {v}");
@@ -97,7 +98,12 @@ fn bad_requests_are_typed_errors() {
     );
     let mut bad_state = settings(None, &[100.0]);
     bad_state.y0 = Some(vec![0.1, 0.0]);
-    let e = convergence(model_of("double_pendulum"), &defaults("double_pendulum"), &bad_state).unwrap_err();
+    let e = convergence(
+        model_of("double_pendulum"),
+        &defaults("double_pendulum"),
+        &bad_state,
+    )
+    .unwrap_err();
     assert!(
         matches!(
             e,

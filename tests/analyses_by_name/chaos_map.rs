@@ -95,9 +95,21 @@ fn bad_requests_are_typed_errors() {
         .unwrap()
         .dynamic
         .defaults();
-    let e = chaos_map(model_of("kapitza"), &kapitza, &settings([0, 2], 2, 2), &|| true).unwrap_err();
+    let e = chaos_map(
+        model_of("kapitza"),
+        &kapitza,
+        &settings([0, 2], 2, 2),
+        &|| true,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("q, p_q"), "{e}");
-    let e = chaos_map(model_of("kapitza"), &kapitza, &settings([1, 1], 2, 2), &|| true).unwrap_err();
+    let e = chaos_map(
+        model_of("kapitza"),
+        &kapitza,
+        &settings([1, 1], 2, 2),
+        &|| true,
+    )
+    .unwrap_err();
     assert!(matches!(e, ChaosMapError::Request { .. }));
     let mut s = settings([0, 1], 2, 2);
     s.through = Some(vec![0.0; 3]);
@@ -107,7 +119,12 @@ fn bad_requests_are_typed_errors() {
         .dynamic
         .defaults();
     assert!(matches!(
-        chaos_map(model_of("painleve_klein"), &none, &settings([0, 1], 2, 2), &|| true),
+        chaos_map(
+            model_of("painleve_klein"),
+            &none,
+            &settings([0, 1], 2, 2),
+            &|| true
+        ),
         Err(ChaosMapError::ContactModel(_))
     ));
 }
@@ -222,7 +239,9 @@ fn tiles_resume_and_merge_bit_for_bit() {
     let tile = sweep.join("tile_2.bin");
     let bytes = std::fs::read(&tile).unwrap();
     std::fs::write(&tile, &bytes[..bytes.len() - 3]).unwrap();
-    let damaged = chaos_map(model_of("kapitza"), &params.values(), &tiled(None), &|| true);
+    let damaged = chaos_map(model_of("kapitza"), &params.values(), &tiled(None), &|| {
+        true
+    });
     assert!(
         matches!(
             damaged,
@@ -230,7 +249,12 @@ fn tiles_resume_and_merge_bit_for_bit() {
         ),
         "{damaged:?}"
     );
-    let missing = chaos_map(model_of("kapitza"), &params.values(), &tiled(Some(vec![7])), &|| true);
+    let missing = chaos_map(
+        model_of("kapitza"),
+        &params.values(),
+        &tiled(Some(vec![7])),
+        &|| true,
+    );
     assert!(
         matches!(
             missing,

@@ -18,14 +18,16 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         let model = mechlab::models::by_name(info.name).unwrap().dynamic;
         let params = model.defaults();
         let Kind::Hamiltonian { dof: n, fast_phase } = model.kind() else {
-            let e = stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err();
+            let e =
+                stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err();
             assert!(
                 matches!(e, StabilityError::ContactModel(_))
                     && e.to_string().contains("contact model")
             );
             let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
             assert!(matches!(e, AveragingError::ContactModel(_)));
-            let e = chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err();
+            let e =
+                chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err();
             assert!(matches!(e, ChaosMapError::ContactModel(_)));
             assert!(portrait(model_of(info.name), &params, &portrait_settings(1)).is_err());
             continue;
@@ -45,7 +47,8 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
                 "{}: {e}",
                 info.name
             );
-            let e = chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap_err();
+            let e =
+                chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap_err();
             assert!(
                 matches!(e, ChaosMapError::NoFastPhase(_)),
                 "{}: {e}",
@@ -58,7 +61,8 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         match info.amplitude {
             Some(amplitude) => check_stability(info.name, &params, amplitude, n),
             None => {
-                let e = stability(model_of(info.name), &params, &stability_settings("")).unwrap_err();
+                let e =
+                    stability(model_of(info.name), &params, &stability_settings("")).unwrap_err();
                 assert!(
                     matches!(e, StabilityError::UnknownAmplitude { .. }),
                     "{}: {e}",

@@ -231,8 +231,12 @@ fn a_chart_of_a_point_the_vibration_moves_is_refused() {
         method: Method::parse("taylor", 1e-10).unwrap(),
         tiles: None,
     };
-    let e =
-        stability_chart(model_of("elastic_pendulum"), &defaults("elastic_pendulum"), &settings).unwrap_err();
+    let e = stability_chart(
+        model_of("elastic_pendulum"),
+        &defaults("elastic_pendulum"),
+        &settings,
+    )
+    .unwrap_err();
     assert!(
         matches!(&e, StabilityError::MovedByVibration { model, q } if model == "elastic_pendulum" && *q == [0.9, 0.0]),
         "{e}"

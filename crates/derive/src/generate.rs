@@ -683,6 +683,14 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
     context.insert("name", &model.name);
     context.insert("description", &model.description);
     context.insert("source_file", source_file);
+    // The file's text as a raw string literal, with enough `#` to hold it.
+    let text = std::fs::read_to_string(source_file).unwrap_or_default();
+    let hashes = "#".repeat(
+        (1..)
+            .find(|n| !text.contains(&format!("\"{}", "#".repeat(*n))))
+            .unwrap_or(1),
+    );
+    context.insert("source_text", &format!("r{hashes}\"{text}\"{hashes}"));
     context.insert("params", &params);
     context.insert("derived", &derived);
     context.insert(

@@ -31,15 +31,6 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-/// What the build script watches (relative to the workspace root): the
-/// model folders and the templates. The derivation code is a dependency of
-/// the build script, so cargo reruns it when that changes.
-pub const WATCHED: [&str; 3] = ["templates", "models", "test_models"];
-
-/// Model folders: the users' models (`mechlab::models`) and the models only
-/// tests and benchmarks use (`mechlab::test_models`).
-const MODEL_DIRS: [(&str, &str); 2] = [("models", "mod.rs"), ("test_models", "test_models.rs")];
-
 /// Stack of the derivation thread: the recursion of expression trees is as
 /// deep as the longest sum, and a model near the size limit needs far more
 /// than the main thread's 8 MiB. Only the pages used are ever committed.
@@ -50,26 +41,53 @@ fn fail(message: String) -> ! {
     std::process::exit(1);
 }
 
-/// Derives every model of the workspace's model folders into
-/// `OUT_DIR/generated` and prints cargo's rerun rules. Run from `build.rs`
-/// (the current directory is the workspace root); any failure ends the
-/// build with a message that names the model file and the reason.
-pub fn build_models() {
-    for watched in WATCHED {
-        println!("cargo:rerun-if-changed={watched}");
+/// Derives every model file of `folder` (`models` or `test_models`, in
+/// the workspace at `root`) into `OUT_DIR/generated` (one module per file
+/// and `mod.rs` listing them) and prints cargo's rerun rules. Run from a
+/// build script; any failure ends the build with a message that names the
+/// model file and the reason. The derivation code is a dependency of the
+/// build script, so cargo reruns it when that changes.
+pub fn build_models(root: &str, folder: &str) {
+    let root = std::fs::canonicalize(root)
+        .unwrap_or_else(|e| fail(format!("cannot find the workspace at {root}: {e}")));
+    for watched in [folder, "templates"] {
+        println!("cargo:rerun-if-changed={}", root.join(watched).display());
     }
     println!("cargo:rerun-if-changed=build.rs");
+    // Paths in messages and in the generated code are the workspace's.
+    std::env::set_current_dir(&root)
+        .unwrap_or_else(|e| fail(format!("cannot enter {}: {e}", root.display())));
+    let _only_derivation = symbolica_lock();
+    let folder = folder.to_string();
     let worker = std::thread::Builder::new()
         .name("derivations".into())
         .stack_size(STACK_BYTES)
-        .spawn(run)
+        .spawn(move || run(&folder))
         .unwrap_or_else(|e| fail(format!("cannot start the derivation thread: {e}")));
     if worker.join().is_err() {
         fail("the derivation thread panicked (see above)".into());
     }
 }
 
-fn run() {
+/// Symbolica's restricted mode aborts when two processes of one user use
+/// it at once, and cargo runs the build scripts of two packages (the
+/// users' models and the test models) in parallel: a lock file per user
+/// makes them take turns. Held until the returned file is dropped.
+fn symbolica_lock() -> std::fs::File {
+    let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+    let path = std::env::temp_dir().join(format!("mechlab-symbolica-{user}.lock"));
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .unwrap_or_else(|e| fail(format!("cannot open {}: {e}", path.display())));
+    file.lock()
+        .unwrap_or_else(|e| fail(format!("cannot lock {}: {e}", path.display())));
+    file
+}
+
+fn run(folder: &str) {
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
     let generated = out_dir.join("generated");
     let cache = out_dir.join("cache");
@@ -83,29 +101,27 @@ fn run() {
 
     let mut timings = String::from("model\tseconds\tcached\n");
     let mut names = std::collections::BTreeSet::new();
-    for (dir, registry_file) in MODEL_DIRS {
-        let mut models = Vec::new();
-        for path in model_files(dir) {
-            let started = Instant::now();
-            let (model, hit) = build_model(&path, &tera, &cache, &generated, code_version);
-            if !names.insert(model.name.clone()) {
-                fail(format!(
-                    "{}: key `name`: '{}' is also the name of another model",
-                    path.display(),
-                    model.name
-                ));
-            }
-            timings.push_str(&format!(
-                "{}\t{:.2}\t{hit}\n",
-                model.name,
-                started.elapsed().as_secs_f64()
+    let mut models = Vec::new();
+    for path in model_files(folder) {
+        let started = Instant::now();
+        let (model, hit) = build_model(&path, &tera, &cache, &generated, code_version);
+        if !names.insert(model.name.clone()) {
+            fail(format!(
+                "{}: key `name`: '{}' is also the name of another model",
+                path.display(),
+                model.name
             ));
-            models.push(model);
         }
-        let registry =
-            generate::render_registry(&tera, &models, dir == "models").unwrap_or_else(|e| fail(e));
-        write_formatted(&generated.join(registry_file), &registry);
+        timings.push_str(&format!(
+            "{}\t{:.2}\t{hit}\n",
+            model.name,
+            started.elapsed().as_secs_f64()
+        ));
+        models.push(model);
     }
+    let registry =
+        generate::render_registry(&tera, &models, folder == "models").unwrap_or_else(|e| fail(e));
+    write_formatted(&generated.join("mod.rs"), &registry);
     let _ = std::fs::write(out_dir.join("derivation_times.tsv"), timings);
 }
 

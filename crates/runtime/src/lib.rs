@@ -20,5 +20,5 @@ pub mod registry;
 pub mod report;
 pub mod scene;
 pub mod scenes;
-pub mod study;
 pub mod studio;
+pub mod study;

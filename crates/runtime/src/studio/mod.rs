@@ -12,7 +12,9 @@ pub mod server;
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::analysis::period_map::{period_map, wrap_angle, PeriodMapError};
 use crate::ode::{Integrator, Method, OdeError};
-use crate::registry::{Catalog, DynamicModel, Fixed, Kind, Model, ModelInfo, ParameterError, WithFixed};
+use crate::registry::{
+    Catalog, DynamicModel, Fixed, Kind, Model, ModelInfo, ParameterError, WithFixed,
+};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -103,10 +105,7 @@ pub struct ModelSummary {
 
 /// Every model of `catalog`, in its order.
 pub fn models(catalog: Catalog) -> Vec<ModelSummary> {
-    catalog
-        .iter()
-        .map(|m| summary(m.info, m.dynamic))
-        .collect()
+    catalog.iter().map(|m| summary(m.info, m.dynamic)).collect()
 }
 
 fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {

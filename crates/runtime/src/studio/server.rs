@@ -16,8 +16,8 @@
 //! goes on.
 
 use super::{ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
-use crate::registry::Catalog;
 use crate::analysis::period_map::PeriodMapError;
+use crate::registry::Catalog;
 use axum::body::{Body, Bytes};
 use axum::extract::{Path, State};
 use axum::http::{header, StatusCode};
