@@ -6,6 +6,6 @@
 
 fn main() {
     mechlab::scene::run(|| {
-        mechlab::scenes::chaos_map_scene(mechlab::models::MODELS, "chaos_map", &[])
+        mechlab::scenes::chaos_map_scene(mechlab::models::MODELS, "chaos_map", &[], None)
     });
 }

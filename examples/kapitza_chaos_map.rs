@@ -9,6 +9,7 @@ fn main() {
             mechlab::models::MODELS,
             "kapitza_chaos_map",
             &[("model", "kapitza"), ("A", "1")],
+            None,
         )
     });
 }

@@ -38,7 +38,7 @@ fn thresholds(model: &str, params: &[f64], amplitude: &str, a_max: f64) -> (f64,
     out
 }
 
-/// K̄ of the Kapitza pendulum by hand (the Lie series of `build/deprit.rs`
+/// K̄ of the Kapitza pendulum by hand (the Lie series of `crates/derive/src/deprit.rs`
 /// worked on H = (p − A sin θ sin q)²/2 + cos q): at (0, 0) its Hessian is
 /// diag(A²/2 − 1 + A²ε²(9A² − 32)/32, 1 + A²ε²).
 #[test]

@@ -2,7 +2,7 @@
 //! the study scenes that are its presets (the same knobs with other
 //! defaults, the same files): knobs → one library call → figures.
 
-use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
+use crate::analysis::chaos_map::{chaos_map, ChaosMap, ChaosMapError, ChaosMapSettings};
 use crate::ode::Method;
 use crate::registry::{Catalog, Model};
 use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError};
@@ -96,11 +96,13 @@ pub fn method_from(scene: &Scene) -> Result<Method, SceneError> {
 
 /// The `chaos_map` scene: the FLI map of any model's period map on a plane
 /// of two state components. `overrides` are the preset's defaults (model
-/// and its parameters, knobs).
+/// and its parameters, knobs); `sharing`, processes that share its tiles
+/// (None: this process computes them all).
 pub fn chaos_map_scene(
     catalog: Catalog,
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
+    sharing: Option<&dyn TileSharing>,
 ) -> Result<(), SceneError> {
     let (model, scene) = generic_scene(
         catalog,
@@ -152,13 +154,12 @@ pub fn chaos_map_scene(
             true
         })
     };
-    #[cfg(feature = "mpi")]
-    if let Some(ranks) = ranks::Ranks::start(&settings)? {
-        return ranks.run(&settings, &run, &|map| write_chaos_map(&scene, map));
+    if let Some(sharing) = sharing {
+        return sharing.run(&settings, &run, &|map| write_chaos_map(&scene, map));
     }
     match run(&settings) {
         // A job of an array: its tiles are written, the last run merges.
-        Err(crate::analysis::chaos_map::ChaosMapError::Partial) => {
+        Err(ChaosMapError::Partial) => {
             eprintln!("tiles {} written", scene.text("only_tiles"));
             Ok(())
         }
@@ -167,10 +168,7 @@ pub fn chaos_map_scene(
 }
 
 /// The chaos map's figures, CSV and summary.
-fn write_chaos_map(
-    scene: &Scene,
-    map: &crate::analysis::chaos_map::ChaosMap,
-) -> Result<(), SceneError> {
+fn write_chaos_map(scene: &Scene, map: &ChaosMap) -> Result<(), SceneError> {
     let [grey, viridis] = map.figures();
     scene.save_figure(&grey, "chaos_map.png")?;
     scene.save_figure(&viridis, "chaos_map_viridis.png")?;
@@ -187,76 +185,19 @@ fn write_chaos_map(
     Ok(())
 }
 
-/// A chaos map across the ranks of `mpirun` (feature `mpi`).
-#[cfg(feature = "mpi")]
-mod ranks {
-    use super::{ChaosMapSettings, SceneError};
-    use crate::analysis::chaos_map::{ChaosMap, ChaosMapError};
-    use mpi::traits::{Communicator, CommunicatorCollectives};
-
-    /// The ranks: each computes the tiles k with k mod size = rank; after a
-    /// barrier the first merges them (all on disk now) and writes the
-    /// scene's files while the others wait (they share its output folder).
-    pub struct Ranks {
-        _universe: mpi::environment::Universe,
-        world: mpi::topology::SimpleCommunicator,
-    }
-
-    impl Ranks {
-        /// None for a single process (no `mpirun`, or one rank).
-        pub fn start(settings: &ChaosMapSettings) -> Result<Option<Ranks>, SceneError> {
-            let Some(universe) = mpi::initialize() else {
-                return Ok(None);
-            };
-            let world = universe.world();
-            if world.size() < 2 {
-                return Ok(None);
-            }
-            if settings.tiles.is_none() {
-                return Err(SceneError::Usage(
-                    "under mpirun the ranks share the map by tiles: set tile_rows > 0".into(),
-                ));
-            }
-            Ok(Some(Ranks {
-                _universe: universe,
-                world,
-            }))
-        }
-
-        pub fn run(
-            self,
-            settings: &ChaosMapSettings,
-            map: &dyn Fn(&ChaosMapSettings) -> Result<ChaosMap, ChaosMapError>,
-            write: &dyn Fn(&ChaosMap) -> Result<(), SceneError>,
-        ) -> Result<(), SceneError> {
-            let (rank, size) = (self.world.rank() as usize, self.world.size() as usize);
-            let mut mine = settings.clone();
-            if let Some(tiles) = &mut mine.tiles {
-                let count = settings.pixels.div_ceil(tiles.rows.max(1));
-                let share: Vec<usize> = (0..count).filter(|k| k % size == rank).collect();
-                eprintln!("rank {rank} of {size}: tiles {share:?}");
-                tiles.only = Some(share);
-            }
-            let computed = match map(&mine) {
-                Err(ChaosMapError::Partial) => Ok(()),
-                Err(e) => Err(e),
-                Ok(_) => Ok(()),
-            };
-            self.world.barrier();
-            let written = match (rank, computed) {
-                (0, Ok(())) => {
-                    let mut all = settings.clone();
-                    if let Some(tiles) = &mut all.tiles {
-                        tiles.only = None;
-                    }
-                    map(&all).map_err(SceneError::from).and_then(|m| write(&m))
-                }
-                (_, computed) => computed.map_err(SceneError::from),
-            };
-            self.world.barrier();
-            written
-        }
-    }
+/// Processes that share a tiled chaos map, such as the ranks of `mpirun`
+/// (`mechlab-mpi`, a package of its own so that neither the runtime nor
+/// the models are compiled again for it).
+pub trait TileSharing {
+    /// Computes this process's share of the tiles of `settings` with `map`;
+    /// then one process merges them (all on disk by then) and writes the
+    /// scene's files with `write`.
+    fn run(
+        &self,
+        settings: &ChaosMapSettings,
+        map: &dyn Fn(&ChaosMapSettings) -> Result<ChaosMap, ChaosMapError>,
+        write: &dyn Fn(&ChaosMap) -> Result<(), SceneError>,
+    ) -> Result<(), SceneError>;
 }
 
 /// The tiles of the knobs `size` (rows or columns per tile, 0 for none)

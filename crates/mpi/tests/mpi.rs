@@ -1,9 +1,7 @@
-//! With the `mpi` feature: `mpirun -n 2` of the `chaos_map` scene (ranks
-//! taking tiles, the first merging them) gives the single process's map bit
-//! for bit. Needs OpenMPI and the example built with the feature
-//! (`cargo build --release --features mpi --example chaos_map`; README,
-//! "On a cluster").
-#![cfg(feature = "mpi")]
+//! `mpirun -n 2` of the `chaos_map` scene (ranks taking tiles, the first
+//! merging them) gives the single process's map bit for bit. Needs OpenMPI;
+//! `cargo test --release -p mechlab-mpi` builds the example it runs
+//! (docs/sweeps.md, "On a cluster").
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -31,7 +29,7 @@ fn two_ranks_give_the_single_process_map() {
         "--set",
         "tile_rows=3",
     ];
-    let status = Command::new(example("chaos_map"))
+    let status = Command::new(example("chaos_map_mpi"))
         .args(knobs)
         .args(["--set", "tile_rows=0", "--out"])
         .arg(&single)
@@ -47,7 +45,7 @@ fn two_ranks_give_the_single_process_map() {
             "-x",
             "RAYON_NUM_THREADS=1",
         ])
-        .arg(example("chaos_map"))
+        .arg(example("chaos_map_mpi"))
         .args(knobs)
         .arg("--out")
         .arg(&ranks)
