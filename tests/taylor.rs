@@ -10,18 +10,8 @@ use mechlab::ode::series::{self, Coefficients, COEFFICIENTS};
 use mechlab::ode::{order_for_tolerance, Integrator, Method, OdeError, System, TaylorWork};
 use std::f64::consts::PI;
 
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn between(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.uniform()
-    }
-}
+mod common;
+use common::Rng;
 
 const ORDER: usize = 14;
 

@@ -11,6 +11,9 @@ use mechlab::ode::{
     Integrator, LaneIntegrator, Lanes, Method, OdeError, Orbit, Scalar, System, TaylorWork, LANES,
 };
 
+mod common;
+use common::assert_streams_equal_scalar;
+
 const TAYLOR: Method = Method::Taylor { tol: 1e-10 };
 
 /// Every lane of a batch run against the scalar run of the same start.
@@ -254,32 +257,6 @@ fn lanes_with_their_own_parameters_equal_scalar_runs() {
     assert_streams_equal_scalar(&orbits);
 }
 
-/// Each orbit streamed for one segment against its scalar run.
-fn assert_streams_equal_scalar<S: System<N>, const N: usize>(orbits: &[Orbit<'_, S, N>]) {
-    let mut ends: Vec<[f64; N]> = orbits.iter().map(|o| o.start).collect();
-    let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
-    let errors = batch.stream(orbits, |k, y| {
-        ends[k] = *y;
-        false
-    });
-    let mut scalar = Integrator::new(TAYLOR).unwrap();
-    for (k, orbit) in orbits.iter().enumerate() {
-        let expected = scalar.advance(orbit.system, 0.0, &orbit.start, orbit.end);
-        let streamed = match &errors[k] {
-            Some(e) => Err(e.clone()),
-            None => Ok(ends[k]),
-        };
-        // Debug text: NaN ≠ NaN, but the errors must read the same.
-        assert_eq!(
-            format!("{streamed:?}"),
-            format!("{expected:?}"),
-            "orbit {k}"
-        );
-    }
-    assert_eq!(batch.stats.steps, scalar.stats.steps);
-    assert_eq!(batch.stats.f_evals, scalar.stats.f_evals);
-}
-
 /// The monodromy matrices of a sweep over (A, ε) in lanes, each over its
 /// own period, equal the scalar ones bit for bit.
 #[test]
@@ -304,57 +281,6 @@ fn monodromies_in_lanes_equal_the_scalar_ones() {
         f_evals += scalar.stats.f_evals;
     }
     assert_eq!(stats.f_evals, f_evals);
-}
-
-/// Models whose recurrences compute with literals only (no parameters:
-/// an empty `Params`, gravity √2 as a power of numbers) or take a
-/// parameter as an exponent (through exp(α ln u), in a batch with each
-/// lane's own α): the closed forms hold, and lanes equal scalar runs.
-#[test]
-fn models_without_parameters_or_with_a_parameter_exponent() {
-    use mechlab_test_models::{bare_pendulum, power_law_oscillator};
-    // H = p²/2 − √2 cos q is conserved.
-    let bare = bare_pendulum::Exact {
-        params: bare_pendulum::Params::default(),
-    };
-    let energy = |y: &[f64; 2]| y[1] * y[1] / 2.0 - 2f64.sqrt() * y[0].cos();
-    let y0 = [1.0, 0.5];
-    let y1 = Integrator::new(TAYLOR)
-        .unwrap()
-        .advance(&bare, 0.0, &y0, 10.0)
-        .unwrap();
-    assert!((energy(&y1) - energy(&y0)).abs() < 1e-11, "{y1:?}");
-    // α = 1: V = 1 + x², x(t) = x₀ cos √2t + (p₀/√2) sin √2t.
-    let oscillators: Vec<power_law_oscillator::Exact> =
-        [0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 1.0, 0.75, 1.25]
-            .map(|alpha| power_law_oscillator::Exact {
-                params: power_law_oscillator::Params { alpha },
-            })
-            .to_vec();
-    let orbits: Vec<Orbit<_, 2>> = oscillators
-        .iter()
-        .enumerate()
-        .map(|(k, system)| Orbit {
-            system,
-            start: [0.3 + 0.1 * k as f64, -0.2],
-            end: 3.0,
-        })
-        .collect();
-    assert_streams_equal_scalar(&orbits);
-    let [x0, p0] = orbits[1].start;
-    let w = 2f64.sqrt();
-    let y = Integrator::new(TAYLOR)
-        .unwrap()
-        .advance(&oscillators[1], 0.0, &orbits[1].start, 3.0)
-        .unwrap();
-    let exact = [
-        x0 * (w * 3.0).cos() + p0 / w * (w * 3.0).sin(),
-        -x0 * w * (w * 3.0).sin() + p0 * (w * 3.0).cos(),
-    ];
-    assert!(
-        (y[0] - exact[0]).abs() < 1e-10 && (y[1] - exact[1]).abs() < 1e-10,
-        "{y:?} vs {exact:?}"
-    );
 }
 
 #[test]

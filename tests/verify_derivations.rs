@@ -3,20 +3,8 @@
 use mechlab::models::{double_pendulum as dp, kapitza};
 use mechlab::ode::{Integrator, Method, System};
 
-/// Deterministic pseudo-random numbers in [-1, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    }
-}
-
-fn close(a: f64, b: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
-}
+mod common;
+use common::{close, Rng};
 
 /// Study 1 (docs/studies.md) with our phase convention y = A ε cos θ, which gives the cross
 /// term with a minus sign: H = p²/2 − A p sin q sin θ + (A²/2) sin²q sin²θ + cos q.
@@ -32,11 +20,15 @@ fn kapitza_hamiltonian_matches_the_closed_form() {
     let mut rng = Rng(7);
     for _ in 0..200 {
         let params = kapitza::Params {
-            A: 3.0 * rng.next(),
-            eps: 0.05 + rng.next().abs(),
-            mu: rng.next().abs(),
+            A: 3.0 * rng.between(-1.0, 1.0),
+            eps: 0.05 + rng.between(-1.0, 1.0).abs(),
+            mu: rng.between(-1.0, 1.0).abs(),
         };
-        let (q, p, t) = (4.0 * rng.next(), 3.0 * rng.next(), 10.0 * rng.next());
+        let (q, p, t) = (
+            4.0 * rng.between(-1.0, 1.0),
+            3.0 * rng.between(-1.0, 1.0),
+            10.0 * rng.between(-1.0, 1.0),
+        );
         let h = kapitza::hamiltonian(t, &[q, p], &params);
         assert!(close(
             h,
@@ -65,11 +57,15 @@ fn kapitza_equations_are_hamiltons_with_friction() {
     let d = 1e-6;
     for _ in 0..100 {
         let params = kapitza::Params {
-            A: 2.0 * rng.next(),
-            eps: 0.1 + rng.next().abs(),
-            mu: rng.next().abs(),
+            A: 2.0 * rng.between(-1.0, 1.0),
+            eps: 0.1 + rng.between(-1.0, 1.0).abs(),
+            mu: rng.between(-1.0, 1.0).abs(),
         };
-        let (q, p, t) = (4.0 * rng.next(), 2.0 * rng.next(), 5.0 * rng.next());
+        let (q, p, t) = (
+            4.0 * rng.between(-1.0, 1.0),
+            2.0 * rng.between(-1.0, 1.0),
+            5.0 * rng.between(-1.0, 1.0),
+        );
         let h = |q: f64, p: f64| kapitza_h_closed_form(q, p, t, params.A, params.eps);
         let dh_dp = (h(q, p + d) - h(q, p - d)) / (2.0 * d);
         let dh_dq = (h(q + d, p) - h(q - d, p)) / (2.0 * d);
@@ -107,12 +103,12 @@ fn jacobians_match_finite_differences() {
     let mut rng = Rng(3);
     for _ in 0..50 {
         let kp = kapitza::Params {
-            A: 2.0 * rng.next(),
+            A: 2.0 * rng.between(-1.0, 1.0),
             eps: 0.2,
-            mu: rng.next().abs(),
+            mu: rng.between(-1.0, 1.0).abs(),
         };
-        let t = rng.next();
-        let y = [3.0 * rng.next(), rng.next()];
+        let t = rng.between(-1.0, 1.0);
+        let y = [3.0 * rng.between(-1.0, 1.0), rng.between(-1.0, 1.0)];
         check_jacobian(
             &|y| kapitza::exact_rhs(t, y, &kp),
             &kapitza::exact_jacobian(t, y.as_ref().try_into().unwrap(), &kp),
@@ -133,7 +129,12 @@ fn jacobians_match_finite_differences() {
             l2: 1.2,
             ..Default::default()
         };
-        let y = [3.0 * rng.next(), 3.0 * rng.next(), rng.next(), rng.next()];
+        let y = [
+            3.0 * rng.between(-1.0, 1.0),
+            3.0 * rng.between(-1.0, 1.0),
+            rng.between(-1.0, 1.0),
+            rng.between(-1.0, 1.0),
+        ];
         check_jacobian(
             &|y| dp::exact_rhs(t, y, &pp),
             &dp::exact_jacobian(t, &y, &pp),
@@ -170,18 +171,18 @@ fn double_pendulum_equations_match_a_hand_derivation() {
     let mut rng = Rng(5);
     for _ in 0..100 {
         let params = dp::Params {
-            m1: 1.0 + rng.next().abs(),
-            m2: 0.5 + rng.next().abs(),
-            l1: 0.5 + rng.next().abs(),
-            l2: 0.5 + rng.next().abs(),
+            m1: 1.0 + rng.between(-1.0, 1.0).abs(),
+            m2: 0.5 + rng.between(-1.0, 1.0).abs(),
+            l1: 0.5 + rng.between(-1.0, 1.0).abs(),
+            l2: 0.5 + rng.between(-1.0, 1.0).abs(),
             g: 9.81,
-            a: 2.0 * rng.next().abs(),
-            nu: 5.0 + 20.0 * rng.next().abs(),
-            mu: rng.next().abs(),
+            a: 2.0 * rng.between(-1.0, 1.0).abs(),
+            nu: 5.0 + 20.0 * rng.between(-1.0, 1.0).abs(),
+            mu: rng.between(-1.0, 1.0).abs(),
         };
-        let t = 3.0 * rng.next();
-        let phi = [3.0 * rng.next(), 3.0 * rng.next()];
-        let w = [2.0 * rng.next(), 2.0 * rng.next()];
+        let t = 3.0 * rng.between(-1.0, 1.0);
+        let phi = [3.0 * rng.between(-1.0, 1.0), 3.0 * rng.between(-1.0, 1.0)];
+        let w = [2.0 * rng.between(-1.0, 1.0), 2.0 * rng.between(-1.0, 1.0)];
         // State from the generated momenta, then accelerations by the chain rule:
         // q'' = ∂v/∂t + ∂v/∂q q' + ∂v/∂p p'.
         let p = dp::momenta(t, &phi, &w, &params);
@@ -215,14 +216,14 @@ fn double_pendulum_vibrational_potential_matches_the_closed_form() {
     let mut rng = Rng(9);
     for _ in 0..100 {
         let p = dp::Params {
-            m1: 1.0 + rng.next().abs(),
-            m2: 0.5 + rng.next().abs(),
-            l1: 0.5 + rng.next().abs(),
-            l2: 0.5 + rng.next().abs(),
-            a: 3.0 * rng.next(),
+            m1: 1.0 + rng.between(-1.0, 1.0).abs(),
+            m2: 0.5 + rng.between(-1.0, 1.0).abs(),
+            l1: 0.5 + rng.between(-1.0, 1.0).abs(),
+            l2: 0.5 + rng.between(-1.0, 1.0).abs(),
+            a: 3.0 * rng.between(-1.0, 1.0),
             ..Default::default()
         };
-        let phi = [3.0 * rng.next(), 3.0 * rng.next()];
+        let phi = [3.0 * rng.between(-1.0, 1.0), 3.0 * rng.between(-1.0, 1.0)];
         let s = [
             (p.m1 + p.m2) * p.l1 * phi[0].sin(),
             p.m2 * p.l2 * phi[1].sin(),

@@ -18,22 +18,9 @@ use mechlab_test_models::{
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 
-struct Rng(u64);
-impl Rng {
-    fn between(&mut self, a: f64, b: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        a + (b - a) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
-
-fn close(what: &str, a: f64, b: f64, tol: f64) {
-    assert!(
-        (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs())),
-        "{what}: {a} vs {b}"
-    );
-}
+#[path = "../../../tests/common/mod.rs"]
+mod common;
+use common::{assert_close as close, Rng};
 
 #[test]
 fn numeric_and_symbolic_forms_agree_on_the_double_pendulum() {
