@@ -38,6 +38,18 @@ fn every_model_can_be_explored() {
         assert_eq!(result.averaged.is_some(), phase, "{}", info.name);
         assert_eq!(result.period_map.is_some(), phase, "{}", info.name);
         assert_eq!(result.energy_change.len(), result.times.len());
+        // Every run starts where it was asked to, the period map at y0.
+        assert_eq!(result.exact[0], y0, "{}", info.name);
+        if let Some(map) = &result.period_map {
+            assert_eq!(map[0], y0, "{}", info.name);
+        }
+        assert_eq!(result.energy_change[0], 0.0, "{}", info.name);
+        // Dry friction only takes energy away.
+        if let Kind::Contacts { .. } = model.kind() {
+            for (w, t) in result.energy_change.windows(2).zip(&result.times) {
+                assert!(w[1] <= w[0] + 1e-9, "{}: E rose at t = {t}", info.name);
+            }
+        }
     }
 }
 
