@@ -4,7 +4,7 @@
 # (build and a short run, until the figures are written). Each case is
 # timed on an already-built tree, as after `cargo test --release`.
 #
-#   bash benches/edit_loop/run.sh        # CI runs this after the tests
+#   bash benches/edit_loop/run.sh        # CI runs this last
 #   bash benches/edit_loop/run.sh --all  # also 4 and 6 degrees of freedom
 #
 # The 4- and 6-degree cases are left out of CI's run: each takes minutes
