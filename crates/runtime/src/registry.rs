@@ -119,7 +119,8 @@ pub enum Kind {
 
 /// Any generated model with dynamically sized states and parameters in
 /// declaration order, so that one scene can run a model chosen by name.
-/// Methods that do not apply to a model's kind return `None`.
+/// Methods that do not apply to a model's kind return `None`. The provided
+/// methods are `#[inline]` for the reason [`crate::ode::System`] gives.
 pub trait DynamicModel: Sync {
     fn info(&self) -> &'static ModelInfo;
     fn kind(&self) -> Kind;
@@ -127,38 +128,47 @@ pub trait DynamicModel: Sync {
     /// Which coordinates are angles.
     fn periodic(&self) -> Vec<bool>;
     /// The exact right-hand side (Hamiltonian models).
+    #[inline]
     fn exact_rhs(&self, _params: &[f64], _t: f64, _y: &[f64]) -> Vec<f64> {
         unimplemented!("a contact model has no smooth right-hand side")
     }
+    #[inline]
     fn averaged_rhs(&self, _params: &[f64], _y: &[f64]) -> Option<Vec<f64>> {
         None
     }
     /// H (Hamiltonian models) or the energy function (contact models).
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> f64;
+    #[inline]
     fn averaged_energy(&self, _params: &[f64], _y: &[f64]) -> Option<f64> {
         None
     }
     /// The Hamiltonian averaged to second order in ε = 1/rate, where derived.
+    #[inline]
     fn averaged2_energy(&self, _params: &[f64], _y: &[f64]) -> Option<f64> {
         None
     }
     /// V + V_vibr (V without a fast phase).
+    #[inline]
     fn effective_potential(&self, _params: &[f64], _q: &[f64]) -> Option<f64> {
         None
     }
     /// Its Hessian, row-major.
+    #[inline]
     fn effective_potential_hessian(&self, _params: &[f64], _q: &[f64]) -> Option<Vec<f64>> {
         None
     }
     /// The period of the fast phase.
+    #[inline]
     fn phase_period(&self, _params: &[f64]) -> Option<f64> {
         None
     }
     /// Free forces and normal reactions (contact models).
+    #[inline]
     fn contact_forces(&self, _params: &[f64], _y: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
         None
     }
     /// Masses and friction coefficients (contact models).
+    #[inline]
     fn contact_constants(&self, _params: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
         None
     }

@@ -20,6 +20,22 @@ pub const LANES: usize = 8;
 #[repr(C, align(64))]
 pub struct Lanes(pub [f64; LANES]);
 
+/// `[f(0), …, f(LANES − 1)]`, for the generated models' per-lane values.
+/// They call this instead of `array::map`: an instance of a generic
+/// function of std with a model's closure lands in a codegen unit shared by
+/// all models, so adding a model would change that unit and make the
+/// compiler re-optimise every model that imports from it. An inlined
+/// function's instances stay in the caller's own unit.
+#[inline(always)]
+pub fn per_lane<T: Copy>(f: impl Fn(usize) -> T) -> [T; LANES] {
+    let mut out = [f(0); LANES];
+    #[allow(clippy::needless_range_loop)] // (an iterator adapter is what this avoids)
+    for l in 1..LANES {
+        out[l] = f(l);
+    }
+    out
+}
+
 impl Lanes {
     /// Every lane `x`.
     #[inline(always)]

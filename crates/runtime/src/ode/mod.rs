@@ -22,15 +22,21 @@ mod taylor_lanes;
 pub use erased::{DynSystem, ErasedSystem};
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
 pub use hyperdual::HyperDual;
-pub use lanes::{Lanes, LANES};
+pub use lanes::{per_lane, Lanes, LANES};
 pub use series::Scalar;
 pub use taylor::{order_for_tolerance, TaylorWork};
 pub use taylor_lanes::{LaneIntegrator, LaneResult, Orbit};
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.
+///
+/// Every provided method is `#[inline]` (and so is the helper it calls): an instance of
+/// a provided method for a generated model's type would otherwise land in a
+/// codegen unit shared by every model, and adding a model would make the
+/// compiler re-optimise them all (docs/building.md).
 pub trait System<const N: usize> {
     fn rhs(&self, t: f64, y: &[f64; N]) -> [f64; N];
     /// ∂f/∂y, when the system knows it (generated models do).
+    #[inline]
     fn jacobian(&self, _t: f64, _y: &[f64; N]) -> Option<[[f64; N]; N]> {
         None
     }
@@ -39,6 +45,7 @@ pub trait System<const N: usize> {
     /// method; false when the system has no recurrences (generated models
     /// have them, see `build/taylor.rs`). `Num` is f64 for one orbit, or
     /// [`Lanes`] for a batch of orbits, one per lane.
+    #[inline]
     fn taylor<Num: Scalar>(
         &self,
         _t: Num,
@@ -52,6 +59,7 @@ pub trait System<const N: usize> {
     /// The same for the system with tangent vectors, state z = [y; v₁; …]
     /// with one or N tangent vectors (see `analysis::variational`), rows of
     /// `out` flattened; false when not available.
+    #[inline]
     fn taylor_variational<Num: Scalar>(
         &self,
         _t: Num,
@@ -66,6 +74,7 @@ pub trait System<const N: usize> {
     /// `lanes[l]`, one of this kind with its own parameters (a sweep over
     /// parameters). Generated models give each lane its parameters; by
     /// default a batch needs one system in every lane.
+    #[inline]
     fn taylor_lanes(
         lanes: [&Self; LANES],
         t: Lanes,
@@ -74,10 +83,14 @@ pub trait System<const N: usize> {
         work: &mut TaylorWork<Lanes>,
         out: &mut [[Lanes; N]],
     ) -> bool {
-        one_system(lanes).is_some_and(|s| s.taylor(t, y, order, work, out))
+        match one_system(lanes) {
+            Some(s) => s.taylor(t, y, order, work, out),
+            None => false,
+        }
     }
     /// [`System::taylor_variational`] for a batch whose lane l follows
     /// `lanes[l]`, as [`System::taylor_lanes`].
+    #[inline]
     fn taylor_variational_lanes(
         lanes: [&Self; LANES],
         t: Lanes,
@@ -86,16 +99,22 @@ pub trait System<const N: usize> {
         work: &mut TaylorWork<Lanes>,
         out: &mut [Lanes],
     ) -> bool {
-        one_system(lanes).is_some_and(|s| s.taylor_variational(t, z, order, work, out))
+        match one_system(lanes) {
+            Some(s) => s.taylor_variational(t, z, order, work, out),
+            None => false,
+        }
     }
 }
 
 /// The system of a batch whose lanes all follow one, if they do.
+#[inline]
 fn one_system<S: ?Sized>(lanes: [&S; LANES]) -> Option<&S> {
-    lanes
-        .iter()
-        .all(|s| std::ptr::eq(*s, lanes[0]))
-        .then_some(lanes[0])
+    for s in &lanes[1..] {
+        if !std::ptr::eq(*s, lanes[0]) {
+            return None;
+        }
+    }
+    Some(lanes[0])
 }
 
 /// One accepted step, as an integrator hands it to observers and to event

@@ -22,7 +22,10 @@ pub struct TaylorWork<L = f64> {
 }
 
 impl<L: Scalar> TaylorWork<L> {
-    /// The first K coefficient arrays (grown on first use).
+    /// The first K coefficient arrays (grown on first use). Inlined: K is
+    /// each generated model's own, and an instance shared between codegen
+    /// units would make adding a model re-optimise every model's code.
+    #[inline(always)]
     pub fn slots<const K: usize>(&mut self) -> &mut [Coefficients<L>; K] {
         if self.slots.len() < K {
             self.slots
