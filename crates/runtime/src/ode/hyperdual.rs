@@ -230,14 +230,24 @@ fn seeded<const S: usize>(y: &[f64; S], i: usize, j: usize) -> [HyperDual; S] {
 }
 
 /// ∇f at y: S evaluations of f.
+///
+/// Inlined, as is [`hessian`]: `f` is a generated model's closure, and an
+/// instance shared between models' codegen units makes adding a model
+/// re-optimise them all (see [`crate::ode::System`]).
+#[inline]
 pub fn gradient<const S: usize>(
     f: impl Fn(&[HyperDual; S]) -> HyperDual,
     y: &[f64; S],
 ) -> [f64; S] {
-    std::array::from_fn(|i| f(&seeded(y, i, i)).e1)
+    let mut g = [0.0; S];
+    for (i, gi) in g.iter_mut().enumerate() {
+        *gi = f(&seeded(y, i, i)).e1;
+    }
+    g
 }
 
 /// The Hessian of f at y: S(S + 1)/2 evaluations of f.
+#[inline]
 pub fn hessian<const S: usize>(
     f: impl Fn(&[HyperDual; S]) -> HyperDual,
     y: &[f64; S],
