@@ -231,6 +231,7 @@ impl LaneIntegrator {
         let y_new = horner(c, Lanes(h));
         // x − x is 0 for finite x, NaN otherwise: one vector pass.
         let mut check = Lanes::splat(0.0);
+        #[allow(clippy::eq_op)] // (x − x is the point)
         for row in &y_new {
             check += *row - *row;
         }
