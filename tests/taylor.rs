@@ -8,6 +8,7 @@ use mechlab::analysis::period_map::orbit;
 use mechlab::models::{double_pendulum, elastic_pendulum, horizontal_pendulum, kapitza};
 use mechlab::ode::series::{self, Coefficients, COEFFICIENTS};
 use mechlab::ode::{order_for_tolerance, Integrator, Method, OdeError, System, TaylorWork};
+use mechlab::registry::DynamicModel;
 use std::f64::consts::PI;
 
 mod common;
@@ -196,6 +197,37 @@ fn generated_coefficients_of_every_model_follow_the_field() {
     }
 }
 
+/// The monodromy over `period` from the Taylor method's tangent
+/// recurrences, checked against DOP853's variational equations at 1e-14
+/// (state to 1e-11, matrix entries to `bound` relative to 1 + |M|).
+fn taylor_monodromy_against_dop853<S: System<N>, const N: usize, const V: usize>(
+    system: &S,
+    period: f64,
+    y0: &[f64; N],
+    bound: f64,
+) -> [[f64; N]; N] {
+    let run = |method| {
+        monodromy::<_, N, V>(&mut Integrator::new(method).unwrap(), system, period, y0).unwrap()
+    };
+    let (y_taylor, m_taylor) = run(Method::Taylor { tol: 1e-15 });
+    let (y_dop, m_dop) = run(Method::Dop853 {
+        rtol: 1e-14,
+        atol: 1e-14,
+    });
+    for i in 0..N {
+        assert!((y_taylor[i] - y_dop[i]).abs() < 1e-11, "y[{i}]");
+        for k in 0..N {
+            assert!(
+                (m_taylor[i][k] - m_dop[i][k]).abs() < bound * (1.0 + m_dop[i][k].abs()),
+                "M[{i}][{k}]: {} vs {}",
+                m_taylor[i][k],
+                m_dop[i][k]
+            );
+        }
+    }
+    m_taylor
+}
+
 #[test]
 fn tangent_recurrences_give_the_monodromy_of_the_variational_equations() {
     let params = kapitza::Params {
@@ -203,33 +235,38 @@ fn tangent_recurrences_give_the_monodromy_of_the_variational_equations() {
         eps: 0.1,
         mu: 0.1,
     };
-    let system = kapitza::Exact { params };
     let period = 2.0 * PI * params.eps;
-    let y0 = [0.4, -0.2];
-    let run = |method| {
-        monodromy::<_, 2, 6>(&mut Integrator::new(method).unwrap(), &system, period, &y0).unwrap()
-    };
-    let (y_taylor, m_taylor) = run(Method::Taylor { tol: 1e-15 });
-    let (y_dop, m_dop) = run(Method::Dop853 {
-        rtol: 1e-14,
-        atol: 1e-14,
-    });
-    for i in 0..2 {
-        assert!((y_taylor[i] - y_dop[i]).abs() < 1e-11);
-        for k in 0..2 {
-            assert!(
-                (m_taylor[i][k] - m_dop[i][k]).abs() < 1e-10,
-                "M[{i}][{k}]: {} vs {}",
-                m_taylor[i][k],
-                m_dop[i][k]
-            );
-        }
-    }
+    let m = taylor_monodromy_against_dop853::<_, 2, 6>(
+        &kapitza::Exact { params },
+        period,
+        &[0.4, -0.2],
+        1e-10,
+    );
     // Liouville: det M = exp(−μ T).
-    let det = m_taylor[0][0] * m_taylor[1][1] - m_taylor[0][1] * m_taylor[1][0];
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
     assert!(
         (det - (-params.mu * period).exp()).abs() < 1e-12,
         "det {det}"
+    );
+}
+
+/// The double pendulum's variational recurrences are long enough to be
+/// split into parts (functions of their own, `PART_LINES` in the
+/// derivation): its monodromy over a period of the base against DOP853's.
+#[test]
+fn split_tangent_recurrences_give_the_double_pendulum_s_monodromy() {
+    let params = double_pendulum::Params {
+        mu: 0.05,
+        ..Default::default()
+    };
+    let period = double_pendulum::Dynamic
+        .phase_period(&params.values())
+        .expect("a fast phase");
+    taylor_monodromy_against_dop853::<_, 4, 20>(
+        &double_pendulum::Exact { params },
+        period,
+        &[0.3, -0.2, 0.1, 0.4],
+        1e-9,
     );
 }
 

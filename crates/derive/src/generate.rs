@@ -22,6 +22,16 @@ pub struct TaylorFunction {
     /// `let &Params { .. } = params;`
     params: String,
     body: Vec<String>,
+    /// Runs of its order-n loop in functions of their own (`taylor::Part`).
+    parts: Vec<TaylorPart>,
+}
+
+#[derive(Serialize)]
+pub struct TaylorPart {
+    name: String,
+    /// Its arguments after `n` and `params`.
+    args: String,
+    body: Vec<String>,
 }
 
 #[derive(Serialize)]
@@ -265,7 +275,7 @@ impl Context<'_> {
                 .map(|p| p.name.clone())
                 .collect(),
         };
-        let body = recurrences(&emitter.into_dag(), &signature, outputs)
+        let body = recurrences(name, &emitter.into_dag(), &signature, outputs)
             .map_err(|e| format!("{name}: {e}"))?;
         Ok(TaylorFunction {
             name: name.into(),
@@ -275,6 +285,15 @@ impl Context<'_> {
             time: self.model.time.clone(),
             params: body.params_line,
             body: body.lines,
+            parts: body
+                .parts
+                .into_iter()
+                .map(|p| TaylorPart {
+                    name: p.name,
+                    args: p.args,
+                    body: p.lines,
+                })
+                .collect(),
         })
     }
 }

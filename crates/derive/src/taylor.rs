@@ -113,7 +113,28 @@ pub struct TaylorBody {
     /// function needs for itself bound under other names.
     pub params_line: String,
     pub lines: Vec<String>,
+    /// The runs of its order-n loop that are functions of their own.
+    pub parts: Vec<Part>,
 }
+
+/// A run of the order-n recurrences as a function of its own, called once
+/// per order: `fn name<Num>(n, params, slots, args…)`.
+pub struct Part {
+    pub name: String,
+    /// The arguments after `n, params, slots`, as declared (`k3: Num, …`).
+    pub args: String,
+    /// Its body after the `params` line.
+    pub lines: Vec<String>,
+}
+
+/// The longest order-n loop left in one function. Past it the loop's
+/// recurrences go in parts of at most this many lines, each a function of
+/// its own: LLVM's loop passes (loop rotation above all) take time growing
+/// with the square of the loops in one function, and every product or
+/// sin/cos recurrence is a loop, so one function holding a 4-link chain's
+/// averaged recurrences took two minutes to optimise. A call per part and
+/// order costs nothing beside the part's own Cauchy sums.
+const PART_LINES: usize = 48;
 
 /// Names the generated Taylor functions use for themselves (arguments,
 /// loop variables, the kernels' module): no node is named so. The time
@@ -536,6 +557,7 @@ impl Lowering<'_> {
 /// rates are the forward-mode derivatives of f's nodes (δ(a·b) = δa·b +
 /// a·δb, δ sin u = cos u·δu, ...), extra nodes of the same DAG.
 pub fn recurrences(
+    function: &str,
     dag: &Dag,
     signature: &Signature,
     outputs: &[String],
@@ -616,6 +638,7 @@ pub fn recurrences(
         solves: &lowering.solves,
         declared: Default::default(),
         time: &signature.time,
+        function,
     }
     .body(&roots, dim, tangents == 1, params_line))
 }
@@ -738,6 +761,46 @@ struct Writer<'a> {
     declared: std::cell::RefCell<std::collections::HashSet<String>>,
     /// The time argument's name (the model's).
     time: &'a str,
+    /// The generated function's name (its parts' names start with it).
+    function: &'a str,
+}
+
+/// The lines of one [`Writer::orders`]: order 0, the order-n recurrences
+/// node by node, and the lines storing the state's next order.
+struct Orders {
+    zero: Vec<String>,
+    recurrences: Vec<Vec<String>>,
+    store: Vec<String>,
+}
+
+/// What every part of one function shares: the slots' destructuring
+/// pattern and count, and the locals a part may read.
+struct Slots {
+    pattern: String,
+    count: usize,
+    locals: Vec<Local>,
+}
+
+/// A local of the generated function, as a part's argument.
+struct Local {
+    name: String,
+    /// Its type in the part's signature.
+    kind: String,
+    /// The expression the call passes.
+    pass: String,
+}
+
+impl Slots {
+    /// `let [names…] = work.slots::<count>();`
+    fn bind(&self) -> String {
+        format!("let {} = work.slots::<{}>();", self.pattern, self.count)
+    }
+}
+
+impl Orders {
+    fn recurrence_lines(&self) -> usize {
+        self.recurrences.iter().map(Vec::len).sum()
+    }
 }
 
 impl Writer<'_> {
@@ -1104,11 +1167,11 @@ impl Writer<'_> {
             }
         }
         let slot_names: Vec<&str> = varying.iter().map(|&k| self.names[k].as_str()).collect();
-        lines.push(format!(
-            "let [{}] = work.slots::<{}>();",
-            slot_names.join(", "),
-            varying.len()
-        ));
+        let slots = Slots {
+            pattern: format!("[{}]", slot_names.join(", ")),
+            count: varying.len(),
+            locals: self.locals(&live, dim, variational),
+        };
         let dependent = if variational {
             self.tangent_dependence(dim)
         } else {
@@ -1116,6 +1179,18 @@ impl Writer<'_> {
         };
         let base: Vec<usize> = varying.iter().copied().filter(|&k| !dependent[k]).collect();
         let tangent: Vec<usize> = varying.iter().copied().filter(|&k| dependent[k]).collect();
+        let base_roots = if variational { &roots[..dim] } else { roots };
+        let base_orders = self.orders(&base, base_roots, if variational { "0" } else { "" });
+        let tangent_orders = variational.then(|| self.orders(&tangent, &roots[dim..], "offset"));
+        let split = std::iter::once(&base_orders)
+            .chain(&tangent_orders)
+            .any(|o| o.recurrence_lines() > PART_LINES);
+        // Unsplit, the slots are bound to their names once; split, each
+        // run of orders binds them again (the parts borrow all of them).
+        if !split {
+            lines.push(slots.bind());
+        }
+        let mut parts = Vec::new();
         if variational {
             lines.push("let len = z.len();".into());
             lines.push(format!("let columns = len / {dim} - 1;"));
@@ -1124,30 +1199,136 @@ impl Writer<'_> {
             ));
             lines.push("out[..len].copy_from_slice(z);".into());
             lines.push("// The solution.".into());
-            self.orders(&base, &roots[..dim], "0", &mut lines);
+            self.emit_orders(base_orders, split, &slots, &mut lines, &mut parts);
             lines.push(
                 "// Each tangent vector in turn: the same recurrences, reading the solution's."
                     .into(),
             );
             lines.push("for column in 0..columns {".into());
             lines.push(format!("let offset = {dim} * (1 + column);"));
-            self.orders(&tangent, &roots[dim..], "offset", &mut lines);
+            let tangent_orders = tangent_orders.expect("variational");
+            self.emit_orders(tangent_orders, split, &slots, &mut lines, &mut parts);
             lines.push("}".into());
         } else {
             lines.push(
                 "assert!(order >= 1 && order < series::COEFFICIENTS && out.len() > order);".into(),
             );
             lines.push("out[0] = *y;".into());
-            self.orders(&base, roots, "", &mut lines);
+            self.emit_orders(base_orders, split, &slots, &mut lines, &mut parts);
         }
-        TaylorBody { params_line, lines }
+        TaylorBody {
+            params_line,
+            lines,
+            parts,
+        }
+    }
+
+    /// The locals of the function a part may read, with their types and how
+    /// they are passed: the time, the constants, the factorisations, `out`
+    /// and the variational function's row length and column offset.
+    fn locals(&self, live: &[usize], dim: usize, variational: bool) -> Vec<Local> {
+        let local = |name: &str, kind: &str, pass: String| Local {
+            name: name.to_string(),
+            kind: kind.to_string(),
+            pass,
+        };
+        let mut locals = vec![local(self.time, "Num", self.time.to_string())];
+        for &k in live {
+            if self.constant(k) && !matches!(self.ops[k], Op::Literal(_) | Op::Parameter(_)) {
+                locals.push(local(&self.names[k], "Num", self.names[k].clone()));
+            }
+        }
+        for s in self.solves {
+            let name = self.factor_name(s);
+            if self.needed[s.solutions[0][0]] && !locals.iter().any(|l| l.name == name) {
+                let kind = format!("&crate::linalg::Cholesky<Num, {}>", s.matrix.len());
+                locals.push(local(&name, &kind, format!("&{name}")));
+            }
+        }
+        if variational {
+            locals.push(local("out", "&mut [Num]", "out".into()));
+            locals.push(local("len", "usize", "len".into()));
+            locals.push(local("offset", "usize", "offset".into()));
+        } else {
+            let kind = format!("&mut [[Num; {dim}]]");
+            locals.push(local("out", &kind, "out".into()));
+        }
+        locals
+    }
+
+    /// Writes one run of orders: order 0, then the loop over orders n, its
+    /// recurrences inline or, past [`PART_LINES`], in parts called in turn
+    /// (the last one also storing the state's next order).
+    fn emit_orders(
+        &self,
+        orders: Orders,
+        split: bool,
+        slots: &Slots,
+        lines: &mut Vec<String>,
+        parts: &mut Vec<Part>,
+    ) {
+        if split {
+            lines.push(slots.bind());
+        }
+        let long = orders.recurrence_lines() > PART_LINES;
+        lines.extend(orders.zero);
+        if !long {
+            lines.push("for n in 1..order {".into());
+            lines.extend(orders.recurrences.into_iter().flatten());
+            lines.extend(orders.store);
+            lines.push("}".into());
+            return;
+        }
+        let mut runs: Vec<Vec<String>> = vec![Vec::new()];
+        for node in orders.recurrences {
+            let run = runs.last_mut().expect("one run at least");
+            if !run.is_empty() && run.len() + node.len() > PART_LINES {
+                runs.push(node);
+            } else {
+                run.extend(node);
+            }
+        }
+        runs.last_mut().expect("one run").extend(orders.store);
+        lines.push(format!("let slots = work.slots::<{}>();", slots.count));
+        lines.push("for n in 1..order {".into());
+        for run in runs {
+            let name = format!("{}_part_{}", self.function, parts.len() + 1);
+            let mut body = vec![format!("let {} = slots;", slots.pattern)];
+            body.extend(run);
+            let read: std::collections::HashSet<&str> = body
+                .iter()
+                .flat_map(|line| {
+                    line.split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                        .filter(|word| !word.is_empty())
+                })
+                .collect();
+            let used: Vec<&Local> = slots
+                .locals
+                .iter()
+                .filter(|l| read.contains(l.name.as_str()))
+                .collect();
+            let mut args = vec![format!(
+                "slots: &mut [crate::ode::series::Coefficients<Num>; {}]",
+                slots.count
+            )];
+            args.extend(used.iter().map(|l| format!("{}: {}", l.name, l.kind)));
+            let mut call = vec!["n".to_string(), "params".into(), "slots".into()];
+            call.extend(used.iter().map(|l| l.pass.clone()));
+            lines.push(format!("{name}({});", call.join(", ")));
+            parts.push(Part {
+                name,
+                args: args.join(", "),
+                lines: body,
+            });
+        }
+        lines.push("}".into());
     }
 
     /// Order 0, then orders 1..order of the nodes `nodes` (in evaluation
     /// order, their state components first), whose rates are `roots`. The
     /// state's coefficients are written to `out` at column `offset` (flat
     /// rows of `len`), or to `out[n][i]` when `offset` is empty.
-    fn orders(&self, nodes: &[usize], roots: &[usize], offset: &str, lines: &mut Vec<String>) {
+    fn orders(&self, nodes: &[usize], roots: &[usize], offset: &str) -> Orders {
         let dim = roots.len();
         let cell = |n: &str, i: usize| -> String {
             match offset {
@@ -1156,12 +1337,12 @@ impl Writer<'_> {
                 o => format!("out[({n}) * len + {o} + {i}]"),
             }
         };
-        lines.push("// Order 0: the values at t.".into());
+        let mut zero = vec!["// Order 0: the values at t.".to_string()];
         for (i, &k) in nodes.iter().enumerate().take(dim) {
-            lines.push(format!("{}[0] = {};", self.names[k], cell("0", i)));
+            zero.push(format!("{}[0] = {};", self.names[k], cell("0", i)));
         }
         for &k in &nodes[dim..] {
-            self.order_zero(k, lines);
+            self.order_zero(k, &mut zero);
         }
         let rates = |n: &str, scale: &str| -> Vec<String> {
             roots
@@ -1192,16 +1373,24 @@ impl Writer<'_> {
                 lines.push(format!("{}[{row}] = {};", self.names[k], cell(row, i)));
             }
         };
-        store(lines, "1", rates("0", ""));
-        lines.push("for n in 1..order {".into());
-        for &k in &nodes[dim..] {
-            if self.classes[k] == Class::Series {
-                self.recurrence(k, lines);
-            }
+        store(&mut zero, "1", rates("0", ""));
+        let recurrences = nodes[dim..]
+            .iter()
+            .filter(|&&k| self.classes[k] == Class::Series)
+            .map(|&k| {
+                let mut node = Vec::new();
+                self.recurrence(k, &mut node);
+                node
+            })
+            .filter(|node| !node.is_empty())
+            .collect();
+        let mut next = vec!["let next = series::INVERSES[n + 1];".to_string()];
+        store(&mut next, "n + 1", rates("n", " * next"));
+        Orders {
+            zero,
+            recurrences,
+            store: next,
         }
-        lines.push("let next = series::INVERSES[n + 1];".into());
-        store(lines, "n + 1", rates("n", " * next"));
-        lines.push("}".into());
     }
 
     /// The order-0 line(s) of a varying node that is not a state component.
