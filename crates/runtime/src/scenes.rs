@@ -497,3 +497,65 @@ pub fn period_map_scene(
     scene.write_summary(&result)?;
     Ok(())
 }
+
+/// The `separatrix_splitting` scene: the hyperbolic fixed point of the
+/// period map of a 1-degree-of-freedom model with a fast phase, its
+/// manifolds, two primary homoclinic points and the lobe between them.
+pub fn separatrix_scene(
+    catalog: Catalog,
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
+    use crate::analysis::separatrix::{separatrix_splitting, SplittingSettings};
+    let (model, scene) = generic_scene(
+        catalog,
+        scene_name,
+        "separatrix splitting in the period map of a 1-degree-of-freedom model",
+        overrides,
+        ("kapitza", "taylor", "1e-14"),
+        &[
+            (
+                "spacing",
+                "0.02",
+                "the largest distance between neighbouring points of a drawn manifold",
+            ),
+            (
+                "p_max",
+                "4",
+                "the manifolds are followed within |p − p*| ≤ p_max",
+            ),
+            (
+                "iterates",
+                "400",
+                "iterates of the period map per manifold, at most",
+            ),
+            (
+                "lobe_points",
+                "400",
+                "points per manifold piece of the lobe polygon",
+            ),
+        ],
+    )?;
+    let settings = SplittingSettings {
+        method: method_from(&scene)?,
+        guess: None,
+        spacing: scene.positive("spacing")?,
+        iterates: scene.count("iterates")?,
+        max_points: 20_000,
+        p_max: scene.positive("p_max")?,
+        lobe_points: scene.count("lobe_points")?,
+    };
+    eprintln!("growing the manifolds of the hyperbolic fixed point …");
+    let result = separatrix_splitting(model, &scene.parameter_values(model.info)?, &settings)?;
+    scene.save_figure(&result.figure(), "separatrix_splitting.png")?;
+    let rows = [
+        ("unstable", &result.unstable),
+        ("stable", &result.stable),
+        ("lobe", &result.lobe),
+    ]
+    .into_iter()
+    .flat_map(|(curve, points)| points.iter().map(move |y| (curve, y[0], y[1])));
+    scene.write_csv("manifolds.csv", &["curve", "q_lifted", "p"], rows)?;
+    scene.write_summary(&result)?;
+    Ok(())
+}

@@ -10,6 +10,7 @@ pub mod fit;
 pub mod floquet;
 pub mod lyapunov;
 pub mod period_map;
+pub mod separatrix;
 pub mod stability;
 pub mod standard_map;
 pub mod tiles;

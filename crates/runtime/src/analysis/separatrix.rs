@@ -1,0 +1,995 @@
+//! Separatrix splitting in the period map P of a model with one degree of
+//! freedom and a fast phase: the hyperbolic fixed point of P, its unstable
+//! and stable manifolds W^u and W^s, their primary homoclinic points, the
+//! splitting angle and the area of a lobe of the turnstile, measured two
+//! ways (MacKay–Meiss–Percival action difference, and the polygon between
+//! the two manifolds with Richardson extrapolation).
+//!
+//! A manifold is parametrised exactly: σ = k + f (0 ≤ f < 1) is the point
+//! P^k(y* + s₀ g^f v) (P⁻¹ for the stable one), v the eigenvector and g > 1
+//! the growth per iterate (λᵤ, or 1/λₛ). Each fractional offset f is one
+//! chain of iterates from the fundamental domain, so every drawn point is
+//! an exact iterate of a point of the local (linear) manifold at distance
+//! s₀ = 1e-9: no interpolation between computed points, and an offset added
+//! where neighbours lie too far apart costs one chain. The q coordinate is
+//! lifted (not wrapped): a homoclinic orbit that goes once round the
+//! cylinder joins y* to y* + (2π, 0), and the stable manifold of that copy
+//! is W^s shifted by 2π.
+
+use crate::analysis::floquet::monodromy;
+use crate::ode::{ErasedSystem, Integrator, Method, OdeError, System};
+use crate::registry::{DynamicModel, Fixed, Model, Sized};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::f64::consts::TAU;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// What to compute and how finely.
+#[derive(Clone, Debug)]
+pub struct SplittingSettings {
+    /// The integrator of the period map (the action uses DOP853 at 1e-13).
+    pub method: Method,
+    /// Where Newton starts for the fixed point; None: the saddles of the
+    /// averaged system (maxima of V + V_vibr), at rest.
+    pub guess: Option<[f64; 2]>,
+    /// The largest distance between neighbouring points of a drawn manifold.
+    pub spacing: f64,
+    /// Iterates of P per manifold, at most.
+    pub iterates: usize,
+    /// Points per manifold, at most.
+    pub max_points: usize,
+    /// A manifold is followed within |p − p*| ≤ p_max and for an arclength
+    /// of at most 2·(2π + 2·p_max) (past the first lobes).
+    pub p_max: f64,
+    /// Points per manifold piece of the lobe polygon (and twice as many for
+    /// its Richardson extrapolation).
+    pub lobe_points: usize,
+}
+
+impl Default for SplittingSettings {
+    fn default() -> Self {
+        SplittingSettings {
+            method: Method::Taylor { tol: 1e-14 },
+            guess: None,
+            spacing: 0.02,
+            iterates: 400,
+            max_points: 20_000,
+            p_max: 4.0,
+            lobe_points: 400,
+        }
+    }
+}
+
+/// A point where W^u meets W^s, with its parameters on both.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Homoclinic {
+    pub point: [f64; 2],
+    pub sigma_unstable: f64,
+    pub sigma_stable: f64,
+    /// The angle between the two manifolds there, radians in [0, π/2].
+    pub angle: f64,
+    /// The MacKay–Meiss–Percival action of its orbit (area-preserving maps).
+    pub action: Option<f64>,
+}
+
+/// The splitting of the separatrix, as measured.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Splitting {
+    pub model: String,
+    pub params: BTreeMap<String, f64>,
+    pub period: f64,
+    pub fixed_point: [f64; 2],
+    /// λᵤ > 1 and λₛ < 1, the multipliers of the fixed point.
+    pub multipliers: [f64; 2],
+    /// det of the monodromy matrix: 1 for an area-preserving map.
+    pub determinant: f64,
+    pub unstable_direction: [f64; 2],
+    pub stable_direction: [f64; 2],
+    /// The two primary homoclinic points bounding a lobe, the first along
+    /// W^u first. Lifted coordinates: W^s is that of y* + (shift, 0).
+    pub homoclinic: Vec<Homoclinic>,
+    pub shift: f64,
+    /// The lobe area from the two orbits' actions (None where the map does
+    /// not preserve area, |det − 1| > 1e-9).
+    pub lobe_area_action: Option<f64>,
+    /// The lobe area from the polygon between the manifold pieces,
+    /// Richardson-extrapolated from two resolutions.
+    pub lobe_area_polygon: f64,
+    /// The two polygon areas it was extrapolated from.
+    pub lobe_area_polygons: [f64; 2],
+    pub map_evaluations: u64,
+    pub points: usize,
+    pub seconds: f64,
+    /// W^u and W^s as drawn (lifted q), and the lobe's boundary.
+    #[serde(skip)]
+    pub unstable: Vec<[f64; 2]>,
+    #[serde(skip)]
+    pub stable: Vec<[f64; 2]>,
+    #[serde(skip)]
+    pub lobe: Vec<[f64; 2]>,
+}
+
+impl Splitting {
+    /// The tangle (W^u red, W^s blue, the lobe green, the homoclinic points
+    /// black) and a zoom on the lobe, in lifted coordinates.
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{Figure, PanelSpec, Rgb};
+        let bounds = |points: &[[f64; 2]], margin: f64| {
+            let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+            for y in points {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(y[k]);
+                    hi[k] = hi[k].max(y[k]);
+                }
+            }
+            let pad = |k: usize| margin * (hi[k] - lo[k]).max(1e-12);
+            (
+                (lo[0] - pad(0), hi[0] + pad(0)),
+                (lo[1] - pad(1), hi[1] + pad(1)),
+            )
+        };
+        let [q0, p0] = self.fixed_point;
+        let all = (
+            (q0 - 0.6, q0 + self.shift.abs().max(TAU) + 0.6),
+            bounds(&[self.unstable.clone(), self.stable.clone()].concat(), 0.05).1,
+        );
+        let zoom = bounds(&self.lobe, 0.25);
+        let area = self.lobe_area_action.unwrap_or(self.lobe_area_polygon);
+        let titles = [
+            format!(
+                "{}: W^u (red), W^s (blue) of ({q0:.4}, {p0:.4})",
+                self.model
+            ),
+            format!(
+                "the lobe: area {area:.6e}, angle {:.4e} rad",
+                self.homoclinic[0].angle
+            ),
+        ];
+        let specs = [
+            PanelSpec::new(&titles[0], "q (lifted)", "p", all.0, all.1),
+            PanelSpec::new(&titles[1], "q (lifted)", "p", zoom.0, zoom.1),
+        ];
+        let mut figure = Figure::grid(2, 1, 640, 560, &specs);
+        let line = |points: &[[f64; 2]]| -> Vec<(f64, f64)> {
+            points.iter().map(|y| (y[0], y[1])).collect()
+        };
+        let mut lobe = line(&self.lobe);
+        lobe.extend(lobe.first().copied());
+        for k in 0..2 {
+            figure.line(k, &line(&self.unstable), Rgb(200, 30, 30));
+            figure.line(k, &line(&self.stable), Rgb(30, 60, 200));
+            figure.line(k, &lobe, Rgb(20, 150, 40));
+            figure.points(
+                k,
+                self.homoclinic.iter().map(|h| (h.point[0], h.point[1])),
+                Rgb(0, 0, 0),
+                5,
+            );
+            figure.points(k, [(q0, p0), (q0 + self.shift, p0)], Rgb(0, 0, 0), 5);
+        }
+        figure
+    }
+}
+
+/// Why the splitting cannot be measured.
+#[derive(Debug, thiserror::Error)]
+pub enum SplittingError {
+    #[error("'{0}' is a contact model: it has no period map")]
+    ContactModel(String),
+    #[error("model '{model}' has {dof} degrees of freedom: separatrix splitting is measured for one (a period map of the plane)")]
+    NotPlanar { model: String, dof: usize },
+    #[error("model '{0}' has no fast phase: it has no period map")]
+    NoFastPhase(String),
+    #[error("model '{0}': the averaged system has no saddle (no maximum of V + V_vibr) to start Newton from; give a guess of the fixed point")]
+    NoSaddle(String),
+    #[error("model '{model}': Newton for a fixed point of the period map did not converge from {start:?}")]
+    FixedPoint { model: String, start: [f64; 2] },
+    #[error("model '{model}': the fixed point {point:?} is not hyperbolic with positive multipliers (multipliers {multipliers})")]
+    NotHyperbolic {
+        model: String,
+        point: [f64; 2],
+        multipliers: String,
+    },
+    #[error("model '{model}': W^u and W^s do not meet within {iterates} iterates and |p − p*| ≤ {p_max} (no homoclinic point: the manifolds leave the box or need more iterates)")]
+    NoHomoclinic {
+        model: String,
+        iterates: usize,
+        p_max: f64,
+    },
+    #[error("model '{model}': Newton for the homoclinic point near {near:?} did not converge")]
+    Homoclinic { model: String, near: [f64; 2] },
+    #[error("model '{model}': {reason}")]
+    Request { model: String, reason: String },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// The separatrix splitting of `model` (one degree of freedom, a fast
+/// phase) at parameter values `params`.
+pub fn separatrix_splitting(
+    model: &Model,
+    params: &[f64],
+    settings: &SplittingSettings,
+) -> Result<Splitting, SplittingError> {
+    let start = std::time::Instant::now();
+    let (map, guesses) = prepare(model, params, settings)?;
+    let name = model.info.name.to_string();
+    let named = model.info.named_values(params).unwrap_or_default();
+    let periodic = model.sized.is_some_and(|_| model.dynamic.periodic()[0]);
+    let saddle = hyperbolic_point(&map, &name, &guesses)?;
+    let found = tangle(&map, &saddle, settings, periodic, &name)?;
+    let [a, b] = &found.homoclinic;
+    let polygon = lobe_polygon(&map, &found, [a, b], settings.lobe_points)?;
+    let area_preserving = (saddle.determinant - 1.0).abs() <= 1e-9;
+    let mut homoclinic = vec![a.clone(), b.clone()];
+    let lobe_area_action = if area_preserving {
+        let actions = [
+            orbit_action(&map, model.dynamic, params, &found, a)?,
+            orbit_action(&map, model.dynamic, params, &found, b)?,
+        ];
+        homoclinic[0].action = Some(actions[0]);
+        homoclinic[1].action = Some(actions[1]);
+        Some((actions[0] - actions[1]).abs())
+    } else {
+        None
+    };
+    let points = found.unstable.len() + found.stable.len();
+    Ok(Splitting {
+        model: name,
+        params: named,
+        period: map.period,
+        fixed_point: saddle.point,
+        multipliers: [saddle.unstable.growth, 1.0 / saddle.stable.growth],
+        determinant: saddle.determinant,
+        unstable_direction: saddle.unstable.direction,
+        stable_direction: saddle.stable.direction,
+        homoclinic,
+        shift: found.shift,
+        lobe_area_action,
+        lobe_area_polygon: polygon.extrapolated,
+        lobe_area_polygons: polygon.areas,
+        map_evaluations: map.evaluations.load(Ordering::Relaxed),
+        points,
+        seconds: start.elapsed().as_secs_f64(),
+        unstable: found.unstable,
+        stable: found.stable,
+        lobe: polygon.boundary,
+    })
+}
+
+/// The hyperbolic fixed point of the period map.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FixedPoint {
+    pub point: [f64; 2],
+    /// λᵤ > 1 and λₛ < 1.
+    pub multipliers: [f64; 2],
+    pub determinant: f64,
+    pub unstable_direction: [f64; 2],
+    pub stable_direction: [f64; 2],
+}
+
+/// The hyperbolic fixed point of the period map of `model` (one degree of
+/// freedom, a fast phase), by Newton from `settings.guess` or from the
+/// averaged system's saddles.
+pub fn hyperbolic_fixed_point(
+    model: &Model,
+    params: &[f64],
+    settings: &SplittingSettings,
+) -> Result<FixedPoint, SplittingError> {
+    let (map, guesses) = prepare(model, params, settings)?;
+    let saddle = hyperbolic_point(&map, model.info.name, &guesses)?;
+    Ok(FixedPoint {
+        point: saddle.point,
+        multipliers: [saddle.unstable.growth, 1.0 / saddle.stable.growth],
+        determinant: saddle.determinant,
+        unstable_direction: saddle.unstable.direction,
+        stable_direction: saddle.stable.direction,
+    })
+}
+
+/// The period map of a planar model and the starts for Newton.
+fn prepare(
+    model: &Model,
+    params: &[f64],
+    settings: &SplittingSettings,
+) -> Result<(Map, Vec<[f64; 2]>), SplittingError> {
+    let name = model.info.name.to_string();
+    let fixed = match model.sized {
+        Some(Sized::Dof1(fixed)) => fixed,
+        Some(_) => {
+            return Err(SplittingError::NotPlanar {
+                model: name,
+                dof: model.info.coordinates.len(),
+            })
+        }
+        None => return Err(SplittingError::ContactModel(name)),
+    };
+    if model.info.named_values(params).is_none() {
+        return Err(SplittingError::Request {
+            model: name,
+            reason: format!("{} parameter values", params.len()),
+        });
+    }
+    let period = match fixed.phase_period(params) {
+        Some(t) if fixed.has_fast_phase() => t,
+        _ => return Err(SplittingError::NoFastPhase(name)),
+    };
+    if !(settings.spacing > 0.0 && settings.p_max > 0.0 && settings.lobe_points >= 8) {
+        return Err(SplittingError::Request {
+            model: name,
+            reason: "spacing and p_max must be positive, lobe_points at least 8".into(),
+        });
+    }
+    let guesses = match settings.guess {
+        Some(g) => vec![g],
+        None => saddles(model.dynamic, params),
+    };
+    if guesses.is_empty() {
+        return Err(SplittingError::NoSaddle(name));
+    }
+    let map = Map {
+        system: fixed.exact(params),
+        period,
+        method: settings.method,
+        evaluations: AtomicU64::new(0),
+    };
+    Ok((map, guesses))
+}
+
+/// The period map and its inverse, counting evaluations.
+struct Map {
+    system: ErasedSystem<2>,
+    period: f64,
+    method: Method,
+    evaluations: AtomicU64,
+}
+
+impl Map {
+    fn integrator(&self) -> Result<Integrator, OdeError> {
+        Integrator::new(self.method)
+    }
+
+    /// P(y) (forward) or P⁻¹(y).
+    fn apply(
+        &self,
+        integrator: &mut Integrator,
+        y: &[f64; 2],
+        forward: bool,
+    ) -> Result<[f64; 2], OdeError> {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let (t0, t1) = if forward {
+            (0.0, self.period)
+        } else {
+            (self.period, 0.0)
+        };
+        integrator.advance(&self.system, t0, y, t1)
+    }
+}
+
+/// Starts for Newton: the maxima of the averaged potential, at rest.
+fn saddles(model: &dyn DynamicModel, params: &[f64]) -> Vec<[f64; 2]> {
+    crate::explore::equilibria(model, params)
+        .into_iter()
+        .filter(|e| e.hessian_eigenvalues.iter().all(|&h| h < 0.0))
+        .map(|e| [e.q[0], 0.0])
+        .collect()
+}
+
+/// One branch of a manifold: σ ↦ P^⌊σ⌋(origin + s₀ g^{σ−⌊σ⌋} direction)
+/// (P⁻¹ for a stable branch).
+#[derive(Clone, Copy, Debug)]
+struct Branch {
+    origin: [f64; 2],
+    direction: [f64; 2],
+    /// g > 1: λᵤ, or 1/λₛ.
+    growth: f64,
+    forward: bool,
+}
+
+/// Distance of the fundamental domain from the fixed point.
+const OFFSET: f64 = 1e-9;
+
+impl Branch {
+    fn flipped(self) -> Branch {
+        Branch {
+            direction: [-self.direction[0], -self.direction[1]],
+            ..self
+        }
+    }
+
+    fn local(&self, f: f64) -> [f64; 2] {
+        let s = OFFSET * self.growth.powf(f);
+        [
+            self.origin[0] + s * self.direction[0],
+            self.origin[1] + s * self.direction[1],
+        ]
+    }
+
+    /// The points at σ = f, f + 1, …, f + levels − 1.
+    fn chain(&self, map: &Map, f: f64, levels: usize) -> Result<Vec<[f64; 2]>, OdeError> {
+        let mut integrator = map.integrator()?;
+        let mut y = self.local(f);
+        let mut points = Vec::with_capacity(levels);
+        points.push(y);
+        for _ in 1..levels {
+            y = map.apply(&mut integrator, &y, self.forward)?;
+            points.push(y);
+        }
+        Ok(points)
+    }
+
+    fn point(&self, map: &Map, sigma: f64) -> Result<[f64; 2], OdeError> {
+        let k = sigma.floor();
+        Ok(*self
+            .chain(map, sigma - k, k as usize + 1)?
+            .last()
+            .expect("one point at least"))
+    }
+
+    /// dy/dσ by central differences.
+    fn tangent(&self, map: &Map, sigma: f64) -> Result<[f64; 2], OdeError> {
+        let h = 1e-6;
+        let (a, b) = (self.point(map, sigma - h)?, self.point(map, sigma + h)?);
+        Ok([(b[0] - a[0]) / (2.0 * h), (b[1] - a[1]) / (2.0 * h)])
+    }
+}
+
+/// The hyperbolic fixed point with its two branches' data.
+struct Saddle {
+    point: [f64; 2],
+    determinant: f64,
+    unstable: Branch,
+    stable: Branch,
+}
+
+/// Newton on P(y) − y with the monodromy, from each guess in turn; the
+/// first hyperbolic fixed point with positive multipliers.
+fn hyperbolic_point(map: &Map, name: &str, guesses: &[[f64; 2]]) -> Result<Saddle, SplittingError> {
+    let mut last = None;
+    for &start in guesses {
+        match newton_fixed_point(map, start)? {
+            Some((point, m)) => match saddle_from(point, &m) {
+                Some(saddle) => return Ok(saddle),
+                None => {
+                    let (tr, det) = (m[0][0] + m[1][1], m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+                    let disc = tr * tr / 4.0 - det;
+                    let multipliers = if disc >= 0.0 {
+                        format!("{}, {}", tr / 2.0 + disc.sqrt(), tr / 2.0 - disc.sqrt())
+                    } else {
+                        format!("{} ± {}i", tr / 2.0, (-disc).sqrt())
+                    };
+                    last = Some(SplittingError::NotHyperbolic {
+                        model: name.into(),
+                        point,
+                        multipliers,
+                    });
+                }
+            },
+            None => {
+                last = Some(SplittingError::FixedPoint {
+                    model: name.into(),
+                    start,
+                })
+            }
+        }
+    }
+    Err(last.expect("one guess at least"))
+}
+
+type Matrix2 = [[f64; 2]; 2];
+
+/// The fixed point and its monodromy, or None when Newton does not converge.
+fn newton_fixed_point(map: &Map, start: [f64; 2]) -> Result<Option<([f64; 2], Matrix2)>, OdeError> {
+    let mut y = start;
+    for _ in 0..40 {
+        let mut integrator = map.integrator()?;
+        map.evaluations.fetch_add(1, Ordering::Relaxed);
+        let (py, m) = monodromy::<_, 2, 6>(&mut integrator, &map.system, map.period, &y)?;
+        let r = [py[0] - y[0], py[1] - y[1]];
+        let a = [[m[0][0] - 1.0, m[0][1]], [m[1][0], m[1][1] - 1.0]];
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        if det == 0.0 || !det.is_finite() {
+            return Ok(None);
+        }
+        let dy = [
+            (a[1][1] * r[0] - a[0][1] * r[1]) / det,
+            (a[0][0] * r[1] - a[1][0] * r[0]) / det,
+        ];
+        y = [y[0] - dy[0], y[1] - dy[1]];
+        if dy[0].hypot(dy[1]) <= 1e-14 * (1.0 + y[0].hypot(y[1])) {
+            let (_, m) = monodromy::<_, 2, 6>(&mut integrator, &map.system, map.period, &y)?;
+            return Ok(Some((y, m)));
+        }
+        if !(y[0].is_finite() && y[1].is_finite()) {
+            return Ok(None);
+        }
+    }
+    Ok(None)
+}
+
+/// The saddle's branches from its monodromy, when both multipliers are
+/// real and positive, one above 1 and one below.
+fn saddle_from(point: [f64; 2], m: &Matrix2) -> Option<Saddle> {
+    let (tr, det) = (m[0][0] + m[1][1], m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+    let disc = tr * tr / 4.0 - det;
+    if disc <= 0.0 {
+        return None;
+    }
+    let (big, small) = (tr / 2.0 + disc.sqrt(), tr / 2.0 - disc.sqrt());
+    if !(big > 1.0 + 1e-12 && small > 0.0 && small < 1.0 - 1e-12) {
+        return None;
+    }
+    let eigenvector = |lambda: f64| {
+        // (M − λ) v = 0: v ⟂ the larger row of M − λ.
+        let rows = [[m[0][0] - lambda, m[0][1]], [m[1][0], m[1][1] - lambda]];
+        let row = if rows[0][0].hypot(rows[0][1]) >= rows[1][0].hypot(rows[1][1]) {
+            rows[0]
+        } else {
+            rows[1]
+        };
+        let v = [-row[1], row[0]];
+        let norm = v[0].hypot(v[1]);
+        // Oriented towards increasing q (or p where q does not change).
+        let sign = if v[0] < 0.0 || (v[0] == 0.0 && v[1] < 0.0) {
+            -1.0
+        } else {
+            1.0
+        };
+        [sign * v[0] / norm, sign * v[1] / norm]
+    };
+    Some(Saddle {
+        point,
+        determinant: det,
+        unstable: Branch {
+            origin: point,
+            direction: eigenvector(big),
+            growth: big,
+            forward: true,
+        },
+        stable: Branch {
+            origin: point,
+            direction: eigenvector(small),
+            growth: 1.0 / small,
+            forward: false,
+        },
+    })
+}
+
+/// A manifold branch as drawn: fractional offsets, and per offset its chain.
+struct Manifold {
+    branch: Branch,
+    /// Sorted offsets in [0, 1).
+    offsets: Vec<f64>,
+    chains: Vec<Vec<[f64; 2]>>,
+    levels: usize,
+}
+
+impl Manifold {
+    /// The points in order of σ, with their σ.
+    fn ordered(&self) -> Vec<(f64, [f64; 2])> {
+        let mut points = Vec::with_capacity(self.offsets.len() * self.levels);
+        for level in 0..self.levels {
+            for (f, chain) in self.offsets.iter().zip(&self.chains) {
+                if let Some(&y) = chain.get(level) {
+                    points.push((level as f64 + f, y));
+                }
+            }
+        }
+        points
+    }
+}
+
+/// Grows a branch: the number of iterates from one chain (until it leaves
+/// the box, passes the arclength or reaches `settings.iterates`), then
+/// offsets added where neighbours lie farther apart than the spacing.
+fn grow(map: &Map, branch: Branch, settings: &SplittingSettings) -> Result<Manifold, OdeError> {
+    let inside = |y: &[f64; 2]| (y[1] - branch.origin[1]).abs() <= settings.p_max;
+    let longest = 2.0 * (TAU + 2.0 * settings.p_max);
+    // The levels: until the coarse curve leaves the box or is long enough.
+    let mut integrator = map.integrator()?;
+    let mut coarse: Vec<[f64; 2]> = (0..16).map(|i| branch.local(i as f64 / 16.0)).collect();
+    let (mut levels, mut length, mut previous) = (0, 0.0, branch.origin);
+    while levels < settings.iterates {
+        levels += 1;
+        let leaves = coarse.iter().any(|y| {
+            length += (y[0] - previous[0]).hypot(y[1] - previous[1]);
+            previous = *y;
+            !inside(y) || length > longest
+        });
+        if leaves {
+            break;
+        }
+        for y in coarse.iter_mut() {
+            *y = map.apply(&mut integrator, y, branch.forward)?;
+        }
+    }
+    let mut manifold = Manifold {
+        branch,
+        offsets: Vec::new(),
+        chains: Vec::new(),
+        levels,
+    };
+    let mut new: Vec<f64> = (0..32).map(|i| i as f64 / 32.0).collect();
+    while !new.is_empty() {
+        let chains: Vec<Vec<[f64; 2]>> = new
+            .par_iter()
+            .map(|&f| branch.chain(map, f, levels))
+            .collect::<Result<_, _>>()?;
+        for (f, chain) in new.iter().zip(chains) {
+            let at = manifold.offsets.partition_point(|&o| o < *f);
+            manifold.offsets.insert(at, *f);
+            manifold.chains.insert(at, chain);
+        }
+        let room = settings.max_points / levels.max(1);
+        new = if manifold.offsets.len() >= room {
+            Vec::new()
+        } else {
+            gaps(
+                &manifold,
+                settings.spacing,
+                &inside,
+                room - manifold.offsets.len(),
+            )
+        };
+    }
+    Ok(manifold)
+}
+
+/// Offsets between neighbours (in σ) farther apart than `spacing`, both
+/// inside the box; at most `room`.
+fn gaps(
+    manifold: &Manifold,
+    spacing: f64,
+    inside: &dyn Fn(&[f64; 2]) -> bool,
+    room: usize,
+) -> Vec<f64> {
+    let offsets = &manifold.offsets;
+    // Keys: the bits of offsets in [0, 1), which sort as the offsets do.
+    let mut wanted = std::collections::BTreeSet::new();
+    let mut check = |ya: Option<&[f64; 2]>, yb: Option<&[f64; 2]>, mid: f64, low: f64| {
+        if let (Some(ya), Some(yb)) = (ya, yb) {
+            if inside(ya)
+                && inside(yb)
+                && (yb[0] - ya[0]).hypot(yb[1] - ya[1]) > spacing
+                && mid - low > 1e-9
+            {
+                wanted.insert(mid.to_bits());
+            }
+        }
+    };
+    let last = offsets.len() - 1;
+    for level in 0..manifold.levels {
+        for i in 0..last {
+            let (a, b) = (&manifold.chains[i], &manifold.chains[i + 1]);
+            check(
+                a.get(level),
+                b.get(level),
+                0.5 * (offsets[i] + offsets[i + 1]),
+                offsets[i],
+            );
+        }
+        // Across the level: the last offset's point and the next level's first.
+        let (a, b) = (&manifold.chains[last], &manifold.chains[0]);
+        check(
+            a.get(level),
+            b.get(level + 1),
+            0.5 * (offsets[last] + 1.0 + offsets[0]),
+            offsets[last],
+        );
+    }
+    wanted.into_iter().take(room).map(f64::from_bits).collect()
+}
+
+/// What the tangle search found: the manifolds as drawn, the branches that
+/// meet, the shift of the stable one, and two primary homoclinic points.
+struct Tangle {
+    unstable_branch: Branch,
+    stable_branch: Branch,
+    shift: f64,
+    unstable: Vec<[f64; 2]>,
+    stable: Vec<[f64; 2]>,
+    homoclinic: [Homoclinic; 2],
+}
+
+/// Grows both branches of W^u and W^s, finds where an unstable branch first
+/// meets a stable one (shifted by 0 or ±2π in an angle), and refines the
+/// first two intersections along W^u that are not iterates of each other.
+fn tangle(
+    map: &Map,
+    saddle: &Saddle,
+    settings: &SplittingSettings,
+    periodic: bool,
+    name: &str,
+) -> Result<Tangle, SplittingError> {
+    let grown = |b: Branch| grow(map, b, settings);
+    let unstable = [grown(saddle.unstable)?, grown(saddle.unstable.flipped())?];
+    let stable = [grown(saddle.stable)?, grown(saddle.stable.flipped())?];
+    let shifts: &[f64] = if periodic { &[TAU, -TAU, 0.0] } else { &[0.0] };
+    // (σᵤ of the first crossing, unstable branch, stable branch, shift, crossings)
+    type Meeting = (f64, usize, usize, f64, Vec<(f64, f64)>);
+    let mut best: Option<Meeting> = None;
+    for (iu, u) in unstable.iter().enumerate() {
+        let pu = u.ordered();
+        for (is, s) in stable.iter().enumerate() {
+            let ps = s.ordered();
+            for &shift in shifts {
+                let crossings = intersections(&pu, &ps, shift);
+                if let Some(&(first, _)) = crossings.first() {
+                    if best.as_ref().is_none_or(|b| first < b.0) {
+                        best = Some((first, iu, is, shift, crossings));
+                    }
+                }
+            }
+        }
+    }
+    let no = || SplittingError::NoHomoclinic {
+        model: name.into(),
+        iterates: settings.iterates,
+        p_max: settings.p_max,
+    };
+    let (_, iu, is, shift, crossings) = best.ok_or_else(no)?;
+    let (su, ss) = (unstable[iu].branch, stable[is].branch);
+    let first = crossings[0];
+    let second = crossings
+        .iter()
+        .find(|c| {
+            let d = c.0 - first.0;
+            d > 1e-6 && (d - d.round()).abs() > 1e-6 && d < 1.0
+        })
+        .copied()
+        .ok_or_else(no)?;
+    // Each orbit's representative halfway between the two fixed points
+    // (σᵤ ≈ σₛ: on a symmetry line of a reversible map); P moves a point by
+    // +1 in σᵤ and −1 in σₛ.
+    let balanced = |(u, s): (f64, f64)| {
+        let j = ((s - u) / 2.0).round();
+        (u + j, s - j)
+    };
+    let (first, mut second) = (balanced(first), balanced(second));
+    if second.0 < first.0 {
+        second = (second.0 + 1.0, second.1 - 1.0);
+    }
+    let refine = |c: (f64, f64)| refine_homoclinic(map, su, ss, shift, c, name);
+    let homoclinic = [refine(first)?, refine(second)?];
+    let lift = |m: &Manifold, dx: f64| -> Vec<[f64; 2]> {
+        m.ordered()
+            .into_iter()
+            .map(|(_, y)| [y[0] + dx, y[1]])
+            .collect()
+    };
+    Ok(Tangle {
+        unstable_branch: su,
+        stable_branch: ss,
+        shift,
+        unstable: lift(&unstable[iu], 0.0),
+        stable: lift(&stable[is], shift),
+        homoclinic,
+    })
+}
+
+/// Crossings of the polyline `u` with the polyline `s` shifted by `shift`
+/// in q, as (σ on u, σ on s) by linear interpolation, sorted along u.
+fn intersections(u: &[(f64, [f64; 2])], s: &[(f64, [f64; 2])], shift: f64) -> Vec<(f64, f64)> {
+    let mut found = Vec::new();
+    for wu in u.windows(2) {
+        let (a, b) = (wu[0].1, wu[1].1);
+        let (ux0, ux1) = (a[0].min(b[0]), a[0].max(b[0]));
+        let (uy0, uy1) = (a[1].min(b[1]), a[1].max(b[1]));
+        for ws in s.windows(2) {
+            let c = [ws[0].1[0] + shift, ws[0].1[1]];
+            let d = [ws[1].1[0] + shift, ws[1].1[1]];
+            if c[0].max(d[0]) < ux0
+                || c[0].min(d[0]) > ux1
+                || c[1].max(d[1]) < uy0
+                || c[1].min(d[1]) > uy1
+            {
+                continue;
+            }
+            // a + t (b − a) = c + r (d − c).
+            let e = [b[0] - a[0], b[1] - a[1]];
+            let g = [d[0] - c[0], d[1] - c[1]];
+            let den = e[0] * g[1] - e[1] * g[0];
+            if den == 0.0 {
+                continue;
+            }
+            let w = [c[0] - a[0], c[1] - a[1]];
+            let t = (w[0] * g[1] - w[1] * g[0]) / den;
+            let r = (w[0] * e[1] - w[1] * e[0]) / den;
+            if (0.0..1.0).contains(&t) && (0.0..1.0).contains(&r) {
+                found.push((
+                    wu[0].0 + t * (wu[1].0 - wu[0].0),
+                    ws[0].0 + r * (ws[1].0 - ws[0].0),
+                ));
+            }
+        }
+    }
+    found.sort_by(|x, y| x.0.total_cmp(&y.0));
+    found
+}
+
+/// Newton on W^u(σᵤ) = W^s(σₛ) + (shift, 0), the Jacobian by differences.
+fn refine_homoclinic(
+    map: &Map,
+    unstable: Branch,
+    stable: Branch,
+    shift: f64,
+    (mut su, mut ss): (f64, f64),
+    name: &str,
+) -> Result<Homoclinic, SplittingError> {
+    let residual = |su: f64, ss: f64| -> Result<[f64; 2], OdeError> {
+        let (a, b) = (unstable.point(map, su)?, stable.point(map, ss)?);
+        Ok([a[0] - b[0] - shift, a[1] - b[1]])
+    };
+    for _ in 0..30 {
+        let r = residual(su, ss)?;
+        let (tu, ts) = (unstable.tangent(map, su)?, stable.tangent(map, ss)?);
+        // [tu, −ts] (dσᵤ, dσₛ) = −r.
+        let det = tu[0] * -ts[1] - (-ts[0]) * tu[1];
+        if det == 0.0 || !det.is_finite() {
+            break;
+        }
+        let du = (-r[0] * -ts[1] - (-ts[0]) * -r[1]) / det;
+        let ds = (tu[0] * -r[1] - tu[1] * -r[0]) / det;
+        su += du;
+        ss += ds;
+        if du.abs().max(ds.abs()) < 1e-13 {
+            let point = unstable.point(map, su)?;
+            let (tu, ts) = (unstable.tangent(map, su)?, stable.tangent(map, ss)?);
+            let cos =
+                (tu[0] * ts[0] + tu[1] * ts[1]).abs() / (tu[0].hypot(tu[1]) * ts[0].hypot(ts[1]));
+            return Ok(Homoclinic {
+                point,
+                sigma_unstable: su,
+                sigma_stable: ss,
+                angle: cos.min(1.0).acos(),
+                action: None,
+            });
+        }
+    }
+    let near = unstable.point(map, su).unwrap_or([f64::NAN; 2]);
+    Err(SplittingError::Homoclinic {
+        model: name.into(),
+        near,
+    })
+}
+
+/// The lobe between two primary homoclinic points: its boundary (W^u from
+/// a to b, then W^s from b back to a), and its area from `n` and 2n points
+/// per piece, Richardson-extrapolated (the trapezoid rule's error falls as
+/// n⁻², each piece being smooth in σ).
+struct Lobe {
+    boundary: Vec<[f64; 2]>,
+    areas: [f64; 2],
+    extrapolated: f64,
+}
+
+fn lobe_polygon(
+    map: &Map,
+    tangle: &Tangle,
+    [a, b]: [&Homoclinic; 2],
+    n: usize,
+) -> Result<Lobe, OdeError> {
+    let piece = |branch: Branch,
+                 from: f64,
+                 to: f64,
+                 shift: f64,
+                 n: usize|
+     -> Result<Vec<[f64; 2]>, OdeError> {
+        (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let sigma = from + (to - from) * i as f64 / n as f64;
+                branch.point(map, sigma).map(|y| [y[0] + shift, y[1]])
+            })
+            .collect()
+    };
+    let boundary = |n: usize| -> Result<Vec<[f64; 2]>, OdeError> {
+        let mut points = piece(
+            tangle.unstable_branch,
+            a.sigma_unstable,
+            b.sigma_unstable,
+            0.0,
+            n,
+        )?;
+        points.extend(piece(
+            tangle.stable_branch,
+            b.sigma_stable,
+            a.sigma_stable,
+            tangle.shift,
+            n,
+        )?);
+        Ok(points)
+    };
+    let coarse = boundary(n)?;
+    let fine = boundary(2 * n)?;
+    let areas = [shoelace(&coarse), shoelace(&fine)];
+    Ok(Lobe {
+        boundary: fine,
+        areas,
+        extrapolated: (4.0 * areas[1] - areas[0]) / 3.0,
+    })
+}
+
+/// |area| of a closed polygon.
+fn shoelace(points: &[[f64; 2]]) -> f64 {
+    let n = points.len();
+    let twice: f64 = (0..n)
+        .map(|i| {
+            let (p, q) = (points[i], points[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum();
+    0.5 * twice.abs()
+}
+
+/// The state with the action S = ∫ (p q' − H) dt as a third component.
+struct WithAction<'a> {
+    system: &'a ErasedSystem<2>,
+    model: &'a dyn DynamicModel,
+    params: &'a [f64],
+}
+
+impl System<3> for WithAction<'_> {
+    fn rhs(&self, t: f64, z: &[f64; 3]) -> [f64; 3] {
+        let y = [z[0], z[1]];
+        let f = self.system.rhs(t, &y);
+        [
+            f[0],
+            f[1],
+            y[1] * f[0] - self.model.energy(self.params, t, &y),
+        ]
+    }
+}
+
+/// The MacKay–Meiss–Percival action of the homoclinic orbit through `h`:
+/// Σₖ [F(zₖ) − F(y*)], F(z) = ∫₀ᵀ (p q' − H) dt from z, over the orbit from
+/// the fundamental domain of W^u (backward, then along the local linear
+/// manifold) to that of W^s (forward). The first-order terms telescope to
+/// p*·(δq at the ends), which is taken off.
+fn orbit_action(
+    map: &Map,
+    model: &dyn DynamicModel,
+    params: &[f64],
+    tangle: &Tangle,
+    h: &Homoclinic,
+) -> Result<f64, OdeError> {
+    let (u, s) = (tangle.unstable_branch, tangle.stable_branch);
+    let (ku, fu) = (h.sigma_unstable.floor(), h.sigma_unstable.fract());
+    let (ks, fs) = (h.sigma_stable.floor(), h.sigma_stable.fract());
+    let tail = |b: &Branch, f: f64, i: i32| -> [f64; 2] {
+        let r = OFFSET * b.growth.powf(f) * b.growth.powi(-i);
+        [
+            b.origin[0] + r * b.direction[0],
+            b.origin[1] + r * b.direction[1],
+        ]
+    };
+    let far = |b: &Branch| ((1e-13 / OFFSET).ln() / -b.growth.ln()).ceil() as i32;
+    let mut orbit: Vec<[f64; 2]> = (1..=far(&u)).rev().map(|i| tail(&u, fu, i)).collect();
+    orbit.extend(u.chain(map, fu, ku as usize + 1)?);
+    let mut forward = s.chain(map, fs, ks as usize + 1)?;
+    forward.pop(); // the homoclinic point itself, reached from W^u
+    let shifted = |y: [f64; 2]| [y[0] + tangle.shift, y[1]];
+    orbit.extend(forward.into_iter().rev().map(shifted));
+    orbit.extend((1..=far(&s)).map(|i| shifted(tail(&s, fs, i))));
+    let after = shifted(tail(&s, fs, far(&s) + 1));
+    let action = |y: [f64; 2]| -> Result<f64, OdeError> {
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: 1e-13,
+            atol: 1e-13,
+        })?;
+        let with_action = WithAction {
+            system: &map.system,
+            model,
+            params,
+        };
+        Ok(integrator.advance(&with_action, 0.0, &[y[0], y[1], 0.0], map.period)?[2])
+    };
+    let star = u.origin;
+    let reference = action(star)?;
+    let terms: Vec<f64> = orbit
+        .par_iter()
+        .map(|&y| action(y).map(|a| a - reference))
+        .collect::<Result<_, _>>()?;
+    let first_order = star[1] * ((after[0] - (star[0] + tangle.shift)) - (orbit[0][0] - star[0]));
+    Ok(terms.iter().sum::<f64>() - first_order)
+}
