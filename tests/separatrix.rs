@@ -59,6 +59,7 @@ fn lobe_area_by_action_equals_the_polygon_and_a_homoclinic_point_is_on_the_symme
     let s = separatrix_splitting(model, &kapitza_at(0.1), &settings).unwrap();
     let action = s.lobe_area_action.expect("an area-preserving map");
     assert!(action > 1e-4 && action < 1e-2, "lobe area {action}");
+    assert!(s.resolved);
     let relative = (action - s.lobe_area_polygon).abs() / action;
     assert!(
         relative < 1e-7,
@@ -104,4 +105,27 @@ fn models_without_a_saddle_get_named_errors() {
         hyperbolic_fixed_point(kapitza, &stable_upright, &at_upright),
         Err(SplittingError::NotHyperbolic { .. })
     ));
+}
+
+/// A pivot running uniformly round a circle forces the pendulum, up to a
+/// total derivative, by one harmonic travelling with the fast phase: the
+/// splitting is exponentially small in the forcing frequency, and at the
+/// model's defaults far below what double precision resolves (the polygon
+/// gives about 1e-11, the action route only its noise). It must be
+/// flagged as not resolved, never reported as a lobe.
+#[test]
+fn a_splitting_below_the_accuracy_is_not_reported_as_a_lobe() {
+    let model = models::by_name("circle_pendulum").unwrap();
+    let settings = SplittingSettings {
+        spacing: 0.05,
+        lobe_points: 200,
+        ..Default::default()
+    };
+    let s = separatrix_splitting(model, &model.dynamic.defaults(), &settings).unwrap();
+    assert!(
+        !s.resolved,
+        "{:?} {}",
+        s.lobe_area_action, s.lobe_area_polygon
+    );
+    assert!(s.lobe_area_polygon < 1e-9, "{}", s.lobe_area_polygon);
 }

@@ -547,6 +547,12 @@ pub fn separatrix_scene(
     };
     eprintln!("growing the manifolds of the hyperbolic fixed point …");
     let result = separatrix_splitting(model, &scene.parameter_values(model.info)?, &settings)?;
+    if !result.resolved {
+        eprintln!(
+            "the lobe area is not resolved: the action ({:?}) and polygon ({:e}) routes disagree, the manifolds split less than double precision tells (or not at all)",
+            result.lobe_area_action, result.lobe_area_polygon
+        );
+    }
     scene.save_figure(&result.figure(), "separatrix_splitting.png")?;
     let rows = [
         ("unstable", &result.unstable),

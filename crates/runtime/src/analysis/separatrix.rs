@@ -66,6 +66,8 @@ pub struct Homoclinic {
     pub point: [f64; 2],
     pub sigma_unstable: f64,
     pub sigma_stable: f64,
+    /// |W^u(σᵤ) − W^s(σₛ)| there: the accuracy of the point.
+    pub closure: f64,
     /// The angle between the two manifolds there, radians in [0, π/2].
     pub angle: f64,
     /// The MacKay–Meiss–Percival action of its orbit (area-preserving maps).
@@ -97,6 +99,12 @@ pub struct Splitting {
     pub lobe_area_polygon: f64,
     /// The two polygon areas it was extrapolated from.
     pub lobe_area_polygons: [f64; 2],
+    /// Whether the lobe area is resolved: the two routes agree to 1e-6
+    /// relative (the polygon alone where the map does not preserve area:
+    /// its two resolutions to 1e-3). Not resolved, the area is below what
+    /// double precision tells apart from zero here: the manifolds split
+    /// less than the points' accuracy (`closure`), or not at all.
+    pub resolved: bool,
     pub map_evaluations: u64,
     pub points: usize,
     pub seconds: f64,
@@ -140,10 +148,14 @@ impl Splitting {
                 "{}: W^u (red), W^s (blue) of ({q0:.4}, {p0:.4})",
                 self.model
             ),
-            format!(
-                "the lobe: area {area:.6e}, angle {:.4e} rad",
-                self.homoclinic[0].angle
-            ),
+            if self.resolved {
+                format!(
+                    "the lobe: area {area:.6e}, angle {:.4e} rad",
+                    self.homoclinic[0].angle
+                )
+            } else {
+                format!("no lobe resolved: area below the accuracy ({area:.1e})")
+            },
         ];
         let specs = [
             PanelSpec::new(&titles[0], "q (lifted)", "p", all.0, all.1),
@@ -234,6 +246,11 @@ pub fn separatrix_splitting(
         None
     };
     let points = found.unstable.len() + found.stable.len();
+    let agree = |x: f64, y: f64, bound: f64| (x - y).abs() <= bound * x.abs().max(y.abs());
+    let resolved = match lobe_area_action {
+        Some(action) => agree(action, polygon.extrapolated, 1e-6),
+        None => agree(polygon.areas[0], polygon.areas[1], 1e-3),
+    };
     Ok(Splitting {
         model: name,
         params: named,
@@ -248,6 +265,7 @@ pub fn separatrix_splitting(
         lobe_area_action,
         lobe_area_polygon: polygon.extrapolated,
         lobe_area_polygons: polygon.areas,
+        resolved,
         map_evaluations: map.evaluations.load(Ordering::Relaxed),
         points,
         seconds: start.elapsed().as_secs_f64(),
@@ -820,8 +838,26 @@ fn refine_homoclinic(
         let (a, b) = (unstable.point(map, su)?, stable.point(map, ss)?);
         Ok([a[0] - b[0] - shift, a[1] - b[1]])
     };
-    for _ in 0..30 {
+    // The chains' step sizes change in jumps with the start, so the
+    // residual has a noise floor (about 1e-15 times the stretching along
+    // the chain): Newton stops at a step below 1e-13 or when the residual
+    // no longer falls, keeping the best iterate.
+    let mut best = (f64::INFINITY, su, ss);
+    let mut stalled = 0;
+    for _ in 0..40 {
         let r = residual(su, ss)?;
+        let size = r[0].hypot(r[1]);
+        if size < 0.5 * best.0 {
+            stalled = 0;
+        } else {
+            stalled += 1;
+        }
+        if size < best.0 {
+            best = (size, su, ss);
+        }
+        if stalled >= 4 {
+            break;
+        }
         let (tu, ts) = (unstable.tangent(map, su)?, stable.tangent(map, ss)?);
         // [tu, −ts] (dσᵤ, dσₛ) = −r.
         let det = tu[0] * -ts[1] - (-ts[0]) * tu[1];
@@ -833,18 +869,23 @@ fn refine_homoclinic(
         su += du;
         ss += ds;
         if du.abs().max(ds.abs()) < 1e-13 {
-            let point = unstable.point(map, su)?;
-            let (tu, ts) = (unstable.tangent(map, su)?, stable.tangent(map, ss)?);
-            let cos =
-                (tu[0] * ts[0] + tu[1] * ts[1]).abs() / (tu[0].hypot(tu[1]) * ts[0].hypot(ts[1]));
-            return Ok(Homoclinic {
-                point,
-                sigma_unstable: su,
-                sigma_stable: ss,
-                angle: cos.min(1.0).acos(),
-                action: None,
-            });
+            best = (residual(su, ss).map_or(size, |r| r[0].hypot(r[1])), su, ss);
+            break;
         }
+    }
+    let (closure, su, ss) = best;
+    if closure < 1e-6 {
+        let point = unstable.point(map, su)?;
+        let (tu, ts) = (unstable.tangent(map, su)?, stable.tangent(map, ss)?);
+        let cos = (tu[0] * ts[0] + tu[1] * ts[1]).abs() / (tu[0].hypot(tu[1]) * ts[0].hypot(ts[1]));
+        return Ok(Homoclinic {
+            point,
+            sigma_unstable: su,
+            sigma_stable: ss,
+            closure,
+            angle: cos.min(1.0).acos(),
+            action: None,
+        });
     }
     let near = unstable.point(map, su).unwrap_or([f64::NAN; 2]);
     Err(SplittingError::Homoclinic {
