@@ -788,36 +788,60 @@ fn tangle(
 /// Crossings of the polyline `u` with the polyline `s` shifted by `shift`
 /// in q, as (σ on u, σ on s) by linear interpolation, sorted along u.
 fn intersections(u: &[(f64, [f64; 2])], s: &[(f64, [f64; 2])], shift: f64) -> Vec<(f64, f64)> {
+    // The segments of s in the cells of a grid that their bounding boxes
+    // touch, so that each segment of u is tested against its neighbours
+    // only (the manifolds have tens of thousands of points).
+    const CELL: f64 = 0.05;
+    let cell = |x: f64| (x / CELL).floor() as i64;
+    let span = |p: [f64; 2], q: [f64; 2]| {
+        (
+            cell(p[0].min(q[0]))..=cell(p[0].max(q[0])),
+            cell(p[1].min(q[1]))..=cell(p[1].max(q[1])),
+        )
+    };
+    let shifted = |k: usize| [s[k].1[0] + shift, s[k].1[1]];
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    for k in 0..s.len().saturating_sub(1) {
+        let (xs, ys) = span(shifted(k), shifted(k + 1));
+        if xs.clone().count() * ys.clone().count() > 10_000 {
+            continue; // a segment across the box: none is that long in a drawn manifold
+        }
+        for x in xs {
+            for y in ys.clone() {
+                grid.entry((x, y)).or_default().push(k);
+            }
+        }
+    }
     let mut found = Vec::new();
-    for wu in u.windows(2) {
+    let mut seen = std::collections::HashSet::new();
+    for (j, wu) in u.windows(2).enumerate() {
         let (a, b) = (wu[0].1, wu[1].1);
-        let (ux0, ux1) = (a[0].min(b[0]), a[0].max(b[0]));
-        let (uy0, uy1) = (a[1].min(b[1]), a[1].max(b[1]));
-        for ws in s.windows(2) {
-            let c = [ws[0].1[0] + shift, ws[0].1[1]];
-            let d = [ws[1].1[0] + shift, ws[1].1[1]];
-            if c[0].max(d[0]) < ux0
-                || c[0].min(d[0]) > ux1
-                || c[1].max(d[1]) < uy0
-                || c[1].min(d[1]) > uy1
-            {
-                continue;
-            }
-            // a + t (b − a) = c + r (d − c).
-            let e = [b[0] - a[0], b[1] - a[1]];
-            let g = [d[0] - c[0], d[1] - c[1]];
-            let den = e[0] * g[1] - e[1] * g[0];
-            if den == 0.0 {
-                continue;
-            }
-            let w = [c[0] - a[0], c[1] - a[1]];
-            let t = (w[0] * g[1] - w[1] * g[0]) / den;
-            let r = (w[0] * e[1] - w[1] * e[0]) / den;
-            if (0.0..1.0).contains(&t) && (0.0..1.0).contains(&r) {
-                found.push((
-                    wu[0].0 + t * (wu[1].0 - wu[0].0),
-                    ws[0].0 + r * (ws[1].0 - ws[0].0),
-                ));
+        let (xs, ys) = span(a, b);
+        seen.clear();
+        for x in xs {
+            for y in ys.clone() {
+                for &k in grid.get(&(x, y)).into_iter().flatten() {
+                    if !seen.insert(k) {
+                        continue;
+                    }
+                    let (c, d) = (shifted(k), shifted(k + 1));
+                    // a + t (b − a) = c + r (d − c).
+                    let e = [b[0] - a[0], b[1] - a[1]];
+                    let g = [d[0] - c[0], d[1] - c[1]];
+                    let den = e[0] * g[1] - e[1] * g[0];
+                    if den == 0.0 {
+                        continue;
+                    }
+                    let w = [c[0] - a[0], c[1] - a[1]];
+                    let t = (w[0] * g[1] - w[1] * g[0]) / den;
+                    let r = (w[0] * e[1] - w[1] * e[0]) / den;
+                    if (0.0..1.0).contains(&t) && (0.0..1.0).contains(&r) {
+                        found.push((
+                            u[j].0 + t * (u[j + 1].0 - u[j].0),
+                            s[k].0 + r * (s[k + 1].0 - s[k].0),
+                        ));
+                    }
+                }
             }
         }
     }
