@@ -549,7 +549,7 @@ pub fn separatrix_scene(
     let result = separatrix_splitting(model, &scene.parameter_values(model.info)?, &settings)?;
     if !result.resolved {
         eprintln!(
-            "the lobe area is not resolved: the action ({:?}) and polygon ({:e}) routes disagree, the manifolds split less than double precision tells (or not at all)",
+            "the lobe area is not resolved to 1e-6: action {:?}, polygon {:e} (the manifolds split by little more than double precision tells)",
             result.lobe_area_action, result.lobe_area_polygon
         );
     }

@@ -99,11 +99,14 @@ pub struct Splitting {
     pub lobe_area_polygon: f64,
     /// The two polygon areas it was extrapolated from.
     pub lobe_area_polygons: [f64; 2],
+    /// |action − polygon| / max of the two (None without the action).
+    pub routes_relative_difference: Option<f64>,
     /// Whether the lobe area is resolved: the two routes agree to 1e-6
     /// relative (the polygon alone where the map does not preserve area:
-    /// its two resolutions to 1e-3). Not resolved, the area is below what
-    /// double precision tells apart from zero here: the manifolds split
-    /// less than the points' accuracy (`closure`), or not at all.
+    /// its two resolutions to 1e-3). Not resolved, the area is too small
+    /// for double precision to give it to that accuracy: the manifolds
+    /// split by little more than the points' accuracy (`closure`), or not
+    /// at all.
     pub resolved: bool,
     pub map_evaluations: u64,
     pub points: usize,
@@ -154,7 +157,10 @@ impl Splitting {
                     self.homoclinic[0].angle
                 )
             } else {
-                format!("no lobe resolved: area below the accuracy ({area:.1e})")
+                format!(
+                    "lobe area {area:.3e}, not resolved to 1e-6 (routes differ by {:.1e})",
+                    self.routes_relative_difference.unwrap_or(f64::NAN)
+                )
             },
         ];
         let specs = [
@@ -246,10 +252,11 @@ pub fn separatrix_splitting(
         None
     };
     let points = found.unstable.len() + found.stable.len();
-    let agree = |x: f64, y: f64, bound: f64| (x - y).abs() <= bound * x.abs().max(y.abs());
-    let resolved = match lobe_area_action {
-        Some(action) => agree(action, polygon.extrapolated, 1e-6),
-        None => agree(polygon.areas[0], polygon.areas[1], 1e-3),
+    let relative = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs());
+    let routes_relative_difference = lobe_area_action.map(|a| relative(a, polygon.extrapolated));
+    let resolved = match routes_relative_difference {
+        Some(difference) => difference <= 1e-6,
+        None => relative(polygon.areas[0], polygon.areas[1]) <= 1e-3,
     };
     Ok(Splitting {
         model: name,
@@ -265,6 +272,7 @@ pub fn separatrix_splitting(
         lobe_area_action,
         lobe_area_polygon: polygon.extrapolated,
         lobe_area_polygons: polygon.areas,
+        routes_relative_difference,
         resolved,
         map_evaluations: map.evaluations.load(Ordering::Relaxed),
         points,
@@ -1037,7 +1045,8 @@ fn orbit_action(
     orbit.extend(forward.into_iter().rev().map(shifted));
     orbit.extend((1..=far(&s)).map(|i| shifted(tail(&s, fs, i))));
     let after = shifted(tail(&s, fs, far(&s) + 1));
-    let action = |y: [f64; 2]| -> Result<f64, OdeError> {
+    // F(z) and P(z), by DOP853 with the action as a third component.
+    let action = |y: [f64; 2]| -> Result<(f64, [f64; 2]), OdeError> {
         let mut integrator = Integrator::new(Method::Dop853 {
             rtol: 1e-13,
             atol: 1e-13,
@@ -1047,14 +1056,24 @@ fn orbit_action(
             model,
             params,
         };
-        Ok(integrator.advance(&with_action, 0.0, &[y[0], y[1], 0.0], map.period)?[2])
+        let end = integrator.advance(&with_action, 0.0, &[y[0], y[1], 0.0], map.period)?;
+        Ok((end[2], [end[0], end[1]]))
     };
     let star = u.origin;
-    let reference = action(star)?;
-    let terms: Vec<f64> = orbit
+    let (reference, _) = action(star)?;
+    let ends: Vec<(f64, [f64; 2])> = orbit
         .par_iter()
-        .map(|&y| action(y).map(|a| a - reference))
+        .map(|&y| action(y))
         .collect::<Result<_, _>>()?;
+    // Where the next point of the list is not exactly the image of the
+    // last (at the homoclinic point, where the W^u and W^s chains meet to
+    // Newton's closure), ∂F/∂q' = p' corrects the sum to first order.
+    let junctions: f64 = ends
+        .iter()
+        .zip(orbit.iter().skip(1).chain([&after]))
+        .map(|((_, image), next)| image[1] * (next[0] - image[0]))
+        .sum();
+    let terms: f64 = ends.iter().map(|(f, _)| f - reference).sum();
     let first_order = star[1] * ((after[0] - (star[0] + tangle.shift)) - (orbit[0][0] - star[0]));
-    Ok(terms.iter().sum::<f64>() - first_order)
+    Ok(terms + junctions - first_order)
 }
