@@ -147,3 +147,32 @@ fn the_routes_agree_on_a_pivot_shaken_sideways() {
     let difference = s.routes_relative_difference.unwrap();
     assert!(s.resolved && difference < 1e-9, "{difference}");
 }
+
+/// The fit ln A = ln C + k ln ε − d/ε recovers its constants from exact
+/// values, and a sweep refuses a value outside the parameter's range
+/// before running anything.
+#[test]
+fn the_exponential_fit_is_exact_on_its_own_law_and_sweeps_check_their_values() {
+    use mechlab::analysis::separatrix::{exponential_fit, splitting_sweep};
+    let law = |e: f64| 14.5 * e.powf(-1.1) * (-1.12 / e).exp();
+    let points: Vec<(f64, f64)> = [0.3, 0.2, 0.15, 0.1, 0.07, 0.05]
+        .iter()
+        .map(|&e| (e, law(e)))
+        .collect();
+    let fit = exponential_fit(&points).unwrap();
+    assert!((fit.c / 14.5 - 1.0).abs() < 1e-9, "{fit:?}");
+    assert!(
+        (fit.k + 1.1).abs() < 1e-9 && (fit.d - 1.12).abs() < 1e-9,
+        "{fit:?}"
+    );
+    assert!(exponential_fit(&points[..3]).is_none());
+    let model = models::by_name("kapitza").unwrap();
+    let refused = splitting_sweep(
+        model,
+        &kapitza_at(0.1),
+        "eps",
+        &[0.2, -0.1],
+        &SplittingSettings::default(),
+    );
+    assert!(matches!(refused, Err(SplittingError::Request { .. })));
+}

@@ -100,6 +100,10 @@ impl<'a> PanelSpec<'a> {
         self.log_x = true;
         self
     }
+    pub fn log_y(mut self) -> Self {
+        self.log_y = true;
+        self
+    }
     pub fn log_log(mut self) -> Self {
         self.log_x = true;
         self.log_y = true;

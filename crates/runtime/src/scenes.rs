@@ -324,18 +324,24 @@ fn values_from(scene: &Scene) -> Result<Option<Vec<f64>>, SceneError> {
         .map(|p| p.trim().parse::<f64>())
         .collect::<Result<_, _>>()
         .map_err(|_| bad("geometric:first,last,count with numbers"))?;
-    let [first, last, count] = parts.as_slice() else {
-        return Err(bad("geometric:first,last,count"));
+    geometric_progression(&parts)
+        .map(Some)
+        .map_err(|reason| bad(reason))
+}
+
+/// `first,last,count`: `count` values from `first` to `last` in geometric
+/// progression, or why not.
+fn geometric_progression(parts: &[f64]) -> Result<Vec<f64>, &'static str> {
+    let [first, last, count] = parts[..] else {
+        return Err("three numbers: first,last,count");
     };
-    if !(*first > 0.0 && *last > 0.0 && *count >= 2.0 && count.fract() == 0.0) {
-        return Err(bad("first and last positive, count a whole number ≥ 2"));
+    if !(first > 0.0 && last > 0.0 && count >= 2.0 && count.fract() == 0.0) {
+        return Err("first and last positive, count a whole number ≥ 2");
     }
-    let n = *count as usize;
-    Ok(Some(
-        (0..n)
-            .map(|k| first * (last / first).powf(k as f64 / (n - 1) as f64))
-            .collect(),
-    ))
+    let n = count as usize;
+    Ok((0..n)
+        .map(|k| first * (last / first).powf(k as f64 / (n - 1) as f64))
+        .collect())
 }
 
 /// Max deviation against ν (log–log, with the fits) and ν × max deviation.
@@ -506,7 +512,7 @@ pub fn separatrix_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use crate::analysis::separatrix::{separatrix_splitting, SplittingSettings};
+    use crate::analysis::separatrix::{separatrix_splitting, splitting_sweep, SplittingSettings};
     let (model, scene) = generic_scene(
         catalog,
         scene_name,
@@ -534,6 +540,12 @@ pub fn separatrix_scene(
                 "400",
                 "points per manifold piece of the lobe polygon",
             ),
+            (
+                "sweep",
+                "none",
+                "also sweep `sweep_parameter` geometrically: first,last,count (none: no sweep)",
+            ),
+            ("sweep_parameter", "eps", "the parameter the sweep sets"),
         ],
     )?;
     let settings = SplittingSettings {
@@ -545,23 +557,81 @@ pub fn separatrix_scene(
         p_max: scene.positive("p_max")?,
         lobe_points: scene.count("lobe_points")?,
     };
+    let params = scene.parameter_values(model.info)?;
     eprintln!("growing the manifolds of the hyperbolic fixed point …");
-    let result = separatrix_splitting(model, &scene.parameter_values(model.info)?, &settings)?;
-    if !result.resolved {
+    let splitting = separatrix_splitting(model, &params, &settings)?;
+    if !splitting.resolved {
         eprintln!(
             "the lobe area is not resolved to 1e-6: action {:?}, polygon {:e} (the manifolds split by little more than double precision tells)",
-            result.lobe_area_action, result.lobe_area_polygon
+            splitting.lobe_area_action, splitting.lobe_area_polygon
         );
     }
-    scene.save_figure(&result.figure(), "separatrix_splitting.png")?;
-    let rows = [
-        ("unstable", &result.unstable),
-        ("stable", &result.stable),
-        ("lobe", &result.lobe),
-    ]
-    .into_iter()
-    .flat_map(|(curve, points)| points.iter().map(move |y| (curve, y[0], y[1])));
+    scene.save_figure(&splitting.figure(), "separatrix_splitting.png")?;
+    let curves = [
+        ("unstable", &splitting.unstable),
+        ("stable", &splitting.stable),
+        ("lobe", &splitting.lobe),
+    ];
+    let rows = curves
+        .into_iter()
+        .flat_map(|(curve, points)| points.iter().map(move |y| (curve, y[0], y[1])));
     scene.write_csv("manifolds.csv", &["curve", "q_lifted", "p"], rows)?;
-    scene.write_summary(&result)?;
+    let sweep = match scene.text("sweep") {
+        "none" => None,
+        _ => {
+            let values = geometric_progression(&scene.numbers("sweep")?).map_err(|reason| {
+                SceneError::BadValue {
+                    name: "sweep".into(),
+                    value: scene.text("sweep").into(),
+                    reason: reason.into(),
+                }
+            })?;
+            eprintln!(
+                "sweeping {} over {} values …",
+                scene.text("sweep_parameter"),
+                values.len()
+            );
+            let sweep = splitting_sweep(
+                model,
+                &params,
+                scene.text("sweep_parameter"),
+                &values,
+                &settings,
+            )?;
+            scene.save_figure(&sweep.figure(), "lobe_area_sweep.png")?;
+            let rows = sweep.rows.iter().map(|r| {
+                (
+                    r.value,
+                    r.eps,
+                    r.lobe_area_action,
+                    r.lobe_area_polygon,
+                    r.angle,
+                    r.resolved,
+                )
+            });
+            scene.write_csv(
+                "lobe_area_sweep.csv",
+                &[
+                    "value",
+                    "eps",
+                    "lobe_area_action",
+                    "lobe_area_polygon",
+                    "angle",
+                    "resolved",
+                ],
+                rows,
+            )?;
+            Some(sweep)
+        }
+    };
+    #[derive(serde::Serialize)]
+    struct Summary<'a> {
+        splitting: &'a crate::analysis::separatrix::Splitting,
+        sweep: Option<&'a crate::analysis::separatrix::SplittingSweep>,
+    }
+    scene.write_summary(&Summary {
+        splitting: &splitting,
+        sweep: sweep.as_ref(),
+    })?;
     Ok(())
 }

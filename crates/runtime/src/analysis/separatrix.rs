@@ -1077,3 +1077,200 @@ fn orbit_action(
     let first_order = star[1] * ((after[0] - (star[0] + tangle.shift)) - (orbit[0][0] - star[0]));
     Ok(terms + junctions - first_order)
 }
+
+/// One value of a sweep: the splitting there, or why it could not be had.
+#[derive(Debug, serde::Serialize)]
+pub struct SweepRow {
+    /// The swept parameter's value.
+    pub value: f64,
+    /// ε = T/2π, the period of the fast phase over 2π (the small parameter
+    /// of averaging, whatever the parameter swept).
+    pub eps: f64,
+    pub lobe_area_action: Option<f64>,
+    pub lobe_area_polygon: Option<f64>,
+    pub angle: Option<f64>,
+    pub resolved: bool,
+    #[serde(serialize_with = "as_text")]
+    pub failure: Option<SplittingError>,
+}
+
+fn as_text<S: serde::Serializer>(e: &Option<SplittingError>, s: S) -> Result<S::Ok, S::Error> {
+    match e {
+        Some(e) => s.serialize_str(&e.to_string()),
+        None => s.serialize_none(),
+    }
+}
+
+/// ln A = ln C + k ln ε − d/ε, fitted by least squares to the resolved
+/// lobe areas: an exponentially small splitting, with the power k and the
+/// exponent d that the nearest complex singularity of the averaged
+/// separatrix sets.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct ExponentialFit {
+    pub c: f64,
+    pub k: f64,
+    pub d: f64,
+    /// The largest |ln A − fit| over the points fitted.
+    pub worst_log_residual: f64,
+}
+
+/// The splitting over values of one parameter.
+#[derive(Debug, serde::Serialize)]
+pub struct SplittingSweep {
+    pub model: String,
+    pub parameter: String,
+    pub rows: Vec<SweepRow>,
+    /// None with fewer than four resolved areas.
+    pub fit: Option<ExponentialFit>,
+    pub seconds: f64,
+}
+
+/// The separatrix splitting of `model` at `params` with `parameter` set to
+/// each of `values` in turn (a value the model file's range refuses is an
+/// error before anything runs); the fit of the resolved lobe areas.
+pub fn splitting_sweep(
+    model: &Model,
+    params: &[f64],
+    parameter: &str,
+    values: &[f64],
+    settings: &SplittingSettings,
+) -> Result<SplittingSweep, SplittingError> {
+    let info = model.info;
+    let index = info.parameter_names.iter().position(|n| *n == parameter);
+    let parameter_error = |value: f64| match info.check_parameter(parameter, value) {
+        Ok(()) => None,
+        Err(e) => Some(e),
+    };
+    let (Some(index), None) = (index, values.iter().find_map(|&v| parameter_error(v))) else {
+        let reason = match values.iter().find_map(|&v| parameter_error(v)) {
+            Some(e) => e.to_string(),
+            None => format!("no parameter '{parameter}'"),
+        };
+        return Err(SplittingError::Request {
+            model: info.name.into(),
+            reason,
+        });
+    };
+    let start = std::time::Instant::now();
+    let mut rows = Vec::with_capacity(values.len());
+    for &value in values {
+        let mut p = params.to_vec();
+        p[index] = value;
+        let eps = model.dynamic.phase_period(&p).unwrap_or(f64::NAN) / TAU;
+        let result = separatrix_splitting(model, &p, settings);
+        let measured = result.as_ref().ok();
+        let row = SweepRow {
+            value,
+            eps,
+            lobe_area_action: measured.and_then(|s| s.lobe_area_action),
+            lobe_area_polygon: measured.map(|s| s.lobe_area_polygon),
+            angle: measured.map(|s| s.homoclinic[0].angle),
+            resolved: measured.is_some_and(|s| s.resolved),
+            failure: result.err(),
+        };
+        rows.push(row);
+    }
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.resolved)
+        .filter_map(|r| Some((r.eps, r.lobe_area_action.or(r.lobe_area_polygon)?)))
+        .collect();
+    Ok(SplittingSweep {
+        model: info.name.into(),
+        parameter: parameter.into(),
+        rows,
+        fit: exponential_fit(&points),
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The least-squares fit of ln A = ln C + k ln ε − d/ε to (ε, A) points.
+pub fn exponential_fit(points: &[(f64, f64)]) -> Option<ExponentialFit> {
+    if points.len() < 4 || points.iter().any(|&(e, a)| !(e > 0.0 && a > 0.0)) {
+        return None;
+    }
+    // Normal equations of the basis (1, ln ε, −1/ε).
+    let basis = |e: f64| [1.0, e.ln(), -1.0 / e];
+    let mut m = [[0.0; 3]; 3];
+    let mut r = [0.0; 3];
+    for &(e, a) in points {
+        let b = basis(e);
+        for i in 0..3 {
+            r[i] += b[i] * a.ln();
+            for j in 0..3 {
+                m[i][j] += b[i] * b[j];
+            }
+        }
+    }
+    let x = nalgebra::Matrix3::from_fn(|i, j| m[i][j])
+        .lu()
+        .solve(&nalgebra::Vector3::from(r))?;
+    let worst_log_residual = points
+        .iter()
+        .map(|&(e, a)| {
+            let b = basis(e);
+            (a.ln() - (x[0] * b[0] + x[1] * b[1] + x[2] * b[2])).abs()
+        })
+        .fold(0.0, f64::max);
+    Some(ExponentialFit {
+        c: x[0].exp(),
+        k: x[1],
+        d: x[2],
+        worst_log_residual,
+    })
+}
+
+impl SplittingSweep {
+    /// The lobe area against 1/ε on a log scale, with the fit.
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{Figure, PanelSpec, Rgb};
+        let points: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter_map(|r| Some((1.0 / r.eps, r.lobe_area_action.or(r.lobe_area_polygon)?)))
+            .filter(|p| p.1 > 0.0)
+            .collect();
+        let x = points.iter().map(|p| p.0);
+        let y = points.iter().map(|p| p.1);
+        let range = |v: &mut dyn Iterator<Item = f64>| {
+            v.fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)))
+        };
+        let (x0, x1) = range(&mut x.clone());
+        let (y0, y1) = range(&mut y.clone());
+        let title = match self.fit {
+            Some(f) => format!(
+                "{}: lobe area ≈ {:.3e}·ε^{:.2}·exp(−{:.4}/ε)",
+                self.model, f.c, f.k, f.d
+            ),
+            None => format!("{}: lobe area (too few resolved values to fit)", self.model),
+        };
+        let spec = PanelSpec::new(
+            &title,
+            "1/ε",
+            "lobe area",
+            (0.9 * x0, 1.1 * x1),
+            (0.3 * y0, 3.0 * y1),
+        )
+        .log_y();
+        let mut figure = Figure::single(720, 560, spec);
+        let resolved: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter(|r| r.resolved)
+            .filter_map(|r| Some((1.0 / r.eps, r.lobe_area_action.or(r.lobe_area_polygon)?)))
+            .collect();
+        figure.points(0, points.iter().copied(), Rgb(160, 160, 160), 5);
+        figure.points(0, resolved, Rgb(200, 30, 30), 5);
+        if let Some(f) = self.fit {
+            let curve: Vec<(f64, f64)> = (0..=100)
+                .map(|i| {
+                    let inv = 0.9 * x0 + (1.1 * x1 - 0.9 * x0) * i as f64 / 100.0;
+                    let e = 1.0 / inv;
+                    (inv, f.c * e.powf(f.k) * (-f.d / e).exp())
+                })
+                .collect();
+            figure.line(0, &curve, Rgb(30, 60, 200));
+        }
+        figure
+    }
+}
