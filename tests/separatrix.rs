@@ -176,3 +176,37 @@ fn the_exponential_fit_is_exact_on_its_own_law_and_sweeps_check_their_values() {
     );
     assert!(matches!(refused, Err(SplittingError::Request { .. })));
 }
+
+/// The splitting is exponentially small, A ≈ C εᵏ e^{−d/ε}, with d the
+/// imaginary time of the nearest complex singularity of the averaged
+/// separatrix. For Kapitza's H̄ = p²/2 + cos q + (A²/4) sin² q, with
+/// x = cos(q/2) the separatrix is dt = −dx / ((1 − x²) √(1 − a x²)),
+/// a = A²/2, and x → ∞ at imaginary time
+/// d = √a ∫₀^∞ du / (cosh² u − a) = arctan(√(a/(1 − a))) / √(1 − a):
+/// π/(2√2) = 1.1107 at A = 1. The fit over ε ∈ [0.06, 0.3] must give it to 1 %.
+#[test]
+fn the_splitting_exponent_is_the_imaginary_time_of_the_separatrix_singularity() {
+    use mechlab::analysis::separatrix::splitting_sweep;
+    let model = models::by_name("kapitza").unwrap();
+    let values: Vec<f64> = (0..12)
+        .map(|k| 0.3 * (0.06f64 / 0.3).powf(k as f64 / 11.0))
+        .collect();
+    let sweep = splitting_sweep(
+        model,
+        &kapitza_at(0.1),
+        "eps",
+        &values,
+        &SplittingSettings::default(),
+    )
+    .unwrap();
+    assert!(sweep.rows.iter().all(|r| r.resolved), "{:?}", sweep.rows);
+    let a: f64 = 0.5;
+    let theory = (a / (1.0 - a)).sqrt().atan() / (1.0 - a).sqrt();
+    assert!((theory - PI / (2.0 * 2f64.sqrt())).abs() < 1e-15);
+    let fit = sweep.fit.unwrap();
+    assert!(
+        (fit.d / theory - 1.0).abs() < 0.01,
+        "fitted d {} against {theory}",
+        fit.d
+    );
+}
