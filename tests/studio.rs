@@ -264,6 +264,55 @@ async fn overlay_matches_the_averaged_hamiltonian_by_hand() {
     assert!(body.contains("order 3 is not derived"), "{body}");
 }
 
+/// The manifolds overlay: Kapitza's W^u and W^s at A = 1 on the page's
+/// cylinder, with a primary homoclinic point on the symmetry line q = ±π and
+/// the lobe area of `analysis::separatrix`; a 2-degree model is refused by
+/// name (422), an unknown field by name (400).
+#[tokio::test]
+async fn manifolds_overlay_gives_the_tangle_or_a_named_error() {
+    let request = json!({"model": "kapitza", "params": {"A": 1.0, "eps": 0.1}});
+    let (status, _, body) = call("POST", "/api/manifolds", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let m: Value = serde_json::from_str(&body).unwrap();
+    for curve in ["unstable", "stable"] {
+        let segments = m[curve].as_array().unwrap();
+        assert!(segments.len() > 100, "{curve}: {}", segments.len());
+        for s in segments {
+            let q = [s[0].as_f64().unwrap(), s[2].as_f64().unwrap()];
+            assert!(
+                q.iter()
+                    .all(|q| (-std::f64::consts::PI..std::f64::consts::PI).contains(q)),
+                "{s}"
+            );
+        }
+    }
+    let on_line = m["homoclinic"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|h| (h[0].as_f64().unwrap().abs() - std::f64::consts::PI).abs() < 1e-8);
+    assert!(on_line, "{}", m["homoclinic"]);
+    let area = m["lobe_area"].as_f64().unwrap();
+    assert!(m["resolved"].as_bool().unwrap());
+    assert!((area / 2.635106352e-3 - 1.0).abs() < 1e-8, "{area}");
+    let (status, _, body) = call(
+        "POST",
+        "/api/manifolds",
+        Some(json!({"model": "double_pendulum"})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(body.contains("degrees of freedom"), "{body}");
+    let (status, _, body) = call(
+        "POST",
+        "/api/manifolds",
+        Some(json!({"model": "kapitza", "colour": "red"})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
+    assert!(body.contains("colour"), "{body}");
+}
+
 /// Every bad request gets a status and a message naming the problem; the
 /// router keeps answering.
 #[tokio::test]
@@ -576,6 +625,30 @@ mod browser {
             assert_eq!(b["seed"], a["seed"]);
             assert_ne!(b["second"], a["second"], "A moved, the orbit did not");
         }
+
+        // The manifolds overlay at A = 1 (a saddle at the upright): W^u and
+        // W^s drawn, a lobe area in the note.
+        client
+            .execute(
+                "const a = document.getElementById('value-A'); a.value = '1'; a.dispatchEvent(new Event('change'));\
+                 document.getElementById('show-manifolds').click(); return true;",
+                vec![],
+            )
+            .await
+            .unwrap();
+        wait_for(
+            &client,
+            "studio.params.A === 1 && studio.manifolds && studio.manifolds.unstable.length > 100",
+            60,
+        )
+        .await;
+        wait_for(
+            &client,
+            "document.getElementById('manifolds-note').textContent.includes('lobe area')",
+            10,
+        )
+        .await;
+        tokio::time::sleep(Duration::from_millis(300)).await;
 
         let png = client.screenshot().await.unwrap();
         let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("studio");

@@ -535,6 +535,7 @@ pub fn separatrix_scene(
                 "400",
                 "iterates of the period map per manifold, at most",
             ),
+            ("max_points", "20000", "points per manifold, at most"),
             (
                 "lobe_points",
                 "400",
@@ -553,7 +554,7 @@ pub fn separatrix_scene(
         guess: None,
         spacing: scene.positive("spacing")?,
         iterates: scene.count("iterates")?,
-        max_points: 20_000,
+        max_points: scene.count("max_points")?,
         p_max: scene.positive("p_max")?,
         lobe_points: scene.count("lobe_points")?,
     };

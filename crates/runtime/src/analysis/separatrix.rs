@@ -214,7 +214,7 @@ pub enum SplittingError {
         iterates: usize,
         p_max: f64,
     },
-    #[error("model '{model}': Newton for the homoclinic point near {near:?} did not converge")]
+    #[error("model '{model}': Newton for the homoclinic point near {near:?} did not converge (where the averaged system has two saddles, as Kapitza's above A = √2, their connections are heteroclinic, which are not measured yet)")]
     Homoclinic { model: String, near: [f64; 2] },
     #[error("model '{model}': {reason}")]
     Request { model: String, reason: String },
@@ -415,6 +415,9 @@ struct Branch {
 /// Distance of the fundamental domain from the fixed point.
 const OFFSET: f64 = 1e-9;
 
+/// The largest manifold parameter σ (iterates of the map) evaluated.
+const MAX_SIGMA: f64 = 1e5;
+
 impl Branch {
     fn flipped(self) -> Branch {
         Branch {
@@ -445,6 +448,14 @@ impl Branch {
     }
 
     fn point(&self, map: &Map, sigma: f64) -> Result<[f64; 2], OdeError> {
+        // A Newton step that ran away must not become a chain of a
+        // billion iterates.
+        if !(0.0..=MAX_SIGMA).contains(&sigma) {
+            return Err(OdeError::InvalidSetting {
+                what: "manifold parameter σ (iterates from the fixed point, at most 10⁵)",
+                value: sigma,
+            });
+        }
         let k = sigma.floor();
         Ok(*self
             .chain(map, sigma - k, k as usize + 1)?
@@ -542,7 +553,9 @@ fn saddle_from(point: [f64; 2], m: &Matrix2) -> Option<Saddle> {
         return None;
     }
     let (big, small) = (tr / 2.0 + disc.sqrt(), tr / 2.0 - disc.sqrt());
-    if !(big > 1.0 + 1e-12 && small > 0.0 && small < 1.0 - 1e-12) {
+    // Multipliers within 1e-6 of 1 would need millions of iterates to grow
+    // a manifold: not treated as hyperbolic.
+    if !(big > 1.0 + 1e-6 && small > 0.0 && small < 1.0 - 1e-6) {
         return None;
     }
     let eigenvector = |lambda: f64| {
@@ -900,6 +913,9 @@ fn refine_homoclinic(
         let ds = (tu[0] * -r[1] - tu[1] * -r[0]) / det;
         su += du;
         ss += ds;
+        if !((0.0..MAX_SIGMA).contains(&su) && (0.0..MAX_SIGMA).contains(&ss)) {
+            break;
+        }
         if du.abs().max(ds.abs()) < 1e-13 {
             best = (residual(su, ss).map_or(size, |r| r[0].hypot(r[1])), su, ss);
             break;

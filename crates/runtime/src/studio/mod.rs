@@ -47,6 +47,8 @@ pub enum StudioError {
     Ode(#[from] OdeError),
     #[error(transparent)]
     PeriodMap(#[from] PeriodMapError),
+    #[error(transparent)]
+    Splitting(#[from] crate::analysis::separatrix::SplittingError),
 }
 
 /// What is wrong with a request's numbers.
@@ -699,5 +701,62 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
         },
         levels,
         equilibria,
+    })
+}
+
+/// A request for the invariant manifolds of the period map's hyperbolic
+/// fixed point (a model of one degree of freedom with a fast phase).
+#[derive(Clone, Debug, Deserialize)]
+pub struct ManifoldsRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+/// W^u and W^s on the page's cylinder (q in [−π, π)) as segments
+/// (q₀, p₀, q₁, p₁), the two primary homoclinic points, and the lobe.
+#[derive(Clone, Debug, Serialize)]
+pub struct Manifolds {
+    pub unstable: Vec<[f64; 4]>,
+    pub stable: Vec<[f64; 4]>,
+    pub homoclinic: Vec<[f64; 2]>,
+    pub fixed_point: [f64; 2],
+    pub lobe_area: f64,
+    pub resolved: bool,
+    pub angle: f64,
+}
+
+/// The manifolds of the hyperbolic fixed point of the model's period map
+/// (`analysis::separatrix`), for the studio's overlay.
+pub fn manifolds(catalog: Catalog, request: &ManifoldsRequest) -> Result<Manifolds, StudioError> {
+    use crate::analysis::separatrix::{separatrix_splitting, SplittingSettings};
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    let settings = SplittingSettings {
+        spacing: 0.03,
+        lobe_points: 100,
+        ..Default::default()
+    };
+    let s = separatrix_splitting(setup.handle, &setup.params, &settings)?;
+    let periodic = setup.model.periodic()[0];
+    let place = |y: &[f64; 2]| [if periodic { wrap_angle(y[0]) } else { y[0] }, y[1]];
+    // Consecutive points as segments, except across the cut at ±π.
+    let segments = |points: &[[f64; 2]]| -> Vec<[f64; 4]> {
+        points
+            .windows(2)
+            .map(|w| (place(&w[0]), place(&w[1])))
+            .filter(|(a, b)| (b[0] - a[0]).abs() < std::f64::consts::PI)
+            .map(|(a, b)| [a[0], a[1], b[0], b[1]])
+            .collect()
+    };
+    Ok(Manifolds {
+        unstable: segments(&s.unstable),
+        stable: segments(&s.stable),
+        homoclinic: s.homoclinic.iter().map(|h| place(&h.point)).collect(),
+        fixed_point: place(&s.fixed_point),
+        lobe_area: s.lobe_area_action.unwrap_or(s.lobe_area_polygon),
+        resolved: s.resolved,
+        angle: s.homoclinic[0].angle,
     })
 }

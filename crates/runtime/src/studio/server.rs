@@ -62,9 +62,11 @@ impl ApiError {
             ApiError::Studio(StudioError::UnknownModel(_)) | ApiError::NotFound(_) => {
                 StatusCode::NOT_FOUND
             }
-            ApiError::Studio(StudioError::ContactModel(_) | StudioError::NoFastPhase(_)) => {
-                StatusCode::UNPROCESSABLE_ENTITY
-            }
+            ApiError::Studio(
+                StudioError::ContactModel(_)
+                | StudioError::NoFastPhase(_)
+                | StudioError::Splitting(_),
+            ) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
@@ -108,6 +110,7 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/orbit", post(orbit))
         .route("/api/chaos", post(chaos))
         .route("/api/overlay", post(overlay))
+        .route("/api/manifolds", post(manifolds))
         .fallback(|uri: axum::http::Uri| async move { ApiError::NotFound(uri.to_string()) })
         .with_state(catalog)
 }
@@ -150,6 +153,13 @@ async fn overlay(State(catalog): State<Catalog>, body: Bytes) -> Result<Response
     let request: OverlayRequest = serde_json::from_slice(&body)?;
     let answer =
         blocking(move || super::overlay(catalog, &request).map_err(ApiError::from)).await?;
+    Ok(axum::Json(answer).into_response())
+}
+
+async fn manifolds(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
+    let request: super::ManifoldsRequest = serde_json::from_slice(&body)?;
+    let answer =
+        blocking(move || super::manifolds(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 

@@ -14,6 +14,7 @@ const studio = {
   orbits: [],
   overlay: null,
   chaos: null,
+  manifolds: null,
   nextId: 1,
   pointsReceived: 0,
 };
@@ -122,7 +123,28 @@ function draw(g, width, height) {
       g.fillRect(px - 0.8, py - 0.8, 1.6, 1.6);
     }
   }
+  if (studio.manifolds && $("show-manifolds").checked) drawManifolds(g);
   if (studio.overlay && $("show-equilibria").checked) drawEquilibria(g);
+}
+
+function drawManifolds(g) {
+  g.lineWidth = 1.2;
+  for (const [curve, color] of [["unstable", "rgba(200, 30, 30, 0.9)"], ["stable", "rgba(30, 60, 200, 0.9)"]]) {
+    g.strokeStyle = color;
+    g.beginPath();
+    for (const [x0, y0, x1, y1] of studio.manifolds[curve]) {
+      const [a, b] = toPixel(x0, y0);
+      const [c, d] = toPixel(x1, y1);
+      g.moveTo(a, b);
+      g.lineTo(c, d);
+    }
+    g.stroke();
+  }
+  g.fillStyle = "#000";
+  for (const [x, y] of studio.manifolds.homoclinic) {
+    const [px, py] = toPixel(x, y);
+    g.fillRect(px - 3, py - 3, 6, 6);
+  }
 }
 
 function drawGrid(g, width, height) {
@@ -338,7 +360,32 @@ function debounce(work, ms) {
   let timer = null;
   return () => { clearTimeout(timer); timer = setTimeout(work, ms); };
 }
-const refreshOverlays = debounce(() => { refreshOverlay(); refreshChaos(); }, 150);
+let manifoldsController = null;
+let manifoldsKey = null;
+
+// The manifolds depend on the model and its parameters, not on the view.
+async function refreshManifolds() {
+  const wanted = $("show-manifolds").checked && studio.model.fast_phase && studio.model.state.length === 2;
+  if (!wanted) { studio.manifolds = null; manifoldsKey = null; $("manifolds-note").textContent = ""; redraw(); return; }
+  const request = { model: studio.model.name, params: setup().params };
+  const key = JSON.stringify(request);
+  if (key === manifoldsKey) return;
+  if (manifoldsController) manifoldsController.abort();
+  manifoldsController = new AbortController();
+  manifoldsKey = key;
+  $("manifolds-note").textContent = "(growing …)";
+  try {
+    studio.manifolds = await postJson("/api/manifolds", request, manifoldsController.signal);
+    const m = studio.manifolds;
+    $("manifolds-note").textContent = m.resolved
+      ? `(lobe area ${m.lobe_area.toPrecision(6)}, angle ${m.angle.toPrecision(3)})`
+      : `(lobe area ${m.lobe_area.toExponential(2)}, not resolved)`;
+    redraw();
+  } catch (e) {
+    if (!aborted(e)) { manifoldsKey = null; studio.manifolds = null; $("manifolds-note").textContent = ""; say(`manifolds: ${e.message}`); }
+  }
+}
+const refreshOverlays = debounce(() => { refreshOverlay(); refreshChaos(); refreshManifolds(); }, 150);
 const rerunOrbits = debounce(() => { for (const orbit of studio.orbits) startOrbit(orbit); listOrbits(); }, 40);
 
 // ---------- the model and its controls ----------
@@ -398,6 +445,8 @@ async function chooseModel(name) {
   studio.through = new Array(model.state.length).fill(0);
   studio.overlay = null;
   studio.chaos = null;
+  studio.manifolds = null;
+  manifoldsKey = null;
   $("model").value = name;
   $("model-file").textContent = model.source_file;
   $("levels-of").textContent = model.fast_phase ? "H̄" : "H";
@@ -518,6 +567,7 @@ function wire() {
   $("reset-view").addEventListener("click", () => { defaultView(studio.model); redraw(); refreshOverlays(); });
   for (const id of ["method", "tol"]) $(id).addEventListener("change", () => { rerunOrbits(); refreshOverlays(); });
   for (const id of ["show-levels", "show-equilibria"]) $(id).addEventListener("change", () => { refreshOverlay(); redraw(); });
+  $("show-manifolds").addEventListener("change", refreshManifolds);
   for (const id of ["show-chaos", "chaos-periods"]) $(id).addEventListener("change", refreshChaos);
   for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
     $(id).addEventListener("change", () => {
