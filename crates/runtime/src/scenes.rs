@@ -606,6 +606,7 @@ pub fn separatrix_scene(
                     r.eps,
                     r.lobe_area_action,
                     r.lobe_area_polygon,
+                    r.lobe_area_melnikov,
                     r.angle,
                     r.resolved,
                 )
@@ -617,6 +618,7 @@ pub fn separatrix_scene(
                     "eps",
                     "lobe_area_action",
                     "lobe_area_polygon",
+                    "lobe_area_melnikov",
                     "angle",
                     "resolved",
                 ],
