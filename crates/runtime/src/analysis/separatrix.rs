@@ -758,7 +758,8 @@ fn tangle(
         for (is, s) in stable.iter().enumerate() {
             let ps = s.ordered();
             for &shift in shifts {
-                let crossings = intersections(&pu, &ps, shift);
+                let saddles = [saddle.point, [saddle.point[0] + shift, saddle.point[1]]];
+                let crossings = intersections(&pu, &ps, shift, &saddles);
                 if let Some(&(first, _)) = crossings.first() {
                     if best.as_ref().is_none_or(|b| first < b.0) {
                         best = Some((first, iu, is, shift, crossings));
@@ -814,7 +815,20 @@ fn tangle(
 
 /// Crossings of the polyline `u` with the polyline `s` shifted by `shift`
 /// in q, as (σ on u, σ on s) by linear interpolation, sorted along u.
-fn intersections(u: &[(f64, [f64; 2])], s: &[(f64, [f64; 2])], shift: f64) -> Vec<(f64, f64)> {
+/// Segments within `NEAR_SADDLE` of a saddle are left out: the tangle is
+/// densest there, and every homoclinic orbit also crosses away from it.
+fn intersections(
+    u: &[(f64, [f64; 2])],
+    s: &[(f64, [f64; 2])],
+    shift: f64,
+    saddles: &[[f64; 2]; 2],
+) -> Vec<(f64, f64)> {
+    const NEAR_SADDLE: f64 = 0.1;
+    let away = |y: &[f64; 2]| {
+        saddles
+            .iter()
+            .all(|z| (y[0] - z[0]).hypot(y[1] - z[1]) > NEAR_SADDLE)
+    };
     // The segments of s in the cells of a grid that their bounding boxes
     // touch, so that each segment of u is tested against its neighbours
     // only (the manifolds have tens of thousands of points).
@@ -829,6 +843,9 @@ fn intersections(u: &[(f64, [f64; 2])], s: &[(f64, [f64; 2])], shift: f64) -> Ve
     let shifted = |k: usize| [s[k].1[0] + shift, s[k].1[1]];
     let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
     for k in 0..s.len().saturating_sub(1) {
+        if !away(&shifted(k)) && !away(&shifted(k + 1)) {
+            continue;
+        }
         let (xs, ys) = span(shifted(k), shifted(k + 1));
         if xs.clone().count() * ys.clone().count() > 10_000 {
             continue; // a segment across the box: none is that long in a drawn manifold
@@ -843,6 +860,9 @@ fn intersections(u: &[(f64, [f64; 2])], s: &[(f64, [f64; 2])], shift: f64) -> Ve
     let mut seen = std::collections::HashSet::new();
     for (j, wu) in u.windows(2).enumerate() {
         let (a, b) = (wu[0].1, wu[1].1);
+        if !away(&a) && !away(&b) {
+            continue;
+        }
         let (xs, ys) = span(a, b);
         seen.clear();
         for x in xs {
