@@ -9,6 +9,15 @@ use mechlab::analysis::separatrix::{
 use mechlab::models::{self, kapitza};
 use std::f64::consts::{PI, TAU};
 
+/// Coarser than the scene's defaults, enough for the tests' bounds.
+fn coarse() -> SplittingSettings {
+    SplittingSettings {
+        spacing: 0.05,
+        lobe_points: 200,
+        ..Default::default()
+    }
+}
+
 fn kapitza_at(eps: f64) -> Vec<f64> {
     kapitza::Params {
         A: 1.0,
@@ -51,11 +60,7 @@ fn multipliers_follow_the_averaged_saddle_to_order_eps_cubed() {
 #[test]
 fn lobe_area_by_action_equals_the_polygon_and_a_homoclinic_point_is_on_the_symmetry_line() {
     let model = models::by_name("kapitza").unwrap();
-    let settings = SplittingSettings {
-        spacing: 0.05,
-        lobe_points: 200,
-        ..Default::default()
-    };
+    let settings = coarse();
     let s = separatrix_splitting(model, &kapitza_at(0.1), &settings).unwrap();
     let action = s.lobe_area_action.expect("an area-preserving map");
     assert!(action > 1e-4 && action < 1e-2, "lobe area {action}");
@@ -117,11 +122,7 @@ fn models_without_a_saddle_get_named_errors() {
 #[test]
 fn a_splitting_below_the_accuracy_is_not_reported_as_a_lobe() {
     let model = models::by_name("circle_pendulum").unwrap();
-    let settings = SplittingSettings {
-        spacing: 0.05,
-        lobe_points: 200,
-        ..Default::default()
-    };
+    let settings = coarse();
     let s = separatrix_splitting(model, &model.dynamic.defaults(), &settings).unwrap();
     assert!(
         !s.resolved,
@@ -138,11 +139,7 @@ fn a_splitting_below_the_accuracy_is_not_reported_as_a_lobe() {
 #[test]
 fn the_routes_agree_on_a_pivot_shaken_sideways() {
     let model = models::by_name("horizontal_pendulum").unwrap();
-    let settings = SplittingSettings {
-        spacing: 0.05,
-        lobe_points: 200,
-        ..Default::default()
-    };
+    let settings = coarse();
     let s = separatrix_splitting(model, &model.dynamic.defaults(), &settings).unwrap();
     assert!(s.fixed_point[0].abs() > 0.05, "{:?}", s.fixed_point);
     let difference = s.routes_relative_difference.unwrap();

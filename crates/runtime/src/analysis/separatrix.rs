@@ -235,10 +235,9 @@ pub fn separatrix_splitting(
     settings: &SplittingSettings,
 ) -> Result<Splitting, SplittingError> {
     let start = std::time::Instant::now();
-    let (map, guesses) = prepare(model, params, settings)?;
+    let (map, guesses, named) = prepare(model, params, settings)?;
     let name = model.info.name.to_string();
-    let named = model.info.named_values(params).unwrap_or_default();
-    let periodic = model.sized.is_some_and(|_| model.dynamic.periodic()[0]);
+    let periodic = model.dynamic.periodic()[0];
     let saddle = hyperbolic_point(&map, &name, &guesses)?;
     let found = tangle(&map, &saddle, settings, periodic, &name)?;
     let [a, b] = &found.homoclinic;
@@ -277,7 +276,13 @@ pub fn separatrix_splitting(
         lobe_area_action,
         lobe_area_polygon: polygon.extrapolated,
         lobe_area_polygons: polygon.areas,
-        lobe_area_melnikov: melnikov_along(model, params, found.unstable_branch.direction).ok(),
+        lobe_area_melnikov: guesses
+            .iter()
+            .min_by(|g, h| distance(g, &saddle.point).total_cmp(&distance(h, &saddle.point)))
+            .and_then(|&averaged| {
+                let toward = found.unstable_branch.direction;
+                melnikov_along(model.dynamic, params, map.period, averaged, toward).ok()
+            }),
         routes_relative_difference,
         resolved,
         map_evaluations: map.evaluations.load(Ordering::Relaxed),
@@ -308,7 +313,7 @@ pub fn hyperbolic_fixed_point(
     params: &[f64],
     settings: &SplittingSettings,
 ) -> Result<FixedPoint, SplittingError> {
-    let (map, guesses) = prepare(model, params, settings)?;
+    let (map, guesses, _) = prepare(model, params, settings)?;
     let saddle = hyperbolic_point(&map, model.info.name, &guesses)?;
     Ok(FixedPoint {
         point: saddle.point,
@@ -324,7 +329,7 @@ fn prepare(
     model: &Model,
     params: &[f64],
     settings: &SplittingSettings,
-) -> Result<(Map, Vec<[f64; 2]>), SplittingError> {
+) -> Result<(Map, Vec<[f64; 2]>, BTreeMap<String, f64>), SplittingError> {
     let name = model.info.name.to_string();
     let fixed = match model.sized {
         Some(Sized::Dof1(fixed)) => fixed,
@@ -336,12 +341,12 @@ fn prepare(
         }
         None => return Err(SplittingError::ContactModel(name)),
     };
-    if model.info.named_values(params).is_none() {
+    let Some(named) = model.info.named_values(params) else {
         return Err(SplittingError::Request {
             model: name,
             reason: format!("{} parameter values", params.len()),
         });
-    }
+    };
     let period = match fixed.phase_period(params) {
         Some(t) if fixed.has_fast_phase() => t,
         _ => return Err(SplittingError::NoFastPhase(name)),
@@ -365,7 +370,7 @@ fn prepare(
         method: settings.method,
         evaluations: AtomicU64::new(0),
     };
-    Ok((map, guesses))
+    Ok((map, guesses, named))
 }
 
 /// The period map and its inverse, counting evaluations.
@@ -1352,22 +1357,27 @@ impl System<2> for AveragedField<'_> {
 /// Along the branch of the separatrix that leaves the saddle towards
 /// increasing q.
 pub fn melnikov_lobe_area(model: &Model, params: &[f64]) -> Result<f64, SplittingError> {
-    melnikov_along(model, params, [1.0, 0.0])
+    // Without a guess, prepare's starts are the averaged saddles.
+    let (map, saddles, _) = prepare(model, params, &SplittingSettings::default())?;
+    melnikov_along(model.dynamic, params, map.period, saddles[0], [1.0, 0.0])
+}
+
+fn distance(a: &[f64; 2], b: &[f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
 /// [`melnikov_lobe_area`] along the branch leaving the saddle on the side
 /// of `toward` (a forcing that travels with the phase splits the two
 /// branches of a separatrix very differently).
-fn melnikov_along(model: &Model, params: &[f64], toward: [f64; 2]) -> Result<f64, SplittingError> {
-    let name = model.info.name.to_string();
-    let (map, _) = prepare(model, params, &SplittingSettings::default())?;
-    let dynamic = model.dynamic;
-    let period = map.period;
+fn melnikov_along(
+    dynamic: &dyn DynamicModel,
+    params: &[f64],
+    period: f64,
+    saddle: [f64; 2],
+    toward: [f64; 2],
+) -> Result<f64, SplittingError> {
+    let name = dynamic.info().name.to_string();
     let eps = period / TAU;
-    let saddle = saddles(dynamic, params)
-        .into_iter()
-        .next()
-        .ok_or_else(|| SplittingError::NoSaddle(name.clone()))?;
     let h_bar = |y: &[f64; 2]| dynamic.averaged_energy(params, y).unwrap_or(f64::NAN);
     let field = AveragedField {
         model: dynamic,
