@@ -164,7 +164,7 @@ fn grid(t_end: f64, samples: usize) -> Vec<f64> {
 
 /// The runs of a Hamiltonian model at its own sizes, on its generated
 /// systems (so every method, `taylor` included, is available).
-struct HamiltonianRuns<'a> {
+pub struct HamiltonianRuns<'a> {
     model: &'a dyn DynamicModel,
     params: &'a [f64],
     y0: &'a [f64],

@@ -357,18 +357,69 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
     }
 }
 
-/// A Hamiltonian model at its own size, for [`with_fixed`]: one variant per
-/// number of degrees of freedom a model file may have (1 to 8).
+/// A Hamiltonian model at its own size, for [`with_fixed`]. The analyses
+/// are compiled ahead, in this crate, for 1 to 4 degrees of freedom; a
+/// model of 5 to 8 brings its own (see [`LargeModel`]).
 #[derive(Clone, Copy)]
 pub enum Sized {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
     Dof4(&'static Erased<4, 8, 16, 72>),
-    Dof5(&'static Erased<5, 10, 20, 110>),
-    Dof6(&'static Erased<6, 12, 24, 156>),
-    Dof7(&'static Erased<7, 14, 28, 210>),
-    Dof8(&'static Erased<8, 16, 32, 272>),
+    Large(&'static dyn LargeModel),
+}
+
+/// Declares the works that run on a model at its own size (each is a
+/// [`WithFixed`] with one lifetime), once: [`LargeModel`] gets a method per
+/// work, [`AtSize`] implements it, and each work a [`LargeWork`] calling it.
+macro_rules! large_works {
+    ($($method:ident: $work:path => $output:ty;)*) => {
+        /// The analyses of one model of 5 to 8 degrees of freedom, compiled
+        /// in the models package for the sizes its model files have. Half
+        /// the runtime's compile time was the analyses at sizes 5–8, which
+        /// no model in `models/` needed (docs/building.md).
+        pub trait LargeModel: Sync {
+            $(fn $method(&self, work: $work) -> $output;)*
+        }
+
+        impl<const D: usize, const S: usize, const T: usize, const V: usize> LargeModel
+            for AtSize<D, S, T, V>
+        {
+            $(fn $method(&self, work: $work) -> $output {
+                work.run(self.0)
+            })*
+        }
+
+        $(impl LargeWork for $work {
+            fn on_large(self, model: &dyn LargeModel) -> $output {
+                model.$method(self)
+            }
+        })*
+    };
+}
+
+large_works! {
+    explore: crate::explore::HamiltonianRuns<'_> => Result<crate::explore::Exploration, crate::explore::ExploreError>;
+    stability: crate::analysis::stability::Analysis<'_> => Result<crate::analysis::stability::Stability, crate::analysis::stability::StabilityError>;
+    at_equilibrium: crate::analysis::stability::AtEquilibrium<'_> => Result<crate::analysis::stability::EquilibriumStability, crate::analysis::stability::StabilityError>;
+    stability_chart: crate::analysis::stability::Chart<'_> => Result<crate::analysis::stability::StabilityChart, crate::analysis::stability::StabilityError>;
+    averaging: crate::analysis::averaging::Sweep<'_> => Result<crate::analysis::averaging::AveragingConvergence, crate::analysis::averaging::AveragingError>;
+    period_map: crate::analysis::period_map::Portraits<'_> => Result<crate::analysis::period_map::Portrait, crate::analysis::period_map::PeriodMapError>;
+    chaos_map: crate::analysis::chaos_map::Map<'_> => Result<crate::analysis::chaos_map::ChaosMap, crate::analysis::chaos_map::ChaosMapError>;
+    studio_orbit: crate::studio::OrbitWork<'_> => Result<crate::studio::OrbitEnd, crate::studio::StudioError>;
+}
+
+/// A model of 5 to 8 degrees of freedom as a [`LargeModel`]: the models
+/// package makes one per such model, which compiles the analyses there at
+/// that size.
+pub struct AtSize<const D: usize, const S: usize, const T: usize, const V: usize>(
+    pub &'static Erased<D, S, T, V>,
+);
+
+/// A work that also runs on a [`LargeModel`] (implemented by
+/// `large_works!` for every work).
+pub trait LargeWork: WithFixed {
+    fn on_large(self, model: &dyn LargeModel) -> Self::Output;
 }
 
 /// One generated model: what it is, its dynamically sized interface, and
@@ -426,17 +477,15 @@ pub trait WithFixed {
 
 /// Runs `work` on a Hamiltonian model at its own sizes (None for a
 /// contact model). The analyses are compiled once per size, whatever the
-/// models are.
-pub fn with_fixed<W: WithFixed>(model: &Model, work: W) -> Option<W::Output> {
+/// models are: here for 1 to 4 degrees of freedom, in the models package
+/// for larger sizes that its model files have.
+pub fn with_fixed<W: LargeWork>(model: &Model, work: W) -> Option<W::Output> {
     model.sized.map(|sized| match sized {
         Sized::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
         Sized::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
         Sized::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
         Sized::Dof4(m) => work.run::<_, 4, 8, 16, 72>(m),
-        Sized::Dof5(m) => work.run::<_, 5, 10, 20, 110>(m),
-        Sized::Dof6(m) => work.run::<_, 6, 12, 24, 156>(m),
-        Sized::Dof7(m) => work.run::<_, 7, 14, 28, 210>(m),
-        Sized::Dof8(m) => work.run::<_, 8, 16, 32, 272>(m),
+        Sized::Large(m) => work.on_large(m),
     })
 }
 

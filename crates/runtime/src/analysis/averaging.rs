@@ -238,7 +238,8 @@ pub fn convergence(
         .ok_or_else(|| AveragingError::ContactModel(model.info.name.into()))?
 }
 
-struct Sweep<'a> {
+/// The work of [`convergence`] at one size.
+pub struct Sweep<'a> {
     params: &'a [f64],
     settings: &'a ConvergenceSettings,
 }

@@ -102,7 +102,8 @@ pub fn chaos_map(
         .ok_or_else(|| ChaosMapError::ContactModel(model.info.name.into()))?
 }
 
-struct Map<'a> {
+/// The work of [`chaos_map`] at one size.
+pub struct Map<'a> {
     params: &'a [f64],
     settings: &'a ChaosMapSettings,
     row_done: &'a (dyn Fn() -> bool + Sync),

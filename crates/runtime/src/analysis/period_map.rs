@@ -141,7 +141,8 @@ pub fn portrait(
         .ok_or_else(|| PeriodMapError::ContactModel(model.info.name.into()))?
 }
 
-struct Portraits<'a> {
+/// The work of [`portrait`] at one size.
+pub struct Portraits<'a> {
     params: &'a [f64],
     settings: &'a PortraitSettings,
 }

@@ -121,7 +121,8 @@ pub fn stability(
         .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
 }
 
-struct Analysis<'a> {
+/// The work of [`stability`]: equilibria, thresholds and windows at one size.
+pub struct Analysis<'a> {
     params: &'a [f64],
     settings: &'a Settings,
 }
@@ -194,7 +195,8 @@ pub fn averaged_stability(
     .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
 }
 
-struct AtEquilibrium<'a> {
+/// The work of [`averaged_stability`]: one equilibrium judged at one size.
+pub struct AtEquilibrium<'a> {
     params: &'a [f64],
     amplitude: &'a str,
     q: &'a [f64],
@@ -752,7 +754,8 @@ pub fn stability_chart(
         .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
 }
 
-struct Chart<'a> {
+/// The work of [`stability_chart`] at one size.
+pub struct Chart<'a> {
     params: &'a [f64],
     settings: &'a ChartSettings,
 }

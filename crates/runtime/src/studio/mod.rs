@@ -411,7 +411,8 @@ pub fn orbit(
         .ok_or_else(|| StudioError::ContactModel(setup.info.name.into()))?
 }
 
-struct OrbitWork<'a> {
+/// The work of [`orbit`] at one size.
+pub struct OrbitWork<'a> {
     setup: &'a Resolved,
     seed: &'a [f64],
     periods: usize,
