@@ -31,8 +31,16 @@ fn a_five_degree_chain_oscillates_in_its_closed_form_normal_modes() {
             for i in 0..5 {
                 let q = shape[i] * (omega * t).cos();
                 let p = -shape[i] * omega * (omega * t).sin();
-                assert!((y[i] - q).abs() < 1e-8, "mode {j}, t = {t}: q{i} {} against {q}", y[i]);
-                assert!((y[5 + i] - p).abs() < 1e-8, "mode {j}, t = {t}: p{i} {} against {p}", y[5 + i]);
+                assert!(
+                    (y[i] - q).abs() < 1e-8,
+                    "mode {j}, t = {t}: q{i} {} against {q}",
+                    y[i]
+                );
+                assert!(
+                    (y[5 + i] - p).abs() < 1e-8,
+                    "mode {j}, t = {t}: p{i} {} against {p}",
+                    y[5 + i]
+                );
             }
         }
         let drift = run.energy_change.iter().fold(0.0f64, |m, e| m.max(e.abs()));
