@@ -315,13 +315,26 @@ impl Figure {
         )
     }
 
-    /// Writes the figure as PNG.
+    /// Writes the figure as PNG: drawn into an RGB buffer and encoded with
+    /// the `png` crate (plotters' own encoder would compile the `image`
+    /// crate and its JPEG decoder, 20 s of a fresh build, for this alone).
     pub fn save(&self, path: &Path) -> std::io::Result<()> {
         register_fonts();
-        let root = BitMapBackend::new(path, self.size()).into_drawing_area();
-        self.draw(&root).map_err(std::io::Error::other)?;
-        root.present()
-            .map_err(|e| std::io::Error::other(e.to_string()))
+        let (width, height) = self.size();
+        let mut pixels = vec![0u8; 3 * width as usize * height as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+            self.draw(&root).map_err(std::io::Error::other)?;
+            root.present()
+                .map_err(|e| std::io::Error::other(e.to_string()))?;
+        }
+        let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut encoder = png::Encoder::new(file, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+        writer.write_image_data(&pixels).map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
     }
 
     /// Writes the figure as SVG.
