@@ -15,7 +15,7 @@ use mechlab::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use mechlab::analysis::period_map::{orbit, period_map, wrap_angle};
 use mechlab::models::kapitza;
 use mechlab::ode::{Integrator, Method};
-use mechlab::studio::server::router;
+use mechlab_studio::router;
 use serde_json::{json, Value};
 use tower::ServiceExt;
 

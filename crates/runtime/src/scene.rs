@@ -90,8 +90,6 @@ pub enum SceneError {
     PeriodMap(#[from] crate::analysis::period_map::PeriodMapError),
     #[error(transparent)]
     Splitting(#[from] crate::analysis::separatrix::SplittingError),
-    #[error(transparent)]
-    Serve(#[from] crate::studio::server::ServeError),
     /// Another scene, run by this one, could not start or failed.
     #[error("cannot run scene {scene}: {source}")]
     Spawn {

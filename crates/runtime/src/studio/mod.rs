@@ -1,5 +1,6 @@
 //! The studio: an interactive page over the period map of any model of
-//! `models/`, served by a local web server ([`server`]). This module holds
+//! `models/`, served by a local web server (the `mechlab-studio` crate).
+//! This module holds
 //! what the page asks for, as library calls the tests reach without HTTP:
 //! the models and their derivations as MathML, an orbit of the period map
 //! handed over in chunks as it grows, the level sets of the averaged
@@ -7,7 +8,6 @@
 //! growing resolutions.
 
 pub mod contour;
-pub mod server;
 
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::analysis::period_map::{period_map, wrap_angle, PeriodMapError};

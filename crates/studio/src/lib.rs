@@ -1,9 +1,11 @@
-//! The studio's HTTP server (axum): one static page with its script and
+//! The studio's HTTP server (axum) over the library calls of
+//! `mechlab_runtime::studio`, in a crate of its own so that no other scene
+//! compiles a web server: one static page with its script and
 //! style (served from the binary: no network, no CDN) and a JSON API.
 //!
 //! | route | answer |
 //! |---|---|
-//! | `GET /api/models` | every model with its parameters ([`super::models`]) |
+//! | `GET /api/models` | every model with its parameters ([`mechlab_runtime::studio::models`]) |
 //! | `GET /api/models/{name}/derivations` | its derivations as MathML |
 //! | `POST /api/orbit` | an orbit of the period map, streamed as NDJSON lines |
 //! | `POST /api/chaos` | the FLI map of a view at growing resolutions, NDJSON |
@@ -15,15 +17,18 @@
 //! stream; a panic in one request is caught and reported, and the server
 //! goes on.
 
-use super::{ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
-use crate::analysis::period_map::PeriodMapError;
-use crate::registry::Catalog;
 use axum::body::{Body, Bytes};
 use axum::extract::{Path, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
+use mechlab_runtime::analysis::period_map::PeriodMapError;
+use mechlab_runtime::registry::Catalog;
+use mechlab_runtime::scene::SceneError;
+use mechlab_runtime::studio::{
+    self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError,
+};
 use serde::Serialize;
 use std::net::SocketAddr;
 
@@ -41,6 +46,15 @@ pub enum ServeError {
     },
     #[error("the server stopped: {0}")]
     Io(#[from] std::io::Error),
+}
+
+/// Why the scene `studio` stopped: its knobs, or the server.
+#[derive(Debug, thiserror::Error)]
+pub enum StudioSceneError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Serve(#[from] ServeError),
 }
 
 /// Why one request failed: a 4xx or 5xx answer with `{"error": message}`.
@@ -104,7 +118,7 @@ pub fn router(catalog: Catalog) -> Router {
         )
         .route(
             "/api/models",
-            get(move || async move { axum::Json(super::models(catalog)) }),
+            get(move || async move { axum::Json(studio::models(catalog)) }),
         )
         .route("/api/models/{name}/derivations", get(derivations))
         .route("/api/orbit", post(orbit))
@@ -146,20 +160,20 @@ async fn derivations(
     State(catalog): State<Catalog>,
     Path(name): Path<String>,
 ) -> Result<Response, ApiError> {
-    Ok(axum::Json(super::derivations(catalog, &name)?).into_response())
+    Ok(axum::Json(studio::derivations(catalog, &name)?).into_response())
 }
 
 async fn overlay(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
     let request: OverlayRequest = serde_json::from_slice(&body)?;
     let answer =
-        blocking(move || super::overlay(catalog, &request).map_err(ApiError::from)).await?;
+        blocking(move || studio::overlay(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 
 async fn manifolds(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: super::ManifoldsRequest = serde_json::from_slice(&body)?;
+    let request: studio::ManifoldsRequest = serde_json::from_slice(&body)?;
     let answer =
-        blocking(move || super::manifolds(catalog, &request).map_err(ApiError::from)).await?;
+        blocking(move || studio::manifolds(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 
@@ -167,7 +181,7 @@ async fn orbit(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, 
     let request: OrbitRequest = serde_json::from_slice(&body)?;
     request.check(catalog)?;
     Ok(stream(move |send, _| {
-        let end = super::orbit(catalog, &request, &mut |chunk| send(&chunk))?;
+        let end = studio::orbit(catalog, &request, &mut |chunk| send(&chunk))?;
         send(&Ended { end });
         Ok(())
     }))
@@ -177,13 +191,13 @@ async fn chaos(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, 
     let request: ChaosRequest = serde_json::from_slice(&body)?;
     request.check(catalog)?;
     Ok(stream(move |send, listening| {
-        super::chaos(catalog, &request, &mut |level| send(&level), listening)
+        studio::chaos(catalog, &request, &mut |level| send(&level), listening)
     }))
 }
 
 #[derive(Serialize)]
 struct Ended {
-    end: super::OrbitEnd,
+    end: studio::OrbitEnd,
 }
 
 /// Runs `work` on a blocking thread, catching a panic as an internal error.
