@@ -14,6 +14,7 @@ use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 /// Orbits per batch: eight f64 fill one AVX-512 register or two AVX ones.
 /// Measured on the Kapitza chaos map (README, "Sweeps"): 8 lanes beat 4.
 pub const LANES: usize = 8;
+const _: () = assert!(LANES == 8, "per_lane, map and zip write the lanes out");
 
 /// One f64 per lane.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -28,12 +29,7 @@ pub struct Lanes(pub [f64; LANES]);
 /// function's instances stay in the caller's own unit.
 #[inline(always)]
 pub fn per_lane<T: Copy>(f: impl Fn(usize) -> T) -> [T; LANES] {
-    let mut out = [f(0); LANES];
-    #[allow(clippy::needless_range_loop)] // (an iterator adapter is what this avoids)
-    for l in 1..LANES {
-        out[l] = f(l);
-    }
-    out
+    [f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7)]
 }
 
 impl Lanes {
@@ -42,17 +38,37 @@ impl Lanes {
     pub const fn splat(x: f64) -> Lanes {
         Lanes([x; LANES])
     }
+    /// Lane by lane, written out rather than looped: a model's Taylor
+    /// recurrences make thousands of these, and as loops each went through
+    /// LLVM's loop passes before being unrolled (the lane code was most of
+    /// a model's compile time); straight-line, the SLP vectoriser packs them.
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Lanes {
-        Lanes(self.0.map(f))
+        let a = self.0;
+        Lanes([
+            f(a[0]),
+            f(a[1]),
+            f(a[2]),
+            f(a[3]),
+            f(a[4]),
+            f(a[5]),
+            f(a[6]),
+            f(a[7]),
+        ])
     }
     #[inline(always)]
     fn zip(self, other: Lanes, f: impl Fn(f64, f64) -> f64) -> Lanes {
-        let mut out = [0.0; LANES];
-        for i in 0..LANES {
-            out[i] = f(self.0[i], other.0[i]);
-        }
-        Lanes(out)
+        let (a, b) = (self.0, other.0);
+        Lanes([
+            f(a[0], b[0]),
+            f(a[1], b[1]),
+            f(a[2], b[2]),
+            f(a[3], b[3]),
+            f(a[4], b[4]),
+            f(a[5], b[5]),
+            f(a[6], b[6]),
+            f(a[7], b[7]),
+        ])
     }
     /// |x| lane by lane.
     #[inline(always)]
