@@ -1,12 +1,8 @@
-//! The readable-forms stage of the derivation
-//! (`crates/derive/src/simplify.rs`), tested directly: it is plain Rust (no
-//! Symbolica, so a test may run it), compiled here from the same file.
+//! The readable-forms stage of the derivation (`crates/simplify`), tested
+//! directly: it is plain Rust (no Symbolica, so a test may run it).
 
 use mechlab::model;
-
-#[allow(dead_code)]
-#[path = "../crates/derive/src/simplify.rs"]
-mod simplify;
+use mechlab_simplify as simplify;
 
 use model::Expr;
 

@@ -4,7 +4,7 @@
 //! allows one thread of one process: never from a test, an example or the
 //! runtime). Reading and validation of the files live in `mechlab-model`,
 //! derivations in `derive.rs` (`contacts.rs` for rough guides), readable
-//! forms in `simplify.rs` and `latex.rs`, common subexpression elimination
+//! forms in `mechlab-simplify` and `latex.rs`, common subexpression elimination
 //! in `emit.rs`, Taylor recurrences in `taylor.rs`, the averaging series in
 //! `lie.rs` (`deprit.rs` closed form, `numeric.rs` through run-time solves),
 //! module assembly in `generate.rs`, layout in the workspace's `templates/`.
@@ -23,7 +23,7 @@ mod generate;
 mod latex;
 mod lie;
 mod numeric;
-mod simplify;
+use mechlab_simplify as simplify;
 mod taylor;
 
 use std::hash::{Hash, Hasher};

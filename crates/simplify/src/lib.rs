@@ -1,4 +1,6 @@
-//! Readable forms of derived expressions (build time, pure Rust).
+//! Readable forms of derived expressions (build time, pure Rust): a crate
+//! of its own, compiled optimised while the rest of the derivation is not
+//! (docs/building.md), and tested directly (tests/simplify_forms.rs).
 //!
 //! Symbolica's `together()` returns one fraction N/D but treats sin x and
 //! cos x as unrelated variables, so identities such as sin² + cos² = 1 and
@@ -25,7 +27,7 @@
 //! Every result is checked against its input at random points by the caller
 //! ([`verify`]); a disagreement fails the build naming the expression.
 
-use crate::model::expr::{BinOp, Expr};
+use mechlab_model::expr::{BinOp, Expr};
 use std::collections::BTreeMap;
 
 /// An exact rational number with a positive, reduced denominator.
