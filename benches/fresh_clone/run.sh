@@ -18,7 +18,6 @@ cargo fetch --quiet
 
 now() { date +%s.%N; }
 failures=0
-printf '%-50s %8s %8s  %s\n' "command" "seconds" "target" "verdict"
 
 # Runs command $2... for row $1 against target $3 s.
 measure() {
@@ -37,6 +36,7 @@ rows=()
 measure "cargo run --release --example kapitza_period_map" 180 \
     cargo run --release --quiet --example kapitza_period_map
 measure "cargo test --release (after it)" 180 cargo test --release
+printf '%-50s %8s %8s  %s\n' "command" "seconds" "target" "verdict"
 printf '%s\n' "${rows[@]}"
 if [ "$failures" -gt 0 ]; then
     echo "$failures command(s) over fifteen times their target" >&2
