@@ -40,7 +40,7 @@ pub struct ContactDerivation {
 }
 
 fn error(reason: String) -> DeriveError {
-    DeriveError {
+    DeriveError::Model {
         key: "contacts".into(),
         reason,
     }

@@ -103,16 +103,12 @@ pub struct NumericForm {
     pub mean_forces: Vec<String>,
 }
 
-/// A derivation failure, with the model quantity it concerns.
-pub struct DeriveError {
-    pub key: String,
-    pub reason: String,
-}
+pub use crate::error::DeriveError;
 
 pub fn atom(text: &str) -> Result<Atom, DeriveError> {
-    try_parse!(text).map_err(|e| DeriveError {
-        key: "(internal)".into(),
-        reason: format!("Symbolica cannot parse '{text}': {e}"),
+    try_parse!(text).map_err(|e| DeriveError::Symbolica {
+        text: text.to_string(),
+        message: e.to_string(),
     })
 }
 
@@ -185,7 +181,7 @@ fn trigonometric_polynomial(
         .replace(atom(&format!("cos({phase})"))?.to_pattern())
         .with(var(c_name).to_pattern());
     if !is_zero(&replaced.derivative(symbol!(phase))) {
-        return Err(DeriveError {
+        return Err(DeriveError::Model {
             key: "fast_phase".into(),
             reason: format!(
                 "the phase '{phase}' enters other than through sin({phase}) and cos({phase}); rewrite multiple angles with addition formulas"
@@ -349,7 +345,7 @@ fn reduce_pythagorean(e: &Atom, angle: &str) -> Result<Atom, DeriveError> {
 /// Drops the terms of an expanded sum that depend on none of `symbols`.
 fn drop_terms_without(e: &Atom, symbols: &[String]) -> Result<Atom, DeriveError> {
     let text = e.expand().to_string();
-    let parsed = Expr::parse(&text).map_err(|err| DeriveError {
+    let parsed = Expr::parse(&text).map_err(|err| DeriveError::Model {
         key: "lagrangian".into(),
         reason: format!("cannot read back '{text}': {err}"),
     })?;
@@ -427,9 +423,9 @@ impl Recorder {
         parts: &[Atom],
     ) -> Result<String, DeriveError> {
         let key = key.into();
-        let failure = |reason: String| DeriveError {
-            key: "lagrangian".into(),
-            reason: format!("derived `{key}`: {reason}"),
+        let failure = |source| DeriveError::Readable {
+            key: key.clone(),
+            source,
         };
         let mut derived = Vec::new();
         let mut readable = Vec::new();
@@ -464,10 +460,7 @@ fn cheaper(
     readable: Vec<Vec<(String, String)>>,
 ) -> Result<(Vec<String>, usize, usize, usize), DeriveError> {
     let count = |stages: &[Vec<(String, String)>]| {
-        crate::emit::operation_count(stages).map_err(|reason| DeriveError {
-            key: "(internal)".into(),
-            reason,
-        })
+        crate::emit::operation_count(stages).map_err(|e| e.in_function("(operation count)"))
     };
     let (before, after) = (count(&derived)?, count(&readable)?);
     let readable_chosen = 10 * after <= 11 * before;
@@ -552,7 +545,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         let clash = model.parameters.iter().any(|x| &x.name == name)
             || model.definitions.iter().any(|(d, _)| d == name);
         if clash || q.contains(name) || qd.contains(name) {
-            return Err(DeriveError {
+            return Err(DeriveError::Model {
                 key: "coordinates".into(),
                 reason: format!("the momentum name '{name}' is already used"),
             });
@@ -602,7 +595,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                 nonzero |= !is_zero(&mass[i][k].derivative(symbol!(v.as_str())));
             }
             if nonzero {
-                return Err(DeriveError {
+                return Err(DeriveError::Model {
                     key: "lagrangian".into(),
                     reason: "is not quadratic in the velocities".into(),
                 });
@@ -664,7 +657,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
     }
     let (det, inv) = inverse(&mass);
     if is_zero(&det) {
-        return Err(DeriveError {
+        return Err(DeriveError::Model {
             key: "lagrangian".into(),
             reason: "the mass matrix is singular".into(),
         });
@@ -922,7 +915,7 @@ fn potential_derivatives(
     mean_potential: &Atom,
 ) -> Result<(String, Vec<String>, Vec<Vec<String>>), DeriveError> {
     if !is_zero(&mean_potential.derivative(symbol!(model.time.as_str()))) {
-        return Err(DeriveError {
+        return Err(DeriveError::Model {
             key: "lagrangian".into(),
             reason: "the potential depends on time other than through a fast phase".into(),
         });
@@ -1052,7 +1045,7 @@ fn numeric_form(
         Some(th) => {
             let depends_on_phase = |e: &Atom| !is_zero(&e.derivative(symbol!(th.as_str())));
             if mass.iter().flatten().any(depends_on_phase) {
-                return Err(DeriveError {
+                return Err(DeriveError::Model {
                     key: "lagrangian".into(),
                     reason: format!("the mass matrix depends on the fast phase '{th}': averaging with a numeric solve of A needs A(q) alone"),
                 });
@@ -1064,7 +1057,7 @@ fn numeric_form(
                         .iter()
                         .any(|w| !is_zero(&slope.derivative(symbol!(w.as_str()))));
                     if nonlinear || depends_on_phase(&slope) {
-                        return Err(DeriveError {
+                        return Err(DeriveError::Model {
                             key: format!("forces.{}", q[i]),
                             reason: format!("averaging with a numeric solve of A needs forces linear in the velocities with coefficients free of the phase '{th}'"),
                         });

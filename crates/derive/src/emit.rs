@@ -8,6 +8,7 @@
 //! the values of an earlier stage (e.g. the velocities) are plain variables of
 //! the next.
 
+use crate::error::EmitError;
 use crate::model::expr::{BinOp, Expr};
 use std::collections::HashMap;
 
@@ -175,7 +176,7 @@ impl Emitter {
         self.nodes.len() - 1
     }
 
-    fn build(&mut self, e: &Expr) -> Result<usize, String> {
+    fn build(&mut self, e: &Expr) -> Result<usize, EmitError> {
         if let Some(x) = as_number(e) {
             return Ok(self.intern(Node::Lit(literal(x))));
         }
@@ -238,7 +239,7 @@ impl Emitter {
                     "exp" => "exp",
                     "log" => "ln",
                     "sqrt" => "sqrt",
-                    other => return Err(format!("cannot emit function '{other}'")),
+                    other => return Err(EmitError::Function(other.to_string())),
                 };
                 let a = self.build(&args[0])?;
                 self.intern(Node::Call(f, a))
@@ -407,10 +408,10 @@ impl Emitter {
 
     /// Adds a stage: named outputs evaluated after the earlier stages, whose
     /// names later stages may use as variables.
-    pub fn stage(&mut self, outputs: &[(String, String)]) -> Result<(), String> {
+    pub fn stage(&mut self, outputs: &[(String, String)]) -> Result<(), EmitError> {
         let mut stage = Vec::new();
         for (name, text) in outputs {
-            let e = Expr::parse(text).map_err(|err| format!("cannot read '{text}': {err}"))?;
+            let e = Expr::parse(text).map_err(|err| EmitError::read(text, err))?;
             stage.push((name.clone(), self.build(&e)?));
         }
         self.stage_nodes(stage);
@@ -418,7 +419,7 @@ impl Emitter {
     }
 
     /// Adds one step.
-    pub fn apply(&mut self, step: &Step) -> Result<(), String> {
+    pub fn apply(&mut self, step: &Step) -> Result<(), EmitError> {
         match step {
             Step::Values(outputs) => self.stage(outputs),
             Step::Solve {
@@ -431,7 +432,7 @@ impl Emitter {
                 for (name, output, variables) in list {
                     let mut node = Some(
                         self.output(output)
-                            .ok_or_else(|| format!("no output '{output}' to differentiate"))?,
+                            .ok_or_else(|| EmitError::NoOutput(output.clone()))?,
                     );
                     for v in variables {
                         node = node.and_then(|k| self.derivative(k, v));
@@ -454,8 +455,8 @@ impl Emitter {
     }
 
     /// The node of an expression over earlier outputs and variables.
-    pub fn node(&mut self, text: &str) -> Result<usize, String> {
-        let e = Expr::parse(text).map_err(|err| format!("cannot read '{text}': {err}"))?;
+    pub fn node(&mut self, text: &str) -> Result<usize, EmitError> {
+        let e = Expr::parse(text).map_err(|err| EmitError::read(text, err))?;
         self.build(&e)
     }
 
@@ -467,15 +468,15 @@ impl Emitter {
         matrix: &[Vec<String>],
         columns: &[Vec<String>],
         names: &[Vec<String>],
-    ) -> Result<(), String> {
+    ) -> Result<(), EmitError> {
         let matrix = matrix
             .iter()
             .map(|row| row.iter().map(|t| self.node(t)).collect())
-            .collect::<Result<Vec<Vec<usize>>, String>>()?;
+            .collect::<Result<Vec<Vec<usize>>, EmitError>>()?;
         let columns = columns
             .iter()
             .map(|col| col.iter().map(|t| self.node(t)).collect())
-            .collect::<Result<Vec<Vec<usize>>, String>>()?;
+            .collect::<Result<Vec<Vec<usize>>, EmitError>>()?;
         let solve = self.add_solve(matrix, columns, Some(names.to_vec()));
         let mut stage = Vec::new();
         for (column, col_names) in names.iter().enumerate() {
@@ -868,13 +869,13 @@ impl Emitter {
 /// literals and variables; transcendental calls weighted): the measure by
 /// which a readable form and a derived form of the same right-hand side are
 /// compared.
-pub fn operation_count(stages: &[Vec<(String, String)>]) -> Result<usize, String> {
+pub fn operation_count(stages: &[Vec<(String, String)>]) -> Result<usize, EmitError> {
     let steps: Vec<Step> = stages.iter().cloned().map(Step::Values).collect();
     step_operation_count(&steps)
 }
 
 /// [`operation_count`] of a function given as steps.
-pub fn step_operation_count(steps: &[Step]) -> Result<usize, String> {
+pub fn step_operation_count(steps: &[Step]) -> Result<usize, EmitError> {
     let mut emitter = Emitter::default();
     for step in steps {
         emitter.apply(step)?;

@@ -4,6 +4,7 @@
 use crate::contacts::ContactDerivation;
 use crate::derive::{momentum_name, Derivation, Derived};
 use crate::emit::{params_line, Emitter, Step};
+use crate::error::DeriveError;
 use crate::model::Model;
 use crate::taylor::{recurrences, Signature};
 use serde::Serialize;
@@ -205,7 +206,7 @@ impl Context<'_> {
         ret: String,
         stages: &[Vec<(String, String)>],
         result: String,
-    ) -> Result<Function, String> {
+    ) -> Result<Function, DeriveError> {
         let steps: Vec<Step> = stages.iter().cloned().map(Step::Values).collect();
         self.function_steps(name, doc, inputs, ret, &steps, result)
     }
@@ -219,7 +220,7 @@ impl Context<'_> {
         ret: String,
         steps: &[Step],
         result: String,
-    ) -> Result<Function, String> {
+    ) -> Result<Function, DeriveError> {
         let (args, mut body) = self.signature_and_prelude(inputs);
         let mut emitter = Emitter::default();
         if matches!(inputs, Inputs::DualAveragedState) {
@@ -227,7 +228,7 @@ impl Context<'_> {
         }
         let result = emitter.lifted(result);
         for step in steps {
-            emitter.apply(step).map_err(|e| format!("{name}: {e}"))?;
+            emitter.apply(step).map_err(|e| e.in_function(name))?;
         }
         body.extend(emitter.finish());
         Ok(Function {
@@ -250,19 +251,19 @@ impl Context<'_> {
         steps: &[Step],
         outputs: &[String],
         state: Vec<String>,
-    ) -> Result<TaylorFunction, String> {
+    ) -> Result<TaylorFunction, DeriveError> {
         let mut emitter = Emitter::default();
         emitter.whole_angles = true;
         let phase = match &self.model.fast_phase {
             Some(phase) => {
                 let rate = vec![("rate__".to_string(), self.model_phase_rate.clone())];
-                emitter.stage(&rate).map_err(|e| format!("{name}: {e}"))?;
+                emitter.stage(&rate).map_err(|e| e.in_function(name))?;
                 Some((phase.name.clone(), "rate__".to_string()))
             }
             None => None,
         };
         for step in steps {
-            emitter.apply(step).map_err(|e| format!("{name}: {e}"))?;
+            emitter.apply(step).map_err(|e| e.in_function(name))?;
         }
         let signature = Signature {
             state,
@@ -276,7 +277,7 @@ impl Context<'_> {
                 .collect(),
         };
         let body = recurrences(name, &emitter.into_dag(), &signature, outputs)
-            .map_err(|e| format!("{name}: {e}"))?;
+            .map_err(|e| e.in_function(name))?;
         Ok(TaylorFunction {
             name: name.into(),
             doc: doc.into(),
@@ -335,7 +336,7 @@ pub fn render(
     model: &Model,
     derivation: &Derivation,
     source_file: &str,
-) -> Result<String, String> {
+) -> Result<String, DeriveError> {
     let cx = Context {
         model,
         n: derivation.dof,
@@ -364,10 +365,10 @@ pub fn render(
                     line.split(|c: char| !c.is_alphanumeric() && c != '_')
                         .any(|w| w == s.as_str())
                 }) {
-                    return Err(format!(
-                        "{}: depends on '{bad}', but should depend on the coordinates only",
-                        f.name
-                    ));
+                    return Err(DeriveError::Dependency {
+                        function: f.name.clone(),
+                        symbol: bad.clone(),
+                    });
                 }
             }
         }
@@ -413,12 +414,18 @@ pub fn render(
             .collect::<Vec<_>>(),
     );
     tera.render("model.rs.tera", &context)
-        .map_err(|e| format!("template model.rs.tera: {e:?}"))
+        .map_err(|source| DeriveError::Template {
+            template: "model.rs.tera",
+            source,
+        })
 }
 
 /// The functions both forms have as closed forms: the phase rate, momenta,
 /// mass matrix, potential and its derivatives.
-pub fn common_functions(cx: &Context, derivation: &Derivation) -> Result<Vec<Function>, String> {
+pub fn common_functions(
+    cx: &Context,
+    derivation: &Derivation,
+) -> Result<Vec<Function>, DeriveError> {
     let n = cx.n();
     let mut functions = Vec::new();
     if cx.model.fast_phase.is_some() {
@@ -482,7 +489,7 @@ pub fn common_functions(cx: &Context, derivation: &Derivation) -> Result<Vec<Fun
 fn symbolic_functions(
     cx: &Context,
     derivation: &Derivation,
-) -> Result<(Vec<Function>, Vec<TaylorFunction>), String> {
+) -> Result<(Vec<Function>, Vec<TaylorFunction>), DeriveError> {
     let n = cx.n();
     let m = 2 * n;
     let model = cx.model;
@@ -624,7 +631,7 @@ fn taylor_functions(
     cx: &Context,
     derivation: &Derivation,
     velocity_stage: &[(String, String)],
-) -> Result<Vec<TaylorFunction>, String> {
+) -> Result<Vec<TaylorFunction>, DeriveError> {
     let (exact_stages, rhs_names) = exact_field(cx, derivation, velocity_stage);
     let exact: Vec<Step> = exact_stages.into_iter().map(Step::Values).collect();
     let averaged = cx.model.fast_phase.as_ref().map(|_| {
@@ -646,7 +653,7 @@ pub fn taylor_set(
     cx: &Context,
     exact: (&[Step], &[String]),
     averaged: Option<(&[Step], &[String])>,
-) -> Result<Vec<TaylorFunction>, String> {
+) -> Result<Vec<TaylorFunction>, DeriveError> {
     let mut state = cx.coordinates();
     state.extend(cx.momenta());
     let mut functions = vec![cx.taylor_steps(
@@ -729,7 +736,7 @@ pub fn render_contacts(
     model: &Model,
     derivation: &ContactDerivation,
     source_file: &str,
-) -> Result<String, String> {
+) -> Result<String, DeriveError> {
     let n = derivation.slides.len();
     let cx = Context {
         model,
@@ -798,7 +805,10 @@ pub fn render_contacts(
     context.insert("coordinates", &derivation.slides);
     context.insert("functions", &functions);
     tera.render("contact_model.rs.tera", &context)
-        .map_err(|e| format!("template contact_model.rs.tera: {e:?}"))
+        .map_err(|source| DeriveError::Template {
+            template: "contact_model.rs.tera",
+            source,
+        })
 }
 
 /// Renders the registry module listing every model.
@@ -806,7 +816,7 @@ pub fn render_registry(
     tera: &tera::Tera,
     models: &[Model],
     users_models: bool,
-) -> Result<String, String> {
+) -> Result<String, DeriveError> {
     #[derive(Serialize)]
     struct Entry {
         name: String,
@@ -826,7 +836,10 @@ pub fn render_registry(
     context.insert("models", &entries);
     context.insert("users_models", &users_models);
     tera.render("registry.rs.tera", &context)
-        .map_err(|e| format!("template registry.rs.tera: {e:?}"))
+        .map_err(|source| DeriveError::Template {
+            template: "registry.rs.tera",
+            source,
+        })
 }
 
 /// The systems a Hamiltonian model puts behind trait objects for the
@@ -879,7 +892,7 @@ pub fn second_order_functions(
     cx: &Context,
     second: &crate::deprit::SecondOrderForm,
     before: &SecondOrderSteps,
-) -> Result<Vec<Function>, String> {
+) -> Result<Vec<Function>, DeriveError> {
     let q = cx.coordinates();
     let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
     let n = q.len();

@@ -19,6 +19,7 @@ mod contacts;
 mod deprit;
 mod derive;
 mod emit;
+mod error;
 mod generate;
 mod latex;
 mod lie;
@@ -119,8 +120,8 @@ fn run(folder: &str) {
         ));
         models.push(model);
     }
-    let registry =
-        generate::render_registry(&tera, &models, folder == "models").unwrap_or_else(|e| fail(e));
+    let registry = generate::render_registry(&tera, &models, folder == "models")
+        .unwrap_or_else(|e| fail(e.to_string()));
     write_formatted(&generated.join("mod.rs"), &registry);
     let _ = std::fs::write(out_dir.join("derivation_times.tsv"), timings);
 }
@@ -212,16 +213,14 @@ fn prune_cache(cache: &Path, name: &str, keep: &Path) {
 
 /// Derives one model and renders its module; errors name the file.
 fn generate_model(tera: &tera::Tera, model: &model::Model, file: &str) -> String {
-    let derive_failure =
-        |e: derive::DeriveError| -> ! { fail(format!("{file}: key `{}`: {}", e.key, e.reason)) };
-    if model.contacts.is_empty() {
-        let derivation = derive::derive(model).unwrap_or_else(|e| derive_failure(e));
-        generate::render(tera, model, &derivation, file)
+    let generated = if model.contacts.is_empty() {
+        derive::derive(model)
+            .and_then(|derivation| generate::render(tera, model, &derivation, file))
     } else {
-        let derivation = contacts::derive(model).unwrap_or_else(|e| derive_failure(e));
-        generate::render_contacts(tera, model, &derivation, file)
-    }
-    .unwrap_or_else(|e| fail(format!("{file}: {e}")))
+        contacts::derive(model)
+            .and_then(|derivation| generate::render_contacts(tera, model, &derivation, file))
+    };
+    generated.unwrap_or_else(|e| fail(format!("{file}: {e}")))
 }
 
 /// A hash of the derivation code and templates (not the model files):

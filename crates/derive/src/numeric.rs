@@ -20,6 +20,7 @@
 
 use crate::derive::{Derivation, NumericForm};
 use crate::emit::Step;
+use crate::error::DeriveError;
 use crate::generate::{
     common_functions, matrix, taylor_set, Context, Function, Inputs, TaylorFunction,
 };
@@ -262,7 +263,7 @@ fn field_functions(
     field: Field,
     state: &[String],
     functions: &mut Vec<Function>,
-) -> Result<(), String> {
+) -> Result<(), DeriveError> {
     let m = 2 * cx.n();
     functions.push(cx.function_steps(
         &format!("{}_rhs", field.prefix),
@@ -305,7 +306,7 @@ pub fn functions(
     cx: &Context,
     derivation: &Derivation,
     form: &NumericForm,
-) -> Result<(Vec<Function>, Vec<TaylorFunction>), String> {
+) -> Result<(Vec<Function>, Vec<TaylorFunction>), DeriveError> {
     let n = cx.n();
     let mut state = cx.coordinates();
     state.extend(cx.momenta());
@@ -372,7 +373,7 @@ fn averaged_functions(
     form: &NumericForm,
     state: &[String],
     functions: &mut Vec<Function>,
-) -> Result<(Vec<Step>, Vec<String>), String> {
+) -> Result<(Vec<Step>, Vec<String>), DeriveError> {
     let n = cx.n();
     let vibrational = vibrational_steps(derivation, form);
     functions.push(cx.function_steps(

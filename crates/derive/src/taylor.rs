@@ -16,6 +16,7 @@
 //! calls the kernels of `mechlab::ode::series`.
 
 use crate::emit::{params_line, Dag, Node};
+use crate::error::EmitError;
 use std::collections::HashMap;
 
 /// How a node varies over a step.
@@ -239,7 +240,7 @@ impl Lowering<'_> {
         }
     }
 
-    fn lower(&mut self, i: usize) -> Result<usize, String> {
+    fn lower(&mut self, i: usize) -> Result<usize, EmitError> {
         if let Some(&k) = self.memo.get(&i) {
             return Ok(k);
         }
@@ -330,7 +331,7 @@ impl Lowering<'_> {
                     "exp" => self.intern(Op::Exp(a)),
                     "ln" => self.intern(Op::Ln(a)),
                     "sqrt" => self.intern(Op::Sqrt(a)),
-                    other => return Err(format!("no Taylor recurrence for '{other}'")),
+                    other => return Err(EmitError::NoRecurrence(other.to_string())),
                 }
             }
         };
@@ -522,7 +523,7 @@ impl Lowering<'_> {
         d
     }
 
-    fn variable(&mut self, v: &str) -> Result<usize, String> {
+    fn variable(&mut self, v: &str) -> Result<usize, EmitError> {
         let s = self.signature;
         if let Some(k) = s.state.iter().position(|x| x == v) {
             return Ok(self.intern(Op::State(k)));
@@ -535,7 +536,7 @@ impl Lowering<'_> {
                 let root = *self
                     .outputs
                     .get(rate.as_str())
-                    .ok_or_else(|| format!("the phase rate '{rate}' is not a stage output"))?;
+                    .ok_or_else(|| EmitError::NotAnOutput(rate.to_string()))?;
                 let r = self.lower(root)?;
                 return Ok(self.intern(Op::Phase(r)));
             }
@@ -546,7 +547,7 @@ impl Lowering<'_> {
         if s.parameters.iter().any(|p| p == v) {
             return Ok(self.intern(Op::Parameter(v.into())));
         }
-        Err(format!("unknown variable '{v}'"))
+        Err(EmitError::UnknownVariable(v.to_string()))
     }
 }
 
@@ -561,20 +562,17 @@ pub fn recurrences(
     dag: &Dag,
     signature: &Signature,
     outputs: &[String],
-) -> Result<TaylorBody, String> {
+) -> Result<TaylorBody, EmitError> {
     let dim = outputs.len();
     if dim == 0 || !signature.state.len().is_multiple_of(dim) {
-        return Err(format!(
-            "{} right-hand sides for {} state components",
-            outputs.len(),
-            signature.state.len()
-        ));
+        return Err(EmitError::Shape {
+            outputs: outputs.len(),
+            state: signature.state.len(),
+        });
     }
     let tangents = signature.state.len() / dim - 1;
     if tangents > 1 {
-        return Err(format!(
-            "{tangents} tangent vectors: the recurrences are generated for one and looped over the columns at run time"
-        ));
+        return Err(EmitError::Tangents(tangents));
     }
     let mut lowering = Lowering {
         dag,
@@ -602,7 +600,7 @@ pub fn recurrences(
         let root = *lowering
             .outputs
             .get(name.as_str())
-            .ok_or_else(|| format!("'{name}' is not a stage output"))?;
+            .ok_or_else(|| EmitError::NotAnOutput(name.to_string()))?;
         roots.push(lowering.lower(root)?);
     }
     for t in 0..tangents {

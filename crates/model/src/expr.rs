@@ -43,6 +43,31 @@ pub enum Expr {
     Call(String, Vec<Expr>),
 }
 
+/// A call of a function the language does not have, or with the wrong
+/// number of arguments.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CallError {
+    #[error("unknown function '{0}'")]
+    UnknownFunction(String),
+    #[error("function '{name}' takes {expected} argument(s), got {got}")]
+    Arity {
+        name: String,
+        expected: usize,
+        got: usize,
+    },
+}
+
+/// Why an expression has no value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EvalError {
+    #[error("malformed number '{0}'")]
+    MalformedNumber(String),
+    #[error("no value for '{0}'")]
+    NoValue(String),
+    #[error("cannot evaluate function '{0}'")]
+    UnknownFunction(String),
+}
+
 /// A parse error with the byte offset where it was found.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ParseError {
@@ -292,19 +317,20 @@ impl Expr {
     }
 
     /// Checks that every call names a known function with the right number of arguments.
-    pub fn check_calls(&self) -> Result<(), String> {
+    pub fn check_calls(&self) -> Result<(), CallError> {
         let mut problem = None;
         self.visit(&mut |e| {
             if let Expr::Call(name, args) = e {
                 match FUNCTIONS.iter().find(|(f, _)| f == name) {
                     None if problem.is_none() => {
-                        problem = Some(format!("unknown function '{name}'"))
+                        problem = Some(CallError::UnknownFunction(name.clone()))
                     }
                     Some((_, arity)) if *arity != args.len() && problem.is_none() => {
-                        problem = Some(format!(
-                            "function '{name}' takes {arity} argument(s), got {}",
-                            args.len()
-                        ))
+                        problem = Some(CallError::Arity {
+                            name: name.clone(),
+                            expected: *arity,
+                            got: args.len(),
+                        })
                     }
                     _ => {}
                 }
@@ -362,12 +388,12 @@ impl Expr {
     }
 
     /// Numerical value; `env` gives the value of each symbol.
-    pub fn eval(&self, env: &dyn Fn(&str) -> Option<f64>) -> Result<f64, String> {
+    pub fn eval(&self, env: &dyn Fn(&str) -> Option<f64>) -> Result<f64, EvalError> {
         Ok(match self {
             Expr::Num(n) => n
                 .parse::<f64>()
-                .map_err(|_| format!("malformed number '{n}'"))?,
-            Expr::Sym(s) => env(s).ok_or_else(|| format!("no value for '{s}'"))?,
+                .map_err(|_| EvalError::MalformedNumber(n.clone()))?,
+            Expr::Sym(s) => env(s).ok_or_else(|| EvalError::NoValue(s.clone()))?,
             Expr::Neg(a) => -a.eval(env)?,
             Expr::Bin(op, a, b) => {
                 let (x, y) = (a.eval(env)?, b.eval(env)?);
@@ -388,7 +414,7 @@ impl Expr {
                     "exp" => x.exp(),
                     "log" => x.ln(),
                     "sqrt" => x.sqrt(),
-                    _ => return Err(format!("cannot evaluate function '{name}'")),
+                    _ => return Err(EvalError::UnknownFunction(name.clone())),
                 }
             }
         })

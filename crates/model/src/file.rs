@@ -167,6 +167,15 @@ pub struct Range {
     pub max_open: bool,
 }
 
+/// Why a parameter's `range` is not an interval.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RangeError {
+    #[error("'{0}' is not an interval such as \"(0, inf)\" or \"[0, 1]\"")]
+    NotAnInterval(String),
+    #[error("'{0}' is empty: its lower end must be below its upper end")]
+    Empty(String),
+}
+
 impl Range {
     /// Every real number.
     pub const ALL: Range = Range {
@@ -178,9 +187,9 @@ impl Range {
 
     /// Reads `(a, b)`, `[a, b]`, `(a, b]` or `[a, b)`, with `inf` and
     /// `-inf` for unbounded ends; the reason when it cannot.
-    pub fn parse(text: &str) -> Result<Range, String> {
+    pub fn parse(text: &str) -> Result<Range, RangeError> {
         let text = text.trim();
-        let bad = || format!("'{text}' is not an interval such as \"(0, inf)\" or \"[0, 1]\"");
+        let bad = || RangeError::NotAnInterval(text.to_string());
         let (min_open, rest) = match text.chars().next() {
             Some('(') => (true, &text[1..]),
             Some('[') => (false, &text[1..]),
@@ -192,7 +201,7 @@ impl Range {
             _ => return Err(bad()),
         };
         let (a, b) = inner.split_once(',').ok_or_else(bad)?;
-        let number = |x: &str| -> Result<f64, String> {
+        let number = |x: &str| -> Result<f64, RangeError> {
             match x.trim() {
                 "inf" | "+inf" => Ok(f64::INFINITY),
                 "-inf" => Ok(f64::NEG_INFINITY),
@@ -210,9 +219,7 @@ impl Range {
             max_open,
         };
         if range.min >= range.max {
-            return Err(format!(
-                "'{text}' is empty: its lower end must be below its upper end"
-            ));
+            return Err(RangeError::Empty(text.to_string()));
         }
         Ok(range)
     }
@@ -479,7 +486,7 @@ impl ModelFile {
             }
             if let Some(text) = &p.range {
                 let range = Range::parse(text)
-                    .map_err(|reason| err(&format!("parameters[{i}].range"), reason))?;
+                    .map_err(|reason| err(&format!("parameters[{i}].range"), reason.to_string()))?;
                 if !range.contains(p.default) {
                     return Err(err(
                         &format!("parameters[{i}].default"),
@@ -531,7 +538,8 @@ impl ModelFile {
                 let more = if length > 60 { "…" } else { "" };
                 err(key, format!("cannot parse '{quoted}{more}': {e}"))
             })?;
-            expr.check_calls().map_err(|reason| err(key, reason))?;
+            expr.check_calls()
+                .map_err(|reason| err(key, reason.to_string()))?;
             for symbol in expr.symbols() {
                 if !allowed.iter().any(|set| set.contains(&symbol)) {
                     let hint = if self.fast_phase.is_some() && symbol == self.time {
@@ -846,7 +854,7 @@ impl Model {
             let rate = p
                 .rate
                 .eval(&params)
-                .map_err(|e| ("fast_phase.rate".to_string(), e))?;
+                .map_err(|e| ("fast_phase.rate".to_string(), e.to_string()))?;
             if !rate.is_finite() || rate == 0.0 {
                 return Err((
                     "fast_phase.rate".into(),
@@ -861,7 +869,7 @@ impl Model {
             let v: Vec<f64> = (0..n).map(|_| random()).collect();
             let phase = 3.0 * random();
             let time = random();
-            let at = |velocity: &[f64]| -> Result<f64, String> {
+            let at = |velocity: &[f64]| -> Result<f64, crate::expr::EvalError> {
                 let env = |s: &str| -> Option<f64> {
                     if let Some(i) = self.coordinates.iter().position(|c| c.name == s) {
                         return Some(q[i]);
@@ -884,7 +892,7 @@ impl Model {
                 .iter()
                 .map(|&s| at(&scaled(s)))
                 .collect::<Result<_, _>>()
-                .map_err(|e| ("lagrangian".to_string(), e))?;
+                .map_err(|e| ("lagrangian".to_string(), e.to_string()))?;
             if l.iter().any(|x| !x.is_finite()) {
                 return Err((
                     "lagrangian".into(),

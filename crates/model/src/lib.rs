@@ -5,4 +5,6 @@ pub mod expr;
 pub mod file;
 
 pub use expr::Expr;
-pub use file::{Contact, Inverse, Model, ModelError, Range, MAX_DOF, SYMBOLIC_INVERSE_MAX_DOF};
+pub use file::{
+    Contact, Inverse, Model, ModelError, Range, RangeError, MAX_DOF, SYMBOLIC_INVERSE_MAX_DOF,
+};

@@ -348,11 +348,20 @@ impl Figure {
             .map_err(|e| std::io::Error::other(e.to_string()))
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        root.fill(&WHITE_COLOR).map_err(|e| e.to_string())?;
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE_COLOR).map_err(|e| DrawError {
+            panel: String::new(),
+            source: e.into(),
+        })?;
         let areas = root.split_evenly((self.rows, self.columns));
         for ((panel, layers), area) in self.panels.iter().zip(&self.layers).zip(&areas) {
-            draw_panel(area, panel, layers).map_err(|e| format!("{}: {e}", panel.title))?;
+            draw_panel(area, panel, layers).map_err(|source| DrawError {
+                panel: panel.title.clone(),
+                source,
+            })?;
         }
         Ok(())
     }
@@ -409,13 +418,28 @@ fn sane_range((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
     (lo, hi)
 }
 
+/// What plotters reports (its error type depends on the backend).
+type PlotFailure = Box<dyn std::error::Error + Send + Sync>;
+
+/// A figure that could not be drawn: the panel (empty for the whole
+/// figure) and plotters' error.
+#[derive(Debug, thiserror::Error)]
+#[error("panel '{panel}': {source}")]
+pub struct DrawError {
+    pub panel: String,
+    pub source: PlotFailure,
+}
+
 type Chart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
 
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
     layers: &[Layer],
-) -> Result<(), String> {
+) -> Result<(), PlotFailure>
+where
+    DB::ErrorType: 'static,
+{
     let map_label = layers.iter().find_map(|l| match l {
         Layer::Map { map, label, .. } => Some((*map, label.clone())),
         _ => None,
@@ -441,27 +465,19 @@ fn draw_panel<DB: DrawingBackend>(
     );
     match (panel.log_x, panel.log_y) {
         (false, false) => {
-            let mut c = builder
-                .build_cartesian_2d(x, y)
-                .map_err(|e| e.to_string())?;
+            let mut c = builder.build_cartesian_2d(x, y)?;
             fill(&mut c, panel, layers)
         }
         (true, false) => {
-            let mut c = builder
-                .build_cartesian_2d(x.log_scale(), y)
-                .map_err(|e| e.to_string())?;
+            let mut c = builder.build_cartesian_2d(x.log_scale(), y)?;
             fill(&mut c, panel, layers)
         }
         (false, true) => {
-            let mut c = builder
-                .build_cartesian_2d(x, y.log_scale())
-                .map_err(|e| e.to_string())?;
+            let mut c = builder.build_cartesian_2d(x, y.log_scale())?;
             fill(&mut c, panel, layers)
         }
         (true, true) => {
-            let mut c = builder
-                .build_cartesian_2d(x.log_scale(), y.log_scale())
-                .map_err(|e| e.to_string())?;
+            let mut c = builder.build_cartesian_2d(x.log_scale(), y.log_scale())?;
             fill(&mut c, panel, layers)
         }
     }?;
@@ -476,22 +492,22 @@ fn color_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     map: ColorMap,
     label: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotFailure>
+where
+    DB::ErrorType: 'static,
+{
     let mut chart = ChartBuilder::on(area)
         .margin_top(30)
         .margin_bottom(48)
         .margin_right(30)
         .y_label_area_size(0)
         .right_y_label_area_size(30)
-        .build_cartesian_2d(0.0..1.0, 0.0..1.0)
-        .map_err(|e| e.to_string())?;
+        .build_cartesian_2d(0.0..1.0, 0.0..1.0)?;
     let n = 100;
-    chart
-        .draw_series((0..n).map(|i| {
-            let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
-            Rectangle::new([(0.0, a), (1.0, b)], map.color(0.5 * (a + b)).filled())
-        }))
-        .map_err(|e| e.to_string())?;
+    chart.draw_series((0..n).map(|i| {
+        let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+        Rectangle::new([(0.0, a), (1.0, b)], map.color(0.5 * (a + b)).filled())
+    }))?;
     chart
         .configure_mesh()
         .disable_x_mesh()
@@ -501,20 +517,21 @@ fn color_bar<DB: DrawingBackend>(
         .y_desc(label)
         .label_style((FONT, 12))
         .draw()
-        .map_err(|e| e.to_string())
+        .map_err(PlotFailure::from)
 }
 
 fn fill<'a, DB, X, Y>(
     chart: &mut Chart<'a, DB, X, Y>,
     panel: &Panel,
     layers: &[Layer],
-) -> Result<(), String>
+) -> Result<(), PlotFailure>
 where
     DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
     X: Ranged<ValueType = f64> + ValueFormatter<f64>,
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotFailure::from(e);
     // Only what lies in the panel is drawn (plotters would pile the rest
     // up on the frame); lines are broken where they leave it.
     let inside = |v: f64, (lo, hi): (f64, f64)| {

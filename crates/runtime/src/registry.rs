@@ -55,13 +55,10 @@ impl ModelInfo {
 
     /// The names of two different state components chosen as a plane's
     /// axes, or why they cannot be.
-    pub fn plane(&self, axes: [usize; 2]) -> Result<[String; 2], String> {
+    pub fn plane(&self, axes: [usize; 2]) -> Result<[String; 2], PlaneError> {
         let names = self.state_names();
         if axes.iter().any(|&a| a >= names.len()) || axes[0] == axes[1] {
-            return Err(format!(
-                "the axes must be two different state components among {}",
-                names.join(", ")
-            ));
+            return Err(PlaneError { names });
         }
         Ok(axes.map(|a| names[a].to_string()))
     }
@@ -439,6 +436,13 @@ impl fmt::Debug for Model {
             .field("kind", &self.dynamic.kind())
             .finish()
     }
+}
+
+/// Axes that are not two different state components of the model.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("the axes must be two different state components among {}", names.join(", "))]
+pub struct PlaneError {
+    pub names: Vec<&'static str>,
 }
 
 /// A model name that no model file has.

@@ -27,7 +27,7 @@
 //! Every result is checked against its input at random points by the caller
 //! ([`verify`]); a disagreement fails the build naming the expression.
 
-use mechlab_model::expr::{BinOp, Expr};
+use mechlab_model::expr::{BinOp, EvalError, Expr, ParseError};
 use std::collections::BTreeMap;
 
 /// An exact rational number with a positive, reduced denominator.
@@ -924,8 +924,11 @@ pub struct Vocabulary {
 /// The readable form of `text` (one of Symbolica's printed results): a sum
 /// over the degrees in the key variables of reduced fractions, each in its
 /// shortest form.
-pub fn simplify(text: &str, vocabulary: &Vocabulary) -> Result<Expr, String> {
-    let e = Expr::parse(text).map_err(|err| format!("cannot read '{text}': {err}"))?;
+pub fn simplify(text: &str, vocabulary: &Vocabulary) -> Result<Expr, SimplifyError> {
+    let e = Expr::parse(text).map_err(|source| SimplifyError::Read {
+        text: text.to_string(),
+        source,
+    })?;
     let mut angles = Vec::new();
     trig_symbols(&e, vocabulary.phase.as_deref(), &mut angles);
     let rank = |a: &String| {
@@ -967,9 +970,27 @@ pub fn sum(parts: Vec<Expr>) -> Expr {
     Expr::sum(parts.iter().flat_map(|p| p.terms()).collect())
 }
 
+/// Why a readable form could not be made or checked.
+#[derive(Debug, thiserror::Error)]
+pub enum SimplifyError {
+    #[error("cannot read '{text}': {source}")]
+    Read { text: String, source: ParseError },
+    #[error("cannot evaluate it at a random point: {0}")]
+    Eval(#[from] EvalError),
+    #[error("the simplified form differs from the derived one at point {point}: {derived} against {simplified}")]
+    Differs {
+        point: usize,
+        derived: f64,
+        simplified: f64,
+    },
+}
+
 /// Checks at random points that `simplified` equals `original`.
-pub fn verify(original: &str, simplified: &Expr, seed: u64) -> Result<(), String> {
-    let original = Expr::parse(original).map_err(|e| format!("cannot read '{original}': {e}"))?;
+pub fn verify(original: &str, simplified: &Expr, seed: u64) -> Result<(), SimplifyError> {
+    let original = Expr::parse(original).map_err(|source| SimplifyError::Read {
+        text: original.to_string(),
+        source,
+    })?;
     let mut symbols = original.symbols();
     symbols.extend(simplified.symbols());
     let mut state = seed
@@ -991,9 +1012,11 @@ pub fn verify(original: &str, simplified: &Expr, seed: u64) -> Result<(), String
         let a = original.eval(&env)?;
         let b = simplified.eval(&env)?;
         if !((a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs()))) {
-            return Err(format!(
-                "the simplified form differs from the derived one at point {point}: {a} against {b}"
-            ));
+            return Err(SimplifyError::Differs {
+                point,
+                derived: a,
+                simplified: b,
+            });
         }
     }
     Ok(())

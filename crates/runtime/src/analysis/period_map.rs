@@ -172,7 +172,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
             Some(t) if model.has_fast_phase() => t,
             _ => return Err(PeriodMapError::NoFastPhase(info.name.into())),
         };
-        let axes = info.plane(settings.axes).map_err(bad)?;
+        let axes = info.plane(settings.axes).map_err(|e| bad(e.to_string()))?;
         let periodic = model.periodic();
         let wrap: Vec<bool> = (0..S).map(|i| i < D && periodic[i]).collect();
         let seeds: Vec<[f64; S]> = match &settings.seeds {
