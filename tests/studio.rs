@@ -196,7 +196,8 @@ async fn chaos_levels_equal_the_library_map() {
 #[tokio::test]
 async fn overlay_matches_the_averaged_hamiltonian_by_hand() {
     let a: f64 = 1.8;
-    let request = json!({"model": "kapitza", "params": {"A": a}, "ranges": [[-3.14159, 3.14159], [-3, 3]],
+    let pi = std::f64::consts::PI;
+    let request = json!({"model": "kapitza", "params": {"A": a}, "ranges": [[-pi, pi], [-3, 3]],
         "grid": 200, "levels": 10});
     let (status, _, body) = call("POST", "/api/overlay", Some(request)).await;
     assert_eq!(status, StatusCode::OK);

@@ -239,9 +239,11 @@ fn lanes_with_their_own_parameters_equal_scalar_runs() {
     assert_streams_equal_scalar(&orbits);
     let triple: Vec<triple_pendulum::Exact> = (0..9)
         .map(|k| {
-            let mut params = triple_pendulum::Params::default();
-            params.m2 = 0.5 + 0.2 * k as f64;
-            params.l3 = 1.5 - 0.1 * k as f64;
+            let params = triple_pendulum::Params {
+                m2: 0.5 + 0.2 * k as f64,
+                l3: 1.5 - 0.1 * k as f64,
+                ..Default::default()
+            };
             triple_pendulum::Exact { params }
         })
         .collect();

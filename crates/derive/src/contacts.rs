@@ -97,7 +97,7 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
         let vc = velocity_of(c);
         let mut e = lagrangian.derivative(symbol!(c)) - rayleigh.derivative(symbol!(vc));
         for (k, vk) in &coordinates {
-            e = e - lagrangian.derivative(symbol!(vc)).derivative(symbol!(*k)) * var(vk);
+            e -= lagrangian.derivative(symbol!(vc)).derivative(symbol!(*k)) * var(vk);
         }
         e
     };
@@ -154,8 +154,8 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
     let mut energy = -lagrangian.clone();
     let mut power = num(0);
     for (_, vk) in &coordinates {
-        energy = energy + lagrangian.derivative(symbol!(*vk)) * var(vk);
-        power = power + rayleigh.derivative(symbol!(*vk)) * var(vk);
+        energy += lagrangian.derivative(symbol!(*vk)) * var(vk);
+        power += rayleigh.derivative(symbol!(*vk)) * var(vk);
     }
     let energy = on_guides(&energy)?;
     rec.record("energy", "E = Σ q'∂L/∂q' − L on the guides", &energy)?;

@@ -154,7 +154,7 @@ fn phase_mean(e: &Atom, phase: &str) -> Result<Atom, DeriveError> {
                 let (numerator, denominator) = monomial_mean(a, b);
                 let weight =
                     Atom::num(numerator) / Atom::num(denominator * a_factorial * b_factorial);
-                mean = mean + coefficient * weight;
+                mean += coefficient * weight;
             }
             dsc = dsc.derivative(symbol!(c_name));
             b += 1;
@@ -332,9 +332,9 @@ fn reduce_pythagorean(e: &Atom, angle: &str) -> Result<Atom, DeriveError> {
         let coefficient = subst(&derivative, s_name, &num(0)) / num(factorial);
         let mut power = if k % 2 == 1 { var(s_name) } else { num(1) };
         for _ in 0..k / 2 {
-            power = power * &one_minus_c2;
+            power *= &one_minus_c2;
         }
-        result = result + coefficient * power;
+        result += coefficient * power;
         derivative = derivative.derivative(symbol!(s_name));
         k += 1;
         factorial *= k;
@@ -506,7 +506,7 @@ pub fn kinematic(model: &Model, e: &Expr) -> Result<Atom, DeriveError> {
     let total_derivative = |x: &Atom| -> Atom {
         let mut d = num(0);
         for (qi, qdi) in q.iter().zip(&qd) {
-            d = d + x.derivative(symbol!(qi)) * var(qdi);
+            d += x.derivative(symbol!(qi)) * var(qdi);
         }
         match &phase {
             Some(th) => d + &rate * x.derivative(symbol!(th.as_str())),
@@ -626,7 +626,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         .map(|i| {
             let mut m = linear[i].clone();
             for j in 0..n {
-                m = m + &mass[i][j] * var(&qd[j]);
+                m += &mass[i][j] * var(&qd[j]);
             }
             m.expand()
         })
@@ -678,7 +678,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
     let mut kinetic = num(0);
     for i in 0..n {
         for j in 0..n {
-            kinetic = kinetic + &shifted[i] * &inv[i][j] * &shifted[j];
+            kinetic += &shifted[i] * &inv[i][j] * &shifted[j];
         }
     }
     let kinetic = kinetic / num(2);
@@ -754,7 +754,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
                 num(0)
             };
             for m in 0..n {
-                d = d + rates[i].derivative(symbol!(qd[m].as_str())) * &dv[m];
+                d += rates[i].derivative(symbol!(qd[m].as_str())) * &dv[m];
             }
             exact_jacobian[n + i][k] = d.to_string();
         }
@@ -794,7 +794,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             let mut quadratic = num(0);
             for i in 0..n {
                 for j in 0..n {
-                    quadratic = quadratic + &linear[i] * &inv[i][j] * &linear[j];
+                    quadratic += &linear[i] * &inv[i][j] * &linear[j];
                 }
             }
             let vibrational = phase_mean(&(quadratic / num(2)), th)?;
@@ -877,7 +877,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         let mut relative_kinetic = num(0);
         for i in 0..n {
             for j in 0..n {
-                relative_kinetic = relative_kinetic + &mass[i][j] * var(&qd[i]) * var(&qd[j]);
+                relative_kinetic += &mass[i][j] * var(&qd[i]) * var(&qd[j]);
             }
         }
         rec.record_sum(
@@ -1100,9 +1100,9 @@ fn numeric_form(
             let mean_potential = phase_mean(&potential, th)?.expand();
             let mut reduced = -mean_potential.clone();
             for i in 0..n {
-                reduced = reduced + &mean_linear[i] * var(&qd[i]);
+                reduced += &mean_linear[i] * var(&qd[i]);
                 for j in 0..n {
-                    reduced = reduced + &mass[i][j] * var(&qd[i]) * var(&qd[j]) / num(2);
+                    reduced += &mass[i][j] * var(&qd[i]) * var(&qd[j]) / num(2);
                 }
             }
             for (h, coefficient) in crate::deprit::fourier(&potential, th)? {

@@ -193,8 +193,8 @@ impl Emitter {
                     Some(k) if k == k.round() && k.abs() <= 64.0 => {
                         self.intern(Node::Powi(b, k as i32))
                     }
-                    Some(k) if k == 0.5 => self.intern(Node::Sqrt(b)),
-                    Some(k) if k == -0.5 => {
+                    Some(0.5) => self.intern(Node::Sqrt(b)),
+                    Some(-0.5) => {
                         let s = self.intern(Node::Sqrt(b));
                         let one = self.intern(Node::Lit("1.0".into()));
                         self.intern(Node::Div(one, s))

@@ -324,9 +324,7 @@ fn values_from(scene: &Scene) -> Result<Option<Vec<f64>>, SceneError> {
         .map(|p| p.trim().parse::<f64>())
         .collect::<Result<_, _>>()
         .map_err(|_| bad("geometric:first,last,count with numbers"))?;
-    geometric_progression(&parts)
-        .map(Some)
-        .map_err(|reason| bad(reason))
+    geometric_progression(&parts).map(Some).map_err(bad)
 }
 
 /// `first,last,count`: `count` values from `first` to `last` in geometric

@@ -1185,10 +1185,7 @@ pub fn splitting_sweep(
 ) -> Result<SplittingSweep, SplittingError> {
     let info = model.info;
     let index = info.parameter_names.iter().position(|n| *n == parameter);
-    let parameter_error = |value: f64| match info.check_parameter(parameter, value) {
-        Ok(()) => None,
-        Err(e) => Some(e),
-    };
+    let parameter_error = |value: f64| info.check_parameter(parameter, value).err();
     let (Some(index), None) = (index, values.iter().find_map(|&v| parameter_error(v))) else {
         let reason = match values.iter().find_map(|&v| parameter_error(v)) {
             Some(e) => e.to_string(),

@@ -14,7 +14,7 @@ impl<'a, S: System<N>, const N: usize, const M: usize> Variational<'a, S, N, M> 
     /// Panics if M is not N plus a multiple of N, or the system has no Jacobian.
     pub fn new(system: &'a S) -> Self {
         assert!(
-            M > N && (M - N) % N == 0,
+            M > N && (M - N).is_multiple_of(N),
             "variational state length {M} is not N + N·K for N = {N}"
         );
         Variational { system }

@@ -115,7 +115,9 @@ impl Mul for HyperDual {
 
 impl Div for HyperDual {
     type Output = HyperDual;
+    /// a / b = a · (1/b), the reciprocal's derivatives from [`HyperDual::recip`].
     #[inline]
+    #[allow(clippy::suspicious_arithmetic_impl)]
     fn div(self, o: HyperDual) -> HyperDual {
         self * o.recip()
     }

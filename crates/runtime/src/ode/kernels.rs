@@ -10,6 +10,10 @@
 //! non-finite arguments go to libm. `log2` and `exp2` give the step rule's
 //! ρ = min_k (M/‖y^[k]‖)^{1/k} as 2^{min_k log2(M/‖y^[k]‖)/k} to 10⁻¹²
 //! relative, plenty for a step size (the rule itself is a heuristic).
+//!
+//! The constants are written with the digits fdlibm prints, so that they
+//! can be checked against it (more than an f64 holds, hence the `allow`).
+#![allow(clippy::excessive_precision)]
 
 /// |x| up to which the three-part reduction is exact.
 const REDUCTION_LIMIT: f64 = 823_549.0;
