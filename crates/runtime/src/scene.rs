@@ -90,6 +90,8 @@ pub enum SceneError {
     PeriodMap(#[from] crate::analysis::period_map::PeriodMapError),
     #[error(transparent)]
     Splitting(#[from] crate::analysis::separatrix::SplittingError),
+    #[error(transparent)]
+    Section(#[from] crate::analysis::section::SectionError),
     /// Another scene, run by this one, could not start or failed.
     #[error("cannot run scene {scene}: {source}")]
     Spawn {

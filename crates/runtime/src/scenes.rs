@@ -636,3 +636,98 @@ pub fn separatrix_scene(
     })?;
     Ok(())
 }
+
+/// Scene `section`: the Poincaré section of an autonomous model of two
+/// degrees of freedom at a fixed energy.
+pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use crate::analysis::section::{section, seeds_across, SectionSettings};
+    let model = model_from_args(catalog, Defaults(&[]).get("model", "henon_heiles"))?;
+    let mut knobs = vec![
+        knob(
+            "model",
+            model.info.name,
+            "the model (a file models/<name>.toml) without a fast phase, 2 degrees of freedom",
+        ),
+        knob("energy", "0.125", "the energy H = E of every orbit"),
+        knob(
+            "coordinate",
+            "0",
+            "the plane is this coordinate (0 = first) equal to `value`",
+        ),
+        knob("value", "0", "the plane's value"),
+        knob(
+            "direction",
+            "rising",
+            "crossings with the coordinate increasing (rising) or decreasing (falling)",
+        ),
+        knob(
+            "orbits",
+            "24",
+            "orbits, seeded evenly across the accessible part of the other coordinate",
+        ),
+        knob("extent", "2", "seeds are searched for in [-extent, extent]"),
+        knob("crossings", "400", "points per orbit"),
+        knob(
+            "t_max",
+            "20000",
+            "an orbit stops at this time, however few its crossings",
+        ),
+        knob("tol", "1e-12", "DOP853's tolerance"),
+    ];
+    knobs.extend(parameter_knobs(model.info, &[]));
+    let scene = Scene::from_args("section", "Poincaré section at a fixed energy", &knobs)?;
+    let rising = match scene.text("direction") {
+        "rising" => true,
+        "falling" => false,
+        other => {
+            return Err(SceneError::BadValue {
+                name: "direction".into(),
+                value: other.into(),
+                reason: "rising or falling".into(),
+            })
+        }
+    };
+    let settings = SectionSettings {
+        coordinate: scene
+            .text("coordinate")
+            .parse()
+            .map_err(|_| SceneError::BadValue {
+                name: "coordinate".into(),
+                value: scene.text("coordinate").into(),
+                reason: "a coordinate's index (0, 1)".into(),
+            })?,
+        value: scene.number("value")?,
+        rising,
+        energy: scene.number("energy")?,
+        crossings: scene.count("crossings")?,
+        t_max: scene.positive("t_max")?,
+        tol: scene.positive("tol")?,
+    };
+    let params = scene.parameter_values(model.info)?;
+    let seeds = seeds_across(
+        model,
+        &params,
+        &settings,
+        scene.positive("extent")?,
+        scene.count("orbits")?,
+    );
+    eprintln!("{} orbits at H = {} …", seeds.len(), settings.energy);
+    let result = section(model, &params, &seeds, &settings)?;
+    scene.save_figure(&result.figure(), "section.png")?;
+    let rows = result
+        .orbits
+        .iter()
+        .enumerate()
+        .flat_map(|(k, o)| o.points.iter().map(move |p| (k, p[0], p[1])));
+    scene.write_csv(
+        "section.csv",
+        &["orbit", result.axes[0].as_str(), result.axes[1].as_str()],
+        rows,
+    )?;
+    eprintln!(
+        "largest |H − E| on the section {:.1e}, largest distance from the plane {:.1e}",
+        result.largest_energy_drift, result.largest_plane_distance
+    );
+    scene.write_summary(&result)?;
+    Ok(())
+}

@@ -1,7 +1,8 @@
 //! Analyses built on the integrators: the period map and its orbits,
 //! variational equations (monodromy, Floquet multipliers, Lyapunov exponents,
 //! the fast Lyapunov indicator), the Chirikov standard map, the comparison
-//! of exact and averaged systems, and stabilisation by vibration.
+//! of exact and averaged systems, stabilisation by vibration, and
+//! Poincaré sections of autonomous models.
 
 pub mod averaging;
 pub mod chaos_map;
@@ -10,6 +11,7 @@ pub mod fit;
 pub mod floquet;
 pub mod lyapunov;
 pub mod period_map;
+pub mod section;
 pub mod separatrix;
 pub mod stability;
 pub mod standard_map;

@@ -1,0 +1,358 @@
+//! Poincaré surfaces of section of autonomous models of two degrees of
+//! freedom at a fixed energy: the plane q_c = value crossed in one
+//! direction, each orbit seeded on the plane by the other coordinate and
+//! its momentum, with the missing momentum p_c solved from H = E.
+//!
+//! H is quadratic in the momenta (the model files are checked for it), so
+//! along p_c it is α p² + β p + γ, read exactly from three values; the root
+//! whose rate q_c' = ∂H/∂p_c = 2αp + β has the crossing's sign is taken.
+//! Crossings are located on DOP853's dense output to 10⁻¹² in time (the
+//! integrator's event location); each orbit reports how far its points
+//! drifted from H = E and from the plane.
+
+use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError};
+use crate::registry::{Fixed, Model, WithFixed};
+use rayon::prelude::*;
+
+/// Where the section lies and how far each orbit is followed.
+#[derive(Clone, Debug)]
+pub struct SectionSettings {
+    /// The coordinate q_c whose value defines the plane.
+    pub coordinate: usize,
+    pub value: f64,
+    /// Crossings with q_c increasing (else decreasing).
+    pub rising: bool,
+    /// The energy of every orbit.
+    pub energy: f64,
+    /// Points per orbit (the seed included).
+    pub crossings: usize,
+    /// An orbit that has not crossed that often by this time stops there.
+    pub t_max: f64,
+    /// DOP853's tolerance.
+    pub tol: f64,
+}
+
+/// One orbit on the section.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SectionOrbit {
+    /// The full state the orbit started from (on the plane, at H = E).
+    pub start: Vec<f64>,
+    /// (other coordinate, its momentum) at each crossing, the seed first
+    /// (in the scene's CSV, not its summary).
+    #[serde(skip)]
+    pub points: Vec<[f64; 2]>,
+    /// How many.
+    pub crossings: usize,
+    /// max |H − E| over its crossings.
+    pub energy_drift: f64,
+    /// max |q_c − value| over its crossings.
+    pub plane_distance: f64,
+}
+
+/// Orbits of the section map of one model at one energy.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Section {
+    pub model: String,
+    pub energy: f64,
+    /// The plane, e.g. "x = 0 (x increasing)".
+    pub plane: String,
+    /// The names of the two axes on the plane.
+    pub axes: [String; 2],
+    pub orbits: Vec<SectionOrbit>,
+    /// max |H − E| and max |q_c − value| over every orbit's crossings.
+    pub largest_energy_drift: f64,
+    pub largest_plane_distance: f64,
+}
+
+/// Why a section cannot be drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum SectionError {
+    #[error("model {0} is a contact model: sections are for Hamiltonian models")]
+    ContactModel(String),
+    #[error("model {0} has a fast phase: its section is the period map (scene period_map)")]
+    FastPhase(String),
+    #[error("model {model} has {dof} degrees of freedom: sections are drawn for 2")]
+    Dimension { model: String, dof: usize },
+    #[error("model {model}: {reason}")]
+    Settings { model: String, reason: String },
+    /// No momentum puts the seed at the energy on the requested branch.
+    #[error("seed ({}, {}): energy {energy} is not accessible there (the least H on the plane at this point is {least})", seed[0], seed[1])]
+    Inaccessible {
+        seed: [f64; 2],
+        energy: f64,
+        least: f64,
+    },
+    /// H is not a convex quadratic in the solved momentum (a coordinate
+    /// singularity of the mass matrix at the seed).
+    #[error("seed ({}, {}): H is not quadratic and convex in the momentum there (a singular point of the chart?)", seed[0], seed[1])]
+    Singular { seed: [f64; 2] },
+    #[error("method: {0}")]
+    Method(#[from] OdeError),
+    /// An orbit the integrator could not follow (it left every bounded
+    /// region, or reached a singular point).
+    #[error("orbit from seed ({}, {}): {source}", seed[0], seed[1])]
+    Orbit { seed: [f64; 2], source: OdeError },
+}
+
+/// The section of `model` through `seeds` (other coordinate, its momentum).
+pub fn section(
+    model: &Model,
+    params: &[f64],
+    seeds: &[[f64; 2]],
+    settings: &SectionSettings,
+) -> Result<Section, SectionError> {
+    let work = Sections {
+        model,
+        params,
+        seeds,
+        settings,
+    };
+    crate::registry::with_fixed(model, work)
+        .ok_or_else(|| SectionError::ContactModel(model.info.name.into()))?
+}
+
+/// The work of [`section`] at one size.
+pub struct Sections<'a> {
+    model: &'a Model,
+    params: &'a [f64],
+    seeds: &'a [[f64; 2]],
+    settings: &'a SectionSettings,
+}
+
+impl WithFixed for Sections<'_> {
+    type Output = Result<Section, SectionError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        fixed: &'static F,
+    ) -> Self::Output {
+        let info = fixed.info();
+        let name = info.name.to_string();
+        if fixed.has_fast_phase() {
+            return Err(SectionError::FastPhase(name));
+        }
+        if D != 2 {
+            return Err(SectionError::Dimension {
+                model: name,
+                dof: D,
+            });
+        }
+        let s = self.settings;
+        let bad = |reason: String| SectionError::Settings {
+            model: name.clone(),
+            reason,
+        };
+        if s.coordinate >= D {
+            return Err(bad(format!("coordinate {} of {D}", s.coordinate)));
+        }
+        if !(s.tol > 0.0 && s.t_max > 0.0 && s.energy.is_finite() && s.value.is_finite()) {
+            return Err(bad(
+                "the tolerance and t_max must be positive, the energy and plane finite".into(),
+            ));
+        }
+        let c = s.coordinate;
+        let other = 1 - c;
+        let names = info.state_names();
+        let system = fixed.exact(self.params);
+        let energy = |y: &[f64; S]| self.model.dynamic.energy(self.params, 0.0, y);
+        let orbits = self
+            .seeds
+            .par_iter()
+            .map(|seed| {
+                let start = on_plane::<S>(seed, c, other, s, &energy)?;
+                let condition = move |_: f64, y: &[f64; S]| y[c] - s.value;
+                let direction = if s.rising {
+                    Direction::Rising
+                } else {
+                    Direction::Falling
+                };
+                let events = [Event::new(&condition).direction(direction).non_terminal()];
+                let mut integrator = Integrator::new(Method::parse("dop853", s.tol)?)?;
+                let mut points = vec![*seed];
+                let (mut energy_drift, mut plane_distance) = (0.0f64, 0.0f64);
+                let (mut t, mut y) = (0.0, start);
+                let chunk = (s.t_max / 64.0).max(1.0);
+                while points.len() < s.crossings && t < s.t_max {
+                    let t1 = (t + chunk).min(s.t_max);
+                    let run = integrator
+                        .advance_with_events(&system, t, &y, t1, &events, EventSettings::default())
+                        .map_err(|source| SectionError::Orbit {
+                            seed: *seed,
+                            source,
+                        })?;
+                    for hit in run.hits.iter().take(s.crossings - points.len()) {
+                        points.push([hit.y[other], hit.y[D + other]]);
+                        energy_drift = energy_drift.max((energy(&hit.y) - s.energy).abs());
+                        plane_distance = plane_distance.max((hit.y[c] - s.value).abs());
+                    }
+                    (t, y) = (run.t, run.y);
+                }
+                Ok(SectionOrbit {
+                    start: start.to_vec(),
+                    crossings: points.len(),
+                    points,
+                    energy_drift,
+                    plane_distance,
+                })
+            })
+            .collect::<Result<Vec<_>, SectionError>>()?;
+        let largest = |f: fn(&SectionOrbit) -> f64| orbits.iter().map(f).fold(0.0, f64::max);
+        Ok(Section {
+            largest_energy_drift: largest(|o| o.energy_drift),
+            largest_plane_distance: largest(|o| o.plane_distance),
+            model: name,
+            energy: s.energy,
+            plane: format!(
+                "{} = {} ({} {})",
+                names[c],
+                s.value,
+                names[c],
+                if s.rising { "increasing" } else { "decreasing" }
+            ),
+            axes: [names[other].to_string(), names[D + other].to_string()],
+            orbits,
+        })
+    }
+}
+
+/// The state on the plane at `seed` with p_c solved from H = E on the
+/// settings' branch.
+fn on_plane<const S: usize>(
+    seed: &[f64; 2],
+    c: usize,
+    other: usize,
+    s: &SectionSettings,
+    energy: &dyn Fn(&[f64; S]) -> f64,
+) -> Result<[f64; S], SectionError> {
+    let d = S / 2;
+    let mut y = [0.0; S];
+    y[c] = s.value;
+    y[other] = seed[0];
+    y[d + other] = seed[1];
+    let at = |p: f64| {
+        let mut z = y;
+        z[d + c] = p;
+        energy(&z)
+    };
+    let [alpha, beta, zero] = quadratic(at);
+    if !(alpha > 0.0) || !beta.is_finite() || !zero.is_finite() {
+        return Err(SectionError::Singular { seed: *seed });
+    }
+    let discriminant = beta * beta - 4.0 * alpha * (zero - s.energy);
+    if !(discriminant >= 0.0) {
+        return Err(SectionError::Inaccessible {
+            seed: *seed,
+            energy: s.energy,
+            least: zero - beta * beta / (4.0 * alpha),
+        });
+    }
+    let root = discriminant.sqrt();
+    y[d + c] = if s.rising {
+        (-beta + root) / (2.0 * alpha)
+    } else {
+        (-beta - root) / (2.0 * alpha)
+    };
+    Ok(y)
+}
+
+/// [α, β, γ] of H = α p² + β p + γ along one momentum, from its values at
+/// p = −1, 0, 1 (exact: H is quadratic in the momenta).
+fn quadratic(h: impl Fn(f64) -> f64) -> [f64; 3] {
+    let (minus, zero, plus) = (h(-1.0), h(0.0), h(1.0));
+    [0.5 * (plus + minus) - zero, 0.5 * (plus - minus), zero]
+}
+
+/// `count` seeds on the line p_other = 0 of the plane, evenly over the
+/// stretch around 0 where the energy is accessible (scanned on
+/// [−extent, extent]); none where it is nowhere accessible.
+pub fn seeds_across(
+    model: &Model,
+    params: &[f64],
+    settings: &SectionSettings,
+    extent: f64,
+    count: usize,
+) -> Vec<[f64; 2]> {
+    let c = settings.coordinate;
+    let n = model.dynamic.periodic().len();
+    let least = |q: f64| {
+        let mut y = vec![0.0; 2 * n];
+        y[c] = settings.value;
+        y[1 - c] = q;
+        let at = |p: f64| {
+            let mut z = y.clone();
+            z[n + c] = p;
+            model.dynamic.energy(params, 0.0, &z)
+        };
+        let [alpha, beta, zero] = quadratic(at);
+        zero - beta * beta / (4.0 * alpha)
+    };
+    let grid = 2001;
+    let q = |i: usize| -extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
+    // The accessible runs of the grid; the one around 0 (else the longest):
+    // beyond a barrier the energy may be accessible again on an open branch.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for i in 0..grid {
+        if least(q(i)) < settings.energy {
+            match runs.last_mut() {
+                Some(run) if run.1 + 1 == i => run.1 = i,
+                _ => runs.push((i, i)),
+            }
+        }
+    }
+    let middle = (grid - 1) / 2;
+    let Some(&(first, last)) = runs
+        .iter()
+        .find(|r| r.0 <= middle && middle <= r.1)
+        .or_else(|| runs.iter().max_by_key(|r| r.1 - r.0))
+    else {
+        return Vec::new();
+    };
+    let (lo, hi) = (q(first), q(last));
+    (0..count)
+        .map(|k| [lo + (hi - lo) * (k as f64 + 0.5) / count as f64, 0.0])
+        .filter(|&[q, _]| least(q) < settings.energy)
+        .collect()
+}
+
+impl Section {
+    /// The orbits' points on the plane, one colour per orbit.
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{Figure, PanelSpec, Rgb};
+        let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+        for p in self.orbits.iter().flat_map(|o| &o.points) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let pad = |k: usize| 0.05 * (hi[k] - lo[k]).max(1e-9);
+        let title = format!(
+            "{}: section {} at H = {}, {} orbits",
+            self.model,
+            self.plane,
+            self.energy,
+            self.orbits.len()
+        );
+        let [x, y] = [
+            crate::registry::display_name(&self.axes[0]),
+            crate::registry::display_name(&self.axes[1]),
+        ];
+        let spec = PanelSpec::new(
+            &title,
+            &x,
+            &y,
+            (lo[0] - pad(0), hi[0] + pad(0)),
+            (lo[1] - pad(1), hi[1] + pad(1)),
+        );
+        let mut figure = Figure::grid(1, 1, 820, 720, &[spec]);
+        for (k, orbit) in self.orbits.iter().enumerate() {
+            let hue = k as f64 / self.orbits.len().max(1) as f64;
+            let color = Rgb(
+                (60.0 + 180.0 * hue) as u8,
+                (40.0 + 120.0 * (1.0 - hue)) as u8,
+                (200.0 - 150.0 * hue) as u8,
+            );
+            figure.points(0, orbit.points.iter().map(|p| (p[0], p[1])), color, 1);
+        }
+        figure
+    }
+}

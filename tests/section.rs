@@ -1,0 +1,103 @@
+//! Poincaré sections at a fixed energy (`analysis::section`), checked on
+//! Hénon–Heiles: with the coupling off it is two equal oscillators, whose
+//! section map is the identity (every crossing returns to the seed); with
+//! it on, every crossing lies on the plane and at H = E.
+
+use mechlab::analysis::section::{section, seeds_across, SectionError, SectionSettings};
+use mechlab::models;
+
+fn settings(energy: f64) -> SectionSettings {
+    SectionSettings {
+        coordinate: 0,
+        value: 0.0,
+        rising: true,
+        energy,
+        crossings: 60,
+        t_max: 2000.0,
+        tol: 1e-12,
+    }
+}
+
+#[test]
+fn equal_oscillators_return_to_their_seed_at_every_crossing() {
+    let model = models::by_name("henon_heiles").unwrap();
+    let params = [0.0];
+    let energy = 0.3;
+    let seeds = [[0.2, 0.0], [-0.5, 0.3], [0.1, -0.6]];
+    let result = section(model, &params, &seeds, &settings(energy)).unwrap();
+    for (orbit, seed) in result.orbits.iter().zip(&seeds) {
+        assert_eq!(orbit.points.len(), 60);
+        // p_x from H = E on the rising branch: (p_x² + y² + p_y²)/2 = E.
+        let p_x = (2.0 * energy - seed[0] * seed[0] - seed[1] * seed[1]).sqrt();
+        assert!((orbit.start[2] - p_x).abs() < 1e-12, "{:?}", orbit.start);
+        for p in &orbit.points {
+            let off = (p[0] - seed[0]).hypot(p[1] - seed[1]);
+            assert!(off < 1e-8, "seed {seed:?}: a crossing at {p:?}");
+        }
+    }
+}
+
+#[test]
+fn henon_heiles_crossings_lie_on_the_plane_at_the_energy() {
+    let model = models::by_name("henon_heiles").unwrap();
+    let params = [1.0];
+    let s = settings(0.125);
+    let seeds = seeds_across(model, &params, &s, 2.0, 8);
+    assert_eq!(seeds.len(), 8);
+    // On x = 0 the accessible stretch of y is where y²/2 − y³/3 < 1/8: it
+    // ends at the roots of that cubic, −0.4149… and 0.6536… (the branch
+    // beyond the barrier at y = 1 is not seeded).
+    assert!(
+        seeds.iter().all(|s| s[0] > -0.42 && s[0] < 0.66),
+        "{seeds:?}"
+    );
+    let result = section(model, &params, &seeds, &s).unwrap();
+    assert!(
+        result.largest_energy_drift < 1e-9,
+        "{}",
+        result.largest_energy_drift
+    );
+    assert!(
+        result.largest_plane_distance < 1e-10,
+        "{}",
+        result.largest_plane_distance
+    );
+    for orbit in &result.orbits {
+        assert_eq!(orbit.points.len(), 60);
+        for p in &orbit.points {
+            // Every crossing is inside the energy's region on the plane.
+            let v = p[0] * p[0] / 2.0 - p[0].powi(3) / 3.0;
+            assert!(p[1] * p[1] / 2.0 + v <= 0.125 + 1e-9, "{p:?}");
+        }
+    }
+    let falling = SectionSettings {
+        rising: false,
+        ..s.clone()
+    };
+    let down = section(model, &params, &seeds[..1], &falling).unwrap();
+    assert!(down.orbits[0].start[2] < 0.0);
+}
+
+#[test]
+fn a_section_says_why_it_cannot_be_drawn() {
+    let hh = models::by_name("henon_heiles").unwrap();
+    // V(0, 0.6) = 0.18 − 0.072 = 0.108 > E.
+    match section(hh, &[1.0], &[[0.6, 0.0]], &settings(0.01)) {
+        Err(SectionError::Inaccessible { least, .. }) => assert!((least - 0.108).abs() < 1e-12),
+        other => panic!("{other:?}"),
+    }
+    let kapitza = models::by_name("kapitza").unwrap();
+    let defaults = kapitza.dynamic.defaults();
+    assert!(matches!(
+        section(kapitza, &defaults, &[[0.0, 0.0]], &settings(1.0)),
+        Err(SectionError::FastPhase(_))
+    ));
+    let zero_tolerance = SectionSettings {
+        tol: 0.0,
+        ..settings(0.1)
+    };
+    assert!(matches!(
+        section(hh, &[1.0], &[[0.0, 0.0]], &zero_tolerance),
+        Err(SectionError::Settings { .. })
+    ));
+}
