@@ -167,7 +167,8 @@ fn double_pendulum_second_order_threshold_meets_the_exact_edge() {
 /// is far closer to the exact (Floquet) edge than a* is.
 #[test]
 fn chains_second_order_thresholds_meet_the_exact_edges() {
-    use mechlab::models::{quadruple_pendulum as quadruple, triple_pendulum as triple};
+    use mechlab::models::triple_pendulum as triple;
+    use mechlab_test_models::quadruple_pendulum as quadruple;
     let triple = triple::Params {
         nu: 100.0,
         ..Default::default()
@@ -263,7 +264,9 @@ fn an_order_not_derived_is_an_error() {
 fn every_second_order_model_converges_like_one_over_nu_squared() {
     use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
     let mut checked = Vec::new();
-    for info in mechlab::models::ALL {
+    // The quadruple chain is a test model (test_models/), checked here too.
+    let quadruple = &mechlab_test_models::quadruple_pendulum::INFO;
+    for info in mechlab::models::ALL.iter().chain([quadruple]) {
         let settings = ConvergenceSettings {
             parameter: None,
             values: None,

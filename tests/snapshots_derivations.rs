@@ -5,7 +5,9 @@
 
 #[test]
 fn every_derived_expression_is_pinned() {
-    for model in mechlab::models::ALL {
+    // The quadruple chain is a test model (test_models/), pinned here too.
+    let quadruple = &mechlab_test_models::quadruple_pendulum::INFO;
+    for model in mechlab::models::ALL.iter().chain([quadruple]) {
         assert!(
             !model.derivations.is_empty(),
             "{} has no derivations",
@@ -90,7 +92,8 @@ fn latex_uses_greek_letters_and_subscripts() {
 /// is pinned instead, to nine digits, in a snapshot.
 #[test]
 fn chains_second_order_hessians_are_pinned() {
-    use mechlab::models::{quadruple_pendulum as quadruple, triple_pendulum as triple};
+    use mechlab::models::triple_pendulum as triple;
+    use mechlab_test_models::quadruple_pendulum as quadruple;
     fn rows<const S: usize>(h: [[f64; S]; S]) -> String {
         let scale = h.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
         // Round-off below 1e-12 of the largest entry prints as zero.

@@ -20,7 +20,7 @@ fn settings(amplitude: &str) -> Settings {
 }
 
 fn defaults(name: &str) -> Vec<f64> {
-    mechlab::models::by_name(name).unwrap().dynamic.defaults()
+    model_of(name).dynamic.defaults()
 }
 
 fn at<'a>(result: &'a [EquilibriumStability], q: &[f64]) -> &'a EquilibriumStability {

@@ -6,7 +6,11 @@ use mechlab::registry::Model;
 
 /// The users' model `name`, which the test expects to exist.
 pub fn model_of(name: &str) -> &'static Model {
-    mechlab::models::by_name(name).unwrap_or_else(|e| panic!("{e}"))
+    match name {
+        // A test model (test_models/): the scenes' build does not compile it.
+        "quadruple_pendulum" => &mechlab_test_models::quadruple_pendulum::MODEL,
+        _ => mechlab::models::by_name(name).unwrap_or_else(|e| panic!("{e}")),
+    }
 }
 
 /// Deterministic pseudo-random numbers (xorshift64), so that a failing

@@ -125,6 +125,11 @@ pub struct Scene {
     staging: PathBuf,
 }
 
+/// With this variable set, a scene checks its arguments (the example, the
+/// model, every knob's name) and exits without running: the test of the
+/// commands shown in the docs runs them so.
+pub const CHECK_ARGUMENTS: &str = "MECHLAB_CHECK_ARGUMENTS";
+
 impl Scene {
     /// Parses `std::env::args`; prints help and exits on `--help`.
     pub fn from_args(name: &'static str, about: &str, knobs: &[Knob]) -> Result<Scene, SceneError> {
@@ -133,7 +138,12 @@ impl Scene {
             println!("{}", Self::help(name, about, knobs));
             std::process::exit(0);
         }
-        Self::parse(name, knobs, &args)
+        let scene = Self::parse(name, knobs, &args)?;
+        if std::env::var_os(CHECK_ARGUMENTS).is_some() {
+            println!("{name}: arguments accepted");
+            std::process::exit(0);
+        }
+        Ok(scene)
     }
 
     pub fn help(name: &str, about: &str, knobs: &[Knob]) -> String {

@@ -9,11 +9,12 @@
 //! their normal modes.
 
 use mechlab::analysis::floquet::monodromy;
-use mechlab::models::{double_pendulum, quadruple_pendulum, triple_pendulum};
+use mechlab::models::{double_pendulum, triple_pendulum};
 use mechlab::ode::{Integrator, Method, System};
 use mechlab::registry::{DynamicModel, Kind};
 use mechlab_test_models::{
-    awkward_names, awkward_names_numeric, double_pendulum_numeric, spring_double_pendulum,
+    awkward_names, awkward_names_numeric, double_pendulum_numeric, quadruple_pendulum,
+    spring_double_pendulum,
 };
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
