@@ -80,10 +80,11 @@ fn main() {
         for e in &result.equilibria {
             println!(
                 "equilibrium q = {:?}: Hessian eigenvalues {:?}: {}",
-                e.q,
-                e.hessian_eigenvalues,
-                if e.stable { "stable" } else { "unstable" }
+                e.q, e.hessian_eigenvalues, e.verdict
             );
+        }
+        if let Some(reason) = &result.equilibria_not_searched {
+            println!("equilibria not searched: {reason}");
         }
         for s in &result.switches {
             println!("{s}");
@@ -105,6 +106,7 @@ fn main() {
             y0: &'a [f64],
             final_state: Option<&'a Vec<f64>>,
             equilibria: &'a [mechlab::explore::Equilibrium],
+            equilibria_not_searched: &'a Option<mechlab::explore::NotSearched>,
             energy: Energy,
             switches: &'a [String],
         }
@@ -119,6 +121,7 @@ fn main() {
             y0: &y0,
             final_state: result.exact.last(),
             equilibria: &result.equilibria,
+            equilibria_not_searched: &result.equilibria_not_searched,
             energy: Energy {
                 label: result.energy_label,
                 max_abs_change: max_energy,

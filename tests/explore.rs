@@ -68,7 +68,7 @@ fn kapitza_equilibria_match_the_closed_form() {
     let a: f64 = 1.5;
     let mut params = model.defaults();
     params[0] = a;
-    let found = mechlab::explore::equilibria(model, &params);
+    let found = mechlab::explore::equilibria(model, &params).unwrap();
     assert_eq!(found.len(), 4, "{found:?}");
     let at = |q: f64| {
         found
@@ -76,10 +76,14 @@ fn kapitza_equilibria_match_the_closed_form() {
             .find(|e| mechlab::analysis::period_map::wrap_angle(e.q[0] - q).abs() < 1e-6)
             .unwrap_or_else(|| panic!("no equilibrium at {q}: {found:?}"))
     };
-    assert!(at(0.0).stable && (at(0.0).hessian_eigenvalues[0] - (a * a / 2.0 - 1.0)).abs() < 1e-9);
-    assert!(at(std::f64::consts::PI).stable);
+    use mechlab::explore::Verdict::{Stable, Unstable};
+    assert!(
+        at(0.0).verdict == Stable
+            && (at(0.0).hessian_eigenvalues[0] - (a * a / 2.0 - 1.0)).abs() < 1e-9
+    );
+    assert_eq!(at(std::f64::consts::PI).verdict, Stable);
     let saddle = (2.0 / (a * a)).acos();
-    assert!(!at(saddle).stable && !at(-saddle).stable);
+    assert!(at(saddle).verdict == Unstable && at(-saddle).verdict == Unstable);
 }
 
 /// Through the generated systems `explore` offers every method, `taylor`
@@ -112,4 +116,41 @@ fn explore_runs_with_taylor() {
             assert!((a - b).abs() < 1e-9, "{name} averaged: {a} vs {b}");
         }
     }
+}
+
+/// The second-order verdict: a degenerate Hessian decides nothing, and an
+/// empty list of equilibria says why.
+#[test]
+fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
+    use mechlab::explore::{equilibria, NotSearched, Verdict};
+    assert_eq!(Verdict::of(&[0.5, 2.0]), Verdict::Stable);
+    assert_eq!(Verdict::of(&[-0.5, 2.0]), Verdict::Unstable);
+    // x⁴ at 0: a Hessian of round-off, not an instability.
+    assert_eq!(Verdict::of(&[8e-12]), Verdict::InconclusiveAtSecondOrder);
+    assert_eq!(
+        Verdict::of(&[-1e-12, 3.0]),
+        Verdict::InconclusiveAtSecondOrder
+    );
+    // Hénon–Heiles: the minimum at 0 and three saddles at V = 1/6.
+    let hh = models::by_name("henon_heiles").unwrap();
+    let found = equilibria(hh.dynamic, &[1.0]).unwrap();
+    let stable: Vec<_> = found
+        .iter()
+        .filter(|e| e.verdict == Verdict::Stable)
+        .collect();
+    assert_eq!(stable.len(), 1);
+    assert!(stable[0].q.iter().all(|x| x.abs() < 1e-9));
+    assert_eq!(
+        found
+            .iter()
+            .filter(|e| e.verdict == Verdict::Unstable)
+            .count(),
+        3
+    );
+    // A contact model has no potential to search.
+    let contact = models::by_name("painleve_klein").unwrap();
+    assert_eq!(
+        equilibria(contact.dynamic, &contact.dynamic.defaults()).unwrap_err(),
+        NotSearched::NoPotential
+    );
 }

@@ -31,8 +31,56 @@ pub struct Equilibrium {
     pub q: Vec<f64>,
     /// Eigenvalues of the Hessian, ascending.
     pub hessian_eigenvalues: Vec<f64>,
-    /// A strict minimum: stable.
-    pub stable: bool,
+    pub verdict: Verdict,
+}
+
+/// What the second-order test of the effective potential says of an
+/// equilibrium. An eigenvalue within round-off of zero (10⁻⁸ of the
+/// largest) decides nothing: a degenerate minimum such as x⁴, or a family
+/// of equilibria along a cyclic coordinate, is never called unstable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// A strict minimum: every eigenvalue positive.
+    Stable,
+    /// A direction of negative curvature.
+    Unstable,
+    /// No negative eigenvalue, but one within round-off of zero.
+    InconclusiveAtSecondOrder,
+}
+
+impl Verdict {
+    /// The verdict of a Hessian with these eigenvalues.
+    pub fn of(eigenvalues: &[f64]) -> Verdict {
+        let scale = eigenvalues.iter().fold(1.0f64, |m, l| m.max(l.abs()));
+        let round_off = 1e-8 * scale;
+        if eigenvalues.iter().any(|&l| l < -round_off) {
+            Verdict::Unstable
+        } else if eigenvalues.iter().all(|&l| l > round_off) {
+            Verdict::Stable
+        } else {
+            Verdict::InconclusiveAtSecondOrder
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Verdict::Stable => "stable",
+            Verdict::Unstable => "unstable",
+            Verdict::InconclusiveAtSecondOrder => "inconclusive at second order",
+        })
+    }
+}
+
+/// Why no equilibria were searched for.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, thiserror::Error)]
+pub enum NotSearched {
+    #[error("the model has no effective potential (a contact model)")]
+    NoPotential,
+    #[error("{dof} degrees of freedom: the grid search for equilibria covers 1 to 3")]
+    TooManyDegrees { dof: usize },
 }
 
 /// Everything the explorer computed.
@@ -49,6 +97,8 @@ pub struct Exploration {
     pub energy_change: Vec<f64>,
     pub energy_label: &'static str,
     pub equilibria: Vec<Equilibrium>,
+    /// Why `equilibria` is empty without a search, if it is.
+    pub equilibria_not_searched: Option<NotSearched>,
     /// Switches of a contact model, as text.
     pub switches: Vec<String>,
 }
@@ -188,9 +238,14 @@ impl WithFixed for HamiltonianRuns<'_> {
         let exact_system = fixed.exact(params);
         let exact =
             Integrator::new(settings.method)?.advance_sampled(&exact_system, 0.0, &y0, &times)?;
+        let (found, not_searched) = match equilibria(model, params) {
+            Ok(found) => (found, None),
+            Err(reason) => (Vec::new(), Some(reason)),
+        };
         let mut out = Exploration {
             exact: exact.iter().map(|y| y.to_vec()).collect(),
-            equilibria: equilibria(model, params),
+            equilibria: found,
+            equilibria_not_searched: not_searched,
             ..Default::default()
         };
         match (fixed.phase_period(params), fixed.averaged(params)) {
@@ -259,6 +314,7 @@ fn contacts<const C: usize, const M: usize>(
             .map(|(t, y)| model.energy(params, *t, y) - e0)
             .collect(),
         energy_label: "E(t) − E(0): friction and dissipation work",
+        equilibria_not_searched: Some(NotSearched::NoPotential),
         switches: run
             .switches
             .iter()
@@ -281,11 +337,17 @@ fn contacts<const C: usize, const M: usize>(
 /// (central differences) with the generated Hessian, from a grid of starts
 /// (12 per coordinate: angles over [−π, π), others over [−2, 2)); duplicates
 /// (angles modulo 2π) merged.
-pub fn equilibria(model: &dyn DynamicModel, params: &[f64]) -> Vec<Equilibrium> {
+pub fn equilibria(
+    model: &dyn DynamicModel,
+    params: &[f64],
+) -> Result<Vec<Equilibrium>, NotSearched> {
     let periodic = model.periodic();
     let n = periodic.len();
-    if model.effective_potential(params, &vec![0.0; n]).is_none() || n > 3 {
-        return Vec::new();
+    if model.effective_potential(params, &vec![0.0; n]).is_none() {
+        return Err(NotSearched::NoPotential);
+    }
+    if n > 3 {
+        return Err(NotSearched::TooManyDegrees { dof: n });
     }
     let v = |q: &[f64]| model.effective_potential(params, q).unwrap_or(f64::NAN);
     let gradient = |q: &[f64]| -> Vec<f64> {
@@ -364,14 +426,13 @@ pub fn equilibria(model: &dyn DynamicModel, params: &[f64]) -> Vec<Equilibrium> 
         let sym = (&hm + hm.transpose()) * 0.5;
         let mut eigenvalues: Vec<f64> = sym.symmetric_eigenvalues().iter().copied().collect();
         eigenvalues.sort_by(f64::total_cmp);
-        let stable = eigenvalues.iter().all(|l| *l > 1e-9);
         found.push(Equilibrium {
             q,
+            verdict: Verdict::of(&eigenvalues),
             hessian_eigenvalues: eigenvalues,
-            stable,
         });
     }
-    found
+    Ok(found)
 }
 
 /// Limits of the finite values, widened a little ((−1, 1) if none).

@@ -406,6 +406,7 @@ impl Map {
 /// Starts for Newton: the maxima of the averaged potential, at rest.
 fn saddles(model: &dyn DynamicModel, params: &[f64]) -> Vec<[f64; 2]> {
     crate::explore::equilibria(model, params)
+        .unwrap_or_default()
         .into_iter()
         .filter(|e| e.hessian_eigenvalues.iter().all(|&h| h < 0.0))
         .map(|e| [e.q[0], 0.0])

@@ -643,6 +643,7 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
     };
     let field = contour::Field::sample(ranges, grid, value);
     let equilibria: Vec<EquilibriumMark> = crate::explore::equilibria(model, params)
+        .unwrap_or_default()
         .into_iter()
         .map(|e| {
             let mut state = e.q.clone();
@@ -669,7 +670,7 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
                     .filter(|k| !setup.axes.contains(k))
                     .all(same),
                 point,
-                stable: e.stable,
+                stable: e.verdict == crate::explore::Verdict::Stable,
                 hessian_eigenvalues: e.hessian_eigenvalues,
                 q: e.q,
             }
