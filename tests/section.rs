@@ -86,6 +86,13 @@ fn a_section_says_why_it_cannot_be_drawn() {
         Err(SectionError::Inaccessible { least, .. }) => assert!((least - 0.108).abs() < 1e-12),
         other => panic!("{other:?}"),
     }
+    // No seeds (energy below the minimum, nothing accessible): named, not
+    // an empty figure.
+    assert!(matches!(
+        section(hh, &[1.0], &[], &settings(-1.0)),
+        Err(SectionError::NoSeeds { .. })
+    ));
+    assert!(seeds_across(hh, &[1.0], &settings(-1.0), 2.0, 8).is_empty());
     let kapitza = models::by_name("kapitza").unwrap();
     let defaults = kapitza.dynamic.defaults();
     assert!(matches!(

@@ -75,6 +75,10 @@ pub enum SectionError {
     Dimension { model: String, dof: usize },
     #[error("model {model}: {reason}")]
     Settings { model: String, reason: String },
+    /// No seed: where the scene looked, the energy is nowhere accessible on
+    /// the plane (or the plane is a singular point of the chart).
+    #[error("model {model}: no seeds on the plane (is the energy accessible there, and is the plane not a singular point of the coordinates?)")]
+    NoSeeds { model: String },
     /// No momentum puts the seed at the energy on the requested branch.
     #[error("seed ({}, {}): energy {energy} is not accessible there (the least H on the plane at this point is {least})", seed[0], seed[1])]
     Inaccessible {
@@ -149,8 +153,12 @@ impl WithFixed for Sections<'_> {
                 "the tolerance and t_max must be positive, the energy and plane finite".into(),
             ));
         }
+        if self.seeds.is_empty() {
+            return Err(SectionError::NoSeeds { model: name });
+        }
         let c = s.coordinate;
         let other = 1 - c;
+        let angle = fixed.periodic()[c];
         let names = info.state_names();
         let system = fixed.exact(self.params);
         let energy = |y: &[f64; S]| self.model.dynamic.energy(self.params, 0.0, y);
@@ -159,7 +167,18 @@ impl WithFixed for Sections<'_> {
             .par_iter()
             .map(|seed| {
                 let start = on_plane::<S>(seed, c, other, s, &energy)?;
-                let condition = move |_: f64, y: &[f64; S]| y[c] - s.value;
+                // An angle crosses the plane at every turn: the condition is
+                // its offset wrapped to [−π, π), whose jump at ±π is a
+                // crossing of the opposite side, dropped below.
+                let offset = move |y: &[f64; S]| {
+                    let d = y[c] - s.value;
+                    if angle {
+                        crate::analysis::period_map::wrap_angle(d)
+                    } else {
+                        d
+                    }
+                };
+                let condition = move |_: f64, y: &[f64; S]| offset(y);
                 let direction = if s.rising {
                     Direction::Rising
                 } else {
@@ -179,10 +198,11 @@ impl WithFixed for Sections<'_> {
                             seed: *seed,
                             source,
                         })?;
-                    for hit in run.hits.iter().take(s.crossings - points.len()) {
+                    let on_plane = run.hits.iter().filter(|hit| offset(&hit.y).abs() < 1e-6);
+                    for hit in on_plane.take(s.crossings - points.len()) {
                         points.push([hit.y[other], hit.y[D + other]]);
                         energy_drift = energy_drift.max((energy(&hit.y) - s.energy).abs());
-                        plane_distance = plane_distance.max((hit.y[c] - s.value).abs());
+                        plane_distance = plane_distance.max(offset(&hit.y).abs());
                     }
                     (t, y) = (run.t, run.y);
                 }
