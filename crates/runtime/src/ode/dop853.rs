@@ -8,7 +8,8 @@
 // The constants are kept exactly as published with dop853.f.
 #![allow(clippy::excessive_precision)]
 
-use super::{check_finite, combine, Observer, OdeError, Stats, Step, StepControl, System};
+use super::driver::{check_finite, Attempt, Schedule, Stepper};
+use super::{combine, OdeError, Stats, Step, System, Tolerances};
 
 const C: [f64; 12] = [
     0.0,
@@ -346,7 +347,7 @@ const D: [[f64; 16]; 4] = [
 ];
 
 /// An accepted DOP853 step with Hairer's dense output of order 7.
-struct Dop853Step<'a, S, const N: usize> {
+pub(super) struct Dop853Step<'a, S, const N: usize> {
     system: &'a S,
     t0: f64,
     y0: [f64; N],
@@ -436,13 +437,31 @@ fn eighth_root(x: f64) -> f64 {
     x.sqrt().sqrt().sqrt()
 }
 
-fn scale(control: &StepControl, a: f64, b: f64) -> f64 {
-    control.atol + control.rtol * a.abs().max(b.abs())
+/// The method's state: its tolerances, its stages (the last one of a step is
+/// the first of the next) and the length of the run.
+pub(super) struct Dop853<const N: usize> {
+    tolerances: Tolerances,
+    k: [[f64; N]; 16],
+    /// The stage k[12] = f(t, y) of the step just accepted is the next
+    /// step's k[0] (first same as last), copied once observers are done.
+    first_same_as_last: bool,
+    span: f64,
+}
+
+impl<const N: usize> Dop853<N> {
+    pub fn new(tolerances: Tolerances) -> Dop853<N> {
+        Dop853 {
+            tolerances,
+            k: [[0.0; N]; 16],
+            first_same_as_last: false,
+            span: 0.0,
+        }
+    }
 }
 
 /// Hairer's initial step size guess.
 fn initial_step<S: System<N>, const N: usize>(
-    control: &StepControl,
+    tolerances: &Tolerances,
     system: &S,
     t: f64,
     y: &[f64; N],
@@ -453,7 +472,7 @@ fn initial_step<S: System<N>, const N: usize>(
     let norm = |v: &[f64; N]| {
         (v.iter()
             .zip(y)
-            .map(|(x, yi)| (x / scale(control, *yi, *yi)).powi(2))
+            .map(|(x, yi)| (x / tolerances.scale(*yi, *yi)).powi(2))
             .sum::<f64>()
             / N as f64)
             .sqrt()
@@ -477,55 +496,76 @@ fn initial_step<S: System<N>, const N: usize>(
     (100.0 * h0).min(h1)
 }
 
-/// Integrates from t0 to t1, starting with (and leaving in) the control's step size.
-pub(super) fn integrate<S: System<N>, const N: usize>(
-    control: &mut StepControl,
-    system: &S,
-    t0: f64,
-    y0: &[f64; N],
-    t1: f64,
-    stats: &mut Stats,
-    observe: Observer<'_, N>,
-) -> Result<(f64, [f64; N]), OdeError> {
-    let direction = (t1 - t0).signum();
-    let span = (t1 - t0).abs();
-    let mut t = t0;
-    let mut y = *y0;
-    let mut k = [[0.0; N]; 16];
-    k[0] = system.rhs(t, &y);
-    stats.f_evals += 1;
-    let mut h = match *control.next_step {
-        Some(h) => h,
-        None => initial_step(control, system, t, &y, &k[0], direction, stats),
+impl<S: System<N>, const N: usize> Stepper<S, N> for Dop853<N> {
+    type Accepted<'a>
+        = Dop853Step<'a, S, N>
+    where
+        S: 'a;
+
+    fn schedule(&self) -> Schedule {
+        Schedule::Adaptive {
+            snap: 1e-12,
+            compensated: false,
+            underflow: 1e-14,
+        }
     }
-    .min(span);
-    let mut steps = 0u64;
-    let mut last_rejected = false;
-    loop {
-        if steps >= control.max_steps {
-            return Err(OdeError::TooManySteps {
-                t,
-                max_steps: control.max_steps,
-            });
+
+    fn begin(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        t1: f64,
+        carried: Option<f64>,
+        stats: &mut Stats,
+    ) -> Result<f64, OdeError> {
+        self.k[0] = system.rhs(t0, y0);
+        stats.f_evals += 1;
+        self.first_same_as_last = false;
+        self.span = (t1 - t0).abs();
+        Ok(match carried {
+            Some(h) => h,
+            None => {
+                let direction = (t1 - t0).signum();
+                initial_step(
+                    &self.tolerances,
+                    system,
+                    t0,
+                    y0,
+                    &self.k[0],
+                    direction,
+                    stats,
+                )
+            }
+        })
+    }
+
+    fn attempt(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        hs: f64,
+        t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<Attempt<N>, OdeError> {
+        let k = &mut self.k;
+        if self.first_same_as_last {
+            k[0] = k[12];
+            self.first_same_as_last = false;
         }
-        let remaining = (t1 - t).abs();
-        let last = h >= remaining * (1.0 - 1e-12);
-        let h_try = if last { remaining } else { h };
-        if h_try < 1e-14 * t.abs().max(1.0) {
-            return Err(OdeError::StepSizeUnderflow { t, h: h_try });
-        }
-        let hs = direction * h_try;
+        let h_try = hs.abs();
         // The stages, written out over the nonzero entries of A only, for
         // the compiler to unroll.
         macro_rules! stage {
-                ($i:literal: $first:literal $(, $j:literal)*) => {{
-                    let mut yi = y;
-                    for n in 0..N {
-                        yi[n] += hs * (A[$i][$first] * k[$first][n] $(+ A[$i][$j] * k[$j][n])*);
-                    }
-                    k[$i] = system.rhs(t + C[$i] * hs, &yi);
-                }};
-            }
+            ($i:literal: $first:literal $(, $j:literal)*) => {{
+                let mut yi = *y;
+                for n in 0..N {
+                    yi[n] += hs * (A[$i][$first] * k[$first][n] $(+ A[$i][$j] * k[$j][n])*);
+                }
+                k[$i] = system.rhs(t + C[$i] * hs, &yi);
+            }};
+        }
         stage!(1: 0);
         stage!(2: 0, 1);
         stage!(3: 0, 2);
@@ -538,10 +578,9 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
         stage!(10: 0, 3, 4, 5, 6, 7, 8, 9);
         stage!(11: 0, 3, 4, 5, 6, 7, 8, 9, 10);
         stats.f_evals += 11;
-        steps += 1;
         // The solution and Hairer's error estimate (5th and 3rd order
         // estimators combined); B and ER vanish on stages 2 to 5.
-        let mut y_new = y;
+        let mut y_new = *y;
         let (mut err5, mut err3) = (0.0, 0.0);
         for i in 0..N {
             let mut bs = B[0] * k[0][i];
@@ -551,7 +590,7 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
                 e5 += ER[j] * k[j][i];
             }
             y_new[i] += hs * bs;
-            let inverse_scale = 1.0 / scale(control, y[i], y_new[i]);
+            let inverse_scale = 1.0 / self.tolerances.scale(y[i], y_new[i]);
             let e3 = bs - BHH[0] * k[0][i] - BHH[1] * k[8][i] - BHH[2] * k[11][i];
             err5 += (e5 * inverse_scale).powi(2);
             err3 += (e3 * inverse_scale).powi(2);
@@ -564,52 +603,48 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
         };
         if !err.is_finite() {
             // A non-finite stage: retry smaller, unless the step is already tiny.
-            if !y_new.iter().all(|x| x.is_finite()) && h_try < 1e-10 * span {
+            if !y_new.iter().all(|x| x.is_finite()) && h_try < 1e-10 * self.span {
                 return Err(OdeError::NonFinite {
                     t,
                     y: y_new.to_vec(),
                 });
             }
-            stats.rejected += 1;
-            h = h_try * 0.1;
-            last_rejected = true;
-            continue;
+            return Ok(Attempt::Rejected { retry: h_try * 0.1 });
+        }
+        if err > 1.0 {
+            return Ok(Attempt::Rejected {
+                retry: h_try / (eighth_root(err) / SAFETY).min(1.0 / MIN_FACTOR),
+            });
         }
         let factor = (eighth_root(err) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
-        if err <= 1.0 {
-            check_finite(t + hs, &y_new)?;
-            let t_new = if last { t1 } else { t + hs };
-            stats.steps += 1;
-            k[12] = system.rhs(t_new, &y_new);
-            stats.f_evals += 1;
-            let mut view = Dop853Step {
-                system,
-                t0: t,
-                y0: y,
-                h: hs,
-                t1: t_new,
-                y1: y_new,
-                k: &mut k,
-                dense: None,
-                stats,
-            };
-            let flow = observe(&mut view)?;
-            t = t_new;
-            y = y_new;
-            k[0] = k[12];
-            let mut h_new = h_try / factor;
-            if last_rejected {
-                h_new = h_new.min(h_try);
-            }
-            last_rejected = false;
-            if let Some(end) = control.end_of_run(flow, last, (t, y), h, h_try, h_new) {
-                return Ok(end);
-            }
-            h = h_new;
-        } else {
-            stats.rejected += 1;
-            last_rejected = true;
-            h = h_try / (eighth_root(err) / SAFETY).min(1.0 / MIN_FACTOR);
+        check_finite(t + hs, &y_new)?;
+        k[12] = system.rhs(t_end, &y_new);
+        stats.f_evals += 1;
+        self.first_same_as_last = true;
+        Ok(Attempt::Accepted {
+            y: y_new,
+            next: h_try / factor,
+        })
+    }
+
+    fn accepted<'a>(
+        &'a mut self,
+        system: &'a S,
+        (t0, y0): (f64, [f64; N]),
+        (t1, y1): (f64, [f64; N]),
+        h: f64,
+        stats: &'a mut Stats,
+    ) -> Dop853Step<'a, S, N> {
+        Dop853Step {
+            system,
+            t0,
+            y0,
+            h,
+            t1,
+            y1,
+            k: &mut self.k,
+            dense: None,
+            stats,
         }
     }
 }

@@ -5,7 +5,8 @@
 //! round-off, and the solution is accumulated with compensated summation so
 //! that round-off does not drift over 10⁶ steps either.
 
-use super::{check_finite, fixed_steps, Flow, Observer, OdeError, Stats, Step, System};
+use super::driver::{Attempt, Schedule, Stepper};
+use super::{OdeError, Stats, Step, System};
 
 struct Tableau {
     c: [f64; 3],
@@ -108,7 +109,7 @@ fn increment<const N: usize>(
 
 /// An accepted Gauss–Legendre step; inside it, states come from a fresh
 /// Gauss step of the partial length (the method's own order).
-struct GaussStep<'a, S, const N: usize> {
+pub(super) struct GaussStep<'a, S, const N: usize> {
     system: &'a S,
     tab: &'a Tableau,
     stages: usize,
@@ -146,57 +147,96 @@ impl<S: System<N>, const N: usize> Step<N> for GaussStep<'_, S, N> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-pub(super) fn integrate<S: System<N>, const N: usize>(
-    system: &S,
+/// The method's state: its tableau, the stage derivatives of the last step
+/// (which start the next step's iteration) and the compensation of the
+/// summed increments.
+pub(super) struct Gauss<const N: usize> {
+    tab: Tableau,
     stages: usize,
-    t0: f64,
-    y0: &[f64; N],
-    t1: f64,
     max_step: f64,
-    max_steps: u64,
-    stats: &mut Stats,
-    observe: Observer<'_, N>,
-) -> Result<(f64, [f64; N]), OdeError> {
-    let tab = tableau(stages);
-    let (n, h) = fixed_steps(t0, t1, max_step, max_steps)?;
-    let mut y = *y0;
-    let mut compensation = [0.0; N];
-    // Stage derivatives; the previous step's values start the iteration.
-    let f0 = system.rhs(t0, &y);
-    stats.f_evals += 1;
-    let mut f = [f0; 3];
-    for step in 0..n {
-        let t = t0 + step as f64 * h;
-        solve_stages(system, &tab, stages, t, &y, h, &mut f, stats)?;
-        let mut y_new = y;
-        for k in 0..N {
-            let delta = increment(&tab, stages, h, &f, k) + compensation[k];
-            y_new[k] = y[k] + delta;
-            compensation[k] = delta - (y_new[k] - y[k]);
-        }
-        let t_next = if step + 1 == n {
-            t1
-        } else {
-            t0 + (step + 1) as f64 * h
-        };
-        check_finite(t_next, &y_new)?;
-        stats.steps += 1;
-        let mut view = GaussStep {
-            system,
-            tab: &tab,
+    f: [[f64; N]; 3],
+    compensation: [f64; N],
+}
+
+impl<const N: usize> Gauss<N> {
+    pub fn new(stages: usize, max_step: f64) -> Gauss<N> {
+        Gauss {
+            tab: tableau(stages),
             stages,
-            t0: t,
-            y0: y,
-            t1: t_next,
-            y1: y_new,
-            f,
-            stats,
-        };
-        if let Flow::Stop { t, y } = observe(&mut view)? {
-            return Ok((t, y));
+            max_step,
+            f: [[0.0; N]; 3],
+            compensation: [0.0; N],
         }
-        y = y_new;
     }
-    Ok((t1, y))
+}
+
+impl<S: System<N>, const N: usize> Stepper<S, N> for Gauss<N> {
+    type Accepted<'a>
+        = GaussStep<'a, S, N>
+    where
+        S: 'a;
+
+    fn schedule(&self) -> Schedule {
+        Schedule::Fixed {
+            max_step: self.max_step,
+        }
+    }
+
+    fn begin(
+        &mut self,
+        system: &S,
+        t0: f64,
+        y0: &[f64; N],
+        _t1: f64,
+        _carried: Option<f64>,
+        stats: &mut Stats,
+    ) -> Result<f64, OdeError> {
+        self.f = [system.rhs(t0, y0); 3];
+        stats.f_evals += 1;
+        self.compensation = [0.0; N];
+        Ok(self.max_step)
+    }
+
+    fn attempt(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        h: f64,
+        _t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<Attempt<N>, OdeError> {
+        solve_stages(system, &self.tab, self.stages, t, y, h, &mut self.f, stats)?;
+        let mut y_new = *y;
+        for k in 0..N {
+            let delta = increment(&self.tab, self.stages, h, &self.f, k) + self.compensation[k];
+            y_new[k] = y[k] + delta;
+            self.compensation[k] = delta - (y_new[k] - y[k]);
+        }
+        Ok(Attempt::Accepted {
+            y: y_new,
+            next: self.max_step,
+        })
+    }
+
+    fn accepted<'a>(
+        &'a mut self,
+        system: &'a S,
+        (t0, y0): (f64, [f64; N]),
+        (t1, y1): (f64, [f64; N]),
+        _h: f64,
+        stats: &'a mut Stats,
+    ) -> GaussStep<'a, S, N> {
+        GaussStep {
+            system,
+            tab: &self.tab,
+            stages: self.stages,
+            t0,
+            y0,
+            t1,
+            y1,
+            f: self.f,
+            stats,
+        }
+    }
 }

@@ -7,6 +7,7 @@
 //! States are `[f64; N]`: no allocation per step.
 
 mod dop853;
+mod driver;
 mod erased;
 mod events;
 mod gauss;
@@ -492,7 +493,8 @@ impl Integrator {
         ))
     }
 
-    /// The one driver every entry point goes through.
+    /// Every entry point goes through here, and every method through
+    /// [`driver::drive`].
     fn run<S: System<N>, const N: usize>(
         &mut self,
         system: &S,
@@ -505,89 +507,43 @@ impl Integrator {
         if t1 == t0 {
             return Ok((t0, *y0));
         }
+        let (max_steps, next_step, stats) = (self.max_steps, &mut self.next_step, &mut self.stats);
+        macro_rules! drive {
+            ($stepper:expr) => {
+                driver::drive(
+                    &mut $stepper,
+                    system,
+                    t0,
+                    y0,
+                    t1,
+                    max_steps,
+                    next_step,
+                    stats,
+                    observe,
+                )
+            };
+        }
         match self.method {
-            Method::Rk4 { step } => rk4::integrate(
-                system,
-                t0,
-                y0,
-                t1,
-                step,
-                self.max_steps,
-                &mut self.stats,
-                observe,
-            ),
-            Method::Gauss { stages, step } => gauss::integrate(
-                system,
-                stages,
-                t0,
-                y0,
-                t1,
-                step,
-                self.max_steps,
-                &mut self.stats,
-                observe,
-            ),
-            Method::Taylor { tol } => taylor::integrate(
-                system,
-                t0,
-                y0,
-                t1,
-                tol,
-                self.max_steps,
-                &mut self.taylor,
-                &mut self.stats,
-                observe,
-            ),
-            Method::Dop853 { rtol, atol } | Method::Radau5 { rtol, atol } => {
-                let mut control = StepControl {
-                    rtol,
-                    atol,
-                    max_steps: self.max_steps,
-                    next_step: &mut self.next_step,
-                };
-                if let Method::Dop853 { .. } = self.method {
-                    dop853::integrate(&mut control, system, t0, y0, t1, &mut self.stats, observe)
-                } else {
-                    radau5::integrate(&mut control, system, t0, y0, t1, &mut self.stats, observe)
-                }
-            }
+            Method::Rk4 { step } => drive!(rk4::Rk4 { max_step: step }),
+            Method::Gauss { stages, step } => drive!(gauss::Gauss::new(stages, step)),
+            Method::Dop853 { rtol, atol } => drive!(dop853::Dop853::new(Tolerances { rtol, atol })),
+            Method::Radau5 { rtol, atol } => drive!(radau5::Radau5::new(Tolerances { rtol, atol })),
+            Method::Taylor { tol } => drive!(taylor::Taylor::new(&mut self.taylor, tol)),
         }
     }
 }
 
-/// Tolerances, step limit and the step size carried between calls: what the
-/// adaptive methods (DOP853, Radau 5) share.
-struct StepControl<'a> {
+/// The tolerances of the adaptive methods (DOP853, Radau 5).
+#[derive(Clone, Copy, Debug)]
+struct Tolerances {
     rtol: f64,
     atol: f64,
-    max_steps: u64,
-    /// Step size to try first; on return, the one to try next.
-    next_step: &'a mut Option<f64>,
 }
 
-impl StepControl<'_> {
-    /// After an accepted step of size `h_try` (h proposed, `h_new` proposed
-    /// next): the end of the run, if the observer stopped it or the step was
-    /// the last. The step size kept for the next call is the proposal, not a
-    /// last step truncated to reach t1.
-    fn end_of_run<const N: usize>(
-        &mut self,
-        flow: Flow<N>,
-        last: bool,
-        (t, y): (f64, [f64; N]),
-        h: f64,
-        h_try: f64,
-        h_new: f64,
-    ) -> Option<(f64, [f64; N])> {
-        if let Flow::Stop { t, y } = flow {
-            *self.next_step = Some(h_new);
-            return Some((t, y));
-        }
-        if last {
-            *self.next_step = Some(if h_try < h { h } else { h_new });
-            return Some((t, y));
-        }
-        None
+impl Tolerances {
+    /// The error scale of a component that goes from a to b.
+    fn scale(&self, a: f64, b: f64) -> f64 {
+        self.atol + self.rtol * a.abs().max(b.abs())
     }
 }
 
@@ -599,24 +555,6 @@ fn check_initial<const N: usize>(t0: f64, y0: &[f64; N], t1: f64) -> Result<(), 
         });
     }
     Ok(())
-}
-
-/// Number of equal fixed steps of at most `step` covering `t0..t1`.
-fn fixed_steps(t0: f64, t1: f64, step: f64, max_steps: u64) -> Result<(u64, f64), OdeError> {
-    let n = ((t1 - t0).abs() / step).ceil().max(1.0);
-    if n > max_steps as f64 {
-        return Err(OdeError::TooManySteps { t: t0, max_steps });
-    }
-    let n = n as u64;
-    Ok((n, (t1 - t0) / n as f64))
-}
-
-fn check_finite<const N: usize>(t: f64, y: &[f64; N]) -> Result<(), OdeError> {
-    if y.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(OdeError::NonFinite { t, y: y.to_vec() })
-    }
 }
 
 /// y + h Σ coefficients[j] k[j], the Runge–Kutta stage combination.

@@ -9,7 +9,8 @@
 //! transformation and needs no constants beyond the Butcher tableau. Its
 //! buffer is allocated once per call, not per step.
 
-use super::{check_finite, Observer, OdeError, Stats, Step, StepControl, System};
+use super::driver::{Attempt, Schedule, Stepper};
+use super::{OdeError, Stats, Step, System, Tolerances};
 
 const SQ6: f64 = 2.449489742783178;
 const C: [f64; 3] = [(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0];
@@ -82,7 +83,7 @@ fn lu_solve(a: &[f64], n: usize, pivots: &[usize], b: &mut [f64]) {
 
 /// An accepted step; inside it, the collocation polynomial through
 /// (0, y₀), (cᵢ, y₀ + Zᵢ).
-struct Radau5Step<const N: usize> {
+pub(super) struct Radau5Step<const N: usize> {
     t0: f64,
     y0: [f64; N],
     h: f64,
@@ -116,54 +117,70 @@ impl<const N: usize> Step<N> for Radau5Step<N> {
     }
 }
 
-/// Integrates from t0 to t1, starting with (and leaving in) the control's step size.
-pub(super) fn integrate<S: System<N>, const N: usize>(
-    control: &mut StepControl,
-    system: &S,
-    t0: f64,
-    y0: &[f64; N],
-    t1: f64,
-    stats: &mut Stats,
-    observe: Observer<'_, N>,
-) -> Result<(f64, [f64; N]), OdeError> {
-    // RADAU5's tolerance transformation: the estimate is O(h⁴) while the local
-    // error is O(h⁶), so tol → 0.1 tol^(2/3) makes the global error track tol.
-    let rtol = 0.1 * control.rtol.powf(2.0 / 3.0);
-    let atol = rtol * control.atol / control.rtol;
-    let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
-    let gamma0 = 30.0 / (6.0 + 81f64.cbrt() - 9f64.cbrt());
-    let n3 = 3 * N;
-    let mut newton = vec![0.0; n3 * n3];
-    let mut newton_pivots = vec![0usize; n3];
-    let mut filter = vec![0.0; N * N];
-    let mut filter_pivots = vec![0usize; N];
-    let mut rhs = vec![0.0; n3];
+/// The method's state: the transformed tolerances, the Newton and
+/// error-filter matrices (allocated once per run), and what is known at the
+/// current point: f, the Jacobian and the error scale, computed once for all
+/// the attempts from it.
+pub(super) struct Radau5<const N: usize> {
+    rtol: f64,
+    atol: f64,
+    newton_tol: f64,
+    newton: Vec<f64>,
+    newton_pivots: Vec<usize>,
+    filter: Vec<f64>,
+    filter_pivots: Vec<usize>,
+    rhs: Vec<f64>,
+    /// (t, y) is a new point: f0, the Jacobian and the scale are due.
+    fresh: bool,
+    f0: [f64; N],
+    jac: [[f64; N]; N],
+    scale: [f64; N],
+    /// No step accepted yet in this run.
+    first: bool,
+    /// The last attempt was rejected.
+    rejected: bool,
+    /// The stage increments of the last accepted step (its dense output).
+    z: [[f64; N]; 3],
+}
 
-    let direction = (t1 - t0).signum();
-    let span = (t1 - t0).abs();
-    let mut t = t0;
-    let mut y = *y0;
-    let mut h = control.next_step.unwrap_or(1e-6 * span.max(1e-3)).min(span);
-    let mut first = true;
-    let mut rejected = false;
-    let mut steps = 0u64;
-    loop {
-        if steps >= control.max_steps {
-            return Err(OdeError::TooManySteps {
-                t,
-                max_steps: control.max_steps,
-            });
+impl<const N: usize> Radau5<N> {
+    pub fn new(tolerances: Tolerances) -> Radau5<N> {
+        // RADAU5's tolerance transformation: the estimate is O(h⁴) while the local
+        // error is O(h⁶), so tol → 0.1 tol^(2/3) makes the global error track tol.
+        let rtol = 0.1 * tolerances.rtol.powf(2.0 / 3.0);
+        let atol = rtol * tolerances.atol / tolerances.rtol;
+        let n3 = 3 * N;
+        Radau5 {
+            rtol,
+            atol,
+            newton_tol: (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt())),
+            newton: vec![0.0; n3 * n3],
+            newton_pivots: vec![0; n3],
+            filter: vec![0.0; N * N],
+            filter_pivots: vec![0; N],
+            rhs: vec![0.0; n3],
+            fresh: true,
+            f0: [0.0; N],
+            jac: [[0.0; N]; N],
+            scale: [0.0; N],
+            first: true,
+            rejected: false,
+            z: [[0.0; N]; 3],
         }
-        let f0 = system.rhs(t, &y);
+    }
+
+    /// f, the Jacobian (the system's, or forward differences as RADAU5
+    /// takes without one) and the error scale at a new point.
+    fn at_point<S: System<N>>(&mut self, system: &S, t: f64, y: &[f64; N], stats: &mut Stats) {
+        let f0 = system.rhs(t, y);
         stats.f_evals += 1;
-        let jac = match system.jacobian(t, &y) {
+        self.jac = match system.jacobian(t, y) {
             Some(j) => j,
             None => {
-                // Forward differences, as RADAU5 does without an analytic Jacobian.
                 let mut j = [[0.0; N]; N];
                 for col in 0..N {
                     let delta = (f64::EPSILON * y[col].abs().max(1e-5)).sqrt();
-                    let mut yd = y;
+                    let mut yd = *y;
                     yd[col] += delta;
                     let fd = system.rhs(t, &yd);
                     for row in 0..N {
@@ -175,160 +192,219 @@ pub(super) fn integrate<S: System<N>, const N: usize>(
             }
         };
         stats.jac_evals += 1;
-        let scale: [f64; N] = std::array::from_fn(|i| atol + rtol * y[i].abs());
-        // Attempt steps from (t, y) until one is accepted.
-        loop {
-            steps += 1;
-            let remaining = (t1 - t).abs();
-            let last = h >= remaining * (1.0 - 1e-12);
-            let h_try = if last { remaining } else { h };
-            if h_try < 1e-14 * t.abs().max(1.0) {
-                return Err(OdeError::StepSizeUnderflow { t, h: h_try });
-            }
-            let hs = direction * h_try;
-            // Newton matrix I − h (A ⊗ J).
-            for i in 0..3 {
-                for a in 0..N {
-                    for j in 0..3 {
-                        for b in 0..N {
-                            let identity = if i == j && a == b { 1.0 } else { 0.0 };
-                            newton[(i * N + a) * n3 + j * N + b] =
-                                identity - hs * A[i][j] * jac[a][b];
-                        }
-                    }
-                }
-            }
-            if !lu_factor(&mut newton, n3, &mut newton_pivots) {
-                return Err(OdeError::NoConvergence {
-                    t,
-                    h: hs,
-                    y: y.to_vec(),
-                });
-            }
-            // Simplified Newton iteration for the stage increments Z.
-            let mut z = [[0.0; N]; 3];
-            let mut previous_norm = 0.0f64;
-            let mut contraction = 1.0f64;
-            let mut converged = false;
-            let mut iterations = 0;
-            while iterations < MAX_NEWTON {
-                iterations += 1;
-                stats.iterations += 1;
-                let f: [[f64; N]; 3] = std::array::from_fn(|i| {
-                    system.rhs(t + C[i] * hs, &std::array::from_fn(|k| y[k] + z[i][k]))
-                });
-                stats.f_evals += 3;
-                for i in 0..3 {
-                    for k in 0..N {
-                        let mut acc = 0.0;
-                        for j in 0..3 {
-                            acc += A[i][j] * f[j][k];
-                        }
-                        rhs[i * N + k] = -z[i][k] + hs * acc;
-                    }
-                }
-                lu_solve(&newton, n3, &newton_pivots, &mut rhs);
-                let mut norm = 0.0;
-                for i in 0..3 {
-                    for k in 0..N {
-                        z[i][k] += rhs[i * N + k];
-                        norm += (rhs[i * N + k] / scale[k]).powi(2);
-                    }
-                }
-                let norm = (norm / n3 as f64).sqrt();
-                if !norm.is_finite() {
-                    break;
-                }
-                if iterations > 1 {
-                    let theta = norm / previous_norm;
-                    if theta >= 0.99 {
-                        break;
-                    }
-                    contraction = theta / (1.0 - theta);
-                }
-                if contraction * norm <= newton_tol {
-                    converged = true;
-                    break;
-                }
-                previous_norm = norm.max(f64::MIN_POSITIVE);
-            }
-            if !converged {
-                stats.rejected += 1;
-                rejected = true;
-                h = 0.5 * h_try;
-                continue;
-            }
-            let y_new: [f64; N] = std::array::from_fn(|k| y[k] + z[2][k]);
-            // Error estimate (γ₀/h − J)⁻¹ (f(t, y) + Σ dᵢ Zᵢ / h).
+        self.f0 = f0;
+        self.scale = std::array::from_fn(|i| self.atol + self.rtol * y[i].abs());
+        self.fresh = false;
+    }
+
+    /// The stage increments Z of a step of size hs by the simplified Newton
+    /// iteration, with the number of iterations; `None` when it does not
+    /// converge (the step is retried smaller), an error when the Newton
+    /// matrix is singular.
+    fn solve_stages<S: System<N>>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        hs: f64,
+        stats: &mut Stats,
+    ) -> Result<Option<([[f64; N]; 3], usize)>, OdeError> {
+        let n3 = 3 * N;
+        // Newton matrix I − h (A ⊗ J).
+        for i in 0..3 {
             for a in 0..N {
-                for b in 0..N {
-                    filter[a * N + b] = if a == b { gamma0 / hs } else { 0.0 } - jac[a][b];
+                for j in 0..3 {
+                    for b in 0..N {
+                        let identity = if i == j && a == b { 1.0 } else { 0.0 };
+                        self.newton[(i * N + a) * n3 + j * N + b] =
+                            identity - hs * A[i][j] * self.jac[a][b];
+                    }
                 }
             }
-            if !lu_factor(&mut filter, N, &mut filter_pivots) {
-                return Err(OdeError::NoConvergence {
-                    t,
-                    h: hs,
-                    y: y.to_vec(),
-                });
-            }
-            let f2: [f64; N] =
-                std::array::from_fn(|k| (0..3).map(|i| DD[i] * z[i][k]).sum::<f64>() / hs);
-            let error_norm = |e: &[f64]| -> f64 {
-                let sum: f64 = (0..N).map(|k| (e[k] / scale[k]).powi(2)).sum();
-                (sum / N as f64).sqrt().max(1e-10)
-            };
-            let mut e: [f64; N] = std::array::from_fn(|k| f0[k] + f2[k]);
-            lu_solve(&filter, N, &filter_pivots, &mut e);
-            let mut err = error_norm(&e);
-            if err >= 1.0 && (first || rejected) {
-                let shifted: [f64; N] = std::array::from_fn(|k| y[k] + e[k]);
-                let f1 = system.rhs(t, &shifted);
-                stats.f_evals += 1;
+        }
+        if !lu_factor(&mut self.newton, n3, &mut self.newton_pivots) {
+            return Err(OdeError::NoConvergence {
+                t,
+                h: hs,
+                y: y.to_vec(),
+            });
+        }
+        let mut z = [[0.0; N]; 3];
+        let mut previous_norm = 0.0f64;
+        let mut contraction = 1.0f64;
+        let mut iterations = 0;
+        while iterations < MAX_NEWTON {
+            iterations += 1;
+            stats.iterations += 1;
+            let f: [[f64; N]; 3] = std::array::from_fn(|i| {
+                system.rhs(t + C[i] * hs, &std::array::from_fn(|k| y[k] + z[i][k]))
+            });
+            stats.f_evals += 3;
+            for i in 0..3 {
                 for k in 0..N {
-                    e[k] = f1[k] + f2[k];
+                    let mut acc = 0.0;
+                    for j in 0..3 {
+                        acc += A[i][j] * f[j][k];
+                    }
+                    self.rhs[i * N + k] = -z[i][k] + hs * acc;
                 }
-                lu_solve(&filter, N, &filter_pivots, &mut e);
-                err = error_norm(&e);
             }
-            if !err.is_finite() {
-                stats.rejected += 1;
-                rejected = true;
-                h = 0.1 * h_try;
-                continue;
+            lu_solve(&self.newton, n3, &self.newton_pivots, &mut self.rhs);
+            let mut norm = 0.0;
+            for i in 0..3 {
+                for k in 0..N {
+                    z[i][k] += self.rhs[i * N + k];
+                    norm += (self.rhs[i * N + k] / self.scale[k]).powi(2);
+                }
             }
-            let safety = 0.9 * (2 * MAX_NEWTON + 1) as f64 / (2 * MAX_NEWTON + iterations) as f64;
-            let quotient = (err.powf(0.25) / safety).clamp(1.0 / 8.0, 5.0);
-            let mut h_new = h_try / quotient;
-            if err < 1.0 {
-                check_finite(t + hs, &y_new)?;
-                let t_new = if last { t1 } else { t + hs };
-                stats.steps += 1;
-                if rejected {
-                    h_new = h_new.min(h_try);
-                }
-                first = false;
-                rejected = false;
-                let mut view = Radau5Step {
-                    t0: t,
-                    y0: y,
-                    h: hs,
-                    t1: t_new,
-                    y1: y_new,
-                    z,
-                };
-                let flow = observe(&mut view)?;
-                t = t_new;
-                y = y_new;
-                if let Some(end) = control.end_of_run(flow, last, (t, y), h, h_try, h_new) {
-                    return Ok(end);
-                }
-                h = h_new;
+            let norm = (norm / n3 as f64).sqrt();
+            if !norm.is_finite() {
                 break;
             }
-            stats.rejected += 1;
-            h = if first { 0.1 * h_try } else { h_new };
-            rejected = true;
+            if iterations > 1 {
+                let theta = norm / previous_norm;
+                if theta >= 0.99 {
+                    break;
+                }
+                contraction = theta / (1.0 - theta);
+            }
+            if contraction * norm <= self.newton_tol {
+                return Ok(Some((z, iterations)));
+            }
+            previous_norm = norm.max(f64::MIN_POSITIVE);
+        }
+        Ok(None)
+    }
+
+    /// The error estimate (γ₀/h − J)⁻¹ (f(t, y) + Σ dᵢ Zᵢ / h), filtered once
+    /// more through f at the shifted point after a first step or a
+    /// rejection, as RADAU5 does.
+    fn error<S: System<N>>(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        hs: f64,
+        z: &[[f64; N]; 3],
+        stats: &mut Stats,
+    ) -> Result<f64, OdeError> {
+        let gamma0 = 30.0 / (6.0 + 81f64.cbrt() - 9f64.cbrt());
+        for a in 0..N {
+            for b in 0..N {
+                self.filter[a * N + b] = if a == b { gamma0 / hs } else { 0.0 } - self.jac[a][b];
+            }
+        }
+        if !lu_factor(&mut self.filter, N, &mut self.filter_pivots) {
+            return Err(OdeError::NoConvergence {
+                t,
+                h: hs,
+                y: y.to_vec(),
+            });
+        }
+        let f2: [f64; N] =
+            std::array::from_fn(|k| (0..3).map(|i| DD[i] * z[i][k]).sum::<f64>() / hs);
+        let scale = self.scale;
+        let error_norm = |e: &[f64]| -> f64 {
+            let sum: f64 = (0..N).map(|k| (e[k] / scale[k]).powi(2)).sum();
+            (sum / N as f64).sqrt().max(1e-10)
+        };
+        let mut e: [f64; N] = std::array::from_fn(|k| self.f0[k] + f2[k]);
+        lu_solve(&self.filter, N, &self.filter_pivots, &mut e);
+        let mut err = error_norm(&e);
+        if err >= 1.0 && (self.first || self.rejected) {
+            let shifted: [f64; N] = std::array::from_fn(|k| y[k] + e[k]);
+            let f1 = system.rhs(t, &shifted);
+            stats.f_evals += 1;
+            for k in 0..N {
+                e[k] = f1[k] + f2[k];
+            }
+            lu_solve(&self.filter, N, &self.filter_pivots, &mut e);
+            err = error_norm(&e);
+        }
+        Ok(err)
+    }
+}
+
+impl<S: System<N>, const N: usize> Stepper<S, N> for Radau5<N> {
+    type Accepted<'a>
+        = Radau5Step<N>
+    where
+        S: 'a;
+
+    fn schedule(&self) -> Schedule {
+        Schedule::Adaptive {
+            snap: 1e-12,
+            compensated: false,
+            underflow: 1e-14,
+        }
+    }
+
+    fn begin(
+        &mut self,
+        _system: &S,
+        t0: f64,
+        _y0: &[f64; N],
+        t1: f64,
+        carried: Option<f64>,
+        _stats: &mut Stats,
+    ) -> Result<f64, OdeError> {
+        (self.fresh, self.first, self.rejected) = (true, true, false);
+        Ok(carried.unwrap_or(1e-6 * (t1 - t0).abs().max(1e-3)))
+    }
+
+    fn attempt(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        hs: f64,
+        _t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<Attempt<N>, OdeError> {
+        if self.fresh {
+            self.at_point(system, t, y, stats);
+        }
+        let h_try = hs.abs();
+        let Some((z, iterations)) = self.solve_stages(system, t, y, hs, stats)? else {
+            self.rejected = true;
+            return Ok(Attempt::Rejected { retry: 0.5 * h_try });
+        };
+        let err = self.error(system, t, y, hs, &z, stats)?;
+        if !err.is_finite() {
+            self.rejected = true;
+            return Ok(Attempt::Rejected { retry: 0.1 * h_try });
+        }
+        let safety = 0.9 * (2 * MAX_NEWTON + 1) as f64 / (2 * MAX_NEWTON + iterations) as f64;
+        let quotient = (err.powf(0.25) / safety).clamp(1.0 / 8.0, 5.0);
+        let h_new = h_try / quotient;
+        if err >= 1.0 {
+            let retry = if self.first { 0.1 * h_try } else { h_new };
+            self.rejected = true;
+            return Ok(Attempt::Rejected { retry });
+        }
+        (self.fresh, self.first, self.rejected) = (true, false, false);
+        self.z = z;
+        Ok(Attempt::Accepted {
+            y: std::array::from_fn(|k| y[k] + z[2][k]),
+            next: h_new,
+        })
+    }
+
+    fn accepted<'a>(
+        &'a mut self,
+        _system: &'a S,
+        (t0, y0): (f64, [f64; N]),
+        (t1, y1): (f64, [f64; N]),
+        h: f64,
+        _stats: &'a mut Stats,
+    ) -> Radau5Step<N> {
+        Radau5Step {
+            t0,
+            y0,
+            h,
+            t1,
+            y1,
+            z: self.z,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The classical fourth-order Runge–Kutta method with a fixed step.
 
-use super::{check_finite, fixed_steps, Flow, Observer, OdeError, Stats, Step, System};
+use super::driver::{Attempt, Schedule, Stepper};
+use super::{OdeError, Stats, Step, System};
 
 /// One RK4 step of size h from (t, y).
 #[inline(always)]
@@ -20,7 +21,7 @@ fn step<S: System<N>, const N: usize>(system: &S, t: f64, y: &[f64; N], h: f64) 
 
 /// An accepted RK4 step; inside it, states come from a fresh RK4 step of the
 /// partial length, so they carry the method's own order.
-struct Rk4Step<'a, S, const N: usize> {
+pub(super) struct Rk4Step<'a, S, const N: usize> {
     system: &'a S,
     t0: f64,
     y0: [f64; N],
@@ -42,42 +43,54 @@ impl<S: System<N>, const N: usize> Step<N> for Rk4Step<'_, S, N> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-pub(super) fn integrate<S: System<N>, const N: usize>(
-    system: &S,
-    t0: f64,
-    y0: &[f64; N],
-    t1: f64,
-    max_step: f64,
-    max_steps: u64,
-    stats: &mut Stats,
-    observe: Observer<'_, N>,
-) -> Result<(f64, [f64; N]), OdeError> {
-    let (n, h) = fixed_steps(t0, t1, max_step, max_steps)?;
-    let mut y = *y0;
-    for i in 0..n {
-        let t = t0 + i as f64 * h;
-        let y_new = step(system, t, &y, h);
-        let t_next = if i + 1 == n {
-            t1
-        } else {
-            t0 + (i + 1) as f64 * h
-        };
-        check_finite(t_next, &y_new)?;
-        stats.f_evals += 4;
-        stats.steps += 1;
-        let mut view = Rk4Step {
-            system,
-            t0: t,
-            y0: y,
-            t1: t_next,
-            y1: y_new,
-            stats,
-        };
-        if let Flow::Stop { t, y } = observe(&mut view)? {
-            return Ok((t, y));
+/// The method's state: none beyond the step.
+pub(super) struct Rk4 {
+    pub max_step: f64,
+}
+
+impl<S: System<N>, const N: usize> Stepper<S, N> for Rk4 {
+    type Accepted<'a>
+        = Rk4Step<'a, S, N>
+    where
+        S: 'a;
+
+    fn schedule(&self) -> Schedule {
+        Schedule::Fixed {
+            max_step: self.max_step,
         }
-        y = y_new;
     }
-    Ok((t1, y))
+
+    fn attempt(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        h: f64,
+        _t_end: f64,
+        stats: &mut Stats,
+    ) -> Result<Attempt<N>, OdeError> {
+        stats.f_evals += 4;
+        Ok(Attempt::Accepted {
+            y: step(system, t, y, h),
+            next: self.max_step,
+        })
+    }
+
+    fn accepted<'a>(
+        &'a mut self,
+        system: &'a S,
+        (t0, y0): (f64, [f64; N]),
+        (t1, y1): (f64, [f64; N]),
+        _h: f64,
+        stats: &'a mut Stats,
+    ) -> Rk4Step<'a, S, N> {
+        Rk4Step {
+            system,
+            t0,
+            y0,
+            t1,
+            y1,
+            stats,
+        }
+    }
 }

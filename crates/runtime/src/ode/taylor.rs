@@ -10,8 +10,9 @@
 //! κ = [`SAFETY_EXPONENT`]. There is no error estimate and no rejected
 //! step. The polynomial of the step is the dense output.
 
+use super::driver::{Attempt, Schedule, Stepper};
 use super::series::{Coefficients, Scalar, MAX_ORDER};
-use super::{check_finite, Flow, Observer, OdeError, Stats, Step, System};
+use super::{OdeError, Stats, Step, System};
 
 /// Coefficient arrays for the generated recurrences, reused from step to
 /// step (no allocation per step); `L` is f64, or [`super::Lanes`] for
@@ -144,22 +145,13 @@ pub(super) fn step_to_take<const N: usize>(
     Ok((if last { remaining } else { h }, last))
 }
 
-/// t + h with Kahan compensation (`carry`): a million steps lose no phase.
-#[inline(always)]
-pub(super) fn compensated_sum(t: f64, h: f64, carry: &mut f64) -> f64 {
-    let increment = h - *carry;
-    let sum = t + increment;
-    *carry = (sum - t) - increment;
-    sum
-}
-
 /// The step's safety factor e^{−κ} e^{−0.7/(p−1)} at order p.
 pub(super) fn safety(order: usize) -> f64 {
     (-SAFETY_EXPONENT - 0.7 / (order - 1) as f64).exp()
 }
 
 /// One accepted step: its polynomial is the dense output.
-struct TaylorStep<'a, const N: usize> {
+pub(super) struct TaylorStep<'a, const N: usize> {
     t0: f64,
     y0: [f64; N],
     t1: f64,
@@ -179,59 +171,105 @@ impl<const N: usize> Step<N> for TaylorStep<'_, N> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-pub(super) fn integrate<S: System<N>, const N: usize>(
-    system: &S,
-    t0: f64,
-    y0: &[f64; N],
-    t1: f64,
-    tol: f64,
-    max_steps: u64,
-    state: &mut TaylorState,
-    stats: &mut Stats,
-    observe: Observer<'_, N>,
-) -> Result<(f64, [f64; N]), OdeError> {
-    let order = order_for_tolerance(tol);
-    stats.order = stats.order.max(order as u64);
-    state.coefficients.resize((order + 1) * N, 0.0);
-    let direction = (t1 - t0).signum();
-    let safety = safety(order);
-    let (mut t, mut y) = (t0, *y0);
-    let mut carry = 0.0;
-    for _ in 0..max_steps {
-        let (c, _) = state.coefficients.as_chunks_mut::<N>();
-        if !system.taylor(t, &y, order, &mut state.work, c) {
+/// The method at one order, with the solver state it keeps between calls.
+pub(super) struct Taylor<'s> {
+    state: &'s mut TaylorState,
+    order: usize,
+    safety: f64,
+}
+
+impl Taylor<'_> {
+    pub fn new(state: &mut TaylorState, tol: f64) -> Taylor<'_> {
+        let order = order_for_tolerance(tol);
+        Taylor {
+            state,
+            order,
+            safety: safety(order),
+        }
+    }
+}
+
+impl<S: System<N>, const N: usize> Stepper<S, N> for Taylor<'_> {
+    type Accepted<'a>
+        = TaylorStep<'a, N>
+    where
+        Self: 'a,
+        S: 'a;
+
+    fn schedule(&self) -> Schedule {
+        Schedule::Adaptive {
+            snap: 0.0,
+            compensated: true,
+            underflow: 0.0,
+        }
+    }
+
+    fn begin(
+        &mut self,
+        _system: &S,
+        _t0: f64,
+        _y0: &[f64; N],
+        _t1: f64,
+        _carried: Option<f64>,
+        stats: &mut Stats,
+    ) -> Result<f64, OdeError> {
+        stats.order = stats.order.max(self.order as u64);
+        self.state.coefficients.resize((self.order + 1) * N, 0.0);
+        Ok(f64::INFINITY)
+    }
+
+    /// The coefficients at (t, y), and the step they allow.
+    fn size(
+        &mut self,
+        system: &S,
+        t: f64,
+        y: &[f64; N],
+        _proposal: f64,
+        stats: &mut Stats,
+    ) -> Result<f64, OdeError> {
+        let (c, _) = self.state.coefficients.as_chunks_mut::<N>();
+        if !system.taylor(t, y, self.order, &mut self.state.work, c) {
             return Err(OdeError::TaylorUnavailable);
         }
-        stats.f_evals += order as u64;
-        let remaining = (t1 - t).abs();
-        let (h, last) = step_to_take(step_size(c, &y, safety), remaining, t, || y)?;
-        let h = h * direction;
-        let y_new = horner(c, h);
-        let t_new = if last {
-            t1
-        } else {
-            compensated_sum(t, h, &mut carry)
-        };
-        check_finite(t_new, &y_new)?;
-        if !last && t_new == t {
-            return Err(OdeError::StepSizeUnderflow { t, h });
+        stats.f_evals += self.order as u64;
+        match step_size(c, y, self.safety) {
+            // Vanishing top coefficients: the series is exact.
+            None => Ok(f64::INFINITY),
+            Some(h) if h.is_finite() => Ok(h),
+            Some(_) => Err(OdeError::NonFinite { t, y: y.to_vec() }),
         }
-        stats.steps += 1;
-        let mut step = TaylorStep {
-            t0: t,
-            y0: y,
-            t1: t_new,
-            y1: y_new,
-            coefficients: c,
-        };
-        if let Flow::Stop { t, y } = observe(&mut step)? {
-            return Ok((t, y));
-        }
-        if last {
-            return Ok((t1, y_new));
-        }
-        (t, y) = (t_new, y_new);
     }
-    Err(OdeError::TooManySteps { t, max_steps })
+
+    fn attempt(
+        &mut self,
+        _system: &S,
+        _t: f64,
+        _y: &[f64; N],
+        h: f64,
+        _t_end: f64,
+        _stats: &mut Stats,
+    ) -> Result<Attempt<N>, OdeError> {
+        let (c, _) = self.state.coefficients.as_chunks::<N>();
+        Ok(Attempt::Accepted {
+            y: horner(c, h),
+            next: h.abs(),
+        })
+    }
+
+    fn accepted<'a>(
+        &'a mut self,
+        _system: &'a S,
+        (t0, y0): (f64, [f64; N]),
+        (t1, y1): (f64, [f64; N]),
+        _h: f64,
+        _stats: &'a mut Stats,
+    ) -> TaylorStep<'a, N> {
+        TaylorStep {
+            t0,
+            y0,
+            t1,
+            y1,
+            coefficients: self.state.coefficients.as_chunks::<N>().0,
+        }
+    }
 }

@@ -10,10 +10,9 @@
 //! they gain the SIMD width and the overlap of independent lanes, where one
 //! orbit's recurrences are a chain of dependent operations.
 
+use super::driver::compensated_sum;
 use super::lanes::{Lanes, LANES};
-use super::taylor::{
-    compensated_sum, horner, safety, step_exponent, step_from_exponent, step_to_take,
-};
+use super::taylor::{horner, safety, step_exponent, step_from_exponent, step_to_take};
 use super::{check_initial, order_for_tolerance, Method, OdeError, Stats, System, TaylorWork};
 
 /// The result of one lane.
