@@ -1077,10 +1077,10 @@ impl Writer<'_> {
                         sum => format!("({sum})"),
                     };
                     lines.push(format!(
-                        "{sn}[n] = {cn}[n - 1] * ({rate} * series::INVERSES[n]);"
+                        "{sn}[n] = {cn}[n - 1] * ({rate} * Num::inverse(n));"
                     ));
                     lines.push(format!(
-                        "{cn}[n] = -({sn}[n - 1] * ({rate} * series::INVERSES[n]));"
+                        "{cn}[n] = -({sn}[n - 1] * ({rate} * Num::inverse(n)));"
                     ));
                 } else {
                     lines.push(format!(
@@ -1382,7 +1382,7 @@ impl Writer<'_> {
             })
             .filter(|node| !node.is_empty())
             .collect();
-        let mut next = vec!["let next = series::INVERSES[n + 1];".to_string()];
+        let mut next = vec!["let next = Num::inverse(n + 1);".to_string()];
         store(&mut next, "n + 1", rates("n", " * next"));
         Orders {
             zero,

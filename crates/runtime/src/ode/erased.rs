@@ -7,7 +7,7 @@
 //! side or per Taylor step (the recurrences of a whole step run inside the
 //! model's own compiled code).
 
-use super::{Lanes, Scalar, System, TaylorWork, LANES};
+use super::{DoubleDouble, Lanes, Scalar, System, TaylorWork, LANES};
 
 /// A generated system's functions with parameters passed as values in the
 /// model file's declaration order. The Taylor methods return false where the
@@ -51,6 +51,20 @@ pub trait DynSystem<const N: usize>: Sync {
         work: &mut TaylorWork<Lanes>,
         out: &mut [Lanes],
     ) -> bool;
+    /// [`DynSystem::taylor`] in double-double precision: compiled for the
+    /// exact systems of one degree of freedom (whose separatrix splitting
+    /// needs it), false for the others.
+    fn taylor_double_double(
+        &self,
+        _params: &[f64],
+        _t: DoubleDouble,
+        _y: &[DoubleDouble; N],
+        _order: usize,
+        _work: &mut TaylorWork<DoubleDouble>,
+        _out: &mut [[DoubleDouble; N]],
+    ) -> bool {
+        false
+    }
 }
 
 /// A [`DynSystem`] with its parameter values: a [`System`] for every

@@ -7,6 +7,7 @@
 //! States are `[f64; N]`: no allocation per step.
 
 mod dop853;
+mod double_double;
 mod driver;
 mod erased;
 mod events;
@@ -20,12 +21,13 @@ pub mod series;
 pub mod taylor;
 mod taylor_lanes;
 
+pub use double_double::DoubleDouble;
 pub use erased::{DynSystem, ErasedSystem};
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
 pub use hyperdual::HyperDual;
 pub use lanes::{per_lane, Lanes, LANES};
 pub use series::Scalar;
-pub use taylor::{order_for_tolerance, TaylorWork};
+pub use taylor::{order_for_tolerance, DoubleDoubleTaylor, TaylorWork};
 pub use taylor_lanes::{LaneIntegrator, LaneResult, Orbit};
 
 /// An ODE y' = f(t, y) on a fixed-size state, optionally with its Jacobian.

@@ -49,6 +49,12 @@ pub trait Scalar:
     fn recip(self) -> Self;
     /// √x where x > 0, NaN elsewhere (a Cholesky pivot).
     fn positive_sqrt(self) -> Self;
+    /// 1/n, by which the recurrences scale order n: from a table for f64
+    /// and lanes, to the number type's own precision for others.
+    #[inline(always)]
+    fn inverse(n: usize) -> Self {
+        Self::from(INVERSES[n])
+    }
     /// Runs the recurrences of a system behind a trait object in this
     /// number type (lane l with `params[l]`): a generic method cannot be
     /// called through a trait object, so each number type picks the one its
@@ -295,7 +301,7 @@ pub fn power<L: Scalar>(w: &Coefficients<L>, b: &Coefficients<L>, alpha: f64, n:
 #[inline(always)]
 pub fn exp<L: Scalar>(w: &Coefficients<L>, u: &Coefficients<L>, n: usize) -> L {
     let earlier = derivative_dots(u, w, w, n).0;
-    earlier * INVERSES[n] + u[n] * w[0]
+    earlier * L::inverse(n) + u[n] * w[0]
 }
 
 /// (ln u)^[n] = (u^[n] − (1/n) Σ_{j=1..n−1} j w^[j] u^[n−j]) / u^[0].
@@ -318,7 +324,7 @@ pub fn sin_cos<L: Scalar>(
     n: usize,
 ) -> (L, L) {
     let (earlier_c, earlier_s) = derivative_dots(u, c, s, n);
-    let inverse = INVERSES[n];
+    let inverse = L::inverse(n);
     // The order-n term j = n: n u^[n] c^[0] / n.
     (
         earlier_c * inverse + u[n] * c[0],

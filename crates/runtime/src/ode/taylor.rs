@@ -12,7 +12,7 @@
 
 use super::driver::{Attempt, Schedule, Stepper};
 use super::series::{Coefficients, Scalar, MAX_ORDER};
-use super::{OdeError, Stats, Step, System};
+use super::{DoubleDouble, OdeError, Stats, Step, System};
 
 /// Coefficient arrays for the generated recurrences, reused from step to
 /// step (no allocation per step); `L` is f64, or [`super::Lanes`] for
@@ -271,5 +271,104 @@ impl<S: System<N>, const N: usize> Stepper<S, N> for Taylor<'_> {
             y1,
             coefficients: self.state.coefficients.as_chunks::<N>().0,
         }
+    }
+}
+
+/// The Taylor method in double-double precision (about 32 digits), for a
+/// system whose recurrences compile for [`DoubleDouble`] (the exact systems
+/// of one degree of freedom): the period maps whose differences fall below
+/// double precision. Order [`MAX_ORDER`] with the Jorba–Zou step for the
+/// tolerance at that order; time and state are double-double throughout.
+/// Its own loop: the driver's steps and observers are f64.
+#[derive(Clone, Debug, Default)]
+pub struct DoubleDoubleTaylor {
+    work: TaylorWork<DoubleDouble>,
+    coefficients: Vec<DoubleDouble>,
+    pub stats: Stats,
+    /// Upper bound on steps per call.
+    pub max_steps: u64,
+}
+
+impl DoubleDoubleTaylor {
+    pub fn new() -> DoubleDoubleTaylor {
+        DoubleDoubleTaylor {
+            max_steps: 10_000_000,
+            ..Default::default()
+        }
+    }
+
+    /// y(t1) from y(t0) = y0 (t1 before or after t0), to `tol` per unit
+    /// of max(1, ‖y‖∞) per step (as small as 1e-32).
+    pub fn advance<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        t0: DoubleDouble,
+        y0: &[DoubleDouble; N],
+        t1: DoubleDouble,
+        tol: f64,
+    ) -> Result<[DoubleDouble; N], OdeError> {
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(OdeError::InvalidSetting {
+                what: "tolerance",
+                value: tol,
+            });
+        }
+        let (mut t, mut y) = (t0, *y0);
+        if !t0.is_finite() || !t1.is_finite() || y.iter().any(|x| !x.is_finite()) {
+            return Err(OdeError::NonFiniteInitialState {
+                t: t0.to_f64(),
+                y: y.iter().map(|x| x.to_f64()).collect(),
+            });
+        }
+        let order = MAX_ORDER;
+        self.stats.order = order as u64;
+        self.coefficients
+            .resize((order + 1) * N, DoubleDouble::ZERO);
+        // The terms fall like e^{−κk}: κ so that the last, e^{−κp}, is tol.
+        let safety = (tol.ln() / order as f64 - 0.7 / (order - 1) as f64).exp();
+        let forward = t1 >= t0;
+        for _ in 0..self.max_steps {
+            let remaining = if forward { t1 - t } else { t - t1 };
+            if remaining.hi <= 0.0 {
+                return Ok(y);
+            }
+            let (c, _) = self.coefficients.as_chunks_mut::<N>();
+            if !system.taylor(t, &y, order, &mut self.work, c) {
+                return Err(OdeError::TaylorUnavailable);
+            }
+            self.stats.f_evals += order as u64;
+            let norm = |row: &[DoubleDouble; N]| row.iter().fold(0.0f64, |m, x| m.max(x.hi.abs()));
+            let y_norm = norm(&y);
+            let step = step_from_norms(
+                y_norm,
+                [norm(&c[order - 1]), norm(&c[order])],
+                order,
+                safety,
+            );
+            let h = match step {
+                Some(h) if !h.is_finite() => {
+                    return Err(OdeError::NonFinite {
+                        t: t.to_f64(),
+                        y: y.iter().map(|x| x.to_f64()).collect(),
+                    })
+                }
+                Some(h) if h < remaining.hi => DoubleDouble::from(h),
+                _ => remaining,
+            };
+            let h = if forward { h } else { -h };
+            y = horner(c, h);
+            t = if h.abs() == remaining { t1 } else { t + h };
+            self.stats.steps += 1;
+            if y.iter().any(|x| !x.is_finite()) {
+                return Err(OdeError::NonFinite {
+                    t: t.to_f64(),
+                    y: y.iter().map(|x| x.to_f64()).collect(),
+                });
+            }
+        }
+        Err(OdeError::TooManySteps {
+            t: t.to_f64(),
+            max_steps: self.max_steps,
+        })
     }
 }
