@@ -256,3 +256,50 @@ fn a_larger_model_has_no_double_double_recurrences() {
         .unwrap_err();
     assert_eq!(error, mechlab::ode::OdeError::TaylorUnavailable);
 }
+
+/// The generated action system: its Taylor recurrences against its
+/// right-hand side (the generated H) by DOP853 over one period, and the
+/// same in double-double; the fourth component is the phase θ = t/ε.
+#[test]
+fn the_action_system_integrates_p_dq_minus_h_dt() {
+    let model = models::by_name("kapitza").unwrap();
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    }
+    .values();
+    let system = mechlab::ode::ErasedSystem {
+        system: model.dynamic.action_system().unwrap(),
+        params,
+    };
+    let period = std::f64::consts::TAU * 0.1;
+    let start = [0.4, 0.9, 0.0, 0.0];
+    let mut taylor = Integrator::new(Method::Taylor { tol: 1e-16 }).unwrap();
+    let by_taylor = taylor.advance(&system, 0.0, &start, period).unwrap();
+    let mut dop = Integrator::new(Method::Dop853 {
+        rtol: 1e-13,
+        atol: 1e-13,
+    })
+    .unwrap();
+    let by_rhs = dop.advance(&system, 0.0, &start, period).unwrap();
+    for i in 0..4 {
+        assert!(
+            (by_taylor[i] - by_rhs[i]).abs() < 1e-11,
+            "{i}: {by_taylor:?} {by_rhs:?}"
+        );
+    }
+    assert!((by_taylor[3] - 2.0 * std::f64::consts::PI).abs() < 1e-12);
+    let precise = DoubleDoubleTaylor::new()
+        .advance(
+            &system,
+            DoubleDouble::ZERO,
+            &start.map(DoubleDouble::from),
+            DoubleDouble::TAU * 0.1,
+            1e-32,
+        )
+        .unwrap();
+    for i in 0..4 {
+        assert!((precise[i].to_f64() - by_taylor[i]).abs() < 1e-13);
+    }
+}

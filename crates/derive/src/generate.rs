@@ -639,10 +639,50 @@ fn taylor_functions(
         let names: Vec<String> = outs.iter().map(|(n, _)| n.clone()).collect();
         (vec![Step::Values(outs)], names)
     });
-    taylor_set(
+    let mut functions = taylor_set(
         cx,
         (&exact, &rhs_names),
         averaged.as_ref().map(|(s, n)| (&s[..], &n[..])),
+    )?;
+    if cx.model.coordinates.len() == 1 && cx.model.fast_phase.is_some() {
+        functions.push(action_taylor(cx, derivation, &exact, &rhs_names)?);
+    }
+    Ok(functions)
+}
+
+/// The exact field with the action S = ∫ (p·q' − H) dt and the fast phase θ
+/// (θ' = its rate) as two more state components, for models of one degree
+/// of freedom with a fast phase: the lobe areas of their separatrix
+/// splitting are differences of such actions (`analysis::separatrix`),
+/// which double-double precision follows below 10⁻¹⁶ of their size, and
+/// the phase gives the period in the same precision as the recurrences
+/// (the rate computed in f64 would make a period map of another system).
+fn action_taylor(
+    cx: &Context,
+    derivation: &Derivation,
+    exact: &[Step],
+    rhs_names: &[String],
+) -> Result<TaylorFunction, DeriveError> {
+    let products: Vec<String> = cx
+        .momenta()
+        .iter()
+        .zip(cx.velocities())
+        .map(|(p, v)| format!("{p}*{v}"))
+        .collect();
+    let rate = format!("{} - ({})", products.join(" + "), derivation.hamiltonian);
+    let mut steps = exact.to_vec();
+    steps.push(Step::Values(vec![("action_rate__".into(), rate)]));
+    let mut outputs = rhs_names.to_vec();
+    outputs.extend(["action_rate__".into(), "rate__".into()]);
+    let mut state = cx.coordinates();
+    state.extend(cx.momenta());
+    state.extend(["action__".into(), "phase__".into()]);
+    cx.taylor_steps(
+        "exact_action_taylor",
+        "Normalised Taylor coefficients of the exact solution with its action S = ∫ (p·q' − H) dt and the fast phase θ: z = [q, p, S, θ].",
+        &steps,
+        &outputs,
+        state,
     )
 }
 

@@ -124,6 +124,13 @@ pub trait DynamicModel: Sync {
     fn defaults(&self) -> Vec<f64>;
     /// Which coordinates are angles.
     fn periodic(&self) -> Vec<bool>;
+    /// The exact system with its action S = ∫ (p·q' − H) dt and the fast
+    /// phase θ as third and fourth state components (models of one degree
+    /// of freedom with a fast phase).
+    #[inline]
+    fn action_system(&self) -> Option<&'static dyn crate::ode::DynSystem<4>> {
+        None
+    }
     /// The exact right-hand side (Hamiltonian models).
     #[inline]
     fn exact_rhs(&self, _params: &[f64], _t: f64, _y: &[f64]) -> Vec<f64> {

@@ -510,7 +510,9 @@ pub fn separatrix_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use crate::analysis::separatrix::{separatrix_splitting, splitting_sweep, SplittingSettings};
+    use crate::analysis::separatrix::{
+        separatrix_splitting, splitting_sweep, Precision, SplittingSettings,
+    };
     let (model, scene) = generic_scene(
         catalog,
         scene_name,
@@ -545,8 +547,19 @@ pub fn separatrix_scene(
                 "also sweep `sweep_parameter` geometrically: first,last,count (none: no sweep)",
             ),
             ("sweep_parameter", "eps", "the parameter the sweep sets"),
+            (
+                "precision",
+                "auto",
+                "double, double-double (lobe areas below 1e-16 of the actions, reversible models) or auto (double-double where double does not resolve the area)",
+            ),
         ],
     )?;
+    let precision =
+        Precision::parse(scene.text("precision")).ok_or_else(|| SceneError::BadValue {
+            name: "precision".into(),
+            value: scene.text("precision").into(),
+            reason: format!("one of {}", Precision::NAMES.join(", ")),
+        })?;
     let settings = SplittingSettings {
         method: method_from(&scene)?,
         guess: None,
@@ -555,13 +568,14 @@ pub fn separatrix_scene(
         max_points: scene.count("max_points")?,
         p_max: scene.positive("p_max")?,
         lobe_points: scene.count("lobe_points")?,
+        precision,
     };
     let params = scene.parameter_values(model.info)?;
     eprintln!("growing the manifolds of the hyperbolic fixed point …");
     let splitting = separatrix_splitting(model, &params, &settings)?;
     if !splitting.resolved {
         eprintln!(
-            "the lobe area is not resolved to 1e-6: action {:?}, polygon {:e} (the manifolds split by little more than double precision tells)",
+            "the lobe area is not resolved to 1e-6: action {:?}, polygon {:?} (the manifolds split by little more than the precision tells)",
             splitting.lobe_area_action, splitting.lobe_area_polygon
         );
     }

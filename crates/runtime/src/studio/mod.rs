@@ -757,8 +757,8 @@ pub fn manifolds(catalog: Catalog, request: &ManifoldsRequest) -> Result<Manifol
         stable: segments(&s.stable),
         homoclinic: s.homoclinic.iter().map(|h| place(&h.point)).collect(),
         fixed_point: place(&s.fixed_point),
-        lobe_area: s.lobe_area_action.unwrap_or(s.lobe_area_polygon),
+        lobe_area: s.lobe_area().unwrap_or(f64::NAN),
         resolved: s.resolved,
-        angle: s.homoclinic[0].angle,
+        angle: s.homoclinic[0].angle.unwrap_or(f64::NAN),
     })
 }

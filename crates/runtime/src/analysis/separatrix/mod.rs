@@ -16,8 +16,12 @@
 //! cylinder joins y* to y* + (2π, 0), and the stable manifold of that copy
 //! is W^s shifted by 2π.
 
+mod symmetric;
+
 use crate::analysis::floquet::monodromy;
-use crate::ode::{ErasedSystem, Integrator, Method, OdeError, System};
+use crate::ode::{
+    DoubleDouble, DoubleDoubleTaylor, ErasedSystem, Integrator, Method, OdeError, System,
+};
 use crate::registry::{DynamicModel, Fixed, Model, Sized};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -44,6 +48,44 @@ pub struct SplittingSettings {
     /// Points per manifold piece of the lobe polygon (and twice as many for
     /// its Richardson extrapolation).
     pub lobe_points: usize,
+    /// Double precision throughout; the lobe area's actions in
+    /// double-double (about 32 digits) from the symmetric homoclinic
+    /// orbits of a reversible model, for areas below 10⁻¹⁶ of the actions;
+    /// or double-double where double precision does not resolve the area.
+    pub precision: Precision,
+}
+
+/// A reversing symmetry of the flow: the map (q, p) ↦ (c − q, p) or
+/// (q, p) ↦ (q, −p) with time reflected about t = `about`·T.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Reversal {
+    /// c of q ↦ c − q; None for p ↦ −p.
+    pub coordinate: Option<f64>,
+    pub about: f64,
+}
+
+/// The precision of a separatrix splitting's measurement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Precision {
+    Double,
+    DoubleDouble,
+    /// Double, then double-double where double does not resolve the area.
+    Auto,
+}
+
+impl Precision {
+    /// The names [`Precision::parse`] accepts.
+    pub const NAMES: [&str; 3] = ["double", "double-double", "auto"];
+
+    pub fn parse(name: &str) -> Option<Precision> {
+        match name {
+            "double" => Some(Precision::Double),
+            "double-double" => Some(Precision::DoubleDouble),
+            "auto" => Some(Precision::Auto),
+            _ => None,
+        }
+    }
 }
 
 impl Default for SplittingSettings {
@@ -56,6 +98,7 @@ impl Default for SplittingSettings {
             max_points: 20_000,
             p_max: 4.0,
             lobe_points: 400,
+            precision: Precision::Auto,
         }
     }
 }
@@ -68,8 +111,10 @@ pub struct Homoclinic {
     pub sigma_stable: f64,
     /// |W^u(σᵤ) − W^s(σₛ)| there: the accuracy of the point.
     pub closure: f64,
-    /// The angle between the two manifolds there, radians in [0, π/2].
-    pub angle: f64,
+    /// The angle between the two manifolds there, radians in [0, π/2]
+    /// (not measured in double-double: it would need the tangent to 32
+    /// digits).
+    pub angle: Option<f64>,
     /// The MacKay–Meiss–Percival action of its orbit (area-preserving maps).
     pub action: Option<f64>,
 }
@@ -78,6 +123,7 @@ pub struct Homoclinic {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Splitting {
     pub model: String,
+    pub precision: Precision,
     pub params: BTreeMap<String, f64>,
     pub period: f64,
     pub fixed_point: [f64; 2],
@@ -91,14 +137,21 @@ pub struct Splitting {
     /// W^u first. Lifted coordinates: W^s is that of y* + (shift, 0).
     pub homoclinic: Vec<Homoclinic>,
     pub shift: f64,
+    /// The reversing symmetry the double-double measurement found its
+    /// homoclinic orbits with.
+    pub symmetry: Option<Reversal>,
     /// The lobe area from the two orbits' actions (None where the map does
     /// not preserve area, |det − 1| > 1e-9).
     pub lobe_area_action: Option<f64>,
+    /// An estimate of the action route's error (double-double: the
+    /// rounding of its sums and the tails cut near the fixed point).
+    pub lobe_area_error: Option<f64>,
     /// The lobe area from the polygon between the manifold pieces,
-    /// Richardson-extrapolated from two resolutions.
-    pub lobe_area_polygon: f64,
+    /// Richardson-extrapolated from two resolutions (double precision only:
+    /// in double-double the manifolds are drawn, not resolved).
+    pub lobe_area_polygon: Option<f64>,
     /// The two polygon areas it was extrapolated from.
-    pub lobe_area_polygons: [f64; 2],
+    pub lobe_area_polygons: Option<[f64; 2]>,
     /// The first-order Melnikov prediction along the branch of the averaged
     /// separatrix that the measured tangle follows ([`melnikov_lobe_area`]);
     /// None where it cannot be had (its error does not stop the
@@ -108,14 +161,18 @@ pub struct Splitting {
     pub routes_relative_difference: Option<f64>,
     /// Whether the lobe area is resolved: the two routes agree to 1e-6
     /// relative (the polygon alone where the map does not preserve area:
-    /// its two resolutions to 1e-3). Not resolved, the area is too small
-    /// for double precision to give it to that accuracy: the manifolds
+    /// its two resolutions to 1e-3; in double-double, the error estimate
+    /// below 1e-6 of the area). Not resolved, the area is too small
+    /// for the precision to give it to that accuracy: the manifolds
     /// split by little more than the points' accuracy (`closure`), or not
     /// at all.
     pub resolved: bool,
     pub map_evaluations: u64,
     pub points: usize,
     pub seconds: f64,
+    /// The direction the measured branch of W^u leaves the fixed point in.
+    #[serde(skip)]
+    pub unstable_toward: [f64; 2],
     /// W^u and W^s as drawn (lifted q), and the lobe's boundary.
     #[serde(skip)]
     pub unstable: Vec<[f64; 2]>,
@@ -126,6 +183,12 @@ pub struct Splitting {
 }
 
 impl Splitting {
+    /// The lobe area: the action route's where there is one, else the
+    /// polygon's.
+    pub fn lobe_area(&self) -> Option<f64> {
+        self.lobe_area_action.or(self.lobe_area_polygon)
+    }
+
     /// The tangle (W^u red, W^s blue, the lobe green, the homoclinic points
     /// black) and a zoom on the lobe, in lifted coordinates.
     pub fn figure(&self) -> crate::plot::Figure {
@@ -150,17 +213,20 @@ impl Splitting {
             bounds(&[self.unstable.clone(), self.stable.clone()].concat(), 0.05).1,
         );
         let zoom = bounds(&self.lobe, 0.25);
-        let area = self.lobe_area_action.unwrap_or(self.lobe_area_polygon);
+        let area = self.lobe_area().unwrap_or(f64::NAN);
         let titles = [
             format!(
                 "{}: W^u (red), W^s (blue) of ({q0:.4}, {p0:.4})",
                 self.model
             ),
             if self.resolved {
-                format!(
-                    "the lobe: area {area:.6e}, angle {:.4e} rad",
-                    self.homoclinic[0].angle
-                )
+                match self.homoclinic[0].angle {
+                    Some(angle) => format!("the lobe: area {area:.6e}, angle {angle:.4e} rad"),
+                    None => format!(
+                        "the lobe: area {area:.6e} (double-double, ± {:.1e})",
+                        self.lobe_area_error.unwrap_or(f64::NAN)
+                    ),
+                }
             } else {
                 format!(
                     "lobe area {area:.3e}, not resolved to 1e-6 (routes differ by {:.1e})",
@@ -177,7 +243,11 @@ impl Splitting {
             points.iter().map(|y| (y[0], y[1])).collect()
         };
         let mut lobe = line(&self.lobe);
-        lobe.extend(lobe.first().copied());
+        // The polygon is closed; in double-double the lobe is thinner than
+        // the figure resolves, and W^u between the two points is drawn.
+        if self.lobe_area_polygon.is_some() {
+            lobe.extend(lobe.first().copied());
+        }
         for k in 0..2 {
             figure.line(k, &line(&self.unstable), Rgb(200, 30, 30));
             figure.line(k, &line(&self.stable), Rgb(30, 60, 200));
@@ -221,6 +291,8 @@ pub enum SplittingError {
     },
     #[error("model '{model}': Newton for the homoclinic point near {near:?} did not converge (where the averaged system has two saddles, as Kapitza's above A = √2, their connections are heteroclinic, which are not measured yet)")]
     Homoclinic { model: String, near: [f64; 2] },
+    #[error("model '{0}': no reversor of the period map at phase 0 ((q, p) ↦ (c − q, p) or (q, −p) with time reversed) maps W^u onto W^s, which double-double needs to find the homoclinic orbits; use precision=double")]
+    NoReversor(String),
     #[error("model '{model}': {reason}")]
     Request { model: String, reason: String },
     #[error(transparent)]
@@ -237,24 +309,92 @@ pub fn separatrix_splitting(
     let start = std::time::Instant::now();
     let (map, guesses, named) = prepare(model, params, settings)?;
     let name = model.info.name.to_string();
-    let periodic = model.dynamic.periodic()[0];
     let saddle = hyperbolic_point(&map, &name, &guesses)?;
-    let found = tangle(&map, &saddle, settings, periodic, &name)?;
+    // The averaged saddle the fixed point continues.
+    let averaged = guesses
+        .iter()
+        .min_by(|g, h| distance(g, &saddle.point).total_cmp(&distance(h, &saddle.point)))
+        .copied();
+    let melnikov = |toward: [f64; 2]| {
+        averaged.and_then(|a| melnikov_along(model.dynamic, params, map.period, a, toward).ok())
+    };
+    let in_double_double =
+        || symmetric::in_double_double(model, params, settings, &map, &saddle, averaged);
+    let mut splitting = match settings.precision {
+        Precision::Double => in_double(model, params, settings, &map, &saddle)?,
+        Precision::DoubleDouble => in_double_double()?,
+        Precision::Auto => {
+            let double = in_double(model, params, settings, &map, &saddle);
+            match (in_double_double(), double) {
+                (Ok(precise), Ok(double)) => with_polygon(precise, &double),
+                (Ok(precise), Err(_)) => precise,
+                (Err(_), Ok(double)) => double,
+                (Err(SplittingError::NoReversor(_)), Err(e)) | (Err(e), Err(_)) => return Err(e),
+            }
+        }
+    };
+    splitting.params = named;
+    splitting.lobe_area_melnikov = melnikov(splitting.unstable_toward);
+    splitting.map_evaluations = map.evaluations.load(Ordering::Relaxed);
+    splitting.seconds = start.elapsed().as_secs_f64();
+    Ok(splitting)
+}
+
+/// The double-double measurement with the double-precision polygon and
+/// angle beside it, where both measured the same branch: the second route
+/// where double precision resolves the lobe.
+fn with_polygon(mut precise: Splitting, double: &Splitting) -> Splitting {
+    if precise.shift != double.shift || !double.resolved {
+        return precise;
+    }
+    precise.lobe_area_polygon = double.lobe_area_polygon;
+    precise.lobe_area_polygons = double.lobe_area_polygons;
+    precise.lobe = double.lobe.clone();
+    precise.routes_relative_difference = match (precise.lobe_area_action, double.lobe_area_polygon)
+    {
+        (Some(a), Some(b)) => Some((a - b).abs() / a.abs().max(b.abs())),
+        _ => None,
+    };
+    for (h, d) in precise.homoclinic.iter_mut().zip(&double.homoclinic) {
+        h.angle = d.angle;
+    }
+    precise
+}
+
+/// The splitting measured in double precision: both manifolds grown, their
+/// crossings found and refined, the lobe's area by the action difference and
+/// by the polygon.
+fn in_double(
+    model: &Model,
+    params: &[f64],
+    settings: &SplittingSettings,
+    map: &Map,
+    saddle: &Saddle,
+) -> Result<Splitting, SplittingError> {
+    let name = model.info.name.to_string();
+    let periodic = model.dynamic.periodic()[0];
+    let found = tangle(map, saddle, settings, periodic, &name)?;
     let [a, b] = &found.homoclinic;
-    let polygon = lobe_polygon(&map, &found, [a, b], settings.lobe_points)?;
+    let polygon = lobe_polygon(map, &found, [a, b], settings.lobe_points)?;
     let area_preserving = (saddle.determinant - 1.0).abs() <= 1e-9;
     let mut homoclinic = vec![a.clone(), b.clone()];
-    let lobe_area_action = if area_preserving {
-        let actions = [
-            orbit_action(&map, model.dynamic, params, &found, a)?,
-            orbit_action(&map, model.dynamic, params, &found, b)?,
-        ];
-        homoclinic[0].action = Some(actions[0]);
-        homoclinic[1].action = Some(actions[1]);
-        Some((actions[0] - actions[1]).abs())
-    } else {
-        None
+    let actions = match ActionFlow::new(model, params, false) {
+        Some(flow) if area_preserving => {
+            let star = saddle.point.map(DoubleDouble::from);
+            let action = |h: &Homoclinic| {
+                double_orbit(map, &found, h).and_then(|(points, after)| {
+                    pseudo_orbit_action(&flow, &points, after, star, found.shift)
+                })
+            };
+            Some([action(a)?, action(b)?])
+        }
+        _ => None,
     };
+    let lobe_area_action = actions.map(|w| {
+        homoclinic[0].action = Some(w[0].value);
+        homoclinic[1].action = Some(w[1].value);
+        (w[0].value - w[1].value).abs()
+    });
     let points = found.unstable.len() + found.stable.len();
     let relative = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs());
     let routes_relative_difference = lobe_area_action.map(|a| relative(a, polygon.extrapolated));
@@ -264,7 +404,8 @@ pub fn separatrix_splitting(
     };
     Ok(Splitting {
         model: name,
-        params: named,
+        precision: Precision::Double,
+        params: BTreeMap::new(),
         period: map.period,
         fixed_point: saddle.point,
         multipliers: [saddle.unstable.growth, 1.0 / saddle.stable.growth],
@@ -273,21 +414,18 @@ pub fn separatrix_splitting(
         stable_direction: saddle.stable.direction,
         homoclinic,
         shift: found.shift,
+        symmetry: None,
         lobe_area_action,
-        lobe_area_polygon: polygon.extrapolated,
-        lobe_area_polygons: polygon.areas,
-        lobe_area_melnikov: guesses
-            .iter()
-            .min_by(|g, h| distance(g, &saddle.point).total_cmp(&distance(h, &saddle.point)))
-            .and_then(|&averaged| {
-                let toward = found.unstable_branch.direction;
-                melnikov_along(model.dynamic, params, map.period, averaged, toward).ok()
-            }),
+        lobe_area_error: None,
+        lobe_area_polygon: Some(polygon.extrapolated),
+        lobe_area_polygons: Some(polygon.areas),
+        lobe_area_melnikov: None,
         routes_relative_difference,
         resolved,
-        map_evaluations: map.evaluations.load(Ordering::Relaxed),
+        map_evaluations: 0,
         points,
-        seconds: start.elapsed().as_secs_f64(),
+        seconds: 0.0,
+        unstable_toward: found.unstable_branch.direction,
         unstable: found.unstable,
         stable: found.stable,
         lobe: polygon.boundary,
@@ -963,7 +1101,7 @@ fn refine_homoclinic(
             sigma_unstable: su,
             sigma_stable: ss,
             closure,
-            angle: cos.min(1.0).acos(),
+            angle: Some(cos.min(1.0).acos()),
             action: None,
         });
     }
@@ -1043,37 +1181,132 @@ fn shoelace(points: &[[f64; 2]]) -> f64 {
     0.5 * twice.abs()
 }
 
-/// The state with the action S = ∫ (p q' − H) dt as a third component.
-struct WithAction<'a> {
-    system: &'a ErasedSystem<2>,
-    model: &'a dyn DynamicModel,
-    params: &'a [f64],
+/// F(z) = ∫₀ᵀ (p q' − H) dt along the orbit from z over one period, and
+/// the orbit's end P(z): the generated system with its action
+/// (`DynamicModel::action_system`), by the Taylor method in double or in
+/// double-double precision. The period comes from the phase's rate as the
+/// recurrences compute it, so that in double-double the map is the
+/// model's own period map to 32 digits.
+struct ActionFlow {
+    system: ErasedSystem<4>,
+    double_double: bool,
+    period: DoubleDouble,
 }
 
-impl System<3> for WithAction<'_> {
-    fn rhs(&self, t: f64, z: &[f64; 3]) -> [f64; 3] {
-        let y = [z[0], z[1]];
-        let f = self.system.rhs(t, &y);
-        [
-            f[0],
-            f[1],
-            y[1] * f[0] - self.model.energy(self.params, t, &y),
-        ]
+impl ActionFlow {
+    /// None where the model has no action system.
+    fn new(model: &Model, params: &[f64], double_double: bool) -> Option<ActionFlow> {
+        let system = ErasedSystem {
+            system: model.dynamic.action_system()?,
+            params: params.to_vec(),
+        };
+        let zero = [DoubleDouble::ZERO; 4];
+        let mut out = [zero; 2];
+        let mut work = Default::default();
+        if !system.taylor(DoubleDouble::ZERO, &zero, 1, &mut work, &mut out) {
+            return None;
+        }
+        let rate = out[1][3];
+        Some(ActionFlow {
+            system,
+            double_double,
+            period: DoubleDouble::TAU / rate,
+        })
+    }
+
+    fn flow(&self, z: [DoubleDouble; 2]) -> Result<(DoubleDouble, [DoubleDouble; 2]), OdeError> {
+        let zero = DoubleDouble::ZERO;
+        if self.double_double {
+            let start = [z[0], z[1], zero, zero];
+            let end = DoubleDoubleTaylor::new().advance(
+                &self.system,
+                zero,
+                &start,
+                self.period,
+                1e-32,
+            )?;
+            Ok((end[2], [end[0], end[1]]))
+        } else {
+            let mut integrator = Integrator::new(Method::Taylor { tol: 1e-16 })?;
+            let start = [z[0].to_f64(), z[1].to_f64(), 0.0, 0.0];
+            let end = integrator.advance(&self.system, 0.0, &start, self.period.to_f64())?;
+            Ok((end[2].into(), [end[0].into(), end[1].into()]))
+        }
     }
 }
 
-/// The MacKay–Meiss–Percival action of the homoclinic orbit through `h`:
-/// Σₖ [F(zₖ) − F(y*)], F(z) = ∫₀ᵀ (p q' − H) dt from z, over the orbit from
-/// the fundamental domain of W^u (backward, then along the local linear
-/// manifold) to that of W^s (forward). The first-order terms telescope to
+/// The MacKay–Meiss–Percival action of an orbit and an estimate of its error.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Action {
+    value: f64,
+    /// The rounding of the sums (10⁻³¹ of their terms in double-double) and
+    /// the terms of the tails cut near the fixed point.
+    error: f64,
+    /// The value to 32 digits.
+    exact: DoubleDouble,
+    /// The largest distance of a point from the image of the one before:
+    /// the points' precision on a true orbit.
+    largest_jump: f64,
+}
+
+/// The action Σₖ [F(zₖ) − F(y*)] of the homoclinic orbit listed by
+/// `points` (from the fundamental domain of W^u, near y*, to that of W^s,
+/// near y* + (shift, 0)), `after` the next point of the list. Where a
+/// point is not exactly the image of the one before (the chains meet to
+/// Newton's closure; double-precision points in double-double), ∂F/∂q' = p'
+/// corrects the sum to first order; the first-order terms telescope to
 /// p*·(δq at the ends), which is taken off.
-fn orbit_action(
+fn pseudo_orbit_action(
+    flow: &ActionFlow,
+    points: &[[DoubleDouble; 2]],
+    after: [DoubleDouble; 2],
+    star: [DoubleDouble; 2],
+    shift: f64,
+) -> Result<Action, OdeError> {
+    let (reference, _) = flow.flow(star)?;
+    let ends: Vec<(DoubleDouble, [DoubleDouble; 2])> = points
+        .par_iter()
+        .map(|&y| flow.flow(y))
+        .collect::<Result<_, _>>()?;
+    let mut sum = DoubleDouble::ZERO;
+    let (mut magnitude, mut largest_jump) = (0.0, 0.0f64);
+    for ((f, image), next) in ends.iter().zip(points.iter().skip(1).chain([&after])) {
+        let jump = [(next[0] - image[0]).to_f64(), (next[1] - image[1]).to_f64()];
+        largest_jump = largest_jump.max(jump[0].hypot(jump[1]));
+        let term = *f - reference + image[1] * (next[0] - image[0]);
+        magnitude += term.hi.abs() + f.hi.abs();
+        sum += term;
+    }
+    let end_q = star[0] + shift;
+    let first_order = star[1] * ((after[0] - end_q) - (points[0][0] - star[0]));
+    let value = sum - first_order;
+    // The tails stop where the next terms are second order in the distance
+    // to y*: as large as the first and last terms' distance squared.
+    let near = |y: &[DoubleDouble; 2], q: DoubleDouble| {
+        let d = (y[0] - q).hi.hypot((y[1] - star[1]).hi);
+        d * d
+    };
+    let cut = near(&points[0], star[0]) + near(&after, end_q);
+    // Each jump between a point and the image of the one before leaves a
+    // second-order error.
+    let rounding = if flow.double_double { 1e-31 } else { 1e-16 };
+    Ok(Action {
+        value: value.to_f64(),
+        error: rounding * magnitude + cut + points.len() as f64 * largest_jump * largest_jump,
+        exact: value,
+        largest_jump,
+    })
+}
+
+/// The orbit through the homoclinic point `h` as computed in double
+/// precision: backward along the local linear manifold, the chain of W^u,
+/// then the chain of W^s (shifted) and its local manifold; and the next
+/// point after the list.
+fn double_orbit(
     map: &Map,
-    model: &dyn DynamicModel,
-    params: &[f64],
     tangle: &Tangle,
     h: &Homoclinic,
-) -> Result<f64, OdeError> {
+) -> Result<(Vec<[DoubleDouble; 2]>, [DoubleDouble; 2]), OdeError> {
     let (u, s) = (tangle.unstable_branch, tangle.stable_branch);
     let (ku, fu) = (h.sigma_unstable.floor(), h.sigma_unstable.fract());
     let (ks, fs) = (h.sigma_stable.floor(), h.sigma_stable.fract());
@@ -1093,37 +1326,8 @@ fn orbit_action(
     orbit.extend(forward.into_iter().rev().map(shifted));
     orbit.extend((1..=far(&s)).map(|i| shifted(tail(&s, fs, i))));
     let after = shifted(tail(&s, fs, far(&s) + 1));
-    // F(z) and P(z), by DOP853 with the action as a third component.
-    let action = |y: [f64; 2]| -> Result<(f64, [f64; 2]), OdeError> {
-        let mut integrator = Integrator::new(Method::Dop853 {
-            rtol: 1e-13,
-            atol: 1e-13,
-        })?;
-        let with_action = WithAction {
-            system: &map.system,
-            model,
-            params,
-        };
-        let end = integrator.advance(&with_action, 0.0, &[y[0], y[1], 0.0], map.period)?;
-        Ok((end[2], [end[0], end[1]]))
-    };
-    let star = u.origin;
-    let (reference, _) = action(star)?;
-    let ends: Vec<(f64, [f64; 2])> = orbit
-        .par_iter()
-        .map(|&y| action(y))
-        .collect::<Result<_, _>>()?;
-    // Where the next point of the list is not exactly the image of the
-    // last (at the homoclinic point, where the W^u and W^s chains meet to
-    // Newton's closure), ∂F/∂q' = p' corrects the sum to first order.
-    let junctions: f64 = ends
-        .iter()
-        .zip(orbit.iter().skip(1).chain([&after]))
-        .map(|((_, image), next)| image[1] * (next[0] - image[0]))
-        .sum();
-    let terms: f64 = ends.iter().map(|(f, _)| f - reference).sum();
-    let first_order = star[1] * ((after[0] - (star[0] + tangle.shift)) - (orbit[0][0] - star[0]));
-    Ok(terms + junctions - first_order)
+    let exact = |y: [f64; 2]| y.map(DoubleDouble::from);
+    Ok((orbit.into_iter().map(exact).collect(), exact(after)))
 }
 
 /// One value of a sweep: the splitting there, or why it could not be had.
@@ -1209,9 +1413,9 @@ pub fn splitting_sweep(
             value,
             eps,
             lobe_area_action: measured.and_then(|s| s.lobe_area_action),
-            lobe_area_polygon: measured.map(|s| s.lobe_area_polygon),
+            lobe_area_polygon: measured.and_then(|s| s.lobe_area_polygon),
             lobe_area_melnikov: measured.and_then(|s| s.lobe_area_melnikov),
-            angle: measured.map(|s| s.homoclinic[0].angle),
+            angle: measured.and_then(|s| s.homoclinic[0].angle),
             resolved: measured.is_some_and(|s| s.resolved),
             failure: result.err(),
         };
@@ -1367,16 +1571,17 @@ fn distance(a: &[f64; 2], b: &[f64; 2]) -> f64 {
 /// [`melnikov_lobe_area`] along the branch leaving the saddle on the side
 /// of `toward` (a forcing that travels with the phase splits the two
 /// branches of a separatrix very differently).
-fn melnikov_along(
+/// The branch of the averaged system's separatrix that leaves its saddle
+/// towards `toward`, sampled every T/40 from 10⁻⁸ of the saddle until it
+/// nears a saddle again, and the sampling step.
+fn averaged_separatrix(
     dynamic: &dyn DynamicModel,
     params: &[f64],
     period: f64,
     saddle: [f64; 2],
     toward: [f64; 2],
-) -> Result<f64, SplittingError> {
+) -> Result<(Vec<[f64; 2]>, f64), SplittingError> {
     let name = dynamic.info().name.to_string();
-    let eps = period / TAU;
-    let h_bar = |y: &[f64; 2]| dynamic.averaged_energy(params, y).unwrap_or(f64::NAN);
     let field = AveragedField {
         model: dynamic,
         params,
@@ -1425,6 +1630,19 @@ fn melnikov_along(
     })?;
     let mut path = vec![start];
     path.extend(integrator.advance_sampled(&field, 0.0, &start, &times)?);
+    Ok((path, step))
+}
+
+fn melnikov_along(
+    dynamic: &dyn DynamicModel,
+    params: &[f64],
+    period: f64,
+    saddle: [f64; 2],
+    toward: [f64; 2],
+) -> Result<f64, SplittingError> {
+    let eps = period / TAU;
+    let h_bar = |y: &[f64; 2]| dynamic.averaged_energy(params, y).unwrap_or(f64::NAN);
+    let (path, step) = averaged_separatrix(dynamic, params, period, saddle, toward)?;
     // f̂₁(x): the first harmonic in the phase of {H̄, H − H̄}.
     let bracket = |y: [f64; 2], theta: f64| {
         let t = theta * eps;
@@ -1449,13 +1667,25 @@ fn melnikov_along(
             )
         })
     };
-    let (mut re, mut im) = (0.0, 0.0);
+    let (mut re, mut im, mut magnitude) = (0.0, 0.0, 0.0);
     for (k, y) in path.iter().enumerate() {
         let (a, b) = harmonic(*y);
         let phase = k as f64 * step / eps;
         let (c, s) = (phase.cos(), phase.sin());
         re += step * (a * c - b * s);
         im += step * (a * s + b * c);
+        magnitude += step * a.hypot(b);
+    }
+    // The oscillating integral cancels to e^{−d/ε} of its terms: below
+    // 10⁻¹⁰ of them (the central differences' accuracy), it is noise.
+    if re.hypot(im) < 1e-10 * magnitude {
+        return Err(SplittingError::Request {
+            model: dynamic.info().name.into(),
+            reason: format!(
+                "the Melnikov integral cancels below the accuracy of its terms ({:.1e} of them)",
+                re.hypot(im) / magnitude
+            ),
+        });
     }
     Ok(4.0 * eps * re.hypot(im))
 }
