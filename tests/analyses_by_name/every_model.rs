@@ -70,10 +70,14 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
                 );
             }
         }
+        // Averaging's error falls with ε as a whole power: ε for a vibration
+        // of fixed velocity amplitude (Kapitza's A/ε scaling), ε² for a
+        // drive of fixed amplitude (Ueda's B cos ωt, whose response is
+        // B/ω²); no slope at all would mean averaging is wrong.
         let result = convergence(model_of(info.name), &params, &averaging_settings()).unwrap();
         for (c, slope) in result.coordinates.iter().zip(&result.slope) {
             assert!(
-                (slope + 1.0).abs() < 0.2,
+                *slope < -0.8 && (slope - slope.round()).abs() < 0.2,
                 "{}: {c}: slope {slope}",
                 info.name
             );

@@ -91,6 +91,8 @@ pub enum SceneError {
     #[error(transparent)]
     Splitting(#[from] crate::analysis::separatrix::SplittingError),
     #[error(transparent)]
+    Attractor(#[from] crate::analysis::attractor::AttractorError),
+    #[error(transparent)]
     Section(#[from] crate::analysis::section::SectionError),
     /// Another scene, run by this one, could not start or failed.
     #[error("cannot run scene {scene}: {source}")]

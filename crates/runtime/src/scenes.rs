@@ -651,6 +651,59 @@ pub fn separatrix_scene(
     Ok(())
 }
 
+/// Scene `attractor`: the attractor of the period map of a forced, damped
+/// 1-degree model by name, its Lyapunov spectrum and dimensions.
+pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use crate::analysis::attractor::{attractor, AttractorSettings};
+    let (model, scene) = generic_scene(
+        catalog,
+        "attractor",
+        "strange attractor of a forced, damped period map, its Lyapunov spectrum and dimensions",
+        &[],
+        ("ueda", "taylor", "1e-10"),
+        &[
+            ("points", "200000", "points of the attractor"),
+            ("transient", "500", "periods dropped first"),
+            (
+                "lyapunov_periods",
+                "16000",
+                "periods of each of the two Lyapunov runs",
+            ),
+            ("start_q", "1", "the first coordinate of the start"),
+            ("start_p", "0", "the momentum of the start"),
+            ("pixels", "500", "pixels per side of the density image"),
+        ],
+    )?;
+    let settings = AttractorSettings {
+        method: method_from(&scene)?,
+        start: [scene.number("start_q")?, scene.number("start_p")?],
+        transient: scene.count("transient")?,
+        points: scene.count("points")?,
+        lyapunov_periods: scene.count("lyapunov_periods")?,
+        pixels: scene.count("pixels")?,
+    };
+    let params = scene.parameter_values(model.info)?;
+    eprintln!(
+        "{} periods of the map and two Lyapunov runs of {} …",
+        settings.transient + settings.points,
+        settings.lyapunov_periods
+    );
+    let result = attractor(model, &params, &settings)?;
+    scene.save_figure(&result.figure(), "attractor.png")?;
+    scene.write_csv(
+        "attractor.csv",
+        &["q", "p"],
+        result.orbit.iter().map(|y| (y[0], y[1])),
+    )?;
+    scene.write_csv(
+        "lyapunov_convergence.csv",
+        &["periods", "lambda_1", "lambda_2"],
+        result.convergence.iter().map(|(k, l)| (*k, l[0], l[1])),
+    )?;
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
 /// Scene `section`: the Poincaré section of an autonomous model of two
 /// degrees of freedom at a fixed energy.
 pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {

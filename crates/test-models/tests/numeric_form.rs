@@ -150,8 +150,10 @@ fn every_model_follows_hamiltons_equations_of_its_hamiltonians() {
             continue;
         };
         let info = model.info();
+        // Hamilton's equations hold without the file's forces and
+        // dissipation: every parameter they name is set to zero.
         let mut params = model.defaults();
-        if let Some(k) = info.parameter_names.iter().position(|p| *p == "mu") {
+        for k in non_conservative(info) {
             params[k] = 0.0;
         }
         let periodic = model.periodic();
@@ -484,4 +486,21 @@ fn too_large_models_are_refused_with_a_reason() {
     assert_eq!(ok.inverse, mechlab::model::Inverse::Numeric);
     let ok = mechlab::model::Model::parse("models/chain.toml", &chain(2, "")).unwrap();
     assert_eq!(ok.inverse, mechlab::model::Inverse::Symbolic);
+}
+
+/// The parameters a model file's `[forces]` and Rayleigh function name
+/// (friction, a drive given as a force), whatever they are called.
+fn non_conservative(info: &mechlab::registry::ModelInfo) -> Vec<usize> {
+    let file = mechlab::model::Model::parse(info.source_file, info.source)
+        .unwrap_or_else(|e| panic!("{} does not parse: {e}", info.name));
+    let mut names = file.rayleigh.symbols();
+    for force in &file.forces {
+        names.extend(force.symbols());
+    }
+    info.parameter_names
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| names.contains(**p))
+        .map(|(k, _)| k)
+        .collect()
 }

@@ -18,6 +18,33 @@ pub fn lyapunov_spectrum<S: System<N>, const N: usize, const M: usize>(
     periods: usize,
     wrap: &[bool],
 ) -> Result<(Vec<f64>, [f64; N]), OdeError> {
+    let run =
+        lyapunov_history::<S, N, M>(integrator, system, period, y0, transient, periods, wrap, 0)?;
+    Ok((run.exponents, run.end))
+}
+
+/// A spectrum's run: the exponents (per period, decreasing), where the orbit
+/// ended, and the running estimates every `every` periods.
+pub struct SpectrumRun<const N: usize> {
+    pub exponents: Vec<f64>,
+    pub end: [f64; N],
+    /// (periods, the exponents so far in the order of the final ones).
+    pub history: Vec<(usize, Vec<f64>)>,
+}
+
+/// [`lyapunov_spectrum`] with the running estimates recorded every
+/// `every` periods (none for 0): their convergence.
+#[allow(clippy::too_many_arguments)]
+pub fn lyapunov_history<S: System<N>, const N: usize, const M: usize>(
+    integrator: &mut Integrator,
+    system: &S,
+    period: f64,
+    y0: &[f64; N],
+    transient: usize,
+    periods: usize,
+    wrap: &[bool],
+    every: usize,
+) -> Result<SpectrumRun<N>, OdeError> {
     assert_eq!(M, N + N * N, "the spectrum needs M = N + N²");
     let variational = Variational::<S, N, M>::new(system);
     let mut y = *y0;
@@ -28,7 +55,8 @@ pub fn lyapunov_spectrum<S: System<N>, const N: usize, const M: usize>(
         .map(|k| std::array::from_fn(|i| f64::from(u8::from(i == k))))
         .collect();
     let mut sums = vec![0.0; N];
-    for _ in 0..periods {
+    let mut history = Vec::new();
+    for done in 1..=periods {
         let z = integrator.advance(
             &variational,
             0.0,
@@ -48,10 +76,20 @@ pub fn lyapunov_spectrum<S: System<N>, const N: usize, const M: usize>(
             sums[k] += r[(k, k)].abs().ln();
             basis[k] = std::array::from_fn(|i| q[(i, k)] * r[(k, k)].signum());
         }
+        if every > 0 && done % every == 0 {
+            history.push((done, sorted(sums.iter().map(|s| s / done as f64).collect())));
+        }
     }
-    let mut exponents: Vec<f64> = sums.iter().map(|s| s / periods as f64).collect();
+    Ok(SpectrumRun {
+        exponents: sorted(sums.iter().map(|s| s / periods as f64).collect()),
+        end: y,
+        history,
+    })
+}
+
+fn sorted(mut exponents: Vec<f64>) -> Vec<f64> {
     exponents.sort_by(|a, b| b.total_cmp(a));
-    Ok((exponents, y))
+    exponents
 }
 
 /// Fast Lyapunov indicator of the period map: max over iterations of

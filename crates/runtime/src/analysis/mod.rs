@@ -4,6 +4,7 @@
 //! of exact and averaged systems, stabilisation by vibration, and
 //! Poincaré sections of autonomous models.
 
+pub mod attractor;
 pub mod averaging;
 pub mod chaos_map;
 pub mod dimension;

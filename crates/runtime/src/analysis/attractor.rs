@@ -1,0 +1,329 @@
+//! The attractor of the period map of a forced, damped model of one degree
+//! of freedom, by model name: the orbit after its transient as a density
+//! image, the full Lyapunov spectrum with its convergence and an error
+//! from a second initial condition, the check Σλ = ∫₀ᵀ div f dt (the
+//! divergence of the flow averaged along the orbit, measured separately),
+//! and the box-counting and Kaplan–Yorke dimensions.
+
+use super::dimension::{bounds, box_counting, kaplan_yorke_dimension};
+use super::lyapunov::lyapunov_history;
+use super::period_map::orbit;
+use crate::ode::{ErasedSystem, Integrator, Method, OdeError, System};
+use crate::plot::{ColorMap, Figure, PanelSpec, Rgb};
+use crate::registry::{Fixed, Model, Sized};
+use std::collections::BTreeMap;
+
+/// What to compute.
+#[derive(Clone, Debug)]
+pub struct AttractorSettings {
+    pub method: Method,
+    /// Where the orbit starts (then a second start for the error, shifted
+    /// by 10⁻³).
+    pub start: [f64; 2],
+    /// Periods dropped before anything is recorded.
+    pub transient: usize,
+    /// Points of the attractor drawn and counted.
+    pub points: usize,
+    /// Periods of each Lyapunov run.
+    pub lyapunov_periods: usize,
+    /// Pixels per side of the density image.
+    pub pixels: usize,
+}
+
+/// Why an attractor cannot be had.
+#[derive(Debug, thiserror::Error)]
+pub enum AttractorError {
+    #[error("'{0}' is a contact model: it has no period map")]
+    ContactModel(String),
+    #[error("model '{model}' has {dof} degrees of freedom: the attractor is drawn for one (a period map of the plane)")]
+    NotPlanar { model: String, dof: usize },
+    #[error("model '{0}' has no periodic forcing (no [fast_phase]): it has no period map")]
+    NoPeriod(String),
+    #[error("attractor of '{model}': {reason}")]
+    Settings { model: String, reason: String },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// The attractor, as measured.
+#[derive(Debug, serde::Serialize)]
+pub struct Attractor {
+    pub model: String,
+    pub params: BTreeMap<String, f64>,
+    pub period: f64,
+    pub points: usize,
+    /// Lyapunov exponents per period, decreasing, from the first start.
+    pub lyapunov: Vec<f64>,
+    /// The same per unit time.
+    pub lyapunov_per_time: Vec<f64>,
+    /// From the second start: |difference| is the error estimate.
+    pub lyapunov_second_start: Vec<f64>,
+    pub lyapunov_error: Vec<f64>,
+    /// Σλ per period, and ∫₀ᵀ div f dt averaged along the orbit (measured
+    /// from the Jacobian's trace, not from the tangent flow): equal for a
+    /// correct spectrum (−k T for a damping k).
+    pub lyapunov_sum: f64,
+    pub divergence_per_period: f64,
+    pub box_dimension: f64,
+    pub kaplan_yorke_dimension: f64,
+    /// Box sides (fractions of the extent) and their counts.
+    pub box_sides: Vec<f64>,
+    pub boxes: Vec<usize>,
+    pub seconds: f64,
+    /// (periods, exponents so far) of the first run.
+    #[serde(skip)]
+    pub convergence: Vec<(usize, Vec<f64>)>,
+    #[serde(skip)]
+    pub orbit: Vec<[f64; 2]>,
+    /// Which coordinate is an angle (drawn in [−π, π)).
+    #[serde(skip)]
+    pub periodic: bool,
+    #[serde(skip)]
+    pub pixels: usize,
+    /// The coordinate's and momentum's names, for the axes.
+    #[serde(skip)]
+    pub axes: [&'static str; 2],
+}
+
+/// The attractor of `model`'s period map at `params`.
+pub fn attractor(
+    model: &Model,
+    params: &[f64],
+    settings: &AttractorSettings,
+) -> Result<Attractor, AttractorError> {
+    let name = model.info.name.to_string();
+    let fixed = match model.sized {
+        Some(Sized::Dof1(fixed)) => fixed,
+        Some(_) => {
+            return Err(AttractorError::NotPlanar {
+                model: name,
+                dof: model.info.coordinates.len(),
+            })
+        }
+        None => return Err(AttractorError::ContactModel(name)),
+    };
+    let period = match fixed.phase_period(params) {
+        Some(t) if fixed.has_fast_phase() => t,
+        _ => return Err(AttractorError::NoPeriod(name)),
+    };
+    let settings_error = |reason: &str| AttractorError::Settings {
+        model: name.clone(),
+        reason: reason.into(),
+    };
+    if settings.points < 100 || settings.lyapunov_periods < 10 || settings.pixels < 10 {
+        return Err(settings_error(
+            "points ≥ 100, lyapunov_periods ≥ 10 and pixels ≥ 10",
+        ));
+    }
+    if !settings.start.iter().all(|x| x.is_finite()) {
+        return Err(settings_error("the start must be finite"));
+    }
+    let named = model
+        .info
+        .named_values(params)
+        .ok_or_else(|| settings_error("wrong number of parameter values"))?;
+    let system = fixed.exact(params);
+    let periodic = model.dynamic.periodic()[0];
+    let wrap = [periodic, false];
+    let start = std::time::Instant::now();
+    let mut integrator = Integrator::new(settings.method)?;
+    let settled = *orbit(
+        &mut integrator,
+        &system,
+        period,
+        &settings.start,
+        settings.transient,
+        &wrap,
+    )?
+    .last()
+    .expect("the start at least");
+    let second = [settled[0] + 1e-3, settled[1]];
+    let spectrum = |from: [f64; 2], every: usize| {
+        let mut integrator = Integrator::new(settings.method)?;
+        lyapunov_history::<_, 2, 6>(
+            &mut integrator,
+            &system,
+            period,
+            &from,
+            0,
+            settings.lyapunov_periods,
+            &wrap,
+            every,
+        )
+    };
+    let every = (settings.lyapunov_periods / 200).max(1);
+    let ((first, other), points) = rayon::join(
+        || rayon::join(|| spectrum(settled, every), || spectrum(second, 0)),
+        || {
+            orbit(
+                &mut integrator,
+                &system,
+                period,
+                &settled,
+                settings.points,
+                &wrap,
+            )
+        },
+    );
+    let (first, other) = (first?, other?);
+    let points = points?;
+    let divergence = mean_divergence(&system, period, &points[..points.len().min(200)])?;
+    let sides: Vec<f64> = (2..=9).map(|k| 0.5f64.powi(k)).collect();
+    let counted = box_counting(&points, &sides, 2..sides.len() - 1);
+    let error = first
+        .exponents
+        .iter()
+        .zip(&other.exponents)
+        .map(|(a, b)| (a - b).abs())
+        .collect();
+    Ok(Attractor {
+        model: name,
+        params: named,
+        period,
+        points: points.len(),
+        lyapunov_per_time: first.exponents.iter().map(|l| l / period).collect(),
+        lyapunov_sum: first.exponents.iter().sum(),
+        kaplan_yorke_dimension: kaplan_yorke_dimension(&first.exponents),
+        lyapunov_second_start: other.exponents,
+        lyapunov_error: error,
+        lyapunov: first.exponents,
+        divergence_per_period: divergence,
+        box_dimension: counted.dimension,
+        box_sides: counted.sides,
+        boxes: counted.boxes,
+        seconds: start.elapsed().as_secs_f64(),
+        convergence: first.history,
+        orbit: points,
+        periodic,
+        pixels: settings.pixels,
+        axes: [model.info.coordinates[0], model.info.momenta[0]],
+    })
+}
+
+/// ∫₀ᵀ tr ∂f/∂y dt from each of `starts` along one period (Simpson's rule
+/// at 64 intervals), averaged over the starts.
+fn mean_divergence(
+    system: &ErasedSystem<2>,
+    period: f64,
+    starts: &[[f64; 2]],
+) -> Result<f64, OdeError> {
+    const INTERVALS: usize = 64;
+    let times: Vec<f64> = (1..=INTERVALS)
+        .map(|k| period * k as f64 / INTERVALS as f64)
+        .collect();
+    let trace = |t: f64, y: &[f64; 2]| {
+        system
+            .jacobian(t, y)
+            .map_or(f64::NAN, |j| j[0][0] + j[1][1])
+    };
+    let mut total = 0.0;
+    for y0 in starts {
+        let mut integrator = Integrator::new(Method::Dop853 {
+            rtol: 1e-10,
+            atol: 1e-10,
+        })?;
+        let states = integrator.advance_sampled(system, 0.0, y0, &times)?;
+        let h = period / INTERVALS as f64;
+        let mut sum = trace(0.0, y0);
+        for (k, (t, y)) in times.iter().zip(&states).enumerate() {
+            let weight = if k + 1 == INTERVALS {
+                1.0
+            } else if k % 2 == 0 {
+                4.0
+            } else {
+                2.0
+            };
+            sum += weight * trace(*t, y);
+        }
+        total += sum * h / 3.0;
+    }
+    Ok(total / starts.len() as f64)
+}
+
+impl Attractor {
+    /// The density of the attractor's points (log scale) and the
+    /// convergence of the Lyapunov exponents.
+    pub fn figure(&self) -> Figure {
+        let (lo, hi) = bounds(&self.orbit);
+        let (q_range, p_range) = (
+            if self.periodic {
+                (-std::f64::consts::PI, std::f64::consts::PI)
+            } else {
+                let pad = 0.03 * (hi[0] - lo[0]);
+                (lo[0] - pad, hi[0] + pad)
+            },
+            {
+                let pad = 0.03 * (hi[1] - lo[1]);
+                (lo[1] - pad, hi[1] + pad)
+            },
+        );
+        let n = self.pixels;
+        let mut counts = vec![0usize; n * n];
+        for y in &self.orbit {
+            let i = ((y[0] - q_range.0) / (q_range.1 - q_range.0) * n as f64).floor();
+            let j = ((y[1] - p_range.0) / (p_range.1 - p_range.0) * n as f64).floor();
+            if (0.0..n as f64).contains(&i) && (0.0..n as f64).contains(&j) {
+                counts[j as usize * n + i as usize] += 1;
+            }
+        }
+        let top = (*counts.iter().max().unwrap_or(&1)).max(1) as f64;
+        let shade: Vec<f64> = counts
+            .iter()
+            .map(|&c| {
+                if c == 0 {
+                    f64::NAN
+                } else {
+                    (c as f64).ln_1p() / top.ln_1p()
+                }
+            })
+            .collect();
+        let titles = [
+            format!(
+                "{}: attractor of the period map, {} points, D_box = {:.3}, D_KY = {:.3}",
+                self.model, self.points, self.box_dimension, self.kaplan_yorke_dimension
+            ),
+            format!(
+                "Lyapunov exponents per period: {:.4} ± {:.1e}, {:.4} ± {:.1e} (sum {:.4}, ∫div f {:.4})",
+                self.lyapunov[0],
+                self.lyapunov_error[0],
+                self.lyapunov[1],
+                self.lyapunov_error[1],
+                self.lyapunov_sum,
+                self.divergence_per_period
+            ),
+        ];
+        let last = self.convergence.last().map_or(1, |(k, _)| *k) as f64;
+        let (low, high) = self
+            .convergence
+            .iter()
+            .skip(self.convergence.len() / 10)
+            .flat_map(|(_, l)| l.iter().copied())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+        let pad = 0.1 * (high - low).max(1e-3);
+        let specs = [
+            PanelSpec::new(&titles[0], self.axes[0], self.axes[1], q_range, p_range),
+            PanelSpec::new(
+                &titles[1],
+                "periods",
+                "λ",
+                (0.0, last),
+                (low - pad, high + pad),
+            ),
+        ];
+        let mut figure = Figure::grid(2, 1, 720, 640, &specs);
+        figure.shaded_map(0, n, n, &shade, ColorMap::Viridis, "log density");
+        for k in 0..self.lyapunov.len() {
+            let line: Vec<(f64, f64)> = self
+                .convergence
+                .iter()
+                .map(|(t, l)| (*t as f64, l[k]))
+                .collect();
+            figure.line(1, &line, crate::plot::palette(k));
+        }
+        let sum = self.divergence_per_period;
+        figure.line(1, &[(0.0, sum), (last, sum)], Rgb(120, 120, 120));
+        figure
+    }
+}
