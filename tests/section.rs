@@ -108,3 +108,43 @@ fn a_section_says_why_it_cannot_be_drawn() {
         Err(SectionError::Settings { .. })
     ));
 }
+
+/// MEGNO maps of the section (`analysis::section_map`): the uncoupled
+/// oscillators are isochronous, so no tangent vector grows and ⟨Y⟩ stays
+/// near 0 on every pixel; Hénon–Heiles is nearly all regular at E = 1/12
+/// and mostly chaotic at E = 1/6, as Hénon and Heiles found.
+#[test]
+fn megno_maps_find_no_chaos_in_oscillators_and_chaos_growing_with_energy() {
+    use mechlab::analysis::section_map::{section_map, SectionMapSettings};
+    let model = models::by_name("henon_heiles").unwrap();
+    let map = |coupling: f64, energy: f64| {
+        let settings = SectionMapSettings {
+            section: settings(energy),
+            pixels: 24,
+            t_max: 400.0,
+            extent: 1.0,
+        };
+        section_map(model, &[coupling], &settings).unwrap()
+    };
+    let free = map(0.0, 0.125);
+    assert!(free.accessible > 300, "{}", free.accessible);
+    let largest = free
+        .megno
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    assert!(largest < 0.5, "⟨Y⟩ up to {largest}");
+    let (low, high) = (map(1.0, 1.0 / 12.0), map(1.0, 1.0 / 6.0));
+    assert!(
+        low.chaotic_fraction < 0.1,
+        "E = 1/12: {}",
+        low.chaotic_fraction
+    );
+    assert!(
+        high.chaotic_fraction > 0.5,
+        "E = 1/6: {}",
+        high.chaotic_fraction
+    );
+    assert_eq!(low.failed + high.failed, 0);
+}

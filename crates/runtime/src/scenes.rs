@@ -739,7 +739,17 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
             "20000",
             "an orbit stops at this time, however few its crossings",
         ),
-        knob("tol", "1e-12", "DOP853's tolerance"),
+        knob(
+            "tol",
+            "1e-12",
+            "DOP853's tolerance (the map's Taylor method uses it too)",
+        ),
+        knob(
+            "map",
+            "0",
+            "pixels per side of a MEGNO chaos map of the section (0: none)",
+        ),
+        knob("map_time", "2000", "the time each orbit of the map runs"),
     ];
     knobs.extend(parameter_knobs(model.info, &[]));
     let scene = Scene::from_args("section", "Poincaré section at a fixed energy", &knobs)?;
@@ -795,6 +805,44 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         "largest |H − E| on the section {:.1e}, largest distance from the plane {:.1e}",
         result.largest_energy_drift, result.largest_plane_distance
     );
-    scene.write_summary(&result)?;
+    let map = match scene.count("map")? {
+        0 => None,
+        pixels => {
+            use crate::analysis::section_map::{section_map, SectionMapSettings};
+            eprintln!("MEGNO map, {pixels}² orbits …");
+            let map_settings = SectionMapSettings {
+                section: settings.clone(),
+                pixels,
+                t_max: scene.positive("map_time")?,
+                extent: scene.positive("extent")?,
+            };
+            let map = section_map(model, &params, &map_settings)?;
+            scene.save_figure(&map.figure(), "section_megno.png")?;
+            let window = map.window;
+            let at = move |k: usize, range: [f64; 2]| {
+                range[0] + (range[1] - range[0]) * (k as f64 + 0.5) / pixels as f64
+            };
+            let rows = map
+                .megno
+                .iter()
+                .enumerate()
+                .map(move |(k, v)| (at(k % pixels, window[0]), at(k / pixels, window[1]), *v));
+            scene.write_csv(
+                "section_megno.csv",
+                &[map.axes[0].as_str(), map.axes[1].as_str(), "megno"],
+                rows,
+            )?;
+            Some(map)
+        }
+    };
+    #[derive(serde::Serialize)]
+    struct Summary<'a> {
+        section: &'a crate::analysis::section::Section,
+        megno_map: Option<&'a crate::analysis::section_map::SectionMap>,
+    }
+    scene.write_summary(&Summary {
+        section: &result,
+        megno_map: map.as_ref(),
+    })?;
     Ok(())
 }

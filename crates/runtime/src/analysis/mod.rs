@@ -13,6 +13,7 @@ pub mod floquet;
 pub mod lyapunov;
 pub mod period_map;
 pub mod section;
+pub mod section_map;
 pub mod separatrix;
 pub mod stability;
 pub mod standard_map;

@@ -236,7 +236,7 @@ impl WithFixed for Sections<'_> {
 
 /// The state on the plane at `seed` with p_c solved from H = E on the
 /// settings' branch.
-fn on_plane<const S: usize>(
+pub(super) fn on_plane<const S: usize>(
     seed: &[f64; 2],
     c: usize,
     other: usize,
@@ -276,7 +276,7 @@ fn on_plane<const S: usize>(
 
 /// [α, β, γ] of H = α p² + β p + γ along one momentum, from its values at
 /// p = −1, 0, 1 (exact: H is quadratic in the momenta).
-fn quadratic(h: impl Fn(f64) -> f64) -> [f64; 3] {
+pub(super) fn quadratic(h: impl Fn(f64) -> f64) -> [f64; 3] {
     let (minus, zero, plus) = (h(-1.0), h(0.0), h(1.0));
     [0.5 * (plus + minus) - zero, 0.5 * (plus - minus), zero]
 }

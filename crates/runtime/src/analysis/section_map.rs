@@ -1,0 +1,299 @@
+//! Chaos maps on a surface of section: MEGNO ⟨Y⟩ over a grid of the
+//! section's accessible region at energy E, each pixel the orbit through
+//! that point of the plane (its missing momentum solved from H = E), run
+//! in the batch Taylor lanes on all cores; the chaotic fraction of the
+//! accessible area.
+
+use super::lyapunov::megno_values;
+use super::section::{on_plane, quadratic, SectionError, SectionSettings};
+use crate::ode::{LaneIntegrator, Method};
+use crate::plot::{ColorMap, Figure, PanelSpec};
+use crate::registry::{Fixed, Model, Sized};
+use rayon::prelude::*;
+
+/// What a section's chaos map computes.
+#[derive(Clone, Debug)]
+pub struct SectionMapSettings {
+    /// The plane, its crossing direction (the branch of the solved
+    /// momentum), the energy, and the Taylor method's tolerance
+    /// (`crossings` is not used).
+    pub section: SectionSettings,
+    /// Pixels per side.
+    pub pixels: usize,
+    /// The time each orbit runs.
+    pub t_max: f64,
+    /// The accessible region is searched for in [−extent, extent]² of the
+    /// other coordinate and its momentum.
+    pub extent: f64,
+}
+
+/// ⟨Y⟩ above this is chaos (regular orbits tend to 2, periodic ones to 0).
+pub const CHAOS_THRESHOLD: f64 = 4.0;
+
+/// A chaos map of a section.
+#[derive(Debug, serde::Serialize)]
+pub struct SectionMap {
+    pub model: String,
+    pub energy: f64,
+    pub axes: [String; 2],
+    /// The window: the other coordinate's range and its momentum's.
+    pub window: [[f64; 2]; 2],
+    pub pixels: usize,
+    pub t_max: f64,
+    /// Pixels where the energy is accessible, and how many of them have
+    /// ⟨Y⟩ above [`CHAOS_THRESHOLD`]: the chaotic fraction by area.
+    pub accessible: usize,
+    pub chaotic: usize,
+    pub chaotic_fraction: f64,
+    /// Orbits the integrator could not follow (left out of both counts).
+    pub failed: usize,
+    pub seconds: f64,
+    /// ⟨Y⟩ per pixel, row 0 at the bottom; NaN where the energy is not
+    /// accessible.
+    #[serde(skip)]
+    pub megno: Vec<f64>,
+}
+
+/// The MEGNO map of the section of a 2-degree autonomous `model`.
+pub fn section_map(
+    model: &Model,
+    params: &[f64],
+    settings: &SectionMapSettings,
+) -> Result<SectionMap, SectionError> {
+    let name = model.info.name.to_string();
+    let fixed = match model.sized {
+        Some(Sized::Dof2(fixed)) => fixed,
+        Some(_) => {
+            return Err(SectionError::Dimension {
+                model: name,
+                dof: model.info.coordinates.len(),
+            })
+        }
+        None => return Err(SectionError::ContactModel(name)),
+    };
+    if fixed.has_fast_phase() {
+        return Err(SectionError::FastPhase(name));
+    }
+    let s = &settings.section;
+    let bad = |reason: &str| SectionError::Settings {
+        model: name.clone(),
+        reason: reason.into(),
+    };
+    if s.coordinate > 1 || settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
+        return Err(bad(
+            "coordinate 0 or 1, pixels ≥ 2, t_max and extent positive",
+        ));
+    }
+    let method = Method::Taylor { tol: s.tol };
+    method.validate()?;
+    let start = std::time::Instant::now();
+    let (c, other) = (s.coordinate, 1 - s.coordinate);
+    let energy = |y: &[f64; 4]| model.dynamic.energy(params, 0.0, y);
+    // The least H over the solved momentum at a point of the plane.
+    let least = |q: f64, p: f64| {
+        let mut y = [0.0; 4];
+        y[c] = s.value;
+        y[other] = q;
+        y[2 + other] = p;
+        let [alpha, beta, zero] = quadratic(|pc| {
+            let mut z = y;
+            z[2 + c] = pc;
+            energy(&z)
+        });
+        zero - beta * beta / (4.0 * alpha)
+    };
+    let region =
+        Region::find(&least, s.energy, settings.extent).ok_or_else(|| SectionError::NoSeeds {
+            model: name.clone(),
+        })?;
+    let window = region.window();
+    let n = settings.pixels;
+    let centre =
+        |i: usize, range: [f64; 2]| range[0] + (range[1] - range[0]) * (i as f64 + 0.5) / n as f64;
+    let system = fixed.exact(params);
+    let chunk = 0.5;
+    let chunks = (settings.t_max / chunk).ceil() as usize;
+    let w0 = [0.5; 4];
+    let rows: Vec<(Vec<f64>, usize)> = (0..n)
+        .into_par_iter()
+        .map(|j| -> Result<(Vec<f64>, usize), SectionError> {
+            let p = centre(j, window[1]);
+            let seeds: Vec<(usize, [f64; 4])> = (0..n)
+                .filter_map(|i| {
+                    let q = centre(i, window[0]);
+                    if !region.contains(q, p) {
+                        return None;
+                    }
+                    on_plane::<4>(&[q, p], c, other, s, &energy)
+                        .ok()
+                        .map(|y| (i, y))
+                })
+                .collect();
+            let mut row = vec![f64::NAN; n];
+            let mut integrator = LaneIntegrator::new(method)?;
+            let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
+            let values =
+                megno_values::<_, 4, 8>(&mut integrator, &system, chunk, &starts, &w0, chunks);
+            let mut failed = 0;
+            for ((i, _), value) in seeds.iter().zip(values) {
+                match value {
+                    Ok(v) => row[*i] = v,
+                    Err(_) => {
+                        row[*i] = f64::INFINITY;
+                        failed += 1;
+                    }
+                }
+            }
+            Ok((row, failed))
+        })
+        .collect::<Result<_, _>>()?;
+    let failed = rows.iter().map(|(_, f)| f).sum();
+    let megno: Vec<f64> = rows.into_iter().flat_map(|(row, _)| row).collect();
+    let accessible = megno.iter().filter(|v| v.is_finite()).count();
+    let chaotic = megno
+        .iter()
+        .filter(|v| v.is_finite() && **v > CHAOS_THRESHOLD)
+        .count();
+    let names = model.info.state_names();
+    Ok(SectionMap {
+        model: name,
+        energy: s.energy,
+        axes: [names[other].to_string(), names[2 + other].to_string()],
+        window,
+        pixels: n,
+        t_max: chunks as f64 * chunk,
+        accessible,
+        chaotic,
+        chaotic_fraction: chaotic as f64 / accessible.max(1) as f64,
+        failed,
+        seconds: start.elapsed().as_secs_f64(),
+        megno,
+    })
+}
+
+/// The region of the plane where H = E is accessible (the least H below
+/// E) and connected to the origin (else the largest such region: beyond a
+/// barrier the energy may be accessible again on an open branch), from a
+/// 400² scan of [−extent, extent]².
+struct Region {
+    extent: f64,
+    inside: Vec<bool>,
+}
+
+const SCAN: usize = 400;
+
+impl Region {
+    fn find(least: &(dyn Fn(f64, f64) -> f64 + Sync), energy: f64, extent: f64) -> Option<Region> {
+        let at = |i: usize| -extent + 2.0 * extent * i as f64 / (SCAN - 1) as f64;
+        let open: Vec<bool> = (0..SCAN * SCAN)
+            .into_par_iter()
+            .map(|k| least(at(k % SCAN), at(k / SCAN)) < energy)
+            .collect();
+        // The connected regions, by flood fill; the one holding the origin.
+        let mut label = vec![usize::MAX; SCAN * SCAN];
+        let mut sizes = Vec::new();
+        for seed in 0..open.len() {
+            if !open[seed] || label[seed] != usize::MAX {
+                continue;
+            }
+            let id = sizes.len();
+            let (mut stack, mut size) = (vec![seed], 0);
+            label[seed] = id;
+            while let Some(k) = stack.pop() {
+                size += 1;
+                let (i, j) = (k % SCAN, k / SCAN);
+                let neighbours = [
+                    (i > 0).then(|| k - 1),
+                    (i + 1 < SCAN).then(|| k + 1),
+                    (j > 0).then(|| k - SCAN),
+                    (j + 1 < SCAN).then(|| k + SCAN),
+                ];
+                for n in neighbours.into_iter().flatten() {
+                    if open[n] && label[n] == usize::MAX {
+                        label[n] = id;
+                        stack.push(n);
+                    }
+                }
+            }
+            sizes.push(size);
+        }
+        let middle = (SCAN / 2) * SCAN + SCAN / 2;
+        let chosen = match label[middle] {
+            usize::MAX => (0..sizes.len()).max_by_key(|&id| sizes[id])?,
+            id => id,
+        };
+        Some(Region {
+            extent,
+            inside: label.iter().map(|&l| l == chosen).collect(),
+        })
+    }
+
+    fn cell(&self, x: f64) -> Option<usize> {
+        let i = ((x + self.extent) / (2.0 * self.extent) * (SCAN - 1) as f64).round();
+        (0.0..SCAN as f64).contains(&i).then_some(i as usize)
+    }
+
+    fn contains(&self, q: f64, p: f64) -> bool {
+        matches!((self.cell(q), self.cell(p)), (Some(i), Some(j)) if self.inside[j * SCAN + i])
+    }
+
+    /// Its bounding box, padded by one scan cell.
+    fn window(&self) -> [[f64; 2]; 2] {
+        let at = |i: usize| -self.extent + 2.0 * self.extent * i as f64 / (SCAN - 1) as f64;
+        let cell = 2.0 * self.extent / (SCAN - 1) as f64;
+        let cells: Vec<(usize, usize)> = (0..self.inside.len())
+            .filter(|&k| self.inside[k])
+            .map(|k| (k % SCAN, k / SCAN))
+            .collect();
+        let range = |pick: fn(&(usize, usize)) -> usize| {
+            let (lo, hi) = cells
+                .iter()
+                .map(pick)
+                .fold((usize::MAX, 0), |(a, b), k| (a.min(k), b.max(k)));
+            [at(lo) - cell, at(hi) + cell]
+        };
+        [range(|c| c.0), range(|c| c.1)]
+    }
+}
+
+impl SectionMap {
+    /// ⟨Y⟩ from 0 to 8 (Viridis; white where the energy is not
+    /// accessible).
+    pub fn figure(&self) -> Figure {
+        let title = format!(
+            "{}: MEGNO ⟨Y⟩ on the section at E = {}, t = {}; chaotic (⟨Y⟩ > {CHAOS_THRESHOLD}) {:.1} % of the area",
+            self.model,
+            self.energy,
+            self.t_max,
+            100.0 * self.chaotic_fraction
+        );
+        let spec = PanelSpec::new(
+            &title,
+            &self.axes[0],
+            &self.axes[1],
+            (self.window[0][0], self.window[0][1]),
+            (self.window[1][0], self.window[1][1]),
+        );
+        let mut figure = Figure::single(720, 660, spec);
+        let shades: Vec<f64> = self
+            .megno
+            .iter()
+            .map(|v| {
+                if v.is_nan() {
+                    f64::NAN
+                } else {
+                    (v / 8.0).clamp(0.0, 1.0)
+                }
+            })
+            .collect();
+        figure.shaded_map(
+            0,
+            self.pixels,
+            self.pixels,
+            &shades,
+            ColorMap::Viridis,
+            "⟨Y⟩ / 8",
+        );
+        figure
+    }
+}
