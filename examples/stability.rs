@@ -23,7 +23,7 @@ fn main() {
         let [method, tol] = method_knobs("dop853", "1e-10");
         let mut knobs = vec![
             knob("model", "kapitza", "the model (a file models/<name>.toml) with a fast phase"),
-            knob("amplitude", info.amplitude.unwrap_or("(none)"), "the parameter that scales the vibration (default: the model file's [fast_phase] amplitude)"),
+            knob("amplitude", info.amplitude.unwrap_or("none"), "the parameter that scales the vibration (default: the model file's [fast_phase] amplitude)"),
             method,
             tol,
             knob("samples", "40", "amplitudes sampled on (0, a_max] to bracket the exact window's edges"),
@@ -56,6 +56,9 @@ fn main() {
         let result = stability(model, &params, &settings)?;
         for q in &result.moved_by_vibration {
             eprintln!("q = {q:?}: an equilibrium without vibration that the vibration moves");
+        }
+        if let Some(reason) = &result.none_because {
+            eprintln!("no equilibrium analysed: {reason}");
         }
         for e in &result.equilibria {
             let reason = e.reason.as_deref().unwrap_or("");

@@ -141,22 +141,27 @@ fn chain_thresholds_match_the_normal_modes() {
     }
 }
 
-/// A pivot on a circle vibrates isotropically: V_vibr = A²/4 is flat, no
-/// amplitude stabilises the upright, and the analysis says why.
+/// A pivot on a circle vibrates isotropically, and its horizontal
+/// component moves the upright and the hanging position: (q, p) = (0, 0)
+/// is no solution of the exact system, so neither has a Floquet window to
+/// give. The analysis says so (an exact window there, from the monodromy of
+/// an orbit that is not periodic, would be wrong); so does Ueda's driven
+/// oscillator, whose drive moves x = 0.
 #[test]
-fn an_isotropic_vibration_has_no_threshold() {
+fn equilibria_the_vibration_moves_are_named_not_judged() {
+    use mechlab::analysis::stability::NoEquilibria;
     let result = stability(
         model_of("circle_pendulum"),
         &defaults("circle_pendulum"),
         &settings("A"),
     )
     .unwrap();
-    let upright = at(&result.equilibria, &[0.0]);
-    assert!(upright.a_star.is_none() && upright.exact_window.is_none());
-    assert!(
-        upright.reason.as_deref().unwrap().contains("no curvature"),
-        "{upright:#?}"
-    );
+    assert!(result.equilibria.is_empty());
+    assert_eq!(result.moved_by_vibration.len(), 2, "{result:#?}");
+    assert_eq!(result.none_because, Some(NoEquilibria::AllMoved));
+    let ueda = stability(model_of("ueda"), &defaults("ueda"), &settings("B")).unwrap();
+    assert_eq!(ueda.moved_by_vibration, vec![vec![0.0]]);
+    assert_eq!(ueda.none_because, Some(NoEquilibria::AllMoved));
 }
 
 #[test]

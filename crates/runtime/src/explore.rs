@@ -407,18 +407,6 @@ pub fn equilibria(
                 *x = crate::analysis::period_map::wrap_angle(*x);
             }
         }
-        if found.iter().any(|e| {
-            e.q.iter().zip(&q).zip(&periodic).all(|((a, b), p)| {
-                let d = if *p {
-                    crate::analysis::period_map::wrap_angle(a - b)
-                } else {
-                    a - b
-                };
-                d.abs() < 1e-6
-            })
-        }) {
-            continue;
-        }
         let h = model
             .effective_potential_hessian(params, &q)
             .unwrap_or_default();
@@ -426,11 +414,36 @@ pub fn equilibria(
         let sym = (&hm + hm.transpose()) * 0.5;
         let mut eigenvalues: Vec<f64> = sym.symmetric_eigenvalues().iter().copied().collect();
         eigenvalues.sort_by(f64::total_cmp);
-        found.push(Equilibrium {
-            q,
-            verdict: Verdict::of(&eigenvalues),
-            hessian_eigenvalues: eigenvalues,
+        let verdict = Verdict::of(&eigenvalues);
+        // Newton converges only linearly on a degenerate equilibrium (x⁴
+        // gives the gradient x³) and the gradient's differences have a noise
+        // floor, so its starts end up to 10⁻³ apart: one equilibrium, kept
+        // where the gradient is least.
+        let radius = match verdict {
+            Verdict::InconclusiveAtSecondOrder => 1e-3,
+            _ => 1e-6,
+        };
+        let norm = |q: &[f64]| gradient(q).iter().map(|x| x * x).sum::<f64>().sqrt();
+        let same = found.iter().position(|e| {
+            e.q.iter().zip(&q).zip(&periodic).all(|((a, b), p)| {
+                let d = if *p {
+                    crate::analysis::period_map::wrap_angle(a - b)
+                } else {
+                    a - b
+                };
+                d.abs() < radius * (1.0 + b.abs())
+            })
         });
+        let equilibrium = Equilibrium {
+            q,
+            verdict,
+            hessian_eigenvalues: eigenvalues,
+        };
+        match same {
+            Some(k) if norm(&equilibrium.q) < norm(&found[k].q) => found[k] = equilibrium,
+            Some(_) => {}
+            None => found.push(equilibrium),
+        }
     }
     Ok(found)
 }

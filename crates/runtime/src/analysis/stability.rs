@@ -75,8 +75,28 @@ pub struct Stability {
     pub params: BTreeMap<String, f64>,
     pub equilibria: Vec<EquilibriumStability>,
     /// Equilibria of the system without vibration that the vibration moves
-    /// (not equilibria of the averaged system).
+    /// (not equilibria of the averaged system, or (q, 0) not a solution of
+    /// the exact one: its periodic orbit nearby is not analysed yet).
     pub moved_by_vibration: Vec<Vec<f64>>,
+    /// Why `equilibria` is empty, when it is.
+    #[serde(serialize_with = "as_text")]
+    pub none_because: Option<NoEquilibria>,
+}
+
+/// Why a stability analysis lists no equilibrium.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NoEquilibria {
+    #[error("Newton found no equilibrium of V from {starts} starts (a degenerate one, where the Hessian vanishes, converges too slowly to be found)")]
+    NoneFound { starts: usize },
+    #[error("every equilibrium is moved by the vibration (see moved_by_vibration)")]
+    AllMoved,
+}
+
+fn as_text<S: serde::Serializer>(e: &Option<NoEquilibria>, s: S) -> Result<S::Ok, S::Error> {
+    match e {
+        Some(e) => s.serialize_str(&e.to_string()),
+        None => s.serialize_none(),
+    }
 }
 
 /// Why the analysis cannot run.
@@ -94,6 +114,8 @@ pub enum StabilityError {
         name: String,
         known: String,
     },
+    #[error("model '{model}' names no amplitude ([fast_phase] amplitude in its file): choose the parameter that scales the vibration with --set amplitude=<name> (parameters: {known})")]
+    NoAmplitude { model: String, known: String },
     #[error("{0} parameter values for model '{1}'")]
     ParameterCount(usize, String),
     /// A chart of an equilibrium that the vibration moves: (q, 0) is no
@@ -143,12 +165,23 @@ impl WithFixed for Analysis<'_> {
             params,
             equilibria: Vec::new(),
             moved_by_vibration: Vec::new(),
+            none_because: None,
         };
-        for q in equilibria_without_vibration(model, self.params) {
-            if !stays_in_averaged_system(model, self.params, &q) {
+        let (found, starts) = equilibria_without_vibration(model, self.params);
+        // The exact system is probed at the given amplitude (1 where it is 0).
+        let mut probe = self.params.to_vec();
+        if probe[amplitude] == 0.0 {
+            probe[amplitude] = 1.0;
+        }
+        for q in &found {
+            let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+            if !stays_in_averaged_system(model, self.params, q)
+                || moved_by_vibration(model, &probe, &y0)
+            {
                 result.moved_by_vibration.push(q.to_vec());
                 continue;
             }
+            let q = *q;
             let mut analysed = averaged_verdict(model, self.params, amplitude, &q);
             exact_window(
                 model,
@@ -160,12 +193,25 @@ impl WithFixed for Analysis<'_> {
             )?;
             result.equilibria.push(analysed);
         }
+        if result.equilibria.is_empty() {
+            result.none_because = Some(if found.is_empty() {
+                NoEquilibria::NoneFound { starts }
+            } else {
+                NoEquilibria::AllMoved
+            });
+        }
         Ok(result)
     }
 }
 
 /// The index of the parameter `name` of the model, or an error listing them.
 fn parameter_index(info: &crate::registry::ModelInfo, name: &str) -> Result<usize, StabilityError> {
+    if name.is_empty() || name == "none" {
+        return Err(StabilityError::NoAmplitude {
+            model: info.name.into(),
+            known: info.parameter_names.join(", "),
+        });
+    }
     info.parameter_names
         .iter()
         .position(|p| *p == name)
@@ -222,7 +268,8 @@ impl WithFixed for AtEquilibrium<'_> {
 /// Equilibria of the potential V without vibration: Newton's method on the
 /// generated ∂V/∂q with the generated C, from a grid of starts (angles at
 /// multiples of 2π/m, m = 8 up to 3 degrees of freedom and 4 beyond, other
-/// coordinates on [−2, 2]); duplicates merged (angles modulo 2π).
+/// coordinates on [−2, 2] and 0); duplicates merged (angles modulo 2π). Also
+/// the number of starts.
 fn equilibria_without_vibration<
     F: Fixed<D, S, T, V>,
     const D: usize,
@@ -232,10 +279,10 @@ fn equilibria_without_vibration<
 >(
     model: &F,
     params: &[f64],
-) -> Vec<[f64; D]> {
+) -> (Vec<[f64; D]>, usize) {
     let periodic = model.periodic();
     let per_angle = if D <= 3 { 8 } else { 4 };
-    let lengths = [-2.0, -1.0, -0.5, 0.5, 1.0, 2.0];
+    let lengths = [-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0];
     let axis: Vec<Vec<f64>> = periodic
         .iter()
         .map(|&p| {
@@ -286,7 +333,7 @@ fn equilibria_without_vibration<
             .find(|o| o.is_ne())
             .unwrap_or(std::cmp::Ordering::Equal)
     });
-    found
+    (found, total)
 }
 
 /// Newton's method for gradient(q) = 0; None unless it converges.
@@ -297,6 +344,11 @@ fn newton<const D: usize>(
 ) -> Option<[f64; D]> {
     for _ in 0..60 {
         let g = gradient(&q);
+        // At an equilibrium already (a start on a degenerate one, whose
+        // Hessian cannot be solved with).
+        if g.iter().all(|x| *x == 0.0) {
+            return Some(q);
+        }
         let h = DMatrix::from_fn(D, D, |i, j| hessian(&q)[i][j]);
         let step = h.lu().solve(&nalgebra::DVector::from_column_slice(&g))?;
         for i in 0..D {
