@@ -154,3 +154,35 @@ fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
         NotSearched::NoPotential
     );
 }
+
+/// A spring whose length r is a polar coordinate (the test model
+/// `spring_double_pendulum`): with a soft spring (k = 0.25) the potential
+/// is stationary at r = 0, where ψ no longer means anything and the mass
+/// matrix is singular. There the verdict is "singular chart", never
+/// "unstable" from the Hessian of a chart that does not see the point;
+/// the hanging rest state keeps its verdict.
+#[test]
+fn a_singular_point_of_the_chart_is_named_not_judged() {
+    use mechlab::explore::{equilibria, Verdict};
+    use mechlab_test_models::spring_double_pendulum::{Params, DYNAMIC};
+    let mut params = Params::default();
+    params.set("k", 0.25).unwrap();
+    let found = equilibria(&DYNAMIC, &params.values()).unwrap();
+    let at_pole: Vec<_> = found.iter().filter(|e| e.q[2].abs() < 1e-6).collect();
+    assert!(!at_pole.is_empty(), "{found:#?}");
+    assert!(
+        at_pole.iter().all(|e| e.verdict == Verdict::SingularChart),
+        "{at_pole:#?}"
+    );
+    // Both links hanging (tilted a little by the inclined vibration), the
+    // spring stretched by about m₂g/k.
+    let hanging = found
+        .iter()
+        .max_by(|a, b| a.q[2].total_cmp(&b.q[2]))
+        .expect("the hanging rest state");
+    assert_eq!(hanging.verdict, Verdict::Stable, "{hanging:?}");
+    assert!(
+        (hanging.q[2] - (1.0 + 0.5 / 0.25)).abs() < 0.1,
+        "{hanging:?}"
+    );
+}

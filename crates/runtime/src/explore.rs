@@ -47,6 +47,9 @@ pub enum Verdict {
     Unstable,
     /// No negative eigenvalue, but one within round-off of zero.
     InconclusiveAtSecondOrder,
+    /// The mass matrix is singular there (a pole of polar or spherical
+    /// coordinates): the chart cannot judge it; other coordinates can.
+    SingularChart,
 }
 
 impl Verdict {
@@ -70,6 +73,9 @@ impl std::fmt::Display for Verdict {
             Verdict::Stable => "stable",
             Verdict::Unstable => "unstable",
             Verdict::InconclusiveAtSecondOrder => "inconclusive at second order",
+            Verdict::SingularChart => {
+                "singular chart (the mass matrix is singular here: judge it in other coordinates)"
+            }
         })
     }
 }
@@ -414,7 +420,11 @@ pub fn equilibria(
         let sym = (&hm + hm.transpose()) * 0.5;
         let mut eigenvalues: Vec<f64> = sym.symmetric_eigenvalues().iter().copied().collect();
         eigenvalues.sort_by(f64::total_cmp);
-        let verdict = Verdict::of(&eigenvalues);
+        let verdict = if singular_chart(model, params, &q) {
+            Verdict::SingularChart
+        } else {
+            Verdict::of(&eigenvalues)
+        };
         // Newton converges only linearly on a degenerate equilibrium (x⁴
         // gives the gradient x³) and the gradient's differences have a noise
         // floor, so its starts end up to 10⁻³ apart: one equilibrium, kept
@@ -446,6 +456,27 @@ pub fn equilibria(
         }
     }
     Ok(found)
+}
+
+/// Whether the mass matrix A is singular at q: H is ½ pᵀA⁻¹p + …, so the
+/// curvature of H along each momentum, read from three energies, is
+/// A⁻¹'s diagonal, which blows up where A is singular.
+fn singular_chart(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> bool {
+    let n = q.len();
+    let energy = |p: &[f64]| {
+        let mut y = q.to_vec();
+        y.extend_from_slice(p);
+        model.energy(params, 0.0, &y)
+    };
+    let zero = energy(&vec![0.0; n]);
+    (0..n).any(|i| {
+        let mut p = vec![0.0; n];
+        p[i] = 1.0;
+        let plus = energy(&p);
+        p[i] = -1.0;
+        let curvature = 0.5 * (plus + energy(&p)) - zero;
+        !(curvature.is_finite() && curvature.abs() < 1e10)
+    })
 }
 
 /// Limits of the finite values, widened a little ((−1, 1) if none).
