@@ -77,9 +77,15 @@ fn main() {
                     .collect::<Vec<f64>>()
             }),
         )?;
+        let names = info.coordinates;
         for e in &result.equilibria {
+            let family: Vec<&str> = e.family_along.iter().map(|&i| names[i]).collect();
+            let family = match family.is_empty() {
+                true => String::new(),
+                false => format!(" (a family along {}, judged reduced)", family.join(", ")),
+            };
             println!(
-                "equilibrium q = {:?}: Hessian eigenvalues {:?}: {}",
+                "equilibrium q = {:?}{family}: Hessian eigenvalues {:?}: {}",
                 e.q, e.hessian_eigenvalues, e.verdict
             );
         }

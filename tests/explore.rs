@@ -186,3 +186,27 @@ fn a_singular_point_of_the_chart_is_named_not_judged() {
         "{hanging:?}"
     );
 }
+
+/// A cyclic angle (the test model `central_spring`, a planar spring
+/// anchored at the origin): the rest states r = l0 are a circle of
+/// equilibria. They are reported once, as a family along φ, and judged on
+/// the system reduced by φ (Routh, conserved momentum 0): stable with the
+/// reduced Hessian [k], where the full Hessian's zero eigenvalue decided
+/// nothing.
+#[test]
+fn a_family_along_a_cyclic_angle_is_reported_once_and_judged_reduced() {
+    use mechlab::explore::{equilibria, Verdict};
+    use mechlab_test_models::central_spring::{Params, DYNAMIC};
+    let params = Params::default().values();
+    let found = equilibria(&DYNAMIC, &params).unwrap();
+    let at_rest: Vec<_> = found
+        .iter()
+        .filter(|e| (e.q[0] - 1.0).abs() < 1e-6)
+        .collect();
+    assert_eq!(at_rest.len(), 1, "{found:#?}");
+    let rest = at_rest[0];
+    assert_eq!(rest.family_along, vec![1]);
+    assert_eq!(rest.verdict, Verdict::Stable);
+    assert_eq!(rest.hessian_eigenvalues.len(), 1);
+    assert!((rest.hessian_eigenvalues[0] - 4.0).abs() < 1e-9, "{rest:?}");
+}

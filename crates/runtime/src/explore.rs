@@ -29,9 +29,15 @@ pub struct Settings {
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Equilibrium {
     pub q: Vec<f64>,
-    /// Eigenvalues of the Hessian, ascending.
+    /// Eigenvalues of the Hessian, ascending: of the reduced system where
+    /// the equilibrium is one of a family along cyclic coordinates.
     pub hessian_eigenvalues: Vec<f64>,
     pub verdict: Verdict,
+    /// The cyclic coordinates (indices) along which this equilibrium is one
+    /// of a family: reported once, judged on the system reduced by them
+    /// (Routh's reduction with their conserved momenta at 0, where the
+    /// amended potential is V itself).
+    pub family_along: Vec<usize>,
 }
 
 /// What the second-order test of the effective potential says of an
@@ -367,6 +373,31 @@ pub fn equilibria(
             })
             .collect()
     };
+    // Cyclic coordinates: H does not depend on them (probed at scattered
+    // states and times), so their momenta are conserved and equilibria come
+    // in families along them.
+    let probes: Vec<(f64, Vec<f64>)> = (0..8)
+        .map(|k| {
+            let y = (0..2 * n)
+                .map(|i| (1.7 * (k * 2 * n + i) as f64 + 0.3).sin() * 1.3)
+                .collect();
+            (0.37 * k as f64, y)
+        })
+        .collect();
+    let cyclic: Vec<usize> = (0..n)
+        .filter(|&i| {
+            probes.iter().all(|(t, y)| {
+                let h = 1e-5;
+                let (mut a, mut b) = (y.clone(), y.clone());
+                a[i] += h;
+                b[i] -= h;
+                let slope =
+                    (model.energy(params, *t, &a) - model.energy(params, *t, &b)) / (2.0 * h);
+                slope.abs() < 1e-8
+            })
+        })
+        .collect();
+    let kept: Vec<usize> = (0..n).filter(|i| !cyclic.contains(i)).collect();
     let per_axis: usize = 12;
     let starts: Vec<Vec<f64>> = (0..per_axis.pow(n as u32))
         .map(|mut k| {
@@ -418,7 +449,11 @@ pub fn equilibria(
             .unwrap_or_default();
         let hm = nalgebra::DMatrix::from_row_slice(n, n, &h);
         let sym = (&hm + hm.transpose()) * 0.5;
-        let mut eigenvalues: Vec<f64> = sym.symmetric_eigenvalues().iter().copied().collect();
+        // The reduced system's Hessian: the rows and columns of the cyclic
+        // coordinates dropped.
+        let reduced =
+            nalgebra::DMatrix::from_fn(kept.len(), kept.len(), |a, b| sym[(kept[a], kept[b])]);
+        let mut eigenvalues: Vec<f64> = reduced.symmetric_eigenvalues().iter().copied().collect();
         eigenvalues.sort_by(f64::total_cmp);
         let verdict = if singular_chart(model, params, &q) {
             Verdict::SingularChart
@@ -435,19 +470,30 @@ pub fn equilibria(
         };
         let norm = |q: &[f64]| gradient(q).iter().map(|x| x * x).sum::<f64>().sqrt();
         let same = found.iter().position(|e| {
-            e.q.iter().zip(&q).zip(&periodic).all(|((a, b), p)| {
-                let d = if *p {
-                    crate::analysis::period_map::wrap_angle(a - b)
-                } else {
-                    a - b
-                };
-                d.abs() < radius * (1.0 + b.abs())
-            })
+            let along = |i: &usize| !cyclic.contains(i);
+            e.q.iter()
+                .zip(&q)
+                .zip(&periodic)
+                .enumerate()
+                .filter(|(i, _)| along(i))
+                .all(|(_, ((a, b), p))| {
+                    let d = if *p {
+                        crate::analysis::period_map::wrap_angle(a - b)
+                    } else {
+                        a - b
+                    };
+                    d.abs() < radius * (1.0 + b.abs())
+                })
         });
+        // A family's representative: its cyclic coordinates at 0.
+        for &i in &cyclic {
+            q[i] = 0.0;
+        }
         let equilibrium = Equilibrium {
             q,
             verdict,
             hessian_eigenvalues: eigenvalues,
+            family_along: cyclic.clone(),
         };
         match same {
             Some(k) if norm(&equilibrium.q) < norm(&found[k].q) => found[k] = equilibrium,
