@@ -343,13 +343,7 @@ fn symmetries(
     let (right, left) = (saddle.unstable, saddle.unstable.flipped());
     let mut found = Vec::new();
     for time in [0.0, 0.25] {
-        let at = DoubleDoubleTaylor::new().advance(
-            &map.system,
-            DoubleDouble::ZERO,
-            &star,
-            period * time,
-            1e-32,
-        )?;
+        let at = flow_for(map, star, period * time)?;
         let two_q = at[0] * 2.0;
         let mut candidates = Vec::new();
         if periodic {
@@ -433,6 +427,18 @@ fn locate(
     Ok(None)
 }
 
+/// The state `duration` after y at t = 0, in double-double (y itself for 0).
+fn flow_for(
+    map: &Map,
+    y: [DoubleDouble; 2],
+    duration: DoubleDouble,
+) -> Result<[DoubleDouble; 2], OdeError> {
+    if duration.hi == 0.0 {
+        return Ok(y);
+    }
+    DoubleDoubleTaylor::new().advance(&map.system, DoubleDouble::ZERO, &y, duration, 1e-32)
+}
+
 /// The point of the local (linear) manifold i iterates before
 /// y* + s₀ g^f v, in double-double.
 fn local(star: [DoubleDouble; 2], branch: &Branch, f: f64, i: i32) -> [DoubleDouble; 2] {
@@ -479,17 +485,7 @@ fn refine(
         let x0 = *chain(map, flow, star, &symmetry.branch, (k, f))?
             .last()
             .expect("one point at least");
-        let at = if centre == 0.0 {
-            x0
-        } else {
-            DoubleDoubleTaylor::new().advance(
-                &map.system,
-                DoubleDouble::ZERO,
-                &x0,
-                flow.period * centre,
-                1e-32,
-            )?
-        };
+        let at = flow_for(map, x0, flow.period * centre)?;
         Ok(symmetry.reversor.off_exact(&at))
     };
     let step = if f0 < 0.5 { 1e-9 } else { -1e-9 };
@@ -536,18 +532,7 @@ fn symmetric_orbit(
     let twice = 2.0 * centre;
     let (m, r) = (twice.floor(), twice.fract());
     let mirror = |y: [DoubleDouble; 2]| -> Result<[DoubleDouble; 2], OdeError> {
-        let y = if r == 0.0 {
-            y
-        } else {
-            DoubleDoubleTaylor::new().advance(
-                &map.system,
-                DoubleDouble::ZERO,
-                &y,
-                flow.period * r,
-                1e-32,
-            )?
-        };
-        Ok(symmetry.reversor.apply(y))
+        Ok(symmetry.reversor.apply(flow_for(map, y, flow.period * r)?))
     };
     // x_{m−1}, x_{m−2}, …: the unstable list backwards, from x₋₁ (m = 0)
     // or x₀ (m = 1).
