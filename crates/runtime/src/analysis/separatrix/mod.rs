@@ -1269,10 +1269,11 @@ fn pseudo_orbit_action(
         .map(|&y| flow.flow(y))
         .collect::<Result<_, _>>()?;
     let mut sum = DoubleDouble::ZERO;
-    let (mut magnitude, mut largest_jump) = (0.0, 0.0f64);
+    let (mut magnitude, mut largest_jump, mut jumps_squared) = (0.0, 0.0f64, 0.0);
     for ((f, image), next) in ends.iter().zip(points.iter().skip(1).chain([&after])) {
         let jump = [(next[0] - image[0]).to_f64(), (next[1] - image[1]).to_f64()];
         largest_jump = largest_jump.max(jump[0].hypot(jump[1]));
+        jumps_squared += jump[0] * jump[0] + jump[1] * jump[1];
         let term = *f - reference + image[1] * (next[0] - image[0]);
         magnitude += term.hi.abs() + f.hi.abs();
         sum += term;
@@ -1288,11 +1289,12 @@ fn pseudo_orbit_action(
     };
     let cut = near(&points[0], star[0]) + near(&after, end_q);
     // Each jump between a point and the image of the one before leaves a
-    // second-order error.
+    // second-order error, about its square (the action is stationary on
+    // true orbits).
     let rounding = if flow.double_double { 1e-31 } else { 1e-16 };
     Ok(Action {
         value: value.to_f64(),
-        error: rounding * magnitude + cut + points.len() as f64 * largest_jump * largest_jump,
+        error: rounding * magnitude + cut + jumps_squared,
         exact: value,
         largest_jump,
     })
