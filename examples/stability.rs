@@ -54,8 +54,17 @@ fn main() {
             method: method_from(&scene)?,
         };
         let result = stability(model, &params, &settings)?;
-        for q in &result.moved_by_vibration {
-            eprintln!("q = {q:?}: an equilibrium without vibration that the vibration moves");
+        for moved in &result.moved_by_vibration {
+            match (&moved.periodic_orbit, moved.verdict) {
+                (Some(orbit), Some(verdict)) => eprintln!(
+                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}",
+                    moved.q, moved.amplitude, moved.multipliers
+                ),
+                _ => eprintln!(
+                    "q = {:?}: moved by the vibration (no periodic orbit found near it)",
+                    moved.q
+                ),
+            }
         }
         if let Some(reason) = &result.none_because {
             eprintln!("no equilibrium analysed: {reason}");

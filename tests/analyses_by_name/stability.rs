@@ -160,7 +160,12 @@ fn equilibria_the_vibration_moves_are_named_not_judged() {
     assert_eq!(result.moved_by_vibration.len(), 2, "{result:#?}");
     assert_eq!(result.none_because, Some(NoEquilibria::AllMoved));
     let ueda = stability(model_of("ueda"), &defaults("ueda"), &settings("B")).unwrap();
-    assert_eq!(ueda.moved_by_vibration, vec![vec![0.0]]);
+    let moved: Vec<_> = ueda
+        .moved_by_vibration
+        .iter()
+        .map(|m| m.q.clone())
+        .collect();
+    assert_eq!(moved, vec![vec![0.0]]);
     assert_eq!(ueda.none_because, Some(NoEquilibria::AllMoved));
 }
 
@@ -402,4 +407,33 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
         ),
         "{missing:?}"
     );
+}
+
+/// The horizontally shaken pivot moves its upright: the periodic orbit
+/// near it, found by Newton on the period map, is the hyperbolic fixed
+/// point that the separatrix analysis finds by its own Newton (from the
+/// averaged saddle, with the Taylor method): the same point and
+/// multipliers. The hanging position's orbit is stable (|λ| = 1).
+#[test]
+fn a_moved_equilibrium_is_replaced_by_its_periodic_orbit() {
+    use mechlab::analysis::separatrix::{hyperbolic_fixed_point, SplittingSettings};
+    let model = model_of("horizontal_pendulum");
+    let params = defaults("horizontal_pendulum");
+    let result = stability(model, &params, &settings("A")).unwrap();
+    let upright = result
+        .moved_by_vibration
+        .iter()
+        .find(|m| m.q[0].abs() < 1e-9)
+        .expect("the upright, moved");
+    assert_eq!(upright.verdict, Some("unstable"));
+    let fixed = hyperbolic_fixed_point(model, &params, &SplittingSettings::default()).unwrap();
+    let orbit = upright.periodic_orbit.as_ref().unwrap();
+    assert!((orbit[0] - fixed.point[0]).abs() < 1e-9 && (orbit[1] - fixed.point[1]).abs() < 1e-9);
+    assert!((upright.multipliers[0].0 / fixed.multipliers[0] - 1.0).abs() < 1e-8);
+    let hanging = result
+        .moved_by_vibration
+        .iter()
+        .find(|m| (m.q[0].abs() - PI).abs() < 1e-9)
+        .expect("the hanging position, moved");
+    assert_eq!(hanging.verdict, Some("stable"));
 }

@@ -77,10 +77,29 @@ pub struct Stability {
     /// Equilibria of the system without vibration that the vibration moves
     /// (not equilibria of the averaged system, or (q, 0) not a solution of
     /// the exact one: its periodic orbit nearby is not analysed yet).
-    pub moved_by_vibration: Vec<Vec<f64>>,
+    pub moved_by_vibration: Vec<MovedEquilibrium>,
     /// Why `equilibria` is empty, when it is.
     #[serde(serialize_with = "as_text")]
     pub none_because: Option<NoEquilibria>,
+}
+
+/// An equilibrium without vibration that the vibration moves, and the
+/// periodic orbit of the exact system near it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MovedEquilibrium {
+    pub q: Vec<f64>,
+    /// The amplitude the exact system was taken at (the given one, or 1
+    /// where it is 0).
+    pub amplitude: f64,
+    /// The periodic orbit's state at t = 0 (Newton on the period map from
+    /// (q, 0) with the monodromy matrix); None where Newton does not
+    /// converge or where (q, 0) is not an equilibrium of the averaged system
+    /// (the vibration moves it by more than a small amount).
+    pub periodic_orbit: Option<Vec<f64>>,
+    /// Its Floquet multipliers (re, im), largest modulus first, and the
+    /// verdict they give.
+    pub multipliers: Vec<(f64, f64)>,
+    pub verdict: Option<&'static str>,
 }
 
 /// Why a stability analysis lists no equilibrium.
@@ -175,10 +194,28 @@ impl WithFixed for Analysis<'_> {
         }
         for q in &found {
             let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
-            if !stays_in_averaged_system(model, self.params, q)
-                || moved_by_vibration(model, &probe, &y0)
-            {
-                result.moved_by_vibration.push(q.to_vec());
+            let averaged = stays_in_averaged_system(model, self.params, q);
+            if !averaged || moved_by_vibration(model, &probe, &y0) {
+                let orbit = if averaged {
+                    periodic_orbit_near::<F, D, S, T, V>(model, &probe, &y0, &self.settings.method)
+                } else {
+                    None
+                };
+                let (periodic_orbit, multipliers, verdict) = match orbit {
+                    Some((y, m)) => {
+                        let multipliers = floquet_multipliers(&m);
+                        let verdict = super::floquet::Verdict::from_multipliers(&multipliers, 1e-7);
+                        (Some(y.to_vec()), multipliers, Some(verdict.name()))
+                    }
+                    None => (None, Vec::new(), None),
+                };
+                result.moved_by_vibration.push(MovedEquilibrium {
+                    q: q.to_vec(),
+                    amplitude: probe[amplitude],
+                    periodic_orbit,
+                    multipliers,
+                    verdict,
+                });
                 continue;
             }
             let q = *q;
@@ -757,6 +794,50 @@ fn moved_by_vibration<
         let f = exact.rhs(period * k as f64 / 8.0, y0);
         f.iter().map(|x| x.abs()).fold(0.0, f64::max) > 1e-9
     })
+}
+
+/// The periodic orbit of the exact system near `y0`: Newton on P(y) − y
+/// with the monodromy matrix M (solving (M − I) δ = −(P(y) − y)), at most
+/// 30 steps and within 1 of `y0`; the orbit's start and its M, or None.
+fn periodic_orbit_near<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    y0: &[f64; S],
+    method: &Method,
+) -> Option<([f64; S], [[f64; S]; S])> {
+    let period = model.phase_period(params)?;
+    let system = model.exact(params);
+    let mut y = *y0;
+    for _ in 0..30 {
+        let mut integrator = crate::ode::Integrator::new(*method).ok()?;
+        let (image, m) =
+            super::floquet::monodromy::<_, S, V>(&mut integrator, &system, period, &y).ok()?;
+        let a = DMatrix::from_fn(S, S, |i, k| m[i][k] - f64::from(u8::from(i == k)));
+        let r = DVector::from_fn(S, |i, _| image[i] - y[i]);
+        let step = a.lu().solve(&r)?;
+        for i in 0..S {
+            y[i] -= step[i];
+        }
+        // An orbit more than 1 away is not the one near the equilibrium
+        // (and a runaway Newton step would integrate far out).
+        let away = (0..S).map(|i| (y[i] - y0[i]).abs()).fold(0.0, f64::max);
+        if !(away <= 1.0) {
+            return None;
+        }
+        if step.norm() < 1e-12 * (1.0 + y.iter().map(|x| x.abs()).fold(0.0, f64::max)) {
+            let mut integrator = crate::ode::Integrator::new(*method).ok()?;
+            let (_, m) =
+                super::floquet::monodromy::<_, S, V>(&mut integrator, &system, period, &y).ok()?;
+            return Some((y, m));
+        }
+    }
+    None
 }
 
 /// What [`stability_chart`] computes.
