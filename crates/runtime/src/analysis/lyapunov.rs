@@ -108,9 +108,9 @@ pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
     let mut fli = Fli::<N, M>::new(w0);
     for _ in 0..periods {
         z = integrator.advance(&variational, 0.0, &z, period)?;
-        fli.after_period(&mut z);
+        fli.after_segment(&mut z);
     }
-    Ok(fli.value)
+    Ok(fli.value())
 }
 
 /// The FLI of every orbit started at `starts`, integrated [`crate::ode::LANES`] at a
@@ -128,27 +128,15 @@ pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
     if periods == 0 {
         return vec![Ok(f64::NEG_INFINITY); starts.len()];
     }
-    let variational = Variational::<S, N, M>::new(system);
-    let packed: Vec<[f64; M]> = starts
-        .iter()
-        .map(|y0| Variational::<S, N, M>::pack(y0, &[*w0]))
-        .collect();
-    let orbits = Orbit::of_one_system(&variational, period, &packed);
-    let mut fli = vec![(Fli::<N, M>::new(w0), 0usize); starts.len()];
-    let errors = integrator.stream(&orbits, |k, z| {
-        let (fli, done) = &mut fli[k];
-        fli.after_period(z);
-        *done += 1;
-        *done < periods
-    });
-    errors
-        .into_iter()
-        .zip(fli)
-        .map(|(error, (fli, _))| match error {
-            Some(e) => Err(e),
-            None => Ok(fli.value),
-        })
-        .collect()
+    in_lanes(
+        integrator,
+        system,
+        period,
+        starts,
+        w0,
+        periods,
+        Fli::<N, M>::new(w0),
+    )
 }
 
 /// MEGNO ⟨Y⟩ (Cincotta and Simó) of every orbit started at `starts` over
@@ -169,34 +157,95 @@ pub fn megno_values<S: System<N>, const N: usize, const M: usize>(
     if chunks == 0 {
         return vec![Ok(0.0); starts.len()];
     }
+    in_lanes(
+        integrator,
+        system,
+        chunk,
+        starts,
+        w0,
+        chunks,
+        Megno::<N, M>::new(w0, chunk),
+    )
+}
+
+/// An indicator of one orbit's tangent vector, taken in after every
+/// segment of its run.
+trait TangentIndicator<const M: usize>: Copy {
+    /// Takes in the state [y; w] after a segment (and may renormalise w).
+    fn after_segment(&mut self, z: &mut [f64; M]);
+    fn value(&self) -> f64;
+}
+
+/// Every orbit from `starts` with the tangent vector `w0`, `segments`
+/// segments of length `segment` in the batch lanes, each with its own copy
+/// of `indicator`; its value, or the orbit's error.
+fn in_lanes<S: System<N>, I: TangentIndicator<M>, const N: usize, const M: usize>(
+    integrator: &mut LaneIntegrator,
+    system: &S,
+    segment: f64,
+    starts: &[[f64; N]],
+    w0: &[f64; N],
+    segments: usize,
+    indicator: I,
+) -> Vec<Result<f64, OdeError>> {
     let variational = Variational::<S, N, M>::new(system);
     let packed: Vec<[f64; M]> = starts
         .iter()
         .map(|y0| Variational::<S, N, M>::pack(y0, &[*w0]))
         .collect();
-    let orbits = Orbit::of_one_system(&variational, chunk, &packed);
-    let mut megno = vec![(Megno::<N, M>::new(w0, chunk), 0usize); starts.len()];
+    let orbits = Orbit::of_one_system(&variational, segment, &packed);
+    let mut state = vec![(indicator, 0usize); starts.len()];
     let errors = integrator.stream(&orbits, |k, z| {
-        let (megno, done) = &mut megno[k];
-        megno.after_chunk(z);
+        let (indicator, done) = &mut state[k];
+        indicator.after_segment(z);
         *done += 1;
-        *done < chunks
+        *done < segments
     });
     errors
         .into_iter()
-        .zip(megno)
-        .map(|(error, (megno, _))| match error {
+        .zip(state)
+        .map(|(error, (indicator, _))| match error {
             Some(e) => Err(e),
-            None => Ok(megno.mean),
+            None => Ok(indicator.value()),
         })
         .collect()
+}
+
+/// ln(‖w‖/‖w₀‖) of a tangent vector, with the logarithms of its
+/// renormalisations kept (w is divided by its norm past 10¹⁰⁰).
+#[derive(Clone, Copy, Debug)]
+struct TangentGrowth<const N: usize, const M: usize> {
+    norm0: f64,
+    log_scale: f64,
+}
+
+impl<const N: usize, const M: usize> TangentGrowth<N, M> {
+    fn new(w0: &[f64; N]) -> Self {
+        assert_eq!(M, 2 * N, "one tangent vector needs M = 2N");
+        TangentGrowth {
+            norm0: w0.iter().map(|x| x * x).sum::<f64>().sqrt(),
+            log_scale: 0.0,
+        }
+    }
+
+    /// ln(‖w‖/‖w₀‖) at the state [y; w]; renormalises w when large.
+    fn log_growth(&mut self, z: &mut [f64; M]) -> f64 {
+        let norm = z[N..].iter().map(|x| x * x).sum::<f64>().sqrt();
+        let growth = self.log_scale + (norm / self.norm0).ln();
+        if norm > 1e100 {
+            self.log_scale += norm.ln();
+            for x in &mut z[N..] {
+                *x /= norm;
+            }
+        }
+        growth
+    }
 }
 
 /// One orbit's MEGNO so far.
 #[derive(Clone, Copy, Debug)]
 struct Megno<const N: usize, const M: usize> {
-    norm0: f64,
-    log_scale: f64,
+    growth: TangentGrowth<N, M>,
     chunk: f64,
     t: f64,
     /// L, ∫L, Y and ∫Y at t.
@@ -209,10 +258,8 @@ struct Megno<const N: usize, const M: usize> {
 
 impl<const N: usize, const M: usize> Megno<N, M> {
     fn new(w0: &[f64; N], chunk: f64) -> Self {
-        assert_eq!(M, 2 * N, "MEGNO needs M = 2N");
         Megno {
-            norm0: w0.iter().map(|x| x * x).sum::<f64>().sqrt(),
-            log_scale: 0.0,
+            growth: TangentGrowth::new(w0),
             chunk,
             t: 0.0,
             log_norm: 0.0,
@@ -222,17 +269,11 @@ impl<const N: usize, const M: usize> Megno<N, M> {
             mean: 0.0,
         }
     }
+}
 
-    /// Takes in the state [y; w] after a chunk; renormalises w when large.
-    fn after_chunk(&mut self, z: &mut [f64; M]) {
-        let norm = z[N..].iter().map(|x| x * x).sum::<f64>().sqrt();
-        let log_norm = self.log_scale + (norm / self.norm0).ln();
-        if norm > 1e100 {
-            self.log_scale += norm.ln();
-            for x in &mut z[N..] {
-                *x /= norm;
-            }
-        }
+impl<const N: usize, const M: usize> TangentIndicator<M> for Megno<N, M> {
+    fn after_segment(&mut self, z: &mut [f64; M]) {
+        let log_norm = self.growth.log_growth(z);
         let h = self.chunk;
         self.t += h;
         self.log_integral += 0.5 * h * (self.log_norm + log_norm);
@@ -242,37 +283,35 @@ impl<const N: usize, const M: usize> Megno<N, M> {
         self.y = y;
         self.mean = self.y_integral / self.t;
     }
+
+    fn value(&self) -> f64 {
+        self.mean
+    }
 }
 
-/// One orbit's FLI so far: the largest ln(‖w‖/‖w₀‖), with the logarithms
-/// of the renormalisations kept.
+/// One orbit's FLI so far: the largest ln(‖w‖/‖w₀‖).
 #[derive(Clone, Copy, Debug)]
 struct Fli<const N: usize, const M: usize> {
-    norm0: f64,
-    log_scale: f64,
+    growth: TangentGrowth<N, M>,
     value: f64,
 }
 
 impl<const N: usize, const M: usize> Fli<N, M> {
     fn new(w0: &[f64; N]) -> Self {
-        assert_eq!(M, 2 * N, "the FLI needs M = 2N");
         Fli {
-            norm0: w0.iter().map(|x| x * x).sum::<f64>().sqrt(),
-            log_scale: 0.0,
+            growth: TangentGrowth::new(w0),
             value: f64::NEG_INFINITY,
         }
     }
+}
 
-    /// Takes in the state [y; w] after a period; renormalises w when large.
-    fn after_period(&mut self, z: &mut [f64; M]) {
-        let norm = z[N..].iter().map(|x| x * x).sum::<f64>().sqrt();
-        self.value = self.value.max(self.log_scale + (norm / self.norm0).ln());
-        if norm > 1e100 {
-            self.log_scale += norm.ln();
-            for x in &mut z[N..] {
-                *x /= norm;
-            }
-        }
+impl<const N: usize, const M: usize> TangentIndicator<M> for Fli<N, M> {
+    fn after_segment(&mut self, z: &mut [f64; M]) {
+        self.value = self.value.max(self.growth.log_growth(z));
+    }
+
+    fn value(&self) -> f64 {
+        self.value
     }
 }
 

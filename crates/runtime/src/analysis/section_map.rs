@@ -182,9 +182,14 @@ struct Region {
 
 const SCAN: usize = 400;
 
+/// The i-th of the scan's points on [−extent, extent].
+fn scan_point(extent: f64, i: usize) -> f64 {
+    -extent + 2.0 * extent * i as f64 / (SCAN - 1) as f64
+}
+
 impl Region {
     fn find(least: &(dyn Fn(f64, f64) -> f64 + Sync), energy: f64, extent: f64) -> Option<Region> {
-        let at = |i: usize| -extent + 2.0 * extent * i as f64 / (SCAN - 1) as f64;
+        let at = |i: usize| scan_point(extent, i);
         let open: Vec<bool> = (0..SCAN * SCAN)
             .into_par_iter()
             .map(|k| least(at(k % SCAN), at(k / SCAN)) < energy)
@@ -239,7 +244,7 @@ impl Region {
 
     /// Its bounding box, padded by one scan cell.
     fn window(&self) -> [[f64; 2]; 2] {
-        let at = |i: usize| -self.extent + 2.0 * self.extent * i as f64 / (SCAN - 1) as f64;
+        let at = |i: usize| scan_point(self.extent, i);
         let cell = 2.0 * self.extent / (SCAN - 1) as f64;
         let cells: Vec<(usize, usize)> = (0..self.inside.len())
             .filter(|&k| self.inside[k])
