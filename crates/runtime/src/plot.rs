@@ -127,6 +127,7 @@ pub struct Panel {
 enum Layer {
     Points(Vec<(f64, f64)>, Rgb, i64),
     Line(Vec<(f64, f64)>, Rgb),
+    Dashed(Vec<(f64, f64)>, Rgb),
     Map {
         columns: usize,
         rows: usize,
@@ -217,6 +218,11 @@ impl Figure {
         self.layers[k].push(Layer::Line(points.to_vec(), color));
     }
 
+    /// A dashed polyline (an unstable branch beside a stable one, solid).
+    pub fn dashed_line(&mut self, k: usize, points: &[(f64, f64)], color: Rgb) {
+        self.layers[k].push(Layer::Dashed(points.to_vec(), color));
+    }
+
     /// Fills the panel with a map of values in [0, 1] (row 0 at the bottom,
     /// non-finite values left white) in the colour map `map`, with a colour
     /// bar labelled `label`.
@@ -301,7 +307,10 @@ impl Figure {
         for layer in self.layers.iter().flatten() {
             points += match layer {
                 Layer::Map { .. } => return false,
-                Layer::Points(p, ..) | Layer::Line(p, _) | Layer::Contours(p, ..) => p.len(),
+                Layer::Points(p, ..)
+                | Layer::Line(p, _)
+                | Layer::Dashed(p, _)
+                | Layer::Contours(p, ..) => p.len(),
                 Layer::Legend(..) => 0,
             };
         }
@@ -614,6 +623,21 @@ where
                     if piece.len() > 1 {
                         chart
                             .draw_series(LineSeries::new(piece.iter().copied(), c.stroke_width(1)))
+                            .map_err(err)?;
+                    }
+                }
+            }
+            Layer::Dashed(pts, color) => {
+                let c = rgb(*color);
+                for piece in pts.split(|p| !visible(p)) {
+                    if piece.len() > 1 {
+                        chart
+                            .draw_series(DashedLineSeries::new(
+                                piece.iter().copied(),
+                                6,
+                                4,
+                                c.stroke_width(1),
+                            ))
                             .map_err(err)?;
                     }
                 }

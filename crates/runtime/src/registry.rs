@@ -412,6 +412,7 @@ large_works! {
     chaos_map: crate::analysis::chaos_map::Map<'_> => Result<crate::analysis::chaos_map::ChaosMap, crate::analysis::chaos_map::ChaosMapError>;
     studio_orbit: crate::studio::OrbitWork<'_> => Result<crate::studio::OrbitEnd, crate::studio::StudioError>;
     section: crate::analysis::section::Sections<'_> => Result<crate::analysis::section::Section, crate::analysis::section::SectionError>;
+    continuation: crate::analysis::continuation::Work<'_> => Result<crate::analysis::continuation::Continuation, crate::analysis::continuation::ContinuationError>;
 }
 
 /// A model of 5 to 8 degrees of freedom as a [`LargeModel`]: the models

@@ -94,6 +94,8 @@ pub enum SceneError {
     Attractor(#[from] crate::analysis::attractor::AttractorError),
     #[error(transparent)]
     Section(#[from] crate::analysis::section::SectionError),
+    #[error(transparent)]
+    Continuation(#[from] crate::analysis::continuation::ContinuationError),
     /// Another scene, run by this one, could not start or failed.
     #[error("cannot run scene {scene}: {source}")]
     Spawn {
@@ -305,6 +307,18 @@ impl Scene {
                 reason: "not a positive whole number".into(),
             }),
         }
+    }
+
+    /// A whole number, 0 allowed (a count that 0 switches off).
+    pub fn whole(&self, name: &str) -> Result<usize, SceneError> {
+        let text = self.text(name);
+        text.trim()
+            .parse::<usize>()
+            .map_err(|_| SceneError::BadValue {
+                name: name.into(),
+                value: text.into(),
+                reason: "not a whole number".into(),
+            })
     }
 
     /// A comma-separated list of finite numbers (at least one).

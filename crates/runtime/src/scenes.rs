@@ -704,6 +704,164 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// Scene `continuation`: the periodic orbits of a model's period map
+/// followed in one parameter, their bifurcations, and the orbit diagram.
+pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use crate::analysis::continuation::{continuation, ContinuationSettings, DiagramSettings};
+    // The parameter defaults to the model file's [fast_phase] amplitude.
+    let named = Scene::peek("model").unwrap_or_else(|| "duffing".into());
+    let amplitude = crate::registry::lookup(catalog, &named)
+        .ok()
+        .and_then(|m| m.info.amplitude)
+        .unwrap_or("none");
+    let (model, scene) = generic_scene(
+        catalog,
+        "continuation",
+        "periodic orbits of the period map continued in a parameter, bifurcations located",
+        &[("parameter", amplitude)],
+        ("duffing", "taylor", "1e-12"),
+        &[
+            (
+                "parameter",
+                "none",
+                "the parameter continued in, from its value below to `to` (default: the model file's [fast_phase] amplitude)",
+            ),
+            ("to", "auto", "the other end of the parameter's interval (auto: 1.8 times its value, 1 where it is 0)"),
+            ("start", "1,0", "a guess of the first periodic orbit's state at t = 0 (zeros appended)"),
+            ("period", "1", "the first branch is of fixed points of P^period"),
+            ("max_period", "16", "switch at period doublings up to this period"),
+            ("switch", "yes", "also switch at branch points (pitchforks): yes or no"),
+            ("branches", "12", "at most this many branches"),
+            ("points", "3000", "at most this many points per branch"),
+            ("step", "0.005", "the first step in arclength"),
+            ("min_step", "1e-8", "a branch ends where the step falls below this"),
+            ("max_step", "0.02", "the largest step"),
+            ("diagram", "400", "parameter values of the orbit diagram (0: none)"),
+            ("transient", "300", "periods of the orbit diagram dropped first"),
+            ("iterates", "100", "periods of the orbit diagram drawn"),
+            ("coordinate", "0", "the state component drawn (0 = first coordinate)"),
+        ],
+    )?;
+    let switch_branch_points = match scene.text("switch") {
+        "yes" => true,
+        "no" => false,
+        other => {
+            return Err(SceneError::BadValue {
+                name: "switch".into(),
+                value: other.into(),
+                reason: "yes or no".into(),
+            })
+        }
+    };
+    let values = scene.whole("diagram")?;
+    let params = scene.parameter_values(model.info)?;
+    let parameter = scene.text("parameter").to_string();
+    let to = match scene.text("to") {
+        "auto" => {
+            let at = model
+                .info
+                .parameter_names
+                .iter()
+                .position(|p| *p == parameter);
+            match at.map(|i| params[i]) {
+                Some(0.0) | None => 1.0,
+                Some(value) => 1.8 * value,
+            }
+        }
+        _ => scene.number("to")?,
+    };
+    let settings = ContinuationSettings {
+        parameter,
+        to,
+        start: scene.numbers("start")?,
+        period: scene.count("period")?,
+        max_period: scene.count("max_period")?,
+        switch_branch_points,
+        max_branches: scene.count("branches")?,
+        points: scene.count("points")?,
+        step: scene.positive("step")?,
+        min_step: scene.positive("min_step")?,
+        max_step: scene.positive("max_step")?,
+        method: method_from(&scene)?,
+        diagram: (values > 0)
+            .then(|| -> Result<DiagramSettings, SceneError> {
+                Ok(DiagramSettings {
+                    values,
+                    transient: scene.whole("transient")?,
+                    iterates: scene.count("iterates")?,
+                })
+            })
+            .transpose()?,
+    };
+    let coordinate = scene.whole("coordinate")?;
+    let states = model.info.state_names().len();
+    if coordinate >= states {
+        return Err(SceneError::BadValue {
+            name: "coordinate".into(),
+            value: coordinate.to_string(),
+            reason: format!("the state has {states} components"),
+        });
+    }
+    eprintln!("continuing in {} …", settings.parameter);
+    let result = continuation(model, &params, &settings)?;
+    scene.save_figure(&result.figure(coordinate), "continuation.png")?;
+    let rows = result.branches.iter().enumerate().flat_map(|(b, branch)| {
+        branch.points.iter().map(move |p| {
+            let radius = crate::analysis::floquet::spectral_radius(&p.multipliers);
+            (
+                b,
+                branch.period,
+                p.parameter,
+                p.state[coordinate],
+                radius,
+                p.stable,
+            )
+        })
+    });
+    scene.write_csv(
+        "branches.csv",
+        &[
+            "branch",
+            "period",
+            "parameter",
+            "coordinate",
+            "spectral_radius",
+            "stable",
+        ],
+        rows,
+    )?;
+    scene.write_csv(
+        "bifurcations.csv",
+        &[
+            "kind",
+            "branch",
+            "period",
+            "parameter",
+            "coordinate",
+            "residual",
+        ],
+        result.bifurcations.iter().map(|b| {
+            (
+                format!("{:?}", b.kind),
+                b.branch,
+                b.period,
+                b.parameter,
+                b.state[coordinate],
+                b.residual,
+            )
+        }),
+    )?;
+    if let Some(d) = &result.diagram {
+        scene.write_csv(
+            "orbit_diagram.csv",
+            &["parameter", "coordinate"],
+            d.points.iter().map(|(p, y)| (*p, y[coordinate])),
+        )?;
+    }
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
 /// Scene `section`: the Poincaré section of an autonomous model of two
 /// degrees of freedom at a fixed energy.
 pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
@@ -805,7 +963,7 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         "largest |H − E| on the section {:.1e}, largest distance from the plane {:.1e}",
         result.largest_energy_drift, result.largest_plane_distance
     );
-    let map = match scene.count("map")? {
+    let map = match scene.whole("map")? {
         0 => None,
         pixels => {
             use crate::analysis::section_map::{section_map, SectionMapSettings};

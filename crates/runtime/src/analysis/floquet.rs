@@ -98,7 +98,11 @@ fn split<S: System<N>, const N: usize, const M: usize>(z: &[f64; M]) -> ([f64; N
 
 /// Eigenvalues of a monodromy matrix, as (re, im), sorted by decreasing modulus.
 pub fn floquet_multipliers<const N: usize>(monodromy: &[[f64; N]; N]) -> Vec<(f64, f64)> {
-    let m = DMatrix::from_fn(N, N, |i, k| monodromy[i][k]);
+    multipliers_of(&DMatrix::from_fn(N, N, |i, k| monodromy[i][k]))
+}
+
+/// [`floquet_multipliers`] of a matrix of any size.
+pub fn multipliers_of(m: &DMatrix<f64>) -> Vec<(f64, f64)> {
     let mut values: Vec<(f64, f64)> = m
         .complex_eigenvalues()
         .iter()

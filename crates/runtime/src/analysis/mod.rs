@@ -2,11 +2,13 @@
 //! variational equations (monodromy, Floquet multipliers, Lyapunov exponents,
 //! the fast Lyapunov indicator), the Chirikov standard map, the comparison
 //! of exact and averaged systems, stabilisation by vibration, and
-//! Poincaré sections of autonomous models.
+//! Poincaré sections of autonomous models, and the continuation of
+//! periodic orbits in a parameter with their bifurcations.
 
 pub mod attractor;
 pub mod averaging;
 pub mod chaos_map;
+pub mod continuation;
 pub mod dimension;
 pub mod fit;
 pub mod floquet;

@@ -1,0 +1,653 @@
+//! How the periodic orbits of a forced or vibrated model change with a
+//! parameter: fixed points of the period map (and of its iterates P^k)
+//! continued by pseudo-arclength, their Floquet multipliers along the
+//! branch, folds, branch points (pitchforks), period doublings and
+//! Neimark–Sacker points located on the branch, new branches switched to
+//! at period doublings (a cascade is followed to a requested period) and at
+//! branch points; beside it the brute-force orbit diagram, the attractor of
+//! P against the parameter, for comparison.
+//!
+//! The numerics (`branch`) see the model only through [`FamilyMap`], one
+//! period of the map and its monodromy matrix at a parameter value, so
+//! they are compiled once, not once per model size.
+
+mod branch;
+mod diagram;
+
+pub use branch::BranchEnd;
+pub use diagram::OrbitDiagram;
+
+use crate::analysis::floquet::{monodromy, multipliers_of, Verdict};
+use crate::ode::{Integrator, Method, OdeError};
+use crate::registry::{Fixed, Model, WithFixed};
+use branch::{Origin, Solution, Steps};
+use nalgebra::{DMatrix, DVector};
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// What to continue, and how far.
+#[derive(Clone, Debug)]
+pub struct ContinuationSettings {
+    /// The parameter continued in; it starts at the model's value.
+    pub parameter: String,
+    /// The other end of the interval [start, to] the branches are followed in.
+    pub to: f64,
+    /// A guess of the state of the first fixed point (zeros are appended up
+    /// to the state's size).
+    pub start: Vec<f64>,
+    /// The first branch is of fixed points of P^period.
+    pub period: usize,
+    /// Period doublings are switched at while the new period is at most this.
+    pub max_period: usize,
+    /// Also switch to the branches crossing at branch points (pitchforks).
+    pub switch_branch_points: bool,
+    /// At most this many branches in all.
+    pub max_branches: usize,
+    /// At most this many points per branch.
+    pub points: usize,
+    /// The first step in arclength, and its bounds.
+    pub step: f64,
+    pub min_step: f64,
+    pub max_step: f64,
+    pub method: Method,
+    /// The orbit diagram beside the branches, if any.
+    pub diagram: Option<DiagramSettings>,
+}
+
+/// The brute-force orbit diagram's sampling.
+#[derive(Clone, Debug)]
+pub struct DiagramSettings {
+    /// Parameter values, evenly over the interval.
+    pub values: usize,
+    /// Periods dropped, then periods drawn, from the settings' start.
+    pub transient: usize,
+    pub iterates: usize,
+}
+
+/// Why a continuation cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ContinuationError {
+    #[error("'{0}' is a contact model: it has no period map")]
+    ContactModel(String),
+    #[error("model '{0}' has no periodic forcing or vibration (no [fast_phase]): continuation follows fixed points of a period map")]
+    NoPeriod(String),
+    #[error("model '{model}' has no parameter '{name}' (parameters: {known})")]
+    UnknownParameter {
+        model: String,
+        name: String,
+        known: String,
+    },
+    #[error("continuation of '{model}': {reason}")]
+    Settings { model: String, reason: String },
+    /// M − I is singular at the start: the guess sits on a bifurcation (or a
+    /// degenerate orbit), where the branch's direction is not defined.
+    #[error("the Jacobian P'(y) − I is singular at the start (parameter {parameter}): start off the bifurcation, at another parameter value")]
+    SingularJacobian { parameter: f64 },
+    #[error("Newton found no fixed point of the period map from {guess:?} at parameter {parameter}: give a better `start`")]
+    NoFixedPoint { guess: Vec<f64>, parameter: f64 },
+    #[error("the first branch has no second point: the step collapsed at parameter {parameter} (step {step:e}); try a smaller `step` or `min_step`")]
+    StepCollapse { parameter: f64, step: f64 },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// The kinds of points located on a branch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BifurcationKind {
+    /// A turning point of the branch in the parameter (multiplier +1).
+    Fold,
+    /// Multiplier +1 where the branch goes on: another branch crosses
+    /// (a pitchfork in a symmetric system, else transcritical).
+    BranchPoint,
+    /// Multiplier −1: a branch of twice the period is born.
+    PeriodDoubling,
+    /// A complex pair of multipliers on the unit circle (dissipative maps
+    /// of dimension ≥ 4): an invariant circle is born.
+    NeimarkSacker,
+}
+
+/// One point of a branch.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BranchPoint {
+    pub parameter: f64,
+    /// The fixed point of P^k.
+    pub state: Vec<f64>,
+    /// The k points of the cycle (the state first).
+    #[serde(skip)]
+    pub cycle: Vec<Vec<f64>>,
+    /// The multipliers (re, im) of P^k, largest modulus first.
+    pub multipliers: Vec<(f64, f64)>,
+    pub stable: bool,
+}
+
+/// A branch of fixed points of P^period.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Branch {
+    pub period: usize,
+    /// The bifurcation (index into `bifurcations`) it was switched to at.
+    pub born_at: Option<usize>,
+    pub points: Vec<BranchPoint>,
+    pub end: BranchEnd,
+}
+
+/// A located bifurcation.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Bifurcation {
+    pub kind: BifurcationKind,
+    /// The branch (index) it lies on, and that branch's period.
+    pub branch: usize,
+    pub period: usize,
+    pub parameter: f64,
+    pub state: Vec<f64>,
+    pub multipliers: Vec<(f64, f64)>,
+    /// The distance of the critical multiplier from +1 or −1 (or of the
+    /// pair's product from 1) at the located point.
+    pub residual: f64,
+    /// False where the locating corrector failed: the point is then the
+    /// end of the bracketing interval.
+    pub located: bool,
+    /// The branch switched to here, if any.
+    pub switched_to: Option<usize>,
+}
+
+/// The result (and summary) of a continuation.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Continuation {
+    pub model: String,
+    pub parameter: String,
+    pub params: BTreeMap<String, f64>,
+    pub from: f64,
+    pub to: f64,
+    /// Whether the map contracts area (det M ≠ 1); an area-preserving map
+    /// has no Neimark–Sacker test.
+    pub dissipative: bool,
+    pub branches: Vec<Branch>,
+    pub bifurcations: Vec<Bifurcation>,
+    /// The period doublings of the cascade from the first branch, in order
+    /// (each on the branch born at the one before).
+    pub cascade: Vec<f64>,
+    /// (p₂ − p₁)/(p₃ − p₂), … of the cascade (Feigenbaum's δ = 4.6692… in
+    /// the limit).
+    pub feigenbaum_ratios: Vec<f64>,
+    /// Periods of the map integrated (with and without tangents).
+    pub map_evaluations: u64,
+    pub seconds: f64,
+    pub diagram: Option<OrbitDiagram>,
+    /// The state's names, for the figure.
+    #[serde(skip)]
+    pub state_names: Vec<&'static str>,
+}
+
+/// The period map of a model as a function of one parameter, its sizes
+/// erased: what the continuation needs of the model.
+trait FamilyMap: Sync {
+    /// Which state components are angles.
+    fn periodic(&self) -> &[bool];
+    /// Whether the model accepts this value of the parameter.
+    fn parameter_allowed(&self, p: f64) -> bool;
+    /// One period of the map from `y` at the parameter value p and, if
+    /// `jacobian`, its monodromy matrix.
+    fn once(
+        &self,
+        y: &[f64],
+        p: f64,
+        jacobian: bool,
+    ) -> Result<(Vec<f64>, Option<DMatrix<f64>>), OdeError>;
+    /// The orbit diagram: for each parameter value, the iterates after the
+    /// transient from `start`.
+    fn diagram(
+        &self,
+        values: &[f64],
+        start: &[f64],
+        transient: usize,
+        iterates: usize,
+    ) -> Vec<Result<Vec<Vec<f64>>, OdeError>>;
+    /// Periods integrated so far.
+    fn evaluations(&self) -> u64;
+}
+
+/// Continues the periodic orbits of `model` at `params` (declaration
+/// order) in the parameter `settings.parameter`.
+pub fn continuation(
+    model: &Model,
+    params: &[f64],
+    settings: &ContinuationSettings,
+) -> Result<Continuation, ContinuationError> {
+    crate::registry::with_fixed(model, Work { params, settings })
+        .ok_or_else(|| ContinuationError::ContactModel(model.info.name.into()))?
+}
+
+/// The work of [`continuation`] at one model's sizes.
+pub struct Work<'a> {
+    params: &'a [f64],
+    settings: &'a ContinuationSettings,
+}
+
+impl WithFixed for Work<'_> {
+    type Output = Result<Continuation, ContinuationError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        let name = info.name.to_string();
+        if !model.has_fast_phase() {
+            return Err(ContinuationError::NoPeriod(name));
+        }
+        let index = info
+            .parameter_names
+            .iter()
+            .position(|p| *p == self.settings.parameter)
+            .ok_or_else(|| ContinuationError::UnknownParameter {
+                model: name.clone(),
+                name: self.settings.parameter.clone(),
+                known: info.parameter_names.join(", "),
+            })?;
+        let named = info
+            .named_values(self.params)
+            .ok_or_else(|| ContinuationError::Settings {
+                model: name.clone(),
+                reason: format!("{} parameter values given", self.params.len()),
+            })?;
+        let periodic = model.periodic();
+        let map = AtModel::<F, D, S, T, V> {
+            model,
+            params: self.params.to_vec(),
+            index,
+            method: self.settings.method,
+            periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
+            evaluations: AtomicU64::new(0),
+        };
+        let mut result = run(&map, self.params[index], self.settings, &name)?;
+        result.params = named;
+        result.state_names = info.state_names();
+        Ok(result)
+    }
+}
+
+/// A model of sizes (D, S) at fixed values of all parameters but one.
+struct AtModel<F: 'static, const D: usize, const S: usize, const T: usize, const V: usize> {
+    model: &'static F,
+    params: Vec<f64>,
+    index: usize,
+    method: Method,
+    periodic: Vec<bool>,
+    evaluations: AtomicU64,
+}
+
+impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>
+    AtModel<F, D, S, T, V>
+{
+    fn with(&self, p: f64) -> Vec<f64> {
+        let mut params = self.params.clone();
+        params[self.index] = p;
+        params
+    }
+
+    fn period(&self, params: &[f64]) -> Result<f64, OdeError> {
+        match self.model.phase_period(params) {
+            Some(t) if t.is_finite() && t > 0.0 => Ok(t),
+            t => Err(OdeError::InvalidSetting {
+                what: "period of the phase at this parameter value",
+                value: t.unwrap_or(f64::NAN),
+            }),
+        }
+    }
+}
+
+impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize> FamilyMap
+    for AtModel<F, D, S, T, V>
+{
+    fn periodic(&self) -> &[bool] {
+        &self.periodic
+    }
+
+    fn parameter_allowed(&self, p: f64) -> bool {
+        let info = self.model.info();
+        info.check_parameter(info.parameter_names[self.index], p)
+            .is_ok()
+    }
+
+    fn once(
+        &self,
+        y: &[f64],
+        p: f64,
+        jacobian: bool,
+    ) -> Result<(Vec<f64>, Option<DMatrix<f64>>), OdeError> {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let params = self.with(p);
+        let period = self.period(&params)?;
+        let system = self.model.exact(&params);
+        let y0: [f64; S] = std::array::from_fn(|i| y[i]);
+        let mut integrator = Integrator::new(self.method)?;
+        if jacobian {
+            let (image, m) = monodromy::<_, S, V>(&mut integrator, &system, period, &y0)?;
+            let m = DMatrix::from_fn(S, S, |i, k| m[i][k]);
+            Ok((image.to_vec(), Some(m)))
+        } else {
+            let image = integrator.advance(&system, 0.0, &y0, period)?;
+            Ok((image.to_vec(), None))
+        }
+    }
+
+    fn diagram(
+        &self,
+        values: &[f64],
+        start: &[f64],
+        transient: usize,
+        iterates: usize,
+    ) -> Vec<Result<Vec<Vec<f64>>, OdeError>> {
+        let problems: Vec<_> = values
+            .iter()
+            .map(|&p| {
+                let params = self.with(p);
+                let period = self.period(&params);
+                (self.model.exact(&params), period)
+            })
+            .collect();
+        let start: [f64; S] = std::array::from_fn(|i| start[i]);
+        let wrap: [bool; S] = std::array::from_fn(|i| self.periodic[i]);
+        self.evaluations.fetch_add(
+            (values.len() * (transient + iterates)) as u64,
+            Ordering::Relaxed,
+        );
+        diagram::iterates(self.method, &problems, &start, &wrap, transient, iterates)
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations.load(Ordering::Relaxed)
+    }
+}
+
+/// A branch to follow: its period, its first point (with the direction to
+/// go in as its tangent) and where it was born.
+struct Job {
+    period: usize,
+    start: Solution,
+    born_at: Option<usize>,
+    origin: Origin,
+}
+
+/// The continuation proper, on the erased map.
+fn run(
+    map: &dyn FamilyMap,
+    p0: f64,
+    settings: &ContinuationSettings,
+    model: &str,
+) -> Result<Continuation, ContinuationError> {
+    let clock = std::time::Instant::now();
+    let n = map.periodic().len();
+    check(settings, p0, n, model)?;
+    let mut guess = settings.start.clone();
+    guess.resize(n, 0.0);
+    let forward = settings.to > p0;
+    let bounds = (p0.min(settings.to), p0.max(settings.to));
+    let first = branch::first_point(map, settings.period, &guess, p0, forward)?;
+    let dissipative = (first.monodromy.determinant() - 1.0).abs() > 1e-6;
+    let steps = Steps {
+        initial: settings.step,
+        min: settings.min_step,
+        max: settings.max_step,
+    };
+    let mut branches: Vec<Branch> = Vec::new();
+    let mut bifurcations: Vec<Bifurcation> = Vec::new();
+    let mut jobs = std::collections::VecDeque::from([Job {
+        period: settings.period,
+        start: first,
+        born_at: None,
+        origin: Origin::Start,
+    }]);
+    while let Some(job) = jobs.pop_front() {
+        if branches.len() >= settings.max_branches {
+            break;
+        }
+        // A bubble's branch already followed from its other end.
+        let rejoined = |b: &Branch| match b.end {
+            BranchEnd::Rejoined { parameter } => {
+                b.period == job.period
+                    && (parameter - job.start.p).abs() < 1e-6 * (1.0 + parameter.abs())
+            }
+            _ => false,
+        };
+        if let Some(same) = branches.iter().position(rejoined) {
+            if let Some(at) = job.born_at {
+                bifurcations[at].switched_to = Some(same);
+            }
+            continue;
+        }
+        let index = branches.len();
+        let k = job.period;
+        if let Some(at) = job.born_at {
+            bifurcations[at].switched_to.get_or_insert(index);
+        }
+        let followed = branch::follow(
+            map,
+            k,
+            job.start,
+            job.origin,
+            steps,
+            bounds,
+            settings.points,
+        );
+        if index == 0 && followed.points.len() < 2 {
+            if let BranchEnd::StepCollapse { parameter, step } = followed.end {
+                return Err(ContinuationError::StepCollapse { parameter, step });
+            }
+        }
+        let changes = branch::sign_changes(&followed.points, dissipative, job.born_at.is_some());
+        for (i, kind, test) in changes {
+            let (a, b) = (&followed.points[i], &followed.points[i + 1]);
+            let (point, located) = branch::locate(map, k, a, b, test);
+            let at = bifurcations.len();
+            let before = &a.tangent;
+            for (period, start) in switch(k, &point, before, kind, settings, &branches, &jobs) {
+                let origin = if period == k {
+                    Origin::BranchPoint
+                } else {
+                    Origin::PeriodDoubling
+                };
+                jobs.push_back(Job {
+                    period,
+                    start,
+                    born_at: Some(at),
+                    origin,
+                });
+            }
+            bifurcations.push(Bifurcation {
+                kind,
+                branch: index,
+                period: k,
+                parameter: point.p,
+                state: point.y.iter().copied().collect(),
+                multipliers: multipliers_of(&point.monodromy),
+                residual: residual(&point, kind),
+                located,
+                switched_to: None,
+            });
+        }
+        branches.push(Branch {
+            period: k,
+            born_at: job.born_at,
+            points: followed.points.iter().map(branch_point).collect(),
+            end: followed.end,
+        });
+    }
+    let cascade = cascade(&branches, &bifurcations);
+    let feigenbaum_ratios = cascade
+        .windows(3)
+        .map(|w| (w[1] - w[0]) / (w[2] - w[1]))
+        .collect();
+    let diagram = settings
+        .diagram
+        .as_ref()
+        .map(|d| diagram::orbit_diagram(map, bounds, &guess, d));
+    Ok(Continuation {
+        model: model.into(),
+        parameter: settings.parameter.clone(),
+        params: BTreeMap::new(),
+        from: p0,
+        to: settings.to,
+        dissipative,
+        branches,
+        bifurcations,
+        cascade,
+        feigenbaum_ratios,
+        map_evaluations: map.evaluations(),
+        seconds: clock.elapsed().as_secs_f64(),
+        diagram,
+        state_names: Vec::new(),
+    })
+}
+
+/// The settings' sanity, as named errors.
+fn check(
+    settings: &ContinuationSettings,
+    p0: f64,
+    n: usize,
+    model: &str,
+) -> Result<(), ContinuationError> {
+    let bad = |reason: &str| {
+        Err(ContinuationError::Settings {
+            model: model.into(),
+            reason: reason.into(),
+        })
+    };
+    if !settings.to.is_finite() || settings.to == p0 {
+        return bad("`to` must be finite and differ from the parameter's value");
+    }
+    if settings.start.len() > n || !settings.start.iter().all(|x| x.is_finite()) {
+        return bad("`start` must be finite, with at most one value per state component");
+    }
+    if settings.period == 0 || settings.max_period < settings.period {
+        return bad("period ≥ 1 and max_period ≥ period");
+    }
+    let steps_ok = settings.min_step > 0.0
+        && settings.min_step <= settings.step
+        && settings.step <= settings.max_step
+        && settings.max_step.is_finite();
+    if !steps_ok {
+        return bad("0 < min_step ≤ step ≤ max_step < ∞");
+    }
+    if settings.points < 2 {
+        return bad("points ≥ 2");
+    }
+    Ok(())
+}
+
+/// The first points of the branches to switch to at a bifurcation (none
+/// if none): at a period doubling (new period ≤ max_period) the branch of
+/// P^{2k} along the eigenvector of −1; at a branch point (if asked) the
+/// crossing branch both ways. Not where a branch was already switched to
+/// at the same point (a branch that comes back to it).
+fn switch(
+    k: usize,
+    point: &Solution,
+    before: &DVector<f64>,
+    kind: BifurcationKind,
+    settings: &ContinuationSettings,
+    branches: &[Branch],
+    queued: &std::collections::VecDeque<Job>,
+) -> Vec<(usize, Solution)> {
+    let near =
+        |p: f64, y: &DVector<f64>| (p - point.p).abs() < 1e-7 && (y - &point.y).amax() < 1e-6;
+    let seen = branches
+        .iter()
+        .filter_map(|b| b.points.first())
+        .any(|q| near(q.parameter, &DVector::from_column_slice(&q.state)))
+        || queued.iter().any(|j| near(j.start.p, &j.start.y));
+    if seen {
+        return Vec::new();
+    }
+    // The new branch's direction: at a period doubling (v, 0) itself (the
+    // branch of P^{2k} is tangent to it); at a branch point the part of
+    // (v, 0) across the old branch (its tangent before the point: at the
+    // point itself the tangent is not defined), so that the corrector's
+    // hyperplane does not hold the old branch's next point.
+    let away = |direction: DVector<f64>, period: usize, monodromy: DMatrix<f64>| {
+        let t = before;
+        let direction = if period == k {
+            &direction - t * t.dot(&direction)
+        } else {
+            direction
+        };
+        let norm = direction.norm();
+        (norm > 1e-8).then(|| Solution {
+            y: point.y.clone(),
+            p: point.p,
+            tangent: direction / norm,
+            monodromy,
+            cycle: point.cycle.iter().cycle().take(period).cloned().collect(),
+        })
+    };
+    let n = point.y.len();
+    let padded = |v: DVector<f64>| DVector::from_fn(n + 1, |i, _| if i < n { v[i] } else { 0.0 });
+    match kind {
+        BifurcationKind::PeriodDoubling if 2 * k <= settings.max_period => {
+            let v = branch::eigenvector_near(&point.monodromy, -1.0);
+            let m2 = &point.monodromy * &point.monodromy;
+            away(padded(v), 2 * k, m2).map_or_else(Vec::new, |s| vec![(2 * k, s)])
+        }
+        BifurcationKind::BranchPoint if settings.switch_branch_points => {
+            let v = branch::eigenvector_near(&point.monodromy, 1.0);
+            let Some(forward) = away(padded(v), k, point.monodromy.clone()) else {
+                return Vec::new();
+            };
+            let mut backward = forward.clone();
+            backward.tangent = -backward.tangent;
+            vec![(k, forward), (k, backward)]
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// The period doublings of the cascade that starts on the first branch.
+fn cascade(branches: &[Branch], bifurcations: &[Bifurcation]) -> Vec<f64> {
+    let mut values = Vec::new();
+    let mut branch = 0;
+    loop {
+        let Some(pd) = bifurcations
+            .iter()
+            .find(|b| b.branch == branch && b.kind == BifurcationKind::PeriodDoubling)
+        else {
+            return values;
+        };
+        values.push(pd.parameter);
+        match pd.switched_to {
+            Some(next) if next < branches.len() => branch = next,
+            _ => return values,
+        }
+    }
+}
+
+/// How far the critical multiplier is from where the bifurcation puts it.
+fn residual(point: &Solution, kind: BifurcationKind) -> f64 {
+    let values = multipliers_of(&point.monodromy);
+    let nearest = |target: f64| {
+        values
+            .iter()
+            .map(|(re, im)| (re - target).hypot(*im))
+            .fold(f64::INFINITY, f64::min)
+    };
+    match kind {
+        BifurcationKind::Fold | BifurcationKind::BranchPoint => nearest(1.0),
+        BifurcationKind::PeriodDoubling => nearest(-1.0),
+        BifurcationKind::NeimarkSacker => values
+            .iter()
+            .filter(|(_, im)| im.abs() > 0.0)
+            .map(|(re, im)| (re.hypot(*im) - 1.0).abs())
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
+fn branch_point(s: &Solution) -> BranchPoint {
+    let multipliers = multipliers_of(&s.monodromy);
+    let verdict = Verdict::from_multipliers(&multipliers, 1e-7);
+    BranchPoint {
+        parameter: s.p,
+        state: s.y.iter().copied().collect(),
+        cycle: s.cycle.clone(),
+        multipliers,
+        stable: verdict != Verdict::Unstable,
+    }
+}

@@ -1,0 +1,380 @@
+//! Continuation of periodic orbits in a parameter: branches against closed
+//! forms, bifurcations against independent computations (the exact Floquet
+//! window by bisection, harmonic balance, hand-written equations), the
+//! period-doubling cascade of Duffing's oscillator, and named errors.
+
+use mechlab::analysis::continuation::{
+    continuation, BifurcationKind, ContinuationError, ContinuationSettings,
+};
+use mechlab::models;
+use mechlab::ode::Method;
+use mechlab_test_models::forced_oscillator::MODEL as FORCED;
+use nalgebra::{DMatrix, DVector};
+
+fn settings(parameter: &str, to: f64, start: &[f64]) -> ContinuationSettings {
+    ContinuationSettings {
+        parameter: parameter.into(),
+        to,
+        start: start.to_vec(),
+        period: 1,
+        max_period: 1,
+        switch_branch_points: false,
+        max_branches: 4,
+        points: 2000,
+        step: 0.005,
+        min_step: 1e-8,
+        max_step: 0.02,
+        method: Method::Taylor { tol: 1e-13 },
+        diagram: None,
+    }
+}
+
+/// Parameter values of the forced oscillator: c, b, F, ω.
+fn forced(c: f64, b: f64, f: f64, omega: f64) -> Vec<f64> {
+    vec![c, b, f, omega]
+}
+
+/// The linear oscillator x'' + c x' + x = F cos ωt has the periodic orbit
+/// x = a cos ωt + b sin ωt, a = F(1 − ω²)/D, b = F c ω/D,
+/// D = (1 − ω²)² + (cω)²: every point of the branch through resonance
+/// (ω from 0.5 to 1.5, amplitude up to 10) lies on it to 1e-10, and a
+/// linear map has no bifurcation.
+#[test]
+fn the_linear_oscillator_is_followed_through_resonance_on_its_closed_form() {
+    let (c, f) = (0.01, 0.1);
+    let result = continuation(
+        &FORCED,
+        &forced(c, 0.0, f, 0.5),
+        &settings("omega", 1.5, &[0.0, 0.0]),
+    )
+    .unwrap();
+    assert!(result.bifurcations.is_empty(), "{:?}", result.bifurcations);
+    let branch = &result.branches[0];
+    assert!(branch.points.len() > 50);
+    let mut largest = 0.0f64;
+    for point in &branch.points {
+        let w = point.parameter;
+        let d = (1.0 - w * w).powi(2) + (c * w).powi(2);
+        let (a, b) = (f * (1.0 - w * w) / d, f * c * w / d);
+        let error = (point.state[0] - a)
+            .abs()
+            .max((point.state[1] - b * w).abs());
+        assert!(
+            error < 1e-10,
+            "ω = {w}: {:?} against ({a}, {})",
+            point.state,
+            b * w
+        );
+        largest = largest.max(a.hypot(b));
+    }
+    assert!(largest > 9.0, "resonance reached: amplitude {largest}");
+}
+
+/// Kapitza's upright (0, 0) is a solution for every amplitude: the branch
+/// stays there, and its two stability changes, a branch point (multiplier
+/// +1: the tilted orbits) and a period doubling (−1), are the exact
+/// system's Floquet window found by bisection on the spectral radius, to
+/// 1e-9. Switching at the branch point follows the two tilted orbits,
+/// mirror images of each other.
+#[test]
+fn kapitzas_upright_changes_stability_at_the_exact_floquet_edges() {
+    use mechlab::analysis::stability::{stability, Settings};
+    let model = models::by_name("kapitza").unwrap();
+    let params = vec![0.5, 0.1, 0.0];
+    let exact = stability(
+        model,
+        &params,
+        &Settings {
+            amplitude: "A".into(),
+            a_max: Some(6.0),
+            samples: 120,
+            edge_tolerance: 1e-12,
+            method: Method::Taylor { tol: 1e-13 },
+        },
+    )
+    .unwrap();
+    let upright = exact.equilibria.iter().find(|e| e.q[0] == 0.0).unwrap();
+    let [Some(low), Some(high)] = upright.exact_window.unwrap() else {
+        panic!("{upright:?}")
+    };
+    let mut s = settings("A", 5.0, &[0.0, 0.0]);
+    s.switch_branch_points = true;
+    let result = continuation(model, &params, &s).unwrap();
+    assert!(!result.dissipative);
+    for point in &result.branches[0].points {
+        assert!(point.state.iter().all(|x| x.abs() < 1e-12), "{point:?}");
+    }
+    let on_upright: Vec<_> = result
+        .bifurcations
+        .iter()
+        .filter(|b| b.branch == 0)
+        .collect();
+    assert_eq!(on_upright.len(), 2, "{on_upright:?}");
+    assert_eq!(on_upright[0].kind, BifurcationKind::BranchPoint);
+    assert!(
+        (on_upright[0].parameter - low).abs() < 1e-9,
+        "{} {low}",
+        on_upright[0].parameter
+    );
+    assert_eq!(on_upright[1].kind, BifurcationKind::PeriodDoubling);
+    assert!(
+        (on_upright[1].parameter - high).abs() < 1e-9,
+        "{} {high}",
+        on_upright[1].parameter
+    );
+    // The tilted orbits: two branches from the branch point, q of opposite
+    // signs at equal amplitudes.
+    let tilted: Vec<_> = result
+        .branches
+        .iter()
+        .filter(|b| b.born_at == Some(0))
+        .collect();
+    assert_eq!(tilted.len(), 2);
+    let (a, b) = (&tilted[0].points[5], &tilted[1].points[5]);
+    assert!((a.parameter - b.parameter).abs() < 1e-9);
+    assert!(
+        (a.state[0] + b.state[0]).abs() < 1e-9 && a.state[0].abs() > 1e-3,
+        "{a:?} {b:?}"
+    );
+}
+
+/// Duffing's x'' + δx' − x + x³ = γ cos ωt (δ = 0.3, ω = 1.2), the orbit in
+/// the right well: its period doublings follow one another on the branches
+/// switched to, each with a multiplier −1 to 1e-9; the ratios of
+/// successive intervals approach Feigenbaum's δ = 4.6692 (within 5 %). The
+/// branch born at the first doubling is a fixed point of P² and not of P,
+/// checked with hand-written equations and RK4.
+#[test]
+fn duffings_cascade_of_period_doublings_gives_feigenbaums_ratio() {
+    let model = models::by_name("duffing").unwrap();
+    let mut s = settings("gamma", 0.3, &[1.0, 0.0]);
+    s.max_period = 16;
+    s.max_branches = 6;
+    s.points = 600;
+    s.method = Method::Taylor { tol: 1e-12 };
+    let result = continuation(model, &model.dynamic.defaults(), &s).unwrap();
+    assert!(result.dissipative);
+    assert!(result.cascade.len() >= 4, "{:?}", result.cascade);
+    // Up to period 8: the monodromy of P^16 is a product of 16 matrices
+    // contracting by 1e-11, whose multiplier −1 holds only to 1e-8.
+    for b in result
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::PeriodDoubling)
+    {
+        assert!(b.located && (b.period > 8 || b.residual < 1e-9), "{b:?}");
+    }
+    let feigenbaum = 4.669_201_6;
+    for ratio in &result.feigenbaum_ratios[..2] {
+        assert!(
+            (ratio / feigenbaum - 1.0).abs() < 0.05,
+            "{:?}",
+            result.feigenbaum_ratios
+        );
+    }
+    let doubled = &result.branches[1];
+    assert_eq!(doubled.period, 2);
+    let point = &doubled.points[doubled.points.len() / 2];
+    let gamma = point.parameter;
+    let y = [point.state[0], point.state[1]];
+    let once = duffing_period(y, gamma);
+    let twice = duffing_period(once, gamma);
+    let distance = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    assert!(
+        distance(twice, y) < 1e-8,
+        "P²(y) − y = {}",
+        distance(twice, y)
+    );
+    assert!(distance(once, y) > 1e-2, "P(y) − y = {}", distance(once, y));
+}
+
+/// One period of Duffing's oscillator (δ = 0.3, ω = 1.2), written out and
+/// integrated by RK4 with 20 000 steps.
+fn duffing_period(mut y: [f64; 2], gamma: f64) -> [f64; 2] {
+    let (delta, omega) = (0.3, 1.2);
+    let f = |t: f64, y: [f64; 2]| {
+        [
+            y[1],
+            y[0] - y[0].powi(3) - delta * y[1] + gamma * (omega * t).cos(),
+        ]
+    };
+    rk4(&f, &mut y, 2.0 * std::f64::consts::PI / omega, 20_000);
+    y
+}
+
+fn rk4(f: &dyn Fn(f64, [f64; 2]) -> [f64; 2], y: &mut [f64; 2], end: f64, steps: usize) {
+    let h = end / steps as f64;
+    let add = |y: [f64; 2], k: [f64; 2], s: f64| [y[0] + s * k[0], y[1] + s * k[1]];
+    for i in 0..steps {
+        let t = i as f64 * h;
+        let k1 = f(t, *y);
+        let k2 = f(t + h / 2.0, add(*y, k1, h / 2.0));
+        let k3 = f(t + h / 2.0, add(*y, k2, h / 2.0));
+        let k4 = f(t + h, add(*y, k3, h));
+        for j in 0..2 {
+            y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+        }
+    }
+}
+
+/// The hardening oscillator x'' + c x' + x + b x³ = F cos ωt: its frequency
+/// response bends right and folds. The fold the continuation locates on
+/// the upper branch is where harmonic balance (24 harmonics, collocation,
+/// exact to far below the tolerance for this analytic orbit) has ω
+/// stationary along its own branch, parametrised by x(0).
+#[test]
+fn the_hardening_fold_is_where_harmonic_balance_turns() {
+    let (c, b, f) = (0.2, 0.5, 0.3);
+    let result = continuation(
+        &FORCED,
+        &forced(c, b, f, 0.6),
+        &settings("omega", 2.0, &[0.0, 0.0]),
+    )
+    .unwrap();
+    let folds: Vec<_> = result
+        .bifurcations
+        .iter()
+        .filter(|x| x.kind == BifurcationKind::Fold)
+        .collect();
+    assert_eq!(folds.len(), 2, "{:?}", result.bifurcations);
+    for fold in folds {
+        assert!(fold.located && fold.residual < 1e-5, "{fold:?}");
+        let x0 = fold.state[0];
+        let balance = HarmonicBalance {
+            c,
+            b,
+            f,
+            harmonics: 24,
+        };
+        let h = 1e-4;
+        let omegas: Vec<f64> = [-h, 0.0, h]
+            .iter()
+            .map(|d| balance.frequency_at(x0 + d, fold.state[1], fold.parameter))
+            .collect();
+        // The vertex of the parabola through the three points.
+        let curvature = omegas[0] - 2.0 * omegas[1] + omegas[2];
+        let shift = 0.5 * h * (omegas[0] - omegas[2]) / curvature;
+        let vertex = omegas[1] - 0.25 * (omegas[0] - omegas[2]) * shift / h;
+        assert!(
+            shift.abs() < 1e-5,
+            "x(0) of the balance's turning point off by {shift}"
+        );
+        assert!(
+            (vertex - fold.parameter).abs() < 1e-8,
+            "fold at ω = {}, harmonic balance turns at {vertex}",
+            fold.parameter
+        );
+    }
+}
+
+/// Harmonic balance by collocation for x'' + c x' + x + b x³ = F cos ωt:
+/// x(t) = a₀ + Σ aₙ cos nωt + bₙ sin nωt, the equation imposed at 2N + 1
+/// equally spaced times of a period.
+struct HarmonicBalance {
+    c: f64,
+    b: f64,
+    f: f64,
+    harmonics: usize,
+}
+
+impl HarmonicBalance {
+    /// The frequency at which the periodic orbit has x(0) = x0: Newton on
+    /// the collocation equations and x(0) = x0, unknowns the coefficients
+    /// and ω, from ω = `omega` and the first harmonic through (x0, v0).
+    fn frequency_at(&self, x0: f64, v0: f64, omega: f64) -> f64 {
+        let n = 2 * self.harmonics + 1;
+        let mut u = DVector::zeros(n + 1);
+        u[1] = x0;
+        u[2] = v0 / omega;
+        u[n] = omega;
+        for _ in 0..60 {
+            let r = self.residual(&u, x0);
+            let mut jacobian = DMatrix::zeros(n + 1, n + 1);
+            for k in 0..=n {
+                let mut v = u.clone();
+                let h = 1e-7 * (1.0 + u[k].abs());
+                v[k] += h;
+                let column = (self.residual(&v, x0) - &r) / h;
+                jacobian.set_column(k, &column);
+            }
+            let step = jacobian.lu().solve(&r).expect("regular");
+            u -= &step;
+            if step.norm() < 1e-14 {
+                break;
+            }
+        }
+        assert!(self.residual(&u, x0).norm() < 1e-11);
+        u[n]
+    }
+
+    fn residual(&self, u: &DVector<f64>, x0: f64) -> DVector<f64> {
+        let n = 2 * self.harmonics + 1;
+        let omega = u[n];
+        let mut r = DVector::zeros(n + 1);
+        for j in 0..n {
+            let phase = std::f64::consts::TAU * j as f64 / n as f64;
+            let (mut x, mut v, mut a) = (u[0], 0.0, 0.0);
+            for h in 1..=self.harmonics {
+                let k = h as f64;
+                let (cos, sin) = ((k * phase).cos(), (k * phase).sin());
+                let (ca, sb) = (u[2 * h - 1], u[2 * h]);
+                x += ca * cos + sb * sin;
+                v += k * omega * (-ca * sin + sb * cos);
+                a -= (k * omega).powi(2) * (ca * cos + sb * sin);
+            }
+            r[j] = a + self.c * v + x + self.b * x.powi(3) - self.f * phase.cos();
+        }
+        let at_zero: f64 = u[0] + (1..=self.harmonics).map(|h| u[2 * h - 1]).sum::<f64>();
+        r[n] = at_zero - x0;
+        r
+    }
+}
+
+/// Bad requests get named errors: a parameter the model lacks, a model
+/// without a period map, a start where P = I (every state a fixed point:
+/// the Jacobian P' − I is singular), and a step too long for Newton that
+/// may not shrink.
+#[test]
+fn bad_requests_are_named() {
+    let duffing = models::by_name("duffing").unwrap();
+    let defaults = duffing.dynamic.defaults();
+    let err = continuation(duffing, &defaults, &settings("kappa", 1.0, &[1.0])).unwrap_err();
+    assert!(
+        matches!(err, ContinuationError::UnknownParameter { .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("gamma"), "{err}");
+
+    let henon = models::by_name("henon_heiles").unwrap();
+    let err = continuation(
+        henon,
+        &henon.dynamic.defaults(),
+        &settings("lambda", 1.0, &[]),
+    )
+    .unwrap_err();
+    assert!(matches!(err, ContinuationError::NoPeriod(_)), "{err}");
+
+    let err = continuation(
+        &FORCED,
+        &forced(0.0, 0.0, 0.0, 1.0),
+        &settings("F", 1.0, &[0.3]),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, ContinuationError::SingularJacobian { .. }),
+        "{err}"
+    );
+
+    let mut s = settings("gamma", 0.3, &[1.0, 0.0]);
+    (s.step, s.min_step, s.max_step) = (50.0, 50.0, 50.0);
+    let err = continuation(duffing, &defaults, &s).unwrap_err();
+    assert!(
+        matches!(err, ContinuationError::StepCollapse { .. }),
+        "{err}"
+    );
+
+    let mut s = settings("gamma", 0.3, &[1.0, 0.0]);
+    s.min_step = 0.0;
+    let err = continuation(duffing, &defaults, &s).unwrap_err();
+    assert!(matches!(err, ContinuationError::Settings { .. }), "{err}");
+}
