@@ -57,12 +57,17 @@ fn main() {
         for moved in &result.moved_by_vibration {
             match (&moved.periodic_orbit, moved.verdict) {
                 (Some(orbit), Some(verdict)) => eprintln!(
-                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}",
-                    moved.q, moved.amplitude, moved.multipliers
+                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}; stable for amplitudes {:?} {}",
+                    moved.q,
+                    moved.amplitude,
+                    moved.multipliers,
+                    moved.exact_window,
+                    moved.exact_reason.as_deref().unwrap_or(""),
                 ),
                 _ => eprintln!(
-                    "q = {:?}: moved by the vibration (no periodic orbit found near it)",
-                    moved.q
+                    "q = {:?}: moved by the vibration, no periodic orbit found near it ({})",
+                    moved.q,
+                    moved.exact_reason.as_deref().unwrap_or("Newton did not converge"),
                 ),
             }
         }

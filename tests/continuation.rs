@@ -378,3 +378,45 @@ fn bad_requests_are_named() {
     let err = continuation(duffing, &defaults, &s).unwrap_err();
     assert!(matches!(err, ContinuationError::Settings { .. }), "{err}");
 }
+
+/// A pendulum whose pivot runs round an ellipse (vertical semi-axis A,
+/// horizontal a, both times ε): the horizontal component moves the upright,
+/// so `stability` replaces it by the periodic orbit near it and finds that
+/// orbit's window in A by continuation. Its lower edge tends to the
+/// averaged threshold √(2 + a²) as ε² (the gap shrinks by about 4 when ε
+/// halves).
+#[test]
+fn the_moved_uprights_window_tends_to_the_averaged_threshold_as_eps_squared() {
+    use mechlab::analysis::stability::{stability, Settings};
+    use mechlab_test_models::elliptic_pendulum::MODEL as ELLIPTIC;
+    let a = 0.5;
+    let threshold = (2.0f64 + a * a).sqrt();
+    let gaps: Vec<f64> = [0.04, 0.02]
+        .iter()
+        .map(|&eps| {
+            let found = stability(
+                &ELLIPTIC,
+                &[2.0, a, eps],
+                &Settings {
+                    amplitude: "A".into(),
+                    a_max: Some(4.0),
+                    samples: 40,
+                    edge_tolerance: 1e-10,
+                    method: Method::Taylor { tol: 1e-12 },
+                },
+            )
+            .unwrap();
+            let upright = found
+                .moved_by_vibration
+                .iter()
+                .find(|m| m.q[0].abs() < 1e-9)
+                .expect("the upright is moved");
+            assert!(upright.periodic_orbit.is_some(), "{upright:?}");
+            let window = upright.exact_window.expect("a window");
+            window[0].unwrap() - threshold
+        })
+        .collect();
+    assert!(gaps[0].abs() < 2e-3, "{gaps:?}");
+    let ratio = gaps[0] / gaps[1];
+    assert!((3.0..5.0).contains(&ratio), "{gaps:?}: ratio {ratio}");
+}

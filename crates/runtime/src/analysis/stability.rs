@@ -12,6 +12,7 @@
 //! generated Hessian is evaluated at a = 0, 1, 2 to find C and K, and the
 //! quadratic dependence is checked (else the reason is given).
 
+use super::continuation::{orbit_branch, OrbitBranch};
 use super::floquet::{floquet_multipliers, monodromies, spectral_radius, window_in_batches};
 use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues;
@@ -100,6 +101,13 @@ pub struct MovedEquilibrium {
     /// verdict they give.
     pub multipliers: Vec<(f64, f64)>,
     pub verdict: Option<&'static str>,
+    /// The first interval of the amplitude on which that orbit is stable,
+    /// its edges the located stability changes along its branch (followed
+    /// from amplitude 0, where it is the equilibrium, to a_max; upper null
+    /// if stable up to a_max).
+    pub exact_window: Option<[Option<f64>; 2]>,
+    /// Why there is no exact window, when there is none.
+    pub exact_reason: Option<String>,
 }
 
 /// Why a stability analysis lists no equilibrium.
@@ -196,10 +204,55 @@ impl WithFixed for Analysis<'_> {
             let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
             let averaged = stays_in_averaged_system(model, self.params, q);
             if !averaged || moved_by_vibration(model, &probe, &y0) {
+                let a_max = self.settings.a_max.unwrap_or(3.0 * probe[amplitude]);
+                let branch = averaged.then(|| {
+                    let mut at_rest = probe.clone();
+                    at_rest[amplitude] = 0.0;
+                    let method = self.settings.method;
+                    orbit_branch(model, &at_rest, amplitude, method, &y0, (0.0, a_max))
+                });
+                // Newton at the probed amplitude from the branch's nearest
+                // point (from (q, 0) where the branch could not be had).
+                let near: [f64; S] = match &branch {
+                    Some(Ok(b)) => b
+                        .states
+                        .iter()
+                        .min_by(|x, y| {
+                            (x.0 - probe[amplitude])
+                                .abs()
+                                .total_cmp(&(y.0 - probe[amplitude]).abs())
+                        })
+                        .map_or(y0, |(_, y)| std::array::from_fn(|i| y[i])),
+                    _ => y0,
+                };
                 let orbit = if averaged {
-                    periodic_orbit_near::<F, D, S, T, V>(model, &probe, &y0, &self.settings.method)
+                    periodic_orbit_near::<F, D, S, T, V>(
+                        model,
+                        &probe,
+                        &near,
+                        &self.settings.method,
+                    )
                 } else {
                     None
+                };
+                let (exact_window, exact_reason) = match branch {
+                    None => (None, Some("the averaged system moves it too".to_string())),
+                    Some(Ok(OrbitBranch {
+                        window: Some(window),
+                        ..
+                    })) => (Some(window), None),
+                    Some(Ok(_)) => (
+                        None,
+                        Some(format!(
+                            "its orbit is not stable for any amplitude up to {a_max}"
+                        )),
+                    ),
+                    Some(Err(e)) => (
+                        None,
+                        Some(format!(
+                            "its orbit could not be followed from amplitude 0: {e}"
+                        )),
+                    ),
                 };
                 let (periodic_orbit, multipliers, verdict) = match orbit {
                     Some((y, m)) => {
@@ -215,6 +268,8 @@ impl WithFixed for Analysis<'_> {
                     periodic_orbit,
                     multipliers,
                     verdict,
+                    exact_window,
+                    exact_reason,
                 });
                 continue;
             }

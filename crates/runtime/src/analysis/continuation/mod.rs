@@ -266,6 +266,112 @@ impl WithFixed for Work<'_> {
     }
 }
 
+/// A periodic orbit followed in one parameter for `stability`: the states
+/// along its branch and the first interval where it is stable.
+pub(crate) struct OrbitBranch {
+    /// (parameter, state) of every point, by increasing parameter.
+    pub states: Vec<(f64, Vec<f64>)>,
+    /// Each edge the located stability change; None above: stable up to
+    /// the interval's end. None: never stable.
+    pub window: Option<[Option<f64>; 2]>,
+}
+
+/// The branch in the parameter `index` of the periodic orbit through
+/// `start` (a fixed point of P at the parameter's value in `params`),
+/// followed down to `bounds.0` and up to `bounds.1`, and its window. For
+/// the orbits of `stability` that the vibration moves off an equilibrium,
+/// followed from amplitude 0, where the equilibrium is one.
+pub(crate) fn orbit_branch<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &'static F,
+    params: &[f64],
+    index: usize,
+    method: Method,
+    start: &[f64],
+    bounds: (f64, f64),
+) -> Result<OrbitBranch, ContinuationError> {
+    let periodic = model.periodic();
+    let map = AtModel::<F, D, S, T, V> {
+        model,
+        params: params.to_vec(),
+        index,
+        method,
+        periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
+        evaluations: AtomicU64::new(0),
+    };
+    let p0 = params[index];
+    let name = model.info().name;
+    // (parameter, stable, state) along the branch, and the located changes.
+    let mut along: Vec<(f64, bool, Vec<f64>)> = Vec::new();
+    let mut changes: Vec<f64> = Vec::new();
+    for to in [bounds.0, bounds.1] {
+        if to == p0 {
+            continue;
+        }
+        let settings = ContinuationSettings {
+            parameter: model.info().parameter_names[index].into(),
+            to,
+            start: start.to_vec(),
+            period: 1,
+            max_period: 1,
+            switch_branch_points: false,
+            max_branches: 1,
+            points: 2000,
+            step: 0.01,
+            min_step: 1e-9,
+            max_step: 0.05 * (bounds.1 - bounds.0).max(1e-3),
+            method,
+            diagram: None,
+        };
+        let result = run(&map, p0, &settings, name)?;
+        along.extend(
+            result.branches[0]
+                .points
+                .iter()
+                .map(|p| (p.parameter, p.stable, p.state.clone())),
+        );
+        changes.extend(result.bifurcations.iter().map(|b| b.parameter));
+    }
+    along.sort_by(|a, b| a.0.total_cmp(&b.0));
+    changes.sort_by(f64::total_cmp);
+    // The change between two points of the branch (their midpoint if none
+    // was located there).
+    let edge = |a: f64, b: f64| {
+        changes
+            .iter()
+            .copied()
+            .find(|c| *c >= a.min(b) && *c <= a.max(b))
+            .unwrap_or(0.5 * (a + b))
+    };
+    let states = along.iter().map(|(p, _, y)| (*p, y.clone())).collect();
+    let Some(first) = along.iter().position(|p| p.1) else {
+        return Ok(OrbitBranch {
+            states,
+            window: None,
+        });
+    };
+    // Stable from the lowest point: from the bound (the branch's last step
+    // may overshoot it).
+    let lower = match first {
+        0 => bounds.0,
+        _ => edge(along[first - 1].0, along[first].0),
+    };
+    let upper = along[first..]
+        .windows(2)
+        .find(|w| !w[1].1)
+        .map(|w| edge(w[0].0, w[1].0))
+        .filter(|&p| p <= bounds.1);
+    Ok(OrbitBranch {
+        states,
+        window: Some([Some(lower.max(bounds.0)), upper]),
+    })
+}
+
 /// A model of sizes (D, S) at fixed values of all parameters but one.
 struct AtModel<F: 'static, const D: usize, const S: usize, const T: usize, const V: usize> {
     model: &'static F,
