@@ -314,6 +314,55 @@ async fn manifolds_overlay_gives_the_tangle_or_a_named_error() {
     assert!(body.contains("colour"), "{body}");
 }
 
+/// "Continue this orbit": the periodic orbit nearest a seed followed in a
+/// parameter, projected on the plane, with its bifurcations: Duffing's
+/// right-well orbit doubles its period at γ = 0.2655817860 (as the
+/// `continuation` scene finds) and the branch of period 2 is followed from
+/// there. Errors are named: a parameter the model lacks (422, listing
+/// them), a model without a period map (422), a seed of the wrong length
+/// (400).
+#[tokio::test]
+async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
+    let request = json!({"model": "duffing", "seed": [1.0, 0.0], "parameter": "gamma", "to": 0.28, "tol": 1e-12});
+    let (status, _, body) = call("POST", "/api/continuation", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let branches = answer["branches"].as_array().unwrap();
+    assert_eq!(branches.len(), 2, "{body}");
+    assert_eq!(branches[1]["period"], 2);
+    let doubling = answer["bifurcations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["kind"] == "period_doubling")
+        .expect("a period doubling");
+    let gamma = doubling["parameter"].as_f64().unwrap();
+    assert!((gamma - 0.2655817860530).abs() < 1e-9, "{gamma}");
+    let first = &branches[0]["points"][0];
+    assert!(
+        (first[2].as_f64().unwrap() - 0.2).abs() < 1e-12,
+        "starts at γ = 0.2: {first}"
+    );
+
+    let bad = |request: Value| async move {
+        let (status, _, body) = call("POST", "/api/continuation", Some(request)).await;
+        (status, body)
+    };
+    let (status, body) =
+        bad(json!({"model": "duffing", "seed": [1.0, 0.0], "parameter": "kappa", "to": 1.0})).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(body.contains("kappa") && body.contains("gamma"), "{body}");
+    let (status, body) = bad(
+        json!({"model": "henon_heiles", "seed": [0.0, 0.0, 0.0, 0.0], "parameter": "x", "to": 1.0}),
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    let (status, body) =
+        bad(json!({"model": "duffing", "seed": [1.0], "parameter": "gamma", "to": 1.0})).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
+    assert!(body.contains("seed"), "{body}");
+}
+
 /// Every bad request gets a status and a message naming the problem; the
 /// router keeps answering.
 #[tokio::test]
@@ -649,6 +698,36 @@ mod browser {
             10,
         )
         .await;
+        tokio::time::sleep(Duration::from_millis(300)).await;
+
+        // Shift-click on the upright: its orbit continued in A (to 1.8 by
+        // default) changes stability at the branch point A = 1.42038.
+        client
+            .execute(
+                "const c = document.getElementById('plane'); const r = c.getBoundingClientRect();\
+                 const [px, py] = studio.pixelOf(0, 0);\
+                 const at = { clientX: r.left + px * r.width / c.width, clientY: r.top + py * r.height / c.height, bubbles: true, shiftKey: true };\
+                 c.dispatchEvent(new MouseEvent('mousedown', at)); c.dispatchEvent(new MouseEvent('mouseup', at)); return true;",
+                vec![],
+            )
+            .await
+            .unwrap();
+        wait_for(&client, "studio.branches !== null", 60).await;
+        let at = client
+            .execute(
+                "return studio.branches.bifurcations.filter(b => b.kind === 'branch_point').map(b => b.parameter);",
+                vec![],
+            )
+            .await
+            .unwrap();
+        let at: Vec<f64> = serde_json::from_value(at).unwrap();
+        assert_eq!(at.len(), 1, "{at:?}");
+        assert!((at[0] - 1.4203816679).abs() < 1e-6, "{at:?}");
+        assert_eq!(
+            orbits(&client).await.len(),
+            3,
+            "a shift-click seeds no orbit"
+        );
         tokio::time::sleep(Duration::from_millis(300)).await;
 
         let png = client.screenshot().await.unwrap();

@@ -10,6 +10,8 @@
 //! | `POST /api/orbit` | an orbit of the period map, streamed as NDJSON lines |
 //! | `POST /api/chaos` | the FLI map of a view at growing resolutions, NDJSON |
 //! | `POST /api/overlay` | level sets of H̄ and the equilibria, JSON |
+//! | `POST /api/manifolds` | W^u, W^s of the hyperbolic point, JSON |
+//! | `POST /api/continuation` | the periodic orbit nearest a seed continued in a parameter, JSON |
 //!
 //! The numerics run on blocking threads; a streamed answer stops computing
 //! when the page drops it (a superseded request). Every error is a JSON
@@ -79,7 +81,8 @@ impl ApiError {
             ApiError::Studio(
                 StudioError::ContactModel(_)
                 | StudioError::NoFastPhase(_)
-                | StudioError::Splitting(_),
+                | StudioError::Splitting(_)
+                | StudioError::Continuation(_),
             ) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
@@ -125,6 +128,7 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/chaos", post(chaos))
         .route("/api/overlay", post(overlay))
         .route("/api/manifolds", post(manifolds))
+        .route("/api/continuation", post(continuation))
         .fallback(|uri: axum::http::Uri| async move { ApiError::NotFound(uri.to_string()) })
         .with_state(catalog)
 }
@@ -174,6 +178,13 @@ async fn manifolds(State(catalog): State<Catalog>, body: Bytes) -> Result<Respon
     let request: studio::ManifoldsRequest = serde_json::from_slice(&body)?;
     let answer =
         blocking(move || studio::manifolds(catalog, &request).map_err(ApiError::from)).await?;
+    Ok(axum::Json(answer).into_response())
+}
+
+async fn continuation(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
+    let request: studio::ContinuationRequest = serde_json::from_slice(&body)?;
+    let answer =
+        blocking(move || studio::continuation(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 

@@ -49,6 +49,8 @@ pub enum StudioError {
     PeriodMap(#[from] PeriodMapError),
     #[error(transparent)]
     Splitting(#[from] crate::analysis::separatrix::SplittingError),
+    #[error(transparent)]
+    Continuation(#[from] crate::analysis::continuation::ContinuationError),
 }
 
 /// What is wrong with a request's numbers.
@@ -760,5 +762,127 @@ pub fn manifolds(catalog: Catalog, request: &ManifoldsRequest) -> Result<Manifol
         lobe_area: s.lobe_area().unwrap_or(f64::NAN),
         resolved: s.resolved,
         angle: s.homoclinic[0].angle.unwrap_or(f64::NAN),
+    })
+}
+
+/// What `POST /api/continuation` asks: the periodic orbit of the period
+/// map nearest `seed` (a state), continued in `parameter` from its value
+/// to `to`.
+#[derive(Clone, Debug, Deserialize)]
+pub struct ContinuationRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub seed: Vec<f64>,
+    pub parameter: String,
+    pub to: f64,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+/// Branches on the page's plane: each point (x, y, parameter) with its
+/// stability, and the located bifurcations.
+#[derive(Clone, Debug, Serialize)]
+pub struct BranchesView {
+    pub branches: Vec<BranchLine>,
+    pub bifurcations: Vec<BifurcationMark>,
+    pub seconds: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BranchLine {
+    pub period: usize,
+    pub points: Vec<[f64; 3]>,
+    pub stable: Vec<bool>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BifurcationMark {
+    pub kind: crate::analysis::continuation::BifurcationKind,
+    pub parameter: f64,
+    pub at: [f64; 2],
+    pub located: bool,
+}
+
+/// The studio's "continue this orbit" (`analysis::continuation`): the
+/// branch of the fixed point of P nearest the seed, and those born at its
+/// period doublings (up to period 4), projected on the page's axes.
+pub fn continuation(
+    catalog: Catalog,
+    request: &ContinuationRequest,
+) -> Result<BranchesView, StudioError> {
+    use crate::analysis::continuation::{continuation, ContinuationSettings};
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    if !setup.fast_phase {
+        return Err(StudioError::NoFastPhase(setup.info.name.into()));
+    }
+    let components = setup.through.len();
+    if request.seed.len() != components {
+        return Err(setup.bad(RequestProblem::SeedLength {
+            got: request.seed.len(),
+            expected: components,
+        }));
+    }
+    if !request.seed.iter().all(|x| x.is_finite()) {
+        return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
+    }
+    let settings = ContinuationSettings {
+        parameter: request.parameter.clone(),
+        to: request.to,
+        start: request.seed.clone(),
+        period: 1,
+        max_period: 4,
+        switch_branch_points: false,
+        max_branches: 4,
+        points: 1500,
+        step: 0.01,
+        min_step: 1e-8,
+        max_step: 0.05,
+        method: setup.method,
+        diagram: None,
+    };
+    let result = continuation(setup.handle, &setup.params, &settings)?;
+    let periodic = setup.model.periodic();
+    let place = |y: &[f64]| -> [f64; 2] {
+        let at = |k: usize| {
+            let axis = setup.axes[k];
+            if periodic.get(axis).copied().unwrap_or(false) {
+                wrap_angle(y[axis])
+            } else {
+                y[axis]
+            }
+        };
+        [at(0), at(1)]
+    };
+    let branches = result
+        .branches
+        .iter()
+        .map(|b| BranchLine {
+            period: b.period,
+            points: b
+                .points
+                .iter()
+                .map(|p| {
+                    let [x, y] = place(&p.state);
+                    [x, y, p.parameter]
+                })
+                .collect(),
+            stable: b.points.iter().map(|p| p.stable).collect(),
+        })
+        .collect();
+    let bifurcations = result
+        .bifurcations
+        .iter()
+        .map(|b| BifurcationMark {
+            kind: b.kind,
+            parameter: b.parameter,
+            at: place(&b.state),
+            located: b.located,
+        })
+        .collect();
+    Ok(BranchesView {
+        branches,
+        bifurcations,
+        seconds: result.seconds,
     })
 }

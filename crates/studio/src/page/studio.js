@@ -15,6 +15,7 @@ const studio = {
   overlay: null,
   chaos: null,
   manifolds: null,
+  branches: null,
   nextId: 1,
   pointsReceived: 0,
 };
@@ -125,6 +126,82 @@ function draw(g, width, height) {
   }
   if (studio.manifolds && $("show-manifolds").checked) drawManifolds(g);
   if (studio.overlay && $("show-equilibria").checked) drawEquilibria(g);
+  if (studio.branches) drawBranches(g);
+}
+
+const BIFURCATION_NAMES = { fold: "fold", branch_point: "branch point", period_doubling: "period doubling", neimark_sacker: "Neimark–Sacker" };
+
+// The branches of "continue this orbit": the fixed point's path in the
+// plane as the parameter moves, stable solid, unstable dashed.
+function drawBranches(g) {
+  g.lineWidth = 1.8;
+  studio.branches.branches.forEach((branch, b) => {
+    g.strokeStyle = `hsl(${(b * 97 + 140) % 360}, 70%, 35%)`;
+    for (let i = 1; i < branch.points.length; i++) {
+      const [x0, y0] = branch.points[i - 1];
+      const [x1, y1] = branch.points[i];
+      if (Math.abs(x1 - x0) > Math.PI) continue;
+      g.setLineDash(branch.stable[i] ? [] : [5, 4]);
+      const [a, c] = toPixel(x0, y0);
+      const [d, e] = toPixel(x1, y1);
+      g.beginPath();
+      g.moveTo(a, c);
+      g.lineTo(d, e);
+      g.stroke();
+    }
+  });
+  g.setLineDash([]);
+  g.font = "11px sans-serif";
+  for (const mark of studio.branches.bifurcations) {
+    const [px, py] = toPixel(mark.at[0], mark.at[1]);
+    g.fillStyle = "#000";
+    g.fillRect(px - 3.5, py - 3.5, 7, 7);
+    g.fillText(`${BIFURCATION_NAMES[mark.kind]} ${mark.parameter.toPrecision(6)}`, px + 6, py - 6);
+  }
+}
+
+let continuationController = null;
+
+// Shift-click: continue the periodic orbit nearest (x, y).
+async function continueAt(x, y) {
+  const seed = studio.through.slice();
+  seed[studio.axes[0]] = x;
+  seed[studio.axes[1]] = y;
+  const parameter = $("cont-parameter").value;
+  const to = Number($("cont-to").value);
+  if (!Number.isFinite(to)) { say("continuation: `to` is not a number"); return; }
+  if (continuationController) continuationController.abort();
+  continuationController = new AbortController();
+  say(`continuing in ${parameter} …`);
+  try {
+    const answer = await postJson("/api/continuation", { ...setup(), seed, parameter, to }, continuationController.signal);
+    studio.branches = answer;
+    const items = answer.bifurcations.map((m) =>
+      `<li>${BIFURCATION_NAMES[m.kind]} at ${parameter} = ${m.parameter.toPrecision(10)}${m.located ? "" : " (bracketed)"}</li>`);
+    const points = answer.branches.reduce((n, b) => n + b.points.length, 0);
+    $("cont-list").innerHTML = items.join("") || "<li>no bifurcation on the way</li>";
+    say(`${answer.branches.length} branch(es), ${points} points in ${answer.seconds.toFixed(2)} s`);
+    redraw();
+  } catch (e) {
+    if (!aborted(e)) say(`continuation: ${e.message}`);
+  }
+}
+
+studio.continueAt = (x, y) => continueAt(x, y);
+
+function buildContinuation(model) {
+  const select = $("cont-parameter");
+  select.innerHTML = model.parameters.map((p) => `<option value="${p.name}">${p.symbol}</option>`).join("");
+  const chosen = model.parameters.find((p) => p.name === model.amplitude) || model.parameters[0];
+  if (chosen) select.value = chosen.name;
+  const setTo = () => {
+    const value = studio.params[select.value];
+    $("cont-to").value = value ? 1.8 * value : 1;
+  };
+  select.onchange = setTo;
+  setTo();
+  studio.branches = null;
+  $("cont-list").innerHTML = "";
 }
 
 function drawManifolds(g) {
@@ -453,6 +530,7 @@ async function chooseModel(name) {
   $("derivations-model").textContent = name;
   buildParameters(model);
   buildAxes(model);
+  buildContinuation(model);
   $("order").disabled = !model.fast_phase;
   $("order").value = "1";
   defaultView(model);
@@ -498,7 +576,8 @@ window.addEventListener("mouseup", (e) => {
   if (wasDrag) { refreshOverlays(); return; }
   if (e.target !== canvas || !studio.model) return;
   const [x, y] = toWorld(e.offsetX, e.offsetY);
-  seedAt(x, y);
+  if (e.shiftKey) continueAt(x, y);
+  else seedAt(x, y);
 });
 canvas.addEventListener("wheel", (e) => {
   e.preventDefault();
@@ -568,6 +647,7 @@ function wire() {
   for (const id of ["method", "tol"]) $(id).addEventListener("change", () => { rerunOrbits(); refreshOverlays(); });
   for (const id of ["show-levels", "show-equilibria"]) $(id).addEventListener("change", () => { refreshOverlay(); redraw(); });
   $("show-manifolds").addEventListener("change", refreshManifolds);
+  $("cont-clear").addEventListener("click", () => { studio.branches = null; $("cont-list").innerHTML = ""; redraw(); });
   for (const id of ["show-chaos", "chaos-periods"]) $(id).addEventListener("change", refreshChaos);
   for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
     $(id).addEventListener("change", () => {
