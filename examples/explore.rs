@@ -84,8 +84,12 @@ fn main() {
                 true => String::new(),
                 false => format!(" (a family along {}, judged reduced)", family.join(", ")),
             };
+            let pole = match e.pole {
+                true => " (a pole of the chart: singular only along the family)",
+                false => "",
+            };
             println!(
-                "equilibrium q = {:?}{family}: Hessian eigenvalues {:?}: {}",
+                "equilibrium q = {:?}{family}{pole}: Hessian eigenvalues {:?}: {}",
                 e.q, e.hessian_eigenvalues, e.verdict
             );
         }

@@ -210,3 +210,60 @@ fn a_family_along_a_cyclic_angle_is_reported_once_and_judged_reduced() {
     assert_eq!(rest.hessian_eigenvalues.len(), 1);
     assert!((rest.hessian_eigenvalues[0] - 4.0).abs() < 1e-9, "{rest:?}");
 }
+
+/// A spherical pendulum on a vibrating pivot (test model
+/// `spherical_pendulum`): the upright is a pole of the chart, where the
+/// mass matrix diag(1, sin²θ) is singular along the cyclic azimuth only.
+/// It is reported once, as a family along φ at a pole, and judged on the
+/// reduced system: stable for A above √2 (the reduced Hessian
+/// −1 + A²/2 > 0), unstable below — never "unstable" from the zero
+/// eigenvalue of φ, never a singular chart that decides nothing.
+#[test]
+fn a_spherical_pendulums_upright_is_judged_at_the_pole_on_the_reduced_system() {
+    use mechlab::explore::{equilibria, Verdict};
+    use mechlab_test_models::spherical_pendulum::DYNAMIC;
+    for (a, verdict) in [(1.6, Verdict::Stable), (1.2, Verdict::Unstable)] {
+        let found = equilibria(&DYNAMIC, &[a, 0.1]).unwrap();
+        let upright: Vec<_> = found.iter().filter(|e| e.q[0].abs() < 1e-6).collect();
+        assert_eq!(upright.len(), 1, "A = {a}: {found:#?}");
+        let upright = upright[0];
+        assert!(upright.pole, "{upright:?}");
+        assert_eq!(upright.family_along, vec![1]);
+        assert_eq!(upright.verdict, verdict, "A = {a}: {upright:?}");
+        let expected = -1.0 + a * a / 2.0;
+        assert_eq!(upright.hessian_eigenvalues.len(), 1);
+        assert!(
+            (upright.hessian_eigenvalues[0] - expected).abs() < 1e-6,
+            "{upright:?}"
+        );
+    }
+}
+
+/// `stability` on the same pendulum names the poles as singular points of
+/// the chart, once each (not once per azimuth of its grid), and never
+/// calls them unstable or unstabilisable.
+#[test]
+fn stability_names_the_spherical_pendulums_poles_once_as_a_singular_chart() {
+    use mechlab::analysis::stability::{stability, Settings};
+    use mechlab::ode::Method;
+    let settings = Settings {
+        amplitude: "A".into(),
+        a_max: None,
+        samples: 40,
+        edge_tolerance: 1e-9,
+        method: Method::Taylor { tol: 1e-12 },
+    };
+    let model = &mechlab_test_models::spherical_pendulum::MODEL;
+    let found = stability(model, &[1.6, 0.1], &settings).unwrap();
+    let poles: Vec<_> = found
+        .equilibria
+        .iter()
+        .filter(|e| e.q[0].abs() < 1e-9 || (e.q[0].abs() - std::f64::consts::PI).abs() < 1e-9)
+        .collect();
+    assert_eq!(poles.len(), 2, "{:#?}", found.equilibria);
+    for pole in poles {
+        let reason = pole.reason.as_deref().unwrap();
+        assert!(reason.starts_with("singular chart"), "{reason}");
+        assert!(pole.a_star.is_none() && pole.exact_window.is_none());
+    }
+}

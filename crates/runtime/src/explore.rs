@@ -38,6 +38,10 @@ pub struct Equilibrium {
     /// (Routh's reduction with their conserved momenta at 0, where the
     /// amended potential is V itself).
     pub family_along: Vec<usize>,
+    /// The mass matrix is singular here only along cyclic coordinates (the
+    /// pole of spherical coordinates, where the azimuth degenerates): the
+    /// chart is singular, but the reduced system is regular and judges it.
+    pub pole: bool,
 }
 
 /// What the second-order test of the effective potential says of an
@@ -455,10 +459,19 @@ pub fn equilibria(
             nalgebra::DMatrix::from_fn(kept.len(), kept.len(), |a, b| sym[(kept[a], kept[b])]);
         let mut eigenvalues: Vec<f64> = reduced.symmetric_eigenvalues().iter().copied().collect();
         eigenvalues.sort_by(f64::total_cmp);
-        let verdict = if singular_chart(model, params, &q) {
-            Verdict::SingularChart
-        } else {
+        // At the singular point itself the Hamiltonian's 1/sin²θ terms make
+        // every curvature 0·∞; a step of 10⁻⁶ off it along the kept
+        // coordinates tells which momenta the singularity is along.
+        let singular = !singular_momenta(model, params, &q).is_empty();
+        let near: Vec<f64> = (0..n)
+            .map(|i| q[i] + if cyclic.contains(&i) { 0.0 } else { 1e-6 })
+            .collect();
+        let along = singular_momenta(model, params, &near);
+        let pole = singular && !along.is_empty() && along.iter().all(|i| cyclic.contains(i));
+        let verdict = if !singular || pole {
             Verdict::of(&eigenvalues)
+        } else {
+            Verdict::SingularChart
         };
         // Newton converges only linearly on a degenerate equilibrium (x⁴
         // gives the gradient x³) and the gradient's differences have a noise
@@ -494,6 +507,7 @@ pub fn equilibria(
             verdict,
             hessian_eigenvalues: eigenvalues,
             family_along: cyclic.clone(),
+            pole,
         };
         match same {
             Some(k) if norm(&equilibrium.q) < norm(&found[k].q) => found[k] = equilibrium,
@@ -504,10 +518,10 @@ pub fn equilibria(
     Ok(found)
 }
 
-/// Whether the mass matrix A is singular at q: H is ½ pᵀA⁻¹p + …, so the
-/// curvature of H along each momentum, read from three energies, is
-/// A⁻¹'s diagonal, which blows up where A is singular.
-fn singular_chart(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> bool {
+/// The momenta along which the mass matrix A is singular at q: H is
+/// ½ pᵀA⁻¹p + …, so the curvature of H along each momentum, read from
+/// three energies, is A⁻¹'s diagonal, which blows up where A is singular.
+fn singular_momenta(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> Vec<usize> {
     let n = q.len();
     let energy = |p: &[f64]| {
         let mut y = q.to_vec();
@@ -515,14 +529,16 @@ fn singular_chart(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> bool {
         model.energy(params, 0.0, &y)
     };
     let zero = energy(&vec![0.0; n]);
-    (0..n).any(|i| {
-        let mut p = vec![0.0; n];
-        p[i] = 1.0;
-        let plus = energy(&p);
-        p[i] = -1.0;
-        let curvature = 0.5 * (plus + energy(&p)) - zero;
-        !(curvature.is_finite() && curvature.abs() < 1e10)
-    })
+    (0..n)
+        .filter(|&i| {
+            let mut p = vec![0.0; n];
+            p[i] = 1.0;
+            let plus = energy(&p);
+            p[i] = -1.0;
+            let curvature = 0.5 * (plus + energy(&p)) - zero;
+            !(curvature.is_finite() && curvature.abs() < 1e10)
+        })
+        .collect()
 }
 
 /// Limits of the finite values, widened a little ((−1, 1) if none).

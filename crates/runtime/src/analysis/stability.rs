@@ -201,6 +201,18 @@ impl WithFixed for Analysis<'_> {
             probe[amplitude] = 1.0;
         }
         for q in &found {
+            if let Some(along) = singular_chart(model, self.params, q) {
+                // One entry per pole: the same point at every value of the
+                // coordinates the chart loses there.
+                let same_pole = |e: &EquilibriumStability| {
+                    e.reason.as_deref() == Some(SINGULAR_CHART)
+                        && (0..D).all(|i| along.contains(&i) || (e.q[i] - q[i]).abs() < 1e-9)
+                };
+                if !result.equilibria.iter().any(same_pole) {
+                    result.equilibria.push(at_singular_chart(q));
+                }
+                continue;
+            }
             let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
             let averaged = stays_in_averaged_system(model, self.params, q);
             if !averaged || moved_by_vibration(model, &probe, &y0) {
@@ -442,7 +454,13 @@ fn newton<const D: usize>(
             return Some(q);
         }
         let h = DMatrix::from_fn(D, D, |i, j| hessian(&q)[i][j]);
-        let step = h.lu().solve(&nalgebra::DVector::from_column_slice(&g))?;
+        let g = nalgebra::DVector::from_column_slice(&g);
+        // A Hessian singular along a cyclic coordinate (a pole, a family
+        // of equilibria): the least-squares step, in the other directions.
+        let step = match h.clone().lu().solve(&g) {
+            Some(step) => step,
+            None => h.svd(true, true).solve(&g, 1e-12).ok()?,
+        };
         for i in 0..D {
             q[i] -= step[i];
         }
@@ -493,6 +511,45 @@ fn stays_in_averaged_system<
             / (2.0 * h);
         slope.abs() < 1e-6 * scale
     })
+}
+
+/// Why an equilibrium at a singular point of the chart gets no verdict.
+const SINGULAR_CHART: &str = "singular chart: the mass matrix is singular here (a pole of the coordinates), so C + a²K and the exact system's orbits in this chart say nothing; `explore` judges a pole along a cyclic coordinate on the reduced system, other coordinates judge it in full";
+
+/// The coordinates along which the mass matrix vanishes at q (a zero
+/// diagonal entry: the azimuth at a pole of spherical coordinates), if its
+/// determinant vanishes there; None where it is regular.
+fn singular_chart<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &F,
+    params: &[f64],
+    q: &[f64; D],
+) -> Option<Vec<usize>> {
+    let a = model.mass_matrix(params, q);
+    let m = DMatrix::from_fn(D, D, |i, j| a[i][j]);
+    let scale = 1.0 + m.amax();
+    (m.determinant().abs() <= 1e-12 * scale.powi(D as i32))
+        .then(|| (0..D).filter(|&i| a[i][i].abs() <= 1e-12 * scale).collect())
+}
+
+/// The entry of an equilibrium at a singular point of the chart.
+fn at_singular_chart<const D: usize>(q: &[f64; D]) -> EquilibriumStability {
+    EquilibriumStability {
+        q: q.to_vec(),
+        lambdas: Vec::new(),
+        stable_without_vibration: false,
+        a_star: None,
+        a_star_second_order: None,
+        reason: Some(SINGULAR_CHART.into()),
+        exact_window: None,
+        exact_reason: Some(SINGULAR_CHART.into()),
+        spectral_radius: Vec::new(),
+    }
 }
 
 /// The roots λ, the verdict without vibration and a* from C + a²K.
