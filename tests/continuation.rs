@@ -4,7 +4,7 @@
 //! period-doubling cascade of Duffing's oscillator, and named errors.
 
 use mechlab::analysis::continuation::{
-    continuation, BifurcationKind, ContinuationError, ContinuationSettings,
+    continuation, BifurcationKind, ContinuationError, ContinuationSettings, Criticality,
 };
 use mechlab::models;
 use mechlab::ode::Method;
@@ -163,6 +163,15 @@ fn duffings_cascade_of_period_doublings_gives_feigenbaums_ratio() {
         .filter(|b| b.kind == BifurcationKind::PeriodDoubling)
     {
         assert!(b.located && (b.period > 8 || b.residual < 1e-9), "{b:?}");
+    }
+    // A cascade of soft onsets: each new branch takes over the stability
+    // the old one loses.
+    for b in result
+        .bifurcations
+        .iter()
+        .filter(|b| b.switched_to.is_some())
+    {
+        assert_eq!(b.criticality, Some(Criticality::Supercritical), "{b:?}");
     }
     let feigenbaum = 4.669_201_6;
     for ratio in &result.feigenbaum_ratios[..2] {

@@ -756,6 +756,17 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
     let values = scene.whole("diagram")?;
     let params = scene.parameter_values(model.info)?;
     let parameter = scene.text("parameter").to_string();
+    if parameter == "none" {
+        return Err(SceneError::BadValue {
+            name: "parameter".into(),
+            value: parameter,
+            reason: format!(
+                "model '{}' names no [fast_phase] amplitude: choose the parameter to continue in ({})",
+                model.info.name,
+                model.info.parameter_names.join(", ")
+            ),
+        });
+    }
     let to = match scene.text("to") {
         "auto" => {
             let at = model
@@ -839,6 +850,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
             "parameter",
             "coordinate",
             "residual",
+            "criticality",
         ],
         result.bifurcations.iter().map(|b| {
             (
@@ -848,6 +860,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
                 b.parameter,
                 b.state[coordinate],
                 b.residual,
+                b.criticality.map_or(String::new(), |c| format!("{c:?}")),
             )
         }),
     )?;

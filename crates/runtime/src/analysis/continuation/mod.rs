@@ -149,6 +149,37 @@ pub struct Bifurcation {
     pub located: bool,
     /// The branch switched to here, if any.
     pub switched_to: Option<usize>,
+    /// A period doubling's: from the side of the parameter the new branch
+    /// is born on (None where the old branch is stable or unstable on both
+    /// sides, or no branch was switched to).
+    pub criticality: Option<Criticality>,
+}
+
+/// Where a period doubling's new branch lies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Criticality {
+    /// Beside the old orbit where it has lost its stability: the new orbit
+    /// takes it over (a soft onset, as in Feigenbaum's cascade).
+    Supercritical,
+    /// Beside the old orbit where it is still stable: the new orbit is the
+    /// boundary of its basin, and past the point the motion jumps.
+    Subcritical,
+}
+
+/// The criticality of a period doubling at p_star whose new branch goes
+/// on at p_next, from the old branch's stability on either side.
+fn criticality(p_star: f64, p_next: f64, sides: [(f64, bool); 2]) -> Option<Criticality> {
+    if sides[0].1 == sides[1].1 {
+        return None;
+    }
+    let born_side = sides
+        .iter()
+        .find(|(p, _)| (p - p_star).signum() == (p_next - p_star).signum())?;
+    Some(match born_side.1 {
+        false => Criticality::Supercritical,
+        true => Criticality::Subcritical,
+    })
 }
 
 /// The result (and summary) of a continuation.
@@ -473,6 +504,9 @@ struct Job {
     start: Solution,
     born_at: Option<usize>,
     origin: Origin,
+    /// (parameter, stable) of the parent branch's points on either side of
+    /// the bifurcation, to tell a period doubling's criticality.
+    sides: [(f64, bool); 2],
 }
 
 /// The continuation proper, on the erased map.
@@ -503,6 +537,7 @@ fn run(
         start: first,
         born_at: None,
         origin: Origin::Start,
+        sides: [(f64::NAN, false); 2],
     }]);
     while let Some(job) = jobs.pop_front() {
         if branches.len() >= settings.max_branches {
@@ -536,6 +571,13 @@ fn run(
             bounds,
             settings.points,
         );
+        if let (Some(at), Origin::PeriodDoubling) = (job.born_at, job.origin) {
+            let first = bifurcations[at].criticality.is_none();
+            if let (true, Some(next)) = (first, followed.points.get(1)) {
+                let born = followed.points[0].p;
+                bifurcations[at].criticality = criticality(born, next.p, job.sides);
+            }
+        }
         if index == 0 && followed.points.len() < 2 {
             if let BranchEnd::StepCollapse { parameter, step } = followed.end {
                 return Err(ContinuationError::StepCollapse { parameter, step });
@@ -547,6 +589,10 @@ fn run(
             let (point, located) = branch::locate(map, k, a, b, test);
             let at = bifurcations.len();
             let before = &a.tangent;
+            let stable = |s: &Solution| {
+                Verdict::from_multipliers(&multipliers_of(&s.monodromy), 1e-7) != Verdict::Unstable
+            };
+            let sides = [(a.p, stable(a)), (b.p, stable(b))];
             for (period, start) in switch(k, &point, before, kind, settings, &branches, &jobs) {
                 let origin = if period == k {
                     Origin::BranchPoint
@@ -558,6 +604,7 @@ fn run(
                     start,
                     born_at: Some(at),
                     origin,
+                    sides,
                 });
             }
             bifurcations.push(Bifurcation {
@@ -570,6 +617,7 @@ fn run(
                 residual: residual(&point, kind),
                 located,
                 switched_to: None,
+                criticality: None,
             });
         }
         branches.push(Branch {
