@@ -339,8 +339,8 @@ impl HarmonicBalance {
     }
 }
 
-/// Bad requests get named errors: a parameter the model lacks, a model
-/// without a period map, a start where P = I (every state a fixed point:
+/// Bad requests get named errors: a parameter the model lacks, a contact
+/// model, a start where P = I (every state a fixed point:
 /// the Jacobian P' − I is singular), and a step too long for Newton that
 /// may not shrink.
 #[test]
@@ -354,14 +354,14 @@ fn bad_requests_are_named() {
     );
     assert!(err.to_string().contains("gamma"), "{err}");
 
-    let henon = models::by_name("henon_heiles").unwrap();
+    let contact = models::by_name("painleve_klein").unwrap();
     let err = continuation(
-        henon,
-        &henon.dynamic.defaults(),
-        &settings("lambda", 1.0, &[]),
+        contact,
+        &contact.dynamic.defaults(),
+        &settings("mu", 1.0, &[]),
     )
     .unwrap_err();
-    assert!(matches!(err, ContinuationError::NoPeriod(_)), "{err}");
+    assert!(matches!(err, ContinuationError::ContactModel(_)), "{err}");
 
     let err = continuation(
         &FORCED,
@@ -428,4 +428,73 @@ fn the_moved_uprights_window_tends_to_the_averaged_threshold_as_eps_squared() {
     assert!(gaps[0].abs() < 2e-3, "{gaps:?}");
     let ratio = gaps[0] / gaps[1];
     assert!((3.0..5.0).contains(&ratio), "{gaps:?}: ratio {ratio}");
+}
+
+/// A model without a fast phase has its equilibria continued. The bead on
+/// a spinning hoop: the bottom loses its stability at ω = 1 by a pitchfork
+/// (an eigenvalue of the Jacobian through 0), located to 1e-10, and the
+/// two branches switched to are cos θ = 1/ω² to 1e-9.
+#[test]
+fn the_spinning_hoops_pitchfork_and_its_branches() {
+    use mechlab_test_models::rotating_hoop::MODEL as HOOP;
+    let mut s = settings("omega", 2.0, &[0.0, 0.0]);
+    s.switch_branch_points = true;
+    let result = continuation(&HOOP, &[0.5, 0.2], &s).unwrap();
+    assert!(result.dissipative && result.diagram.is_none());
+    let pitchfork: Vec<_> = result
+        .bifurcations
+        .iter()
+        .filter(|b| b.branch == 0)
+        .collect();
+    assert_eq!(pitchfork.len(), 1, "{:?}", result.bifurcations);
+    assert_eq!(pitchfork[0].kind, BifurcationKind::BranchPoint);
+    assert!(
+        (pitchfork[0].parameter - 1.0).abs() < 1e-10,
+        "{:?}",
+        pitchfork[0]
+    );
+    assert!(pitchfork[0].residual < 1e-8, "{:?}", pitchfork[0]);
+    for p in &result.branches[0].points {
+        if (p.parameter - 1.0).abs() > 1e-6 {
+            assert_eq!(p.stable, p.parameter < 1.0, "{p:?}");
+        }
+    }
+    let off_axis: Vec<_> = result
+        .branches
+        .iter()
+        .filter(|b| b.born_at == Some(0))
+        .collect();
+    assert_eq!(off_axis.len(), 2);
+    let signs: Vec<f64> = off_axis
+        .iter()
+        .map(|b| b.points[3].state[0].signum())
+        .collect();
+    assert_eq!(signs[0], -signs[1], "one on each side");
+    for branch in off_axis {
+        for p in &branch.points[1..] {
+            let w = p.parameter;
+            assert!((p.state[0].cos() - 1.0 / (w * w)).abs() < 1e-9, "{p:?}");
+            assert!(p.stable, "off the axis the bead rests stably: {p:?}");
+        }
+    }
+}
+
+/// Van der Pol's rest state loses its stability at μ = 0 by a Hopf point:
+/// located to 1e-10, the pair of eigenvalues on the imaginary axis (±i)
+/// there.
+#[test]
+fn van_der_pols_rest_state_has_its_hopf_point_at_zero() {
+    use mechlab_test_models::van_der_pol::MODEL as VDP;
+    let result = continuation(&VDP, &[-0.5], &settings("mu", 0.5, &[0.0, 0.0])).unwrap();
+    assert_eq!(result.bifurcations.len(), 1, "{:?}", result.bifurcations);
+    let hopf = &result.bifurcations[0];
+    assert_eq!(hopf.kind, BifurcationKind::Hopf);
+    assert!(hopf.parameter.abs() < 1e-10, "{hopf:?}");
+    assert!(hopf.residual < 1e-10, "{hopf:?}");
+    for (re, im) in &hopf.multipliers {
+        assert!(
+            re.abs() < 1e-10 && (im.abs() - 1.0).abs() < 1e-10,
+            "{hopf:?}"
+        );
+    }
 }

@@ -319,8 +319,7 @@ async fn manifolds_overlay_gives_the_tangle_or_a_named_error() {
 /// right-well orbit doubles its period at γ = 0.2655817860 (as the
 /// `continuation` scene finds) and the branch of period 2 is followed from
 /// there. Errors are named: a parameter the model lacks (422, listing
-/// them), a model without a period map (422), a seed of the wrong length
-/// (400).
+/// them), a contact model (422), a seed of the wrong length (400).
 #[tokio::test]
 async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
     let request = json!({"model": "duffing", "seed": [1.0, 0.0], "parameter": "gamma", "to": 0.28, "tol": 1e-12});
@@ -352,11 +351,11 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
         bad(json!({"model": "duffing", "seed": [1.0, 0.0], "parameter": "kappa", "to": 1.0})).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
     assert!(body.contains("kappa") && body.contains("gamma"), "{body}");
-    let (status, body) = bad(
-        json!({"model": "henon_heiles", "seed": [0.0, 0.0, 0.0, 0.0], "parameter": "x", "to": 1.0}),
-    )
-    .await;
+    let (status, body) =
+        bad(json!({"model": "painleve_klein", "seed": [0.0, 0.0], "parameter": "mu", "to": 1.0}))
+            .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(body.contains("contact"), "{body}");
     let (status, body) =
         bad(json!({"model": "duffing", "seed": [1.0], "parameter": "gamma", "to": 1.0})).await;
     assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");

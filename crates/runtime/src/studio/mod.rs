@@ -805,17 +805,15 @@ pub struct BifurcationMark {
 }
 
 /// The studio's "continue this orbit" (`analysis::continuation`): the
-/// branch of the fixed point of P nearest the seed, and those born at its
-/// period doublings (up to period 4), projected on the page's axes.
+/// branch of the fixed point of P nearest the seed (the equilibrium, for a
+/// model without a fast phase), and those born at its period doublings (up
+/// to period 4), projected on the page's axes.
 pub fn continuation(
     catalog: Catalog,
     request: &ContinuationRequest,
 ) -> Result<BranchesView, StudioError> {
     use crate::analysis::continuation::{continuation, ContinuationSettings};
     let setup = request.setup.resolve(catalog, &request.unknown)?;
-    if !setup.fast_phase {
-        return Err(StudioError::NoFastPhase(setup.info.name.into()));
-    }
     let components = setup.through.len();
     if request.seed.len() != components {
         return Err(setup.bad(RequestProblem::SeedLength {

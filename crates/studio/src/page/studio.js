@@ -129,7 +129,7 @@ function draw(g, width, height) {
   if (studio.branches) drawBranches(g);
 }
 
-const BIFURCATION_NAMES = { fold: "fold", branch_point: "branch point", period_doubling: "period doubling", neimark_sacker: "Neimark–Sacker" };
+const BIFURCATION_NAMES = { fold: "fold", branch_point: "branch point", period_doubling: "period doubling", neimark_sacker: "Neimark–Sacker", hopf: "Hopf" };
 
 // The branches of "continue this orbit": the fixed point's path in the
 // plane as the parameter moves, stable solid, unstable dashed.

@@ -14,9 +14,10 @@ use crate::analysis::period_map::wrap_angle;
 use crate::ode::OdeError;
 use nalgebra::{DMatrix, DVector};
 
-/// A point of a branch: the state y of the fixed point of P^k at the
-/// parameter value p, the unit tangent of the branch there (in (y, p)),
-/// the monodromy matrix M = ∂P^k/∂y and the k points of the cycle.
+/// A point of a branch: the state y of the fixed point of P^k (or the
+/// equilibrium of a flow) at the parameter value p, the unit tangent of
+/// the branch there (in (y, p)), the linearisation — the monodromy matrix
+/// M = ∂P^k/∂y, or the flow's Jacobian J — and the k points of the cycle.
 #[derive(Clone, Debug)]
 pub(super) struct Solution {
     pub y: DVector<f64>,
@@ -24,6 +25,7 @@ pub(super) struct Solution {
     pub tangent: DVector<f64>,
     pub monodromy: DMatrix<f64>,
     pub cycle: Vec<Vec<f64>>,
+    pub flow: bool,
 }
 
 impl Solution {
@@ -39,15 +41,19 @@ impl Solution {
     pub fn test(&self, kind: TestFunction) -> f64 {
         let n = self.y.len();
         let identity = DMatrix::<f64>::identity(n, n);
-        match kind {
-            TestFunction::PlusOne => (&self.monodromy - identity).determinant(),
-            TestFunction::MinusOne => (&self.monodromy + identity).determinant(),
-            TestFunction::UnitPair => {
+        match (kind, self.flow) {
+            (TestFunction::PlusOne, false) => (&self.monodromy - identity).determinant(),
+            (TestFunction::PlusOne, true) => self.monodromy.determinant(),
+            (TestFunction::MinusOne, false) => (&self.monodromy + identity).determinant(),
+            // A flow has no period doubling.
+            (TestFunction::MinusOne, true) => 1.0,
+            (TestFunction::UnitPair, false) => {
                 let b = bialternate(&self.monodromy);
                 let m = b.nrows();
                 (b - DMatrix::<f64>::identity(m, m)).determinant()
             }
-            TestFunction::Turning => self.tangent[n],
+            (TestFunction::UnitPair, true) => bialternate_sum(&self.monodromy).determinant(),
+            (TestFunction::Turning, _) => self.tangent[n],
         }
     }
 }
@@ -55,12 +61,14 @@ impl Solution {
 /// The functions whose sign changes mark bifurcations along a branch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum TestFunction {
-    /// det(M − I): a multiplier crosses +1 (fold or branch point).
+    /// det(M − I): a multiplier crosses +1 (fold or branch point); for a
+    /// flow det(J), an eigenvalue crosses 0.
     PlusOne,
     /// det(M + I): a multiplier crosses −1 (period doubling).
     MinusOne,
     /// det(M⊙M − I): two multipliers with product 1 (a complex pair on the
-    /// unit circle: Neimark–Sacker).
+    /// unit circle: Neimark–Sacker); for a flow det(2J⊙I), two eigenvalues
+    /// of sum 0 (a pair on the imaginary axis: Hopf).
     UnitPair,
     /// The parameter's component of the tangent: a turning point.
     Turning,
@@ -75,6 +83,29 @@ fn bialternate(m: &DMatrix<f64>) -> DMatrix<f64> {
     DMatrix::from_fn(pairs.len(), pairs.len(), |r, c| {
         let ((i, j), (k, l)) = (pairs[r], pairs[c]);
         m[(i, k)] * m[(j, l)] - m[(i, l)] * m[(j, k)]
+    })
+}
+
+/// The bialternate sum 2J⊙I, whose eigenvalues are the sums λᵢ + λⱼ
+/// (i < j) of J's (Govaerts' formula, rows and columns the pairs i > j).
+fn bialternate_sum(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (0..i).map(move |j| (i, j))).collect();
+    DMatrix::from_fn(pairs.len(), pairs.len(), |r, c| {
+        let ((p, q), (r2, s)) = (pairs[r], pairs[c]);
+        if r2 == p && s == q {
+            a[(p, p)] + a[(q, q)]
+        } else if r2 == p {
+            a[(q, s)]
+        } else if s == q {
+            a[(p, r2)]
+        } else if r2 == q {
+            -a[(p, s)]
+        } else if s == p {
+            -a[(q, r2)]
+        } else {
+            0.0
+        }
     })
 }
 
@@ -144,6 +175,21 @@ fn difference(map: &dyn FamilyMap, image: &[f64], y: &[f64]) -> DVector<f64> {
 
 fn evaluate(map: &dyn FamilyMap, y: &DVector<f64>, p: f64, k: usize) -> Result<Evaluation, Miss> {
     let y: Vec<f64> = y.iter().copied().collect();
+    if map.flow() {
+        let (f, jacobian) = map.field(&y, p);
+        let h = 1e-6 * (1.0 + p.abs());
+        let (up, _) = map.field(&y, p + h);
+        let (down, _) = map.field(&y, p - h);
+        if !f.iter().chain(&up).chain(&down).all(|x| x.is_finite()) {
+            return Err(Miss::NoConvergence);
+        }
+        return Ok(Evaluation {
+            residual: DVector::from_vec(f),
+            monodromy: jacobian,
+            derivative_p: DVector::from_fn(y.len(), |i, _| (up[i] - down[i]) / (2.0 * h)),
+            cycle: vec![y],
+        });
+    }
     let (image, m, cycle) = iterate(map, &y, p, k, true)?;
     let residual = difference(map, &image, &y);
     // The integration's error varies smoothly with p, so a step of 10⁻⁵
@@ -169,26 +215,27 @@ fn evaluate(map: &dyn FamilyMap, y: &DVector<f64>, p: f64, k: usize) -> Result<E
     })
 }
 
-/// The bordered matrix [M − I, F_p; rowᵀ].
-fn bordered(e: &Evaluation, row: &DVector<f64>) -> DMatrix<f64> {
+/// The bordered matrix [F_y, F_p; rowᵀ], F_y = M − I for a map, J for a flow.
+fn bordered(e: &Evaluation, row: &DVector<f64>, flow: bool) -> DMatrix<f64> {
     let n = e.residual.len();
+    let shift = if flow { 0.0 } else { 1.0 };
     DMatrix::from_fn(n + 1, n + 1, |i, j| {
         if i == n {
             row[j]
         } else if j == n {
             e.derivative_p[i]
         } else {
-            e.monodromy[(i, j)] - f64::from(u8::from(i == j))
+            e.monodromy[(i, j)] - shift * f64::from(u8::from(i == j))
         }
     })
 }
 
 /// The unit tangent at an evaluated point, oriented along `previous`:
 /// the solution of [M − I, F_p; previousᵀ] t = (0, 1).
-fn tangent_at(e: &Evaluation, previous: &DVector<f64>) -> Option<DVector<f64>> {
+fn tangent_at(e: &Evaluation, previous: &DVector<f64>, flow: bool) -> Option<DVector<f64>> {
     let n = e.residual.len();
     let rhs = DVector::from_fn(n + 1, |i, _| f64::from(u8::from(i == n)));
-    let t = bordered(e, previous).lu().solve(&rhs)?;
+    let t = bordered(e, previous, flow).lu().solve(&rhs)?;
     let norm = t.norm();
     (norm.is_finite() && norm > 0.0).then(|| {
         let t = t / norm;
@@ -228,7 +275,7 @@ pub(super) fn correct(
         let mut rhs = DVector::zeros(n + 1);
         rhs.rows_mut(0, n).copy_from(&e.residual);
         rhs[n] = direction.dot(&(&x - predicted));
-        let step = bordered(&e, direction)
+        let step = bordered(&e, direction, map.flow())
             .lu()
             .solve(&rhs)
             .ok_or(Miss::Singular)?;
@@ -239,13 +286,14 @@ pub(super) fn correct(
         if step.norm() <= CORRECTOR_TOLERANCE * (1.0 + x.norm()) {
             // M, F_p and the tangent from the last evaluation, a step of
             // at most 1e-11 away: well within what they are used for.
-            let tangent = tangent_at(&e, direction).ok_or(Miss::Singular)?;
+            let tangent = tangent_at(&e, direction, map.flow()).ok_or(Miss::Singular)?;
             let solution = Solution {
                 y: x.rows(0, n).into_owned(),
                 p: x[n],
                 tangent,
                 monodromy: e.monodromy,
                 cycle: e.cycle,
+                flow: map.flow(),
             };
             return Ok((solution, iteration));
         }
@@ -281,7 +329,8 @@ pub(super) fn first_point(
             Err(Miss::Ode(e)) => return Err(e.into()),
             Err(_) => unreachable!("evaluate only fails in the integration"),
         };
-        let a = &e.monodromy - DMatrix::<f64>::identity(n, n);
+        let shift = if map.flow() { 0.0 } else { 1.0 };
+        let a = &e.monodromy - DMatrix::<f64>::identity(n, n) * shift;
         // Singular to working precision: no direction to continue in.
         let singular_values = a.singular_values();
         if singular_values.min() <= 1e-9 * (1.0 + e.monodromy.norm()) {
@@ -301,7 +350,7 @@ pub(super) fn first_point(
                 Miss::Ode(e) => ContinuationError::from(e),
                 _ => ContinuationError::SingularJacobian { parameter: p0 },
             })?;
-            let tangent = tangent_at(&e, &along_p)
+            let tangent = tangent_at(&e, &along_p, map.flow())
                 .ok_or(ContinuationError::SingularJacobian { parameter: p0 })?;
             return Ok(Solution {
                 y,
@@ -309,6 +358,7 @@ pub(super) fn first_point(
                 tangent,
                 monodromy: e.monodromy,
                 cycle: e.cycle,
+                flow: map.flow(),
             });
         }
     }
@@ -532,8 +582,16 @@ pub(super) fn sign_changes(
         if changes(TestFunction::MinusOne) {
             found.push((i, BifurcationKind::PeriodDoubling, TestFunction::MinusOne));
         }
-        if dissipative && a.y.len() >= 4 && changes(TestFunction::UnitPair) {
-            found.push((i, BifurcationKind::NeimarkSacker, TestFunction::UnitPair));
+        // A map of the plane has det M constant along a branch; a flow of
+        // the plane has its pair of eigenvalues, whose sum is the trace.
+        let pairs = a.y.len() >= 4 || (a.flow && a.y.len() >= 2);
+        if dissipative && pairs && changes(TestFunction::UnitPair) {
+            let kind = if a.flow {
+                BifurcationKind::Hopf
+            } else {
+                BifurcationKind::NeimarkSacker
+            };
+            found.push((i, kind, TestFunction::UnitPair));
         }
     }
     found
@@ -575,6 +633,26 @@ mod tests {
         values.sort_by(f64::total_cmp);
         for (got, want) in values.iter().zip([6.0, 10.0, 15.0]) {
             assert!((got - want).abs() < 1e-12, "{values:?}");
+        }
+    }
+
+    #[test]
+    fn bialternate_sum_eigenvalues_are_pairwise_sums() {
+        // A full matrix with eigenvalues 1, 2, 4, 7 (a similarity transform
+        // of the diagonal), so that every entry of the formula is exercised.
+        let d = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 4.0, 7.0]));
+        let t = DMatrix::from_fn(4, 4, |i, j| {
+            1.0 / (1.0 + i as f64 + 2.0 * j as f64) + f64::from(u8::from(i == j))
+        });
+        let a = &t * d * t.clone().try_inverse().unwrap();
+        let mut values: Vec<f64> = bialternate_sum(&a)
+            .complex_eigenvalues()
+            .iter()
+            .map(|z| z.re)
+            .collect();
+        values.sort_by(f64::total_cmp);
+        for (got, want) in values.iter().zip([3.0, 5.0, 6.0, 8.0, 9.0, 11.0]) {
+            assert!((got - want).abs() < 1e-9, "{values:?}");
         }
     }
 }

@@ -175,7 +175,10 @@ impl Continuation {
         let pad = 0.05 * (hi - lo).max(1e-3);
         let y_range = (lo - pad, hi + pad);
         let branches_title = format!("{} branches of periodic orbits", self.branches.len());
-        let diagram_title = "orbit diagram (attractor of P)".to_string();
+        let diagram_title = match self.flow {
+            true => "no period map: no orbit diagram".to_string(),
+            false => "orbit diagram (attractor of P)".to_string(),
+        };
         let mut figure = Figure::grid(
             3,
             1,
@@ -197,7 +200,11 @@ impl Continuation {
                     y_range,
                 ),
                 PanelSpec::new(
-                    "Floquet multipliers of P^k along the branches",
+                    if self.flow {
+                        "eigenvalues of the Jacobian along the branches"
+                    } else {
+                        "Floquet multipliers of P^k along the branches"
+                    },
                     "Re λ",
                     "Im λ",
                     (-2.5, 2.5),
@@ -237,13 +244,18 @@ impl Continuation {
                 2,
             );
         }
-        let circle: Vec<(f64, f64)> = (0..=200)
-            .map(|i| {
-                let a = std::f64::consts::TAU * i as f64 / 200.0;
-                (a.cos(), a.sin())
-            })
-            .collect();
-        figure.line(2, &circle, Rgb(120, 120, 120));
+        // Where stability is lost: the unit circle for multipliers, the
+        // imaginary axis for eigenvalues.
+        let edge: Vec<(f64, f64)> = match self.flow {
+            true => vec![(0.0, -2.0), (0.0, 2.0)],
+            false => (0..=200)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / 200.0;
+                    (a.cos(), a.sin())
+                })
+                .collect(),
+        };
+        figure.line(2, &edge, Rgb(120, 120, 120));
         let mut legend = Vec::new();
         for (kind, label, color) in KINDS {
             let marks: Vec<(f64, f64)> = self
@@ -277,7 +289,7 @@ impl Continuation {
     }
 }
 
-const KINDS: [(BifurcationKind, &str, Rgb); 4] = [
+const KINDS: [(BifurcationKind, &str, Rgb); 5] = [
     (BifurcationKind::Fold, "fold", Rgb(214, 39, 40)),
     (
         BifurcationKind::BranchPoint,
@@ -294,6 +306,7 @@ const KINDS: [(BifurcationKind, &str, Rgb); 4] = [
         "Neimark–Sacker",
         Rgb(148, 103, 189),
     ),
+    (BifurcationKind::Hopf, "Hopf", Rgb(148, 103, 189)),
 ];
 
 fn draw_run(figure: &mut Figure, run: &[(f64, f64)], stable: bool, color: Rgb) {

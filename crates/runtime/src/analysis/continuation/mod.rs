@@ -1,6 +1,8 @@
 //! How the periodic orbits of a forced or vibrated model change with a
 //! parameter: fixed points of the period map (and of its iterates P^k)
-//! continued by pseudo-arclength, their Floquet multipliers along the
+//! continued by pseudo-arclength (the equilibria of a model without a
+//! fast phase likewise, with the eigenvalues of the Jacobian and Hopf
+//! points), their Floquet multipliers along the
 //! branch, folds, branch points (pitchforks), period doublings and
 //! Neimark–Sacker points located on the branch, new branches switched to
 //! at period doublings (a cascade is followed to a requested period) and at
@@ -18,7 +20,7 @@ pub use branch::BranchEnd;
 pub use diagram::OrbitDiagram;
 
 use crate::analysis::floquet::{monodromy, multipliers_of, Verdict};
-use crate::ode::{Integrator, Method, OdeError};
+use crate::ode::{Integrator, Method, OdeError, System};
 use crate::registry::{Fixed, Model, WithFixed};
 use branch::{Origin, Solution, Steps};
 use nalgebra::{DMatrix, DVector};
@@ -69,8 +71,6 @@ pub struct DiagramSettings {
 pub enum ContinuationError {
     #[error("'{0}' is a contact model: it has no period map")]
     ContactModel(String),
-    #[error("model '{0}' has no periodic forcing or vibration (no [fast_phase]): continuation follows fixed points of a period map")]
-    NoPeriod(String),
     #[error("model '{model}' has no parameter '{name}' (parameters: {known})")]
     UnknownParameter {
         model: String,
@@ -105,6 +105,9 @@ pub enum BifurcationKind {
     /// A complex pair of multipliers on the unit circle (dissipative maps
     /// of dimension ≥ 4): an invariant circle is born.
     NeimarkSacker,
+    /// A pair of eigenvalues of an equilibrium's Jacobian on the imaginary
+    /// axis (dissipative flows): a periodic orbit is born.
+    Hopf,
 }
 
 /// One point of a branch.
@@ -116,7 +119,8 @@ pub struct BranchPoint {
     /// The k points of the cycle (the state first).
     #[serde(skip)]
     pub cycle: Vec<Vec<f64>>,
-    /// The multipliers (re, im) of P^k, largest modulus first.
+    /// The multipliers (re, im) of P^k (the eigenvalues of the Jacobian for
+    /// an equilibrium of a flow), largest modulus first.
     pub multipliers: Vec<(f64, f64)>,
     pub stable: bool,
 }
@@ -190,8 +194,12 @@ pub struct Continuation {
     pub params: BTreeMap<String, f64>,
     pub from: f64,
     pub to: f64,
-    /// Whether the map contracts area (det M ≠ 1); an area-preserving map
-    /// has no Neimark–Sacker test.
+    /// Whether the branches are of equilibria of a flow (a model without
+    /// a fast phase), with eigenvalues of the Jacobian for multipliers.
+    pub flow: bool,
+    /// Whether the map contracts area (det M ≠ 1; for a flow, trace J ≠ 0):
+    /// an area-preserving map has no Neimark–Sacker test, a Hamiltonian
+    /// flow no Hopf test.
     pub dissipative: bool,
     pub branches: Vec<Branch>,
     pub bifurcations: Vec<Bifurcation>,
@@ -215,6 +223,11 @@ pub struct Continuation {
 trait FamilyMap: Sync {
     /// Which state components are angles.
     fn periodic(&self) -> &[bool];
+    /// Whether the branches are of equilibria of a flow (a model without a
+    /// fast phase) rather than of fixed points of a period map.
+    fn flow(&self) -> bool;
+    /// The flow's field f(y; p) and its Jacobian ∂f/∂y.
+    fn field(&self, y: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>);
     /// Whether the model accepts this value of the parameter.
     fn parameter_allowed(&self, p: f64) -> bool;
     /// One period of the map from `y` at the parameter value p and, if
@@ -263,9 +276,6 @@ impl WithFixed for Work<'_> {
     ) -> Self::Output {
         let info = model.info();
         let name = info.name.to_string();
-        if !model.has_fast_phase() {
-            return Err(ContinuationError::NoPeriod(name));
-        }
         let index = info
             .parameter_names
             .iter()
@@ -289,6 +299,7 @@ impl WithFixed for Work<'_> {
             method: self.settings.method,
             periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
             evaluations: AtomicU64::new(0),
+            flow: !model.has_fast_phase(),
         };
         let mut result = run(&map, self.params[index], self.settings, &name)?;
         result.params = named;
@@ -334,6 +345,7 @@ pub(crate) fn orbit_branch<
         method,
         periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
         evaluations: AtomicU64::new(0),
+        flow: !model.has_fast_phase(),
     };
     let p0 = params[index];
     let name = model.info().name;
@@ -411,6 +423,7 @@ struct AtModel<F: 'static, const D: usize, const S: usize, const T: usize, const
     method: Method,
     periodic: Vec<bool>,
     evaluations: AtomicU64,
+    flow: bool,
 }
 
 impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>
@@ -438,6 +451,22 @@ impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const
 {
     fn periodic(&self) -> &[bool] {
         &self.periodic
+    }
+
+    fn flow(&self) -> bool {
+        self.flow
+    }
+
+    fn field(&self, y: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>) {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let system = self.model.exact(&self.with(p));
+        let y: [f64; S] = std::array::from_fn(|i| y[i]);
+        let f = system.rhs(0.0, &y);
+        let jacobian = match system.jacobian(0.0, &y) {
+            Some(j) => DMatrix::from_fn(S, S, |i, k| j[i][k]),
+            None => DMatrix::from_element(S, S, f64::NAN),
+        };
+        (f.to_vec(), jacobian)
     }
 
     fn parameter_allowed(&self, p: f64) -> bool {
@@ -524,7 +553,12 @@ fn run(
     let forward = settings.to > p0;
     let bounds = (p0.min(settings.to), p0.max(settings.to));
     let first = branch::first_point(map, settings.period, &guess, p0, forward)?;
-    let dissipative = (first.monodromy.determinant() - 1.0).abs() > 1e-6;
+    // An area-preserving map has det M = 1, a Hamiltonian flow trace J = 0.
+    let dissipative = if map.flow() {
+        first.monodromy.trace().abs() > 1e-8 * (1.0 + first.monodromy.amax())
+    } else {
+        (first.monodromy.determinant() - 1.0).abs() > 1e-6
+    };
     let steps = Steps {
         initial: settings.step,
         min: settings.min_step,
@@ -589,9 +623,7 @@ fn run(
             let (point, located) = branch::locate(map, k, a, b, test);
             let at = bifurcations.len();
             let before = &a.tangent;
-            let stable = |s: &Solution| {
-                Verdict::from_multipliers(&multipliers_of(&s.monodromy), 1e-7) != Verdict::Unstable
-            };
+            let stable = |s: &Solution| branch_point(s).stable;
             let sides = [(a.p, stable(a)), (b.p, stable(b))];
             for (period, start) in switch(k, &point, before, kind, settings, &branches, &jobs) {
                 let origin = if period == k {
@@ -632,9 +664,11 @@ fn run(
         .windows(3)
         .map(|w| (w[1] - w[0]) / (w[2] - w[1]))
         .collect();
+    // A flow has no period map to draw the attractor of.
     let diagram = settings
         .diagram
         .as_ref()
+        .filter(|_| !map.flow())
         .map(|d| diagram::orbit_diagram(map, bounds, &guess, d));
     Ok(Continuation {
         model: model.into(),
@@ -642,6 +676,7 @@ fn run(
         params: BTreeMap::new(),
         from: p0,
         to: settings.to,
+        flow: map.flow(),
         dissipative,
         branches,
         bifurcations,
@@ -732,6 +767,7 @@ fn switch(
             tangent: direction / norm,
             monodromy,
             cycle: point.cycle.iter().cycle().take(period).cloned().collect(),
+            flow: point.flow,
         })
     };
     let n = point.y.len();
@@ -743,7 +779,9 @@ fn switch(
             away(padded(v), 2 * k, m2).map_or_else(Vec::new, |s| vec![(2 * k, s)])
         }
         BifurcationKind::BranchPoint if settings.switch_branch_points => {
-            let v = branch::eigenvector_near(&point.monodromy, 1.0);
+            // The null vector of M − I (of J for a flow).
+            let target = if point.flow { 0.0 } else { 1.0 };
+            let v = branch::eigenvector_near(&point.monodromy, target);
             let Some(forward) = away(padded(v), k, point.monodromy.clone()) else {
                 return Vec::new();
             };
@@ -784,6 +822,7 @@ fn residual(point: &Solution, kind: BifurcationKind) -> f64 {
             .fold(f64::INFINITY, f64::min)
     };
     match kind {
+        BifurcationKind::Fold | BifurcationKind::BranchPoint if point.flow => nearest(0.0),
         BifurcationKind::Fold | BifurcationKind::BranchPoint => nearest(1.0),
         BifurcationKind::PeriodDoubling => nearest(-1.0),
         BifurcationKind::NeimarkSacker => values
@@ -791,17 +830,30 @@ fn residual(point: &Solution, kind: BifurcationKind) -> f64 {
             .filter(|(_, im)| im.abs() > 0.0)
             .map(|(re, im)| (re.hypot(*im) - 1.0).abs())
             .fold(f64::INFINITY, f64::min),
+        BifurcationKind::Hopf => values
+            .iter()
+            .filter(|(_, im)| im.abs() > 0.0)
+            .map(|(re, _)| re.abs())
+            .fold(f64::INFINITY, f64::min),
     }
 }
 
 fn branch_point(s: &Solution) -> BranchPoint {
     let multipliers = multipliers_of(&s.monodromy);
-    let verdict = Verdict::from_multipliers(&multipliers, 1e-7);
+    // An equilibrium is stable with no eigenvalue right of the imaginary
+    // axis (beyond round-off), a fixed point with no multiplier outside
+    // the unit circle.
+    let stable = if s.flow {
+        let scale = 1.0 + s.monodromy.amax();
+        multipliers.iter().all(|(re, _)| *re <= 1e-7 * scale)
+    } else {
+        Verdict::from_multipliers(&multipliers, 1e-7) != Verdict::Unstable
+    };
     BranchPoint {
         parameter: s.p,
         state: s.y.iter().copied().collect(),
         cycle: s.cycle.clone(),
         multipliers,
-        stable: verdict != Verdict::Unstable,
+        stable,
     }
 }
