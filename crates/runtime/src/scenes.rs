@@ -756,7 +756,8 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
     let values = scene.whole("diagram")?;
     let params = scene.parameter_values(model.info)?;
     let parameter = scene.text("parameter").to_string();
-    if parameter == "none" {
+    // (A contact model is refused by the analysis, by name.)
+    if parameter == "none" && model.sized.is_some() {
         return Err(SceneError::BadValue {
             name: "parameter".into(),
             value: parameter,
