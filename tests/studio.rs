@@ -362,6 +362,63 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
     assert!(body.contains("seed"), "{body}");
 }
 
+/// The Poincaré section of a model without a fast phase: an orbit of
+/// Hénon–Heiles at E = 1/8 from a seed on the plane x = 0 is the library's
+/// section orbit point for point, on H = E to 1e-9; the MEGNO map has
+/// accessible and inaccessible pixels and a chaotic fraction; a model with
+/// a fast phase and a seed where the energy is not accessible are named
+/// errors (422).
+#[tokio::test]
+async fn section_orbits_and_their_megno_map() {
+    use mechlab::analysis::section::{section, SectionSettings};
+    let request = json!({"model": "henon_heiles", "energy": 0.125, "seed": [0.1, 0.0], "crossings": 50, "method": "dop853", "tol": 1e-12});
+    let (status, _, body) = call("POST", "/api/section", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let points: Vec<[f64; 2]> = serde_json::from_value(answer["points"].clone()).unwrap();
+    assert_eq!(points.len(), 50);
+    assert!(answer["energy_drift"].as_f64().unwrap() < 1e-9, "{body}");
+    let model = mechlab::models::by_name("henon_heiles").unwrap();
+    let settings = SectionSettings {
+        coordinate: 0,
+        value: 0.0,
+        rising: true,
+        energy: 0.125,
+        crossings: 50,
+        t_max: 20.0 * 50.0 + 100.0,
+        tol: 1e-12,
+    };
+    let library = section(model, &model.dynamic.defaults(), &[[0.1, 0.0]], &settings).unwrap();
+    assert_eq!(points, library.orbits[0].points);
+
+    let map = json!({"model": "henon_heiles", "energy": 0.125, "pixels": 16, "t_max": 200.0});
+    let (status, _, body) = call("POST", "/api/section_map", Some(map)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let megno = answer["megno"].as_array().unwrap();
+    assert_eq!(megno.len(), 256);
+    assert!(megno.iter().any(Value::is_null) && megno.iter().any(Value::is_f64));
+    let fraction = answer["chaotic_fraction"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&fraction), "{fraction}");
+
+    let (status, _, body) = call(
+        "POST",
+        "/api/section",
+        Some(json!({"model": "kapitza", "energy": 0.1, "seed": [0.1, 0.0], "crossings": 5})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(body.contains("fast phase"), "{body}");
+    let (status, _, body) = call(
+        "POST",
+        "/api/section",
+        Some(json!({"model": "henon_heiles", "energy": 0.125, "seed": [0.9, 0.0], "crossings": 5})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(body.contains("not accessible"), "{body}");
+}
+
 /// Every bad request gets a status and a message naming the problem; the
 /// router keeps answering.
 #[tokio::test]
@@ -734,6 +791,52 @@ mod browser {
         std::fs::create_dir_all(&folder).unwrap();
         std::fs::write(folder.join("browser.png"), png).unwrap();
         eprintln!("screenshot: {}", folder.join("browser.png").display());
+
+        // Hénon–Heiles has no fast phase: its Poincaré section at
+        // E = 1/8, a clicked orbit's crossings drawn, the MEGNO map behind.
+        client
+            .find(Locator::Id("model"))
+            .await
+            .unwrap()
+            .select_by_value("henon_heiles")
+            .await
+            .unwrap();
+        wait_for(
+            &client,
+            "studio.ready && studio.model.name === 'henon_heiles'",
+            30,
+        )
+        .await;
+        client
+            .execute(
+                "document.getElementById('show-section').click(); document.getElementById('show-megno').click(); return true;",
+                vec![],
+            )
+            .await
+            .unwrap();
+        wait_for(&client, "studio.section && studio.megno !== null", 60).await;
+        client
+            .execute("studio.sectionSeed(0.1, 0.0); return true;", vec![])
+            .await
+            .unwrap();
+        wait_for(
+            &client,
+            "studio.orbits.length === 1 && studio.orbits[0].done && studio.orbits[0].points.length > 100",
+            60,
+        )
+        .await;
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        let painted = client
+            .execute(
+                "const [x, y] = studio.orbits[0].points[20]; const [px, py] = studio.pixelOf(x, y); return studio.colorAt(px, py);",
+                vec![],
+            )
+            .await
+            .unwrap();
+        let painted: Vec<u8> = serde_json::from_value(painted).unwrap();
+        assert_ne!(&painted[..3], &[255, 255, 255], "a crossing not drawn");
+        let png = client.screenshot().await.unwrap();
+        std::fs::write(folder.join("section.png"), png).unwrap();
         client.close().await.unwrap();
     }
 }

@@ -12,6 +12,8 @@
 //! | `POST /api/overlay` | level sets of H̄ and the equilibria, JSON |
 //! | `POST /api/manifolds` | W^u, W^s of the hyperbolic point, JSON |
 //! | `POST /api/continuation` | the periodic orbit nearest a seed continued in a parameter, JSON |
+//! | `POST /api/section` | a Poincaré section orbit at a fixed energy from a seed, JSON |
+//! | `POST /api/section_map` | the MEGNO map of that section, JSON |
 //!
 //! The numerics run on blocking threads; a streamed answer stops computing
 //! when the page drops it (a superseded request). Every error is a JSON
@@ -82,7 +84,8 @@ impl ApiError {
                 StudioError::ContactModel(_)
                 | StudioError::NoFastPhase(_)
                 | StudioError::Splitting(_)
-                | StudioError::Continuation(_),
+                | StudioError::Continuation(_)
+                | StudioError::Section(_),
             ) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
@@ -129,6 +132,8 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/overlay", post(overlay))
         .route("/api/manifolds", post(manifolds))
         .route("/api/continuation", post(continuation))
+        .route("/api/section", post(section))
+        .route("/api/section_map", post(section_map))
         .fallback(|uri: axum::http::Uri| async move { ApiError::NotFound(uri.to_string()) })
         .with_state(catalog)
 }
@@ -185,6 +190,20 @@ async fn continuation(State(catalog): State<Catalog>, body: Bytes) -> Result<Res
     let request: studio::ContinuationRequest = serde_json::from_slice(&body)?;
     let answer =
         blocking(move || studio::continuation(catalog, &request).map_err(ApiError::from)).await?;
+    Ok(axum::Json(answer).into_response())
+}
+
+async fn section(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
+    let request: studio::SectionRequest = serde_json::from_slice(&body)?;
+    let answer =
+        blocking(move || studio::section(catalog, &request).map_err(ApiError::from)).await?;
+    Ok(axum::Json(answer).into_response())
+}
+
+async fn section_map(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
+    let request: studio::SectionMapRequest = serde_json::from_slice(&body)?;
+    let answer =
+        blocking(move || studio::section_map(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 

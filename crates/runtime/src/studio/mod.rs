@@ -51,6 +51,8 @@ pub enum StudioError {
     Splitting(#[from] crate::analysis::separatrix::SplittingError),
     #[error(transparent)]
     Continuation(#[from] crate::analysis::continuation::ContinuationError),
+    #[error(transparent)]
+    Section(#[from] crate::analysis::section::SectionError),
 }
 
 /// What is wrong with a request's numbers.
@@ -883,4 +885,145 @@ pub fn continuation(
         bifurcations,
         seconds: result.seconds,
     })
+}
+
+/// The plane of a Poincaré section on the page: q_c = value crossed in one
+/// direction, at the energy H = E (models without a fast phase, 2 degrees
+/// of freedom).
+#[derive(Clone, Debug, Deserialize)]
+pub struct SectionPlane {
+    pub energy: f64,
+    #[serde(default)]
+    pub coordinate: usize,
+    #[serde(default)]
+    pub value: f64,
+    #[serde(default = "rising")]
+    pub rising: bool,
+}
+
+fn rising() -> bool {
+    true
+}
+
+impl SectionPlane {
+    fn settings(&self, crossings: usize, tol: f64) -> crate::analysis::section::SectionSettings {
+        crate::analysis::section::SectionSettings {
+            coordinate: self.coordinate,
+            value: self.value,
+            rising: self.rising,
+            energy: self.energy,
+            crossings,
+            t_max: 20.0 * crossings as f64 + 100.0,
+            tol,
+        }
+    }
+}
+
+/// What `POST /api/section` asks: the section orbit from a seed on the
+/// plane (the other coordinate and its momentum; the missing momentum is
+/// solved from H = E).
+#[derive(Clone, Debug, Deserialize)]
+pub struct SectionRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    #[serde(flatten)]
+    pub plane: SectionPlane,
+    pub seed: [f64; 2],
+    pub crossings: usize,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+/// A section orbit: its points on the plane (the seed first), its full
+/// start and its largest drift from H = E.
+#[derive(Clone, Debug, Serialize)]
+pub struct SectionPoints {
+    pub points: Vec<[f64; 2]>,
+    pub start: Vec<f64>,
+    pub energy_drift: f64,
+}
+
+/// One orbit of the section map (`analysis::section`) for the studio.
+pub fn section(catalog: Catalog, request: &SectionRequest) -> Result<SectionPoints, StudioError> {
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    let crossings = setup.count("crossings", request.crossings, MAX_PERIODS)?;
+    let settings = request.plane.settings(crossings, setup_tol(&setup));
+    let mut found =
+        crate::analysis::section::section(setup.handle, &setup.params, &[request.seed], &settings)?;
+    let orbit = found.orbits.remove(0);
+    Ok(SectionPoints {
+        points: orbit.points,
+        start: orbit.start,
+        energy_drift: orbit.energy_drift,
+    })
+}
+
+/// What `POST /api/section_map` asks: the MEGNO map of the section.
+#[derive(Clone, Debug, Deserialize)]
+pub struct SectionMapRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    #[serde(flatten)]
+    pub plane: SectionPlane,
+    pub pixels: usize,
+    /// The time each orbit of the map runs.
+    pub t_max: f64,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+/// The MEGNO map of a section: ⟨Y⟩ per pixel (row 0 at the bottom, null
+/// where the energy is not accessible) over `window`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SectionMapView {
+    pub window: [[f64; 2]; 2],
+    pub pixels: usize,
+    pub megno: Vec<Option<f64>>,
+    pub chaotic_fraction: f64,
+    pub seconds: f64,
+}
+
+/// The MEGNO map of the section (`analysis::section_map`) for the studio.
+pub fn section_map(
+    catalog: Catalog,
+    request: &SectionMapRequest,
+) -> Result<SectionMapView, StudioError> {
+    use crate::analysis::section_map::{section_map, SectionMapSettings};
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    let pixels = setup.count("pixels", request.pixels, MAX_CHAOS_PIXELS)?;
+    if !(request.t_max > 0.0 && request.t_max <= 10_000.0) {
+        return Err(setup.bad(RequestProblem::NotFinite {
+            what: "t_max (in (0, 10 000])",
+        }));
+    }
+    let settings = SectionMapSettings {
+        section: request.plane.settings(1, setup_tol(&setup)),
+        pixels,
+        t_max: request.t_max,
+        extent: 3.0,
+    };
+    let map = section_map(setup.handle, &setup.params, &settings)?;
+    Ok(SectionMapView {
+        window: map.window,
+        pixels: map.pixels,
+        megno: map
+            .megno
+            .iter()
+            .map(|y| y.is_finite().then_some(*y))
+            .collect(),
+        chaotic_fraction: map.chaotic_fraction,
+        seconds: map.seconds,
+    })
+}
+
+/// The tolerance of the page's method, for the section's DOP853 and the
+/// map's Taylor method.
+fn setup_tol(setup: &Resolved) -> f64 {
+    match setup.method {
+        Method::Dop853 { rtol, .. } | Method::Radau5 { rtol, .. } => rtol,
+        Method::Taylor { tol } => tol,
+        Method::Rk4 { .. } | Method::Gauss { .. } => 1e-10,
+    }
 }

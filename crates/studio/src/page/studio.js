@@ -16,6 +16,8 @@ const studio = {
   chaos: null,
   manifolds: null,
   branches: null,
+  section: false,
+  megno: null,
   nextId: 1,
   pointsReceived: 0,
 };
@@ -114,9 +116,10 @@ function draw(g, width, height) {
   g.fillStyle = "#fff";
   g.fillRect(0, 0, width, height);
   if (!studio.model) return;
-  if ($("show-chaos").checked && studio.chaos) drawChaos(g);
+  if (studio.section && studio.megno && $("show-megno").checked) drawImage(g, studio.megno);
+  if (!studio.section && $("show-chaos").checked && studio.chaos) drawChaos(g);
   drawGrid(g, width, height);
-  if (studio.overlay && $("show-levels").checked) drawLevels(g);
+  if (!studio.section && studio.overlay && $("show-levels").checked) drawLevels(g);
   for (const orbit of studio.orbits) {
     g.fillStyle = orbit.color;
     for (const [x, y] of orbit.points) {
@@ -124,6 +127,7 @@ function draw(g, width, height) {
       g.fillRect(px - 0.8, py - 0.8, 1.6, 1.6);
     }
   }
+  if (studio.section) return;
   if (studio.manifolds && $("show-manifolds").checked) drawManifolds(g);
   if (studio.overlay && $("show-equilibria").checked) drawEquilibria(g);
   if (studio.branches) drawBranches(g);
@@ -292,23 +296,26 @@ function shadeColor(s) {
 }
 
 function chaosImage(level) {
-  const n = level.pixels;
+  return pixelImage(level.pixels, (k) => shadeColor(level.shades[k]));
+}
+
+// An n × n image of the colours [r, g, b] of the pixels k (row 0 at the bottom).
+function pixelImage(n, colorOf) {
   const image = document.createElement("canvas");
   image.width = n;
   image.height = n;
   const data = image.getContext("2d").createImageData(n, n);
   for (let k = 0; k < n * n; k++) {
     const i = k % n, j = Math.floor(k / n);
-    const [r, g, b] = shadeColor(level.shades[k]);
-    const at = ((n - 1 - j) * n + i) * 4;
-    data.data.set([r, g, b, 255], at);
+    data.data.set([...colorOf(k), 255], ((n - 1 - j) * n + i) * 4);
   }
   image.getContext("2d").putImageData(data, 0, 0);
   return image;
 }
 
-function drawChaos(g) {
-  const { image, ranges } = studio.chaos;
+function drawChaos(g) { drawImage(g, studio.chaos); }
+
+function drawImage(g, { image, ranges }) {
   const [x0, y1] = toPixel(ranges[0][0], ranges[1][1]);
   const [x1, y0] = toPixel(ranges[0][1], ranges[1][0]);
   g.imageSmoothingEnabled = false;
@@ -323,13 +330,19 @@ function orbitRequest(orbit) {
   return { ...setup(), seed: orbit.seed, periods: orbit.periods };
 }
 
-function startOrbit(orbit) {
+// Cancels an orbit's run under way and empties it for a new one.
+function restart(orbit) {
   if (orbit.controller) orbit.controller.abort();
   orbit.controller = new AbortController();
   orbit.points = [];
   orbit.done = false;
   orbit.error = null;
   orbit.params = { ...studio.params };
+}
+
+function startOrbit(orbit) {
+  if (orbit.section) { startSectionOrbit(orbit); return; }
+  restart(orbit);
   const request = orbitRequest(orbit);
   postStream("/api/orbit", request, orbit.controller.signal, (line) => {
     if (line.points) {
@@ -353,6 +366,7 @@ function startOrbit(orbit) {
 }
 
 function seedAt(x, y) {
+  if (studio.section) { seedSection(x, y); return; }
   if (!studio.model.fast_phase) {
     say(`model '${studio.model.name}' has no fast phase: there is no period map to draw`);
     return;
@@ -367,6 +381,113 @@ function seedAt(x, y) {
   startOrbit(orbit);
   listOrbits();
 }
+
+// ---------- the Poincaré section of a model without a fast phase ----------
+
+function sectionPlane() {
+  return {
+    energy: Number($("energy").value),
+    coordinate: Number($("section-coordinate").value),
+    value: Number($("section-value").value),
+    rising: $("section-direction").value === "rising",
+  };
+}
+
+function seedSection(x, y) {
+  const id = studio.nextId++;
+  const orbit = { id, seed: [x, y], section: true, color: orbitColor(id),
+    periods: Math.max(1, Math.round(Number($("periods").value))), points: [] };
+  studio.orbits.push(orbit);
+  say("");
+  startSectionOrbit(orbit);
+  listOrbits();
+}
+
+async function startSectionOrbit(orbit) {
+  restart(orbit);
+  const request = { ...setup(), ...sectionPlane(), seed: orbit.seed, crossings: orbit.periods };
+  try {
+    const answer = await postJson("/api/section", request, orbit.controller.signal);
+    orbit.points = answer.points;
+    orbit.drift = answer.energy_drift;
+    studio.pointsReceived += answer.points.length;
+  } catch (e) {
+    if (aborted(e)) return;
+    orbit.error = e.message;
+    say(`section: ${e.message}`);
+  }
+  orbit.done = true;
+  listOrbits();
+  redraw();
+}
+
+let megnoController = null;
+
+// The MEGNO map of the section, refined 32² → 64² → 128².
+async function refreshMegno() {
+  if (megnoController) megnoController.abort();
+  megnoController = null;
+  if (!studio.section || !$("show-megno").checked) { studio.megno = null; $("megno-note").textContent = ""; redraw(); return; }
+  megnoController = new AbortController();
+  const signal = megnoController.signal;
+  const t_max = Number($("megno-time").value);
+  for (const pixels of [32, 64, 128]) {
+    try {
+      const map = await postJson("/api/section_map", { ...setup(), ...sectionPlane(), pixels, t_max }, signal);
+      studio.megno = { ranges: map.window, image: megnoImage(map) };
+      $("megno-note").textContent = `(${pixels}², chaotic ${(100 * map.chaotic_fraction).toFixed(1)} %)`;
+      if (pixels === 32 && !studio.megnoViewSet) {
+        studio.view = { x: map.window[0].slice(), y: map.window[1].slice() };
+        studio.megnoViewSet = true;
+      }
+      redraw();
+    } catch (e) {
+      if (!aborted(e)) { say(`MEGNO map: ${e.message}`); studio.megno = null; redraw(); }
+      return;
+    }
+  }
+}
+
+// ⟨Y⟩ ≈ 2 on tori (light), growing in the chaotic sea (dark); white where
+// the energy is not accessible.
+function megnoImage(map) {
+  return pixelImage(map.pixels, (k) => {
+    const y = map.megno[k];
+    if (y === null) return [255, 255, 255];
+    const shade = Math.round(255 - 200 * Math.min(1, Math.max(0, (y - 2) / 4)));
+    return [shade, shade, Math.min(255, shade + 20)];
+  });
+}
+
+// Section mode: the page's plane becomes (other coordinate, its momentum).
+function setSectionMode(on) {
+  const model = studio.model;
+  studio.section = on;
+  removeOrbits(0);
+  if (on) {
+    const other = 1 - Number($("section-coordinate").value);
+    studio.axes = [other, 2 + other];
+    studio.view = { x: [-1, 1], y: [-1, 1] };
+    studio.megnoViewSet = false;
+  } else {
+    studio.axes = model.default_axes.slice();
+    defaultView(model);
+  }
+  buildAxes(model);
+  refreshMegno();
+  redraw();
+}
+
+function buildSection(model) {
+  const applies = !model.fast_phase && model.state.length === 4 && model.kind === "hamiltonian";
+  $("section-controls").style.display = applies ? "" : "none";
+  $("show-section").checked = false;
+  studio.section = false;
+  studio.megno = null;
+  $("section-coordinate").innerHTML = model.state.slice(0, 2).map((name, i) => `<option value="${i}">${name}</option>`).join("");
+}
+
+studio.sectionSeed = (x, y) => seedSection(x, y);
 
 // Scripting from the browser's console: studio.seed(q, p) seeds an orbit.
 studio.seed = (x, y) => seedAt(x, y);
@@ -531,6 +652,7 @@ async function chooseModel(name) {
   buildParameters(model);
   buildAxes(model);
   buildContinuation(model);
+  buildSection(model);
   $("order").disabled = !model.fast_phase;
   $("order").value = "1";
   defaultView(model);
@@ -647,6 +769,12 @@ function wire() {
   for (const id of ["method", "tol"]) $(id).addEventListener("change", () => { rerunOrbits(); refreshOverlays(); });
   for (const id of ["show-levels", "show-equilibria"]) $(id).addEventListener("change", () => { refreshOverlay(); redraw(); });
   $("show-manifolds").addEventListener("change", refreshManifolds);
+  $("show-section").addEventListener("change", () => setSectionMode($("show-section").checked));
+  const sectionChanged = debounce(() => { if (studio.section) { rerunOrbits(); refreshMegno(); } }, 150);
+  $("energy").addEventListener("change", () => { $("energy-slider").value = $("energy").value; sectionChanged(); });
+  $("energy-slider").addEventListener("input", () => { $("energy").value = $("energy-slider").value; sectionChanged(); });
+  for (const id of ["section-value", "section-direction", "show-megno", "megno-time"]) $(id).addEventListener("change", sectionChanged);
+  $("section-coordinate").addEventListener("change", () => { if (studio.section) setSectionMode(true); });
   $("cont-clear").addEventListener("click", () => { studio.branches = null; $("cont-list").innerHTML = ""; redraw(); });
   for (const id of ["show-chaos", "chaos-periods"]) $(id).addEventListener("change", refreshChaos);
   for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
