@@ -148,3 +148,30 @@ fn megno_maps_find_no_chaos_in_oscillators_and_chaos_growing_with_energy() {
     );
     assert_eq!(low.failed + high.failed, 0);
 }
+
+/// The free double pendulum (`models/free_double_pendulum.toml`): near
+/// the bottom of its well (E = −2.9, the least H being −3) it is nearly
+/// linear, two normal modes, and its MEGNO map finds no chaos; at
+/// E = −1 most of the section is chaotic. Its second angle is drawn on
+/// its circle, [−π, π), however often the rod turns.
+#[test]
+fn the_free_double_pendulum_goes_from_regular_to_chaotic_with_energy() {
+    use mechlab::analysis::section_map::{section_map, SectionMapSettings};
+    let model = models::by_name("free_double_pendulum").unwrap();
+    let params = model.dynamic.defaults();
+    let map = |energy: f64| {
+        let settings = SectionMapSettings {
+            section: settings(energy),
+            pixels: 24,
+            t_max: 300.0,
+            extent: 3.2,
+        };
+        section_map(model, &params, &settings).unwrap()
+    };
+    let (low, high) = (map(-2.9), map(-1.0));
+    assert_eq!(low.chaotic_fraction, 0.0, "E = −2.9");
+    assert!(high.chaotic_fraction > 0.6, "E = −1: {}", high.chaotic_fraction);
+    let turning = section(model, &params, &[[0.0, 0.0]], &settings(0.0)).unwrap();
+    let angles = turning.orbits[0].points.iter().map(|p| p[0]);
+    assert!(angles.clone().all(|a| (-std::f64::consts::PI..std::f64::consts::PI).contains(&a)));
+}

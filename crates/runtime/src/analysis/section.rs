@@ -159,6 +159,7 @@ impl WithFixed for Sections<'_> {
         let c = s.coordinate;
         let other = 1 - c;
         let angle = fixed.periodic()[c];
+        let other_angle = fixed.periodic()[other];
         let names = info.state_names();
         let system = fixed.exact(self.params);
         let energy = |y: &[f64; S]| self.model.dynamic.energy(self.params, 0.0, y);
@@ -200,7 +201,12 @@ impl WithFixed for Sections<'_> {
                         })?;
                     let on_plane = run.hits.iter().filter(|hit| offset(&hit.y).abs() < 1e-6);
                     for hit in on_plane.take(s.crossings - points.len()) {
-                        points.push([hit.y[other], hit.y[D + other]]);
+                        // The other coordinate on its circle, if an angle.
+                        let along = match other_angle {
+                            true => crate::analysis::period_map::wrap_angle(hit.y[other]),
+                            false => hit.y[other],
+                        };
+                        points.push([along, hit.y[D + other]]);
                         energy_drift = energy_drift.max((energy(&hit.y) - s.energy).abs());
                         plane_distance = plane_distance.max(offset(&hit.y).abs());
                     }
