@@ -170,8 +170,14 @@ fn the_free_double_pendulum_goes_from_regular_to_chaotic_with_energy() {
     };
     let (low, high) = (map(-2.9), map(-1.0));
     assert_eq!(low.chaotic_fraction, 0.0, "E = −2.9");
-    assert!(high.chaotic_fraction > 0.6, "E = −1: {}", high.chaotic_fraction);
+    assert!(
+        high.chaotic_fraction > 0.6,
+        "E = −1: {}",
+        high.chaotic_fraction
+    );
     let turning = section(model, &params, &[[0.0, 0.0]], &settings(0.0)).unwrap();
     let angles = turning.orbits[0].points.iter().map(|p| p[0]);
-    assert!(angles.clone().all(|a| (-std::f64::consts::PI..std::f64::consts::PI).contains(&a)));
+    assert!(angles
+        .clone()
+        .all(|a| (-std::f64::consts::PI..std::f64::consts::PI).contains(&a)));
 }
