@@ -411,7 +411,6 @@ large_works! {
     period_map: crate::analysis::period_map::Portraits<'_> => Result<crate::analysis::period_map::Portrait, crate::analysis::period_map::PeriodMapError>;
     chaos_map: crate::analysis::chaos_map::Map<'_> => Result<crate::analysis::chaos_map::ChaosMap, crate::analysis::chaos_map::ChaosMapError>;
     studio_orbit: crate::studio::OrbitWork<'_> => Result<crate::studio::OrbitEnd, crate::studio::StudioError>;
-    section: crate::analysis::section::Sections<'_> => Result<crate::analysis::section::Section, crate::analysis::section::SectionError>;
     continuation: crate::analysis::continuation::Work<'_> => Result<crate::analysis::continuation::Continuation, crate::analysis::continuation::ContinuationError>;
 }
 

@@ -11,7 +11,7 @@
 //! drifted from H = E and from the plane.
 
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError};
-use crate::registry::{Fixed, Model, WithFixed};
+use crate::registry::{Fixed, Model, Sized, WithFixed};
 use rayon::prelude::*;
 
 /// Where the section lies and how far each orbit is followed.
@@ -111,8 +111,25 @@ pub fn section(
         seeds,
         settings,
     };
-    crate::registry::with_fixed(model, work)
-        .ok_or_else(|| SectionError::ContactModel(model.info.name.into()))?
+    // Compiled for 2 degrees of freedom only: the event location's
+    // instances at the other sizes were compile time for nothing.
+    let name = model.info.name.to_string();
+    let fast_phase = matches!(
+        model.dynamic.kind(),
+        crate::registry::Kind::Hamiltonian {
+            fast_phase: true,
+            ..
+        }
+    );
+    match model.sized {
+        Some(_) if fast_phase => Err(SectionError::FastPhase(name)),
+        Some(Sized::Dof2(fixed)) => work.run::<_, 2, 4, 8, 20>(fixed),
+        Some(_) => Err(SectionError::Dimension {
+            model: name,
+            dof: model.info.coordinates.len(),
+        }),
+        None => Err(SectionError::ContactModel(name)),
+    }
 }
 
 /// The work of [`section`] at one size.

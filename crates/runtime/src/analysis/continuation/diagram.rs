@@ -3,8 +3,8 @@
 //! batch lanes) and the figure of a continuation.
 
 use super::{BifurcationKind, Continuation, DiagramSettings, FamilyMap};
-use crate::analysis::period_map::{orbit, wrap_angle};
-use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, Orbit, System};
+use crate::analysis::period_map::orbit;
+use crate::ode::{Integrator, Method, OdeError, System};
 use crate::plot::{palette, Figure, PanelSpec, Rgb};
 use rayon::prelude::*;
 
@@ -55,9 +55,10 @@ pub(super) fn orbit_diagram(
 }
 
 /// Orbits of the period map of each (system, period), from `start`: the
-/// `iterates` states after `transient` periods, angles wrapped. In the
-/// batch lanes for `taylor` (each lane its own system), in chunks on all
-/// cores.
+/// `iterates` states after `transient` periods, angles wrapped, on all
+/// cores. (The batch lanes would be 2–3× faster, but their instances for
+/// the plain field at every size cost the runtime's compile more than the
+/// diagram's seconds are worth.)
 pub(super) fn iterates<S: System<N> + Sync, const N: usize>(
     method: Method,
     problems: &[(S, Result<f64, OdeError>)],
@@ -66,78 +67,21 @@ pub(super) fn iterates<S: System<N> + Sync, const N: usize>(
     transient: usize,
     iterates: usize,
 ) -> Vec<Result<Vec<Vec<f64>>, OdeError>> {
-    let chunk = 64;
     problems
-        .par_chunks(chunk)
-        .flat_map_iter(|problems| {
-            chunk_iterates(method, problems, start, wrap, transient, iterates)
-        })
-        .collect()
-}
-
-fn chunk_iterates<S: System<N>, const N: usize>(
-    method: Method,
-    problems: &[(S, Result<f64, OdeError>)],
-    start: &[f64; N],
-    wrap: &[bool; N],
-    transient: usize,
-    iterates: usize,
-) -> Vec<Result<Vec<Vec<f64>>, OdeError>> {
-    let wrapped = |y: &[f64; N]| -> Vec<f64> {
-        y.iter()
-            .zip(wrap)
-            .map(|(x, w)| if *w { wrap_angle(*x) } else { *x })
-            .collect()
-    };
-    let scalar = |(system, period): &(S, Result<f64, OdeError>)| {
-        let period = period.clone()?;
-        let mut integrator = Integrator::new(method)?;
-        let states = orbit(
-            &mut integrator,
-            system,
-            period,
-            start,
-            transient + iterates,
-            wrap,
-        )?;
-        Ok(states[transient + 1..].iter().map(wrapped).collect())
-    };
-    let lanes = match method {
-        Method::Taylor { .. } => LaneIntegrator::new(method).ok(),
-        _ => None,
-    };
-    let Some(mut lanes) = lanes.filter(|_| problems.iter().all(|(_, t)| t.is_ok())) else {
-        return problems.iter().map(scalar).collect();
-    };
-    let orbits: Vec<Orbit<S, N>> = problems
-        .iter()
-        .map(|(system, period)| Orbit {
-            system,
-            start: *start,
-            end: *period.as_ref().expect("checked"),
-        })
-        .collect();
-    let mut recorded: Vec<(usize, Vec<Vec<f64>>)> =
-        vec![(0, Vec::with_capacity(iterates)); problems.len()];
-    let errors = lanes.stream(&orbits, |k, y| {
-        for (x, w) in y.iter_mut().zip(wrap) {
-            if *w {
-                *x = wrap_angle(*x);
-            }
-        }
-        let (done, states) = &mut recorded[k];
-        *done += 1;
-        if *done > transient {
-            states.push(y.to_vec());
-        }
-        *done < transient + iterates
-    });
-    errors
-        .into_iter()
-        .zip(recorded)
-        .map(|(error, (_, states))| match error {
-            Some(e) => Err(e),
-            None => Ok(states),
+        .par_iter()
+        .map(|(system, period)| {
+            let period = period.clone()?;
+            let mut integrator = Integrator::new(method)?;
+            // `orbit` keeps the angles in [−π, π).
+            let states = orbit(
+                &mut integrator,
+                system,
+                period,
+                start,
+                transient + iterates,
+                wrap,
+            )?;
+            Ok(states[transient + 1..].iter().map(|y| y.to_vec()).collect())
         })
         .collect()
 }
