@@ -33,7 +33,7 @@ import heyoka as hy
 ENERGY = 0.125
 PIXELS = 100
 T_MAX = 1000.0
-CHUNK = 0.5
+CHUNK = 2.0
 TOLERANCES = [1e-9, 1e-12]
 REPEAT = 3
 ROOT = Path(__file__).resolve().parent.parent

@@ -111,7 +111,7 @@ pub fn section_map(
     let centre =
         |i: usize, range: [f64; 2]| range[0] + (range[1] - range[0]) * (i as f64 + 0.5) / n as f64;
     let system = fixed.exact(params);
-    let chunk = 0.5;
+    let chunk = 2.0;
     let chunks = (settings.t_max / chunk).ceil() as usize;
     let w0 = [0.5; 4];
     let rows: Vec<(Vec<f64>, usize)> = (0..n)
