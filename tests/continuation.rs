@@ -136,6 +136,25 @@ fn kapitzas_upright_changes_stability_at_the_exact_floquet_edges() {
         (a.state[0] + b.state[0]).abs() < 1e-9 && a.state[0].abs() > 1e-3,
         "{a:?} {b:?}"
     );
+
+    // Past the period doubling, the branch of period 2 breaks its symmetry
+    // at a branch point where the corrector's matrix is singular: located
+    // all the same (on the chord between trials), its multipliers at +1 to
+    // the square root of round-off (a double multiplier).
+    s.to = 6.0;
+    s.max_period = 2;
+    let result = continuation(model, &params, &s).unwrap();
+    let on_doubled: Vec<_> = result
+        .bifurcations
+        .iter()
+        .filter(|b| b.period == 2 && b.kind == BifurcationKind::BranchPoint)
+        .collect();
+    assert_eq!(on_doubled.len(), 1, "{:?}", result.bifurcations);
+    assert!(
+        on_doubled[0].located && on_doubled[0].residual < 1e-6,
+        "{:?}",
+        on_doubled[0]
+    );
 }
 
 /// Duffing's x'' + δx' − x + x³ = γ cos ωt (δ = 0.3, ω = 1.2), the orbit in

@@ -496,8 +496,9 @@ pub(super) fn follow(
 /// changes sign: regula falsi (Illinois) in the arclength s along a's
 /// tangent, each trial point corrected onto the branch, until p moves by
 /// less than 10⁻¹² (1 + |p|). Where a corrector fails (at a branch point
-/// the bordered Jacobian is singular, so trials close to it may), the
-/// bracket's end of smaller |test|; the flag says whether the point is
+/// the bordered Jacobian is singular, so trials close to it may), the trial
+/// is the chord's point; where even that cannot be evaluated, the
+/// bracket's end of smaller |test|. The flag says whether the point is
 /// located to 10⁻⁹ (1 + |p|) in the parameter.
 pub(super) fn locate(
     map: &dyn FamilyMap,
@@ -522,7 +523,26 @@ pub(super) fn locate(
         } else {
             0.5 * (lo.0 + hi.0)
         };
-        let Some(point) = at(s).or_else(|| at(0.5 * (lo.0 + hi.0))) else {
+        // Near a branch point the corrector's bordered matrix is singular
+        // and its trials may fail: then the point of the chord between the
+        // bracket's ends, off the branch by O(width²), with its own
+        // linearisation.
+        let on_chord = || -> Option<Solution> {
+            let theta = (s - lo.0) / (hi.0 - lo.0);
+            let x = lo.2.x() + (hi.2.x() - lo.2.x()) * theta;
+            let n = x.len() - 1;
+            let (y, p) = (x.rows(0, n).into_owned(), x[n]);
+            let e = evaluate(map, &y, p, k).ok()?;
+            Some(Solution {
+                y,
+                p,
+                tangent: lo.2.tangent.clone(),
+                monodromy: e.monodromy,
+                cycle: e.cycle,
+                flow: map.flow(),
+            })
+        };
+        let Some(point) = at(s).or_else(on_chord) else {
             break;
         };
         let f = point.test(test);
