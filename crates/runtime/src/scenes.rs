@@ -704,6 +704,157 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// Scene `stability`: stabilisation by vibration of any model's
+/// equilibria (thresholds, exact windows, the orbits the vibration moves
+/// them into) and, with `chart=x,y`, a stability chart in two parameters.
+pub fn stability_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use crate::analysis::stability::{stability, stability_chart, Settings, StabilityError};
+    let model = model_from_args(catalog, "kapitza")?;
+    let info = model.info;
+    let [method, tol] = method_knobs("dop853", "1e-10");
+    let mut knobs = vec![
+        knob("model", "kapitza", "the model (a file models/<name>.toml) with a fast phase"),
+        knob("amplitude", info.amplitude.unwrap_or("none"), "the parameter that scales the vibration (default: the model file's [fast_phase] amplitude)"),
+        method,
+        tol,
+        knob("samples", "40", "amplitudes sampled on (0, a_max] to bracket the exact window's edges"),
+        knob("a_max", "auto", "largest amplitude of the exact window (auto: 3 a*)"),
+        knob("edge_tolerance", "1e-9", "the window's edges and the chart's boundaries are bisected to this"),
+        knob("chart", "none", "two parameters x,y for a stability chart of the equilibrium chart_q (none: no chart)"),
+        knob("chart_q", "0", "the equilibrium of the chart, comma-separated (0: all coordinates zero)"),
+        knob("chart_x", "0.02,0.5,40", "first, last value and count of x"),
+        knob("chart_y_max", "12", "y is sampled on (0, chart_y_max]"),
+        knob("chart_y_samples", "120", "samples of y that bracket the boundaries"),
+        knob("chart_tile_columns", "4", "chart columns per tile, each written to out/stability.tiles/ when done so a rerun resumes (0: no tiles)"),
+        knob("chart_only_tiles", "all", "compute only these chart tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the chart"),
+    ];
+    knobs.extend(parameter_knobs(info, &[]));
+    let scene = Scene::from_args(
+        "stability",
+        "stabilisation by vibration of any model's equilibria",
+        &knobs,
+    )?;
+    let params = scene.parameter_values(info)?;
+    let settings = Settings {
+        amplitude: scene.text("amplitude").to_string(),
+        a_max: (scene.text("a_max") != "auto")
+            .then(|| scene.positive("a_max"))
+            .transpose()?,
+        samples: scene.count("samples")?,
+        edge_tolerance: scene.positive("edge_tolerance")?,
+        method: method_from(&scene)?,
+    };
+    let result = stability(model, &params, &settings)?;
+    for moved in &result.moved_by_vibration {
+        match (&moved.periodic_orbit, moved.verdict) {
+            (Some(orbit), Some(verdict)) => eprintln!(
+                "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}; stable for amplitudes {:?} {}",
+                moved.q,
+                moved.amplitude,
+                moved.multipliers,
+                moved.exact_window,
+                moved.exact_reason.as_deref().unwrap_or(""),
+            ),
+            _ => eprintln!(
+                "q = {:?}: moved by the vibration, no periodic orbit found near it ({})",
+                moved.q,
+                moved.exact_reason.as_deref().unwrap_or("Newton did not converge"),
+            ),
+        }
+    }
+    if let Some(reason) = &result.none_because {
+        eprintln!("no equilibrium analysed: {reason}");
+    }
+    for e in &result.equilibria {
+        let reason = e.reason.as_deref().unwrap_or("");
+        eprintln!(
+            "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?}",
+            e.q, e.lambdas, e.a_star, e.exact_window
+        );
+    }
+    let rows = result
+        .equilibria
+        .iter()
+        .enumerate()
+        .flat_map(|(k, e)| e.spectral_radius.iter().map(move |p| (k, p[0], p[1])));
+    scene.write_csv(
+        "spectral_radius.csv",
+        &["equilibrium", "amplitude", "spectral_radius"],
+        rows,
+    )?;
+    if let Some(figure) = result.figure() {
+        scene.save_figure(&figure, "spectral_radius.png")?;
+    }
+    if scene.text("chart") != "none" {
+        let chart_settings = chart_settings(&scene, &settings, info.coordinates.len())?;
+        let chart = match stability_chart(model, &params, &chart_settings) {
+            // A job of an array: its tiles are written, the last run draws.
+            Err(StabilityError::Partial) => {
+                eprintln!("chart tiles {} written", scene.text("chart_only_tiles"));
+                return Ok(());
+            }
+            chart => chart?,
+        };
+        let rows = chart
+            .boundaries
+            .iter()
+            .zip(&chart.x_values)
+            .flat_map(|(edges, x)| edges.iter().map(move |y| (*x, *y)));
+        scene.write_csv(
+            "chart_boundaries.csv",
+            &[chart.x.as_str(), chart.y.as_str()],
+            rows,
+        )?;
+        scene.save_figure(&chart.figure(), "chart.png")?;
+        scene.write_text(
+            "chart.json",
+            &serde_json::to_string_pretty(&chart).unwrap_or_default(),
+        )?;
+    }
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
+/// The chart's settings from its knobs.
+fn chart_settings(
+    scene: &Scene,
+    settings: &crate::analysis::stability::Settings,
+    dof: usize,
+) -> Result<crate::analysis::stability::ChartSettings, SceneError> {
+    let bad = |name: &str, reason: &str| SceneError::BadValue {
+        name: name.into(),
+        value: scene.text(name).into(),
+        reason: reason.into(),
+    };
+    let Some((x, y)) = scene.text("chart").split_once(',') else {
+        return Err(bad("chart", "two parameter names x,y"));
+    };
+    let [first, last, count] = scene.numbers("chart_x")?[..] else {
+        return Err(bad("chart_x", "first,last,count"));
+    };
+    if !(count >= 2.0 && count.fract() == 0.0) {
+        return Err(bad("chart_x", "a whole count of at least 2"));
+    }
+    let n = count as usize;
+    Ok(crate::analysis::stability::ChartSettings {
+        q: if scene.text("chart_q") == "0" {
+            vec![0.0; dof]
+        } else {
+            scene.numbers("chart_q")?
+        },
+        x: x.trim().into(),
+        x_values: (0..n)
+            .map(|k| first + (last - first) * k as f64 / (n - 1) as f64)
+            .collect(),
+        y: y.trim().into(),
+        y_max: scene.positive("chart_y_max")?,
+        y_samples: scene.count("chart_y_samples")?,
+        edge_tolerance: settings.edge_tolerance,
+        method: settings.method,
+        tiles: tiles_from(scene, ["chart_tile_columns", "chart_only_tiles"])?,
+    })
+}
+
 /// Scene `continuation`: the periodic orbits of a model's period map
 /// followed in one parameter, their bifurcations, and the orbit diagram.
 pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
