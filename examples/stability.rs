@@ -3,15 +3,164 @@
 //! that stays one of the averaged system: the roots λ of det(C − λA) = 0,
 //! the threshold a* of the amplitude from V + V_vibr = C + a²K (or why there
 //! is none), and the exact system's stability window from its Floquet
-//! multipliers, drawn as the spectral radius against the amplitude; an
-//! equilibrium the vibration moves is replaced by the periodic orbit it
-//! turns into, with its window. With `--set chart=x,y`, the stability chart
-//! of one equilibrium in two parameters, its boundaries located by
-//! bisection.
+//! multipliers, drawn as the spectral radius against the amplitude. With
+//! `--set chart=x,y`, the stability chart of one equilibrium in two
+//! parameters, its boundaries located by bisection.
 //!
 //! `cargo run --release --example stability -- --set model=triple_pendulum`
 //! `cargo run --release --example stability -- --set chart=eps,A --set chart_y_max=12`
 
+use mechlab::analysis::stability::{
+    stability, stability_chart, ChartSettings, Settings, StabilityError,
+};
+use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
+use mechlab::scenes::{method_from, method_knobs, model_from_args, tiles_from};
+
 fn main() {
-    mechlab::scene::run(|| mechlab::scenes::stability_scene(mechlab::models::MODELS));
+    run(|| {
+        let model = model_from_args(mechlab::models::MODELS, "kapitza")?;
+        let info = model.info;
+        let [method, tol] = method_knobs("dop853", "1e-10");
+        let mut knobs = vec![
+            knob("model", "kapitza", "the model (a file models/<name>.toml) with a fast phase"),
+            knob("amplitude", info.amplitude.unwrap_or("none"), "the parameter that scales the vibration (default: the model file's [fast_phase] amplitude)"),
+            method,
+            tol,
+            knob("samples", "40", "amplitudes sampled on (0, a_max] to bracket the exact window's edges"),
+            knob("a_max", "auto", "largest amplitude of the exact window (auto: 3 a*)"),
+            knob("edge_tolerance", "1e-9", "the window's edges and the chart's boundaries are bisected to this"),
+            knob("chart", "none", "two parameters x,y for a stability chart of the equilibrium chart_q (none: no chart)"),
+            knob("chart_q", "0", "the equilibrium of the chart, comma-separated (0: all coordinates zero)"),
+            knob("chart_x", "0.02,0.5,40", "first, last value and count of x"),
+            knob("chart_y_max", "12", "y is sampled on (0, chart_y_max]"),
+            knob("chart_y_samples", "120", "samples of y that bracket the boundaries"),
+            knob("chart_tile_columns", "4", "chart columns per tile, each written to out/stability.tiles/ when done so a rerun resumes (0: no tiles)"),
+            knob("chart_only_tiles", "all", "compute only these chart tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the chart"),
+        ];
+        knobs.extend(parameter_knobs(info, &[]));
+        let scene = Scene::from_args(
+            "stability",
+            "stabilisation by vibration of any model's equilibria",
+            &knobs,
+        )?;
+        let params = scene.parameter_values(info)?;
+        let settings = Settings {
+            amplitude: scene.text("amplitude").to_string(),
+            a_max: (scene.text("a_max") != "auto")
+                .then(|| scene.positive("a_max"))
+                .transpose()?,
+            samples: scene.count("samples")?,
+            edge_tolerance: scene.positive("edge_tolerance")?,
+            method: method_from(&scene)?,
+        };
+        let result = stability(model, &params, &settings)?;
+        for moved in &result.moved_by_vibration {
+            match (&moved.periodic_orbit, moved.verdict) {
+                (Some(orbit), Some(verdict)) => eprintln!(
+                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}; stable for amplitudes {:?} {}",
+                    moved.q,
+                    moved.amplitude,
+                    moved.multipliers,
+                    moved.exact_window,
+                    moved.exact_reason.as_deref().unwrap_or(""),
+                ),
+                _ => eprintln!(
+                    "q = {:?}: moved by the vibration, no periodic orbit found near it ({})",
+                    moved.q,
+                    moved.exact_reason.as_deref().unwrap_or("Newton did not converge"),
+                ),
+            }
+        }
+        if let Some(reason) = &result.none_because {
+            eprintln!("no equilibrium analysed: {reason}");
+        }
+        for e in &result.equilibria {
+            let reason = e.reason.as_deref().unwrap_or("");
+            eprintln!(
+                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?}",
+                e.q, e.lambdas, e.a_star, e.exact_window
+            );
+        }
+        let rows = result
+            .equilibria
+            .iter()
+            .enumerate()
+            .flat_map(|(k, e)| e.spectral_radius.iter().map(move |p| (k, p[0], p[1])));
+        scene.write_csv(
+            "spectral_radius.csv",
+            &["equilibrium", "amplitude", "spectral_radius"],
+            rows,
+        )?;
+        if let Some(figure) = result.figure() {
+            scene.save_figure(&figure, "spectral_radius.png")?;
+        }
+        if scene.text("chart") != "none" {
+            let chart_settings = chart_settings(&scene, &settings, info.coordinates.len())?;
+            let chart = match stability_chart(model, &params, &chart_settings) {
+                // A job of an array: its tiles are written, the last run draws.
+                Err(StabilityError::Partial) => {
+                    eprintln!("chart tiles {} written", scene.text("chart_only_tiles"));
+                    return Ok(());
+                }
+                chart => chart?,
+            };
+            let rows = chart
+                .boundaries
+                .iter()
+                .zip(&chart.x_values)
+                .flat_map(|(edges, x)| edges.iter().map(move |y| (*x, *y)));
+            scene.write_csv(
+                "chart_boundaries.csv",
+                &[chart.x.as_str(), chart.y.as_str()],
+                rows,
+            )?;
+            scene.save_figure(&chart.figure(), "chart.png")?;
+            scene.write_text(
+                "chart.json",
+                &serde_json::to_string_pretty(&chart).unwrap_or_default(),
+            )?;
+        }
+        scene.write_summary(&result)?;
+        Ok(())
+    });
+}
+
+/// The chart's settings from its knobs.
+fn chart_settings(
+    scene: &Scene,
+    settings: &Settings,
+    dof: usize,
+) -> Result<ChartSettings, SceneError> {
+    let bad = |name: &str, reason: &str| SceneError::BadValue {
+        name: name.into(),
+        value: scene.text(name).into(),
+        reason: reason.into(),
+    };
+    let Some((x, y)) = scene.text("chart").split_once(',') else {
+        return Err(bad("chart", "two parameter names x,y"));
+    };
+    let [first, last, count] = scene.numbers("chart_x")?[..] else {
+        return Err(bad("chart_x", "first,last,count"));
+    };
+    if !(count >= 2.0 && count.fract() == 0.0) {
+        return Err(bad("chart_x", "a whole count of at least 2"));
+    }
+    let n = count as usize;
+    Ok(ChartSettings {
+        q: if scene.text("chart_q") == "0" {
+            vec![0.0; dof]
+        } else {
+            scene.numbers("chart_q")?
+        },
+        x: x.trim().into(),
+        x_values: (0..n)
+            .map(|k| first + (last - first) * k as f64 / (n - 1) as f64)
+            .collect(),
+        y: y.trim().into(),
+        y_max: scene.positive("chart_y_max")?,
+        y_samples: scene.count("chart_y_samples")?,
+        edge_tolerance: settings.edge_tolerance,
+        method: settings.method,
+        tiles: tiles_from(scene, ["chart_tile_columns", "chart_only_tiles"])?,
+    })
 }
