@@ -9,9 +9,9 @@
 //! `cargo run --release --example explore -- --set model=elastic_pendulum --set k=20`
 
 use mechlab::explore::{explore, Settings};
-use mechlab::ode::Method;
 use mechlab::registry::Kind;
 use mechlab::scene::{knob, parameter_knobs, run, Scene};
+use mechlab::scenes::{method_from, method_knobs};
 
 fn main() {
     run(|| {
@@ -19,12 +19,13 @@ fn main() {
         let handle = mechlab::models::by_name(&name)?;
         let model = handle.dynamic;
         let info = model.info();
+        let [method, tol] = method_knobs("dop853", "1e-10");
         let mut knobs = vec![
             knob("model", "kapitza", "the model (a file models/<name>.toml)"),
             knob("y0", "auto", "initial state, comma-separated: [q; p] or [s; s'] (auto: q = 0.3, 0.5, …, p = 0; contacts: s = 0, −0.3, …, s' = 1)"),
             knob("t_end", "20", "length of the run"),
-            knob("method", "dop853", "integration method (rk4, dop853, gauss4, gauss6, radau5, taylor)"),
-            knob("tol", "1e-10", "tolerance, or step for fixed-step methods"),
+            method,
+            tol,
             knob("samples", "2000", "samples of the time series"),
             knob("periods", "300", "periods of the period map (models with a fast phase)"),
         ];
@@ -51,7 +52,7 @@ fn main() {
             _ => scene.numbers("y0")?,
         };
         let settings = Settings {
-            method: Method::parse(scene.text("method"), scene.positive("tol")?)?,
+            method: method_from(&scene)?,
             t_end: scene.positive("t_end")?,
             samples: scene.count("samples")?,
             periods: scene.count("periods")?,
