@@ -359,7 +359,7 @@ impl HarmonicBalance {
 }
 
 /// Bad requests get named errors: a parameter the model lacks, a contact
-/// model, a start where P = I (every state a fixed point:
+/// model, a start at a singular point of the model, a start where P = I (every state a fixed point:
 /// the Jacobian P' − I is singular), and a step too long for Newton that
 /// may not shrink.
 #[test]
@@ -400,6 +400,19 @@ fn bad_requests_are_named() {
         matches!(err, ContinuationError::StepCollapse { .. }),
         "{err}"
     );
+
+    // The elastic pendulum's spring at length 0, a singular point of its
+    // polar coordinates: the start's orbit cannot be followed, and the
+    // error says where.
+    let elastic = models::by_name("elastic_pendulum").unwrap();
+    let err = continuation(
+        elastic,
+        &elastic.dynamic.defaults(),
+        &settings("a", 3.0, &[0.0]),
+    )
+    .unwrap_err();
+    assert!(matches!(err, ContinuationError::Start { .. }), "{err}");
+    assert!(err.to_string().contains("elastic_pendulum"), "{err}");
 
     let mut s = settings("gamma", 0.3, &[1.0, 0.0]);
     s.min_step = 0.0;

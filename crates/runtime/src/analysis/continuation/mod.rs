@@ -85,6 +85,15 @@ pub enum ContinuationError {
     SingularJacobian { parameter: f64 },
     #[error("Newton found no fixed point of the period map from {guess:?} at parameter {parameter}: give a better `start`")]
     NoFixedPoint { guess: Vec<f64>, parameter: f64 },
+    /// The integration failed during Newton's search for the first point
+    /// (a start at a singular point of the model, an orbit that leaves).
+    #[error("model '{model}': the orbit from the start {guess:?} (parameter {parameter}) could not be followed while searching for the first point ({source}); start elsewhere")]
+    Start {
+        model: String,
+        guess: Vec<f64>,
+        parameter: f64,
+        source: OdeError,
+    },
     #[error("the first branch has no second point: the step collapsed at parameter {parameter} (step {step:e}); try a smaller `step` or `min_step`")]
     StepCollapse { parameter: f64, step: f64 },
     #[error(transparent)]
@@ -552,7 +561,16 @@ fn run(
     guess.resize(n, 0.0);
     let forward = settings.to > p0;
     let bounds = (p0.min(settings.to), p0.max(settings.to));
-    let first = branch::first_point(map, settings.period, &guess, p0, forward)?;
+    let first =
+        branch::first_point(map, settings.period, &guess, p0, forward).map_err(|e| match e {
+            ContinuationError::Ode(source) => ContinuationError::Start {
+                model: model.into(),
+                guess: guess.clone(),
+                parameter: p0,
+                source,
+            },
+            other => other,
+        })?;
     // An area-preserving map has det M = 1, a Hamiltonian flow trace J = 0.
     let dissipative = if map.flow() {
         first.monodromy.trace().abs() > 1e-8 * (1.0 + first.monodromy.amax())
