@@ -300,16 +300,7 @@ impl WithFixed for Work<'_> {
                 model: name.clone(),
                 reason: format!("{} parameter values given", self.params.len()),
             })?;
-        let periodic = model.periodic();
-        let map = AtModel::<F, D, S, T, V> {
-            model,
-            params: self.params.to_vec(),
-            index,
-            method: self.settings.method,
-            periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
-            evaluations: AtomicU64::new(0),
-            flow: !model.has_fast_phase(),
-        };
+        let map = AtModel::<F, D, S, T, V>::new(model, self.params, index, self.settings.method);
         let mut result = run(&map, self.params[index], self.settings, &name)?;
         result.params = named;
         result.state_names = info.state_names();
@@ -346,16 +337,7 @@ pub(crate) fn orbit_branch<
     start: &[f64],
     bounds: (f64, f64),
 ) -> Result<OrbitBranch, ContinuationError> {
-    let periodic = model.periodic();
-    let map = AtModel::<F, D, S, T, V> {
-        model,
-        params: params.to_vec(),
-        index,
-        method,
-        periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
-        evaluations: AtomicU64::new(0),
-        flow: !model.has_fast_phase(),
-    };
+    let map = AtModel::<F, D, S, T, V>::new(model, params, index, method);
     let p0 = params[index];
     let name = model.info().name;
     // (parameter, stable, state) along the branch, and the located changes.
@@ -438,6 +420,21 @@ struct AtModel<F: 'static, const D: usize, const S: usize, const T: usize, const
 impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>
     AtModel<F, D, S, T, V>
 {
+    /// The model at `params`, its parameter `index` free: a map if it has
+    /// a fast phase, a flow if not.
+    fn new(model: &'static F, params: &[f64], index: usize, method: Method) -> Self {
+        let periodic = model.periodic();
+        AtModel {
+            model,
+            params: params.to_vec(),
+            index,
+            method,
+            periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
+            evaluations: AtomicU64::new(0),
+            flow: !model.has_fast_phase(),
+        }
+    }
+
     fn with(&self, p: f64) -> Vec<f64> {
         let mut params = self.params.clone();
         params[self.index] = p;
