@@ -3,12 +3,14 @@
 //! section map is the identity (every crossing returns to the seed); with
 //! it on, every crossing lies on the plane and at H = E.
 
-use mechlab::analysis::section::{section, seeds_across, SectionError, SectionSettings};
+use mechlab::analysis::section::{
+    parse_plane, section, seeds_across, SectionError, SectionSettings,
+};
 use mechlab::models;
 
 fn settings(energy: f64) -> SectionSettings {
     SectionSettings {
-        coordinate: 0,
+        plane: [1.0, 0.0],
         value: 0.0,
         rising: true,
         energy,
@@ -180,4 +182,83 @@ fn the_free_double_pendulum_goes_from_regular_to_chaotic_with_energy() {
     assert!(angles
         .clone()
         .all(|a| (-std::f64::consts::PI..std::f64::consts::PI).contains(&a)));
+}
+
+/// Planes given as linear functions of the coordinates.
+#[test]
+fn planes_are_read_as_linear_functions_of_the_coordinates() {
+    let names = ["x", "y"];
+    let read = |text: &str| parse_plane(text, &names);
+    assert_eq!(read("x").unwrap(), [1.0, 0.0]);
+    assert_eq!(read("x - y").unwrap(), [1.0, -1.0]);
+    assert_eq!(read("x + 0.5*y").unwrap(), [1.0, 0.5]);
+    assert_eq!(read("-2*y").unwrap(), [0.0, -2.0]);
+    assert_eq!(read("1e-3*x − y").unwrap(), [1e-3, -1.0]);
+    for bad in ["z", "x*", "0*x", "", "2*x*y", "inf*x"] {
+        assert!(read(bad).is_err(), "{bad:?} was read");
+    }
+}
+
+/// On the tilted plane x + 0.5 y = 0 the seeds lie on the plane at H = E,
+/// the uncoupled (isochronous) oscillators return to their seed, and the
+/// coupled section map is area-preserving in the plane's canonical chart
+/// (Q_o, P_o) = (y, p_y − 0.5 p_x): its Jacobian's determinant, by central
+/// differences, is 1.
+#[test]
+fn a_tilted_plane_has_a_canonical_chart() {
+    let model = models::by_name("henon_heiles").unwrap();
+    let tilted = |energy: f64, crossings: usize| SectionSettings {
+        plane: [1.0, 0.5],
+        crossings,
+        ..settings(energy)
+    };
+    let seeds = [[0.2, 0.1], [-0.3, -0.2]];
+    let free = section(model, &[0.0], &seeds, &tilted(0.3, 20)).unwrap();
+    assert_eq!(free.plane, "x + 0.5·y = 0 (increasing)");
+    assert_eq!(free.axes, ["y".to_string(), "p_y − 0.5·p_x".to_string()]);
+    for (orbit, seed) in free.orbits.iter().zip(&seeds) {
+        let y = &orbit.start;
+        assert!((y[0] + 0.5 * y[1]).abs() < 1e-15);
+        let energy = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3]) / 2.0;
+        assert!((energy - 0.3).abs() < 1e-12);
+        // Rising: (x + 0.5 y)' = px + 0.5 py > 0, and P_o is the seed's.
+        assert!(y[2] + 0.5 * y[3] > 0.0);
+        assert!((y[3] - 0.5 * y[2] - seed[1]).abs() < 1e-14);
+        assert_eq!(orbit.points.len(), 20);
+        for p in &orbit.points {
+            assert!((p[0] - seed[0]).hypot(p[1] - seed[1]) < 1e-8, "{p:?}");
+        }
+    }
+    // The same plane written as −x − 0.5 y, crossed falling: the same map.
+    let turned = SectionSettings {
+        plane: [-1.0, -0.5],
+        rising: false,
+        ..tilted(0.125, 2)
+    };
+    let first_return = |settings: &SectionSettings, seed: [f64; 2]| {
+        section(model, &[1.0], &[seed], settings).unwrap().orbits[0].points[1]
+    };
+    let seed = [0.1, 0.05];
+    let (a, b) = (
+        first_return(&tilted(0.125, 2), seed),
+        first_return(&turned, seed),
+    );
+    assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-12, "{a:?} {b:?}");
+    // Area preservation of the coupled map at E = 1/8.
+    let h = 1e-5;
+    let column = |k: usize| {
+        let (mut plus, mut minus) = (seed, seed);
+        plus[k] += h;
+        minus[k] -= h;
+        let (p, m) = (
+            first_return(&tilted(0.125, 2), plus),
+            first_return(&tilted(0.125, 2), minus),
+        );
+        [(p[0] - m[0]) / (2.0 * h), (p[1] - m[1]) / (2.0 * h)]
+    };
+    let (c0, c1) = (column(0), column(1));
+    let determinant = c0[0] * c1[1] - c0[1] * c1[0];
+    assert!((determinant - 1.0).abs() < 1e-6, "det {determinant}");
+    // The map is not trivial there: the return moved the seed.
+    assert!((a[0] - seed[0]).hypot(a[1] - seed[1]) > 1e-3, "{a:?}");
 }

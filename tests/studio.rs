@@ -380,7 +380,7 @@ async fn section_orbits_and_their_megno_map() {
     assert!(answer["energy_drift"].as_f64().unwrap() < 1e-9, "{body}");
     let model = mechlab::models::by_name("henon_heiles").unwrap();
     let settings = SectionSettings {
-        coordinate: 0,
+        plane: [1.0, 0.0],
         value: 0.0,
         rising: true,
         energy: 0.125,

@@ -879,7 +879,9 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
 /// Scene `section`: the Poincaré section of an autonomous model of two
 /// degrees of freedom at a fixed energy.
 pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use crate::analysis::section::{section, seeds_across, SectionSettings};
+    use crate::analysis::section::{
+        parse_plane, section, seeds_across, SectionError, SectionSettings,
+    };
     let model = model_from_args(catalog, Defaults(&[]).get("model", "henon_heiles"))?;
     let mut knobs = vec![
         knob(
@@ -889,15 +891,15 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         ),
         knob("energy", "0.125", "the energy H = E of every orbit"),
         knob(
-            "coordinate",
-            "0",
-            "the plane is this coordinate (0 = first) equal to `value`",
+            "plane",
+            model.info.coordinates[0],
+            "the plane: a linear function of the coordinates (\"x\", \"q1 - q2\", \"x + 0.5*y\") equal to `value`",
         ),
         knob("value", "0", "the plane's value"),
         knob(
             "direction",
             "rising",
-            "crossings with the coordinate increasing (rising) or decreasing (falling)",
+            "crossings with the plane's function increasing (rising) or decreasing (falling)",
         ),
         knob(
             "orbits",
@@ -937,14 +939,8 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         }
     };
     let settings = SectionSettings {
-        coordinate: scene
-            .text("coordinate")
-            .parse()
-            .map_err(|_| SceneError::BadValue {
-                name: "coordinate".into(),
-                value: scene.text("coordinate").into(),
-                reason: "a coordinate's index (0, 1)".into(),
-            })?,
+        plane: parse_plane(scene.text("plane"), model.info.coordinates)
+            .map_err(SectionError::from)?,
         value: scene.number("value")?,
         rising,
         energy: scene.number("energy")?,

@@ -1,14 +1,19 @@
 //! Poincaré surfaces of section of autonomous models of two degrees of
-//! freedom at a fixed energy: the plane q_c = value crossed in one
-//! direction, each orbit seeded on the plane by the other coordinate and
-//! its momentum, with the missing momentum p_c solved from H = E.
+//! freedom at a fixed energy: the plane q_c + slope·q_o = value (a linear
+//! function of the coordinates) crossed in one direction, each orbit
+//! seeded on the plane by a point of its canonical chart with the missing
+//! momentum solved from H = E.
 //!
-//! H is quadratic in the momenta (the model files are checked for it), so
-//! along p_c it is α p² + β p + γ, read exactly from three values; the root
-//! whose rate q_c' = ∂H/∂p_c = 2αp + β has the crossing's sign is taken.
-//! Crossings are located on DOP853's dense output to 10⁻¹² in time (the
-//! integrator's event location); each orbit reports how far its points
-//! drifted from H = E and from the plane.
+//! The chart is that of the linear canonical change Q_c = q_c + slope·q_o,
+//! Q_o = q_o, P_c = p_c, P_o = p_o − slope·p_c: the plane is Q_c = value,
+//! the section map is area-preserving in (Q_o, P_o), and with slope 0 they
+//! are the other coordinate and its momentum. H is quadratic in the
+//! momenta (the model files are checked for it), so along P_c it is
+//! α P² + β P + γ, read exactly from three values; the root whose rate
+//! Q_c' = ∂H/∂P_c = 2αP + β has the crossing's sign is taken. Crossings are
+//! located on DOP853's dense output to 10⁻¹² in time (the integrator's
+//! event location); each orbit reports how far its points drifted from
+//! H = E and from the plane.
 
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError};
 use crate::registry::{Fixed, Model, Sized, WithFixed};
@@ -17,10 +22,11 @@ use rayon::prelude::*;
 /// Where the section lies and how far each orbit is followed.
 #[derive(Clone, Debug)]
 pub struct SectionSettings {
-    /// The coordinate q_c whose value defines the plane.
-    pub coordinate: usize,
+    /// The plane a·q = value, a linear function of the coordinates ([1, 0]:
+    /// the first coordinate's plane; [1, −1]: equal coordinates).
+    pub plane: [f64; 2],
     pub value: f64,
-    /// Crossings with q_c increasing (else decreasing).
+    /// Crossings with a·q increasing (else decreasing).
     pub rising: bool,
     /// The energy of every orbit.
     pub energy: f64,
@@ -37,8 +43,8 @@ pub struct SectionSettings {
 pub struct SectionOrbit {
     /// The full state the orbit started from (on the plane, at H = E).
     pub start: Vec<f64>,
-    /// (other coordinate, its momentum) at each crossing, the seed first
-    /// (in the scene's CSV, not its summary).
+    /// (Q_o, P_o) at each crossing, the seed first (in the scene's CSV,
+    /// not its summary).
     #[serde(skip)]
     pub points: Vec<[f64; 2]>,
     /// How many.
@@ -54,9 +60,9 @@ pub struct SectionOrbit {
 pub struct Section {
     pub model: String,
     pub energy: f64,
-    /// The plane, e.g. "x = 0 (x increasing)".
+    /// The plane, e.g. "x = 0 (increasing)".
     pub plane: String,
-    /// The names of the two axes on the plane.
+    /// The names of the two axes on the plane, Q_o and P_o.
     pub axes: [String; 2],
     pub orbits: Vec<SectionOrbit>,
     /// max |H − E| and max |q_c − value| over every orbit's crossings.
@@ -90,6 +96,8 @@ pub enum SectionError {
     /// singularity of the mass matrix at the seed).
     #[error("seed ({}, {}): H is not quadratic and convex in the momentum there (a singular point of the chart?)", seed[0], seed[1])]
     Singular { seed: [f64; 2] },
+    #[error(transparent)]
+    Plane(#[from] PlaneError),
     #[error("method: {0}")]
     Method(#[from] OdeError),
     /// An orbit the integrator could not follow (it left every bounded
@@ -162,21 +170,16 @@ impl WithFixed for Sections<'_> {
             model: name.clone(),
             reason,
         };
-        if s.coordinate >= D {
-            return Err(bad(format!("coordinate {} of {D}", s.coordinate)));
-        }
         if !(s.tol > 0.0 && s.t_max > 0.0 && s.energy.is_finite() && s.value.is_finite()) {
             return Err(bad(
-                "the tolerance and t_max must be positive, the energy and plane finite".into(),
+                "the tolerance and t_max must be positive, the energy and value finite".into(),
             ));
         }
+        let chart = Chart::new(s, D, &fixed.periodic())
+            .ok_or_else(|| bad(format!("the plane's coefficients {:?}", s.plane)))?;
         if self.seeds.is_empty() {
             return Err(SectionError::NoSeeds { model: name });
         }
-        let c = s.coordinate;
-        let other = 1 - c;
-        let angle = fixed.periodic()[c];
-        let other_angle = fixed.periodic()[other];
         let names = info.state_names();
         let system = fixed.exact(self.params);
         let energy = |y: &[f64; S]| self.model.dynamic.energy(self.params, 0.0, y);
@@ -184,20 +187,10 @@ impl WithFixed for Sections<'_> {
             .seeds
             .par_iter()
             .map(|seed| {
-                let start = on_plane::<S>(seed, c, other, s, &energy)?;
-                // An angle crosses the plane at every turn: the condition is
-                // its offset wrapped to [−π, π), whose jump at ±π is a
-                // crossing of the opposite side, dropped below.
-                let offset = move |y: &[f64; S]| {
-                    let d = y[c] - s.value;
-                    if angle {
-                        crate::analysis::period_map::wrap_angle(d)
-                    } else {
-                        d
-                    }
-                };
+                let start = on_plane::<S>(seed, &chart, s, &energy)?;
+                let offset = move |y: &[f64; S]| chart.offset(y);
                 let condition = move |_: f64, y: &[f64; S]| offset(y);
-                let direction = if s.rising {
+                let direction = if chart.rising {
                     Direction::Rising
                 } else {
                     Direction::Falling
@@ -218,12 +211,7 @@ impl WithFixed for Sections<'_> {
                         })?;
                     let on_plane = run.hits.iter().filter(|hit| offset(&hit.y).abs() < 1e-6);
                     for hit in on_plane.take(s.crossings - points.len()) {
-                        // The other coordinate on its circle, if an angle.
-                        let along = match other_angle {
-                            true => crate::analysis::period_map::wrap_angle(hit.y[other]),
-                            false => hit.y[other],
-                        };
-                        points.push([along, hit.y[D + other]]);
+                        points.push(chart.point(&hit.y));
                         energy_drift = energy_drift.max((energy(&hit.y) - s.energy).abs());
                         plane_distance = plane_distance.max(offset(&hit.y).abs());
                     }
@@ -245,38 +233,225 @@ impl WithFixed for Sections<'_> {
             model: name,
             energy: s.energy,
             plane: format!(
-                "{} = {} ({} {})",
-                names[c],
+                "{} = {} ({})",
+                plane_name(s.plane, &names),
                 s.value,
-                names[c],
                 if s.rising { "increasing" } else { "decreasing" }
             ),
-            axes: [names[other].to_string(), names[D + other].to_string()],
+            axes: chart.axes(&names),
             orbits,
         })
     }
 }
 
-/// The state on the plane at `seed` with p_c solved from H = E on the
-/// settings' branch.
-pub(super) fn on_plane<const S: usize>(
-    seed: &[f64; 2],
+/// The plane's canonical chart (module docs): a·q = value divided by a_c,
+/// c the coordinate of the larger |a_c| and o the other, is
+/// Q_c = q_c + slope·q_o = value, and Q_o = q_o, P_c = p_c,
+/// P_o = p_o − slope·p_c.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Chart {
     c: usize,
     other: usize,
+    slope: f64,
+    value: f64,
+    /// Q_c increasing (a·q's direction, turned if a_c < 0).
+    pub(super) rising: bool,
+    dof: usize,
+    /// Q_c is an angle (q_c one, and slope a whole multiple of q_o's turn
+    /// or 0): its offset from the plane is wrapped to [−π, π).
+    wrap_plane: bool,
+    /// Q_o is an angle: drawn on its circle.
+    wrap_other: bool,
+}
+
+impl Chart {
+    /// None for a plane whose coefficients are not finite or both 0.
+    pub(super) fn new(s: &SectionSettings, dof: usize, periodic: &[bool]) -> Option<Chart> {
+        let a = s.plane;
+        if dof != 2 || !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
+            return None;
+        }
+        let c = if a[0].abs() >= a[1].abs() { 0 } else { 1 };
+        let other = 1 - c;
+        let slope = a[other] / a[c];
+        let whole = slope == slope.round();
+        Some(Chart {
+            c,
+            other,
+            slope,
+            value: s.value / a[c],
+            rising: s.rising == (a[c] > 0.0),
+            dof,
+            wrap_plane: periodic[c] && (slope == 0.0 || (whole && periodic[other])),
+            wrap_other: periodic[other],
+        })
+    }
+
+    /// The state at (Q_o, P_o) = `seed` on the plane, with P_c = `p_c`.
+    pub(super) fn state<const S: usize>(&self, seed: &[f64; 2], p_c: f64) -> [f64; S] {
+        let d = self.dof;
+        let mut y = [0.0; S];
+        y[self.c] = self.value - self.slope * seed[0];
+        y[self.other] = seed[0];
+        y[d + self.c] = p_c;
+        y[d + self.other] = seed[1] + self.slope * p_c;
+        y
+    }
+
+    /// Q_c − value: an angle's wrapped to [−π, π), whose jump at ±π is a
+    /// crossing of the opposite side (dropped by the callers).
+    pub(super) fn offset(&self, y: &[f64]) -> f64 {
+        let d = y[self.c] + self.slope * y[self.other] - self.value;
+        if self.wrap_plane {
+            crate::analysis::period_map::wrap_angle(d)
+        } else {
+            d
+        }
+    }
+
+    /// (Q_o, P_o) of a state, Q_o on its circle if an angle.
+    pub(super) fn point(&self, y: &[f64]) -> [f64; 2] {
+        let d = self.dof;
+        let q = match self.wrap_other {
+            true => crate::analysis::period_map::wrap_angle(y[self.other]),
+            false => y[self.other],
+        };
+        [q, y[d + self.other] - self.slope * y[d + self.c]]
+    }
+
+    /// [α, β, γ] of H along P_c at `seed`.
+    pub(super) fn quadratic<const S: usize>(
+        &self,
+        seed: &[f64; 2],
+        energy: &dyn Fn(&[f64; S]) -> f64,
+    ) -> [f64; 3] {
+        quadratic(|p| energy(&self.state(seed, p)))
+    }
+
+    /// The least H over P_c at `seed`: the energy is accessible there
+    /// above it.
+    pub(super) fn least_energy<const S: usize>(
+        &self,
+        seed: &[f64; 2],
+        energy: &dyn Fn(&[f64; S]) -> f64,
+    ) -> f64 {
+        let [alpha, beta, zero] = self.quadratic(seed, energy);
+        zero - beta * beta / (4.0 * alpha)
+    }
+
+    pub(super) fn axes(&self, names: &[&str]) -> [String; 2] {
+        let d = self.dof;
+        let momentum = match self.slope {
+            0.0 => names[d + self.other].to_string(),
+            k => format!(
+                "{} {} {}{}",
+                names[d + self.other],
+                sign(-k),
+                factor(k),
+                names[d + self.c]
+            ),
+        };
+        [names[self.other].to_string(), momentum]
+    }
+}
+
+/// a·q as text, "x", "q1 − q2", "2·x + 0.5·y".
+fn plane_name(a: [f64; 2], names: &[&str]) -> String {
+    let mut text = String::new();
+    for (k, name) in a.iter().zip(names) {
+        if *k == 0.0 {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(&format!(" {} ", sign(*k)));
+        } else if *k < 0.0 {
+            text.push('−');
+        }
+        text.push_str(&factor(*k));
+        text.push_str(name);
+    }
+    text
+}
+
+/// A plane written as a linear function of the coordinates' names, as in
+/// "x", "q1 - q2", "x + 0.5*y" or "-2*y", as its coefficients.
+pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneError> {
+    let bad = |reason: &str| PlaneError {
+        text: text.to_string(),
+        reason: reason.to_string(),
+    };
+    let mut a = [0.0; 2];
+    // Split into signed terms at + or − that do not follow an exponent's e.
+    let mut terms: Vec<String> = vec![String::new()];
+    let chars: Vec<char> = text.chars().filter(|c| !c.is_whitespace()).collect();
+    for (i, &ch) in chars.iter().enumerate() {
+        let exponent = i > 1 && matches!(chars[i - 1], 'e' | 'E') && chars[i - 2].is_ascii_digit();
+        if (ch == '+' || ch == '-' || ch == '−') && i > 0 && !exponent {
+            terms.push(String::new());
+        }
+        terms
+            .last_mut()
+            .unwrap()
+            .push(if ch == '−' { '-' } else { ch });
+    }
+    for term in terms.iter().filter(|t| !t.is_empty()) {
+        let (sign, body) = match term.strip_prefix('-') {
+            Some(rest) => (-1.0, rest),
+            None => (1.0, term.strip_prefix('+').unwrap_or(term)),
+        };
+        let (factor, name) = match body.split_once('*') {
+            Some((k, name)) => (
+                k.parse::<f64>()
+                    .map_err(|_| bad("a coefficient is not a number"))?,
+                name,
+            ),
+            None => (1.0, body),
+        };
+        let index = names
+            .iter()
+            .position(|n| *n == name)
+            .ok_or_else(|| bad("a term is not a coordinate's name (write k*name)"))?;
+        a[index] += sign * factor;
+    }
+    if !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
+        return Err(bad("no coordinate with a finite coefficient other than 0"));
+    }
+    Ok(a)
+}
+
+/// A plane's text that [`parse_plane`] cannot read.
+#[derive(Debug, thiserror::Error)]
+#[error("plane {text:?}: {reason}")]
+pub struct PlaneError {
+    pub text: String,
+    pub reason: String,
+}
+
+/// "|k|·", or nothing for ±1.
+fn factor(k: f64) -> String {
+    match k.abs() {
+        1.0 => String::new(),
+        m => format!("{m}·"),
+    }
+}
+
+fn sign(k: f64) -> char {
+    if k < 0.0 {
+        '−'
+    } else {
+        '+'
+    }
+}
+
+/// The state on the plane at `seed` (Q_o, P_o) with P_c solved from H = E
+/// on the settings' branch.
+pub(super) fn on_plane<const S: usize>(
+    seed: &[f64; 2],
+    chart: &Chart,
     s: &SectionSettings,
     energy: &dyn Fn(&[f64; S]) -> f64,
 ) -> Result<[f64; S], SectionError> {
-    let d = S / 2;
-    let mut y = [0.0; S];
-    y[c] = s.value;
-    y[other] = seed[0];
-    y[d + other] = seed[1];
-    let at = |p: f64| {
-        let mut z = y;
-        z[d + c] = p;
-        energy(&z)
-    };
-    let [alpha, beta, zero] = quadratic(at);
+    let [alpha, beta, zero] = chart.quadratic(seed, energy);
     if !(alpha > 0.0) || !beta.is_finite() || !zero.is_finite() {
         return Err(SectionError::Singular { seed: *seed });
     }
@@ -289,12 +464,12 @@ pub(super) fn on_plane<const S: usize>(
         });
     }
     let root = discriminant.sqrt();
-    y[d + c] = if s.rising {
+    let p_c = if chart.rising {
         (-beta + root) / (2.0 * alpha)
     } else {
         (-beta - root) / (2.0 * alpha)
     };
-    Ok(y)
+    Ok(chart.state(seed, p_c))
 }
 
 /// [α, β, γ] of H = α p² + β p + γ along one momentum, from its values at
@@ -304,7 +479,7 @@ pub(super) fn quadratic(h: impl Fn(f64) -> f64) -> [f64; 3] {
     [0.5 * (plus + minus) - zero, 0.5 * (plus - minus), zero]
 }
 
-/// `count` seeds on the line p_other = 0 of the plane, evenly over the
+/// `count` seeds on the line P_o = 0 of the plane, evenly over the
 /// stretch around 0 where the energy is accessible (scanned on
 /// [−extent, extent]); none where it is nowhere accessible.
 pub fn seeds_across(
@@ -314,20 +489,11 @@ pub fn seeds_across(
     extent: f64,
     count: usize,
 ) -> Vec<[f64; 2]> {
-    let c = settings.coordinate;
-    let n = model.dynamic.periodic().len();
-    let least = |q: f64| {
-        let mut y = vec![0.0; 2 * n];
-        y[c] = settings.value;
-        y[1 - c] = q;
-        let at = |p: f64| {
-            let mut z = y.clone();
-            z[n + c] = p;
-            model.dynamic.energy(params, 0.0, &z)
-        };
-        let [alpha, beta, zero] = quadratic(at);
-        zero - beta * beta / (4.0 * alpha)
+    let Some(chart) = Chart::new(settings, 2, &model.dynamic.periodic()) else {
+        return Vec::new();
     };
+    let energy = |y: &[f64; 4]| model.dynamic.energy(params, 0.0, y);
+    let least = |q: f64| chart.least_energy(&[q, 0.0], &energy);
     let grid = 2001;
     let q = |i: usize| -extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
     // The accessible runs of the grid; the one around 0 (else the longest):

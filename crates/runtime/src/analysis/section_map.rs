@@ -5,7 +5,7 @@
 //! accessible area.
 
 use super::lyapunov::megno_values;
-use super::section::{on_plane, quadratic, SectionError, SectionSettings};
+use super::section::{on_plane, Chart, SectionError, SectionSettings};
 use crate::ode::{LaneIntegrator, Method};
 use crate::plot::{ColorMap, Figure, PanelSpec};
 use crate::registry::{Fixed, Model, Sized};
@@ -79,29 +79,17 @@ pub fn section_map(
         model: name.clone(),
         reason: reason.into(),
     };
-    if s.coordinate > 1 || settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
-        return Err(bad(
-            "coordinate 0 or 1, pixels ≥ 2, t_max and extent positive",
-        ));
+    if settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
+        return Err(bad("pixels ≥ 2, t_max and extent positive"));
     }
+    let chart = Chart::new(s, 2, &fixed.periodic())
+        .ok_or_else(|| bad("the plane's coefficients are 0 or not finite"))?;
     let method = Method::Taylor { tol: s.tol };
     method.validate()?;
     let start = std::time::Instant::now();
-    let (c, other) = (s.coordinate, 1 - s.coordinate);
     let energy = |y: &[f64; 4]| model.dynamic.energy(params, 0.0, y);
     // The least H over the solved momentum at a point of the plane.
-    let least = |q: f64, p: f64| {
-        let mut y = [0.0; 4];
-        y[c] = s.value;
-        y[other] = q;
-        y[2 + other] = p;
-        let [alpha, beta, zero] = quadratic(|pc| {
-            let mut z = y;
-            z[2 + c] = pc;
-            energy(&z)
-        });
-        zero - beta * beta / (4.0 * alpha)
-    };
+    let least = |q: f64, p: f64| chart.least_energy(&[q, p], &energy);
     let region =
         Region::find(&least, s.energy, settings.extent).ok_or_else(|| SectionError::NoSeeds {
             model: name.clone(),
@@ -124,7 +112,7 @@ pub fn section_map(
                     if !region.contains(q, p) {
                         return None;
                     }
-                    on_plane::<4>(&[q, p], c, other, s, &energy)
+                    on_plane::<4>(&[q, p], &chart, s, &energy)
                         .ok()
                         .map(|y| (i, y))
                 })
@@ -158,7 +146,7 @@ pub fn section_map(
     Ok(SectionMap {
         model: name,
         energy: s.energy,
-        axes: [names[other].to_string(), names[2 + other].to_string()],
+        axes: chart.axes(&names),
         window,
         pixels: n,
         t_max: chunks as f64 * chunk,

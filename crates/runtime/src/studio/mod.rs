@@ -908,7 +908,10 @@ fn rising() -> bool {
 impl SectionPlane {
     fn settings(&self, crossings: usize, tol: f64) -> crate::analysis::section::SectionSettings {
         crate::analysis::section::SectionSettings {
-            coordinate: self.coordinate,
+            plane: match self.coordinate {
+                0 => [1.0, 0.0],
+                _ => [0.0, 1.0],
+            },
             value: self.value,
             rising: self.rising,
             energy: self.energy,
