@@ -387,6 +387,8 @@ async fn section_orbits_and_their_megno_map() {
         crossings: 50,
         t_max: 20.0 * 50.0 + 100.0,
         tol: 1e-12,
+        phase: 0.0,
+        slab: 0.05,
     };
     let library = section(model, &model.dynamic.defaults(), &[[0.1, 0.0]], &settings).unwrap();
     assert_eq!(points, library.orbits[0].points);

@@ -887,9 +887,13 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         knob(
             "model",
             model.info.name,
-            "the model (a file models/<name>.toml) without a fast phase, 2 degrees of freedom",
+            "the model (a file models/<name>.toml) of 2 degrees of freedom (with a fast phase: a slice of its period map)",
         ),
-        knob("energy", "0.125", "the energy H = E of every orbit"),
+        knob(
+            "energy",
+            "0.125",
+            "the energy H = E of every orbit's seed (H̄, averaged, with a fast phase)",
+        ),
         knob(
             "plane",
             model.info.coordinates[0],
@@ -924,6 +928,16 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
             "pixels per side of a MEGNO chaos map of the section (0: none)",
         ),
         knob("map_time", "2000", "the time each orbit of the map runs"),
+        knob(
+            "phase",
+            "0",
+            "with a fast phase: the forcing's phase 2πt/T at which the period map samples",
+        ),
+        knob(
+            "slab",
+            "0.05",
+            "with a fast phase: points of the period map within this of the plane are kept",
+        ),
     ];
     knobs.extend(parameter_knobs(model.info, &[]));
     let scene = Scene::from_args("section", "Poincaré section at a fixed energy", &knobs)?;
@@ -947,6 +961,8 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         crossings: scene.count("crossings")?,
         t_max: scene.positive("t_max")?,
         tol: scene.positive("tol")?,
+        phase: scene.number("phase")?,
+        slab: scene.positive("slab")?,
     };
     let params = scene.parameter_values(model.info)?;
     let seeds = seeds_across(
@@ -970,8 +986,8 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         rows,
     )?;
     eprintln!(
-        "largest |H − E| on the section {:.1e}, largest distance from the plane {:.1e}",
-        result.largest_energy_drift, result.largest_plane_distance
+        "largest |{} − E| on the section {:.1e}, largest distance from the plane {:.1e}",
+        result.energy_of, result.largest_energy_drift, result.largest_plane_distance
     );
     let map = match scene.whole("map")? {
         0 => None,

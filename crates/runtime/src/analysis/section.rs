@@ -36,6 +36,13 @@ pub struct SectionSettings {
     pub t_max: f64,
     /// DOP853's tolerance.
     pub tol: f64,
+    /// For a model with a fast phase, a slice of its period map: the
+    /// orbit is sampled at the forcing's phase 2πt/T = `phase` (each seed
+    /// at t = phase·T/2π), and its points within `slab` of the plane and
+    /// moving in the direction asked are kept; `energy` is that of the
+    /// averaged Hamiltonian H̄. Not used for autonomous models.
+    pub phase: f64,
+    pub slab: f64,
 }
 
 /// One orbit on the section.
@@ -49,18 +56,37 @@ pub struct SectionOrbit {
     pub points: Vec<[f64; 2]>,
     /// How many.
     pub crossings: usize,
-    /// max |H − E| over its crossings.
+    /// max |H − E| over its crossings (|H̄ − E| with a fast phase: H̄ is
+    /// conserved to O(ε) only).
     pub energy_drift: f64,
-    /// max |q_c − value| over its crossings.
+    /// max |q_c − value| over its crossings (below `slab` for a slice of
+    /// the period map).
     pub plane_distance: f64,
+}
+
+impl SectionOrbit {
+    /// The orbit so far: its seed, as the first point.
+    fn from_seed(seed: &[f64; 2], start: &[f64]) -> SectionOrbit {
+        SectionOrbit {
+            start: start.to_vec(),
+            points: vec![*seed],
+            crossings: 1,
+            energy_drift: 0.0,
+            plane_distance: 0.0,
+        }
+    }
 }
 
 /// Orbits of the section map of one model at one energy.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Section {
     pub model: String,
+    /// The energy, of H ("H") or, with a fast phase, of the averaged H̄
+    /// ("H̄").
     pub energy: f64,
-    /// The plane, e.g. "x = 0 (increasing)".
+    pub energy_of: &'static str,
+    /// The plane, e.g. "x = 0 (increasing)", and with a fast phase the
+    /// period map's phase and slab.
     pub plane: String,
     /// The names of the two axes on the plane, Q_o and P_o.
     pub axes: [String; 2],
@@ -75,7 +101,7 @@ pub struct Section {
 pub enum SectionError {
     #[error("model {0} is a contact model: sections are for Hamiltonian models")]
     ContactModel(String),
-    #[error("model {0} has a fast phase: its section is the period map (scene period_map)")]
+    #[error("model {0} has a fast phase: its section is the period map (scenes period_map, chaos_map); slices of it are drawn for 2 degrees of freedom, without a MEGNO map")]
     FastPhase(String),
     #[error("model {model} has {dof} degrees of freedom: sections are drawn for 2")]
     Dimension { model: String, dof: usize },
@@ -122,22 +148,51 @@ pub fn section(
     // Compiled for 2 degrees of freedom only: the event location's
     // instances at the other sizes were compile time for nothing.
     let name = model.info.name.to_string();
-    let fast_phase = matches!(
-        model.dynamic.kind(),
-        crate::registry::Kind::Hamiltonian {
-            fast_phase: true,
-            ..
-        }
-    );
     match model.sized {
-        Some(_) if fast_phase => Err(SectionError::FastPhase(name)),
         Some(Sized::Dof2(fixed)) => work.run::<_, 2, 4, 8, 20>(fixed),
+        Some(_) if has_fast_phase(model) => Err(SectionError::FastPhase(name)),
         Some(_) => Err(SectionError::Dimension {
             model: name,
             dof: model.info.coordinates.len(),
         }),
         None => Err(SectionError::ContactModel(name)),
     }
+}
+
+pub(super) fn has_fast_phase(model: &Model) -> bool {
+    matches!(
+        model.dynamic.kind(),
+        crate::registry::Kind::Hamiltonian {
+            fast_phase: true,
+            ..
+        }
+    )
+}
+
+/// The energy that fixes a section's seeds: H, or the averaged H̄ for a
+/// model with a fast phase (None where H̄ is not derived).
+pub(super) fn seed_energy<'a>(
+    model: &'a Model,
+    params: &'a [f64],
+) -> Option<impl Fn(&[f64]) -> f64 + Sync + 'a> {
+    let fast = has_fast_phase(model);
+    let zero = vec![0.0; 2 * model.info.coordinates.len()];
+    if fast && model.dynamic.averaged_energy(params, &zero).is_none() {
+        return None;
+    }
+    Some(move |y: &[f64]| match fast {
+        true => model.dynamic.averaged_energy(params, y).unwrap_or(f64::NAN),
+        false => model.dynamic.energy(params, 0.0, y),
+    })
+}
+
+/// Where a model with a fast phase is sampled: at its period map's phase.
+#[derive(Clone, Copy)]
+struct Stroboscope {
+    period: f64,
+    /// The time of the first sample, phase·T/2π.
+    start: f64,
+    slab: f64,
 }
 
 /// The work of [`section`] at one size.
@@ -156,9 +211,6 @@ impl WithFixed for Sections<'_> {
     ) -> Self::Output {
         let info = fixed.info();
         let name = info.name.to_string();
-        if fixed.has_fast_phase() {
-            return Err(SectionError::FastPhase(name));
-        }
         if D != 2 {
             return Err(SectionError::Dimension {
                 model: name,
@@ -177,54 +229,37 @@ impl WithFixed for Sections<'_> {
         }
         let chart = Chart::new(s, D, &fixed.periodic())
             .ok_or_else(|| bad(format!("the plane's coefficients {:?}", s.plane)))?;
+        let stroboscope = match fixed.has_fast_phase() {
+            false => None,
+            true => match fixed.phase_period(self.params) {
+                Some(period) if period > 0.0 && s.phase.is_finite() && s.slab > 0.0 => {
+                    Some(Stroboscope {
+                        period,
+                        start: s.phase / std::f64::consts::TAU * period,
+                        slab: s.slab,
+                    })
+                }
+                _ => return Err(bad("a positive slab and a finite phase".into())),
+            },
+        };
+        let energy = seed_energy(self.model, self.params)
+            .ok_or_else(|| bad("its averaged Hamiltonian is not derived".into()))?;
         if self.seeds.is_empty() {
             return Err(SectionError::NoSeeds { model: name });
         }
         let names = info.state_names();
         let system = fixed.exact(self.params);
-        let energy = |y: &[f64; S]| self.model.dynamic.energy(self.params, 0.0, y);
+        let orbit = Orbit {
+            system: &system,
+            chart,
+            stroboscope,
+            settings: s,
+            energy: &|y: &[f64; S]| energy(y),
+        };
         let orbits = self
             .seeds
             .par_iter()
-            .map(|seed| {
-                let start = on_plane::<S>(seed, &chart, s, &energy)?;
-                let offset = move |y: &[f64; S]| chart.offset(y);
-                let condition = move |_: f64, y: &[f64; S]| offset(y);
-                let direction = if chart.rising {
-                    Direction::Rising
-                } else {
-                    Direction::Falling
-                };
-                let events = [Event::new(&condition).direction(direction).non_terminal()];
-                let mut integrator = Integrator::new(Method::parse("dop853", s.tol)?)?;
-                let mut points = vec![*seed];
-                let (mut energy_drift, mut plane_distance) = (0.0f64, 0.0f64);
-                let (mut t, mut y) = (0.0, start);
-                let chunk = (s.t_max / 64.0).max(1.0);
-                while points.len() < s.crossings && t < s.t_max {
-                    let t1 = (t + chunk).min(s.t_max);
-                    let run = integrator
-                        .advance_with_events(&system, t, &y, t1, &events, EventSettings::default())
-                        .map_err(|source| SectionError::Orbit {
-                            seed: *seed,
-                            source,
-                        })?;
-                    let on_plane = run.hits.iter().filter(|hit| offset(&hit.y).abs() < 1e-6);
-                    for hit in on_plane.take(s.crossings - points.len()) {
-                        points.push(chart.point(&hit.y));
-                        energy_drift = energy_drift.max((energy(&hit.y) - s.energy).abs());
-                        plane_distance = plane_distance.max(offset(&hit.y).abs());
-                    }
-                    (t, y) = (run.t, run.y);
-                }
-                Ok(SectionOrbit {
-                    start: start.to_vec(),
-                    crossings: points.len(),
-                    points,
-                    energy_drift,
-                    plane_distance,
-                })
-            })
+            .map(|seed| orbit.follow(seed))
             .collect::<Result<Vec<_>, SectionError>>()?;
         let largest = |f: fn(&SectionOrbit) -> f64| orbits.iter().map(f).fold(0.0, f64::max);
         Ok(Section {
@@ -232,15 +267,127 @@ impl WithFixed for Sections<'_> {
             largest_plane_distance: largest(|o| o.plane_distance),
             model: name,
             energy: s.energy,
+            energy_of: if stroboscope.is_some() { "H̄" } else { "H" },
             plane: format!(
-                "{} = {} ({})",
+                "{} = {} ({}{})",
                 plane_name(s.plane, &names),
                 s.value,
-                if s.rising { "increasing" } else { "decreasing" }
+                if s.rising { "increasing" } else { "decreasing" },
+                match stroboscope {
+                    Some(strobe) => format!(
+                        "; the period map at phase {}, within {} of it",
+                        s.phase, strobe.slab
+                    ),
+                    None => String::new(),
+                }
             ),
             axes: chart.axes(&names),
             orbits,
         })
+    }
+}
+
+/// One orbit's work: its system, plane, stroboscope and energy.
+struct Orbit<'a, Y, const S: usize> {
+    system: &'a Y,
+    chart: Chart,
+    stroboscope: Option<Stroboscope>,
+    settings: &'a SectionSettings,
+    energy: &'a (dyn Fn(&[f64; S]) -> f64 + Sync),
+}
+
+impl<Y: crate::ode::System<S> + Sync, const S: usize> Orbit<'_, Y, S> {
+    /// The crossings of the orbit through `seed`.
+    fn follow(&self, seed: &[f64; 2]) -> Result<SectionOrbit, SectionError> {
+        let (s, chart) = (self.settings, self.chart);
+        let start = on_plane::<S>(seed, &chart, s, self.energy)?;
+        if let Some(stroboscope) = self.stroboscope {
+            return self.sample(seed, start, stroboscope);
+        }
+        let condition = move |_: f64, y: &[f64; S]| chart.offset(y);
+        let direction = if chart.rising {
+            Direction::Rising
+        } else {
+            Direction::Falling
+        };
+        let events = [Event::new(&condition).direction(direction).non_terminal()];
+        let mut integrator = Integrator::new(Method::parse("dop853", s.tol)?)?;
+        let mut orbit = SectionOrbit::from_seed(seed, &start);
+        let (mut t, mut y) = (0.0, start);
+        let chunk = (s.t_max / 64.0).max(1.0);
+        while orbit.crossings < s.crossings && t < s.t_max {
+            let t1 = (t + chunk).min(s.t_max);
+            let run = integrator
+                .advance_with_events(self.system, t, &y, t1, &events, EventSettings::default())
+                .map_err(|source| SectionError::Orbit {
+                    seed: *seed,
+                    source,
+                })?;
+            // A wrapped angle's jump at ±π is a crossing of the other side.
+            let on_plane = run
+                .hits
+                .iter()
+                .filter(|hit| chart.offset(&hit.y).abs() < 1e-6);
+            for hit in on_plane.take(s.crossings - orbit.crossings) {
+                self.keep(&mut orbit, &hit.y);
+            }
+            (t, y) = (run.t, run.y);
+        }
+        Ok(orbit)
+    }
+
+    /// Adds a state on the plane to the orbit, with its drifts.
+    fn keep(&self, orbit: &mut SectionOrbit, y: &[f64; S]) {
+        orbit.points.push(self.chart.point(y));
+        orbit.crossings += 1;
+        let drift = ((self.energy)(y) - self.settings.energy).abs();
+        orbit.energy_drift = orbit.energy_drift.max(drift);
+        orbit.plane_distance = orbit.plane_distance.max(self.chart.offset(y).abs());
+    }
+}
+
+impl<Y: crate::ode::System<S> + Sync, const S: usize> Orbit<'_, Y, S> {
+    /// The slice of the period map through `seed`: the orbit from `start`
+    /// at the stroboscope's phase, its points within the slab and moving
+    /// the way asked (the plane function's rate from the exact field).
+    fn sample(
+        &self,
+        seed: &[f64; 2],
+        start: [f64; S],
+        stroboscope: Stroboscope,
+    ) -> Result<SectionOrbit, SectionError> {
+        let (s, chart) = (self.settings, self.chart);
+        let d = S / 2;
+        let mut integrator = Integrator::new(Method::parse("dop853", s.tol)?)?;
+        let mut orbit = SectionOrbit::from_seed(seed, &start);
+        let (mut t, mut y) = (stroboscope.start, start);
+        let periods = ((s.t_max / stroboscope.period).ceil() as usize).max(1);
+        let chunk = 1000.min(periods);
+        let mut done = 0;
+        while orbit.crossings < s.crossings && done < periods {
+            let count = chunk.min(periods - done);
+            let times: Vec<f64> = (1..=count)
+                .map(|k| stroboscope.start + (done + k) as f64 * stroboscope.period)
+                .collect();
+            let states = integrator
+                .advance_sampled(self.system, t, &y, &times)
+                .map_err(|source| SectionError::Orbit {
+                    seed: *seed,
+                    source,
+                })?;
+            for (&time, state) in times.iter().zip(&states) {
+                if chart.offset(state).abs() >= stroboscope.slab || orbit.crossings == s.crossings {
+                    continue;
+                }
+                let field = self.system.rhs(time, state);
+                if (chart.rate(&field[..d]) > 0.0) == chart.rising {
+                    self.keep(&mut orbit, state);
+                }
+            }
+            done += count;
+            (t, y) = (times[count - 1], states[count - 1]);
+        }
+        Ok(orbit)
     }
 }
 
@@ -307,6 +454,11 @@ impl Chart {
         } else {
             d
         }
+    }
+
+    /// Q_c' from the coordinates' rates q'.
+    pub(super) fn rate(&self, q_rate: &[f64]) -> f64 {
+        q_rate[self.c] + self.slope * q_rate[self.other]
     }
 
     /// (Q_o, P_o) of a state, Q_o on its circle if an angle.
@@ -492,7 +644,10 @@ pub fn seeds_across(
     let Some(chart) = Chart::new(settings, 2, &model.dynamic.periodic()) else {
         return Vec::new();
     };
-    let energy = |y: &[f64; 4]| model.dynamic.energy(params, 0.0, y);
+    let Some(energy) = seed_energy(model, params) else {
+        return Vec::new();
+    };
+    let energy = |y: &[f64; 4]| energy(y);
     let least = |q: f64| chart.least_energy(&[q, 0.0], &energy);
     let grid = 2001;
     let q = |i: usize| -extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
@@ -535,9 +690,10 @@ impl Section {
         }
         let pad = |k: usize| 0.05 * (hi[k] - lo[k]).max(1e-9);
         let title = format!(
-            "{}: section {} at H = {}, {} orbits",
+            "{}: section {} at {} = {}, {} orbits",
             self.model,
             self.plane,
+            self.energy_of,
             self.energy,
             self.orbits.len()
         );

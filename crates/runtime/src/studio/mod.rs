@@ -918,6 +918,9 @@ impl SectionPlane {
             crossings,
             t_max: 20.0 * crossings as f64 + 100.0,
             tol,
+            // The studio's sections are of models without a fast phase.
+            phase: 0.0,
+            slab: 0.05,
         }
     }
 }
