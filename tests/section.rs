@@ -378,3 +378,27 @@ fn a_model_with_a_fast_phase_gets_a_slice_of_its_period_map() {
     let (coarse, fine) = (drift(100.0), drift(400.0));
     assert!(coarse / fine > 3.0, "H̄ drifted by {coarse}, then by {fine}");
 }
+
+/// Every model in models/ gets a section or a named reason, never a panic:
+/// its seeds are searched, and its section drawn from them (or from one
+/// seed at the origin where none was found).
+#[test]
+fn every_model_gets_a_section_or_a_named_reason() {
+    for info in models::ALL {
+        let model = models::by_name(info.name).unwrap();
+        let params = model.dynamic.defaults();
+        let s = SectionSettings {
+            crossings: 5,
+            t_max: 50.0,
+            ..settings(0.5)
+        };
+        let mut seeds = seeds_across(model, &params, &s, 2.0, 3);
+        if seeds.is_empty() {
+            seeds.push([0.0, 0.0]);
+        }
+        match section(model, &params, &seeds, &s) {
+            Ok(result) => assert_eq!(result.orbits.len(), seeds.len(), "{}", info.name),
+            Err(e) => assert!(!e.to_string().is_empty(), "{}", info.name),
+        }
+    }
+}

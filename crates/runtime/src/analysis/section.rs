@@ -415,7 +415,7 @@ impl Chart {
     /// None for a plane whose coefficients are not finite or both 0.
     pub(super) fn new(s: &SectionSettings, dof: usize, periodic: &[bool]) -> Option<Chart> {
         let a = s.plane;
-        if dof != 2 || !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
+        if dof != 2 || periodic.len() != 2 || !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
             return None;
         }
         let c = if a[0].abs() >= a[1].abs() { 0 } else { 1 };
@@ -641,7 +641,8 @@ pub fn seeds_across(
     extent: f64,
     count: usize,
 ) -> Vec<[f64; 2]> {
-    let Some(chart) = Chart::new(settings, 2, &model.dynamic.periodic()) else {
+    let dof = model.info.coordinates.len();
+    let Some(chart) = Chart::new(settings, dof, &model.dynamic.periodic()) else {
         return Vec::new();
     };
     let Some(energy) = seed_energy(model, params) else {
