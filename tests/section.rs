@@ -265,6 +265,18 @@ fn a_tilted_plane_has_a_canonical_chart() {
     assert!((a[0] - seed[0]).hypot(a[1] - seed[1]) > 1e-3, "{a:?}");
 }
 
+/// The shaken double pendulum's defaults with the base's amplitude a and
+/// frequency ν.
+fn shaken_params(a: f64, nu: f64) -> Vec<f64> {
+    let model = models::by_name("double_pendulum").unwrap();
+    let mut params = model.dynamic.defaults();
+    for (name, value) in [("a", a), ("nu", nu)] {
+        let k = model.info.parameter_names.iter().position(|n| *n == name);
+        params[k.unwrap()] = value;
+    }
+    params
+}
+
 /// The free double pendulum (m = l = g = 1) with its angles from the
 /// upward vertical, written by hand: M φ'' = f with
 /// M = [[2, c], [c, 1]], c = cos(φ₁ − φ₂), s = sin(φ₁ − φ₂),
@@ -295,17 +307,8 @@ fn upright_double_pendulum(y: [f64; 4]) -> [f64; 4] {
 fn a_model_with_a_fast_phase_gets_a_slice_of_its_period_map() {
     use std::f64::consts::{PI, TAU};
     let shaken = models::by_name("double_pendulum").unwrap();
-    let mut params = shaken.dynamic.defaults();
-    let index = |name: &str| {
-        shaken
-            .info
-            .parameter_names
-            .iter()
-            .position(|n| *n == name)
-            .unwrap()
-    };
-    params[index("a")] = 0.0;
-    let period = TAU / params[index("nu")];
+    let params = shaken_params(0.0, 100.0);
+    let period = TAU / 100.0;
     let slice = SectionSettings {
         value: PI,
         crossings: 25,
@@ -359,8 +362,7 @@ fn a_model_with_a_fast_phase_gets_a_slice_of_its_period_map() {
     // ε = 1/ν → 0, at first order or better: its largest drift falls at
     // least three-fold when ν quadruples (0.81 at ν = 100, 0.15 at 400).
     let drift = |nu: f64| {
-        let mut vibrated = shaken.dynamic.defaults();
-        vibrated[index("nu")] = nu;
+        let vibrated = shaken_params(5.0, nu);
         let raised = SectionSettings {
             energy: -1.5,
             ..slice.clone()
@@ -401,4 +403,42 @@ fn every_model_gets_a_section_or_a_named_reason() {
             Err(e) => assert!(!e.to_string().is_empty(), "{}", info.name),
         }
     }
+}
+
+/// The MEGNO map of a model with a fast phase: every pixel's orbit from
+/// the plane at the averaged energy, its tangent vector sampled every
+/// whole number of periods. Low in the double pendulum's well (H̄ = −2.5,
+/// near its two normal modes) no pixel is chaotic with the base at rest
+/// (a = 0) or shaken gently (a = 0.3, ν = 20); shaken hard (a = 2, a
+/// pivot acceleration of 40 g) most of the section is chaotic.
+#[test]
+fn a_model_with_a_fast_phase_gets_a_megno_map_of_its_slice() {
+    use mechlab::analysis::section_map::{section_map, SectionMapSettings};
+    use std::f64::consts::PI;
+    let shaken = models::by_name("double_pendulum").unwrap();
+    let map = |a: f64| {
+        let params = shaken_params(a, 20.0);
+        let settings = SectionMapSettings {
+            section: SectionSettings {
+                value: PI,
+                ..settings(-2.5)
+            },
+            pixels: 12,
+            t_max: 100.0,
+            extent: 3.2,
+        };
+        section_map(shaken, &params, &settings).unwrap()
+    };
+    let (rest, gentle, hard) = (map(0.0), map(0.3), map(2.0));
+    assert_eq!(hard.energy_of, "H̄");
+    for m in [&rest, &gentle, &hard] {
+        assert!(
+            m.accessible > 50 && m.failed == 0,
+            "{} accessible",
+            m.accessible
+        );
+    }
+    assert_eq!(rest.chaotic, 0);
+    assert_eq!(gentle.chaotic, 0);
+    assert!(hard.chaotic_fraction > 0.5, "{}", hard.chaotic_fraction);
 }

@@ -101,7 +101,7 @@ pub struct Section {
 pub enum SectionError {
     #[error("model {0} is a contact model: sections are for Hamiltonian models")]
     ContactModel(String),
-    #[error("model {0} has a fast phase: its section is the period map (scenes period_map, chaos_map); slices of it are drawn for 2 degrees of freedom, without a MEGNO map")]
+    #[error("model {0} has a fast phase: its section is the period map (scenes period_map, chaos_map); slices of it are drawn for 2 degrees of freedom")]
     FastPhase(String),
     #[error("model {model} has {dof} degrees of freedom: sections are drawn for 2")]
     Dimension { model: String, dof: usize },
@@ -271,13 +271,11 @@ impl WithFixed for Sections<'_> {
             plane: format!(
                 "{} = {} ({}{})",
                 plane_name(s.plane, &names),
-                s.value,
+                short(s.value),
                 if s.rising { "increasing" } else { "decreasing" },
                 match stroboscope {
-                    Some(strobe) => format!(
-                        "; the period map at phase {}, within {} of it",
-                        s.phase, strobe.slab
-                    ),
+                    Some(strobe) =>
+                        format!("; period map at phase {}, slab {}", s.phase, strobe.slab),
                     None => String::new(),
                 }
             ),
@@ -456,6 +454,17 @@ impl Chart {
         }
     }
 
+    /// Where the search for accessible seeds centres Q_o: 0, or π where
+    /// Q_o is an angle whose energy is accessible at π and not at 0 (a
+    /// region around π scanned from 0 would be cut in two at ±π).
+    pub(super) fn scan_centre(&self, least_at: impl Fn(f64) -> f64, energy: f64) -> f64 {
+        let pi = std::f64::consts::PI;
+        match self.wrap_other && least_at(0.0) >= energy && least_at(pi) < energy {
+            true => pi,
+            false => 0.0,
+        }
+    }
+
     /// Q_c' from the coordinates' rates q'.
     pub(super) fn rate(&self, q_rate: &[f64]) -> f64 {
         q_rate[self.c] + self.slope * q_rate[self.other]
@@ -579,6 +588,15 @@ pub struct PlaneError {
     pub reason: String,
 }
 
+/// x to six significant digits at most (π as 3.14159).
+pub(super) fn short(x: f64) -> String {
+    let text = format!("{x}");
+    match text.len() > 8 {
+        true => format!("{:.6}", x).trim_end_matches('0').to_string(),
+        false => text,
+    }
+}
+
 /// "|k|·", or nothing for ±1.
 fn factor(k: f64) -> String {
     match k.abs() {
@@ -632,8 +650,9 @@ pub(super) fn quadratic(h: impl Fn(f64) -> f64) -> [f64; 3] {
 }
 
 /// `count` seeds on the line P_o = 0 of the plane, evenly over the
-/// stretch around 0 where the energy is accessible (scanned on
-/// [−extent, extent]); none where it is nowhere accessible.
+/// stretch around 0 (π for an angle accessible there and not at 0) where
+/// the energy is accessible (scanned on [−extent, extent] about it); none
+/// where it is nowhere accessible.
 pub fn seeds_across(
     model: &Model,
     params: &[f64],
@@ -651,7 +670,8 @@ pub fn seeds_across(
     let energy = |y: &[f64; 4]| energy(y);
     let least = |q: f64| chart.least_energy(&[q, 0.0], &energy);
     let grid = 2001;
-    let q = |i: usize| -extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
+    let centre = chart.scan_centre(least, settings.energy);
+    let q = |i: usize| centre - extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
     // The accessible runs of the grid; the one around 0 (else the longest):
     // beyond a barrier the energy may be accessible again on an open branch.
     let mut runs: Vec<(usize, usize)> = Vec::new();

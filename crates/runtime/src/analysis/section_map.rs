@@ -34,7 +34,9 @@ pub const CHAOS_THRESHOLD: f64 = 4.0;
 #[derive(Debug, serde::Serialize)]
 pub struct SectionMap {
     pub model: String,
+    /// The energy, of H or, with a fast phase, of the averaged H̄.
     pub energy: f64,
+    pub energy_of: &'static str,
     pub axes: [String; 2],
     /// The window: the other coordinate's range and its momentum's.
     pub window: [[f64; 2]; 2],
@@ -71,9 +73,6 @@ pub fn section_map(
         }
         None => return Err(SectionError::ContactModel(name)),
     };
-    if fixed.has_fast_phase() {
-        return Err(SectionError::FastPhase(name));
-    }
     let s = &settings.section;
     let bad = |reason: &str| SectionError::Settings {
         model: name.clone(),
@@ -86,20 +85,39 @@ pub fn section_map(
         .ok_or_else(|| bad("the plane's coefficients are 0 or not finite"))?;
     let method = Method::Taylor { tol: s.tol };
     method.validate()?;
+    // MEGNO's samples every 2 time units, or with a fast phase every whole
+    // number of periods nearest 2 (the lanes restart the time at 0 after
+    // each: the field must be the same there), the orbits from phase 0.
+    let chunk = match fixed.has_fast_phase() {
+        false => 2.0,
+        true => match fixed.phase_period(params) {
+            Some(period) if period > 0.0 && s.phase == 0.0 => {
+                (2.0 / period).round().max(1.0) * period
+            }
+            _ => {
+                return Err(bad(
+                    "with a fast phase the map starts its orbits at phase 0",
+                ))
+            }
+        },
+    };
     let start = std::time::Instant::now();
-    let energy = |y: &[f64; 4]| model.dynamic.energy(params, 0.0, y);
+    let energy = super::section::seed_energy(model, params)
+        .ok_or_else(|| bad("its averaged Hamiltonian is not derived"))?;
+    let energy = |y: &[f64; 4]| energy(y);
     // The least H over the solved momentum at a point of the plane.
     let least = |q: f64, p: f64| chart.least_energy(&[q, p], &energy);
-    let region =
-        Region::find(&least, s.energy, settings.extent).ok_or_else(|| SectionError::NoSeeds {
+    let centre = chart.scan_centre(|q| least(q, 0.0), s.energy);
+    let region = Region::find(&least, s.energy, settings.extent, centre).ok_or_else(|| {
+        SectionError::NoSeeds {
             model: name.clone(),
-        })?;
+        }
+    })?;
     let window = region.window();
     let n = settings.pixels;
     let centre =
         |i: usize, range: [f64; 2]| range[0] + (range[1] - range[0]) * (i as f64 + 0.5) / n as f64;
     let system = fixed.exact(params);
-    let chunk = 2.0;
     let chunks = (settings.t_max / chunk).ceil() as usize;
     let w0 = [0.5; 4];
     let rows: Vec<(Vec<f64>, usize)> = (0..n)
@@ -146,6 +164,7 @@ pub fn section_map(
     Ok(SectionMap {
         model: name,
         energy: s.energy,
+        energy_of: if fixed.has_fast_phase() { "H̄" } else { "H" },
         axes: chart.axes(&names),
         window,
         pixels: n,
@@ -162,9 +181,12 @@ pub fn section_map(
 /// The region of the plane where H = E is accessible (the least H below
 /// E) and connected to the origin (else the largest such region: beyond a
 /// barrier the energy may be accessible again on an open branch), from a
-/// 400² scan of [−extent, extent]².
+/// 400² scan of [−extent, extent]² about (centre, 0).
 struct Region {
     extent: f64,
+    /// The scan's centre in the first coordinate (0, or π for an angle
+    /// accessible only there).
+    centre: f64,
     inside: Vec<bool>,
 }
 
@@ -176,11 +198,16 @@ fn scan_point(extent: f64, i: usize) -> f64 {
 }
 
 impl Region {
-    fn find(least: &(dyn Fn(f64, f64) -> f64 + Sync), energy: f64, extent: f64) -> Option<Region> {
+    fn find(
+        least: &(dyn Fn(f64, f64) -> f64 + Sync),
+        energy: f64,
+        extent: f64,
+        centre: f64,
+    ) -> Option<Region> {
         let at = |i: usize| scan_point(extent, i);
         let open: Vec<bool> = (0..SCAN * SCAN)
             .into_par_iter()
-            .map(|k| least(at(k % SCAN), at(k / SCAN)) < energy)
+            .map(|k| least(centre + at(k % SCAN), at(k / SCAN)) < energy)
             .collect();
         // The connected regions, by flood fill; the one holding the origin.
         let mut label = vec![usize::MAX; SCAN * SCAN];
@@ -217,6 +244,7 @@ impl Region {
         };
         Some(Region {
             extent,
+            centre,
             inside: label.iter().map(|&l| l == chosen).collect(),
         })
     }
@@ -227,7 +255,7 @@ impl Region {
     }
 
     fn contains(&self, q: f64, p: f64) -> bool {
-        matches!((self.cell(q), self.cell(p)), (Some(i), Some(j)) if self.inside[j * SCAN + i])
+        matches!((self.cell(q - self.centre), self.cell(p)), (Some(i), Some(j)) if self.inside[j * SCAN + i])
     }
 
     /// Its bounding box, padded by one scan cell.
@@ -245,7 +273,8 @@ impl Region {
                 .fold((usize::MAX, 0), |(a, b), k| (a.min(k), b.max(k)));
             [at(lo) - cell, at(hi) + cell]
         };
-        [range(|c| c.0), range(|c| c.1)]
+        let q = range(|c| c.0);
+        [[q[0] + self.centre, q[1] + self.centre], range(|c| c.1)]
     }
 }
 
@@ -254,10 +283,11 @@ impl SectionMap {
     /// accessible).
     pub fn figure(&self) -> Figure {
         let title = format!(
-            "{}: MEGNO ⟨Y⟩ on the section at E = {}, t = {}; chaotic (⟨Y⟩ > {CHAOS_THRESHOLD}) {:.1} % of the area",
+            "{}: MEGNO ⟨Y⟩ at {} = {}, t = {}; chaotic (⟨Y⟩ > {CHAOS_THRESHOLD}): {:.1} % of the area",
             self.model,
+            self.energy_of,
             self.energy,
-            self.t_max,
+            super::section::short(self.t_max),
             100.0 * self.chaotic_fraction
         );
         let spec = PanelSpec::new(
