@@ -365,9 +365,10 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
 /// The Poincaré section of a model without a fast phase: an orbit of
 /// Hénon–Heiles at E = 1/8 from a seed on the plane x = 0 is the library's
 /// section orbit point for point, on H = E to 1e-9; the MEGNO map has
-/// accessible and inaccessible pixels and a chaotic fraction; a model with
-/// a fast phase and a seed where the energy is not accessible are named
-/// errors (422).
+/// accessible and inaccessible pixels and a chaotic fraction; the shaken
+/// double pendulum gets the slice of its period map the library draws; a
+/// model of 1 degree of freedom with a fast phase and a seed where the
+/// energy is not accessible are named errors (422).
 #[tokio::test]
 async fn section_orbits_and_their_megno_map() {
     use mechlab::analysis::section::{section, SectionSettings};
@@ -402,6 +403,27 @@ async fn section_orbits_and_their_megno_map() {
     assert!(megno.iter().any(Value::is_null) && megno.iter().any(Value::is_f64));
     let fraction = answer["chaotic_fraction"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&fraction), "{fraction}");
+
+    // A model with a fast phase and 2 degrees of freedom: the slice of its
+    // period map, as the library draws it.
+    let pi = std::f64::consts::PI;
+    let slice = json!({"model": "double_pendulum", "energy": -1.5, "value": pi, "seed": [pi + 0.3, 0.0], "crossings": 20, "method": "dop853", "tol": 1e-12});
+    let (status, _, body) = call("POST", "/api/section", Some(slice)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let points: Vec<[f64; 2]> = serde_json::from_value(answer["points"].clone()).unwrap();
+    let shaken = mechlab::models::by_name("double_pendulum").unwrap();
+    let settings = SectionSettings {
+        value: pi,
+        energy: -1.5,
+        crossings: 20,
+        t_max: 20.0 * 20.0 + 100.0,
+        ..settings
+    };
+    let params = shaken.dynamic.defaults();
+    let library = section(shaken, &params, &[[pi + 0.3, 0.0]], &settings).unwrap();
+    assert_eq!(points, library.orbits[0].points);
+    assert_eq!(points.len(), 20);
 
     let (status, _, body) = call(
         "POST",
@@ -839,6 +861,66 @@ mod browser {
         assert_ne!(&painted[..3], &[255, 255, 255], "a crossing not drawn");
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("section.png"), png).unwrap();
+
+        // The shaken double pendulum has a fast phase: its section is a
+        // slice of the period map, at the averaged energy H̄.
+        client
+            .find(Locator::Id("model"))
+            .await
+            .unwrap()
+            .select_by_value("double_pendulum")
+            .await
+            .unwrap();
+        wait_for(
+            &client,
+            "studio.ready && studio.model.name === 'double_pendulum'",
+            30,
+        )
+        .await;
+        let label = client
+            .execute(
+                "const m = document.getElementById('show-megno'); if (m.checked) m.click(); \
+                 const e = document.getElementById('energy'); e.value = -1.5; e.dispatchEvent(new Event('change')); \
+                 const v = document.getElementById('section-value'); v.value = Math.PI; v.dispatchEvent(new Event('change')); \
+                 document.getElementById('show-section').click(); \
+                 return [document.getElementById('section-controls').style.display, document.getElementById('section-energy-of').textContent];",
+                vec![],
+            )
+            .await
+            .unwrap();
+        assert_eq!(label, serde_json::json!(["", "H̄"]));
+        wait_for(&client, "studio.section", 30).await;
+        client
+            .execute(
+                "studio.sectionSeed(Math.PI + 0.3, 0.0); return true;",
+                vec![],
+            )
+            .await
+            .unwrap();
+        wait_for(
+            &client,
+            "studio.orbits.length === 1 && studio.orbits[0].done && studio.orbits[0].points.length > 5",
+            60,
+        )
+        .await;
+        // Drawn about π (the hanging rod), and the view moved onto it.
+        let shown = client
+            .execute(
+                "const o = studio.orbits[0]; const [x, y] = o.points[3]; const [px, py] = studio.pixelOf(x, y); \
+                 return [o.points.every(([q]) => q > 0), studio.colorAt(px, py)];",
+                vec![],
+            )
+            .await
+            .unwrap();
+        assert_eq!(shown[0], serde_json::json!(true), "{shown}");
+        let painted: Vec<u8> = serde_json::from_value(shown[1].clone()).unwrap();
+        assert_ne!(
+            &painted[..3],
+            &[255, 255, 255],
+            "a point of the slice not drawn"
+        );
+        let png = client.screenshot().await.unwrap();
+        std::fs::write(folder.join("section_slice.png"), png).unwrap();
         client.close().await.unwrap();
     }
 }

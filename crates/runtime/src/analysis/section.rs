@@ -244,6 +244,8 @@ impl WithFixed for Sections<'_> {
         };
         let energy = seed_energy(self.model, self.params)
             .ok_or_else(|| bad("its averaged Hamiltonian is not derived".into()))?;
+        let energy = |y: &[f64; S]| energy(y);
+        let chart = chart.centred(|q| chart.least_energy(&[q, 0.0], &energy), s.energy);
         if self.seeds.is_empty() {
             return Err(SectionError::NoSeeds { model: name });
         }
@@ -254,7 +256,7 @@ impl WithFixed for Sections<'_> {
             chart,
             stroboscope,
             settings: s,
-            energy: &|y: &[f64; S]| energy(y),
+            energy: &energy,
         };
         let orbits = self
             .seeds
@@ -405,8 +407,9 @@ pub(super) struct Chart {
     /// Q_c is an angle (q_c one, and slope a whole multiple of q_o's turn
     /// or 0): its offset from the plane is wrapped to [−π, π).
     wrap_plane: bool,
-    /// Q_o is an angle: drawn on its circle.
+    /// Q_o is an angle: drawn on its circle about `centre`.
     wrap_other: bool,
+    centre: f64,
 }
 
 impl Chart {
@@ -429,6 +432,7 @@ impl Chart {
             dof,
             wrap_plane: periodic[c] && (slope == 0.0 || (whole && periodic[other])),
             wrap_other: periodic[other],
+            centre: 0.0,
         })
     }
 
@@ -454,15 +458,21 @@ impl Chart {
         }
     }
 
-    /// Where the search for accessible seeds centres Q_o: 0, or π where
-    /// Q_o is an angle whose energy is accessible at π and not at 0 (a
-    /// region around π scanned from 0 would be cut in two at ±π).
-    pub(super) fn scan_centre(&self, least_at: impl Fn(f64) -> f64, energy: f64) -> f64 {
+    /// The chart centred where its seeds are searched and its angle Q_o is
+    /// drawn, [centre − π, centre + π): 0, or π where Q_o is an angle whose
+    /// energy (the least H on the line P_o = 0, `least_at`) is accessible
+    /// at π and not at 0, as a pendulum's hanging rod in angles from the
+    /// upward vertical (about 0 its region would be cut in two at ±π).
+    pub(super) fn centred(mut self, least_at: impl Fn(f64) -> f64, energy: f64) -> Chart {
         let pi = std::f64::consts::PI;
-        match self.wrap_other && least_at(0.0) >= energy && least_at(pi) < energy {
-            true => pi,
-            false => 0.0,
+        if self.wrap_other && least_at(0.0) >= energy && least_at(pi) < energy {
+            self.centre = pi;
         }
+        self
+    }
+
+    pub(super) fn centre(&self) -> f64 {
+        self.centre
     }
 
     /// Q_c' from the coordinates' rates q'.
@@ -470,11 +480,14 @@ impl Chart {
         q_rate[self.c] + self.slope * q_rate[self.other]
     }
 
-    /// (Q_o, P_o) of a state, Q_o on its circle if an angle.
+    /// (Q_o, P_o) of a state, Q_o on its circle about the centre if an
+    /// angle.
     pub(super) fn point(&self, y: &[f64]) -> [f64; 2] {
         let d = self.dof;
         let q = match self.wrap_other {
-            true => crate::analysis::period_map::wrap_angle(y[self.other]),
+            true => {
+                self.centre + crate::analysis::period_map::wrap_angle(y[self.other] - self.centre)
+            }
             false => y[self.other],
         };
         [q, y[d + self.other] - self.slope * y[d + self.c]]
@@ -670,7 +683,7 @@ pub fn seeds_across(
     let energy = |y: &[f64; 4]| energy(y);
     let least = |q: f64| chart.least_energy(&[q, 0.0], &energy);
     let grid = 2001;
-    let centre = chart.scan_centre(least, settings.energy);
+    let centre = chart.centred(least, settings.energy).centre();
     let q = |i: usize| centre - extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
     // The accessible runs of the grid; the one around 0 (else the longest):
     // beyond a barrier the energy may be accessible again on an open branch.

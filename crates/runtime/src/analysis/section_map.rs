@@ -107,7 +107,7 @@ pub fn section_map(
     let energy = |y: &[f64; 4]| energy(y);
     // The least H over the solved momentum at a point of the plane.
     let least = |q: f64, p: f64| chart.least_energy(&[q, p], &energy);
-    let centre = chart.scan_centre(|q| least(q, 0.0), s.energy);
+    let centre = chart.centred(|q| least(q, 0.0), s.energy).centre();
     let region = Region::find(&least, s.energy, settings.extent, centre).ok_or_else(|| {
         SectionError::NoSeeds {
             model: name.clone(),

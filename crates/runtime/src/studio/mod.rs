@@ -888,8 +888,8 @@ pub fn continuation(
 }
 
 /// The plane of a Poincaré section on the page: q_c = value crossed in one
-/// direction, at the energy H = E (models without a fast phase, 2 degrees
-/// of freedom).
+/// direction, at the energy H = E (models of 2 degrees of freedom; with a
+/// fast phase, H̄ = E and a slice of the period map).
 #[derive(Clone, Debug, Deserialize)]
 pub struct SectionPlane {
     pub energy: f64,
@@ -918,7 +918,8 @@ impl SectionPlane {
             crossings,
             t_max: 20.0 * crossings as f64 + 100.0,
             tol,
-            // The studio's sections are of models without a fast phase.
+            // With a fast phase: the period map at phase 0, within 0.05 of
+            // the plane.
             phase: 0.0,
             slab: 0.05,
         }

@@ -382,7 +382,7 @@ function seedAt(x, y) {
   listOrbits();
 }
 
-// ---------- the Poincaré section of a model without a fast phase ----------
+// ---------- the Poincaré section (a slice of the period map with a fast phase) ----------
 
 function sectionPlane() {
   return {
@@ -417,8 +417,20 @@ async function startSectionOrbit(orbit) {
     say(`section: ${e.message}`);
   }
   orbit.done = true;
+  // No map has placed the view, and the orbit is outside it: show the orbit.
+  const visible = ([x, y]) => x >= studio.view.x[0] && x <= studio.view.x[1] && y >= studio.view.y[0] && y <= studio.view.y[1];
+  if (!studio.megnoViewSet && orbit.points.length && !orbit.points.some(visible)) fitView(orbit.points);
   listOrbits();
   redraw();
+}
+
+// The view around `points`, padded by a tenth of each side.
+function fitView(points) {
+  const side = (values) => {
+    const lo = Math.min(...values), hi = Math.max(...values), pad = 0.1 * Math.max(hi - lo, 1e-3);
+    return [lo - pad, hi + pad];
+  };
+  studio.view = { x: side(points.map((p) => p[0])), y: side(points.map((p) => p[1])) };
 }
 
 let megnoController = null;
@@ -479,7 +491,8 @@ function setSectionMode(on) {
 }
 
 function buildSection(model) {
-  const applies = !model.fast_phase && model.state.length === 4 && model.kind === "hamiltonian";
+  const applies = model.state.length === 4 && model.kind === "hamiltonian";
+  $("section-energy-of").textContent = model.fast_phase ? "H̄" : "H";
   $("section-controls").style.display = applies ? "" : "none";
   $("show-section").checked = false;
   studio.section = false;
