@@ -111,9 +111,9 @@ pub struct Homoclinic {
     pub sigma_stable: f64,
     /// |W^u(σᵤ) − W^s(σₛ)| there: the accuracy of the point.
     pub closure: f64,
-    /// The angle between the two manifolds there, radians in [0, π/2]
-    /// (not measured in double-double: it would need the tangent to 32
-    /// digits).
+    /// The angle between the two manifolds there, radians in [0, π/2]; in
+    /// double-double at the symmetric point of the orbit (its phase the
+    /// symmetry's), from tangents to about 24 digits.
     pub angle: Option<f64>,
     /// The MacKay–Meiss–Percival action of its orbit (area-preserving maps).
     pub action: Option<f64>,
@@ -356,7 +356,7 @@ fn with_polygon(mut precise: Splitting, double: &Splitting) -> Splitting {
         _ => None,
     };
     for (h, d) in precise.homoclinic.iter_mut().zip(&double.homoclinic) {
-        h.angle = d.angle;
+        h.angle = h.angle.or(d.angle);
     }
     precise
 }
