@@ -197,7 +197,15 @@ fn measure(
         })?;
         let (k, f) = refine(map, flow, star, symmetry, sigma, centre)?;
         let sigma = k as f64 + f;
-        let (points, after, x0) = symmetric_orbit(map, flow, star, symmetry, (k, f), centre)?;
+        let located = Located {
+            map,
+            flow,
+            star,
+            symmetry,
+            at: (k, f),
+            centre,
+        };
+        let (points, after, x0) = located.symmetric_orbit()?;
         let action = pseudo_orbit_action(flow, &points, after, star, symmetry.shift)?;
         // A true orbit: every point the image of the one before, to the
         // points' double precision (a symmetry line met near the other
@@ -213,47 +221,12 @@ fn measure(
             sigma_unstable: sigma,
             sigma_stable: sigma + (2.0 * centre).floor(),
             closure: action.largest_jump,
-            angle: splitting_angle(map, flow, star, symmetry, (k, f), centre)?,
+            angle: located.splitting_angle()?,
             action: Some(action.value),
         };
         Ok((homoclinic, action))
     };
     Ok([orbit(0.0)?, orbit(0.5)?])
-}
-
-/// The angle between W^u and W^s at the symmetric homoclinic point
-/// z = W^u(σ) at t = centre·T, in double-double. On the symmetry line R
-/// maps W^u onto W^s, so the stable tangent is DR t with t = dz/dσ, and the
-/// lines' angle is atan2(|t × DR t|, |t · DR t|) = atan2(2|t₀t₁|, |t₀² − t₁²|)
-/// for either reversor. t by the fourth-order central difference
-/// (8(z₊₁ − z₋₁) − (z₊₂ − z₋₂))/(12δ) on chains in double-double, at δ and
-/// 2δ (δ = 10⁻⁵ in σ). Measured on Kapitza, the angle does not move with δ
-/// from 10⁻³ to 10⁻⁶ beyond a floor of about 10⁻¹⁵ rad (whose source is not
-/// yet found): it is given where the two agree to 10⁻⁴ of it, None below
-/// (at ε = 0.035, 9.7253·10⁻¹⁰ to 10⁻⁶; from ε ≈ 0.03 on, none).
-fn splitting_angle(
-    map: &Map,
-    flow: &ActionFlow,
-    star: [DoubleDouble; 2],
-    symmetry: &Symmetry,
-    (k, f): (usize, f64),
-    centre: f64,
-) -> Result<Option<f64>, OdeError> {
-    let z = |df: f64| -> Result<[DoubleDouble; 2], OdeError> {
-        let chain = chain(map, flow, star, &symmetry.branch, (k, f + df))?;
-        let x0 = *chain.last().expect("one point at least");
-        flow_for(map, x0, flow.period * centre)
-    };
-    let angle = |delta: f64| -> Result<f64, OdeError> {
-        let (p1, m1, p2, m2) = (z(delta)?, z(-delta)?, z(2.0 * delta)?, z(-2.0 * delta)?);
-        let t: [DoubleDouble; 2] =
-            std::array::from_fn(|i| ((p1[i] - m1[i]) * 8.0 - (p2[i] - m2[i])) / (12.0 * delta));
-        let cross = (t[0] * t[1] * 2.0).to_f64().abs();
-        let dot = (t[0] * t[0] - t[1] * t[1]).to_f64().abs();
-        Ok(cross.atan2(dot))
-    };
-    let (fine, coarse) = (angle(1e-5)?, angle(2e-5)?);
-    Ok(((fine - coarse).abs() <= 1e-4 * fine).then_some(fine))
 }
 
 fn branch_point(map: &Map, branch: &Branch, sigma: f64) -> [f64; 2] {
@@ -546,40 +519,82 @@ fn refine(
     Ok((k, b))
 }
 
-/// The homoclinic orbit through x₀ = W^u(σ), symmetric about t = centre·T,
-/// in double-double: the local manifold from 10⁻¹⁷ of y*, the chain of
-/// W^u to x₀, then the stable half
-/// x_k = R φ_r(x_{m−k}), 2·centre·T = mT + r (φ_r in double-double); the
-/// point after the list, and x₀.
-fn symmetric_orbit(
-    map: &Map,
-    flow: &ActionFlow,
+/// A symmetric homoclinic orbit located on W^u: its map, flow, fixed
+/// point in double-double and symmetry, σ = k + f on the chain and the
+/// phase of its symmetric point (centre·T).
+#[derive(Clone, Copy)]
+struct Located<'a> {
+    map: &'a Map,
+    flow: &'a ActionFlow,
     star: [DoubleDouble; 2],
-    symmetry: &Symmetry,
-    (k, f): (usize, f64),
+    symmetry: &'a Symmetry,
+    at: (usize, f64),
     centre: f64,
-) -> Result<(Vec<[DoubleDouble; 2]>, [DoubleDouble; 2], [DoubleDouble; 2]), OdeError> {
-    let branch = &symmetry.branch;
-    let tail = |i: i32| local(star, branch, f, i);
-    let far = ((1e-17 / OFFSET).ln() / -branch.growth.ln()).ceil() as i32;
-    let mut unstable: Vec<[DoubleDouble; 2]> = (1..=far).rev().map(tail).collect();
-    unstable.extend(chain(map, flow, star, branch, (k, f))?);
-    let twice = 2.0 * centre;
-    let (m, r) = (twice.floor(), twice.fract());
-    let mirror = |y: [DoubleDouble; 2]| -> Result<[DoubleDouble; 2], OdeError> {
-        Ok(symmetry.reversor.apply(flow_for(map, y, flow.period * r)?))
-    };
-    // x_{m−1}, x_{m−2}, …: the unstable list backwards, from x₋₁ (m = 0)
-    // or x₀ (m = 1).
-    let skip = if m == 0.0 { 1 } else { 0 };
-    let backwards: Vec<[DoubleDouble; 2]> = unstable.iter().rev().skip(skip).copied().collect();
-    let stable: Vec<[DoubleDouble; 2]> = backwards
-        .par_iter()
-        .map(|&y| mirror(y))
-        .collect::<Result<_, _>>()?;
-    let after = mirror(tail(far + 1))?;
-    let x0 = *unstable.last().expect("the chain has x₀");
-    let mut points = unstable;
-    points.extend(stable);
-    Ok((points, after, x0))
+}
+
+impl Located<'_> {
+    /// The homoclinic orbit through x₀ = W^u(σ), symmetric about t = centre·T,
+    /// in double-double: the local manifold from 10⁻¹⁷ of y*, the chain of
+    /// W^u to x₀, then the stable half
+    /// x_k = R φ_r(x_{m−k}), 2·centre·T = mT + r (φ_r in double-double); the
+    /// point after the list, and x₀.
+    fn symmetric_orbit(
+        &self,
+    ) -> Result<(Vec<[DoubleDouble; 2]>, [DoubleDouble; 2], [DoubleDouble; 2]), OdeError> {
+        let (map, flow, star, symmetry) = (self.map, self.flow, self.star, self.symmetry);
+        let ((k, f), centre) = (self.at, self.centre);
+        let branch = &symmetry.branch;
+        let tail = |i: i32| local(star, branch, f, i);
+        let far = ((1e-17 / OFFSET).ln() / -branch.growth.ln()).ceil() as i32;
+        let mut unstable: Vec<[DoubleDouble; 2]> = (1..=far).rev().map(tail).collect();
+        unstable.extend(chain(map, flow, star, branch, (k, f))?);
+        let twice = 2.0 * centre;
+        let (m, r) = (twice.floor(), twice.fract());
+        let mirror = |y: [DoubleDouble; 2]| -> Result<[DoubleDouble; 2], OdeError> {
+            Ok(symmetry.reversor.apply(flow_for(map, y, flow.period * r)?))
+        };
+        // x_{m−1}, x_{m−2}, …: the unstable list backwards, from x₋₁ (m = 0)
+        // or x₀ (m = 1).
+        let skip = if m == 0.0 { 1 } else { 0 };
+        let backwards: Vec<[DoubleDouble; 2]> = unstable.iter().rev().skip(skip).copied().collect();
+        let stable: Vec<[DoubleDouble; 2]> = backwards
+            .par_iter()
+            .map(|&y| mirror(y))
+            .collect::<Result<_, _>>()?;
+        let after = mirror(tail(far + 1))?;
+        let x0 = *unstable.last().expect("the chain has x₀");
+        let mut points = unstable;
+        points.extend(stable);
+        Ok((points, after, x0))
+    }
+
+    /// The angle between W^u and W^s at the symmetric homoclinic point
+    /// z = W^u(σ) at t = centre·T, in double-double. On the symmetry line R
+    /// maps W^u onto W^s, so the stable tangent is DR t with t = dz/dσ, and the
+    /// lines' angle is atan2(|t × DR t|, |t · DR t|) = atan2(2|t₀t₁|, |t₀² − t₁²|)
+    /// for either reversor. t by the fourth-order central difference
+    /// (8(z₊₁ − z₋₁) − (z₊₂ − z₋₂))/(12δ) on chains in double-double, at δ and
+    /// 2δ (δ = 10⁻⁵ in σ). Measured on Kapitza, the angle does not move with δ
+    /// from 10⁻³ to 10⁻⁶ beyond a floor of about 10⁻¹⁵ rad (whose source is not
+    /// yet found): it is given where the two agree to 10⁻⁴ of it, None below
+    /// (at ε = 0.035, 9.7253·10⁻¹⁰ to 10⁻⁶; from ε ≈ 0.03 on, none).
+    fn splitting_angle(&self) -> Result<Option<f64>, OdeError> {
+        let (map, flow, star, symmetry) = (self.map, self.flow, self.star, self.symmetry);
+        let ((k, f), centre) = (self.at, self.centre);
+        let z = |df: f64| -> Result<[DoubleDouble; 2], OdeError> {
+            let chain = chain(map, flow, star, &symmetry.branch, (k, f + df))?;
+            let x0 = *chain.last().expect("one point at least");
+            flow_for(map, x0, flow.period * centre)
+        };
+        let angle = |delta: f64| -> Result<f64, OdeError> {
+            let (p1, m1, p2, m2) = (z(delta)?, z(-delta)?, z(2.0 * delta)?, z(-2.0 * delta)?);
+            let t: [DoubleDouble; 2] =
+                std::array::from_fn(|i| ((p1[i] - m1[i]) * 8.0 - (p2[i] - m2[i])) / (12.0 * delta));
+            let cross = (t[0] * t[1] * 2.0).to_f64().abs();
+            let dot = (t[0] * t[0] - t[1] * t[1]).to_f64().abs();
+            Ok(cross.atan2(dot))
+        };
+        let (fine, coarse) = (angle(1e-5)?, angle(2e-5)?);
+        Ok(((fine - coarse).abs() <= 1e-4 * fine).then_some(fine))
+    }
 }
