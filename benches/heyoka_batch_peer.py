@@ -127,6 +127,7 @@ def main():
     for r in rows:
         print(f"{r['tol']:<8g} {r['heyoka_batch_seconds']:8.3f}  {r['mechlab_batch_seconds']:9.3f}"
               f"  {r['speedup']:8.2f}  {r['median_abs_fli_difference']:12.2e}  {r['p99_abs_fli_difference']:9.2e}")
+    return rows
 
 
 if __name__ == "__main__":

@@ -110,13 +110,16 @@ def main():
     dop = [(e, r) for n, _, e, r in rows if n == "dop853"]
     print("\nAt heyoka's error: mechlab taylor (and dop853) periods/s over heyoka's")
     print(f"{'tol':>7} {'error':>9} {'taylor/heyoka':>14} {'dop853/heyoka':>14}")
+    ratios = []
     for name, tol, err, rate in rows:
         if name != "heyoka":
             continue
         t, d = rate_at(ours, err), rate_at(dop, err)
         fmt = lambda x: f"{x / rate:14.2f}" if x else f"{'-':>14}"
         print(f"{tol:7.0e} {err:9.2e} {fmt(t)} {fmt(d)}")
+        ratios.append({"tol": tol, "speedup": t / rate if t else None})
+    return ratios
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -136,6 +136,7 @@ def main():
         print(f"{r['tol']:<8g} {r['orbits']:6d}  {r['heyoka_batch_seconds']:8.2f}  {r['mechlab_batch_seconds']:9.2f}"
               f"  {r['speedup']:8.2f}  {r['median_abs_megno_difference']:10.2e}  {r['same_verdict_share']:12.3f}"
               f"  {r['chaotic_fraction_mechlab']:.3f} / {r['chaotic_fraction_heyoka']:.3f}")
+    return rows
 
 
 if __name__ == "__main__":
