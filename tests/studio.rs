@@ -404,6 +404,34 @@ async fn section_orbits_and_their_megno_map() {
     let fraction = answer["chaotic_fraction"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&fraction), "{fraction}");
 
+    // A plane given as a linear function of the coordinates: the library's
+    // section on it, in the plane's chart, named; a bad plane is refused.
+    let tilted = json!({"model": "henon_heiles", "energy": 0.125, "plane": "x + 0.5*y", "seed": [0.1, 0.05], "crossings": 30, "method": "dop853", "tol": 1e-12});
+    let (status, _, body) = call("POST", "/api/section", Some(tilted)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(answer["axes"], json!(["y", "p_y − 0.5·p_x"]));
+    let points: Vec<[f64; 2]> = serde_json::from_value(answer["points"].clone()).unwrap();
+    let on_tilted = SectionSettings {
+        plane: [1.0, 0.5],
+        crossings: 30,
+        t_max: 20.0 * 30.0 + 100.0,
+        ..settings.clone()
+    };
+    let library = section(model, &model.dynamic.defaults(), &[[0.1, 0.05]], &on_tilted).unwrap();
+    assert_eq!(points, library.orbits[0].points);
+    let (status, _, body) = call(
+        "POST",
+        "/api/section",
+        Some(json!({"model": "henon_heiles", "energy": 0.125, "plane": "z", "seed": [0.1, 0.0], "crossings": 5})),
+    )
+    .await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(
+        body.contains("plane") && body.contains("not a coordinate"),
+        "{body}"
+    );
+
     // A model with a fast phase and 2 degrees of freedom: the slice of its
     // period map, as the library draws it.
     let pi = std::f64::consts::PI;
@@ -606,6 +634,10 @@ mod browser {
             }
         }
     }
+
+    /// The page holds one orbit, done, with more than 100 points.
+    const ONE_LONG_ORBIT: &str =
+    "studio.orbits.length === 1 && studio.orbits[0].done && studio.orbits[0].points.length > 100";
 
     /// Evaluates `expression` in the page until it is true (or fails after
     /// `seconds`).
@@ -843,12 +875,7 @@ mod browser {
             .execute("studio.sectionSeed(0.1, 0.0); return true;", vec![])
             .await
             .unwrap();
-        wait_for(
-            &client,
-            "studio.orbits.length === 1 && studio.orbits[0].done && studio.orbits[0].points.length > 100",
-            60,
-        )
-        .await;
+        wait_for(&client, ONE_LONG_ORBIT, 60).await;
         tokio::time::sleep(Duration::from_millis(500)).await;
         let painted = client
             .execute(
@@ -861,6 +888,23 @@ mod browser {
         assert_ne!(&painted[..3], &[255, 255, 255], "a crossing not drawn");
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("section.png"), png).unwrap();
+
+        // The tilted plane x + 0.5 y = 0: the page's axes become its chart.
+        client
+            .execute(
+                "const m = document.getElementById('show-megno'); if (m.checked) m.click(); \
+                 const p = document.getElementById('section-plane'); p.value = 'x + 0.5*y'; p.dispatchEvent(new Event('change')); \
+                 studio.sectionSeed(0.1, 0.05); return true;",
+                vec![],
+            )
+            .await
+            .unwrap();
+        wait_for(&client, ONE_LONG_ORBIT, 60).await;
+        let axes = client
+            .execute("return studio.sectionAxes;", vec![])
+            .await
+            .unwrap();
+        assert_eq!(axes, serde_json::json!(["y", "p_y − 0.5·p_x"]));
 
         // The shaken double pendulum has a fast phase: its section is a
         // slice of the period map, at the averaged energy H̄.

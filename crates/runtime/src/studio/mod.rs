@@ -895,6 +895,10 @@ pub struct SectionPlane {
     pub energy: f64,
     #[serde(default)]
     pub coordinate: usize,
+    /// A linear function of the coordinates ("phi1 - phi2"), in place of
+    /// `coordinate` where given.
+    #[serde(default)]
+    pub plane: Option<String>,
     #[serde(default)]
     pub value: f64,
     #[serde(default = "rising")]
@@ -906,12 +910,25 @@ fn rising() -> bool {
 }
 
 impl SectionPlane {
-    fn settings(&self, crossings: usize, tol: f64) -> crate::analysis::section::SectionSettings {
-        crate::analysis::section::SectionSettings {
-            plane: match self.coordinate {
-                0 => [1.0, 0.0],
-                _ => [0.0, 1.0],
-            },
+    /// The library's settings: the plane `plane` (a linear function of the
+    /// coordinates, as the `section` scene reads it) where given, else the
+    /// coordinate's.
+    fn settings(
+        &self,
+        coordinates: &[&str],
+        crossings: usize,
+        tol: f64,
+    ) -> Result<crate::analysis::section::SectionSettings, crate::analysis::section::SectionError>
+    {
+        let plane = match (&self.plane, self.coordinate) {
+            (Some(text), _) if !text.trim().is_empty() => {
+                crate::analysis::section::parse_plane(text, coordinates)?
+            }
+            (_, 0) => [1.0, 0.0],
+            _ => [0.0, 1.0],
+        };
+        Ok(crate::analysis::section::SectionSettings {
+            plane,
             value: self.value,
             rising: self.rising,
             energy: self.energy,
@@ -922,7 +939,7 @@ impl SectionPlane {
             // the plane.
             phase: 0.0,
             slab: 0.05,
-        }
+        })
     }
 }
 
@@ -946,6 +963,8 @@ pub struct SectionRequest {
 /// start and its largest drift from H = E.
 #[derive(Clone, Debug, Serialize)]
 pub struct SectionPoints {
+    /// The names of the plane's two axes (Q_o and P_o of its chart).
+    pub axes: [String; 2],
     pub points: Vec<[f64; 2]>,
     pub start: Vec<f64>,
     pub energy_drift: f64,
@@ -955,11 +974,15 @@ pub struct SectionPoints {
 pub fn section(catalog: Catalog, request: &SectionRequest) -> Result<SectionPoints, StudioError> {
     let setup = request.setup.resolve(catalog, &request.unknown)?;
     let crossings = setup.count("crossings", request.crossings, MAX_PERIODS)?;
-    let settings = request.plane.settings(crossings, setup_tol(&setup));
+    let coordinates = setup.handle.info.coordinates;
+    let settings = request
+        .plane
+        .settings(coordinates, crossings, setup_tol(&setup))?;
     let mut found =
         crate::analysis::section::section(setup.handle, &setup.params, &[request.seed], &settings)?;
     let orbit = found.orbits.remove(0);
     Ok(SectionPoints {
+        axes: found.axes,
         points: orbit.points,
         start: orbit.start,
         energy_drift: orbit.energy_drift,
@@ -985,6 +1008,8 @@ pub struct SectionMapRequest {
 /// where the energy is not accessible) over `window`.
 #[derive(Clone, Debug, Serialize)]
 pub struct SectionMapView {
+    /// The names of the plane's two axes (Q_o and P_o of its chart).
+    pub axes: [String; 2],
     pub window: [[f64; 2]; 2],
     pub pixels: usize,
     pub megno: Vec<Option<f64>>,
@@ -1006,13 +1031,16 @@ pub fn section_map(
         }));
     }
     let settings = SectionMapSettings {
-        section: request.plane.settings(1, setup_tol(&setup)),
+        section: request
+            .plane
+            .settings(setup.handle.info.coordinates, 1, setup_tol(&setup))?,
         pixels,
         t_max: request.t_max,
         extent: 3.0,
     };
     let map = section_map(setup.handle, &setup.params, &settings)?;
     Ok(SectionMapView {
+        axes: map.axes.clone(),
         window: map.window,
         pixels: map.pixels,
         megno: map

@@ -97,6 +97,8 @@ function toPixel(wx, wy) {
   return [((wx - x[0]) / (x[1] - x[0])) * canvas.width, ((y[1] - wy) / (y[1] - y[0])) * canvas.height];
 }
 const stateName = (k) => studio.model.state[k];
+// The page's axis i: on a section, the plane's chart as the server names it.
+const axisName = (i) => (studio.section && studio.sectionAxes ? studio.sectionAxes[i] : stateName(studio.axes[i]));
 // For the browser test: where a point is drawn, and the colour there.
 studio.pixelOf = (x, y) => toPixel(x, y);
 studio.colorAt = (px, py) => Array.from(ctx.getImageData(Math.round(px), Math.round(py), 1, 1).data);
@@ -247,8 +249,9 @@ function drawGrid(g, width, height) {
   }
   g.fillStyle = "#222";
   g.font = "italic 14px serif";
-  g.fillText(stateName(studio.axes[0]), width - 40, height - 18);
-  g.fillText(stateName(studio.axes[1]), 30, 16);
+  const [xName, yName] = [axisName(0), axisName(1)];
+  g.fillText(xName, width - 12 - g.measureText(xName).width, height - 18);
+  g.fillText(yName, 30, 16);
 }
 
 function niceStep(raw) {
@@ -388,6 +391,7 @@ function sectionPlane() {
   return {
     energy: Number($("energy").value),
     coordinate: Number($("section-coordinate").value),
+    plane: $("section-plane").value.trim() || undefined,
     value: Number($("section-value").value),
     rising: $("section-direction").value === "rising",
   };
@@ -410,6 +414,7 @@ async function startSectionOrbit(orbit) {
     const answer = await postJson("/api/section", request, orbit.controller.signal);
     orbit.points = answer.points;
     orbit.drift = answer.energy_drift;
+    studio.sectionAxes = answer.axes;
     studio.pointsReceived += answer.points.length;
   } catch (e) {
     if (aborted(e)) return;
@@ -447,6 +452,7 @@ async function refreshMegno() {
     try {
       const map = await postJson("/api/section_map", { ...setup(), ...sectionPlane(), pixels, t_max }, signal);
       studio.megno = { ranges: map.window, image: megnoImage(map) };
+      studio.sectionAxes = map.axes;
       $("megno-note").textContent = `(${pixels}², chaotic ${(100 * map.chaotic_fraction).toFixed(1)} %)`;
       if (pixels === 32 && !studio.megnoViewSet) {
         studio.view = { x: map.window[0].slice(), y: map.window[1].slice() };
@@ -475,6 +481,7 @@ function megnoImage(map) {
 function setSectionMode(on) {
   const model = studio.model;
   studio.section = on;
+  studio.sectionAxes = null;
   removeOrbits(0);
   if (on) {
     const other = 1 - Number($("section-coordinate").value);
@@ -495,6 +502,7 @@ function buildSection(model) {
   $("section-energy-of").textContent = model.fast_phase ? "H̄" : "H";
   $("section-controls").style.display = applies ? "" : "none";
   $("show-section").checked = false;
+  $("section-plane").value = "";
   studio.section = false;
   studio.megno = null;
   $("section-coordinate").innerHTML = model.state.slice(0, 2).map((name, i) => `<option value="${i}">${name}</option>`).join("");
@@ -693,7 +701,7 @@ canvas.addEventListener("mousedown", (e) => {
 canvas.addEventListener("mousemove", (e) => {
   if (studio.model) {
     const [x, y] = toWorld(e.offsetX, e.offsetY);
-    $("hover").textContent = `${stateName(studio.axes[0])} = ${x.toFixed(4)}, ${stateName(studio.axes[1])} = ${y.toFixed(4)}`;
+    $("hover").textContent = `${axisName(0)} = ${x.toFixed(4)}, ${axisName(1)} = ${y.toFixed(4)}`;
   }
   if (!press) return;
   const dx = e.offsetX - press.x, dy = e.offsetY - press.y;
@@ -788,6 +796,7 @@ function wire() {
   $("energy-slider").addEventListener("input", () => { $("energy").value = $("energy-slider").value; sectionChanged(); });
   for (const id of ["section-value", "section-direction", "show-megno", "megno-time"]) $(id).addEventListener("change", sectionChanged);
   $("section-coordinate").addEventListener("change", () => { if (studio.section) setSectionMode(true); });
+  $("section-plane").addEventListener("change", () => { if (studio.section) setSectionMode(true); });
   $("cont-clear").addEventListener("click", () => { studio.branches = null; $("cont-list").innerHTML = ""; redraw(); });
   for (const id of ["show-chaos", "chaos-periods"]) $(id).addEventListener("change", refreshChaos);
   for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
