@@ -251,7 +251,7 @@ impl WithFixed for Sections<'_> {
         }
         let names = info.state_names();
         let system = fixed.exact(self.params);
-        let orbit = Orbit {
+        let orbit = OrbitRun {
             system: &system,
             chart,
             stroboscope,
@@ -288,7 +288,7 @@ impl WithFixed for Sections<'_> {
 }
 
 /// One orbit's work: its system, plane, stroboscope and energy.
-struct Orbit<'a, Y, const S: usize> {
+struct OrbitRun<'a, Y, const S: usize> {
     system: &'a Y,
     chart: Chart,
     stroboscope: Option<Stroboscope>,
@@ -296,7 +296,7 @@ struct Orbit<'a, Y, const S: usize> {
     energy: &'a (dyn Fn(&[f64; S]) -> f64 + Sync),
 }
 
-impl<Y: crate::ode::System<S> + Sync, const S: usize> Orbit<'_, Y, S> {
+impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
     /// The crossings of the orbit through `seed`.
     fn follow(&self, seed: &[f64; 2]) -> Result<SectionOrbit, SectionError> {
         let (s, chart) = (self.settings, self.chart);
@@ -344,9 +344,7 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> Orbit<'_, Y, S> {
         orbit.energy_drift = orbit.energy_drift.max(drift);
         orbit.plane_distance = orbit.plane_distance.max(self.chart.offset(y).abs());
     }
-}
 
-impl<Y: crate::ode::System<S> + Sync, const S: usize> Orbit<'_, Y, S> {
     /// The slice of the period map through `seed`: the orbit from `start`
     /// at the stroboscope's phase, its points within the slab and moving
     /// the way asked (the plane function's rate from the exact field).
@@ -604,9 +602,16 @@ pub struct PlaneError {
 /// x to six significant digits at most (π as 3.14159).
 pub(super) fn short(x: f64) -> String {
     let text = format!("{x}");
-    match text.len() > 8 {
-        true => format!("{:.6}", x).trim_end_matches('0').to_string(),
-        false => text,
+    if text.len() <= 8 {
+        text
+    } else if x.abs() >= 1e-3 && x.abs() < 1e6 {
+        let fixed = format!("{x:.6}");
+        fixed
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{x:.5e}")
     }
 }
 
