@@ -1492,7 +1492,7 @@ impl SplittingSweep {
         let (y0, y1) = range(&mut y.clone());
         let title = match self.fit {
             Some(f) => format!(
-                "{}: lobe area (red) ≈ {:.3e}·ε^{:.2}·exp(−{:.4}/ε) (blue), Melnikov (green)",
+                "{}: lobe area (red) ≈ {:.3e}·ε^{:.2}·exp(−{:.4}/ε) (blue), Melnikov (green), angle (orange, rad)",
                 self.model, f.c, f.k, f.d
             ),
             None => format!("{}: lobe area (too few resolved values to fit)", self.model),
@@ -1500,7 +1500,7 @@ impl SplittingSweep {
         let spec = PanelSpec::new(
             &title,
             "1/ε",
-            "lobe area",
+            "lobe area; splitting angle (rad)",
             (0.9 * x0, 1.1 * x1),
             (0.3 * y0, 3.0 * y1),
         )
@@ -1520,6 +1520,12 @@ impl SplittingSweep {
             .filter_map(|r| Some((1.0 / r.eps, r.lobe_area_melnikov?)))
             .collect();
         figure.line(0, &melnikov, Rgb(20, 150, 40));
+        let angles: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter_map(|r| Some((1.0 / r.eps, r.angle?)))
+            .collect();
+        figure.points(0, angles, Rgb(230, 130, 20), 5);
         if let Some(f) = self.fit {
             let curve: Vec<(f64, f64)> = (0..=100)
                 .map(|i| {
