@@ -104,12 +104,12 @@ pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
     periods: usize,
 ) -> Result<f64, OdeError> {
     let variational = Variational::<S, N, M>::new(system);
-    let mut z = Variational::<S, N, M>::pack(y0, &[*w0]);
+    let z = Variational::<S, N, M>::pack(y0, &[*w0]);
     let mut fli = Fli::<N, M>::new(w0);
-    for _ in 0..periods {
-        z = integrator.advance(&variational, 0.0, &z, period)?;
-        fli.after_segment(&mut z);
-    }
+    integrator.advance_segments(&variational, &z, period, periods, &mut |z| {
+        fli.after_segment(z);
+        true
+    })?;
     Ok(fli.value())
 }
 

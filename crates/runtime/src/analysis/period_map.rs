@@ -33,7 +33,11 @@ pub fn period_map<S: System<N>, const N: usize>(
 }
 
 /// `periods` iterates of the period map from `y0` (y0 first), with the
-/// coordinates flagged in `wrap` kept in [−π, π) (exact: the field is 2π-periodic in them).
+/// coordinates flagged in `wrap` given in [−π, π) (exact: the field is
+/// 2π-periodic in them). With the Taylor method the steps run across the
+/// periods' ends (see [`Integrator::advance_segments`]); the state itself is
+/// brought back only once it is past ±3π, a change that restarts the step
+/// there, so an orbit about π is not cut at every period.
 pub fn orbit<S: System<N>, const N: usize>(
     integrator: &mut Integrator,
     system: &S,
@@ -43,18 +47,28 @@ pub fn orbit<S: System<N>, const N: usize>(
     wrap: &[bool],
 ) -> Result<Vec<[f64; N]>, OdeError> {
     let mut points = Vec::with_capacity(periods + 1);
-    let mut y = *y0;
-    points.push(y);
-    for _ in 0..periods {
-        y = period_map(integrator, system, period, &y)?;
-        for (x, w) in y.iter_mut().zip(wrap) {
-            if *w {
-                *x = wrap_angle(*x);
+    points.push(*y0);
+    integrator.advance_segments(system, y0, period, periods, &mut |y| {
+        points.push(wrapped_point(y, wrap));
+        true
+    })?;
+    Ok(points)
+}
+
+/// The point of the map at state `y`, its coordinates flagged in `wrap` in
+/// [−π, π); `y`'s own are brought back only once past ±3π (a change of
+/// the state restarts the Taylor step: see [`orbit`]).
+pub fn wrapped_point<const N: usize>(y: &mut [f64; N], wrap: &[bool]) -> [f64; N] {
+    let mut point = *y;
+    for ((x, p), w) in y.iter_mut().zip(&mut point).zip(wrap) {
+        if *w {
+            *p = wrap_angle(*p);
+            if x.abs() > 3.0 * std::f64::consts::PI {
+                *x = *p;
             }
         }
-        points.push(y);
     }
-    Ok(points)
+    point
 }
 
 /// Orbits of many initial conditions in parallel, in input order, each with its statistics.

@@ -227,10 +227,14 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
             let mut step = stepper.accepted(system, (t, y), (t_new, y_new), signed, stats);
             observe(&mut step)?
         };
-        if let Flow::Stop { t, y } = flow {
-            *next_step = Some(next);
-            return Ok((t, y));
-        }
+        let t_new = match flow {
+            Flow::Stop { t, y } => {
+                *next_step = Some(next);
+                return Ok((t, y));
+            }
+            Flow::Retime { t } => t,
+            Flow::Continue => t_new,
+        };
         if last {
             *next_step = Some(if size < h { h } else { next });
             return Ok((t1, y_new));

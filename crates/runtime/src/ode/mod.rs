@@ -129,6 +129,12 @@ pub trait Step<const N: usize> {
     /// dense output of order 7 (built on the first call, 3 more f-evaluations),
     /// or for the other methods a fresh step of length t − start.
     fn state_at(&mut self, t: f64) -> Result<[f64; N], OdeError>;
+    /// The state a time `tau` after the step's start: for the Taylor
+    /// method its polynomial at `tau` itself (no rounding of start + tau).
+    fn state_after(&mut self, tau: f64) -> Result<[f64; N], OdeError> {
+        let start = self.start().0;
+        self.state_at(start + tau)
+    }
 }
 
 /// What an observer tells the integrator after a step.
@@ -139,6 +145,11 @@ pub enum Flow<const N: usize> {
     Stop {
         t: f64,
         y: [f64; N],
+    },
+    /// Go on, the step's end now at time `t` (a periodic field's time
+    /// restarted at 0 at a period's end; the steps go on across it).
+    Retime {
+        t: f64,
     },
 }
 
@@ -436,6 +447,82 @@ impl Integrator {
         Ok(states)
     }
 
+    /// Runs one orbit from (0, y0) over `segments` segments of time
+    /// `segment`, calling `after(y)` with the state at each one's end: it
+    /// may change the state (the run restarts from it there) and says
+    /// whether to go on. The time restarts at 0 at each end, as a period
+    /// map's does: the field must be the same at t and t + `segment` (a
+    /// period of its forcing, or any time if it is autonomous). The Taylor
+    /// method samples the ends from its steps' polynomials, its steps
+    /// running across them (as heyoka's `propagate_grid`), exactly as
+    /// [`LaneIntegrator::stream`] does lane by lane; the other methods
+    /// advance segment by segment, their step grids being the segment's.
+    /// Segments of length 0 leave nothing to run.
+    pub fn advance_segments<S: System<N>, const N: usize>(
+        &mut self,
+        system: &S,
+        y0: &[f64; N],
+        segment: f64,
+        segments: usize,
+        after: &mut dyn FnMut(&mut [f64; N]) -> bool,
+    ) -> Result<(), OdeError> {
+        if !matches!(self.method, Method::Taylor { .. }) {
+            let mut y = *y0;
+            for _ in 0..segments {
+                y = self.advance(system, 0.0, &y, segment)?;
+                if !after(&mut y) {
+                    break;
+                }
+            }
+            return Ok(());
+        }
+        if segment == 0.0 {
+            // Nothing to run (as a stream skips an orbit of length 0).
+            return check_initial(0.0, y0, segment);
+        }
+        let mut y = *y0;
+        let mut reached = 0;
+        while reached < segments {
+            let mut restart = None;
+            self.run(system, 0.0, &y, taylor_lanes::HORIZON, &mut |step| {
+                let (mut start, mut end) = (step.start().0, step.end().0);
+                let y_end = *step.end().1;
+                let mut retimed = false;
+                while reached < segments && segment <= end {
+                    reached += 1;
+                    let mut sample = match segment == end {
+                        true => y_end,
+                        false => step.state_after(segment - start)?,
+                    };
+                    (start, end, retimed) = (start - segment, end - segment, true);
+                    let sampled = sample;
+                    let go_on = after(&mut sample);
+                    if !go_on || reached == segments {
+                        reached = segments;
+                        return Ok(Flow::Stop { t: 0.0, y: sample });
+                    }
+                    if sample
+                        .iter()
+                        .zip(&sampled)
+                        .any(|(a, b)| a.to_bits() != b.to_bits())
+                    {
+                        restart = Some(sample);
+                        return Ok(Flow::Stop { t: 0.0, y: sample });
+                    }
+                }
+                Ok(match retimed {
+                    true => Flow::Retime { t: end },
+                    false => Flow::Continue,
+                })
+            })?;
+            match restart {
+                Some(sample) => y = sample,
+                None => break,
+            }
+        }
+        Ok(())
+    }
+
     /// Advances `y0` from `t0` towards `t1`, locating the zero crossings of
     /// the events; stops at the first terminal one. A later call from the
     /// returned state restarts cleanly (the reported state is past the root).
@@ -475,7 +562,8 @@ impl Integrator {
             let flow = locator.scan(step)?;
             let limit = match flow {
                 Flow::Stop { t, .. } => t,
-                Flow::Continue => step.end().0,
+                // (The event locator never retimes.)
+                Flow::Continue | Flow::Retime { .. } => step.end().0,
             };
             while next < times.len() && times[next] <= limit {
                 samples.push((times[next], step.state_at(times[next])?));

@@ -169,6 +169,9 @@ impl<const N: usize> Step<N> for TaylorStep<'_, N> {
     fn state_at(&mut self, t: f64) -> Result<[f64; N], OdeError> {
         Ok(horner(self.coefficients, t - self.t0))
     }
+    fn state_after(&mut self, tau: f64) -> Result<[f64; N], OdeError> {
+        Ok(horner(self.coefficients, tau))
+    }
 }
 
 /// The method at one order, with the solver state it keeps between calls.

@@ -46,6 +46,9 @@ impl<'a, S, const N: usize> Orbit<'a, S, N> {
     }
 }
 
+/// Each lane's system, orbit (its index) and segment length, in a stream.
+type LaneOrbits<'a, S> = ([&'a S; LANES], [usize; LANES], [f64; LANES]);
+
 /// The batch Taylor integrator: the method's tolerance, its workspace and the
 /// run's statistics, summed over lanes (`steps` and `f_evals` count each
 /// lane's steps, as the scalar runs would).
@@ -111,14 +114,18 @@ impl LaneIntegrator {
         results
     }
 
-    /// Integrates every orbit over consecutive segments [0, its end] (the
-    /// time restarts at 0 after each, as a period map's does), [`LANES`]
-    /// orbits at a time, each lane exactly as the scalar method (one
-    /// `advance` per segment) would. After each segment
-    /// `after_segment(k, y)` may change orbit k's state and says whether it
-    /// goes on. A lane whose orbit ends takes the next orbit at once: no
-    /// lane waits for a slower one, as with [`LaneIntegrator::advance`] at
-    /// every segment's end. Returns each orbit's error, if it ended with one.
+    /// Integrates every orbit over consecutive segments of time `end`, the
+    /// time restarting at 0 after each (as a period map's does: the field
+    /// must be the same there), [`LANES`] orbits at a time, each lane
+    /// exactly as the scalar
+    /// [`Integrator::advance_segments`](super::Integrator::advance_segments)
+    /// would: the steps run across the segments' ends, and the state at
+    /// each end is sampled from the step's polynomial (as heyoka's
+    /// `propagate_grid` does), so no step is cut short to land on one.
+    /// After each segment `after_segment(k, y)` may change orbit k's state
+    /// (its run then restarts from it there) and says whether it goes on.
+    /// A lane whose orbit ends takes the next orbit at once: no lane waits
+    /// for a slower one. Returns each orbit's error, if it ended with one.
     pub fn stream<'a, S: System<N>, const N: usize>(
         &mut self,
         orbits: &[Orbit<'a, S, N>],
@@ -128,15 +135,14 @@ impl LaneIntegrator {
         let Some(first) = orbits.first() else {
             return errors;
         };
-        let mut systems = [first.system; LANES];
-        let mut orbit_of: [usize; LANES] = [0; LANES];
+        // Each lane's system, orbit and segment length.
+        let mut lanes = ([first.system; LANES], [0usize; LANES], [0.0; LANES]);
         let mut queue = 0..orbits.len();
         let mut run = Run::new(0.0, &[[0.0; N]; LANES], 0.0);
         run.running = [false; LANES];
         // Gives lane `l` the next orbit that starts well, or leaves it idle.
         let mut load = |run: &mut Run<N>,
-                        systems: &mut [&'a S; LANES],
-                        orbit_of: &mut [usize; LANES],
+                        (systems, orbit_of, segment): &mut LaneOrbits<'a, S>,
                         l: usize,
                         errors: &mut [Option<OdeError>]| {
             for k in queue.by_ref() {
@@ -146,8 +152,8 @@ impl LaneIntegrator {
                     // scalar `advance` over [0, 0] returns its start.
                     Ok(()) if orbit.end == 0.0 => {}
                     Ok(()) => {
-                        (orbit_of[l], systems[l], run.end[l]) = (k, orbit.system, orbit.end);
-                        run.restart(l, &orbit.start);
+                        (systems[l], orbit_of[l], segment[l]) = (orbit.system, k, orbit.end);
+                        run.restart(l, 0.0, &orbit.start);
                         return;
                     }
                     Err(e) => errors[k] = Some(e),
@@ -156,30 +162,56 @@ impl LaneIntegrator {
             run.running[l] = false;
         };
         for l in 0..LANES {
-            load(&mut run, &mut systems, &mut orbit_of, l, &mut errors);
+            load(&mut run, &mut lanes, l, &mut errors);
         }
         while run.running.iter().any(|&r| r) {
-            let Some(ends) = self.step_lanes(systems, &mut run) else {
+            let mut starts = run.t;
+            let Some(ends) = self.step_lanes(lanes.0, &mut run) else {
                 return vec![Some(OdeError::TaylorUnavailable); orbits.len()];
             };
+            let (c, _) = self.coefficients.as_chunks::<N>();
             for (l, end) in ends.into_iter().enumerate() {
-                let Some(result) = end else { continue };
-                self.stats.steps += run.steps[l];
-                let k = orbit_of[l];
-                // Its next segment, or why it ends (None: it is done).
-                let next = match result {
-                    Ok(mut y) => after_segment(k, &mut y)
-                        .then(|| check_initial(0.0, &y, run.end[l]).map(|()| y)),
-                    Err(e) => Some(Err(e)),
+                let (k, segment) = (lanes.1[l], lanes.2[l]);
+                // How its orbit ends with this step, if it does: Some(None)
+                // when done, Some(Some(e)) with an error.
+                let mut outcome = match end {
+                    Some(Err(e)) => Some(Some(e)),
+                    None if !run.running[l] => continue,
+                    // Reached the horizon (an exact series: its segment
+                    // ends are all sampled from this one step) or not.
+                    _ => None,
                 };
-                match next {
-                    Some(Ok(y)) => run.restart(l, &y),
-                    Some(Err(e)) => {
-                        errors[k] = Some(e);
-                        load(&mut run, &mut systems, &mut orbit_of, l, &mut errors);
+                // Each segment end the step reached, the time restarting
+                // at 0 there.
+                while outcome.is_none() && segment <= run.t[l] {
+                    let mut y = if segment == run.t[l] {
+                        run.state(l)
+                    } else {
+                        lane_horner(c, l, segment - starts[l])
+                    };
+                    starts[l] -= segment;
+                    run.t[l] -= segment;
+                    let sampled = y;
+                    if !after_segment(k, &mut y) {
+                        outcome = Some(None);
+                    } else if y
+                        .iter()
+                        .zip(&sampled)
+                        .any(|(a, b)| a.to_bits() != b.to_bits())
+                    {
+                        self.stats.steps += run.steps[l];
+                        match check_initial(0.0, &y, run.end[l]) {
+                            Ok(()) => run.restart(l, 0.0, &y),
+                            Err(e) => outcome = Some(Some(e)),
+                        }
                     }
-                    None => load(&mut run, &mut systems, &mut orbit_of, l, &mut errors),
                 }
+                let Some(error) = outcome else { continue };
+                self.stats.steps += run.steps[l];
+                if error.is_some() {
+                    errors[k] = error;
+                }
+                load(&mut run, &mut lanes, l, &mut errors);
             }
         }
         errors
@@ -247,6 +279,24 @@ impl LaneIntegrator {
     }
 }
 
+/// Where a stream's lanes run towards: never reached by a step of a
+/// series that is not exact (an exact one takes it in one step, its
+/// polynomial then covering every segment end).
+pub(super) const HORIZON: f64 = f64::MAX;
+
+/// Σ_k c[k] τ^k of lane `l` alone: as [`horner`] computes it for that
+/// lane, and as the scalar method's dense output does.
+fn lane_horner<const N: usize>(c: &[[Lanes; N]], l: usize, tau: f64) -> [f64; N] {
+    let (last, lower) = c.split_last().expect("at least order 0");
+    let mut y: [f64; N] = std::array::from_fn(|i| last[i].0[l]);
+    for row in lower.iter().rev() {
+        for i in 0..N {
+            y[i] = y[i] * tau + row[i].0[l];
+        }
+    }
+    y
+}
+
 /// The lanes' times, ends, Kahan carries, states, step counts (of the
 /// current run from t0) and whether each is running.
 struct Run<const N: usize> {
@@ -270,12 +320,14 @@ impl<const N: usize> Run<N> {
         }
     }
 
-    /// Starts lane `l` afresh at t = 0 from `y`.
-    fn restart(&mut self, l: usize, y: &[f64; N]) {
+    /// Starts lane `l` afresh at time `t` from `y`, towards the horizon
+    /// (a stream's lanes run on until their orbit is done).
+    fn restart(&mut self, l: usize, t: f64, y: &[f64; N]) {
         for (i, x) in y.iter().enumerate() {
             self.y[i].0[l] = *x;
         }
-        (self.t[l], self.carry[l], self.steps[l], self.running[l]) = (0.0, 0.0, 0, true);
+        (self.t[l], self.carry[l], self.steps[l], self.running[l]) = (t, 0.0, 0, true);
+        self.end[l] = HORIZON;
     }
 
     fn state(&self, l: usize) -> [f64; N] {

@@ -10,7 +10,7 @@
 pub mod contour;
 
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
-use crate::analysis::period_map::{period_map, wrap_angle, PeriodMapError};
+use crate::analysis::period_map::{wrap_angle, wrapped_point, PeriodMapError};
 use crate::ode::{Integrator, Method, OdeError};
 use crate::registry::{
     Catalog, DynamicModel, Fixed, Kind, Model, ModelInfo, ParameterError, WithFixed,
@@ -436,7 +436,7 @@ impl WithFixed for OrbitWork<'_> {
             .ok_or_else(|| StudioError::NoFastPhase(setup.info.name.into()))?;
         let system = model.exact(&setup.params);
         let periodic = model.periodic();
-        let mut y: [f64; S] = std::array::from_fn(|k| self.seed[k]);
+        let y: [f64; S] = std::array::from_fn(|k| self.seed[k]);
         let project = |y: &[f64; S]| {
             setup.axes.map(|a| {
                 if a < D && periodic[a] {
@@ -455,31 +455,27 @@ impl WithFixed for OrbitWork<'_> {
             f_evals: integrator.stats.f_evals,
             seconds: started.elapsed().as_secs_f64(),
         };
-        for k in 0..self.periods {
-            y = match period_map(&mut integrator, &system, period, &y) {
-                Ok(y) => y,
-                Err(error) => {
-                    // The points before the failure are the page's to keep.
-                    (self.sink)(OrbitChunk { points: chunk });
-                    return Err(error.into());
-                }
-            };
-            for (x, &angle) in y.iter_mut().zip(&periodic) {
-                if angle {
-                    *x = wrap_angle(*x);
-                }
-            }
-            chunk.push(project(&y));
+        let (mut done, mut cancelled) = (0, false);
+        let sink = self.sink;
+        let run = integrator.advance_segments(&system, &y, period, self.periods, &mut |y| {
+            chunk.push(project(&wrapped_point(y, &periodic)));
+            done += 1;
             if chunk.len() >= CHUNK_POINTS || last_sent.elapsed() >= CHUNK_INTERVAL {
-                if !(self.sink)(OrbitChunk {
-                    points: std::mem::take(&mut chunk),
-                }) {
-                    return Ok(end(k + 1, true, &integrator));
-                }
+                let points = std::mem::take(&mut chunk);
+                cancelled = !sink(OrbitChunk { points });
                 last_sent = Instant::now();
             }
+            !cancelled
+        });
+        if let Err(error) = run {
+            // The points before the failure are the page's to keep.
+            sink(OrbitChunk { points: chunk });
+            return Err(error.into());
         }
-        let listening = chunk.is_empty() || (self.sink)(OrbitChunk { points: chunk });
+        if cancelled {
+            return Ok(end(done, true, &integrator));
+        }
+        let listening = chunk.is_empty() || sink(OrbitChunk { points: chunk });
         Ok(end(self.periods, !listening, &integrator))
     }
 }
