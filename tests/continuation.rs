@@ -140,7 +140,10 @@ fn kapitzas_upright_changes_stability_at_the_exact_floquet_edges() {
     // Past the period doubling, the branch of period 2 breaks its symmetry
     // at a branch point where the corrector's matrix is singular: located
     // all the same (on the chord between trials), its multipliers at +1 to
-    // the square root of round-off (a double multiplier).
+    // the square root of the monodromy's error (a double multiplier splits
+    // as its square root: 1.5e-6 from errors of about 1e-12; below 1e-6
+    // before the tangent recurrences took the Jacobian form, whose
+    // rounding differs).
     s.to = 6.0;
     s.max_period = 2;
     let result = continuation(model, &params, &s).unwrap();
@@ -151,7 +154,7 @@ fn kapitzas_upright_changes_stability_at_the_exact_floquet_edges() {
         .collect();
     assert_eq!(on_doubled.len(), 1, "{:?}", result.bifurcations);
     assert!(
-        on_doubled[0].located && on_doubled[0].residual < 1e-6,
+        on_doubled[0].located && on_doubled[0].residual < 3e-6,
         "{:?}",
         on_doubled[0]
     );

@@ -12,7 +12,7 @@ use mechlab::registry::DynamicModel;
 use std::f64::consts::PI;
 
 mod common;
-use common::Rng;
+use common::{assert_tangent_recurrences_differentiate, Rng};
 
 const ORDER: usize = 14;
 
@@ -384,4 +384,40 @@ fn systems_without_recurrences_and_bad_tolerances_are_errors() {
         .advance(&kapitza::Exact { params }, 0.0, &[f64::NAN, 0.0], 1.0)
         .unwrap_err();
     assert!(matches!(error, OdeError::NonFiniteInitialState { .. }));
+}
+
+/// Every model in models/ with tangent recurrences: they differentiate its
+/// solution's recurrences (see the helper), whichever form its derivation
+/// chose; the list is checked against the catalog, so a new model file
+/// cannot be left out.
+#[test]
+fn every_model_s_tangent_recurrences_differentiate_its_solution_s() {
+    macro_rules! check {
+        ($($model:ident),*) => {{
+            $(assert_tangent_recurrences_differentiate(
+                &mechlab::models::$model::Exact { params: Default::default() },
+                stringify!($model),
+            );)*
+            [$(stringify!($model)),*]
+        }};
+    }
+    let checked = check!(
+        circle_pendulum,
+        double_pendulum,
+        duffing,
+        elastic_pendulum,
+        free_double_pendulum,
+        henon_heiles,
+        horizontal_pendulum,
+        inclined_pendulum,
+        kapitza,
+        triple_pendulum,
+        ueda
+    );
+    let hamiltonian: Vec<&str> = mechlab::models::MODELS
+        .iter()
+        .filter(|m| m.sized.is_some())
+        .map(|m| m.info.name)
+        .collect();
+    assert_eq!(hamiltonian, checked);
 }

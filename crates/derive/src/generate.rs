@@ -716,7 +716,7 @@ pub fn taylor_set(
     with_tangent.extend(state.iter().map(|s| format!("tangent_{s}")));
     functions.push(cx.taylor_steps(
         "exact_variational_taylor",
-        "Taylor coefficients of the exact solution and its tangent vectors V' = J V: z = [y; V] with any number of columns (one for the FLI, a full set for the monodromy matrix), out flat with rows of z.len(). The tangent recurrences are the forward-mode derivatives of the field's nodes, run once per column.",
+        "Taylor coefficients of the exact solution and its tangent vectors V' = J V: z = [y; V] with any number of columns (one for the FLI, a full set for the monodromy matrix), out flat with rows of z.len(). The tangent recurrences run once per column, in forward mode (the derivatives of the field's nodes) or in Jacobian form (δf_i = Σ_j c_ij·δx_j with coefficients computed once per step), whichever the derivation counted cheaper.",
         exact.0,
         exact.1,
         with_tangent,

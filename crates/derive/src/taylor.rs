@@ -15,6 +15,8 @@
 //! recurrence divides by u^[0] and fails at u = 0). The emitted function
 //! calls the kernels of `mechlab::ode::series`.
 
+mod jacobian;
+
 use crate::emit::{params_line, Dag, Node};
 use crate::error::EmitError;
 use std::collections::HashMap;
@@ -603,15 +605,30 @@ pub fn recurrences(
             .ok_or_else(|| EmitError::NotAnOutput(name.to_string()))?;
         roots.push(lowering.lower(root)?);
     }
-    for t in 0..tangents {
+    let mut jacobian_form = false;
+    if tangents == 1 {
         let mut memo = HashMap::new();
-        for i in 0..dim {
-            let root = match lowering.derivative(roots[i], dim, t, &mut memo) {
+        let forward: Vec<usize> = (0..dim)
+            .map(|i| match lowering.derivative(roots[i], dim, 0, &mut memo) {
                 Some(r) => r,
                 None => lowering.literal("0.0"),
-            };
-            roots.push(root);
-        }
+            })
+            .collect();
+        // The cheaper of forward mode and the Jacobian form (ties: forward).
+        let cost = |lowering: &Lowering, tangent: &[usize]| {
+            let all: Vec<usize> = roots.iter().chain(tangent).copied().collect();
+            let needed = reachable(&lowering.ops, &lowering.index, &lowering.solves, &all);
+            jacobian::cost(lowering, &needed)
+        };
+        let forward_cost = cost(&lowering, &forward);
+        let chosen = match jacobian::tangent_roots(&mut lowering, dim, &roots) {
+            Some(j) if cost(&lowering, &j) < forward_cost => {
+                jacobian_form = true;
+                j
+            }
+            _ => forward,
+        };
+        roots.extend(chosen);
     }
     let needed = reachable(&lowering.ops, &lowering.index, &lowering.solves, &roots);
     let names = names(&lowering, dag, &needed);
@@ -638,7 +655,12 @@ pub fn recurrences(
         time: &signature.time,
         function,
     }
-    .body(&roots, dim, tangents == 1, params_line))
+    .body(
+        &roots,
+        dim,
+        (tangents == 1).then_some(jacobian_form),
+        params_line,
+    ))
 }
 
 fn reachable(
@@ -1130,13 +1152,16 @@ impl Writer<'_> {
     /// z.len(); the base recurrences run once, then the tangent
     /// recurrences once per column (a run-time loop, so the generated code
     /// does not grow with the number of tangents).
+    /// `tangent_form`: None without tangents, else whether the tangent
+    /// recurrences are in Jacobian form (see [`jacobian`]) or forward mode.
     fn body(
         &self,
         roots: &[usize],
         dim: usize,
-        variational: bool,
+        tangent_form: Option<bool>,
         params_line: String,
     ) -> TaylorBody {
+        let variational = tangent_form.is_some();
         let mut lines = Vec::new();
         let live: Vec<usize> = (0..self.ops.len()).filter(|&k| self.needed[k]).collect();
         let varying: Vec<usize> = live
@@ -1198,10 +1223,10 @@ impl Writer<'_> {
             lines.push("out[..len].copy_from_slice(z);".into());
             lines.push("// The solution.".into());
             self.emit_orders(base_orders, split, &slots, &mut lines, &mut parts);
-            lines.push(
-                "// Each tangent vector in turn: the same recurrences, reading the solution's."
-                    .into(),
-            );
+            lines.push(match tangent_form {
+                Some(true) => "// Each tangent vector in turn, in Jacobian form: δf_i = Σ_j c_ij·δx_j, the coefficients c_ij among the solution's nodes.".into(),
+                _ => "// Each tangent vector in turn, in forward mode: the derivatives of the solution's nodes.".into(),
+            });
             lines.push("for column in 0..columns {".into());
             lines.push(format!("let offset = {dim} * (1 + column);"));
             let tangent_orders = tangent_orders.expect("variational");
