@@ -8,8 +8,8 @@ largest ln‖w‖/‖w₀‖ after a whole period. Both sides run on ONE thread
 (RAYON_NUM_THREADS=1 for mechlab), at tolerances 1e-6, 1e-8 and 1e-10:
 heyoka with `taylor_adaptive_batch` over its recommended SIMD width and one
 `propagate_grid` per batch over the 180 period ends; mechlab with its
-`kapitza_chaos_map` scene (8 lanes, a fresh run from t = 0 each period, no
-tiles). Each time is the best of `REPEAT` runs; the maps are compared pixel
+`kapitza_chaos_map` scene (8 lanes, each period's end sampled from the step
+across it, no tiles). Each time is the best of `REPEAT` runs; the maps are compared pixel
 by pixel (median and 99th percentile of |ΔFLI|).
 
 Not part of CI. Install the peer first (any recent Python 3):

@@ -5,7 +5,8 @@ Problem (deliverable 1.2's single-orbit mode): ε = 0.1, A = 1.5, μ = 0, from
 (q, p) = (π − 0.5, 0), 1000 periods T = 2πε, one core. The error is the
 max-norm distance of the final state from a reference computed by heyoka in
 80-bit extended precision (tolerance 1e-19). heyoka advances with
-`propagate_grid` over the period grid; mechlab restarts every period at t = 0
+`propagate_grid` over the period grid; mechlab samples each period's end from
+the step across it, as propagate_grid does, the time restarting at 0 there
 (`kapitza_period_map --set q0=… --set p0=…`, best of `repeat` timed runs).
 
 Not part of CI. Install the peer first (any recent Python 3):

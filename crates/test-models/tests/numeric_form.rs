@@ -6,7 +6,9 @@
 //! Checked against the symbolic-inverse form of the same double pendulum,
 //! against finite differences of the generated Hamiltonians, against
 //! DOP853, and the N-link chains' thresholds against the closed form from
-//! their normal modes.
+//! their normal modes. Here too (one test binary for the test models):
+//! every test model's tangent recurrences against differences of its
+//! solution's.
 
 use mechlab::analysis::floquet::monodromy;
 use mechlab::models::{double_pendulum, triple_pendulum};
@@ -21,7 +23,7 @@ use std::f64::consts::PI;
 
 #[path = "../../../tests/common/mod.rs"]
 mod common;
-use common::{assert_close as close, Rng};
+use common::{assert_close as close, assert_tangent_recurrences_differentiate, Rng};
 
 #[test]
 fn numeric_and_symbolic_forms_agree_on_the_double_pendulum() {
@@ -503,4 +505,36 @@ fn non_conservative(info: &mechlab::registry::ModelInfo) -> Vec<usize> {
         .filter(|(_, p)| names.contains(**p))
         .map(|(k, _)| k)
         .collect()
+}
+
+/// The tangent recurrences of every model in test_models/ (forward mode or
+/// Jacobian form, whichever its derivation chose) differentiate its
+/// solution's recurrences: the solves of the numeric form, powers, square
+/// roots, quotients and awkward names included.
+#[test]
+fn every_test_model_s_tangent_recurrences_differentiate_its_solution_s() {
+    macro_rules! check {
+        ($($model:ident),*) => {$(
+            assert_tangent_recurrences_differentiate(
+                &mechlab_test_models::$model::Exact { params: Default::default() },
+                stringify!($model),
+            );
+        )*};
+    }
+    check!(
+        awkward_names,
+        awkward_names_numeric,
+        bare_pendulum,
+        central_spring,
+        double_pendulum_numeric,
+        elliptic_pendulum,
+        forced_oscillator,
+        power_law_oscillator,
+        quadruple_pendulum,
+        rotating_hoop,
+        spherical_pendulum,
+        spring_chain5,
+        spring_double_pendulum,
+        van_der_pol
+    );
 }
