@@ -20,7 +20,7 @@ pub type LaneResult<const N: usize> = Result<[f64; N], OdeError>;
 
 /// One orbit of a sweep: the system it follows (a generated model's has its
 /// own parameters, so one batch can sweep them), its state at t = 0 and the
-/// end of its segments [0, end].
+/// length `end` of its segments (the time restarts at 0 after each).
 #[derive(Debug)]
 pub struct Orbit<'a, S, const N: usize> {
     pub system: &'a S,
