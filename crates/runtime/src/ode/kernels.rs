@@ -102,10 +102,12 @@ pub fn log2(x: f64) -> f64 {
         1.0 / 11.0,
         1.0 / 13.0,
     ];
-    let mut series = ODD[6];
-    for c in ODD[..6].iter().rev() {
-        series = series * z + c;
-    }
+    // Σ ODD[j] z^j by Estrin's scheme: three levels of independent
+    // multiply-adds instead of a chain of six (the step size waits on it).
+    let z2 = z * z;
+    let low = (ODD[0] + ODD[1] * z) + (ODD[2] + ODD[3] * z) * z2;
+    let high = (ODD[4] + ODD[5] * z) + ODD[6] * z2;
+    let series = low + high * (z2 * z2);
     e + s * series * (2.0 * std::f64::consts::LOG2_E)
 }
 
@@ -116,9 +118,21 @@ pub fn exp2(y: f64) -> f64 {
     // to degree 10.
     let n = y.round_ties_even();
     let u = (y - n) * std::f64::consts::LN_2;
-    let mut power = 1.0;
-    for j in (1..=10).rev() {
-        power = 1.0 + power * u * super::series::INVERSES[j];
-    }
+    // Σ u^j/j!, j ≤ 10, by Estrin's scheme (four levels, not ten).
+    const F: [f64; 11] = {
+        let mut f = [1.0; 11];
+        let mut j = 1;
+        while j < 11 {
+            f[j] = f[j - 1] / j as f64;
+            j += 1;
+        }
+        f
+    };
+    let (u2, u4) = (u * u, u * u * (u * u));
+    let pairs = |j: usize| F[j] + F[j + 1] * u;
+    let low = pairs(0) + pairs(2) * u2;
+    let mid = pairs(4) + pairs(6) * u2;
+    let high = pairs(8) + F[10] * u2;
+    let power = (low + mid * u4) + high * (u4 * u4);
     power * f64::from_bits(((n as i64 + 1023) as u64) << 52)
 }

@@ -54,7 +54,10 @@ type LaneOrbits<'a, S> = ([&'a S; LANES], [usize; LANES], [f64; LANES]);
 /// lane's steps, as the scalar runs would).
 #[derive(Clone, Debug)]
 pub struct LaneIntegrator {
-    tol: f64,
+    /// The order and step safety factor of the method's tolerance (fixed:
+    /// a logarithm and an exponential per step saved).
+    order: usize,
+    safety: f64,
     work: TaylorWork<Lanes>,
     coefficients: Vec<Lanes>,
     pub stats: Stats,
@@ -70,8 +73,10 @@ impl LaneIntegrator {
             return Err(OdeError::NoBatchMode(method.name()));
         };
         method.validate()?;
+        let order = order_for_tolerance(tol);
         Ok(LaneIntegrator {
-            tol,
+            order,
+            safety: safety(order),
             work: TaylorWork::default(),
             coefficients: Vec::new(),
             stats: Stats::default(),
@@ -226,10 +231,9 @@ impl LaneIntegrator {
         systems: [&S; LANES],
         run: &mut Run<N>,
     ) -> Option<[Option<LaneResult<N>>; LANES]> {
-        let order = order_for_tolerance(self.tol);
+        let (order, safety) = (self.order, self.safety);
         self.stats.order = self.stats.order.max(order as u64);
         self.coefficients.resize((order + 1) * N, Lanes::default());
-        let safety = safety(order);
         let mut ends: [Option<LaneResult<N>>; LANES] = std::array::from_fn(|_| None);
         let (c, _) = self.coefficients.as_chunks_mut::<N>();
         if !S::taylor_lanes(systems, Lanes(run.t), &run.y, order, &mut self.work, c) {
