@@ -641,6 +641,19 @@ mod browser {
 
     /// Evaluates `expression` in the page until it is true (or fails after
     /// `seconds`).
+    /// Picks `name` in the model list and waits until the page has it.
+    async fn select_model(client: &Client, name: &str) {
+        client
+            .find(Locator::Id("model"))
+            .await
+            .unwrap()
+            .select_by_value(name)
+            .await
+            .unwrap();
+        let ready = format!("studio.ready && studio.model.name === '{name}'");
+        wait_for(client, &ready, 30).await;
+    }
+
     async fn wait_for(client: &Client, expression: &str, seconds: u64) {
         let started = Instant::now();
         loop {
@@ -738,19 +751,7 @@ mod browser {
 
         client.goto(&studio).await.unwrap();
         wait_for(&client, "window.studio && studio.ready", 30).await;
-        client
-            .find(Locator::Id("model"))
-            .await
-            .unwrap()
-            .select_by_value("kapitza")
-            .await
-            .unwrap();
-        wait_for(
-            &client,
-            "studio.ready && studio.model.name === 'kapitza'",
-            30,
-        )
-        .await;
+        select_model(&client, "kapitza").await;
         let periods = client.find(Locator::Id("periods")).await.unwrap();
         periods.clear().await.unwrap();
         periods.send_keys("400").await.unwrap();
@@ -850,19 +851,7 @@ mod browser {
 
         // Hénon–Heiles has no fast phase: its Poincaré section at
         // E = 1/8, a clicked orbit's crossings drawn, the MEGNO map behind.
-        client
-            .find(Locator::Id("model"))
-            .await
-            .unwrap()
-            .select_by_value("henon_heiles")
-            .await
-            .unwrap();
-        wait_for(
-            &client,
-            "studio.ready && studio.model.name === 'henon_heiles'",
-            30,
-        )
-        .await;
+        select_model(&client, "henon_heiles").await;
         client
             .execute(
                 "document.getElementById('show-section').click(); document.getElementById('show-megno').click(); return true;",
@@ -908,19 +897,7 @@ mod browser {
 
         // The shaken double pendulum has a fast phase: its section is a
         // slice of the period map, at the averaged energy H̄.
-        client
-            .find(Locator::Id("model"))
-            .await
-            .unwrap()
-            .select_by_value("double_pendulum")
-            .await
-            .unwrap();
-        wait_for(
-            &client,
-            "studio.ready && studio.model.name === 'double_pendulum'",
-            30,
-        )
-        .await;
+        select_model(&client, "double_pendulum").await;
         let label = client
             .execute(
                 "const m = document.getElementById('show-megno'); if (m.checked) m.click(); \

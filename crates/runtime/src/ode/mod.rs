@@ -501,11 +501,7 @@ impl Integrator {
                         reached = segments;
                         return Ok(Flow::Stop { t: 0.0, y: sample });
                     }
-                    if sample
-                        .iter()
-                        .zip(&sampled)
-                        .any(|(a, b)| a.to_bits() != b.to_bits())
-                    {
+                    if taylor_lanes::changed(&sample, &sampled) {
                         restart = Some(sample);
                         return Ok(Flow::Stop { t: 0.0, y: sample });
                     }

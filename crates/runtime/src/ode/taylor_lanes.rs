@@ -199,11 +199,7 @@ impl LaneIntegrator {
                     let sampled = y;
                     if !after_segment(k, &mut y) {
                         outcome = Some(None);
-                    } else if y
-                        .iter()
-                        .zip(&sampled)
-                        .any(|(a, b)| a.to_bits() != b.to_bits())
-                    {
+                    } else if changed(&y, &sampled) {
                         self.stats.steps += run.steps[l];
                         match check_initial(0.0, &y, run.end[l]) {
                             Ok(()) => run.restart(l, 0.0, &y),
@@ -287,6 +283,15 @@ impl LaneIntegrator {
 /// series that is not exact (an exact one takes it in one step, its
 /// polynomial then covering every segment end).
 pub(super) const HORIZON: f64 = f64::MAX;
+
+/// Whether a segment's callback changed the state sampled (bit for bit, so
+/// that a NaN left alone is no change): the run then restarts from it.
+pub(super) fn changed<const N: usize>(state: &[f64; N], sampled: &[f64; N]) -> bool {
+    state
+        .iter()
+        .zip(sampled)
+        .any(|(a, b)| a.to_bits() != b.to_bits())
+}
 
 /// Σ_k c[k] τ^k of lane `l` alone: as [`horner`] computes it for that
 /// lane, and as the scalar method's dense output does.
