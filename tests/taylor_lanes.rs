@@ -316,3 +316,43 @@ fn straight_line_kernels_match_libm() {
     assert_eq!(sin_cos(1e7), 1e7f64.sin_cos());
     assert!(sin_cos(f64::NAN).0.is_nan());
 }
+
+/// A field whose series is NaN past order 0 (as at a model's singular
+/// point, where a quotient divides by 0).
+struct NanSeries;
+impl System<1> for NanSeries {
+    fn rhs(&self, _t: f64, _y: &[f64; 1]) -> [f64; 1] {
+        [f64::NAN]
+    }
+    fn taylor<Num: Scalar>(
+        &self,
+        _t: Num,
+        y: &[Num; 1],
+        order: usize,
+        _work: &mut TaylorWork<Num>,
+        out: &mut [[Num; 1]],
+    ) -> bool {
+        out[0] = *y;
+        for row in &mut out[1..=order] {
+            *row = [Num::from(f64::NAN)];
+        }
+        true
+    }
+}
+
+/// NaN coefficients are a non-finite state where the step starts, in a
+/// stream and in its scalar run alike, not a vanishing (exact) series
+/// whose step would run to the end of time.
+#[test]
+fn nan_coefficients_stop_the_run_where_they_appear() {
+    let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
+    let errors = batch.stream(&Orbit::of_one_system(&NanSeries, 0.5, &[[1.0]]), |_, _| true);
+    let mut scalar = Integrator::new(TAYLOR).unwrap();
+    let expected = scalar.advance_segments(&NanSeries, &[1.0], 0.5, 3, &mut |_| true);
+    assert_eq!(errors[0], expected.err());
+    assert!(
+        matches!(errors[0], Some(OdeError::NonFinite { t, .. }) if t == 0.0),
+        "{:?}",
+        errors[0]
+    );
+}

@@ -78,8 +78,18 @@ pub(super) fn horner<L: Scalar, const N: usize>(c: &[[L; N]], h: L) -> [L; N] {
 /// when both vanish (the solution is a polynomial of lower degree).
 fn step_size<const N: usize>(c: &[[f64; N]], y: &[f64; N], safety: f64) -> Option<f64> {
     let p = c.len() - 1;
-    let norm = |row: &[f64; N]| row.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let norm = |row: &[f64; N]| row.iter().fold(0.0, |m, &x| norm_with(m, x));
     step_from_norms(norm(y), [norm(&c[p - 1]), norm(&c[p])], p, safety)
+}
+
+/// max(m, |x|), and NaN once an x is NaN or infinite (`f64::max` drops a
+/// NaN: NaN coefficients would pass for a vanishing, exact series, and the
+/// step would run to the end of the interval). x − x adds 0 to a finite x.
+/// The lanes compute it lane by lane with the same operations.
+#[inline(always)]
+#[allow(clippy::eq_op)] // (x − x is the point)
+pub(super) fn norm_with(m: f64, x: f64) -> f64 {
+    m.max(x.abs()) + (x - x)
 }
 
 /// The step size from ‖y‖∞ and the norms of the coefficients of order
@@ -94,7 +104,7 @@ pub(super) fn step_from_norms(
 }
 
 /// log2 ρ = min_k log2(M/‖y^[k]‖)/k over k = p−1, p with M = max(1, ‖y‖∞);
-/// +∞ when both norms vanish. Branch-free, so that the batch method
+/// +∞ when both norms vanish, NaN when both are NaN. Branch-free, so that the batch method
 /// computes it for all lanes at once.
 #[inline(always)]
 pub(super) fn step_exponent(y_norm: f64, top_norms: [f64; 2], p: usize) -> f64 {
@@ -105,8 +115,10 @@ pub(super) fn step_exponent(y_norm: f64, top_norms: [f64; 2], p: usize) -> f64 {
         let e = log2(scale / a) * INVERSES[k];
         if a > 0.0 {
             e
-        } else {
+        } else if a == 0.0 {
             f64::INFINITY
+        } else {
+            f64::NAN
         }
     };
     exponent(top_norms[0], p - 1).min(exponent(top_norms[1], p))
@@ -117,7 +129,8 @@ pub(super) fn step_exponent(y_norm: f64, top_norms: [f64; 2], p: usize) -> f64 {
 /// the batch method computes it for all lanes at once.
 #[inline(always)]
 pub(super) fn step_from_exponent(exponent: f64, safety: f64) -> Option<f64> {
-    let exact = !(exponent < f64::INFINITY);
+    // (A NaN exponent is not exact: its NaN step is a non-finite state.)
+    let exact = exponent == f64::INFINITY;
     let step = super::kernels::exp2(if exact { 0.0 } else { exponent }) * safety;
     (!exact).then_some(step)
 }

@@ -235,8 +235,12 @@ impl LaneIntegrator {
         if !S::taylor_lanes(systems, Lanes(run.t), &run.y, order, &mut self.work, c) {
             return None;
         }
-        let row_norms =
-            |row: &[Lanes; N]| row.iter().fold(Lanes::splat(0.0), |m, x| m.max(x.abs()));
+        // As the scalar `norm_with`: NaN once a component is not finite.
+        #[allow(clippy::eq_op)] // (x − x is the point)
+        let row_norms = |row: &[Lanes; N]| {
+            row.iter()
+                .fold(Lanes::splat(0.0), |m, &x| m.max(x.abs()) + (x - x))
+        };
         let (y_norm, top) = (
             row_norms(&run.y),
             [row_norms(&c[order - 1]), row_norms(&c[order])],
