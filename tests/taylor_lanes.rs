@@ -346,7 +346,9 @@ impl System<1> for NanSeries {
 #[test]
 fn nan_coefficients_stop_the_run_where_they_appear() {
     let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
-    let errors = batch.stream(&Orbit::of_one_system(&NanSeries, 0.5, &[[1.0]]), |_, _| true);
+    let errors = batch.stream(&Orbit::of_one_system(&NanSeries, 0.5, &[[1.0]]), |_, _| {
+        true
+    });
     let mut scalar = Integrator::new(TAYLOR).unwrap();
     let expected = scalar.advance_segments(&NanSeries, &[1.0], 0.5, 3, &mut |_| true);
     assert_eq!(errors[0], expected.err());
