@@ -4,13 +4,16 @@
 Problem (the `kapitza_chaos_map` scene): A = 1, ε = 0.1, μ = 0, a 100×100
 grid of pixel centres on (q, p) ∈ [−π, π] × [−3, 3], 180 periods T = 2πε,
 the state and one tangent vector w₀ = (1, 1)/√2; the FLI of a pixel is the
-largest ln‖w‖/‖w₀‖ after a whole period. Both sides run on ONE thread
-(RAYON_NUM_THREADS=1 for mechlab), at tolerances 1e-6, 1e-8 and 1e-10:
-heyoka with `taylor_adaptive_batch` over its recommended SIMD width and one
-`propagate_grid` per batch over the 180 period ends; mechlab with its
-`kapitza_chaos_map` scene (8 lanes, each period's end sampled from the step
-across it, no tiles). Each time is the best of `REPEAT` runs; the maps are compared pixel
-by pixel (median and 99th percentile of |ΔFLI|).
+largest ln‖w‖/‖w₀‖ after a whole period. Both sides run on one thread at
+tolerances 1e-6, 1e-8 and 1e-10, and on two threads at 1e-6 and 1e-8
+(RAYON_NUM_THREADS for mechlab; for heyoka, the batches split between two
+Python threads, each with its own integrator: heyoka releases the GIL while
+it propagates). heyoka runs `taylor_adaptive_batch` over its recommended
+SIMD width and one `propagate_grid` per batch over the 180 period ends;
+mechlab its `kapitza_chaos_map` scene (8 lanes, each period's end sampled
+from the step across it, no tiles). Each time is the best of `REPEAT` runs,
+the two solvers taking turns so that both see the same spells of load; the
+maps are compared pixel by pixel (median and 99th percentile of |ΔFLI|).
 
 Not part of CI. Install the peer first (any recent Python 3):
     python3 -m pip install heyoka numpy
@@ -23,6 +26,7 @@ import math
 import os
 import subprocess
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +36,7 @@ A, EPS, MU = 1.0, 0.1, 0.0
 PIXELS = 100
 PERIODS = 180
 PERIOD = 2.0 * math.pi * EPS
-TOLERANCES = [1e-6, 1e-8, 1e-10]
+ROWS = [(1, 1e-6), (1, 1e-8), (1, 1e-10), (2, 1e-6), (2, 1e-8)]  # (threads, tol)
 REPEAT = 3
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "out" / "heyoka_batch_peer"
@@ -56,38 +60,45 @@ def pixel_centres():
     return q, p
 
 
-def heyoka_map(tol, batch):
-    """FLI of every pixel by heyoka's batch mode; (seconds, values)."""
+def heyoka_map(tol, batch, threads):
+    """FLI of every pixel by heyoka's batch mode on `threads` threads; (seconds, values)."""
     q, p = pixel_centres()
     n = q.size
     w0 = 1.0 / math.sqrt(2.0)
-    ta = hy.taylor_adaptive_batch(
-        equations(), np.zeros((4, batch)), tol=tol, compact_mode=False
-    )
+    integrators = [
+        hy.taylor_adaptive_batch(equations(), np.zeros((4, batch)), tol=tol, compact_mode=False)
+        for _ in range(threads)
+    ]
     grid = np.repeat((np.arange(0, PERIODS + 1) * PERIOD)[:, None], batch, axis=1)
     fli = np.empty(n)
+
+    def run_batches(worker):
+        ta = integrators[worker]
+        for b in range(worker * batch, n, threads * batch):
+            idx = np.arange(b, b + batch) % n
+            ta.set_time(np.zeros(batch))
+            ta.state[:] = np.array([q[idx], p[idx], np.full(batch, w0), np.full(batch, w0)])
+            out = ta.propagate_grid(grid)[-1][1:]  # (periods, 4, batch) after t = 0
+            norms = np.sqrt(out[:, 2, :] ** 2 + out[:, 3, :] ** 2)
+            values = np.log(norms).max(axis=0)
+            count = min(batch, n - b)
+            fli[b : b + count] = values[:count]
+
     start = time.perf_counter()
-    for b in range(0, n, batch):
-        idx = np.arange(b, b + batch) % n
-        ta.set_time(np.zeros(batch))
-        ta.state[:] = np.array([q[idx], p[idx], np.full(batch, w0), np.full(batch, w0)])
-        out = ta.propagate_grid(grid)[-1][1:]  # (periods, 4, batch) after t = 0
-        norms = np.sqrt(out[:, 2, :] ** 2 + out[:, 3, :] ** 2)
-        values = np.log(norms).max(axis=0)
-        count = min(batch, n - b)
-        fli[b : b + count] = values[:count]
+    with ThreadPoolExecutor(threads) as pool:
+        list(pool.map(run_batches, range(threads)))
     return time.perf_counter() - start, fli
 
 
-def mechlab_map(tol):
-    """The scene's FLI map on one thread; (seconds reported by the scene, values)."""
+def mechlab_map(tol, threads):
+    """The scene's FLI map on `threads` threads; (seconds reported by the scene, values)."""
     out = OUT / f"mechlab_{tol:g}"
     cmd = [
         str(ROOT / "target" / "release" / "examples" / "kapitza_chaos_map"),
         "--set", f"pixels={PIXELS}", "--set", f"periods={PERIODS}",
         "--set", f"tol={tol}", "--set", "tile_rows=0", "--out", str(out),
     ]
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
     subprocess.run(cmd, check=True, env=env, capture_output=True)
     summary = json.loads((out / "summary.json").read_text())
     values = np.loadtxt(out / "chaos_map.csv", delimiter=",", skiprows=1)[:, 2]
@@ -98,13 +109,16 @@ def main():
     OUT.mkdir(parents=True, exist_ok=True)
     batch = hy.recommended_simd_size()
     rows = []
-    for tol in TOLERANCES:
-        hey = [heyoka_map(tol, batch) for _ in range(REPEAT)]
-        mine = [mechlab_map(tol) for _ in range(REPEAT)]
+    for threads, tol in ROWS:
+        hey, mine = [], []
+        for _ in range(REPEAT):
+            hey.append(heyoka_map(tol, batch, threads))
+            mine.append(mechlab_map(tol, threads))
         t_hey, fli_hey = min(hey, key=lambda r: r[0])
         t_mine, fli_mine = min(mine, key=lambda r: r[0])
         diff = np.abs(fli_hey - fli_mine)
         rows.append({
+            "threads": threads,
             "tol": tol,
             "heyoka_batch_seconds": t_hey,
             "mechlab_batch_seconds": t_mine,
@@ -115,17 +129,17 @@ def main():
             "p99_abs_fli_difference": float(np.percentile(diff, 99)),
         })
     summary = {
-        "problem": f"Kapitza chaos map A={A}, eps={EPS}, {PIXELS}x{PIXELS}, {PERIODS} periods, one thread",
+        "problem": f"Kapitza chaos map A={A}, eps={EPS}, {PIXELS}x{PIXELS}, {PERIODS} periods",
         "heyoka": hy.__version__,
         "heyoka_batch_size": batch,
         "mechlab_lanes": 8,
         "rows": rows,
     }
     (OUT / "summary.json").write_text(json.dumps(summary, indent=2))
-    print(f"heyoka {hy.__version__}, batch of {batch}; mechlab 8 lanes; one thread each")
-    print("tol      heyoka s  mechlab s  speed-up  median|dFLI|  p99|dFLI|")
+    print(f"heyoka {hy.__version__}, batch of {batch}; mechlab 8 lanes")
+    print("threads tol      heyoka s  mechlab s  speed-up  median|dFLI|  p99|dFLI|")
     for r in rows:
-        print(f"{r['tol']:<8g} {r['heyoka_batch_seconds']:8.3f}  {r['mechlab_batch_seconds']:9.3f}"
+        print(f"{r['threads']:<7} {r['tol']:<8g} {r['heyoka_batch_seconds']:8.3f}  {r['mechlab_batch_seconds']:9.3f}"
               f"  {r['speedup']:8.2f}  {r['median_abs_fli_difference']:12.2e}  {r['p99_abs_fli_difference']:9.2e}")
     return rows
 

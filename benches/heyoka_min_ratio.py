@@ -4,7 +4,7 @@
 A ratio measured once moves with the machine (±20 % seen on these 2-core
 machines), so a lead is claimed only if it holds in every run: this runs
 `heyoka_peer.py` (one orbit, at heyoka's errors), `heyoka_batch_peer.py`
-(the FLI chaos map) and `heyoka_section_peer.py` (a section's MEGNO map)
+(the FLI chaos map, on one and on two threads) and `heyoka_section_peer.py` (a section's MEGNO map)
 RUNS times in turn and prints, per workload and tolerance, the ratio
 mechlab/heyoka of every run and their minimum. It writes
 out/heyoka_min_ratio/summary.json.
@@ -39,14 +39,15 @@ def main():
         for name, measure in WORKLOADS:
             print(f"\n--- run {run + 1} of {runs}: {name}")
             for row in measure():
-                ratios.setdefault((name, row["tol"]), []).append(row["speedup"])
+                label = f"{name}, {row['threads']} thr" if "threads" in row else name
+                ratios.setdefault((label, row["tol"]), []).append(row["speedup"])
     print(f"\nmechlab/heyoka over {runs} runs (minimum first; '-': no run reached heyoka's error)")
     table = []
     for (name, tol), values in ratios.items():
         known = [v for v in values if v is not None]
         low = min(known) if len(known) == len(values) else None
         shown = " ".join(f"{v:.2f}" if v is not None else "-" for v in values)
-        print(f"{name:18} {tol:7.0e}  min {low if low is None else f'{low:.2f}'}   [{shown}]")
+        print(f"{name:24} {tol:7.0e}  min {low if low is None else f'{low:.2f}'}   [{shown}]")
         table.append({"workload": name, "tol": tol, "min": low, "runs": values})
     OUT.mkdir(parents=True, exist_ok=True)
     (OUT / "summary.json").write_text(json.dumps({"runs": runs, "rows": table}, indent=2))
