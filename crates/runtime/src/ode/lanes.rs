@@ -181,6 +181,13 @@ impl Scalar for Lanes {
         self.map(|a| 1.0 / a)
     }
     #[inline(always)]
+    fn mul_add(self, a: Lanes, b: Lanes) -> Lanes {
+        let (x, y, z) = (self.0, a.0, b.0);
+        Lanes(std::array::from_fn(|i| {
+            super::series::fused(x[i], y[i], z[i])
+        }))
+    }
+    #[inline(always)]
     fn positive_sqrt(self) -> Lanes {
         self.map(<f64 as Scalar>::positive_sqrt)
     }

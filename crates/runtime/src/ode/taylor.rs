@@ -67,7 +67,7 @@ pub(super) fn horner<L: Scalar, const N: usize>(c: &[[L; N]], h: L) -> [L; N] {
     let mut y = *last;
     for row in lower.iter().rev() {
         for i in 0..N {
-            y[i] = y[i] * h + row[i];
+            y[i] = y[i].mul_add(h, row[i]);
         }
     }
     y

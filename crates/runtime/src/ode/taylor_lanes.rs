@@ -304,7 +304,7 @@ fn lane_horner<const N: usize>(c: &[[Lanes; N]], l: usize, tau: f64) -> [f64; N]
     let mut y: [f64; N] = std::array::from_fn(|i| last[i].0[l]);
     for row in lower.iter().rev() {
         for i in 0..N {
-            y[i] = y[i] * tau + row[i].0[l];
+            y[i] = super::series::fused(y[i], tau, row[i].0[l]);
         }
     }
     y
