@@ -13,7 +13,9 @@ Not part of CI. Install the peer first (any recent Python 3):
     python3 -m pip install heyoka numpy
 then, from the repository root, after
 `cargo build --release --example kapitza_chaos_map --example section`:
-    python3 benches/heyoka_min_ratio.py [RUNS]      # RUNS = 5 by default
+    python3 benches/heyoka_min_ratio.py [RUNS] [WORKLOAD]
+RUNS is 5 by default; WORKLOAD ("one orbit", "batch chaos map" or
+"section MEGNO map") runs that one alone.
 """
 import json
 import sys
@@ -34,9 +36,12 @@ OUT = Path(__file__).resolve().parent.parent / "out" / "heyoka_min_ratio"
 
 def main():
     runs = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+    chosen = [w for w in WORKLOADS if len(sys.argv) < 3 or w[0] == sys.argv[2]]
+    if not chosen:
+        sys.exit(f"unknown workload {sys.argv[2]!r}: one of {[w[0] for w in WORKLOADS]}")
     ratios = {}
     for run in range(runs):
-        for name, measure in WORKLOADS:
+        for name, measure in chosen:
             print(f"\n--- run {run + 1} of {runs}: {name}")
             for row in measure():
                 label = f"{name}, {row['threads']} thr" if "threads" in row else name
@@ -50,7 +55,8 @@ def main():
         print(f"{name:24} {tol:7.0e}  min {low if low is None else f'{low:.2f}'}   [{shown}]")
         table.append({"workload": name, "tol": tol, "min": low, "runs": values})
     OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "summary.json").write_text(json.dumps({"runs": runs, "rows": table}, indent=2))
+    name = "summary.json" if len(chosen) == len(WORKLOADS) else f"summary_{chosen[0][0].replace(' ', '_')}.json"
+    (OUT / name).write_text(json.dumps({"runs": runs, "rows": table}, indent=2))
 
 
 if __name__ == "__main__":
