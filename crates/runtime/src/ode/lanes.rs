@@ -180,12 +180,23 @@ impl Scalar for Lanes {
     fn recip(self) -> Lanes {
         self.map(|a| 1.0 / a)
     }
+    /// Written out as [`Lanes::zip`] is (not `array::from_fn`): every
+    /// Cauchy-sum term of a model is one, and as loops they would go
+    /// through LLVM's loop passes in every model's compile.
     #[inline(always)]
     fn mul_add(self, a: Lanes, b: Lanes) -> Lanes {
+        use super::series::fused;
         let (x, y, z) = (self.0, a.0, b.0);
-        Lanes(std::array::from_fn(|i| {
-            super::series::fused(x[i], y[i], z[i])
-        }))
+        Lanes([
+            fused(x[0], y[0], z[0]),
+            fused(x[1], y[1], z[1]),
+            fused(x[2], y[2], z[2]),
+            fused(x[3], y[3], z[3]),
+            fused(x[4], y[4], z[4]),
+            fused(x[5], y[5], z[5]),
+            fused(x[6], y[6], z[6]),
+            fused(x[7], y[7], z[7]),
+        ])
     }
     #[inline(always)]
     fn positive_sqrt(self) -> Lanes {
