@@ -1218,7 +1218,7 @@ impl Writer<'_> {
             lines.push("let len = z.len();".into());
             lines.push(format!("let columns = len / {dim} - 1;"));
             lines.push(format!(
-                "assert!(order >= 1 && order < series::COEFFICIENTS && columns >= 1 && len == {dim} * (1 + columns) && out.len() > order * len);"
+                "assert!(order >= 1 && order <= series::MAX_ORDER && columns >= 1 && len == {dim} * (1 + columns) && out.len() > order * len);"
             ));
             lines.push("out[..len].copy_from_slice(z);".into());
             lines.push("// The solution.".into());
@@ -1234,7 +1234,7 @@ impl Writer<'_> {
             lines.push("}".into());
         } else {
             lines.push(
-                "assert!(order >= 1 && order < series::COEFFICIENTS && out.len() > order);".into(),
+                "assert!(order >= 1 && order <= series::MAX_ORDER && out.len() > order);".into(),
             );
             lines.push("out[0] = *y;".into());
             self.emit_orders(base_orders, split, &slots, &mut lines, &mut parts);

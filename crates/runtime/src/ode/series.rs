@@ -182,10 +182,14 @@ pub fn fused(a: f64, b: f64, c: f64) -> f64 {
     }
 }
 
-/// Coefficient capacity: orders 0..=31.
-pub const COEFFICIENTS: usize = 32;
 /// The highest Taylor order the generated recurrences support.
-pub const MAX_ORDER: usize = COEFFICIENTS - 1;
+pub const MAX_ORDER: usize = 31;
+/// Coefficient capacity: orders 0..=[`MAX_ORDER`] and one spare, so that a
+/// node's array is not a power of two long. The recurrences of one order
+/// read and write coefficient n of every node; with arrays of 32 batch
+/// numbers (2 KiB) those all fell in two sets of the processor's L1 cache,
+/// more lines than its ways, and evicted each other every order.
+pub const COEFFICIENTS: usize = MAX_ORDER + 2;
 
 /// The normalised Taylor coefficients of one node.
 pub type Coefficients<L = f64> = [L; COEFFICIENTS];
