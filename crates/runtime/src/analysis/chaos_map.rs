@@ -82,10 +82,29 @@ fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64)
 /// Why [`chaos_map`] cannot run: the errors of the period map's analyses.
 pub use super::period_map::PeriodMapError as ChaosMapError;
 
+/// Orbits in one block of rows at most: a cancelled map (the studio's view
+/// moved) stops once the blocks running end.
+pub const BLOCK_ORBITS: usize = 1024;
+
+/// The rows of a block when `rows` rows of `pixels` orbits are mapped on
+/// the current rayon pool: about four blocks a thread, to keep the
+/// threads' loads even, and at most [`BLOCK_ORBITS`] orbits. Each block is
+/// streamed through one batch integrator, whose lanes idle only at the
+/// stream's end while its last orbits finish: rows of 100 orbits one at a
+/// time wasted a few per cent of them (Kapitza's 100² map at 1e-8, medians
+/// of five runs: 2.23 s by rows against 2.15 s in blocks on one thread,
+/// 1.30 s against 1.24 s on two).
+pub fn block_rows(rows: usize, pixels: usize) -> usize {
+    rows.div_ceil(4 * rayon::current_num_threads())
+        .min(BLOCK_ORBITS / pixels.max(1))
+        .max(1)
+}
+
 /// The FLI map of `model` with parameter values `params`
-/// (declaration order); `row_done` is called as each row is finished (from
-/// the worker threads) and returns whether to go on: once it says false,
-/// rows not yet started are skipped and the map ends with
+/// (declaration order); `row_done` is called for each row as the block of
+/// rows holding it is finished (from the worker threads) and returns
+/// whether to go on: once it says false, blocks not yet started are
+/// skipped and the map ends with
 /// [`ChaosMapError::Cancelled`] (nobody is waiting for it any more).
 pub fn chaos_map(
     model: &Model,
@@ -158,15 +177,17 @@ impl WithFixed for Map<'_> {
             y0[settings.axes[1]] = y;
             y0
         };
-        // One row of FLI values and its f-evaluations; a fresh integrator
-        // per row, so a row's values do not depend on what ran before.
-        // The Taylor method streams the row through its LANES lanes.
+        // The FLI values of a block of rows and their f-evaluations, with
+        // an integrator of its own. The Taylor method streams the block's
+        // orbits through its LANES lanes.
         let stopped = std::sync::atomic::AtomicBool::new(false);
-        let row = |j: usize| -> Result<(Vec<f64>, u64), OdeError> {
+        let block = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
             if stopped.load(std::sync::atomic::Ordering::Relaxed) {
                 return Ok((Vec::new(), 0));
             }
-            let starts: Vec<[f64; S]> = (0..pixels).map(|i| start_of(j * pixels + i)).collect();
+            let starts: Vec<[f64; S]> = (rows.start * pixels..rows.end * pixels)
+                .map(start_of)
+                .collect();
             let (values, f_evals) = match settings.method {
                 Method::Taylor { .. } => {
                     let mut integrator = LaneIntegrator::new(settings.method)?;
@@ -204,14 +225,27 @@ impl WithFixed for Map<'_> {
                     (values, integrator.stats.f_evals)
                 }
             };
-            if !(self.row_done)() {
-                stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+            for _ in rows {
+                if !(self.row_done)() {
+                    stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
             }
             Ok((values, f_evals))
         };
+        // Rows in blocks of [`block_rows`]; a lane equals its orbit's scalar
+        // run bit for bit, so the map does not depend on how the rows are
+        // grouped (nor on tiles).
         let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), ChaosMapError> {
-            let rows: Vec<(Vec<f64>, u64)> =
-                range.into_par_iter().map(row).collect::<Result<_, _>>()?;
+            let size = block_rows(range.len(), pixels);
+            let blocks: Vec<std::ops::Range<usize>> = range
+                .clone()
+                .step_by(size)
+                .map(|j| j..(j + size).min(range.end))
+                .collect();
+            let rows: Vec<(Vec<f64>, u64)> = blocks
+                .into_par_iter()
+                .map(block)
+                .collect::<Result<_, _>>()?;
             if stopped.load(std::sync::atomic::Ordering::Relaxed) {
                 return Err(ChaosMapError::Cancelled);
             }

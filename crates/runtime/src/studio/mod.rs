@@ -526,7 +526,7 @@ pub struct ChaosLevel {
 /// The FLI map of the view at each resolution of `request.levels` (rows
 /// on all cores; the Taylor method in batches), each handed to `sink` when
 /// done; `sink` returns false to stop before the next, and once `listening`
-/// says false a level stops between rows (ending with
+/// says false a level stops between blocks of rows (ending with
 /// `PeriodMapError::Cancelled`).
 pub fn chaos(
     catalog: Catalog,
