@@ -2,9 +2,8 @@
 //! of `kapitza_chaos_map` and of a plane of the double pendulum.
 
 use crate::model_of;
-use mechlab::analysis::chaos_map::{
-    block_rows, chaos_map, ChaosMapError, ChaosMapSettings, TileError, Tiles,
-};
+use mechlab::analysis::block_rows;
+use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings, TileError, Tiles};
 use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
 use mechlab::models::{double_pendulum, kapitza};
 use mechlab::ode::{Integrator, Method};

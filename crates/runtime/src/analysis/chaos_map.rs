@@ -82,24 +82,6 @@ fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64)
 /// Why [`chaos_map`] cannot run: the errors of the period map's analyses.
 pub use super::period_map::PeriodMapError as ChaosMapError;
 
-/// Orbits in one block of rows at most: a cancelled map (the studio's view
-/// moved) stops once the blocks running end.
-pub const BLOCK_ORBITS: usize = 1024;
-
-/// The rows of a block when `rows` rows of `pixels` orbits are mapped on
-/// the current rayon pool: about four blocks a thread, to keep the
-/// threads' loads even, and at most [`BLOCK_ORBITS`] orbits. Each block is
-/// streamed through one batch integrator, whose lanes idle only at the
-/// stream's end while its last orbits finish: rows of 100 orbits one at a
-/// time wasted a few per cent of them (Kapitza's 100² map at 1e-8, medians
-/// of five runs: 2.23 s by rows against 2.15 s in blocks on one thread,
-/// 1.30 s against 1.24 s on two).
-pub fn block_rows(rows: usize, pixels: usize) -> usize {
-    rows.div_ceil(4 * rayon::current_num_threads())
-        .min(BLOCK_ORBITS / pixels.max(1))
-        .max(1)
-}
-
 /// The FLI map of `model` with parameter values `params`
 /// (declaration order); `row_done` is called for each row as the block of
 /// rows holding it is finished (from the worker threads) and returns
@@ -232,11 +214,11 @@ impl WithFixed for Map<'_> {
             }
             Ok((values, f_evals))
         };
-        // Rows in blocks of [`block_rows`]; a lane equals its orbit's scalar
+        // Rows in blocks of [`super::block_rows`]; a lane equals its orbit's scalar
         // run bit for bit, so the map does not depend on how the rows are
         // grouped (nor on tiles).
         let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), ChaosMapError> {
-            let size = block_rows(range.len(), pixels);
+            let size = super::block_rows(range.len(), pixels);
             let blocks: Vec<std::ops::Range<usize>> = range
                 .clone()
                 .step_by(size)

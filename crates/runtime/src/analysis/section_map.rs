@@ -120,37 +120,44 @@ pub fn section_map(
     let system = fixed.exact(params);
     let chunks = (settings.t_max / chunk).ceil() as usize;
     let w0 = [0.5; 4];
-    let rows: Vec<(Vec<f64>, usize)> = (0..n)
+    // Rows in blocks, each streamed through one batch integrator.
+    let size = super::block_rows(n, n);
+    let blocks: Vec<std::ops::Range<usize>> =
+        (0..n).step_by(size).map(|j| j..(j + size).min(n)).collect();
+    let rows: Vec<(Vec<f64>, usize)> = blocks
         .into_par_iter()
-        .map(|j| -> Result<(Vec<f64>, usize), SectionError> {
-            let p = centre(j, window[1]);
-            let seeds: Vec<(usize, [f64; 4])> = (0..n)
-                .filter_map(|i| {
-                    let q = centre(i, window[0]);
+        .map(|rows| -> Result<(Vec<f64>, usize), SectionError> {
+            // The accessible pixels' states, by their place in the block.
+            let seeds: Vec<(usize, [f64; 4])> = rows
+                .clone()
+                .flat_map(|j| (0..n).map(move |i| (j, i)))
+                .enumerate()
+                .filter_map(|(k, (j, i))| {
+                    let (q, p) = (centre(i, window[0]), centre(j, window[1]));
                     if !region.contains(q, p) {
                         return None;
                     }
                     on_plane::<4>(&[q, p], &chart, s, &energy)
                         .ok()
-                        .map(|y| (i, y))
+                        .map(|y| (k, y))
                 })
                 .collect();
-            let mut row = vec![f64::NAN; n];
+            let mut block = vec![f64::NAN; rows.len() * n];
             let mut integrator = LaneIntegrator::new(method)?;
             let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
             let values =
                 megno_values::<_, 4, 8>(&mut integrator, &system, chunk, &starts, &w0, chunks);
             let mut failed = 0;
-            for ((i, _), value) in seeds.iter().zip(values) {
+            for ((k, _), value) in seeds.iter().zip(values) {
                 match value {
-                    Ok(v) => row[*i] = v,
+                    Ok(v) => block[*k] = v,
                     Err(_) => {
-                        row[*i] = f64::INFINITY;
+                        block[*k] = f64::INFINITY;
                         failed += 1;
                     }
                 }
             }
-            Ok((row, failed))
+            Ok((block, failed))
         })
         .collect::<Result<_, _>>()?;
     let failed = rows.iter().map(|(_, f)| f).sum();
