@@ -52,21 +52,10 @@ fn recurrence_kernels_match_direct_evaluation_including_zero_arguments() {
         let b = argument(&mut rng, b0);
         let u0 = if zero { 0.0 } else { rng.between(-3.0, 3.0) };
         let u = argument(&mut rng, u0);
-        let (mut product, mut square, mut quotient) = (
-            [0.0; COEFFICIENTS],
-            [0.0; COEFFICIENTS],
-            [0.0; COEFFICIENTS],
-        );
-        let (mut exp, mut ln, mut sqrt) = (
-            [0.0; COEFFICIENTS],
-            [0.0; COEFFICIENTS],
-            [0.0; COEFFICIENTS],
-        );
-        let (mut sin, mut cos, mut power) = (
-            [0.0; COEFFICIENTS],
-            [0.0; COEFFICIENTS],
-            [0.0; COEFFICIENTS],
-        );
+        let zero: Coefficients = [0.0; COEFFICIENTS];
+        let (mut product, mut square, mut quotient) = (zero, zero, zero);
+        let (mut exp, mut ln, mut sqrt) = (zero, zero, zero);
+        let (mut sin, mut cos, mut power) = (zero, zero, zero);
         let alpha = -1.5 + 3.0 * rng.uniform();
         product[0] = a[0] * b[0];
         square[0] = a[0] * a[0];

@@ -2,9 +2,9 @@
 //! of `kapitza_chaos_map` and of a plane of the double pendulum.
 
 use crate::model_of;
-use mechlab::analysis::block_rows;
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings, TileError, Tiles};
 use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
+use mechlab::analysis::row_blocks;
 use mechlab::models::{double_pendulum, kapitza};
 use mechlab::ode::{Integrator, Method};
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
@@ -325,7 +325,7 @@ fn a_map_nobody_waits_for_stops() {
     let done = rows.load(std::sync::atomic::Ordering::Relaxed);
     // Blocks of rows already running on the workers finish; no new one
     // starts.
-    let block = block_rows(64, 64);
+    let block = row_blocks(0..64, 64)[0].len();
     assert!(
         done <= block * (1 + rayon::current_num_threads()) && done < 64,
         "{done} of 64 rows in blocks of {block}"

@@ -214,17 +214,11 @@ impl WithFixed for Map<'_> {
             }
             Ok((values, f_evals))
         };
-        // Rows in blocks of [`super::block_rows`]; a lane equals its orbit's scalar
-        // run bit for bit, so the map does not depend on how the rows are
-        // grouped (nor on tiles).
+        // Rows in blocks ([`super::row_blocks`]); a lane equals its orbit's
+        // scalar run bit for bit, so the map does not depend on how the rows
+        // are grouped (nor on tiles).
         let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), ChaosMapError> {
-            let size = super::block_rows(range.len(), pixels);
-            let blocks: Vec<std::ops::Range<usize>> = range
-                .clone()
-                .step_by(size)
-                .map(|j| j..(j + size).min(range.end))
-                .collect();
-            let rows: Vec<(Vec<f64>, u64)> = blocks
+            let rows: Vec<(Vec<f64>, u64)> = super::row_blocks(range, pixels)
                 .into_par_iter()
                 .map(block)
                 .collect::<Result<_, _>>()?;

@@ -23,21 +23,27 @@ pub mod tiles;
 pub mod variational;
 pub mod vibrational_stability;
 
+use std::ops::Range;
+
 /// Orbits in one block of rows at most: a cancelled chaos map (the
 /// studio's view moved) stops once the blocks running end.
 pub const BLOCK_ORBITS: usize = 1024;
 
-/// The rows of a block when a map (a chaos map, a section's MEGNO map) of
-/// `rows` rows of `pixels` orbits runs on the current rayon pool: about
-/// four blocks a thread, to keep the threads' loads even, and at most
-/// [`BLOCK_ORBITS`] orbits. Each block is
-/// streamed through one batch integrator, whose lanes idle only at the
-/// stream's end while its last orbits finish: rows of 100 orbits one at a
-/// time wasted a few per cent of them (Kapitza's 100² map at 1e-8, medians
-/// of five runs: 2.23 s by rows against 2.15 s in blocks on one thread,
-/// 1.30 s against 1.24 s on two).
-pub fn block_rows(rows: usize, pixels: usize) -> usize {
-    rows.div_ceil(4 * rayon::current_num_threads())
+/// The blocks of rows in which a map (a chaos map, a section's MEGNO map)
+/// of the rows `rows`, each of `pixels` orbits, runs on the current rayon
+/// pool: about four blocks a thread, to keep the threads' loads even, and
+/// at most [`BLOCK_ORBITS`] orbits a block. Each block is streamed through
+/// one batch integrator, whose lanes idle only at the stream's end while
+/// its last orbits finish: rows of 100 orbits one at a time wasted a few
+/// per cent of them (Kapitza's 100² map at 1e-8, medians of five runs:
+/// 2.23 s by rows against 2.15 s in blocks on one thread, 1.30 s against
+/// 1.24 s on two).
+pub fn row_blocks(rows: Range<usize>, pixels: usize) -> Vec<Range<usize>> {
+    let size = rows
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
         .min(BLOCK_ORBITS / pixels.max(1))
-        .max(1)
+        .max(1);
+    let end = rows.end;
+    rows.step_by(size).map(|j| j..(j + size).min(end)).collect()
 }

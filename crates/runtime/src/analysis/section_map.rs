@@ -121,10 +121,7 @@ pub fn section_map(
     let chunks = (settings.t_max / chunk).ceil() as usize;
     let w0 = [0.5; 4];
     // Rows in blocks, each streamed through one batch integrator.
-    let size = super::block_rows(n, n);
-    let blocks: Vec<std::ops::Range<usize>> =
-        (0..n).step_by(size).map(|j| j..(j + size).min(n)).collect();
-    let rows: Vec<(Vec<f64>, usize)> = blocks
+    let rows: Vec<(Vec<f64>, usize)> = super::row_blocks(0..n, n)
         .into_par_iter()
         .map(|rows| -> Result<(Vec<f64>, usize), SectionError> {
             // The accessible pixels' states, by their place in the block.
