@@ -147,6 +147,40 @@ fn a_diverging_or_nan_lane_ends_alone_with_the_scalar_error() {
 }
 
 #[test]
+fn lanes_out_of_steps_or_run_backwards_end_as_their_scalar_runs() {
+    // Backwards in time, every lane with its own number of steps: lane l
+    // from y₀ = −0.3 − 0.3 l, blowing up at t = 1/y₀, so lanes 6 and 7
+    // diverge on the way to t = −0.5.
+    let starts: [[f64; 1]; LANES] = std::array::from_fn(|l| [-0.3 - 0.3 * l as f64]);
+    for max_steps in [1_000, 4] {
+        let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
+        batch.max_steps = max_steps;
+        let ends = batch.advance(&BlowUp, 0.0, &starts, [true; LANES], -0.5);
+        let mut scalar = Integrator::new(TAYLOR).unwrap();
+        scalar.max_steps = max_steps;
+        let mut out_of_steps = 0;
+        for (l, end) in ends.into_iter().enumerate() {
+            let expected = scalar.advance(&BlowUp, 0.0, &starts[l], -0.5);
+            assert_eq!(format!("{end:?}"), format!("{expected:?}"), "lane {l}");
+            out_of_steps += usize::from(matches!(end, Err(OdeError::TooManySteps { .. })));
+            if max_steps == 1_000 {
+                let y0 = starts[l][0];
+                let exact = y0 / (1.0 + 0.5 * y0);
+                match end {
+                    Ok(y) => assert!(l <= 5 && (y[0] - exact).abs() < 1e-9 * exact.abs()),
+                    Err(_) => assert!(l >= 6, "lane {l}: {end:?}"),
+                }
+            }
+        }
+        // The budget of 4 steps stops some lanes and not others.
+        if max_steps == 4 {
+            assert!(out_of_steps > 0 && out_of_steps < LANES, "{out_of_steps}");
+        }
+        assert_eq!(batch.stats.f_evals, scalar.stats.f_evals);
+    }
+}
+
+#[test]
 fn a_stream_ends_each_orbit_with_its_scalar_segments() {
     // Ten orbits over three segments [0, 0.2] each, every segment started
     // from 1.5 × the last end: orbit 3 (y₀ = 3, then 11.25) blows up in

@@ -135,29 +135,6 @@ pub(super) fn step_from_exponent(exponent: f64, safety: f64) -> Option<f64> {
     (!exact).then_some(step)
 }
 
-/// The step to take from t towards t1 (`remaining` = |t1 − t| away), and
-/// whether it is the last one.
-/// `y` gives the state for the error of a non-finite step.
-#[inline(always)]
-pub(super) fn step_to_take<const N: usize>(
-    step: Option<f64>,
-    remaining: f64,
-    t: f64,
-    y: impl FnOnce() -> [f64; N],
-) -> Result<(f64, bool), OdeError> {
-    let h = match step {
-        Some(h) if h.is_finite() => h,
-        // Vanishing top coefficients: the series is exact.
-        None => remaining,
-        Some(_) => return Err(OdeError::NonFinite { t, y: y().to_vec() }),
-    };
-    if h <= 0.0 && remaining > 0.0 {
-        return Err(OdeError::StepSizeUnderflow { t, h });
-    }
-    let last = h >= remaining;
-    Ok((if last { remaining } else { h }, last))
-}
-
 /// The step's safety factor e^{−κ} e^{−0.7/(p−1)} at order p.
 pub(super) fn safety(order: usize) -> f64 {
     (-SAFETY_EXPONENT - 0.7 / (order - 1) as f64).exp()

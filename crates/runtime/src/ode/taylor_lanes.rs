@@ -12,7 +12,7 @@
 
 use super::driver::compensated_sum;
 use super::lanes::{Lanes, LANES};
-use super::taylor::{horner, safety, step_exponent, step_from_exponent, step_to_take};
+use super::taylor::{horner, safety, step_exponent, step_from_exponent};
 use super::{check_initial, order_for_tolerance, Method, OdeError, Stats, System, TaylorWork};
 
 /// The result of one lane.
@@ -106,13 +106,15 @@ impl LaneIntegrator {
             return results;
         }
         while run.running.iter().any(|&r| r) {
-            let Some(ends) = self.step_lanes([system; LANES], &mut run) else {
+            let Some(ended) = self.step_lanes([system; LANES], &mut run) else {
                 return std::array::from_fn(|_| Err(OdeError::TaylorUnavailable));
             };
-            for (l, end) in ends.into_iter().enumerate() {
-                if let Some(result) = end {
-                    (results[l], run.running[l]) = (result, false);
-                }
+            for l in members(ended) {
+                results[l] = match run.errors[l].take() {
+                    Some(e) => Err(e),
+                    None => Ok(run.state(l)),
+                };
+                run.running[l] = false;
             }
         }
         self.stats.steps += run.steps.iter().sum::<u64>();
@@ -171,21 +173,21 @@ impl LaneIntegrator {
         }
         while run.running.iter().any(|&r| r) {
             let mut starts = run.t;
-            let Some(ends) = self.step_lanes(lanes.0, &mut run) else {
+            let Some(ended) = self.step_lanes(lanes.0, &mut run) else {
                 return vec![Some(OdeError::TaylorUnavailable); orbits.len()];
             };
+            // The running lanes whose step reached their segment's end.
+            let crossed = lane_set(std::array::from_fn(|l| {
+                run.running[l] && lanes.2[l] <= run.t[l]
+            }));
             let (c, _) = self.coefficients.as_chunks::<N>();
-            for (l, end) in ends.into_iter().enumerate() {
+            for l in members(ended | crossed) {
                 let (k, segment) = (lanes.1[l], lanes.2[l]);
                 // How its orbit ends with this step, if it does: Some(None)
-                // when done, Some(Some(e)) with an error.
-                let mut outcome = match end {
-                    Some(Err(e)) => Some(Some(e)),
-                    None if !run.running[l] => continue,
-                    // Reached the horizon (an exact series: its segment
-                    // ends are all sampled from this one step) or not.
-                    _ => None,
-                };
+                // when done, Some(Some(e)) with an error. A lane that ended
+                // without one reached the horizon (an exact series: its
+                // segment ends are all sampled from this one step).
+                let mut outcome = run.errors[l].take().map(Some);
                 // Each segment end the step reached, the time restarting
                 // at 0 there.
                 while outcome.is_none() && segment <= run.t[l] {
@@ -219,22 +221,25 @@ impl LaneIntegrator {
     }
 
     /// One step of every running lane, lane l of the system `systems[l]`,
-    /// towards its end: for each lane whose run ends with it (at its end, or
-    /// with an error), how; `None` when the system has no Taylor
-    /// recurrences (for these lanes).
+    /// towards its end: the lanes whose run ends with it, at its end or with
+    /// an error (left in `run.errors`); `None` when the system has no Taylor
+    /// recurrences. The step rule, the steps and the new states are taken
+    /// for all lanes at once (branch-free loops over the lanes, which the
+    /// compiler vectorises); only a lane in trouble is handled on its own.
     fn step_lanes<S: System<N>, const N: usize>(
         &mut self,
         systems: [&S; LANES],
         run: &mut Run<N>,
-    ) -> Option<[Option<LaneResult<N>>; LANES]> {
+    ) -> Option<LaneSet> {
         let (order, safety) = (self.order, self.safety);
         self.stats.order = self.stats.order.max(order as u64);
         self.coefficients.resize((order + 1) * N, Lanes::default());
-        let mut ends: [Option<LaneResult<N>>; LANES] = std::array::from_fn(|_| None);
         let (c, _) = self.coefficients.as_chunks_mut::<N>();
         if !S::taylor_lanes(systems, Lanes(run.t), &run.y, order, &mut self.work, c) {
             return None;
         }
+        let running = lane_set(run.running);
+        self.stats.f_evals += order as u64 * u64::from(running.count_ones());
         // As the scalar `norm_with`: NaN once a component is not finite.
         #[allow(clippy::eq_op)] // (x − x is the point)
         let row_norms = |row: &[Lanes; N]| {
@@ -245,24 +250,38 @@ impl LaneIntegrator {
             row_norms(&run.y),
             [row_norms(&c[order - 1]), row_norms(&c[order])],
         );
-        // The step rule for all lanes at once (vectorised), then lane by lane.
-        let mut steps = [None; LANES];
-        for (l, step) in steps.iter_mut().enumerate() {
+        // The step rule and `step_to_take` of the scalar method, lane by lane
+        // with the same operations, as selects instead of branches.
+        let (mut h, mut last, mut sizes) = ([0.0; LANES], [false; LANES], [0.0; LANES]);
+        let (mut non_finite, mut underflow) = ([false; LANES], [false; LANES]);
+        for l in 0..LANES {
             let exponent = step_exponent(y_norm.0[l], [top[0].0[l], top[1].0[l]], order);
-            *step = step_from_exponent(exponent, safety);
-        }
-        let mut h = [0.0; LANES];
-        let mut last = [false; LANES];
-        let mut stepping = run.running;
-        for l in (0..LANES).filter(|&l| run.running[l]) {
-            self.stats.f_evals += order as u64;
+            let step = step_from_exponent(exponent, safety);
             let (t, t1) = (run.t[l], run.end[l]);
-            let direction = (t1 - t).signum();
-            match step_to_take(steps[l], (t1 - t).abs(), t, || run.state(l)) {
-                Ok((step, is_last)) => (h[l], last[l]) = (step * direction, is_last),
-                Err(e) => (ends[l], stepping[l]) = (Some(Err(e)), false),
-            }
+            let remaining = (t1 - t).abs();
+            // No step (None): the series is exact, and covers the rest.
+            let size = step.unwrap_or(remaining);
+            sizes[l] = size;
+            non_finite[l] = !size.is_finite();
+            underflow[l] = size <= 0.0 && remaining > 0.0;
+            last[l] = size >= remaining;
+            h[l] = (if last[l] { remaining } else { size }) * (t1 - t).signum();
         }
+        let troubled = running & (lane_set(non_finite) | lane_set(underflow));
+        for l in members(troubled) {
+            run.errors[l] = Some(if non_finite[l] {
+                OdeError::NonFinite {
+                    t: run.t[l],
+                    y: run.state(l).to_vec(),
+                }
+            } else {
+                OdeError::StepSizeUnderflow {
+                    t: run.t[l],
+                    h: sizes[l],
+                }
+            });
+        }
+        let stepping = running & !troubled;
         let y_new = horner(c, Lanes(h));
         // x − x is 0 for finite x, NaN otherwise: one vector pass.
         let mut check = Lanes::splat(0.0);
@@ -270,16 +289,21 @@ impl LaneIntegrator {
         for row in &y_new {
             check += *row - *row;
         }
-        for l in (0..LANES).filter(|&l| stepping[l]) {
-            ends[l] = run.step(
-                l,
-                &y_new,
-                check.0[l] == 0.0,
-                (h[l], last[l]),
-                self.max_steps,
-            );
+        let (ended, failed, t_new) = run.step(stepping, &y_new, check, (h, last), self.max_steps);
+        for l in members(failed) {
+            run.errors[l] = Some(if check.0[l] != 0.0 {
+                OdeError::NonFinite {
+                    t: t_new[l],
+                    y: (0..N).map(|i| y_new[i].0[l]).collect(),
+                }
+            } else {
+                OdeError::StepSizeUnderflow {
+                    t: run.t[l],
+                    h: h[l],
+                }
+            });
         }
-        Some(ends)
+        Some(troubled | ended | failed)
     }
 }
 
@@ -310,8 +334,30 @@ fn lane_horner<const N: usize>(c: &[[Lanes; N]], l: usize, tau: f64) -> [f64; N]
     y
 }
 
+/// Lanes as a set: bit l for lane l.
+type LaneSet = u32;
+
+fn lane_set(flags: [bool; LANES]) -> LaneSet {
+    flags
+        .iter()
+        .enumerate()
+        .fold(0, |set, (l, &f)| set | (LaneSet::from(f) << l))
+}
+
+/// The lanes of a set, in order.
+fn members(mut set: LaneSet) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (set != 0).then(|| {
+            let l = set.trailing_zeros() as usize;
+            set &= set - 1;
+            l
+        })
+    })
+}
+
 /// The lanes' times, ends, Kahan carries, states, step counts (of the
-/// current run from t0) and whether each is running.
+/// current run from t0), whether each is running, and the error each
+/// lane's run ended with.
 struct Run<const N: usize> {
     t: [f64; LANES],
     end: [f64; LANES],
@@ -319,6 +365,7 @@ struct Run<const N: usize> {
     y: [Lanes; N],
     steps: [u64; LANES],
     running: [bool; LANES],
+    errors: [Option<OdeError>; LANES],
 }
 
 impl<const N: usize> Run<N> {
@@ -330,6 +377,7 @@ impl<const N: usize> Run<N> {
             y: std::array::from_fn(|i| Lanes(std::array::from_fn(|l| y0[l][i]))),
             steps: [0; LANES],
             running: [true; LANES],
+            errors: std::array::from_fn(|_| None),
         }
     }
 
@@ -341,51 +389,58 @@ impl<const N: usize> Run<N> {
         }
         (self.t[l], self.carry[l], self.steps[l], self.running[l]) = (t, 0.0, 0, true);
         self.end[l] = HORIZON;
+        self.errors[l] = None;
     }
 
     fn state(&self, l: usize) -> [f64; N] {
         std::array::from_fn(|i| self.y[i].0[l])
     }
 
-    /// Moves lane `l` to the end of its step (`finite`: whether its new
-    /// state is); its result when its run ends there (reached t1, diverged,
-    /// or out of steps).
-    #[inline(always)]
+    /// Moves the `stepping` lanes by their steps (h, last) to the states
+    /// `y_new` (`check` is 0 in the lanes where they are finite), as the
+    /// scalar method does. Returns the lanes whose run ends there (at its
+    /// end, or out of steps with the error in `errors`), those whose step
+    /// failed (a non-finite state, or a step too small to move t: left
+    /// where they were), and the time each step reached.
     fn step(
         &mut self,
-        l: usize,
+        stepping: LaneSet,
         y_new: &[Lanes; N],
-        finite: bool,
-        (h, last): (f64, bool),
+        check: Lanes,
+        (h, last): ([f64; LANES], [bool; LANES]),
         max_steps: u64,
-    ) -> Option<LaneResult<N>> {
-        let t = self.t[l];
-        let t_new = if last {
-            self.end[l]
-        } else {
-            compensated_sum(t, h, &mut self.carry[l])
-        };
-        if !finite {
-            let y: [f64; N] = std::array::from_fn(|i| y_new[i].0[l]);
-            return Some(Err(OdeError::NonFinite {
-                t: t_new,
-                y: y.to_vec(),
-            }));
+    ) -> (LaneSet, LaneSet, [f64; LANES]) {
+        let mut t_new = [0.0; LANES];
+        let (mut moved, mut out_of_steps) = ([false; LANES], [false; LANES]);
+        for l in 0..LANES {
+            let t = self.t[l];
+            let mut carry = self.carry[l];
+            let sum = compensated_sum(t, h[l], &mut carry);
+            t_new[l] = if last[l] { self.end[l] } else { sum };
+            moved[l] = stepping >> l & 1 == 1 && check.0[l] == 0.0 && (last[l] || t_new[l] != t);
+            if moved[l] {
+                self.t[l] = t_new[l];
+                if !last[l] {
+                    self.carry[l] = carry;
+                }
+                self.steps[l] += 1;
+            }
+            out_of_steps[l] = !last[l] && self.steps[l] >= max_steps;
         }
-        if !last && t_new == t {
-            return Some(Err(OdeError::StepSizeUnderflow { t, h }));
+        for (row, new) in self.y.iter_mut().zip(y_new) {
+            for l in 0..LANES {
+                row.0[l] = if moved[l] { new.0[l] } else { row.0[l] };
+            }
         }
-        for (i, row) in y_new.iter().enumerate() {
-            self.y[i].0[l] = row.0[l];
+        let moved = lane_set(moved);
+        let out_of_steps = moved & lane_set(out_of_steps);
+        for l in members(out_of_steps) {
+            self.errors[l] = Some(OdeError::TooManySteps {
+                t: t_new[l],
+                max_steps,
+            });
         }
-        self.t[l] = t_new;
-        self.steps[l] += 1;
-        if last {
-            return Some(Ok(self.state(l)));
-        }
-        (self.steps[l] >= max_steps).then_some(Err(OdeError::TooManySteps {
-            t: t_new,
-            max_steps,
-        }))
+        let ended = moved & (lane_set(last) | out_of_steps);
+        (ended, stepping & !moved, t_new)
     }
 }
