@@ -250,8 +250,9 @@ impl LaneIntegrator {
             row_norms(&run.y),
             [row_norms(&c[order - 1]), row_norms(&c[order])],
         );
-        // The step rule and `step_to_take` of the scalar method, lane by lane
-        // with the same operations, as selects instead of branches.
+        // The step rule and the step the scalar driver takes from it (cut to
+        // the end it reaches), lane by lane with the same operations, as
+        // selects instead of branches.
         let (mut h, mut last, mut sizes) = ([0.0; LANES], [false; LANES], [0.0; LANES]);
         let (mut non_finite, mut underflow) = ([false; LANES], [false; LANES]);
         for l in 0..LANES {
