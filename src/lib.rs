@@ -26,8 +26,8 @@
 //! ```
 
 pub use mechlab_runtime::{
-    analysis, contact, explore, linalg, mathml, model, ode, plot, registry, report, scene, scenes,
-    studio,
+    analysis, budget, contact, explore, linalg, mathml, model, ode, plot, registry, report, scene,
+    scenes, studio, study,
 };
 
 pub mod models;

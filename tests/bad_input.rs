@@ -104,3 +104,51 @@ proptest! {
         }
     }
 }
+
+/// Requests whose results could not be held in memory are named errors
+/// before any work (they aborted the process on an allocation before).
+#[test]
+fn too_large_requests_are_refused_before_any_work() {
+    use mechlab::analysis::chaos_map::{chaos_map, ChaosMapSettings};
+    use mechlab::models::kapitza::Params;
+    use mechlab::ode::{Method, OdeError};
+    use mechlab::studies::kapitza::{portrait, single_orbit};
+    use mechlab::study::StudyError;
+    let params = Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    let method = Method::parse("dop853", 1e-10).unwrap();
+    let too_large = |e: &StudyError| matches!(e, StudyError::Ode(OdeError::TooLarge(_)));
+    let e = single_orbit(params, [0.1, 0.0], 2_000_000_000, method, 1).unwrap_err();
+    assert!(too_large(&e), "{e}");
+    assert!(
+        e.to_string().contains("1 orbit(s) of 2000000000 periods"),
+        "{e}"
+    );
+    // 24 orbits that each would fit, but not together.
+    let e = portrait(params, 24, 20_000_000, method).unwrap_err();
+    assert!(too_large(&e), "{e}");
+    let settings = ChaosMapSettings {
+        axes: [0, 1],
+        ranges: [None, None],
+        p_max: 3.0,
+        through: None,
+        pixels: 1_000_000,
+        periods: 10,
+        method,
+        tiles: None,
+    };
+    let e = chaos_map(
+        mechlab::models::by_name("kapitza").unwrap(),
+        &params.values(),
+        &settings,
+        &|| true,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("a map of 1000000 × 1000000 pixels"),
+        "{e}"
+    );
+}

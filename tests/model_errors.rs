@@ -151,6 +151,21 @@ fn reserved_name() {
 }
 
 #[test]
+fn a_model_named_by_a_rust_keyword_is_refused_before_code_is_generated() {
+    // The model's module is named after it: `pub mod type` would not compile.
+    for keyword in ["type", "box", "loop", "match", "fn", "self", "gen"] {
+        assert_error(
+            &GOOD.replace("name = \"toy\"", &format!("name = \"{keyword}\"")),
+            "name",
+            &format!("'{keyword}' is a Rust keyword"),
+        );
+    }
+    // Names that merely contain one are fine.
+    let text = GOOD.replace("name = \"toy\"", "name = \"type_model\"");
+    Model::parse("models/toy.toml", &text).unwrap();
+}
+
+#[test]
 fn force_on_unknown_coordinate() {
     assert_error(
         &format!("{GOOD}\n[forces]\nx = \"-qd\"\n"),

@@ -4,7 +4,7 @@
 //! it on, every crossing lies on the plane and at H = E.
 
 use mechlab::analysis::section::{
-    parse_plane, section, seeds_across, SectionError, SectionSettings,
+    parse_plane, section, seeds_across, OrbitEnd, SectionError, SectionSettings,
 };
 use mechlab::models;
 
@@ -399,10 +399,83 @@ fn every_model_gets_a_section_or_a_named_reason() {
             seeds.push([0.0, 0.0]);
         }
         match section(model, &params, &seeds, &s) {
-            Ok(result) => assert_eq!(result.orbits.len(), seeds.len(), "{}", info.name),
+            Ok(result) => {
+                assert_eq!(result.orbits.len(), seeds.len(), "{}", info.name);
+                // Every orbit has its crossings, or says why not.
+                for o in &result.orbits {
+                    assert_eq!(o.points.len(), o.crossings, "{}", info.name);
+                    assert_eq!(
+                        o.end == OrbitEnd::Complete,
+                        o.crossings == s.crossings,
+                        "{}: {} crossings, {}",
+                        info.name,
+                        o.crossings,
+                        o.end
+                    );
+                }
+            }
             Err(e) => assert!(!e.to_string().is_empty(), "{}", info.name),
         }
     }
+}
+
+/// The swinging Atwood machine on the plane θ = 0: r = 0 is a singular
+/// point of its chart and r < 0 an open branch of the energy surface. The
+/// seeds are placed on the closed stretch 0 < r < E/(g(M − m)), where
+/// orbits recur; an orbit started on the open branch ends early and says
+/// why instead of showing one point and nothing else.
+#[test]
+fn orbits_that_end_early_say_why_and_seeds_go_where_orbits_recur() {
+    let model = &mechlab_test_models::swinging_atwood::MODEL;
+    let params = model.dynamic.defaults(); // M = 3, m = 1, g = 1
+    let s = SectionSettings {
+        plane: [0.0, 1.0],
+        energy: 1.0,
+        crossings: 20,
+        t_max: 400.0,
+        ..settings(1.0)
+    };
+    let seeds = seeds_across(model, &params, &s, 2.0, 12);
+    assert_eq!(seeds.len(), 12);
+    let barrier = 1.0 / (1.0 * (3.0 - 1.0));
+    assert!(
+        seeds.iter().all(|&[r, _]| r > 0.0 && r < barrier),
+        "{seeds:?}"
+    );
+    let result = section(model, &params, &seeds, &s).unwrap();
+    // At M = 3m the orbits from these seeds reach the pulley (r = 0) in
+    // finite time, where the polar chart is singular: they say so (or,
+    // stepped across it, that they left along r < 0).
+    let mut singular = 0;
+    for (k, end) in result.ended_early() {
+        match end {
+            OrbitEnd::Singular { at, .. } => {
+                assert_eq!(at[0].0, "r");
+                assert!(at[0].1.abs() < 1e-4, "orbit {k}: {end}");
+                singular += 1;
+            }
+            // Stepped across r = 0 onto the open branch r < 0.
+            OrbitEnd::Escaped { coordinate, .. } => assert_eq!(coordinate, "r"),
+            OrbitEnd::TimeLimit { .. } => {}
+            other => panic!("orbit {k} ended as {other}"),
+        }
+    }
+    assert!(singular > 0);
+    // On the open branch: the rope's swinging side runs off to r → −∞.
+    let open = section(model, &params, &[[-1.0, 0.0]], &s).unwrap();
+    let orbit = &open.orbits[0];
+    assert!(orbit.crossings < s.crossings);
+    match &orbit.end {
+        OrbitEnd::Escaped {
+            coordinate, value, ..
+        } => {
+            assert_eq!(coordinate, "r");
+            assert!(*value < -1e3, "{value}");
+        }
+        OrbitEnd::Failed { .. } => {}
+        other => panic!("the open branch's orbit ended as {other:?}"),
+    }
+    assert!(!orbit.end.to_string().is_empty());
 }
 
 /// The MEGNO map of a model with a fast phase: every pixel's orbit from

@@ -81,7 +81,7 @@ pub fn portrait(
         &initial,
         periods,
         &PERIODIC_STATE,
-    );
+    )?;
     let seconds = start.elapsed().as_secs_f64();
     let mut points = Vec::with_capacity(runs.len());
     let mut f_evals = 0;

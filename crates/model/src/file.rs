@@ -315,14 +315,18 @@ pub struct Contact {
     pub description: String,
 }
 
-const RESERVED: &[&str] = &[
-    "params", "pi", "e", "i", "as", "break", "const", "continue", "crate", "else", "enum",
-    "extern", "false", "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move",
-    "mut", "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true",
-    "type", "unsafe", "use", "where", "while", "async", "await", "dyn", "abstract", "become",
-    "box", "do", "final", "macro", "override", "priv", "typeof", "unsized", "virtual", "yield",
-    "try", "gen",
+/// Rust's keywords, strict and reserved: a model's module and its
+/// generated identifiers are named after the model and its names.
+const RUST_KEYWORDS: &[&str] = &[
+    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for",
+    "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return",
+    "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe", "use", "where",
+    "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "gen",
 ];
+
+/// Names that the generated code or the expression reader take for themselves.
+const RESERVED: &[&str] = &["params", "pi", "e", "i"];
 
 fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
@@ -413,6 +417,15 @@ impl ModelFile {
                 ),
             ));
         }
+        if RUST_KEYWORDS.contains(&self.name.as_str()) {
+            return Err(err(
+                "name",
+                format!(
+                    "'{}' is a Rust keyword, and the model's generated module is named after the model: choose another name (e.g. '{}_model')",
+                    self.name, self.name
+                ),
+            ));
+        }
         if self.coordinates.is_empty() {
             return Err(err(
                 "coordinates",
@@ -455,7 +468,10 @@ impl ModelFile {
             if !is_identifier(name) {
                 return Err(err(key, format!("'{name}' is not an identifier (a letter, then letters, digits or single '_')")));
             }
-            if RESERVED.contains(&name) || super::expr::FUNCTIONS.iter().any(|(f, _)| *f == name) {
+            if RESERVED.contains(&name)
+                || RUST_KEYWORDS.contains(&name)
+                || super::expr::FUNCTIONS.iter().any(|(f, _)| *f == name)
+            {
                 return Err(err(key, format!("'{name}' is a reserved name")));
             }
             if name.starts_with("cse_") {

@@ -10,6 +10,7 @@
 pub use mechlab_model as model;
 
 pub mod analysis;
+pub mod budget;
 pub mod contact;
 pub mod explore;
 pub mod linalg;

@@ -989,6 +989,13 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         "largest |{} − E| on the section {:.1e}, largest distance from the plane {:.1e}",
         result.energy_of, result.largest_energy_drift, result.largest_plane_distance
     );
+    for (k, end) in result.ended_early() {
+        let o = &result.orbits[k];
+        eprintln!(
+            "orbit {k} (seed {:?}) ended after {} of {} points: {end}",
+            o.points[0], o.crossings, settings.crossings
+        );
+    }
     let map = match scene.whole("map")? {
         0 => None,
         pixels => {

@@ -118,6 +118,17 @@ pub fn attractor(
     if !settings.start.iter().all(|x| x.is_finite()) {
         return Err(settings_error("the start must be finite"));
     }
+    crate::budget::check(
+        || {
+            format!(
+                "{} points of the attractor and {1} × {1} pixels",
+                settings.points, settings.pixels
+            )
+        },
+        settings.points as u128 + settings.pixels as u128 * settings.pixels as u128,
+        2 * std::mem::size_of::<f64>(),
+    )
+    .map_err(OdeError::from)?;
     let named = model
         .info
         .named_values(params)

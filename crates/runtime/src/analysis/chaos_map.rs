@@ -148,6 +148,12 @@ impl WithFixed for Map<'_> {
                 (-settings.p_max, settings.p_max)
             })
         });
+        crate::budget::check(
+            || format!("a map of {0} × {0} pixels", settings.pixels),
+            settings.pixels as u128 * settings.pixels as u128,
+            std::mem::size_of::<f64>(),
+        )
+        .map_err(OdeError::from)?;
         let system = model.exact(self.params);
         // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
         let w0 = [(1.0 / S as f64).sqrt(); S];

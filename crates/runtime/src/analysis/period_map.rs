@@ -46,6 +46,7 @@ pub fn orbit<S: System<N>, const N: usize>(
     periods: usize,
     wrap: &[bool],
 ) -> Result<Vec<[f64; N]>, OdeError> {
+    orbit_budget(1, periods, N)?;
     let mut points = Vec::with_capacity(periods + 1);
     points.push(*y0);
     integrator.advance_segments(system, y0, period, periods, &mut |y| {
@@ -79,15 +80,27 @@ pub fn orbits<S: System<N> + Sync, const N: usize>(
     initial: &[[f64; N]],
     periods: usize,
     wrap: &[bool],
-) -> Vec<Result<(Vec<[f64; N]>, Stats), OdeError>> {
-    initial
+) -> Result<Vec<Result<(Vec<[f64; N]>, Stats), OdeError>>, OdeError> {
+    orbit_budget(initial.len(), periods, N)?;
+    Ok(initial
         .par_iter()
         .map(|y0| {
             let mut integrator = Integrator::new(method)?;
             let points = orbit(&mut integrator, system, period, y0, periods, wrap)?;
             Ok((points, integrator.stats))
         })
-        .collect()
+        .collect())
+}
+
+/// Whether `count` orbits of `periods` periods of an `n`-number state fit
+/// in the memory a run may keep.
+fn orbit_budget(count: usize, periods: usize, n: usize) -> Result<(), OdeError> {
+    crate::budget::check(
+        || format!("the points of {count} orbit(s) of {periods} periods"),
+        count as u128 * (periods as u128 + 1),
+        n * std::mem::size_of::<f64>(),
+    )?;
+    Ok(())
 }
 
 /// What [`portrait`] computes.
@@ -222,7 +235,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
             &seeds,
             settings.periods,
             &wrap,
-        );
+        )?;
         let (mut projected, mut failed) = (Vec::new(), Vec::new());
         for (k, run) in runs.into_iter().enumerate() {
             match run {

@@ -62,6 +62,66 @@ pub struct SectionOrbit {
     /// max |q_c − value| over its crossings (below `slab` for a slice of
     /// the period map).
     pub plane_distance: f64,
+    /// Why the orbit ended: an orbit with fewer crossings than asked says why.
+    pub end: OrbitEnd,
+}
+
+/// How an orbit of a section ended.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum OrbitEnd {
+    /// It crossed the plane as often as asked.
+    Complete,
+    /// It had crossed the plane fewer times than asked by `t_max`.
+    TimeLimit { t_max: f64 },
+    /// A coordinate ran off past [`ESCAPE`] times the seed's scale: the
+    /// orbit leaves along an open branch of the energy surface.
+    Escaped {
+        t: f64,
+        coordinate: String,
+        value: f64,
+    },
+    /// The step collapsed where the mass matrix is (nearly) singular, at
+    /// the coordinates `at`: a singular point of the chart (a polar
+    /// chart's pole, a rope of no length), which the orbit may pass in
+    /// other coordinates but not in these.
+    Singular { t: f64, at: Vec<(String, f64)> },
+    /// The integrator could not follow it (a blow-up); the crossings
+    /// before are kept.
+    Failed {
+        #[serde(serialize_with = "as_text")]
+        error: OdeError,
+    },
+}
+
+/// How far past the seeds' scale a coordinate (not an angle) may run
+/// before its orbit is called escaped.
+pub const ESCAPE: f64 = 1e3;
+
+fn as_text<E: std::fmt::Display, Z: serde::Serializer>(e: &E, z: Z) -> Result<Z::Ok, Z::Error> {
+    z.collect_str(e)
+}
+
+impl std::fmt::Display for OrbitEnd {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            OrbitEnd::Complete => write!(f, "all its crossings"),
+            OrbitEnd::TimeLimit { t_max } => write!(f, "fewer crossings than asked by t_max = {t_max}"),
+            OrbitEnd::Escaped { t, coordinate, value } => write!(
+                f,
+                "escaped: {coordinate} = {value:.3e} at t = {t:.4} (an open branch of the energy surface)"
+            ),
+            OrbitEnd::Singular { t, at } => {
+                let at: Vec<String> = at.iter().map(|(name, q)| format!("{name} = {q:.3e}")).collect();
+                write!(
+                    f,
+                    "reached a singular point of the coordinates at t = {t:.4} ({}: the mass matrix is singular there)",
+                    at.join(", ")
+                )
+            }
+            OrbitEnd::Failed { error } => write!(f, "stopped: {error}"),
+        }
+    }
 }
 
 impl SectionOrbit {
@@ -73,6 +133,7 @@ impl SectionOrbit {
             crossings: 1,
             energy_drift: 0.0,
             plane_distance: 0.0,
+            end: OrbitEnd::Complete,
         }
     }
 }
@@ -94,6 +155,17 @@ pub struct Section {
     /// max |H − E| and max |q_c − value| over every orbit's crossings.
     pub largest_energy_drift: f64,
     pub largest_plane_distance: f64,
+}
+
+impl Section {
+    /// The orbits that ended before their crossings, with why (index, end).
+    pub fn ended_early(&self) -> impl Iterator<Item = (usize, &OrbitEnd)> {
+        self.orbits
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.end != OrbitEnd::Complete)
+            .map(|(k, o)| (k, &o.end))
+    }
 }
 
 /// Why a section cannot be drawn.
@@ -126,10 +198,6 @@ pub enum SectionError {
     Plane(#[from] PlaneError),
     #[error("method: {0}")]
     Method(#[from] OdeError),
-    /// An orbit the integrator could not follow (it left every bounded
-    /// region, or reached a singular point).
-    #[error("orbit from seed ({}, {}): {source}", seed[0], seed[1])]
-    Orbit { seed: [f64; 2], source: OdeError },
 }
 
 /// The section of `model` through `seeds` (other coordinate, its momentum).
@@ -249,14 +317,32 @@ impl WithFixed for Sections<'_> {
         if self.seeds.is_empty() {
             return Err(SectionError::NoSeeds { model: name });
         }
+        crate::budget::check(
+            || format!("{} orbits of {} crossings", self.seeds.len(), s.crossings),
+            self.seeds.len() as u128 * s.crossings as u128,
+            2 * std::mem::size_of::<f64>(),
+        )
+        .map_err(OdeError::from)?;
         let names = info.state_names();
         let system = fixed.exact(self.params);
+        let scale = self
+            .seeds
+            .iter()
+            .flat_map(|seed| seed.iter())
+            .fold(1.0, |m: f64, x| m.max(x.abs()));
         let orbit = OrbitRun {
             system: &system,
             chart,
             stroboscope,
             settings: s,
             energy: &energy,
+            escape: ESCAPE * scale,
+            names: &names[..D],
+            periodic: &fixed.periodic(),
+            conditioning: &|q: &[f64]| {
+                let q: [f64; D] = std::array::from_fn(|i| q[i]);
+                conditioning(&fixed.mass_matrix(self.params, &q))
+            },
         };
         let orbits = self
             .seeds
@@ -294,6 +380,29 @@ struct OrbitRun<'a, Y, const S: usize> {
     stroboscope: Option<Stroboscope>,
     settings: &'a SectionSettings,
     energy: &'a (dyn Fn(&[f64; S]) -> f64 + Sync),
+    /// A coordinate past this has escaped (see [`OrbitEnd::Escaped`]).
+    escape: f64,
+    /// The coordinates' names, and which are angles (never escaped).
+    names: &'a [&'static str],
+    periodic: &'a [bool],
+    /// The mass matrix's smallest eigenvalue over its largest at q.
+    conditioning: &'a (dyn Fn(&[f64]) -> f64 + Sync),
+}
+
+/// Below this ratio of a mass matrix's eigenvalues, a collapsed step is
+/// put down to a singular point of the coordinates.
+const SINGULAR_CONDITIONING: f64 = 1e-8;
+
+/// The smallest eigenvalue of a symmetric 2 × 2 matrix over its largest
+/// in magnitude (0 where it is singular, NaN where not finite).
+fn conditioning<const D: usize>(m: &[[f64; D]; D]) -> f64 {
+    if D != 2 {
+        return f64::NAN;
+    }
+    let (a, b, d) = (m[0][0], 0.5 * (m[0][1] + m[1][0]), m[1][1]);
+    let (mean, radius) = (0.5 * (a + d), (0.25 * (a - d) * (a - d) + b * b).sqrt());
+    let (small, large) = ((mean - radius).abs(), (mean + radius).abs());
+    small.min(large) / small.max(large)
 }
 
 impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
@@ -317,12 +426,17 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
         let chunk = (s.t_max / 64.0).max(1.0);
         while orbit.crossings < s.crossings && t < s.t_max {
             let t1 = (t + chunk).min(s.t_max);
-            let run = integrator
-                .advance_with_events(self.system, t, &y, t1, &events, EventSettings::default())
-                .map_err(|source| SectionError::Orbit {
-                    seed: *seed,
-                    source,
-                })?;
+            let run = match integrator.advance_with_events(
+                self.system,
+                t,
+                &y,
+                t1,
+                &events,
+                EventSettings::default(),
+            ) {
+                Ok(run) => run,
+                Err(error) => return Ok(self.ended(orbit, error)),
+            };
             // A wrapped angle's jump at ±π is a crossing of the other side.
             let on_plane = run
                 .hits
@@ -332,8 +446,57 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
                 self.keep(&mut orbit, &hit.y);
             }
             (t, y) = (run.t, run.y);
+            if let Some(end) = self.escaped(t, &y) {
+                orbit.end = end;
+                return Ok(orbit);
+            }
+        }
+        if orbit.crossings < s.crossings {
+            orbit.end = OrbitEnd::TimeLimit { t_max: s.t_max };
         }
         Ok(orbit)
+    }
+
+    /// The orbit ended by the integrator's `error`: at a singular point of
+    /// the coordinates, a coordinate run off, or a failure.
+    fn ended(&self, mut orbit: SectionOrbit, error: OdeError) -> SectionOrbit {
+        let d = self.names.len();
+        orbit.end = match &error {
+            OdeError::StepSizeUnderflow { t, y, .. }
+                if y.len() >= d && (self.conditioning)(&y[..d]) < SINGULAR_CONDITIONING =>
+            {
+                OrbitEnd::Singular {
+                    t: *t,
+                    at: self
+                        .names
+                        .iter()
+                        .map(|n| n.to_string())
+                        .zip(y[..d].iter().copied())
+                        .collect(),
+                }
+            }
+            OdeError::StepSizeUnderflow { t, y, .. } if y.len() == S => {
+                let y: [f64; S] = std::array::from_fn(|i| y[i]);
+                self.escaped(*t, &y).unwrap_or(OrbitEnd::Failed { error })
+            }
+            _ => OrbitEnd::Failed { error },
+        };
+        orbit
+    }
+
+    /// The end of an orbit whose coordinate has run off, if one has.
+    fn escaped(&self, t: f64, y: &[f64; S]) -> Option<OrbitEnd> {
+        let (k, value) = y[..self.names.len()]
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|&(k, _)| !self.periodic[k])
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))?;
+        (value.abs() > self.escape).then(|| OrbitEnd::Escaped {
+            t,
+            coordinate: self.names[k].to_string(),
+            value,
+        })
     }
 
     /// Adds a state on the plane to the orbit, with its drifts.
@@ -367,12 +530,10 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
             let times: Vec<f64> = (1..=count)
                 .map(|k| stroboscope.start + (done + k) as f64 * stroboscope.period)
                 .collect();
-            let states = integrator
-                .advance_sampled(self.system, t, &y, &times)
-                .map_err(|source| SectionError::Orbit {
-                    seed: *seed,
-                    source,
-                })?;
+            let states = match integrator.advance_sampled(self.system, t, &y, &times) {
+                Ok(states) => states,
+                Err(error) => return Ok(self.ended(orbit, error)),
+            };
             for (&time, state) in times.iter().zip(&states) {
                 if chart.offset(state).abs() >= stroboscope.slab || orbit.crossings == s.crossings {
                     continue;
@@ -384,6 +545,13 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
             }
             done += count;
             (t, y) = (times[count - 1], states[count - 1]);
+            if let Some(end) = self.escaped(t, &y) {
+                orbit.end = end;
+                return Ok(orbit);
+            }
+        }
+        if orbit.crossings < s.crossings {
+            orbit.end = OrbitEnd::TimeLimit { t_max: s.t_max };
         }
         Ok(orbit)
     }
@@ -701,6 +869,16 @@ pub fn seeds_across(
             }
         }
     }
+    // Runs closed on both sides (by barriers of the energy, or singular
+    // points of the chart where the least H is not finite) hold orbits
+    // that recur; one that reaches the scan's edge may be open (the
+    // swinging Atwood machine's r < 0, where orbits fall off to −∞).
+    let closed: Vec<(usize, usize)> = runs
+        .iter()
+        .copied()
+        .filter(|&(first, last)| first > 0 && last < grid - 1)
+        .collect();
+    let runs = if closed.is_empty() { runs } else { closed };
     let middle = (grid - 1) / 2;
     let Some(&(first, last)) = runs
         .iter()

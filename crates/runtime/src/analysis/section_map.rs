@@ -6,7 +6,7 @@
 
 use super::lyapunov::megno_values;
 use super::section::{on_plane, Chart, SectionError, SectionSettings};
-use crate::ode::{LaneIntegrator, Method};
+use crate::ode::{LaneIntegrator, Method, OdeError};
 use crate::plot::{ColorMap, Figure, PanelSpec};
 use crate::registry::{Fixed, Model, Sized};
 use rayon::prelude::*;
@@ -81,6 +81,12 @@ pub fn section_map(
     if settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
         return Err(bad("pixels ≥ 2, t_max and extent positive"));
     }
+    crate::budget::check(
+        || format!("a map of {0} × {0} pixels", settings.pixels),
+        settings.pixels as u128 * settings.pixels as u128,
+        std::mem::size_of::<f64>(),
+    )
+    .map_err(OdeError::from)?;
     let chart = Chart::new(s, 2, &fixed.periodic())
         .ok_or_else(|| bad("the plane's coefficients are 0 or not finite"))?;
     let method = Method::Taylor { tol: s.tol };

@@ -182,7 +182,11 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
                 let last = size >= remaining * (1.0 - snap);
                 let size = if last { remaining } else { size };
                 if size < underflow * t.abs().max(1.0) {
-                    return Err(OdeError::StepSizeUnderflow { t, h: size });
+                    return Err(OdeError::StepSizeUnderflow {
+                        t,
+                        h: size,
+                        y: y.to_vec(),
+                    });
                 }
                 (direction * size, last)
             }
@@ -220,7 +224,11 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
         }
         check_finite(t_new, &y_new)?;
         if !last && t_new == t {
-            return Err(OdeError::StepSizeUnderflow { t, h: signed });
+            return Err(OdeError::StepSizeUnderflow {
+                t,
+                h: signed,
+                y: y.to_vec(),
+            });
         }
         stats.steps += 1;
         let flow = {

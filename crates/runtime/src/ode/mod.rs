@@ -321,8 +321,9 @@ pub enum OdeError {
     /// The solution became NaN or infinite (the run diverged).
     #[error("solution diverged (non-finite state) at t = {t}: y = {y:?}")]
     NonFinite { t: f64, y: Vec<f64> },
-    #[error("step size underflow at t = {t} (h = {h:e})")]
-    StepSizeUnderflow { t: f64, h: f64 },
+    /// The step collapsed at state `y` (a singular point, or a blow-up).
+    #[error("step size underflow at t = {t} (h = {h:e}), y = {y:?}")]
+    StepSizeUnderflow { t: f64, h: f64, y: Vec<f64> },
     #[error("more than {max_steps} steps, stopped at t = {t}")]
     TooManySteps { t: f64, max_steps: u64 },
     /// The implicit stage equations did not converge.
@@ -333,6 +334,9 @@ pub enum OdeError {
     /// Only the Taylor method integrates batches of orbits.
     #[error("method '{0}' has no batch mode (only 'taylor' integrates {lanes} orbits at once)", lanes = LANES)]
     NoBatchMode(&'static str),
+    /// More output than a run may keep in memory, refused before the run.
+    #[error(transparent)]
+    TooLarge(#[from] crate::budget::TooLarge),
 }
 
 /// Solver state: the method, the last step size, statistics.

@@ -279,6 +279,7 @@ impl LaneIntegrator {
                 OdeError::StepSizeUnderflow {
                     t: run.t[l],
                     h: sizes[l],
+                    y: run.state(l).to_vec(),
                 }
             });
         }
@@ -301,6 +302,7 @@ impl LaneIntegrator {
                 OdeError::StepSizeUnderflow {
                     t: run.t[l],
                     h: h[l],
+                    y: run.state(l).to_vec(),
                 }
             });
         }

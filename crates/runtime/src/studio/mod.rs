@@ -964,6 +964,10 @@ pub struct SectionPoints {
     pub points: Vec<[f64; 2]>,
     pub start: Vec<f64>,
     pub energy_drift: f64,
+    /// Why the orbit ended (before its crossings: escaped, stopped, t_max).
+    pub end: crate::analysis::section::OrbitEnd,
+    /// The same, in words, for the page.
+    pub end_text: String,
 }
 
 /// One orbit of the section map (`analysis::section`) for the studio.
@@ -982,6 +986,8 @@ pub fn section(catalog: Catalog, request: &SectionRequest) -> Result<SectionPoin
         points: orbit.points,
         start: orbit.start,
         energy_drift: orbit.energy_drift,
+        end_text: orbit.end.to_string(),
+        end: orbit.end,
     })
 }
 

@@ -414,6 +414,7 @@ async function startSectionOrbit(orbit) {
     const answer = await postJson("/api/section", request, orbit.controller.signal);
     orbit.points = answer.points;
     orbit.drift = answer.energy_drift;
+    if (answer.end.kind !== "complete") say(`section orbit ${answer.points.length} points: ${answer.end_text}`);
     studio.sectionAxes = answer.axes;
     studio.pointsReceived += answer.points.length;
   } catch (e) {
