@@ -594,11 +594,26 @@ mod browser {
     use std::process::{Child, Command};
     use std::time::{Duration, Instant};
 
-    /// chromedriver, killed when the test ends (even by a failed assertion).
+    /// chromedriver in a process group of its own, with the Chromium it
+    /// starts: the whole group is killed when the test ends, even by a
+    /// failed assertion (killing chromedriver alone left its browser
+    /// running).
     struct Driver(Child);
+    impl Driver {
+        fn start(program: &str, port: u16) -> Driver {
+            use std::os::unix::process::CommandExt;
+            let child = Command::new(program)
+                .arg(format!("--port={port}"))
+                .process_group(0)
+                .spawn()
+                .unwrap_or_else(|e| panic!("{program}: {e}"));
+            Driver(child)
+        }
+    }
     impl Drop for Driver {
         fn drop(&mut self) {
-            let _ = self.0.kill();
+            let group = format!("-{}", self.0.id());
+            let _ = Command::new("kill").args(["-KILL", "--", &group]).status();
             let _ = self.0.wait();
         }
     }
@@ -655,21 +670,36 @@ mod browser {
     }
 
     async fn wait_for(client: &Client, expression: &str, seconds: u64) {
+        read_when(client, expression, "return true;", seconds).await;
+    }
+
+    /// Runs the script `read` in the same turn of the page's event loop as
+    /// the check that `condition` holds, once it does (or fails after
+    /// `seconds`): what it reads is one snapshot of the state the
+    /// condition saw. A separate read could find the page's orbits
+    /// already replaced by a later answer.
+    async fn read_when(client: &Client, condition: &str, read: &str, seconds: u64) -> Value {
         let started = Instant::now();
+        let script = format!("if (!({condition})) return {{waiting: true}}; {read}");
         loop {
-            let value = client
-                .execute(&format!("return !!({expression});"), vec![])
-                .await
-                .unwrap();
-            if value == Value::Bool(true) {
-                return;
+            let value = client.execute(&script, vec![]).await.unwrap();
+            if value.get("waiting") != Some(&Value::Bool(true)) {
+                return value;
             }
             assert!(
                 started.elapsed() < Duration::from_secs(seconds),
-                "timed out waiting for {expression}"
+                "timed out waiting for {condition}"
             );
             tokio::time::sleep(Duration::from_millis(100)).await;
         }
+    }
+
+    /// A page expression: whether state point (x, y) is painted (not white)
+    /// on the canvas.
+    fn painted(x: &str, y: &str) -> String {
+        format!(
+            "(studio.colorAt(...studio.pixelOf({x}, {y})).slice(0, 3).join() !== '255,255,255')"
+        )
     }
 
     async fn click_at(client: &Client, element: &fantoccini::elements::Element, x: f64, y: f64) {
@@ -690,18 +720,34 @@ mod browser {
     }
 
     /// Seeds, counts, second points (the first iterate) and parameters of
-    /// the page's orbits.
+    /// the page's orbits, once `condition` holds and each orbit's 10th
+    /// point is painted (read in one snapshot; see [`read_when`]).
+    async fn orbits_when(client: &Client, condition: &str) -> Vec<Value> {
+        let tenth = "o.points[Math.min(10, o.points.length - 1)]";
+        let all_painted = format!(
+            "studio.orbits.every(o => o.points.length > 0 && {})",
+            painted(&format!("{tenth}[0]"), &format!("{tenth}[1]"))
+        );
+        let read = format!(
+            "return studio.orbits.map(o => ({{seed: o.seed, count: o.points.length, first: o.points[0], \
+             second: o.points[1], error: o.error, params: o.params, \
+             color: studio.colorAt(...studio.pixelOf(...{tenth}))}}));"
+        );
+        read_when(
+            client,
+            &format!("({condition}) && {all_painted}"),
+            &read,
+            60,
+        )
+        .await
+        .as_array()
+        .unwrap()
+        .clone()
+    }
+
+    /// The page's orbits as they are now.
     async fn orbits(client: &Client) -> Vec<Value> {
-        let script = "return studio.orbits.map(o => ({seed: o.seed, count: o.points.length, first: o.points[0], \
-                      second: o.points[1], error: o.error, params: o.params, \
-                      color: studio.colorAt(...studio.pixelOf(...o.points[Math.min(10, o.points.length - 1)]))}));";
-        client
-            .execute(script, vec![])
-            .await
-            .unwrap()
-            .as_array()
-            .unwrap()
-            .clone()
+        orbits_when(client, "true").await
     }
 
     /// Each orbit's second point is the library's period map of its seed at
@@ -741,12 +787,7 @@ mod browser {
         let port = free_port();
         let driver =
             std::env::var("CHROMEDRIVER").unwrap_or_else(|_| "/usr/bin/chromedriver".into());
-        let _driver = Driver(
-            Command::new(&driver)
-                .arg(format!("--port={port}"))
-                .spawn()
-                .unwrap_or_else(|e| panic!("{driver}: {e}")),
-        );
+        let _driver = Driver::start(&driver, port);
         let client = connect(port).await;
 
         client.goto(&studio).await.unwrap();
@@ -760,15 +801,11 @@ mod browser {
         for (x, y) in [(-250.0, 60.0), (120.0, -140.0), (300.0, 200.0)] {
             click_at(&client, &canvas, x, y).await;
         }
-        wait_for(
+        let before = orbits_when(
             &client,
             "studio.orbits.length === 3 && studio.orbits.every(o => o.done)",
-            60,
         )
         .await;
-        // One more frame for the last points to be painted.
-        tokio::time::sleep(Duration::from_millis(300)).await;
-        let before = orbits(&client).await;
         assert_eq!(before.len(), 3);
         check_against_library(&before, 400);
         let seeds: Vec<&Value> = before.iter().map(|o| &o["seed"]).collect();
@@ -780,9 +817,11 @@ mod browser {
         // Move the A slider: every orbit is redrawn for the new value.
         let slider = client.find(Locator::Id("param-A")).await.unwrap();
         click_at(&client, &slider, 30.0, 0.0).await;
-        wait_for(&client, "studio.params.A !== 1.5 && studio.orbits.every(o => o.done && o.params.A === studio.params.A)", 60).await;
-        tokio::time::sleep(Duration::from_millis(300)).await;
-        let after = orbits(&client).await;
+        let after = orbits_when(
+            &client,
+            "studio.params.A !== 1.5 && studio.orbits.every(o => o.done && o.params.A === studio.params.A)",
+        )
+        .await;
         check_against_library(&after, 400);
         for (b, a) in before.iter().zip(&after) {
             assert_eq!(b["seed"], a["seed"]);
@@ -864,17 +903,19 @@ mod browser {
             .execute("studio.sectionSeed(0.1, 0.0); return true;", vec![])
             .await
             .unwrap();
-        wait_for(&client, ONE_LONG_ORBIT, 60).await;
-        tokio::time::sleep(Duration::from_millis(500)).await;
-        let painted = client
-            .execute(
-                "const [x, y] = studio.orbits[0].points[20]; const [px, py] = studio.pixelOf(x, y); return studio.colorAt(px, py);",
-                vec![],
-            )
-            .await
-            .unwrap();
-        let painted: Vec<u8> = serde_json::from_value(painted).unwrap();
-        assert_ne!(&painted[..3], &[255, 255, 255], "a crossing not drawn");
+        // Waits for the 20th crossing to be painted (the frame after the
+        // orbit is done): a crossing not drawn times out.
+        let crossing = "studio.orbits[0].points[20]";
+        read_when(
+            &client,
+            &format!(
+                "{ONE_LONG_ORBIT} && {}",
+                painted(&format!("{crossing}[0]"), &format!("{crossing}[1]"))
+            ),
+            "return true;",
+            60,
+        )
+        .await;
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("section.png"), png).unwrap();
 
@@ -918,28 +959,21 @@ mod browser {
             )
             .await
             .unwrap();
-        wait_for(
+        // Drawn about π (the hanging rod), and the view moved onto it: the
+        // 4th point painted (waited for; a point not drawn times out),
+        // then every point read from the same snapshot.
+        let drawn = format!(
+            "studio.orbits.length === 1 && studio.orbits[0].done && studio.orbits[0].points.length > 5 && {}",
+            painted("studio.orbits[0].points[3][0]", "studio.orbits[0].points[3][1]")
+        );
+        let about_pi = read_when(
             &client,
-            "studio.orbits.length === 1 && studio.orbits[0].done && studio.orbits[0].points.length > 5",
+            &drawn,
+            "return studio.orbits[0].points.every(([q]) => q > 0);",
             60,
         )
         .await;
-        // Drawn about π (the hanging rod), and the view moved onto it.
-        let shown = client
-            .execute(
-                "const o = studio.orbits[0]; const [x, y] = o.points[3]; const [px, py] = studio.pixelOf(x, y); \
-                 return [o.points.every(([q]) => q > 0), studio.colorAt(px, py)];",
-                vec![],
-            )
-            .await
-            .unwrap();
-        assert_eq!(shown[0], serde_json::json!(true), "{shown}");
-        let painted: Vec<u8> = serde_json::from_value(shown[1].clone()).unwrap();
-        assert_ne!(
-            &painted[..3],
-            &[255, 255, 255],
-            "a point of the slice not drawn"
-        );
+        assert_eq!(about_pi, serde_json::json!(true));
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("section_slice.png"), png).unwrap();
         client.close().await.unwrap();

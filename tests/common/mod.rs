@@ -116,3 +116,51 @@ pub fn assert_tangent_recurrences_differentiate<S: System<N>, const N: usize>(
         }
     }
 }
+
+/// Each coordinate's asymptotic exponent of the averaging deviation
+/// against ν for `model` at `params`, or why it was not reached: where the
+/// sweep's last local slopes have not settled (a coordinate whose leading
+/// term is small at the model's own frequencies), the sweep is run again
+/// at frequencies 8 and 64 times higher before giving up.
+pub fn asymptotic_slopes(
+    model: &Model,
+    params: &[f64],
+    settings: &mechlab::analysis::averaging::ConvergenceSettings,
+) -> Result<Vec<Result<f64, String>>, mechlab::analysis::averaging::AveragingError> {
+    use mechlab::analysis::averaging::convergence;
+    let first = convergence(model, params, settings)?;
+    let mut slopes: Vec<Option<f64>> = first.settled_slope.clone();
+    let mut last = first;
+    for _ in 0..2 {
+        if slopes.iter().all(|s| s.is_some()) {
+            break;
+        }
+        // 8 times the frequencies, whether ν grows with the parameter or
+        // falls with it.
+        let (v, f) = (&last.values, &last.frequencies);
+        let proportional = ((f[1] / f[0]) / (v[1] / v[0]) - 1.0).abs() < 1e-6;
+        let factor = if proportional { 8.0 } else { 1.0 / 8.0 };
+        let higher = mechlab::analysis::averaging::ConvergenceSettings {
+            values: Some(v.iter().map(|x| x * factor).collect()),
+            parameter: Some(last.parameter.clone()),
+            ..settings.clone()
+        };
+        last = convergence(model, params, &higher)?;
+        for (s, again) in slopes.iter_mut().zip(&last.settled_slope) {
+            *s = s.or(*again);
+        }
+    }
+    Ok(slopes
+        .iter()
+        .zip(&last.local_slopes)
+        .zip(&last.coordinates)
+        .map(|((s, local), c)| {
+            s.ok_or_else(|| {
+                format!(
+                    "{c}: the local slopes {local:.2?} have not settled by ν = {:.3e}",
+                    last.frequencies.last().unwrap()
+                )
+            })
+        })
+        .collect())
+}

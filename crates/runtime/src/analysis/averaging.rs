@@ -168,6 +168,36 @@ pub struct AveragingConvergence {
     pub slope: Vec<f64>,
     /// The fitted level c in deviation ≈ c ν^slope.
     pub level: Vec<f64>,
+    /// The slope between each two neighbouring frequencies, [coordinate][k].
+    pub local_slopes: Vec<Vec<f64>>,
+    /// The asymptotic exponent, where the sweep has reached it: the last
+    /// two local slopes agree to [`SETTLED`]. None where the deviation
+    /// still turns between two powers of ν (a coordinate whose 1/ν term
+    /// is small at these frequencies): raise the frequencies to see it.
+    pub settled_slope: Vec<Option<f64>>,
+}
+
+/// How closely the last two local slopes agree where the sweep has
+/// reached its asymptotic exponent.
+pub const SETTLED: f64 = 0.2;
+
+/// The slopes of log d against log ν between neighbouring frequencies.
+fn local_slopes(frequencies: &[f64], deviations: &[f64]) -> Vec<f64> {
+    frequencies
+        .windows(2)
+        .zip(deviations.windows(2))
+        .map(|(f, d)| (d[1] / d[0]).ln() / (f[1] / f[0]).ln())
+        .collect()
+}
+
+/// The mean of the last two local slopes where they agree to [`SETTLED`].
+fn settled(local: &[f64]) -> Option<f64> {
+    match local {
+        [.., a, b] if a.is_finite() && b.is_finite() && (a - b).abs() < SETTLED => {
+            Some(0.5 * (a + b))
+        }
+        _ => None,
+    }
 }
 
 /// Why [`convergence`] cannot run.
@@ -341,6 +371,11 @@ impl crate::registry::WithFixed for Sweep<'_> {
             }
             order => return Err(AveragingError::Order(info.name.into(), order)),
         };
+        let local: Vec<Vec<f64>> = run
+            .max_deviation
+            .iter()
+            .map(|d| local_slopes(&frequencies, d))
+            .collect();
         let frequency_times_deviation = run
             .max_deviation
             .iter()
@@ -359,6 +394,8 @@ impl crate::registry::WithFixed for Sweep<'_> {
             max_deviation: run.max_deviation,
             slope: run.fits.iter().map(|f| f.slope).collect(),
             level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
+            settled_slope: local.iter().map(|l| settled(l)).collect(),
+            local_slopes: local,
         })
     }
 }
