@@ -1,7 +1,9 @@
 //! Unit-level checks of runtime pieces that need no model: hyper-dual
-//! derivatives, formulas as MathML, the studio's level sets. (The runtime
-//! crate's own test target is not built by `cargo test`, so they live here.)
+//! derivatives, bialternate products, formulas as MathML, the studio's
+//! level sets, the memory budget. (The runtime crate has no test target of
+//! its own: its tests live in this package, which `cargo test` runs.)
 
+use mechlab::linalg::{bialternate, bialternate_sum};
 use mechlab::ode::hyperdual::{gradient, hessian};
 use mechlab::ode::Scalar;
 use mechlab::studio::contour::Field;
@@ -106,4 +108,60 @@ fn saddle_and_quantiles() {
     let levels = field.quantiles(9);
     assert!(levels.windows(2).all(|w| w[0] < w[1]));
     assert!(levels[0] < 0.0 && levels[8] > 0.0);
+}
+
+#[test]
+fn bialternate_eigenvalues_are_pairwise_products() {
+    let m = nalgebra::DMatrix::from_row_slice(
+        3,
+        3,
+        &[2.0, 1.0, 0.0, 0.0, 3.0, 1.0, 0.0, 0.0, 5.0], // eigenvalues 2, 3, 5
+    );
+    let mut values: Vec<f64> = bialternate(&m)
+        .eigenvalues()
+        .unwrap()
+        .iter()
+        .copied()
+        .collect();
+    values.sort_by(f64::total_cmp);
+    for (got, want) in values.iter().zip([6.0, 10.0, 15.0]) {
+        assert!((got - want).abs() < 1e-12, "{values:?}");
+    }
+}
+
+#[test]
+fn bialternate_sum_eigenvalues_are_pairwise_sums() {
+    // A full matrix with eigenvalues 1, 2, 4, 7 (a similarity transform
+    // of the diagonal), so that every entry of the formula is exercised.
+    let d =
+        nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 2.0, 4.0, 7.0]));
+    let t = nalgebra::DMatrix::from_fn(4, 4, |i, j| {
+        1.0 / (1.0 + i as f64 + 2.0 * j as f64) + f64::from(u8::from(i == j))
+    });
+    let a = &t * d * t.clone().try_inverse().unwrap();
+    let mut values: Vec<f64> = bialternate_sum(&a)
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.re)
+        .collect();
+    values.sort_by(f64::total_cmp);
+    for (got, want) in values.iter().zip([3.0, 5.0, 6.0, 8.0, 9.0, 11.0]) {
+        assert!((got - want).abs() < 1e-9, "{values:?}");
+    }
+}
+
+#[test]
+fn a_request_over_the_memory_budget_is_named_and_one_within_passes() {
+    use mechlab::budget::check;
+    let points = |n: u128| check(|| format!("{n} points"), n, 16);
+    assert!(points(1_000_000).is_ok());
+    let e = points(2_000_000_001).unwrap_err();
+    assert_eq!(e.count, 2_000_000_001);
+    assert!(
+        e.to_string()
+            .starts_with("2000000001 points: 2000000001 × 16 bytes would keep 29.8 GiB"),
+        "{e}"
+    );
+    // Products that overflow are refused, not wrapped.
+    assert!(check(|| "huge".into(), u128::MAX, 2).is_err());
 }

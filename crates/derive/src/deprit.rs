@@ -1,5 +1,5 @@
 //! Averaging to second order in closed form: the Lie series of
-//! `build/lie.rs` over Symbolica atoms, for models whose Hamiltonian is an
+//! `crates/derive/src/lie.rs` over Symbolica atoms, for models whose Hamiltonian is an
 //! expression in (q, p, θ).
 //!
 //! The averaged Hamiltonian to second order is K̄ = H̄ + εK̄₁ + ε²K̄₂; the

@@ -17,9 +17,9 @@
 //! - the Jacobians of both vector fields, ∂V/∂q, C = ∂²V/∂q² and the Hessian
 //!   of the effective potential V + V_vibr.
 //!
-//! Every recorded result goes through `build/simplify.rs` (readable forms,
+//! Every recorded result goes through `crates/simplify` (readable forms,
 //! checked against Symbolica's result at random points) and is kept as text
-//! (for snapshots and code generation) and as LaTeX (`build/latex.rs`).
+//! (for snapshots and code generation) and as LaTeX (`crates/derive/src/latex.rs`).
 
 use crate::latex::Names;
 use crate::model::{Expr, Model};

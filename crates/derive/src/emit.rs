@@ -846,7 +846,7 @@ impl Emitter {
 }
 
 /// The DAG of a function: nodes in evaluation order (children before
-/// parents) and the named outputs of each stage. `build/taylor.rs` turns it
+/// parents) and the named outputs of each stage. `crates/derive/src/taylor.rs` turns it
 /// into Taylor-coefficient recurrences.
 pub struct Dag {
     pub nodes: Vec<Node>,

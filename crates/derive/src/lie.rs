@@ -1,7 +1,7 @@
 //! The Lie series of second-order averaging over any coefficient
 //! arithmetic: Symbolica atoms where the Hamiltonian has a closed form
-//! (`build/deprit.rs`), named nodes of the emitter's DAG where A⁻¹ is only
-//! known through numeric solves (`build/numeric.rs`).
+//! (`crates/derive/src/deprit.rs`), named nodes of the emitter's DAG where A⁻¹ is only
+//! known through numeric solves (`crates/derive/src/numeric.rs`).
 //!
 //! In the extended phase space (q, θ; p, I) the system is
 //! K = I/ε + H(q, p, θ), H = H̄ + H̃ with H̄ the mean over θ. The new

@@ -526,7 +526,7 @@ impl crate::lie::Coefficients for DagCoefficients {
 }
 
 /// The second-order averaged system of a numeric-solve model: the Lie
-/// series of `build/lie.rs` with coefficients in the DAG. With y = A⁻¹p,
+/// series of `crates/derive/src/lie.rs` with coefficients in the DAG. With y = A⁻¹p,
 /// x_s = A⁻¹g_s (one factorisation) and b = Σ h_s(θ) g_s,
 /// H = ½ pᵀy − Σ h_s g_s·y + ½ Σ h_s h_t g_s·x_t + V(q, θ), whose Fourier
 /// series in θ follows from the products h_s h_t (monomials in sin θ,

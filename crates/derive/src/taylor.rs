@@ -2,7 +2,7 @@
 //!
 //! The Taylor method needs the normalised coefficients x^[k] = x^(k)(t0)/k!
 //! of the solution through (t0, x0). Every node u of the right-hand side's
-//! DAG (see `build/emit.rs`) gets its own coefficients u^[0..p]: order 0 is
+//! DAG (see `crates/derive/src/emit.rs`) gets its own coefficients u^[0..p]: order 0 is
 //! the ordinary evaluation, order n follows from lower orders by the
 //! recurrence of the node's operation (sums termwise, products by Cauchy
 //! sums, quotients, sqrt, powers, exp, ln, sin and cos as a pair), and the

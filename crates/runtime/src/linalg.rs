@@ -1,5 +1,5 @@
 //! Fixed-size linear algebra for the generated code of models whose mass
-//! matrix is solved numerically (`build/emit.rs`, `Node::Solution`).
+//! matrix is solved numerically (`crates/derive/src/emit.rs`, `Node::Solution`).
 //!
 //! The generated right-hand sides of models with three or more degrees of
 //! freedom evaluate the mass matrix A(q) and solve A q' = p − b: a Cholesky
@@ -77,4 +77,39 @@ fn dot<L: Scalar>(a: &[L], b: &[L]) -> L {
         sum += *x * *y;
     }
     sum
+}
+
+/// The bialternate product M⊙M, whose eigenvalues are the products
+/// λᵢλⱼ (i < j) of M's: its rows and columns are the pairs (i, j), i > j,
+/// and its entries the 2×2 minors of M.
+pub fn bialternate(m: &nalgebra::DMatrix<f64>) -> nalgebra::DMatrix<f64> {
+    let n = m.nrows();
+    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (0..i).map(move |j| (i, j))).collect();
+    nalgebra::DMatrix::from_fn(pairs.len(), pairs.len(), |r, c| {
+        let ((i, j), (k, l)) = (pairs[r], pairs[c]);
+        m[(i, k)] * m[(j, l)] - m[(i, l)] * m[(j, k)]
+    })
+}
+
+/// The bialternate sum 2J⊙I, whose eigenvalues are the sums λᵢ + λⱼ
+/// (i < j) of J's (Govaerts' formula, rows and columns the pairs i > j).
+pub fn bialternate_sum(a: &nalgebra::DMatrix<f64>) -> nalgebra::DMatrix<f64> {
+    let n = a.nrows();
+    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (0..i).map(move |j| (i, j))).collect();
+    nalgebra::DMatrix::from_fn(pairs.len(), pairs.len(), |r, c| {
+        let ((p, q), (r2, s)) = (pairs[r], pairs[c]);
+        if r2 == p && s == q {
+            a[(p, p)] + a[(q, q)]
+        } else if r2 == p {
+            a[(q, s)]
+        } else if s == q {
+            a[(p, r2)]
+        } else if r2 == q {
+            -a[(p, s)]
+        } else if s == p {
+            -a[(q, r2)]
+        } else {
+            0.0
+        }
+    })
 }

@@ -185,7 +185,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
                     return Err(OdeError::StepSizeUnderflow {
                         t,
                         h: size,
-                        y: y.to_vec(),
+                        y: y.as_slice().into(),
                     });
                 }
                 (direction * size, last)
@@ -227,7 +227,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
             return Err(OdeError::StepSizeUnderflow {
                 t,
                 h: signed,
-                y: y.to_vec(),
+                y: y.as_slice().into(),
             });
         }
         stats.steps += 1;

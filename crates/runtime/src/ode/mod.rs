@@ -46,7 +46,7 @@ pub trait System<const N: usize> {
     /// The normalised Taylor coefficients `out[k] = y^(k)(t)/k!`,
     /// k = 0..=order, of the solution through (t, y), for the `taylor`
     /// method; false when the system has no recurrences (generated models
-    /// have them, see `build/taylor.rs`). `Num` is f64 for one orbit, or
+    /// have them, see `crates/derive/src/taylor.rs`). `Num` is f64 for one orbit, or
     /// [`Lanes`] for a batch of orbits, one per lane.
     #[inline]
     fn taylor<Num: Scalar>(
@@ -323,7 +323,7 @@ pub enum OdeError {
     NonFinite { t: f64, y: Vec<f64> },
     /// The step collapsed at state `y` (a singular point, or a blow-up).
     #[error("step size underflow at t = {t} (h = {h:e}), y = {y:?}")]
-    StepSizeUnderflow { t: f64, h: f64, y: Vec<f64> },
+    StepSizeUnderflow { t: f64, h: f64, y: Box<[f64]> },
     #[error("more than {max_steps} steps, stopped at t = {t}")]
     TooManySteps { t: f64, max_steps: u64 },
     /// The implicit stage equations did not converge.

@@ -1,5 +1,5 @@
 //! Kernels of the Taylor-coefficient recurrences, called by the generated
-//! `*_taylor` functions (see `build/taylor.rs`).
+//! `*_taylor` functions (see `crates/derive/src/taylor.rs`).
 //!
 //! Every node u of a right-hand side keeps its normalised coefficients
 //! u^[k] = u^(k)(t0)/k! in a [`Coefficients`] array; each kernel returns the

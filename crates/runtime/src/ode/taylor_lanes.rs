@@ -279,7 +279,7 @@ impl LaneIntegrator {
                 OdeError::StepSizeUnderflow {
                     t: run.t[l],
                     h: sizes[l],
-                    y: run.state(l).to_vec(),
+                    y: run.state(l).into(),
                 }
             });
         }
@@ -302,7 +302,7 @@ impl LaneIntegrator {
                 OdeError::StepSizeUnderflow {
                     t: run.t[l],
                     h: h[l],
-                    y: run.state(l).to_vec(),
+                    y: run.state(l).into(),
                 }
             });
         }

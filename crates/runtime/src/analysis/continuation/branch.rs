@@ -48,11 +48,13 @@ impl Solution {
             // A flow has no period doubling.
             (TestFunction::MinusOne, true) => 1.0,
             (TestFunction::UnitPair, false) => {
-                let b = bialternate(&self.monodromy);
+                let b = crate::linalg::bialternate(&self.monodromy);
                 let m = b.nrows();
                 (b - DMatrix::<f64>::identity(m, m)).determinant()
             }
-            (TestFunction::UnitPair, true) => bialternate_sum(&self.monodromy).determinant(),
+            (TestFunction::UnitPair, true) => {
+                crate::linalg::bialternate_sum(&self.monodromy).determinant()
+            }
             (TestFunction::Turning, _) => self.tangent[n],
         }
     }
@@ -72,41 +74,6 @@ pub(super) enum TestFunction {
     UnitPair,
     /// The parameter's component of the tangent: a turning point.
     Turning,
-}
-
-/// The bialternate product M⊙M, whose eigenvalues are the products
-/// λᵢλⱼ (i < j) of M's: its rows and columns are the pairs (i, j), i > j,
-/// and its entries the 2×2 minors of M.
-fn bialternate(m: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = m.nrows();
-    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (0..i).map(move |j| (i, j))).collect();
-    DMatrix::from_fn(pairs.len(), pairs.len(), |r, c| {
-        let ((i, j), (k, l)) = (pairs[r], pairs[c]);
-        m[(i, k)] * m[(j, l)] - m[(i, l)] * m[(j, k)]
-    })
-}
-
-/// The bialternate sum 2J⊙I, whose eigenvalues are the sums λᵢ + λⱼ
-/// (i < j) of J's (Govaerts' formula, rows and columns the pairs i > j).
-fn bialternate_sum(a: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = a.nrows();
-    let pairs: Vec<(usize, usize)> = (0..n).flat_map(|i| (0..i).map(move |j| (i, j))).collect();
-    DMatrix::from_fn(pairs.len(), pairs.len(), |r, c| {
-        let ((p, q), (r2, s)) = (pairs[r], pairs[c]);
-        if r2 == p && s == q {
-            a[(p, p)] + a[(q, q)]
-        } else if r2 == p {
-            a[(q, s)]
-        } else if s == q {
-            a[(p, r2)]
-        } else if r2 == q {
-            -a[(p, s)]
-        } else if s == p {
-            -a[(q, r2)]
-        } else {
-            0.0
-        }
-    })
 }
 
 /// Why one corrector run gave no point (the step is retried shorter).
@@ -631,48 +598,4 @@ pub(super) fn eigenvector_near(m: &DMatrix<f64>, target: f64) -> DVector<f64> {
         .min_by(|a, b| a.1.total_cmp(b.1))
         .expect("n ≥ 1");
     v_t.row(smallest).transpose()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn bialternate_eigenvalues_are_pairwise_products() {
-        let m = DMatrix::from_row_slice(
-            3,
-            3,
-            &[2.0, 1.0, 0.0, 0.0, 3.0, 1.0, 0.0, 0.0, 5.0], // eigenvalues 2, 3, 5
-        );
-        let mut values: Vec<f64> = bialternate(&m)
-            .eigenvalues()
-            .unwrap()
-            .iter()
-            .copied()
-            .collect();
-        values.sort_by(f64::total_cmp);
-        for (got, want) in values.iter().zip([6.0, 10.0, 15.0]) {
-            assert!((got - want).abs() < 1e-12, "{values:?}");
-        }
-    }
-
-    #[test]
-    fn bialternate_sum_eigenvalues_are_pairwise_sums() {
-        // A full matrix with eigenvalues 1, 2, 4, 7 (a similarity transform
-        // of the diagonal), so that every entry of the formula is exercised.
-        let d = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 2.0, 4.0, 7.0]));
-        let t = DMatrix::from_fn(4, 4, |i, j| {
-            1.0 / (1.0 + i as f64 + 2.0 * j as f64) + f64::from(u8::from(i == j))
-        });
-        let a = &t * d * t.clone().try_inverse().unwrap();
-        let mut values: Vec<f64> = bialternate_sum(&a)
-            .complex_eigenvalues()
-            .iter()
-            .map(|z| z.re)
-            .collect();
-        values.sort_by(f64::total_cmp);
-        for (got, want) in values.iter().zip([3.0, 5.0, 6.0, 8.0, 9.0, 11.0]) {
-            assert!((got - want).abs() < 1e-9, "{values:?}");
-        }
-    }
 }
