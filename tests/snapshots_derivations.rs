@@ -3,8 +3,9 @@
 //! `build.rs` wrote into the generated modules; Symbolica is not called
 //! here. A model file a user adds has no snapshots yet: the test names it
 //! and passes (so `cargo test` stays green for any valid model file), and
-//! `INSTA_UPDATE=always cargo test --release --test snapshots_derivations`
-//! pins it.
+//! `INSTA_UPDATE=new cargo test --release --test snapshots_derivations`
+//! writes its snapshots as `.snap.new` files for `cargo insta review`
+//! (`INSTA_UPDATE=always` accepts them at once).
 
 use std::path::Path;
 
@@ -25,21 +26,28 @@ fn every_derived_expression_is_pinned() {
     };
     // The quadruple chain is a test model (test_models/), pinned here too.
     let quadruple = &mechlab_test_models::quadruple_pendulum::INFO;
-    let mut pinned = 0;
+    // Asked to write snapshots: a model without any gets them written.
+    let writing = matches!(
+        std::env::var("INSTA_UPDATE").as_deref(),
+        Ok("new" | "always")
+    );
+    let (mut pinned, mut new_snapshots) = (0, Vec::new());
     for model in mechlab::models::ALL.iter().chain([quadruple]) {
         assert!(
             !model.derivations.is_empty(),
             "{} has no derivations",
             model.name
         );
-        if !has_snapshots(model.name) {
+        if !has_snapshots(model.name) && !writing {
             eprintln!(
-                "{}: no snapshots yet (a model file of your own?); pin them with INSTA_UPDATE=always",
+                "{}: no snapshots yet (a model file of your own?); write them for review with \
+                 INSTA_UPDATE=new cargo test --release --test snapshots_derivations",
                 model.name
             );
             continue;
         }
-        pinned += 1;
+        let fresh = !has_snapshots(model.name);
+        pinned += usize::from(!fresh);
         for d in model.derivations {
             let name = format!(
                 "{}__{}",
@@ -53,9 +61,26 @@ fn every_derived_expression_is_pinned() {
                 "{}\n\ntext:\n{}\n\nlatex:\n{}\n",
                 d.description, d.text, d.latex
             );
-            insta::assert_snapshot!(name, body);
+            if fresh {
+                // Every snapshot of a new model is written before the test
+                // reports them (insta stops a test at its first new one).
+                let written =
+                    std::panic::catch_unwind(|| insta::assert_snapshot!(name.clone(), body));
+                if written.is_err() {
+                    new_snapshots.push(name);
+                }
+            } else {
+                insta::assert_snapshot!(name, body);
+            }
         }
     }
+    assert!(
+        new_snapshots.is_empty(),
+        "{} new snapshots written as .snap.new in tests/snapshots for review \
+         (cargo insta review, or accept them by renaming to .snap): {}",
+        new_snapshots.len(),
+        new_snapshots.join(", ")
+    );
     assert!(pinned >= SHIPPED, "only {pinned} models pinned");
 }
 

@@ -8,12 +8,17 @@
 # restores models/ however it ends.
 #
 #   bash benches/added_models/run.sh     # CI runs this after the edit loop
+#
+# Then it writes their snapshots with the command tests/snapshots_derivations.rs
+# documents, checks that every added model got some, and removes them.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 added=()
 restore() {
-    for f in "${added[@]}"; do rm -f "$f"; done
+    for f in "${added[@]}"; do
+        rm -f "$f" tests/snapshots/snapshots_derivations__"$(basename "$f" .toml)"__*.snap.new
+    done
 }
 trap restore EXIT
 
@@ -36,3 +41,20 @@ done
 echo "added to models/: ${added[*]}"
 cargo test --release
 echo "cargo test --release passed with ${#added[@]} model files added"
+
+# The documented command writes every derived expression of each new model
+# as a snapshot for review (and fails, as insta does, until they are
+# accepted).
+if INSTA_UPDATE=new cargo test --release --test snapshots_derivations >/dev/null 2>&1; then
+    echo "the snapshot test passed with new models: no snapshots written for review" >&2
+    exit 1
+fi
+for f in "${added[@]}"; do
+    name=$(basename "$f" .toml)
+    count=$(find tests/snapshots -name "snapshots_derivations__${name}__*.snap.new" | wc -l)
+    if [ "$count" -eq 0 ]; then
+        echo "$name: no snapshots written for review" >&2
+        exit 1
+    fi
+    echo "$name: $count snapshots written for review"
+done
