@@ -131,6 +131,12 @@ fn latex_uses_greek_letters_and_subscripts() {
             }
         }
     }
+    // A two-digit index (the test model's parameter h10) is one subscript;
+    // reading it as a name again sent the build into endless recursion.
+    let awkward = &mechlab_test_models::awkward_names::INFO;
+    let potential = awkward.derivations.iter().find(|d| d.key == "potential");
+    let latex = potential.expect("awkward_names has a potential").latex;
+    assert!(latex.contains("h_{10}"), "{latex}");
     let p = derived("double_pendulum", "velocities[0]").latex;
     assert!(p.contains("p_{\\varphi_2}") && p.contains("\\frac{"), "{p}");
     let rates = derived("double_pendulum", "momentum_rates[0]").latex;

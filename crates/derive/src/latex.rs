@@ -63,6 +63,9 @@ pub fn default_name(name: &str) -> String {
     match subscript.as_str() {
         "" => base,
         s if s.chars().count() == 1 => format!("{base}_{s}"),
+        // A number (`phi10`): as it is. Read as a name, "10" would be
+        // split into no base and the subscript "10" again, forever.
+        s if s.chars().all(|c| c.is_ascii_digit()) => format!("{base}_{{{s}}}"),
         s => format!("{base}_{{{}}}", default_name(s)),
     }
 }
