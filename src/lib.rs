@@ -26,8 +26,8 @@
 //! ```
 
 pub use mechlab_runtime::{
-    analysis, budget, contact, explore, linalg, mathml, model, ode, plot, registry, report, scene,
-    scenes, studio, study,
+    analysis, budget, contact, explore, large_models, linalg, mathml, model, ode, plot, registry,
+    report, scene, scenes, studio, study,
 };
 
 pub mod models;

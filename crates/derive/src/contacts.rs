@@ -20,7 +20,8 @@
 //! Also derived: the energy function E = Σ q'∂L/∂q' − L, which changes only
 //! by the friction work and the dissipation P_D = Σ q' ∂D/∂q'.
 
-use crate::derive::{is_zero, kinematic, num, subst, var, DeriveError, Derived, Recorder};
+use crate::algebra::{is_zero, num, subst, var, DeriveError, Derived, Recorder};
+use crate::derive::kinematic;
 use crate::model::Model;
 use symbolica::prelude::*;
 
@@ -109,7 +110,7 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
             r = subst(
                 &r,
                 &contact.held,
-                &crate::derive::atom(&contact.at.to_string())?,
+                &crate::algebra::atom(&contact.at.to_string())?,
             );
         }
         Ok(r)
@@ -148,7 +149,7 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
         friction.push(rec.record(
             format!("friction[{i}]"),
             "μ, the friction coefficient",
-            &crate::derive::atom(&contact.friction.to_string())?,
+            &crate::algebra::atom(&contact.friction.to_string())?,
         )?);
     }
     let mut energy = -lagrangian.clone();

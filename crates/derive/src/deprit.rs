@@ -6,7 +6,7 @@
 //! map to first order is y = y′ + ε J∇χ₁(y′, θ) (J the symplectic unit:
 //! q = q′ + ε ∂χ₁/∂p, p = p′ − ε ∂χ₁/∂q).
 
-use crate::derive::{num, phase_modes, DeriveError};
+use crate::algebra::{num, phase_modes, DeriveError};
 use crate::lie::{monomial, Coefficients, Harmonic, Series};
 use symbolica::prelude::*;
 
@@ -57,8 +57,8 @@ fn to_atom(series: &Series<Atom>, phase: &str) -> Result<Atom, DeriveError> {
     for (h, c) in series {
         let term = match h {
             Harmonic::Cos(0) => c.clone(),
-            Harmonic::Cos(k) => c * &crate::derive::atom(&format!("cos({k}*{phase})"))?,
-            Harmonic::Sin(k) => c * &crate::derive::atom(&format!("sin({k}*{phase})"))?,
+            Harmonic::Cos(k) => c * &crate::algebra::atom(&format!("cos({k}*{phase})"))?,
+            Harmonic::Sin(k) => c * &crate::algebra::atom(&format!("sin({k}*{phase})"))?,
         };
         sum += term;
     }
@@ -86,7 +86,7 @@ pub fn second_order_form(
     (phase, rate): (&str, &Atom),
     q: &[String],
     p: &[String],
-    rec: &mut crate::derive::Recorder,
+    rec: &mut crate::algebra::Recorder,
 ) -> Result<SecondOrderForm, DeriveError> {
     let series = fourier(hamiltonian, phase)?;
     let terms = crate::lie::second_order(&mut Atoms { q, p }, &series);

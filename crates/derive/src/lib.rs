@@ -15,11 +15,13 @@
 
 use mechlab_model as model;
 
+mod algebra;
 mod contacts;
 mod deprit;
 mod derive;
 mod emit;
 mod error;
+mod functions;
 mod generate;
 mod latex;
 mod lie;

@@ -21,7 +21,7 @@
 use crate::derive::{Derivation, NumericForm};
 use crate::emit::Step;
 use crate::error::DeriveError;
-use crate::generate::{
+use crate::functions::{
     common_functions, matrix, taylor_set, Context, Function, Inputs, TaylorFunction,
 };
 
@@ -349,7 +349,7 @@ pub fn functions(
             let field = averaged_functions(cx, derivation, form, &state, &mut functions)?;
             if has_second_order(derivation, cx.model) {
                 let (second, steps) = second_order(cx, derivation, form);
-                functions.extend(crate::generate::second_order_functions(
+                functions.extend(crate::functions::second_order_functions(
                     cx, &second, &steps,
                 )?);
             }
@@ -537,7 +537,7 @@ pub fn second_order(
     form: &NumericForm,
 ) -> (
     crate::deprit::SecondOrderForm,
-    crate::generate::SecondOrderSteps,
+    crate::functions::SecondOrderSteps,
 ) {
     use crate::lie::{add_to, monomial, Harmonic, Series};
     let n = cx.n();
@@ -647,7 +647,7 @@ pub fn second_order(
                 false => format!("{eps}*({})", generator.join("+")),
             },
         },
-        crate::generate::SecondOrderSteps {
+        crate::functions::SecondOrderSteps {
             hamiltonian,
             forces: velocities,
             generator: base,

@@ -28,7 +28,7 @@ pub fn mathml(latex: &str, block: bool) -> String {
             .replace("<mo><</mo>", "<mo>&lt;</mo>")
             .replace("<mo>></mo>", "<mo>&gt;</mo>"),
         // Writing into a String cannot fail; keep the source visible anyway.
-        Err(_) => format!("<code>{}</code>", crate::report::escape(&latex)),
+        Err(_) => format!("<code>{}</code>", escape(&latex)),
     }
 }
 
@@ -79,4 +79,12 @@ fn balanced_group_len(s: &str) -> Option<usize> {
         }
     }
     None
+}
+
+/// Text safe inside HTML: the characters markup reads, escaped.
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }

@@ -363,69 +363,29 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
 
 /// A Hamiltonian model at its own size, for [`with_fixed`]. The analyses
 /// are compiled ahead, in this crate, for 1 to 4 degrees of freedom; a
-/// model of 5 to 8 brings its own (see [`LargeModel`]).
+/// model of 5 to 8 brings its own (see [`crate::large_models`]).
 #[derive(Clone, Copy)]
 pub enum Sized {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
     Dof4(&'static Erased<4, 8, 16, 72>),
-    Large(&'static dyn LargeModel),
+    /// 5 to 8 degrees of freedom: a [`crate::large_models::LargeHandle`].
+    Large(LargeHandleRef),
 }
 
-/// Declares the works that run on a model at its own size (each is a
-/// [`WithFixed`] with one lifetime), once: [`LargeModel`] gets a method per
-/// work, [`AtSize`] implements it, and each work a [`LargeWork`] calling it.
-macro_rules! large_works {
-    ($($method:ident: $work:path => $output:ty;)*) => {
-        /// The analyses of one model of 5 to 8 degrees of freedom, compiled
-        /// in the models package for the sizes its model files have. Half
-        /// the runtime's compile time was the analyses at sizes 5–8, which
-        /// no model in `models/` needed (docs/building.md).
-        pub trait LargeModel: Sync {
-            $(fn $method(&self, work: $work) -> $output;)*
-        }
-
-        impl<const D: usize, const S: usize, const T: usize, const V: usize> LargeModel
-            for AtSize<D, S, T, V>
-        {
-            $(fn $method(&self, work: $work) -> $output {
-                work.run(self.0)
-            })*
-        }
-
-        $(impl LargeWork for $work {
-            fn on_large(self, model: &dyn LargeModel) -> $output {
-                model.$method(self)
-            }
-        })*
-    };
-}
-
-large_works! {
-    explore: crate::explore::HamiltonianRuns<'_> => Result<crate::explore::Exploration, crate::explore::ExploreError>;
-    stability: crate::analysis::stability::Analysis<'_> => Result<crate::analysis::stability::Stability, crate::analysis::stability::StabilityError>;
-    at_equilibrium: crate::analysis::stability::AtEquilibrium<'_> => Result<crate::analysis::stability::EquilibriumStability, crate::analysis::stability::StabilityError>;
-    stability_chart: crate::analysis::stability::Chart<'_> => Result<crate::analysis::stability::StabilityChart, crate::analysis::stability::StabilityError>;
-    averaging: crate::analysis::averaging::Sweep<'_> => Result<crate::analysis::averaging::AveragingConvergence, crate::analysis::averaging::AveragingError>;
-    period_map: crate::analysis::period_map::Portraits<'_> => Result<crate::analysis::period_map::Portrait, crate::analysis::period_map::PeriodMapError>;
-    chaos_map: crate::analysis::chaos_map::Map<'_> => Result<crate::analysis::chaos_map::ChaosMap, crate::analysis::chaos_map::ChaosMapError>;
-    studio_orbit: crate::studio::OrbitWork<'_> => Result<crate::studio::OrbitEnd, crate::studio::StudioError>;
-    continuation: crate::analysis::continuation::Work<'_> => Result<crate::analysis::continuation::Continuation, crate::analysis::continuation::ContinuationError>;
-}
-
-/// A model of 5 to 8 degrees of freedom as a [`LargeModel`]: the models
-/// package makes one per such model, which compiles the analyses there at
-/// that size.
-pub struct AtSize<const D: usize, const S: usize, const T: usize, const V: usize>(
-    pub &'static Erased<D, S, T, V>,
-);
-
-/// A work that also runs on a [`LargeModel`] (implemented by
-/// `large_works!` for every work).
+/// A work that also runs on a model of 5 to 8 degrees of freedom, whose
+/// analyses are compiled in the models package at its size
+/// ([`crate::large_models`] implements it for every analysis's work).
 pub trait LargeWork: WithFixed {
-    fn on_large(self, model: &dyn LargeModel) -> Self::Output;
+    /// Runs on the model behind `model`, a [`crate::large_models::LargeHandle`].
+    fn on_large(self, model: LargeHandleRef) -> Self::Output;
 }
+
+/// A model of 5 to 8 degrees of freedom, type-erased: the registry holds it
+/// without naming the analyses (which import the registry), and
+/// [`crate::large_models`], above both, reads it back.
+pub type LargeHandleRef = &'static (dyn std::any::Any + Send + Sync);
 
 /// One generated model: what it is, its dynamically sized interface, and
 /// for Hamiltonian models the same at its own sizes.

@@ -4,6 +4,7 @@
 //! behind it as formulas (MathML, which browsers draw natively). No
 //! network, no script: the figures are linked files.
 
+use crate::mathml::escape;
 use crate::registry::Catalog;
 use serde_json::Value;
 use std::path::Path;
@@ -106,13 +107,6 @@ pub const SECTIONS: &[Section] = &[
         numbers: &[("slopes (chaotic Kapitza)", "/slopes_error_vs_f_evals/kapitza_chaotic"), ("periods per second at 1e-10", "/performance/periods_per_second_at_1e-10")],
         formulas: NONE },
 ];
-
-pub fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
 
 /// The formulas of `keys` of the model `name`, each with what it is.
 fn formulas(catalog: Catalog, name: &str, keys: &[&str]) -> String {
