@@ -176,10 +176,21 @@ fn a_singular_point_of_the_chart_is_named_not_judged() {
     );
     // Both links hanging (tilted a little by the inclined vibration), the
     // spring stretched by about m₂g/k.
+    // (The first link upright over the stretched spring is an
+    // equilibrium too, with the same r: the first angle tells them apart.)
     let hanging = found
         .iter()
+        .filter(|e| e.q[0].abs() < 0.5)
         .max_by(|a, b| a.q[2].total_cmp(&b.q[2]))
         .expect("the hanging rest state");
+    let upright = found
+        .iter()
+        .find(|e| (e.q[0].abs() - std::f64::consts::PI).abs() < 0.5 && e.q[2] > 2.0);
+    assert_eq!(
+        upright.map(|e| e.verdict),
+        Some(Verdict::Unstable),
+        "{found:#?}"
+    );
     assert_eq!(hanging.verdict, Verdict::Stable, "{hanging:?}");
     assert!(
         (hanging.q[2] - (1.0 + 0.5 / 0.25)).abs() < 0.1,
@@ -266,4 +277,37 @@ fn stability_names_the_spherical_pendulums_poles_once_as_a_singular_chart() {
         assert!(reason.starts_with("singular chart"), "{reason}");
         assert!(pole.a_star.is_none() && pole.exact_window.is_none());
     }
+}
+
+/// A 4-link chain (the test model `quadruple_pendulum`, shaken with a = 5):
+/// `explore` searches its equilibria as `stability` does (the shared
+/// finder; before, it searched none beyond 3 degrees of freedom), and its
+/// verdict on V + V_vibr at the upright chain is `stability`'s averaged one
+/// at the same amplitude: stable exactly when a exceeds a*.
+#[test]
+fn a_four_link_chain_gets_its_equilibria_judged_as_stability_judges_them() {
+    use mechlab::analysis::stability::averaged_stability;
+    use mechlab::explore::{equilibria, Verdict};
+    use mechlab_test_models::quadruple_pendulum::{Params, DYNAMIC, MODEL};
+    let params = Params::default().values();
+    let found = equilibria(&DYNAMIC, &params).unwrap();
+    let at = |target: f64| {
+        found.iter().find(|e| {
+            e.q.iter()
+                .all(|x| mechlab::analysis::period_map::wrap_angle(x - target).abs() < 1e-6)
+        })
+    };
+    let hanging = at(std::f64::consts::PI).expect("the hanging chain");
+    assert_eq!(hanging.verdict, Verdict::Stable);
+    let upright = at(0.0).expect("the upright chain");
+    let averaged = averaged_stability(&MODEL, &params, "a", &[0.0; 4]).unwrap();
+    let a = 5.0;
+    let stable = averaged.stable_without_vibration || averaged.a_star.is_some_and(|s| a > s);
+    assert_eq!(
+        upright.verdict == Verdict::Stable,
+        stable,
+        "explore: {upright:?}; stability: {averaged:?}"
+    );
+    // Each link up or down is an equilibrium of the shaken chain too.
+    assert!(found.len() >= 16, "{} equilibria", found.len());
 }

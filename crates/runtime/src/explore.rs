@@ -95,8 +95,6 @@ impl std::fmt::Display for Verdict {
 pub enum NotSearched {
     #[error("the model has no effective potential (a contact model)")]
     NoPotential,
-    #[error("{dof} degrees of freedom: the grid search for equilibria covers 1 to 3")]
-    TooManyDegrees { dof: usize },
 }
 
 /// Everything the explorer computed.
@@ -349,21 +347,20 @@ fn contacts<const C: usize, const M: usize>(
     })
 }
 
-/// Equilibria of the effective potential: Newton's method on its gradient
-/// (central differences) with the generated Hessian, from a grid of starts
-/// (12 per coordinate: angles over [−π, π), others over [−2, 2)); duplicates
-/// (angles modulo 2π) merged.
+/// Equilibria of the effective potential: the shared finder
+/// ([`crate::analysis::equilibria`], the starts and steps `stability` uses)
+/// on its gradient by central differences with the generated Hessian, at
+/// any number of degrees of freedom; duplicates (angles modulo 2π, and
+/// along cyclic coordinates) merged.
 pub fn equilibria(
     model: &dyn DynamicModel,
     params: &[f64],
 ) -> Result<Vec<Equilibrium>, NotSearched> {
+    use crate::analysis::equilibria::{newton, starts, wrapped, Convergence};
     let periodic = model.periodic();
     let n = periodic.len();
     if model.effective_potential(params, &vec![0.0; n]).is_none() {
         return Err(NotSearched::NoPotential);
-    }
-    if n > 3 {
-        return Err(NotSearched::TooManyDegrees { dof: n });
     }
     let v = |q: &[f64]| model.effective_potential(params, q).unwrap_or(f64::NAN);
     let gradient = |q: &[f64]| -> Vec<f64> {
@@ -402,52 +399,21 @@ pub fn equilibria(
         })
         .collect();
     let kept: Vec<usize> = (0..n).filter(|i| !cyclic.contains(i)).collect();
-    let per_axis: usize = 12;
-    let starts: Vec<Vec<f64>> = (0..per_axis.pow(n as u32))
-        .map(|mut k| {
-            (0..n)
-                .map(|i| {
-                    let j = k % per_axis;
-                    k /= per_axis;
-                    // The grid includes 0 and −π, where symmetric models have equilibria.
-                    let u = j as f64 / per_axis as f64;
-                    if periodic[i] {
-                        -std::f64::consts::PI + 2.0 * std::f64::consts::PI * u
-                    } else {
-                        -2.0 + 4.0 * u
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let hessian = |q: &[f64]| {
+        let h = model
+            .effective_potential_hessian(params, q)
+            .unwrap_or_else(|| vec![f64::NAN; n * n]);
+        nalgebra::DMatrix::from_row_slice(n, n, &h)
+    };
     let mut found: Vec<Equilibrium> = Vec::new();
-    for start in starts {
-        let mut q = start;
-        for _ in 0..50 {
-            let g = gradient(&q);
-            let h = model
-                .effective_potential_hessian(params, &q)
-                .unwrap_or_default();
-            let hm = nalgebra::DMatrix::from_row_slice(n, n, &h);
-            let Some(step) = hm.lu().solve(&nalgebra::DVector::from_vec(g.clone())) else {
-                break;
-            };
-            for i in 0..n {
-                q[i] -= step[i];
-            }
-            if step.norm() < 1e-12 {
-                break;
-            }
-        }
-        let g = gradient(&q);
-        if !q.iter().all(|x| x.is_finite()) || g.iter().map(|x| x * x).sum::<f64>().sqrt() > 1e-7 {
+    for start in starts(&periodic) {
+        // The differences' noise floor: a root is where the gradient is
+        // below 10⁻⁷.
+        let convergence = Convergence::Noisy { gradient: 1e-7 };
+        let Some(q) = newton(gradient, hessian, start, convergence) else {
             continue;
-        }
-        for (x, p) in q.iter_mut().zip(&periodic) {
-            if *p {
-                *x = crate::analysis::period_map::wrap_angle(*x);
-            }
-        }
+        };
+        let mut q = wrapped(q, &periodic);
         let h = model
             .effective_potential_hessian(params, &q)
             .unwrap_or_default();

@@ -10,6 +10,7 @@ pub mod averaging;
 pub mod chaos_map;
 pub mod continuation;
 pub mod dimension;
+pub mod equilibria;
 pub mod fit;
 pub mod floquet;
 pub mod lyapunov;

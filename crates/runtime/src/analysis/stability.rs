@@ -23,7 +23,6 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
-use std::f64::consts::PI;
 
 /// How the analysis runs.
 #[derive(Clone, Debug)]
@@ -369,11 +368,9 @@ impl WithFixed for AtEquilibrium<'_> {
     }
 }
 
-/// Equilibria of the potential V without vibration: Newton's method on the
-/// generated ∂V/∂q with the generated C, from a grid of starts (angles at
-/// multiples of 2π/m, m = 8 up to 3 degrees of freedom and 4 beyond, other
-/// coordinates on [−2, 2] and 0); duplicates merged (angles modulo 2π). Also
-/// the number of starts.
+/// Equilibria of the potential V without vibration: the shared finder
+/// ([`super::equilibria`]) on the generated ∂V/∂q with the generated C;
+/// duplicates merged (angles modulo 2π). Also the number of starts.
 fn equilibria_without_vibration<
     F: Fixed<D, S, T, V>,
     const D: usize,
@@ -384,38 +381,21 @@ fn equilibria_without_vibration<
     model: &F,
     params: &[f64],
 ) -> (Vec<[f64; D]>, usize) {
+    use super::equilibria::{newton, starts, wrapped, Convergence};
     let periodic = model.periodic();
-    let per_angle = if D <= 3 { 8 } else { 4 };
-    let lengths = [-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0];
-    let axis: Vec<Vec<f64>> = periodic
-        .iter()
-        .map(|&p| {
-            if p {
-                (0..per_angle)
-                    .map(|k| wrap_angle(2.0 * PI * k as f64 / per_angle as f64))
-                    .collect()
-            } else {
-                lengths.to_vec()
-            }
-        })
-        .collect();
-    let total: usize = axis.iter().map(Vec::len).product();
+    let at = |q: &[f64]| -> [f64; D] { std::array::from_fn(|i| q[i]) };
+    let gradient = |q: &[f64]| model.potential_gradient(params, &at(q)).to_vec();
+    let hessian = |q: &[f64]| {
+        let h = model.potential_hessian(params, &at(q));
+        DMatrix::from_fn(D, D, |i, j| h[i][j])
+    };
+    let starts = starts(&periodic);
     let mut found: Vec<[f64; D]> = Vec::new();
-    for mut k in 0..total {
-        let mut q = [0.0; D];
-        for (i, values) in axis.iter().enumerate() {
-            q[i] = values[k % values.len()];
-            k /= values.len();
-        }
-        let Some(q) = newton(
-            |q| model.potential_gradient(params, q),
-            |q| model.potential_hessian(params, q),
-            q,
-        ) else {
+    for start in &starts {
+        let Some(q) = newton(gradient, hessian, start.clone(), Convergence::Exact) else {
             continue;
         };
-        let q: [f64; D] =
-            std::array::from_fn(|i| if periodic[i] { wrap_angle(q[i]) } else { q[i] });
+        let q = at(&wrapped(q, &periodic));
         let same = |e: &[f64; D]| {
             (0..D).all(|i| {
                 let d = if periodic[i] {
@@ -437,48 +417,7 @@ fn equilibria_without_vibration<
             .find(|o| o.is_ne())
             .unwrap_or(std::cmp::Ordering::Equal)
     });
-    (found, total)
-}
-
-/// Newton's method for gradient(q) = 0; None unless it converges.
-fn newton<const D: usize>(
-    gradient: impl Fn(&[f64; D]) -> [f64; D],
-    hessian: impl Fn(&[f64; D]) -> [[f64; D]; D],
-    mut q: [f64; D],
-) -> Option<[f64; D]> {
-    for _ in 0..60 {
-        let g = gradient(&q);
-        // At an equilibrium already (a start on a degenerate one, whose
-        // Hessian cannot be solved with).
-        if g.iter().all(|x| *x == 0.0) {
-            return Some(q);
-        }
-        let h = DMatrix::from_fn(D, D, |i, j| hessian(&q)[i][j]);
-        let g = nalgebra::DVector::from_column_slice(&g);
-        // A Hessian singular along a cyclic coordinate (a pole, a family
-        // of equilibria): the least-squares step, in the other directions.
-        let step = match h.clone().lu().solve(&g) {
-            Some(step) => step,
-            None => h.svd(true, true).solve(&g, 1e-12).ok()?,
-        };
-        for i in 0..D {
-            q[i] -= step[i];
-        }
-        if !q.iter().all(|x| x.is_finite()) {
-            return None;
-        }
-        if step.norm() < 1e-13 * (1.0 + q.iter().map(|x| x.abs()).fold(0.0, f64::max)) {
-            let g = gradient(&q);
-            let scale = 1.0
-                + hessian(&q)
-                    .iter()
-                    .flatten()
-                    .map(|x| x.abs())
-                    .fold(0.0, f64::max);
-            return (g.iter().map(|x| x.abs()).fold(0.0, f64::max) < 1e-9 * scale).then_some(q);
-        }
-    }
-    None
+    (found, starts.len())
 }
 
 /// Whether ∇(V + V_vibr) vanishes at q too (central differences of the

@@ -398,10 +398,12 @@ fn in_double(
     let points = found.unstable.len() + found.stable.len();
     let relative = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs());
     let routes_relative_difference = lobe_area_action.map(|a| relative(a, polygon.extrapolated));
-    let resolved = match routes_relative_difference {
-        Some(difference) => difference <= 1e-6,
-        None => relative(polygon.areas[0], polygon.areas[1]) <= 1e-3,
-    };
+    let closed = homoclinic.iter().all(|h| h.closure < CLOSED);
+    let resolved = closed
+        && match routes_relative_difference {
+            Some(difference) => difference <= 1e-6,
+            None => relative(polygon.areas[0], polygon.areas[1]) <= 1e-3,
+        };
     Ok(Splitting {
         model: name,
         precision: Precision::Double,
@@ -541,14 +543,17 @@ impl Map {
     }
 }
 
-/// Starts for Newton: the maxima of the averaged potential, at rest.
+/// Starts for Newton: the maxima of the averaged potential, at rest, from
+/// −π up (the branch the search follows first).
 fn saddles(model: &dyn DynamicModel, params: &[f64]) -> Vec<[f64; 2]> {
-    crate::explore::equilibria(model, params)
+    let mut saddles: Vec<[f64; 2]> = crate::explore::equilibria(model, params)
         .unwrap_or_default()
         .into_iter()
         .filter(|e| e.hessian_eigenvalues.iter().all(|&h| h < 0.0))
         .map(|e| [e.q[0], 0.0])
-        .collect()
+        .collect();
+    saddles.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    saddles
 }
 
 /// One branch of a manifold: σ ↦ P^⌊σ⌋(origin + s₀ g^{σ−⌊σ⌋} direction)
@@ -1040,6 +1045,13 @@ fn intersections(
     found
 }
 
+/// A homoclinic point's closure |W^u(σᵤ) − W^s(σₛ)| below which it is one.
+const CLOSED: f64 = 1e-6;
+
+/// Below this closure (and not below [`CLOSED`]) a crossing is the
+/// manifolds' noise: kept, and its lobe not resolved.
+const UNRESOLVED_CLOSURE: f64 = 1e-4;
+
 /// Newton on W^u(σᵤ) = W^s(σₛ) + (shift, 0), the Jacobian by differences.
 fn refine_homoclinic(
     map: &Map,
@@ -1092,7 +1104,10 @@ fn refine_homoclinic(
         }
     }
     let (closure, su, ss) = best;
-    if closure < 1e-6 {
+    // Closed to 1e-6: a homoclinic point. Closed to 1e-4 only: the
+    // manifolds split by about the accuracy of their points, the crossing
+    // is kept with its closure (no angle), and the lobe is not resolved.
+    if closure < UNRESOLVED_CLOSURE {
         let point = unstable.point(map, su)?;
         let (tu, ts) = (unstable.tangent(map, su)?, stable.tangent(map, ss)?);
         let cos = (tu[0] * ts[0] + tu[1] * ts[1]).abs() / (tu[0].hypot(tu[1]) * ts[0].hypot(ts[1]));
@@ -1101,7 +1116,7 @@ fn refine_homoclinic(
             sigma_unstable: su,
             sigma_stable: ss,
             closure,
-            angle: Some(cos.min(1.0).acos()),
+            angle: (closure < CLOSED).then(|| cos.min(1.0).acos()),
             action: None,
         });
     }

@@ -1,0 +1,116 @@
+//! The one equilibrium finder of every analysis: Newton's method on a
+//! potential's gradient from a grid of starts, at any number of degrees of
+//! freedom. `stability` runs it on V (the generated gradient and C), and
+//! `explore` on V + V_vibr (its gradient by central differences): both
+//! search the same starts with the same steps, and judge what they find.
+
+use crate::analysis::period_map::wrap_angle;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+/// Coordinates that are not angles start at these values.
+const LENGTHS: [f64; 7] = [-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0];
+
+/// The starts of the search: each angle at the multiples of 2π/m (m = 8 up
+/// to 3 degrees of freedom, 4 beyond, so that an 8-link chain has 4⁸
+/// starts rather than 8⁸), each other coordinate at [`LENGTHS`]; all zero
+/// and every angle at −π are among them, where symmetric models have
+/// their equilibria.
+pub fn starts(periodic: &[bool]) -> Vec<Vec<f64>> {
+    let per_angle = if periodic.len() <= 3 { 8 } else { 4 };
+    let axis: Vec<Vec<f64>> = periodic
+        .iter()
+        .map(|&p| match p {
+            true => (0..per_angle)
+                .map(|k| wrap_angle(2.0 * PI * k as f64 / per_angle as f64))
+                .collect(),
+            false => LENGTHS.to_vec(),
+        })
+        .collect();
+    let total: usize = axis.iter().map(Vec::len).product();
+    (0..total)
+        .map(|mut k| {
+            axis.iter()
+                .map(|values| {
+                    let x = values[k % values.len()];
+                    k /= values.len();
+                    x
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// When Newton's iterate is a root.
+#[derive(Clone, Copy, Debug)]
+pub enum Convergence {
+    /// An exact gradient: the step falls below 10⁻¹³ of q's size within 60
+    /// iterations, where the gradient is below 10⁻⁹ of the Hessian's scale.
+    Exact,
+    /// A gradient with a noise floor (differences): the iterate after at
+    /// most 60 steps (fewer once a step is below 10⁻¹²) whose gradient's
+    /// norm is at most `gradient`.
+    Noisy { gradient: f64 },
+}
+
+/// Newton's method for gradient(q) = 0 from `q`; None unless it converges.
+/// A Hessian singular along a cyclic coordinate (a pole, a family of
+/// equilibria) gets the least-squares step, in the other directions.
+pub fn newton(
+    gradient: impl Fn(&[f64]) -> Vec<f64>,
+    hessian: impl Fn(&[f64]) -> DMatrix<f64>,
+    mut q: Vec<f64>,
+    convergence: Convergence,
+) -> Option<Vec<f64>> {
+    let norm = |g: &[f64]| g.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for _ in 0..60 {
+        let g = gradient(&q);
+        // At an equilibrium already (a start on a degenerate one, whose
+        // Hessian cannot be solved with). A gradient of differences takes
+        // its step from there as from anywhere.
+        if matches!(convergence, Convergence::Exact) && g.iter().all(|x| *x == 0.0) {
+            return Some(q);
+        }
+        let h = hessian(&q);
+        let g = DVector::from_column_slice(&g);
+        let step = match h.clone().lu().solve(&g) {
+            Some(step) => step,
+            None => h.svd(true, true).solve(&g, 1e-12).ok()?,
+        };
+        for (x, s) in q.iter_mut().zip(step.iter()) {
+            *x -= s;
+        }
+        if !q.iter().all(|x| x.is_finite()) {
+            return None;
+        }
+        match convergence {
+            Convergence::Exact => {
+                let size = 1.0 + q.iter().map(|x| x.abs()).fold(0.0, f64::max);
+                if step.norm() < 1e-13 * size {
+                    let g = gradient(&q);
+                    let scale = 1.0 + hessian(&q).amax();
+                    let largest = g.iter().map(|x| x.abs()).fold(0.0, f64::max);
+                    return (largest < 1e-9 * scale).then_some(q);
+                }
+            }
+            Convergence::Noisy { .. } if step.norm() < 1e-12 => break,
+            Convergence::Noisy { .. } => {}
+        }
+    }
+    match convergence {
+        Convergence::Exact => None,
+        Convergence::Noisy {
+            gradient: tolerance,
+        } => (norm(&gradient(&q)) <= tolerance).then_some(q),
+    }
+}
+
+/// `q` with its angles (flagged in `periodic`) in [−π, π).
+pub fn wrapped(mut q: Vec<f64>, periodic: &[bool]) -> Vec<f64> {
+    for (x, p) in q.iter_mut().zip(periodic) {
+        if *p {
+            *x = wrap_angle(*x);
+        }
+    }
+    q
+}
