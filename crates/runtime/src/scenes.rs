@@ -484,8 +484,8 @@ pub fn period_map_scene(
         method: method_from(&scene)?,
     };
     let result = portrait(model, &scene.parameter_values(info)?, &settings)?;
-    for (k, reason) in &result.failed {
-        eprintln!("orbit {k} stopped: {reason}");
+    for stopped in &result.failed {
+        eprintln!("orbit {} stopped: {}", stopped.orbit, stopped.error);
     }
     scene.save_figure(&result.figure(), "period_map.png")?;
     let rows = result

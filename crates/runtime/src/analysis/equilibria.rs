@@ -8,23 +8,28 @@ use crate::analysis::period_map::wrap_angle;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
-/// Coordinates that are not angles start at these values.
+/// Beyond 3 degrees of freedom, coordinates that are not angles start at
+/// these values.
 const LENGTHS: [f64; 7] = [-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0];
 
-/// The starts of the search: each angle at the multiples of 2π/m (m = 8 up
-/// to 3 degrees of freedom, 4 beyond, so that an 8-link chain has 4⁸
-/// starts rather than 8⁸), each other coordinate at [`LENGTHS`]; all zero
-/// and every angle at −π are among them, where symmetric models have
-/// their equilibria.
+/// The starts of the search. Up to 3 degrees of freedom, 12 values per
+/// coordinate: angles at −π + 2πk/12, others at −2 + 4k/12 (0 and −π among
+/// them, where symmetric models have their equilibria; a vibrated triple
+/// pendulum has over a hundred). Beyond, each angle at the multiples of
+/// 2π/4 and each other coordinate at [`LENGTHS`], so that an 8-link chain
+/// has 4⁸ starts rather than 12⁸.
 pub fn starts(periodic: &[bool]) -> Vec<Vec<f64>> {
-    let per_angle = if periodic.len() <= 3 { 8 } else { 4 };
     let axis: Vec<Vec<f64>> = periodic
         .iter()
-        .map(|&p| match p {
-            true => (0..per_angle)
-                .map(|k| wrap_angle(2.0 * PI * k as f64 / per_angle as f64))
+        .map(|&p| match (periodic.len() <= 3, p) {
+            (true, true) => (0..12)
+                .map(|k| -PI + 2.0 * PI * (k as f64 / 12.0))
                 .collect(),
-            false => LENGTHS.to_vec(),
+            (true, false) => (0..12).map(|k| -2.0 + 4.0 * (k as f64 / 12.0)).collect(),
+            (false, true) => (0..4)
+                .map(|k| wrap_angle(2.0 * PI * k as f64 / 4.0))
+                .collect(),
+            (false, false) => LENGTHS.to_vec(),
         })
         .collect();
     let total: usize = axis.iter().map(Vec::len).product();
@@ -48,14 +53,15 @@ pub enum Convergence {
     /// iterations, where the gradient is below 10⁻⁹ of the Hessian's scale.
     Exact,
     /// A gradient with a noise floor (differences): the iterate after at
-    /// most 60 steps (fewer once a step is below 10⁻¹²) whose gradient's
-    /// norm is at most `gradient`.
+    /// most 50 steps (fewer once a step is below 10⁻¹², or where the
+    /// Hessian is singular) whose gradient's norm is at most `gradient`.
     Noisy { gradient: f64 },
 }
 
 /// Newton's method for gradient(q) = 0 from `q`; None unless it converges.
-/// A Hessian singular along a cyclic coordinate (a pole, a family of
-/// equilibria) gets the least-squares step, in the other directions.
+/// With an exact gradient, a Hessian singular along a cyclic coordinate (a
+/// pole, a family of equilibria) gets the least-squares step, in the other
+/// directions.
 pub fn newton(
     gradient: impl Fn(&[f64]) -> Vec<f64>,
     hessian: impl Fn(&[f64]) -> DMatrix<f64>,
@@ -63,7 +69,11 @@ pub fn newton(
     convergence: Convergence,
 ) -> Option<Vec<f64>> {
     let norm = |g: &[f64]| g.iter().map(|x| x * x).sum::<f64>().sqrt();
-    for _ in 0..60 {
+    let iterations = match convergence {
+        Convergence::Exact => 60,
+        Convergence::Noisy { .. } => 50,
+    };
+    for _ in 0..iterations {
         let g = gradient(&q);
         // At an equilibrium already (a start on a degenerate one, whose
         // Hessian cannot be solved with). A gradient of differences takes
@@ -73,9 +83,12 @@ pub fn newton(
         }
         let h = hessian(&q);
         let g = DVector::from_column_slice(&g);
-        let step = match h.clone().lu().solve(&g) {
-            Some(step) => step,
-            None => h.svd(true, true).solve(&g, 1e-12).ok()?,
+        let step = match (h.clone().lu().solve(&g), convergence) {
+            (Some(step), _) => step,
+            (None, Convergence::Exact) => h.svd(true, true).solve(&g, 1e-12).ok()?,
+            // Where the Hessian of differences is singular, the iterate
+            // stands and is judged by its gradient.
+            (None, Convergence::Noisy { .. }) => break,
         };
         for (x, s) in q.iter_mut().zip(step.iter()) {
             *x -= s;

@@ -118,6 +118,20 @@ pub struct PortraitSettings {
     pub method: Method,
 }
 
+/// An orbit that stopped: its index among the seeds and the integrator's
+/// error (in a summary, `[index, "the error's text"]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stopped {
+    pub orbit: usize,
+    pub error: OdeError,
+}
+
+impl serde::Serialize for Stopped {
+    fn serialize<Z: serde::Serializer>(&self, z: Z) -> Result<Z::Ok, Z::Error> {
+        (self.orbit, self.error.to_string()).serialize(z)
+    }
+}
+
 /// Orbits of the period map of any model with a fast phase, projected on
 /// two state components (angles in [−π, π)); orbits that left the model's
 /// domain are listed with their reason instead.
@@ -129,7 +143,7 @@ pub struct Portrait {
     pub seeds: Vec<Vec<f64>>,
     pub periods: usize,
     /// Orbits that stopped, with the reason (the others are in `orbits`).
-    pub failed: Vec<(usize, String)>,
+    pub failed: Vec<Stopped>,
     pub seconds: f64,
     /// Per seed, the projected points (empty for a failed orbit).
     #[serde(skip)]
@@ -246,7 +260,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
                         .collect(),
                 ),
                 Err(e) => {
-                    failed.push((k, e.to_string()));
+                    failed.push(Stopped { orbit: k, error: e });
                     projected.push(Vec::new());
                 }
             }
