@@ -383,7 +383,13 @@ fn bad_requests_are_named() {
         &settings("mu", 1.0, &[]),
     )
     .unwrap_err();
-    assert!(matches!(err, ContinuationError::ContactModel(_)), "{err}");
+    assert!(
+        matches!(
+            err,
+            ContinuationError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+        ),
+        "{err}"
+    );
 
     let err = continuation(
         &FORCED,

@@ -302,8 +302,8 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             }
             Err(
                 AveragingError::Order(..)
-                | AveragingError::NoFastPhase(_)
-                | AveragingError::ContactModel(_),
+                | AveragingError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
+                | AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. }),
             ) => {}
             Err(e) => panic!("{}: {e}", info.name),
         }

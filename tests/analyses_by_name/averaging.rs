@@ -78,7 +78,13 @@ fn bad_requests_are_typed_errors() {
         &settings(None, &[1.0]),
     )
     .unwrap_err();
-    assert!(matches!(e, AveragingError::ContactModel(_)), "{e}");
+    assert!(
+        matches!(
+            e,
+            AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+        ),
+        "{e}"
+    );
     let e = convergence(
         model_of("kapitza"),
         &defaults("kapitza"),

@@ -164,7 +164,9 @@ fn bad_requests_are_typed_errors() {
             &settings([0, 1], 2, 2),
             &|| true
         ),
-        Err(ChaosMapError::ContactModel(_))
+        Err(ChaosMapError::Refused(
+            mechlab::analysis::Refusal::ContactModel { .. }
+        ))
     ));
 }
 

@@ -18,17 +18,46 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         let model = mechlab::models::by_name(info.name).unwrap().dynamic;
         let params = model.defaults();
         let Kind::Hamiltonian { dof: n, fast_phase } = model.kind() else {
+            // One refusal, the same value from every analysis.
+            let refused = mechlab::analysis::Refusal::ContactModel {
+                model: info.name.to_string(),
+            };
+            let (a, b, c) = (
+                stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err(),
+                convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err(),
+                chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err(),
+            );
+            assert!(
+                matches!(a, StabilityError::Refused(ref r) if *r == refused),
+                "{a}"
+            );
+            assert!(
+                matches!(b, AveragingError::Refused(ref r) if *r == refused),
+                "{b}"
+            );
+            assert!(
+                matches!(c, ChaosMapError::Refused(ref r) if *r == refused),
+                "{c}"
+            );
             let e =
                 stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err();
             assert!(
-                matches!(e, StabilityError::ContactModel(_))
-                    && e.to_string().contains("contact model")
+                matches!(
+                    e,
+                    StabilityError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+                ) && e.to_string().contains("contact model")
             );
             let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
-            assert!(matches!(e, AveragingError::ContactModel(_)));
+            assert!(matches!(
+                e,
+                AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+            ));
             let e =
                 chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err();
-            assert!(matches!(e, ChaosMapError::ContactModel(_)));
+            assert!(matches!(
+                e,
+                ChaosMapError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+            ));
             assert!(portrait(model_of(info.name), &params, &portrait_settings(1)).is_err());
             continue;
         };
@@ -37,20 +66,29 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         if !fast_phase {
             let e = stability(model_of(info.name), &params, &stability_settings("x")).unwrap_err();
             assert!(
-                matches!(e, StabilityError::NoFastPhase(_)),
+                matches!(
+                    e,
+                    StabilityError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
+                ),
                 "{}: {e}",
                 info.name
             );
             let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
             assert!(
-                matches!(e, AveragingError::NoFastPhase(_)),
+                matches!(
+                    e,
+                    AveragingError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
+                ),
                 "{}: {e}",
                 info.name
             );
             let e =
                 chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap_err();
             assert!(
-                matches!(e, ChaosMapError::NoFastPhase(_)),
+                matches!(
+                    e,
+                    ChaosMapError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
+                ),
                 "{}: {e}",
                 info.name
             );

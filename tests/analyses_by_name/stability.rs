@@ -177,7 +177,13 @@ fn bad_requests_are_typed_errors() {
         &settings("mu1"),
     )
     .unwrap_err();
-    assert!(matches!(e, StabilityError::ContactModel(_)), "{e}");
+    assert!(
+        matches!(
+            e,
+            StabilityError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+        ),
+        "{e}"
+    );
     let e = stability(model_of("kapitza"), &defaults("kapitza"), &settings("B")).unwrap_err();
     assert!(
         e.to_string().contains("no parameter 'B'") && e.to_string().contains("A, eps, mu"),

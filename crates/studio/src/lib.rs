@@ -81,8 +81,7 @@ impl ApiError {
                 StatusCode::NOT_FOUND
             }
             ApiError::Studio(
-                StudioError::ContactModel(_)
-                | StudioError::NoFastPhase(_)
+                StudioError::Refused(_)
                 | StudioError::Splitting(_)
                 | StudioError::Continuation(_)
                 | StudioError::Section(_),

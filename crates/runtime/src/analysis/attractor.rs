@@ -33,12 +33,11 @@ pub struct AttractorSettings {
 /// Why an attractor cannot be had.
 #[derive(Debug, thiserror::Error)]
 pub enum AttractorError {
-    #[error("'{0}' is a contact model: it has no period map")]
-    ContactModel(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}' has {dof} degrees of freedom: the attractor is drawn for one (a period map of the plane)")]
     NotPlanar { model: String, dof: usize },
-    #[error("model '{0}' has no periodic forcing (no [fast_phase]): it has no period map")]
-    NoPeriod(String),
     #[error("attractor of '{model}': {reason}")]
     Settings { model: String, reason: String },
     #[error(transparent)]
@@ -100,11 +99,19 @@ pub fn attractor(
                 dof: model.info.coordinates.len(),
             })
         }
-        None => return Err(AttractorError::ContactModel(name)),
+        None => {
+            return Err(AttractorError::Refused(
+                crate::analysis::Refusal::ContactModel { model: name },
+            ))
+        }
     };
     let period = match fixed.phase_period(params) {
         Some(t) if fixed.has_fast_phase() => t,
-        _ => return Err(AttractorError::NoPeriod(name)),
+        _ => {
+            return Err(AttractorError::Refused(
+                crate::analysis::Refusal::NoFastPhase { model: name },
+            ))
+        }
     };
     let settings_error = |reason: &str| AttractorError::Settings {
         model: name.clone(),

@@ -203,10 +203,9 @@ fn settled(local: &[f64]) -> Option<f64> {
 /// Why [`convergence`] cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum AveragingError {
-    #[error("'{0}' is a contact model: it has no period map or averaged system")]
-    ContactModel(String),
-    #[error("model '{0}' has no fast phase: there is no averaged system")]
-    NoFastPhase(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}': {reason}")]
     Parameter { model: String, reason: String },
     #[error("model '{model}': the initial state has {got} components, the model {expected}")]
@@ -264,8 +263,11 @@ pub fn convergence(
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
-    crate::registry::with_fixed(model, Sweep { params, settings })
-        .ok_or_else(|| AveragingError::ContactModel(model.info.name.into()))?
+    crate::registry::with_fixed(model, Sweep { params, settings }).ok_or_else(|| {
+        AveragingError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`convergence`] at one size.
@@ -301,7 +303,11 @@ impl crate::registry::WithFixed for Sweep<'_> {
             reason,
         };
         if !model.has_fast_phase() {
-            return Err(AveragingError::NoFastPhase(info.name.into()));
+            return Err(AveragingError::Refused(
+                crate::analysis::Refusal::NoFastPhase {
+                    model: info.name.into(),
+                },
+            ));
         }
         if info.named_values(self.params).is_none() {
             return Err(bad(format!("{} parameter values", self.params.len())));

@@ -99,8 +99,11 @@ pub fn chaos_map(
         settings,
         row_done,
     };
-    crate::registry::with_fixed(model, work)
-        .ok_or_else(|| ChaosMapError::ContactModel(model.info.name.into()))?
+    crate::registry::with_fixed(model, work).ok_or_else(|| {
+        ChaosMapError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`chaos_map`] at one size.
@@ -124,7 +127,13 @@ impl WithFixed for Map<'_> {
         let settings = self.settings;
         let period = match model.phase_period(self.params) {
             Some(t) if model.has_fast_phase() => t,
-            _ => return Err(ChaosMapError::NoFastPhase(info.name.into())),
+            _ => {
+                return Err(ChaosMapError::Refused(
+                    crate::analysis::Refusal::NoFastPhase {
+                        model: info.name.into(),
+                    },
+                ))
+            }
         };
         let params = info
             .named_values(self.params)

@@ -26,6 +26,20 @@ pub mod vibrational_stability;
 
 use std::ops::Range;
 
+/// Why an analysis does not apply to a model, the same for every analysis
+/// (each analysis's error wraps it as `Refused`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Refusal {
+    /// A model of points on rough guides: it has no Hamiltonian form,
+    /// period map or averaged system (`explore` runs it with stick–slip
+    /// switching).
+    #[error("'{model}' is a contact model: it has no Hamiltonian form, period map or averaged system (`explore` runs it with its stick–slip switching)")]
+    ContactModel { model: String },
+    /// No `[fast_phase]` in its model file: no period map, nothing to average.
+    #[error("model '{model}' has no fast phase ([fast_phase] in its model file): it has no period map and nothing to average")]
+    NoFastPhase { model: String },
+}
+
 /// Orbits in one block of rows at most: a cancelled chaos map (the
 /// studio's view moved) stops once the blocks running end.
 pub const BLOCK_ORBITS: usize = 1024;

@@ -153,10 +153,9 @@ pub struct Portrait {
 /// Why an analysis of the period map ([`portrait`], the chaos map) cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum PeriodMapError {
-    #[error("'{0}' is a contact model: it has no period map or averaged system")]
-    ContactModel(String),
-    #[error("model '{0}' has no fast phase: it has no period map")]
-    NoFastPhase(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}': {reason}")]
     Request { model: String, reason: String },
     /// Only some tiles of a map were asked for: they are written, there is
@@ -178,8 +177,11 @@ pub fn portrait(
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    crate::registry::with_fixed(model, Portraits { params, settings })
-        .ok_or_else(|| PeriodMapError::ContactModel(model.info.name.into()))?
+    crate::registry::with_fixed(model, Portraits { params, settings }).ok_or_else(|| {
+        PeriodMapError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`portrait`] at one size.
@@ -211,7 +213,13 @@ impl crate::registry::WithFixed for Portraits<'_> {
             .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
         let period = match model.phase_period(self.params) {
             Some(t) if model.has_fast_phase() => t,
-            _ => return Err(PeriodMapError::NoFastPhase(info.name.into())),
+            _ => {
+                return Err(PeriodMapError::Refused(
+                    crate::analysis::Refusal::NoFastPhase {
+                        model: info.name.into(),
+                    },
+                ))
+            }
         };
         let axes = info.plane(settings.axes).map_err(|e| bad(e.to_string()))?;
         let periodic = model.periodic();

@@ -171,8 +171,9 @@ impl Section {
 /// Why a section cannot be drawn.
 #[derive(Debug, thiserror::Error)]
 pub enum SectionError {
-    #[error("model {0} is a contact model: sections are for Hamiltonian models")]
-    ContactModel(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model {0} has a fast phase: its section is the period map (scenes period_map, chaos_map); slices of it are drawn for 2 degrees of freedom")]
     FastPhase(String),
     #[error("model {model} has {dof} degrees of freedom: sections are drawn for 2")]
@@ -223,7 +224,9 @@ pub fn section(
             model: name,
             dof: model.info.coordinates.len(),
         }),
-        None => Err(SectionError::ContactModel(name)),
+        None => Err(SectionError::Refused(
+            crate::analysis::Refusal::ContactModel { model: name },
+        )),
     }
 }
 

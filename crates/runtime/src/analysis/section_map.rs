@@ -71,7 +71,11 @@ pub fn section_map(
                 dof: model.info.coordinates.len(),
             })
         }
-        None => return Err(SectionError::ContactModel(name)),
+        None => {
+            return Err(SectionError::Refused(
+                crate::analysis::Refusal::ContactModel { model: name },
+            ))
+        }
     };
     let s = &settings.section;
     let bad = |reason: &str| SectionError::Settings {

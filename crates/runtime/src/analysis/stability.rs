@@ -128,10 +128,9 @@ fn as_text<S: serde::Serializer>(e: &Option<NoEquilibria>, s: S) -> Result<S::Ok
 /// Why the analysis cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum StabilityError {
-    #[error("'{0}' is a contact model: it has no period map or averaged system")]
-    ContactModel(String),
-    #[error("model '{0}' has no fast phase: there is no vibration to stabilise by")]
-    NoFastPhase(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error(
         "model '{model}' has no parameter '{name}' to use as the amplitude (parameters: {known})"
     )]
@@ -165,8 +164,11 @@ pub fn stability(
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
-    crate::registry::with_fixed(model, Analysis { params, settings })
-        .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
+    crate::registry::with_fixed(model, Analysis { params, settings }).ok_or_else(|| {
+        StabilityError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`stability`]: equilibria, thresholds and windows at one size.
@@ -341,7 +343,11 @@ pub fn averaged_stability(
             q,
         },
     )
-    .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
+    .ok_or_else(|| {
+        StabilityError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`averaged_stability`]: one equilibrium judged at one size.
@@ -761,7 +767,11 @@ fn vibrating_model<
 ) -> Result<BTreeMap<String, f64>, StabilityError> {
     let info = model.info();
     if !model.has_fast_phase() {
-        return Err(StabilityError::NoFastPhase(info.name.into()));
+        return Err(StabilityError::Refused(
+            crate::analysis::Refusal::NoFastPhase {
+                model: info.name.into(),
+            },
+        ));
     }
     info.named_values(params)
         .ok_or_else(|| StabilityError::ParameterCount(params.len(), info.name.into()))
@@ -934,8 +944,11 @@ pub fn stability_chart(
     params: &[f64],
     settings: &ChartSettings,
 ) -> Result<StabilityChart, StabilityError> {
-    crate::registry::with_fixed(model, Chart { params, settings })
-        .ok_or_else(|| StabilityError::ContactModel(model.info.name.into()))?
+    crate::registry::with_fixed(model, Chart { params, settings }).ok_or_else(|| {
+        StabilityError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`stability_chart`] at one size.

@@ -32,10 +32,9 @@ pub const MAX_GRID: usize = 400;
 pub enum StudioError {
     #[error(transparent)]
     UnknownModel(#[from] crate::registry::UnknownModel),
-    #[error("model '{0}' is a contact model: it has no Hamiltonian phase plane (its derivations are shown)")]
-    ContactModel(String),
-    #[error("model '{0}' has no fast phase: it has no period map (its derivations and equilibria are shown)")]
-    NoFastPhase(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}': {problem}")]
     BadRequest {
         model: String,
@@ -266,7 +265,13 @@ impl Setup {
         };
         let (dof, fast_phase) = match model.kind() {
             Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
-            Kind::Contacts { .. } => return Err(StudioError::ContactModel(info.name.into())),
+            Kind::Contacts { .. } => {
+                return Err(StudioError::Refused(
+                    crate::analysis::Refusal::ContactModel {
+                        model: info.name.into(),
+                    },
+                ))
+            }
         };
         let mut params = model.defaults();
         for (name, &value) in &self.params {
@@ -335,7 +340,11 @@ impl Resolved {
         if self.fast_phase {
             Ok(())
         } else {
-            Err(StudioError::NoFastPhase(self.info.name.into()))
+            Err(StudioError::Refused(
+                crate::analysis::Refusal::NoFastPhase {
+                    model: self.info.name.into(),
+                },
+            ))
         }
     }
 }
@@ -411,8 +420,11 @@ pub fn orbit(
         periods: request.periods,
         sink,
     };
-    crate::registry::with_fixed(setup.handle, work)
-        .ok_or_else(|| StudioError::ContactModel(setup.info.name.into()))?
+    crate::registry::with_fixed(setup.handle, work).ok_or_else(|| {
+        StudioError::Refused(crate::analysis::Refusal::ContactModel {
+            model: setup.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`orbit`] at one size.
@@ -431,9 +443,11 @@ impl WithFixed for OrbitWork<'_> {
     ) -> Self::Output {
         let setup = self.setup;
         let started = Instant::now();
-        let period = model
-            .phase_period(&setup.params)
-            .ok_or_else(|| StudioError::NoFastPhase(setup.info.name.into()))?;
+        let period = model.phase_period(&setup.params).ok_or_else(|| {
+            StudioError::Refused(crate::analysis::Refusal::NoFastPhase {
+                model: setup.info.name.into(),
+            })
+        })?;
         let system = model.exact(&setup.params);
         let periodic = model.periodic();
         let y: [f64; S] = std::array::from_fn(|k| self.seed[k]);

@@ -69,8 +69,9 @@ pub struct DiagramSettings {
 /// Why a continuation cannot run.
 #[derive(Debug, thiserror::Error)]
 pub enum ContinuationError {
-    #[error("'{0}' is a contact model: it has no period map")]
-    ContactModel(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}' has no parameter '{name}' (parameters: {known})")]
     UnknownParameter {
         model: String,
@@ -267,8 +268,11 @@ pub fn continuation(
     params: &[f64],
     settings: &ContinuationSettings,
 ) -> Result<Continuation, ContinuationError> {
-    crate::registry::with_fixed(model, Work { params, settings })
-        .ok_or_else(|| ContinuationError::ContactModel(model.info.name.into()))?
+    crate::registry::with_fixed(model, Work { params, settings }).ok_or_else(|| {
+        ContinuationError::Refused(crate::analysis::Refusal::ContactModel {
+            model: model.info.name.into(),
+        })
+    })?
 }
 
 /// The work of [`continuation`] at one model's sizes.

@@ -267,12 +267,11 @@ impl Splitting {
 /// Why the splitting cannot be measured.
 #[derive(Debug, thiserror::Error)]
 pub enum SplittingError {
-    #[error("'{0}' is a contact model: it has no period map")]
-    ContactModel(String),
+    /// The analysis does not apply to this kind of model.
+    #[error(transparent)]
+    Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}' has {dof} degrees of freedom: separatrix splitting is measured for one (a period map of the plane)")]
     NotPlanar { model: String, dof: usize },
-    #[error("model '{0}' has no fast phase: it has no period map")]
-    NoFastPhase(String),
     #[error("model '{0}': the averaged system has no saddle (no maximum of V + V_vibr) to start Newton from; give a guess of the fixed point")]
     NoSaddle(String),
     #[error("model '{model}': Newton for a fixed point of the period map did not converge from {start:?}")]
@@ -479,7 +478,11 @@ fn prepare(
                 dof: model.info.coordinates.len(),
             })
         }
-        None => return Err(SplittingError::ContactModel(name)),
+        None => {
+            return Err(SplittingError::Refused(
+                crate::analysis::Refusal::ContactModel { model: name },
+            ))
+        }
     };
     let Some(named) = model.info.named_values(params) else {
         return Err(SplittingError::Request {
@@ -489,7 +492,11 @@ fn prepare(
     };
     let period = match fixed.phase_period(params) {
         Some(t) if fixed.has_fast_phase() => t,
-        _ => return Err(SplittingError::NoFastPhase(name)),
+        _ => {
+            return Err(SplittingError::Refused(
+                crate::analysis::Refusal::NoFastPhase { model: name },
+            ))
+        }
     };
     if !(settings.spacing > 0.0 && settings.p_max > 0.0 && settings.lobe_points >= 8) {
         return Err(SplittingError::Request {
