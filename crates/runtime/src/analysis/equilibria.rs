@@ -2,7 +2,8 @@
 //! potential's gradient from a grid of starts, at any number of degrees of
 //! freedom. `stability` runs it on V (the generated gradient and C), and
 //! `explore` on V + V_vibr (its gradient by central differences): both
-//! search the same starts with the same steps, and judge what they find.
+//! search the same starts with Newton's method, stopped as their
+//! gradient's kind allows ([`Convergence`]), and judge what they find.
 
 use crate::analysis::period_map::wrap_angle;
 use nalgebra::{DMatrix, DVector};
