@@ -282,21 +282,8 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             .collect();
         match common::asymptotic_slopes(model_of(info.name), &defaults, &settings) {
             Ok(slopes) => {
-                let settled = slopes.iter().all(|s| s.is_ok());
-                for slope in slopes {
-                    match slope {
-                        // −2, or −3 for a coordinate whose 1/ν² term vanishes.
-                        Ok(slope) => assert!(
-                            slope < -1.8 && (slope - slope.round()).abs() < 0.2,
-                            "{}: slope {slope}",
-                            info.name
-                        ),
-                        Err(reason) => {
-                            eprintln!("{}: second-order slope skipped: {reason}", info.name)
-                        }
-                    }
-                }
-                if settled {
+                // −2, or −3 for a coordinate whose 1/ν² term vanishes.
+                if common::assert_whole_power_slopes(info.name, &slopes, -2.0) {
                     checked.push(info.name);
                 }
             }

@@ -118,16 +118,7 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         let slopes =
             crate::common::asymptotic_slopes(model_of(info.name), &params, &averaging_settings())
                 .unwrap();
-        for slope in slopes {
-            match slope {
-                Ok(slope) => assert!(
-                    slope < -0.8 && (slope - slope.round()).abs() < 0.2,
-                    "{}: slope {slope}",
-                    info.name
-                ),
-                Err(reason) => eprintln!("{}: averaging slope skipped: {reason}", info.name),
-            }
-        }
+        crate::common::assert_whole_power_slopes(info.name, &slopes, -1.0);
         // The FLI is a maximum over the iterations: more periods never lower it.
         let (short, long) = (
             chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap(),

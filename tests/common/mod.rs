@@ -164,3 +164,19 @@ pub fn asymptotic_slopes(
         })
         .collect())
 }
+
+/// Asserts that each settled slope of [`asymptotic_slopes`] is a whole
+/// power at most `most` (−1 for first-order averaging, −2 for second);
+/// prints the reason of each that did not settle. Whether all settled.
+pub fn assert_whole_power_slopes(model: &str, slopes: &[Result<f64, String>], most: f64) -> bool {
+    for slope in slopes {
+        match slope {
+            Ok(slope) => assert!(
+                *slope < most + 0.2 && (slope - slope.round()).abs() < 0.2,
+                "{model}: slope {slope}"
+            ),
+            Err(reason) => eprintln!("{model}: slope not checked: {reason}"),
+        }
+    }
+    slopes.iter().all(|s| s.is_ok())
+}

@@ -414,10 +414,7 @@ pub fn equilibria(
             continue;
         };
         let mut q = wrapped(q, &periodic);
-        let h = model
-            .effective_potential_hessian(params, &q)
-            .unwrap_or_default();
-        let hm = nalgebra::DMatrix::from_row_slice(n, n, &h);
+        let hm = hessian(&q);
         let sym = (&hm + hm.transpose()) * 0.5;
         // The reduced system's Hessian: the rows and columns of the cyclic
         // coordinates dropped.

@@ -8,6 +8,7 @@
 use super::dimension::{bounds, box_counting, kaplan_yorke_dimension};
 use super::lyapunov::lyapunov_history;
 use super::period_map::orbit;
+use crate::analysis::Refusal;
 use crate::ode::{ErasedSystem, Integrator, Method, OdeError, System};
 use crate::plot::{ColorMap, Figure, PanelSpec, Rgb};
 use crate::registry::{Fixed, Model, Sized};
@@ -99,19 +100,11 @@ pub fn attractor(
                 dof: model.info.coordinates.len(),
             })
         }
-        None => {
-            return Err(AttractorError::Refused(
-                crate::analysis::Refusal::ContactModel { model: name },
-            ))
-        }
+        None => return Err(AttractorError::Refused(Refusal::contact_model(name))),
     };
     let period = match fixed.phase_period(params) {
         Some(t) if fixed.has_fast_phase() => t,
-        _ => {
-            return Err(AttractorError::Refused(
-                crate::analysis::Refusal::NoFastPhase { model: name },
-            ))
-        }
+        _ => return Err(AttractorError::Refused(Refusal::no_fast_phase(name))),
     };
     let settings_error = |reason: &str| AttractorError::Settings {
         model: name.clone(),

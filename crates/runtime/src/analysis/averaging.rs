@@ -7,6 +7,7 @@
 //! measure the deviation.
 
 use super::fit::{log_log, LineFit};
+use crate::analysis::Refusal;
 use crate::ode::{Integrator, Method, OdeError, System};
 use crate::registry::Model;
 use rayon::prelude::*;
@@ -263,11 +264,8 @@ pub fn convergence(
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
-    crate::registry::with_fixed(model, Sweep { params, settings }).ok_or_else(|| {
-        AveragingError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(model, Sweep { params, settings })
+        .ok_or_else(|| AveragingError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`convergence`] at one size.
@@ -303,11 +301,7 @@ impl crate::registry::WithFixed for Sweep<'_> {
             reason,
         };
         if !model.has_fast_phase() {
-            return Err(AveragingError::Refused(
-                crate::analysis::Refusal::NoFastPhase {
-                    model: info.name.into(),
-                },
-            ));
+            return Err(AveragingError::Refused(Refusal::no_fast_phase(info.name)));
         }
         if info.named_values(self.params).is_none() {
             return Err(bad(format!("{} parameter values", self.params.len())));

@@ -6,6 +6,7 @@
 use super::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators, fli_shading};
 use super::tiles::{fingerprint, run_tiles};
 pub use super::tiles::{TileError, Tiles};
+use crate::analysis::Refusal;
 use crate::ode::{Integrator, LaneIntegrator, Method, OdeError};
 use crate::registry::{Fixed, Model, WithFixed};
 use rayon::prelude::*;
@@ -99,11 +100,8 @@ pub fn chaos_map(
         settings,
         row_done,
     };
-    crate::registry::with_fixed(model, work).ok_or_else(|| {
-        ChaosMapError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(model, work)
+        .ok_or_else(|| ChaosMapError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`chaos_map`] at one size.
@@ -127,13 +125,7 @@ impl WithFixed for Map<'_> {
         let settings = self.settings;
         let period = match model.phase_period(self.params) {
             Some(t) if model.has_fast_phase() => t,
-            _ => {
-                return Err(ChaosMapError::Refused(
-                    crate::analysis::Refusal::NoFastPhase {
-                        model: info.name.into(),
-                    },
-                ))
-            }
+            _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
         };
         let params = info
             .named_values(self.params)

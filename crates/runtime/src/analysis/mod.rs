@@ -40,6 +40,20 @@ pub enum Refusal {
     NoFastPhase { model: String },
 }
 
+impl Refusal {
+    pub fn contact_model(model: impl Into<String>) -> Refusal {
+        Refusal::ContactModel {
+            model: model.into(),
+        }
+    }
+
+    pub fn no_fast_phase(model: impl Into<String>) -> Refusal {
+        Refusal::NoFastPhase {
+            model: model.into(),
+        }
+    }
+}
+
 /// Orbits in one block of rows at most: a cancelled chaos map (the
 /// studio's view moved) stops once the blocks running end.
 pub const BLOCK_ORBITS: usize = 1024;

@@ -1,5 +1,6 @@
 //! The period map of a T-periodic system and its orbits.
 
+use crate::analysis::Refusal;
 use crate::ode::{Integrator, Method, OdeError, Stats, System};
 use crate::registry::Model;
 use rayon::prelude::*;
@@ -177,11 +178,8 @@ pub fn portrait(
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    crate::registry::with_fixed(model, Portraits { params, settings }).ok_or_else(|| {
-        PeriodMapError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(model, Portraits { params, settings })
+        .ok_or_else(|| PeriodMapError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`portrait`] at one size.
@@ -213,13 +211,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
             .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
         let period = match model.phase_period(self.params) {
             Some(t) if model.has_fast_phase() => t,
-            _ => {
-                return Err(PeriodMapError::Refused(
-                    crate::analysis::Refusal::NoFastPhase {
-                        model: info.name.into(),
-                    },
-                ))
-            }
+            _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
         };
         let axes = info.plane(settings.axes).map_err(|e| bad(e.to_string()))?;
         let periodic = model.periodic();

@@ -15,6 +15,7 @@
 //! event location); each orbit reports how far its points drifted from
 //! H = E and from the plane.
 
+use crate::analysis::Refusal;
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError};
 use crate::registry::{Fixed, Model, Sized, WithFixed};
 use rayon::prelude::*;
@@ -224,9 +225,7 @@ pub fn section(
             model: name,
             dof: model.info.coordinates.len(),
         }),
-        None => Err(SectionError::Refused(
-            crate::analysis::Refusal::ContactModel { model: name },
-        )),
+        None => Err(SectionError::Refused(Refusal::contact_model(name))),
     }
 }
 

@@ -6,6 +6,7 @@
 
 use super::lyapunov::megno_values;
 use super::section::{on_plane, Chart, SectionError, SectionSettings};
+use crate::analysis::Refusal;
 use crate::ode::{LaneIntegrator, Method, OdeError};
 use crate::plot::{ColorMap, Figure, PanelSpec};
 use crate::registry::{Fixed, Model, Sized};
@@ -71,11 +72,7 @@ pub fn section_map(
                 dof: model.info.coordinates.len(),
             })
         }
-        None => {
-            return Err(SectionError::Refused(
-                crate::analysis::Refusal::ContactModel { model: name },
-            ))
-        }
+        None => return Err(SectionError::Refused(Refusal::contact_model(name))),
     };
     let s = &settings.section;
     let bad = |reason: &str| SectionError::Settings {

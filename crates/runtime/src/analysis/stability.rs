@@ -17,6 +17,7 @@ use super::floquet::{floquet_multipliers, monodromies, spectral_radius, window_i
 use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues;
 use crate::analysis::period_map::wrap_angle;
+use crate::analysis::Refusal;
 use crate::ode::{Method, OdeError, System};
 use crate::registry::{Fixed, Model, WithFixed};
 use nalgebra::{DMatrix, DVector};
@@ -164,11 +165,8 @@ pub fn stability(
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
-    crate::registry::with_fixed(model, Analysis { params, settings }).ok_or_else(|| {
-        StabilityError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(model, Analysis { params, settings })
+        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`stability`]: equilibria, thresholds and windows at one size.
@@ -343,11 +341,7 @@ pub fn averaged_stability(
             q,
         },
     )
-    .ok_or_else(|| {
-        StabilityError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`averaged_stability`]: one equilibrium judged at one size.
@@ -767,11 +761,7 @@ fn vibrating_model<
 ) -> Result<BTreeMap<String, f64>, StabilityError> {
     let info = model.info();
     if !model.has_fast_phase() {
-        return Err(StabilityError::Refused(
-            crate::analysis::Refusal::NoFastPhase {
-                model: info.name.into(),
-            },
-        ));
+        return Err(StabilityError::Refused(Refusal::no_fast_phase(info.name)));
     }
     info.named_values(params)
         .ok_or_else(|| StabilityError::ParameterCount(params.len(), info.name.into()))
@@ -944,11 +934,8 @@ pub fn stability_chart(
     params: &[f64],
     settings: &ChartSettings,
 ) -> Result<StabilityChart, StabilityError> {
-    crate::registry::with_fixed(model, Chart { params, settings }).ok_or_else(|| {
-        StabilityError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(model, Chart { params, settings })
+        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`stability_chart`] at one size.

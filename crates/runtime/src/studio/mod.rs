@@ -11,6 +11,7 @@ pub mod contour;
 
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::analysis::period_map::{wrap_angle, wrapped_point, PeriodMapError};
+use crate::analysis::Refusal;
 use crate::ode::{Integrator, Method, OdeError};
 use crate::registry::{
     Catalog, DynamicModel, Fixed, Kind, Model, ModelInfo, ParameterError, WithFixed,
@@ -266,11 +267,7 @@ impl Setup {
         let (dof, fast_phase) = match model.kind() {
             Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
             Kind::Contacts { .. } => {
-                return Err(StudioError::Refused(
-                    crate::analysis::Refusal::ContactModel {
-                        model: info.name.into(),
-                    },
-                ))
+                return Err(StudioError::Refused(Refusal::contact_model(info.name)))
             }
         };
         let mut params = model.defaults();
@@ -340,11 +337,7 @@ impl Resolved {
         if self.fast_phase {
             Ok(())
         } else {
-            Err(StudioError::Refused(
-                crate::analysis::Refusal::NoFastPhase {
-                    model: self.info.name.into(),
-                },
-            ))
+            Err(StudioError::Refused(Refusal::no_fast_phase(self.info.name)))
         }
     }
 }
@@ -420,11 +413,8 @@ pub fn orbit(
         periods: request.periods,
         sink,
     };
-    crate::registry::with_fixed(setup.handle, work).ok_or_else(|| {
-        StudioError::Refused(crate::analysis::Refusal::ContactModel {
-            model: setup.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(setup.handle, work)
+        .ok_or_else(|| StudioError::Refused(Refusal::contact_model(setup.info.name)))?
 }
 
 /// The work of [`orbit`] at one size.
@@ -443,11 +433,9 @@ impl WithFixed for OrbitWork<'_> {
     ) -> Self::Output {
         let setup = self.setup;
         let started = Instant::now();
-        let period = model.phase_period(&setup.params).ok_or_else(|| {
-            StudioError::Refused(crate::analysis::Refusal::NoFastPhase {
-                model: setup.info.name.into(),
-            })
-        })?;
+        let period = model
+            .phase_period(&setup.params)
+            .ok_or_else(|| StudioError::Refused(Refusal::no_fast_phase(setup.info.name)))?;
         let system = model.exact(&setup.params);
         let periodic = model.periodic();
         let y: [f64; S] = std::array::from_fn(|k| self.seed[k]);

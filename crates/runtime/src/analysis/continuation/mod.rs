@@ -20,6 +20,7 @@ pub use branch::BranchEnd;
 pub use diagram::OrbitDiagram;
 
 use crate::analysis::floquet::{monodromy, multipliers_of, Verdict};
+use crate::analysis::Refusal;
 use crate::ode::{Integrator, Method, OdeError, System};
 use crate::registry::{Fixed, Model, WithFixed};
 use branch::{Origin, Solution, Steps};
@@ -268,11 +269,8 @@ pub fn continuation(
     params: &[f64],
     settings: &ContinuationSettings,
 ) -> Result<Continuation, ContinuationError> {
-    crate::registry::with_fixed(model, Work { params, settings }).ok_or_else(|| {
-        ContinuationError::Refused(crate::analysis::Refusal::ContactModel {
-            model: model.info.name.into(),
-        })
-    })?
+    crate::registry::with_fixed(model, Work { params, settings })
+        .ok_or_else(|| ContinuationError::Refused(Refusal::contact_model(model.info.name)))?
 }
 
 /// The work of [`continuation`] at one model's sizes.

@@ -19,6 +19,7 @@
 mod symmetric;
 
 use crate::analysis::floquet::monodromy;
+use crate::analysis::Refusal;
 use crate::ode::{
     DoubleDouble, DoubleDoubleTaylor, ErasedSystem, Integrator, Method, OdeError, System,
 };
@@ -478,11 +479,7 @@ fn prepare(
                 dof: model.info.coordinates.len(),
             })
         }
-        None => {
-            return Err(SplittingError::Refused(
-                crate::analysis::Refusal::ContactModel { model: name },
-            ))
-        }
+        None => return Err(SplittingError::Refused(Refusal::contact_model(name))),
     };
     let Some(named) = model.info.named_values(params) else {
         return Err(SplittingError::Request {
@@ -492,11 +489,7 @@ fn prepare(
     };
     let period = match fixed.phase_period(params) {
         Some(t) if fixed.has_fast_phase() => t,
-        _ => {
-            return Err(SplittingError::Refused(
-                crate::analysis::Refusal::NoFastPhase { model: name },
-            ))
-        }
+        _ => return Err(SplittingError::Refused(Refusal::no_fast_phase(name))),
     };
     if !(settings.spacing > 0.0 && settings.p_max > 0.0 && settings.lobe_points >= 8) {
         return Err(SplittingError::Request {
