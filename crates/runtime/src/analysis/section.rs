@@ -937,6 +937,40 @@ impl Section {
             );
             figure.points(0, orbit.points.iter().map(|p| (p[0], p[1])), color, 1);
         }
+        // Orbits that ended early, counted by why, beside the picture.
+        let count =
+            |kind: fn(&OrbitEnd) -> bool| self.ended_early().filter(|(_, e)| kind(e)).count();
+        let ends = [
+            (
+                count(|e| matches!(e, OrbitEnd::Singular { .. })),
+                "reached a singular point of the coordinates",
+            ),
+            (
+                count(|e| matches!(e, OrbitEnd::Escaped { .. })),
+                "escaped along an open branch",
+            ),
+            (
+                count(|e| matches!(e, OrbitEnd::TimeLimit { .. })),
+                "had fewer crossings by t_max",
+            ),
+            (
+                count(|e| matches!(e, OrbitEnd::Failed { .. })),
+                "stopped by the integrator",
+            ),
+        ];
+        let lines: Vec<(String, Rgb)> = ends
+            .iter()
+            .filter(|(n, _)| *n > 0)
+            .map(|(n, why)| {
+                (
+                    format!("{n} of {} orbits {why}", self.orbits.len()),
+                    Rgb(90, 90, 90),
+                )
+            })
+            .collect();
+        if !lines.is_empty() {
+            figure.legend(0, &lines);
+        }
         figure
     }
 }
