@@ -79,7 +79,8 @@ fn main() {
             }),
         )?;
         let names = info.coordinates;
-        for e in &result.equilibria {
+        const PRINTED: usize = 32;
+        for e in result.equilibria.iter().take(PRINTED) {
             let family: Vec<&str> = e.family_along.iter().map(|&i| names[i]).collect();
             let family = match family.is_empty() {
                 true => String::new(),
@@ -94,8 +95,15 @@ fn main() {
                 e.q, e.hessian_eigenvalues, e.verdict
             );
         }
+        if result.equilibria.len() > PRINTED {
+            let more = result.equilibria.len() - PRINTED;
+            println!("… and {more} more equilibria in summary.json");
+        }
         if let Some(reason) = &result.equilibria_not_searched {
             println!("equilibria not searched: {reason}");
+        }
+        if let Some(search) = &result.equilibria_search_sampled {
+            println!("equilibria searched from {search}");
         }
         for s in &result.switches {
             println!("{s}");
@@ -118,6 +126,8 @@ fn main() {
             final_state: Option<&'a Vec<f64>>,
             equilibria: &'a [mechlab::explore::Equilibrium],
             equilibria_not_searched: &'a Option<mechlab::explore::NotSearched>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            equilibria_search_sampled: Option<mechlab::analysis::equilibria::Search>,
             energy: Energy,
             switches: &'a [String],
         }
@@ -133,6 +143,7 @@ fn main() {
             final_state: result.exact.last(),
             equilibria: &result.equilibria,
             equilibria_not_searched: &result.equilibria_not_searched,
+            equilibria_search_sampled: result.equilibria_search_sampled,
             energy: Energy {
                 label: result.energy_label,
                 max_abs_change: max_energy,

@@ -28,6 +28,7 @@ fn main() {
             tol,
             knob("samples", "40", "amplitudes sampled on (0, a_max] to bracket the exact window's edges"),
             knob("a_max", "auto", "largest amplitude of the exact window (auto: 3 a*)"),
+            knob("max_windows", "64", "at most this many equilibria get an exact window (a Floquet sweep each): those with the lowest thresholds a*, then those the vibration moves"),
             knob("edge_tolerance", "1e-9", "the window's edges and the chart's boundaries are bisected to this"),
             knob("chart", "none", "two parameters x,y for a stability chart of the equilibrium chart_q (none: no chart)"),
             knob("chart_q", "0", "the equilibrium of the chart, comma-separated (0: all coordinates zero)"),
@@ -52,6 +53,7 @@ fn main() {
             samples: scene.count("samples")?,
             edge_tolerance: scene.positive("edge_tolerance")?,
             method: method_from(&scene)?,
+            max_windows: scene.count("max_windows")?,
         };
         let result = stability(model, &params, &settings)?;
         for moved in &result.moved_by_vibration {
@@ -74,10 +76,19 @@ fn main() {
         if let Some(reason) = &result.none_because {
             eprintln!("no equilibrium analysed: {reason}");
         }
-        for e in &result.equilibria {
+        if let Some(search) = &result.search_sampled {
+            eprintln!("equilibria searched from {search}");
+        }
+        const PRINTED: usize = 32;
+        if result.equilibria.len() > PRINTED {
+            let more = result.equilibria.len() - PRINTED;
+            eprintln!("{more} equilibria beyond the first {PRINTED} are in summary.json");
+        }
+        for e in result.equilibria.iter().take(PRINTED) {
             let reason = e.reason.as_deref().unwrap_or("");
+            let exact_reason = e.exact_reason.as_deref().unwrap_or("");
             eprintln!(
-                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?}",
+                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?} {exact_reason}",
                 e.q, e.lambdas, e.a_star, e.exact_window
             );
         }

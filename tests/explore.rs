@@ -68,7 +68,7 @@ fn kapitza_equilibria_match_the_closed_form() {
     let a: f64 = 1.5;
     let mut params = model.defaults();
     params[0] = a;
-    let found = mechlab::explore::equilibria(model, &params).unwrap();
+    let (found, _) = mechlab::explore::equilibria(model, &params).unwrap();
     assert_eq!(found.len(), 4, "{found:?}");
     let at = |q: f64| {
         found
@@ -133,7 +133,7 @@ fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
     );
     // Hénon–Heiles: the minimum at 0 and three saddles at V = 1/6.
     let hh = models::by_name("henon_heiles").unwrap();
-    let found = equilibria(hh.dynamic, &[1.0]).unwrap();
+    let (found, _) = equilibria(hh.dynamic, &[1.0]).unwrap();
     let stable: Vec<_> = found
         .iter()
         .filter(|e| e.verdict == Verdict::Stable)
@@ -167,7 +167,7 @@ fn a_singular_point_of_the_chart_is_named_not_judged() {
     use mechlab_test_models::spring_double_pendulum::{Params, DYNAMIC};
     let mut params = Params::default();
     params.set("k", 0.25).unwrap();
-    let found = equilibria(&DYNAMIC, &params.values()).unwrap();
+    let (found, _) = equilibria(&DYNAMIC, &params.values()).unwrap();
     let at_pole: Vec<_> = found.iter().filter(|e| e.q[2].abs() < 1e-6).collect();
     assert!(!at_pole.is_empty(), "{found:#?}");
     assert!(
@@ -209,7 +209,7 @@ fn a_family_along_a_cyclic_angle_is_reported_once_and_judged_reduced() {
     use mechlab::explore::{equilibria, Verdict};
     use mechlab_test_models::central_spring::{Params, DYNAMIC};
     let params = Params::default().values();
-    let found = equilibria(&DYNAMIC, &params).unwrap();
+    let (found, _) = equilibria(&DYNAMIC, &params).unwrap();
     let at_rest: Vec<_> = found
         .iter()
         .filter(|e| (e.q[0] - 1.0).abs() < 1e-6)
@@ -234,7 +234,7 @@ fn a_spherical_pendulums_upright_is_judged_at_the_pole_on_the_reduced_system() {
     use mechlab::explore::{equilibria, Verdict};
     use mechlab_test_models::spherical_pendulum::DYNAMIC;
     for (a, verdict) in [(1.6, Verdict::Stable), (1.2, Verdict::Unstable)] {
-        let found = equilibria(&DYNAMIC, &[a, 0.1]).unwrap();
+        let (found, _) = equilibria(&DYNAMIC, &[a, 0.1]).unwrap();
         let upright: Vec<_> = found.iter().filter(|e| e.q[0].abs() < 1e-6).collect();
         assert_eq!(upright.len(), 1, "A = {a}: {found:#?}");
         let upright = upright[0];
@@ -263,6 +263,7 @@ fn stability_names_the_spherical_pendulums_poles_once_as_a_singular_chart() {
         samples: 40,
         edge_tolerance: 1e-9,
         method: Method::Taylor { tol: 1e-12 },
+        max_windows: mechlab::analysis::stability::MAX_WINDOWS,
     };
     let model = &mechlab_test_models::spherical_pendulum::MODEL;
     let found = stability(model, &[1.6, 0.1], &settings).unwrap();
@@ -290,7 +291,7 @@ fn a_four_link_chain_gets_its_equilibria_judged_as_stability_judges_them() {
     use mechlab::explore::{equilibria, Verdict};
     use mechlab_test_models::quadruple_pendulum::{Params, DYNAMIC, MODEL};
     let params = Params::default().values();
-    let found = equilibria(&DYNAMIC, &params).unwrap();
+    let (found, _) = equilibria(&DYNAMIC, &params).unwrap();
     let at = |target: f64| {
         found.iter().find(|e| {
             e.q.iter()

@@ -165,3 +165,50 @@ fn a_request_over_the_memory_budget_is_named_and_one_within_passes() {
     // Products that overflow are refused, not wrapped.
     assert!(check(|| "huge".into(), u128::MAX, 2).is_err());
 }
+
+/// The equilibrium finder's starts: the whole grid up to 4⁸ points (an
+/// 8-link chain), a sample of the same size at any larger number of
+/// coordinates, always with every angle at 0 and every one at −π, every
+/// point on the grid, the same on every run.
+#[test]
+fn equilibrium_starts_are_the_grid_or_a_bounded_sample_of_it() {
+    use mechlab::analysis::equilibria::{starts, GRID_STARTS, SAMPLED_STARTS};
+    use std::f64::consts::PI;
+    let eight = starts(&[true; 8]);
+    assert_eq!(eight.points.len(), GRID_STARTS);
+    assert!(!eight.search.sampled());
+    assert_eq!(starts(&[true, false, true]).points.len(), 12 * 12 * 12);
+    for (periodic, grid) in [
+        (vec![true; 12], 4f64.powi(12)),
+        (vec![true; 40], 4f64.powi(40)),
+        (
+            [vec![true; 6], vec![false; 6]].concat(),
+            4f64.powi(6) * 7f64.powi(6),
+        ),
+    ] {
+        let sample = starts(&periodic);
+        assert!(sample.search.sampled());
+        assert_eq!(sample.search.starts, SAMPLED_STARTS);
+        assert_eq!(sample.search.grid, grid);
+        assert_eq!(sample.points.len(), SAMPLED_STARTS);
+        let upright: Vec<f64> = vec![0.0; periodic.len()];
+        let hanging: Vec<f64> = periodic
+            .iter()
+            .map(|&p| if p { -PI } else { 0.0 })
+            .collect();
+        assert!(sample.points.contains(&upright));
+        assert!(sample.points.contains(&hanging));
+        let angles = [-PI, -PI / 2.0, 0.0, PI / 2.0];
+        let lengths = [-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0];
+        for point in &sample.points {
+            for (x, &p) in point.iter().zip(&periodic) {
+                let axis: &[f64] = if p { &angles } else { &lengths };
+                assert!(
+                    axis.iter().any(|a| (a - x).abs() < 1e-15),
+                    "{x} not on the grid"
+                );
+            }
+        }
+        assert_eq!(starts(&periodic).points, sample.points);
+    }
+}

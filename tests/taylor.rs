@@ -401,7 +401,7 @@ fn every_model_s_tangent_recurrences_differentiate_its_solution_s() {
             Some(Sized::Dof3(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
             Some(Sized::Dof4(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
             Some(Sized::Large(_)) => eprintln!(
-                "{name}: skipped (5 to 8 degrees of freedom: this test's instances are compiled for 1 to 4)"
+                "{name}: skipped (5 to 16 degrees of freedom: this test's instances are compiled for 1 to 4)"
             ),
             None => eprintln!("{name}: skipped (a contact model has no tangent recurrences)"),
         }

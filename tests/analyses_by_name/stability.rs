@@ -16,6 +16,7 @@ fn settings(amplitude: &str) -> Settings {
         samples: 60,
         edge_tolerance: 1e-11,
         method: Method::parse("dop853", 1e-12).unwrap(),
+        max_windows: mechlab::analysis::stability::MAX_WINDOWS,
     }
 }
 
@@ -138,6 +139,37 @@ fn chain_thresholds_match_the_normal_modes() {
         let hanging = at(&result.equilibria, &vec![PI; upright.q.len()]);
         assert!(hanging.stable_without_vibration);
         assert_eq!(result.equilibria.len(), 1 << upright.q.len());
+    }
+}
+
+/// With more equilibria than exact sweeps allowed, the sweeps go to the
+/// lowest thresholds a*, give the same windows as an unlimited run, and
+/// every other equilibrium says why it has none.
+#[test]
+fn exact_windows_beyond_the_budget_are_named_not_computed() {
+    let mut fast = settings("a");
+    fast.samples = 8;
+    fast.edge_tolerance = 1e-6;
+    let model = model_of("triple_pendulum");
+    let all = stability(model, &defaults("triple_pendulum"), &fast).unwrap();
+    fast.max_windows = 2;
+    let budget = stability(model, &defaults("triple_pendulum"), &fast).unwrap();
+    let mut thresholds: Vec<f64> = all.equilibria.iter().filter_map(|e| e.a_star).collect();
+    assert!(thresholds.len() > 2, "{thresholds:?}");
+    thresholds.sort_by(f64::total_cmp);
+    assert_eq!(budget.equilibria.len(), all.equilibria.len());
+    for (limited, full) in budget.equilibria.iter().zip(&all.equilibria) {
+        assert_eq!(limited.q, full.q);
+        assert_eq!(limited.a_star, full.a_star);
+        match limited.a_star {
+            Some(a) if a <= thresholds[1] => assert_eq!(limited.exact_window, full.exact_window),
+            Some(_) => {
+                assert_eq!(limited.exact_window, None);
+                let reason = limited.exact_reason.as_deref().unwrap();
+                assert!(reason.starts_with("not computed"), "{reason}");
+            }
+            None => assert_eq!(limited.exact_reason, full.exact_reason),
+        }
     }
 }
 

@@ -147,15 +147,18 @@ pub fn kinematic(model: &Model, e: &Expr) -> Result<Atom, DeriveError> {
     Ok(result)
 }
 
-/// Runs every derivation for one model.
-pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
-    let n = model.dof();
-    let q: Vec<String> = model.coordinates.iter().map(|c| c.name.clone()).collect();
-    let qd: Vec<String> = model
+/// The names of the model's coordinates and of their velocities.
+fn coordinates_and_velocities(model: &Model) -> (Vec<String>, Vec<String>) {
+    model
         .coordinates
         .iter()
-        .map(|c| c.velocity.clone())
-        .collect();
+        .map(|c| (c.name.clone(), c.velocity.clone()))
+        .unzip()
+}
+
+/// Runs every derivation for one model.
+pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
+    let (q, qd) = coordinates_and_velocities(model);
     let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
     for name in &p {
         let clash = model.parameters.iter().any(|x| &x.name == name)
@@ -167,13 +170,51 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
             });
         }
     }
-    let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
     let rate = match &model.fast_phase {
         Some(f) => atom(&f.rate.to_string())?,
         None => num(1),
     };
     let mut rec = Recorder::for_model(model, p.iter().chain(&qd).cloned().collect());
+    let pieces = mechanical_pieces(model, &qd, &p, rate, &mut rec)?;
+    if model.inverse == crate::model::Inverse::Numeric {
+        return numeric_form(model, pieces, rec);
+    }
+    let (mut derivation, exact) = symbolic_exact(model, &p, &pieces, &mut rec)?;
+    let (mean_potential, vibrational) = match &model.fast_phase {
+        Some(phase) => symbolic_averaged(
+            model,
+            &p,
+            &pieces,
+            &exact,
+            &phase.name,
+            &mut derivation,
+            &mut rec,
+        )?,
+        None => (pieces.potential.clone(), num(0)),
+    };
+    potentials(
+        model,
+        &pieces,
+        mean_potential,
+        vibrational,
+        &mut derivation,
+        &mut rec,
+    )?;
+    derivation.derived = rec.finish();
+    Ok(derivation)
+}
 
+/// L with the terms of time alone dropped, A = ∂²L/∂q'², b = ∂L/∂q' and
+/// V = −L at q' = 0, and the momenta, recorded.
+fn mechanical_pieces(
+    model: &Model,
+    qd: &[String],
+    p: &[String],
+    rate: Atom,
+    rec: &mut Recorder,
+) -> Result<Pieces, DeriveError> {
+    let n = model.dof();
+    let q: Vec<String> = model.coordinates.iter().map(|c| c.name.clone()).collect();
     let lagrangian = kinematic(model, &model.lagrangian)?;
     let mut dynamic: Vec<String> = q.clone();
     dynamic.extend(qd.iter().cloned());
@@ -255,23 +296,47 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         )?;
     }
 
-    if model.inverse == crate::model::Inverse::Numeric {
-        return numeric_form(
-            model,
-            Pieces {
-                lagrangian,
-                mass,
-                linear,
-                readable_mass,
-                readable_linear,
-                potential,
-                momenta,
-                rate,
-            },
-            rec,
-        );
-    }
-    let (det, inv) = inverse(&mass);
+    Ok(Pieces {
+        lagrangian,
+        mass,
+        linear,
+        readable_mass,
+        readable_linear,
+        potential,
+        momenta,
+        rate,
+    })
+}
+
+/// What the symbolic form's averaging needs of its exact system.
+struct SymbolicExact {
+    inverse: Vec<Vec<Atom>>,
+    velocities: Vec<Atom>,
+    kinetic: Atom,
+    hamiltonian: Atom,
+    forces: Vec<Atom>,
+}
+
+/// The symbolic form's exact system: A⁻¹, q' = A⁻¹(p − b), H, the momentum
+/// rates and the Jacobian, each in the cheaper of its forms.
+fn symbolic_exact(
+    model: &Model,
+    p: &[String],
+    pieces: &Pieces,
+    rec: &mut Recorder,
+) -> Result<(Derivation, SymbolicExact), DeriveError> {
+    let n = model.dof();
+    let (q, qd) = coordinates_and_velocities(model);
+    let Pieces {
+        lagrangian,
+        mass,
+        linear,
+        potential,
+        momenta,
+        rate,
+        ..
+    } = pieces;
+    let (det, inv) = inverse(mass);
     if is_zero(&det) {
         return Err(DeriveError::Model {
             key: "lagrangian".into(),
@@ -298,7 +363,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         }
     }
     let kinetic = kinetic / num(2);
-    let hamiltonian = &kinetic + &potential;
+    let hamiltonian = &kinetic + potential;
     let hamiltonian_text = rec.record_sum(
         "hamiltonian",
         "H = ½(p − b)ᵀA⁻¹(p − b) + V, by powers of the momenta",
@@ -314,11 +379,6 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
     let rates: Vec<Atom> = (0..n)
         .map(|i| (lagrangian.derivative(symbol!(q[i].as_str())) + &forces[i]).expand())
         .collect();
-    let substitute_velocities = |e: &Atom| -> Atom {
-        qd.iter()
-            .zip(&velocities)
-            .fold(e.clone(), |acc, (name, value)| subst(&acc, name, value))
-    };
     let mut readable_rates = Vec::new();
     for i in 0..n {
         readable_rates.push(rec.record(
@@ -355,7 +415,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
     let exact_counts = ("exact_rhs".to_string(), before, after, used);
 
     // Jacobian of the exact field by the chain rule through q'(q, p).
-    let state: Vec<String> = q.iter().chain(&p).cloned().collect();
+    let state: Vec<String> = q.iter().chain(p).cloned().collect();
     let mut exact_jacobian = vec![vec![String::new(); 2 * n]; 2 * n];
     for (k, s) in state.iter().enumerate() {
         let dv: Vec<Atom> = velocities
@@ -376,7 +436,7 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         }
     }
 
-    let mut derivation = Derivation {
+    let derivation = Derivation {
         dof: n,
         velocities: if use_readable {
             readable_velocities
@@ -391,105 +451,156 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         momenta: momenta.iter().map(|m| m.to_string()).collect(),
         hamiltonian: hamiltonian_text,
         exact_jacobian,
-        mass_matrix: matrix_text(&mass),
+        mass_matrix: matrix_text(mass),
         phase_rate: rate.to_string(),
         operation_counts: vec![exact_counts],
         ..Default::default()
     };
 
-    // Averaging over the fast phase.
-    let (mean_potential, vibrational) = match &phase {
-        Some(th) => {
-            let averaged_hamiltonian = phase_mean(&hamiltonian, th)?.together();
-            let mean_potential = phase_mean(&potential, th)?.expand();
-            derivation.averaged_hamiltonian = rec.record_sum(
-                "averaged_hamiltonian",
-                "H̄ = mean over the phase of H, by powers of the momenta",
-                &[phase_mean(&kinetic, th)?, mean_potential.clone()],
-            )?;
-            let mut quadratic = num(0);
-            for i in 0..n {
-                for j in 0..n {
-                    quadratic += &linear[i] * &inv[i][j] * &linear[j];
-                }
-            }
-            let vibrational = phase_mean(&(quadratic / num(2)), th)?;
-            let vibrational = vibrational.together();
-            let averaged_forces: Vec<Atom> = forces
-                .iter()
-                .map(|f| phase_mean(&substitute_velocities(f), th).map(|a| a.together()))
-                .collect::<Result<_, _>>()?;
-            for (i, f) in averaged_forces.iter().enumerate() {
-                rec.record(
-                    format!("averaged_forces[{i}]"),
-                    "P̄ = mean Q(q, q'(q, p, θ))",
-                    f,
-                )?;
-            }
-            let mut rhs: Vec<Atom> = (0..n)
-                .map(|i| averaged_hamiltonian.derivative(symbol!(p[i].as_str())))
-                .collect();
-            for i in 0..n {
-                rhs.push(
-                    -averaged_hamiltonian.derivative(symbol!(q[i].as_str())) + &averaged_forces[i],
-                );
-            }
-            let mut readable_rhs = Vec::new();
-            for (i, r) in rhs.iter().enumerate() {
-                readable_rhs.push(rec.record(
-                    format!("averaged_rhs[{i}]"),
-                    format!("d{}/dt of the averaged system", state[i]),
-                    r,
-                )?);
-            }
-            let outputs = |texts: Vec<String>| -> Vec<Vec<(String, String)>> {
-                vec![texts
-                    .into_iter()
-                    .enumerate()
-                    .map(|(i, t)| (format!("f{i}"), t))
-                    .collect()]
-            };
-            let (chosen, before, after, used) = cheaper(
-                outputs(rhs.iter().map(|r| r.to_string()).collect()),
-                outputs(readable_rhs),
-            )?;
-            derivation
-                .operation_counts
-                .push(("averaged_rhs".into(), before, after, used));
-            derivation.averaged_rhs = chosen;
-            derivation.averaged_jacobian = rhs
-                .iter()
-                .map(|r| {
-                    state
-                        .iter()
-                        .map(|s| r.derivative(symbol!(s.as_str())).to_string())
-                        .collect()
-                })
-                .collect();
-            derivation.second_order = Some(crate::deprit::second_order_form(
-                &hamiltonian,
-                &averaged_hamiltonian,
-                &averaged_forces,
-                (th, &rate),
-                &q,
-                &p,
-                &mut rec,
-            )?);
-            (mean_potential, vibrational)
-        }
-        None => (potential.clone(), num(0)),
+    Ok((
+        derivation,
+        SymbolicExact {
+            inverse: inv,
+            velocities,
+            kinetic,
+            hamiltonian,
+            forces,
+        },
+    ))
+}
+
+/// The symbolic form averaged over the phase `th`: H̄, the averaged field
+/// and its Jacobian, the second order; V̄ and V_vibr returned.
+fn symbolic_averaged(
+    model: &Model,
+    p: &[String],
+    pieces: &Pieces,
+    exact: &SymbolicExact,
+    th: &str,
+    derivation: &mut Derivation,
+    rec: &mut Recorder,
+) -> Result<(Atom, Atom), DeriveError> {
+    let n = model.dof();
+    let (q, qd) = coordinates_and_velocities(model);
+    let state: Vec<String> = q.iter().chain(p).cloned().collect();
+    let Pieces {
+        linear,
+        potential,
+        rate,
+        ..
+    } = pieces;
+    let SymbolicExact {
+        inverse: inv,
+        velocities,
+        kinetic,
+        hamiltonian,
+        forces,
+    } = exact;
+    let substitute_velocities = |e: &Atom| -> Atom {
+        qd.iter()
+            .zip(velocities)
+            .fold(e.clone(), |acc, (name, value)| subst(&acc, name, value))
     };
+    let averaged_hamiltonian = phase_mean(hamiltonian, th)?.together();
+    let mean_potential = phase_mean(potential, th)?.expand();
+    derivation.averaged_hamiltonian = rec.record_sum(
+        "averaged_hamiltonian",
+        "H̄ = mean over the phase of H, by powers of the momenta",
+        &[phase_mean(kinetic, th)?, mean_potential.clone()],
+    )?;
+    let mut quadratic = num(0);
+    for i in 0..n {
+        for j in 0..n {
+            quadratic += &linear[i] * &inv[i][j] * &linear[j];
+        }
+    }
+    let vibrational = phase_mean(&(quadratic / num(2)), th)?;
+    let vibrational = vibrational.together();
+    let averaged_forces: Vec<Atom> = forces
+        .iter()
+        .map(|f| phase_mean(&substitute_velocities(f), th).map(|a| a.together()))
+        .collect::<Result<_, _>>()?;
+    for (i, f) in averaged_forces.iter().enumerate() {
+        rec.record(
+            format!("averaged_forces[{i}]"),
+            "P̄ = mean Q(q, q'(q, p, θ))",
+            f,
+        )?;
+    }
+    let mut rhs: Vec<Atom> = (0..n)
+        .map(|i| averaged_hamiltonian.derivative(symbol!(p[i].as_str())))
+        .collect();
+    for i in 0..n {
+        rhs.push(-averaged_hamiltonian.derivative(symbol!(q[i].as_str())) + &averaged_forces[i]);
+    }
+    let mut readable_rhs = Vec::new();
+    for (i, r) in rhs.iter().enumerate() {
+        readable_rhs.push(rec.record(
+            format!("averaged_rhs[{i}]"),
+            format!("d{}/dt of the averaged system", state[i]),
+            r,
+        )?);
+    }
+    let outputs = |texts: Vec<String>| -> Vec<Vec<(String, String)>> {
+        vec![texts
+            .into_iter()
+            .enumerate()
+            .map(|(i, t)| (format!("f{i}"), t))
+            .collect()]
+    };
+    let (chosen, before, after, used) = cheaper(
+        outputs(rhs.iter().map(|r| r.to_string()).collect()),
+        outputs(readable_rhs),
+    )?;
+    derivation
+        .operation_counts
+        .push(("averaged_rhs".into(), before, after, used));
+    derivation.averaged_rhs = chosen;
+    derivation.averaged_jacobian = rhs
+        .iter()
+        .map(|r| {
+            state
+                .iter()
+                .map(|s| r.derivative(symbol!(s.as_str())).to_string())
+                .collect()
+        })
+        .collect();
+    derivation.second_order = Some(crate::deprit::second_order_form(
+        hamiltonian,
+        &averaged_hamiltonian,
+        &averaged_forces,
+        (th, rate),
+        &q,
+        p,
+        rec,
+    )?);
+    Ok((mean_potential, vibrational))
+}
+
+/// V̄, its derivatives, V_vibr, the limiting Lagrangian and the Hessian of
+/// V + V_vibr, recorded into `derivation`.
+fn potentials(
+    model: &Model,
+    pieces: &Pieces,
+    mean_potential: Atom,
+    vibrational: Atom,
+    derivation: &mut Derivation,
+    rec: &mut Recorder,
+) -> Result<(), DeriveError> {
+    let n = model.dof();
+    let (q, qd) = coordinates_and_velocities(model);
+    let mass = &pieces.mass;
     (
         derivation.potential,
         derivation.potential_gradient,
         derivation.potential_hessian,
-    ) = potential_derivatives(model, &mut rec, &mean_potential)?;
+    ) = potential_derivatives(model, rec, &mean_potential)?;
     derivation.vibrational_potential = rec.record(
         "vibrational_potential",
         "V_vibr = ½ mean(bᵀ A⁻¹ b)",
         &vibrational,
     )?;
-    if phase.is_some() {
+    if model.fast_phase.is_some() {
         let mut relative_kinetic = num(0);
         for i in 0..n {
             for j in 0..n {
@@ -517,10 +628,9 @@ pub fn derive(model: &Model) -> Result<Derivation, DeriveError> {
         &q,
         "effective_potential_hessian",
         "∂²(V + V_vibr)/∂q²",
-        &mut rec,
+        rec,
     )?;
-    derivation.derived = rec.finish();
-    Ok(derivation)
+    Ok(())
 }
 
 /// The potential V̄ (averaged over the phase, if any), ∂V̄/∂q and
@@ -612,12 +722,7 @@ fn numeric_form(
         rate,
     } = pieces;
     let n = model.dof();
-    let q: Vec<String> = model.coordinates.iter().map(|c| c.name.clone()).collect();
-    let qd: Vec<String> = model
-        .coordinates
-        .iter()
-        .map(|c| c.velocity.clone())
-        .collect();
+    let (q, qd) = coordinates_and_velocities(model);
     let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
     let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
     let forces: Vec<Atom> = model

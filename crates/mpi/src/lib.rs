@@ -35,9 +35,10 @@ impl TileSharing for Ranks {
         write: &dyn Fn(&ChaosMap) -> Result<(), SceneError>,
     ) -> Result<(), SceneError> {
         let Some(tiles) = &settings.tiles else {
-            return Err(SceneError::Usage(
-                "under mpirun the ranks share the map by tiles: set tile_rows > 0".into(),
-            ));
+            return Err(SceneError::Inconsistent {
+                knobs: "tile_rows",
+                reason: "under mpirun the ranks share the map by tiles: set tile_rows > 0",
+            });
         };
         let (rank, size) = (self.world.rank() as usize, self.world.size() as usize);
         let count = settings.pixels.div_ceil(tiles.rows.max(1));

@@ -103,9 +103,8 @@ pub enum ContactError {
     /// More than `limit` switches within `window` of time: chattering.
     #[error("chattering at t = {t}: more than {limit} switches within {window} time units")]
     Chattering { t: f64, limit: usize, window: f64 },
-    /// A bad initial state or setting.
-    #[error("{0}")]
-    Invalid(String),
+    #[error("the initial state {state:?} is not finite")]
+    NotFinite { state: Vec<f64> },
 }
 
 /// The smooth motion in fixed modes.
@@ -174,9 +173,7 @@ impl StickSlip {
     ) -> Result<HybridRun<C, M>, ContactError> {
         assert_eq!(M, 2 * C, "the state is [s; s'] of length 2C");
         if y0.iter().any(|x| !x.is_finite()) {
-            return Err(ContactError::Invalid(format!(
-                "non-finite initial state {y0:?}"
-            )));
+            return Err(ContactError::NotFinite { state: y0.to_vec() });
         }
         let (mut t, mut y) = (t0, *y0);
         let mu = model.friction();

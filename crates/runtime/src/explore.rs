@@ -9,6 +9,7 @@
 //! three contacts). The slice conversions cost an allocation per call: the
 //! explorer is for looking, the study scenes for measuring.
 
+use crate::analysis::equilibria::Search;
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Integrator, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
@@ -113,6 +114,9 @@ pub struct Exploration {
     pub equilibria: Vec<Equilibrium>,
     /// Why `equilibria` is empty without a search, if it is.
     pub equilibria_not_searched: Option<NotSearched>,
+    /// The search, where it sampled its grid of starts (more than 8
+    /// degrees of freedom): equilibria may be missing.
+    pub equilibria_search_sampled: Option<Search>,
     /// Switches of a contact model, as text.
     pub switches: Vec<String>,
 }
@@ -124,9 +128,15 @@ pub enum ExploreError {
     Ode(#[from] OdeError),
     #[error(transparent)]
     Contact(#[from] ContactError),
-    /// A state of the wrong length or an unsupported size.
-    #[error("{0}")]
-    Shape(String),
+    #[error("the state of '{model}' has {expected} components, got {got}")]
+    StateLength {
+        model: &'static str,
+        expected: usize,
+        got: usize,
+    },
+    /// A contact model of more points than the explorer is compiled for.
+    #[error("'{model}' has {points} contact points: the explorer runs contact models of 1 to 3")]
+    TooManyContacts { model: &'static str, points: usize },
 }
 
 struct Contacts<'a> {
@@ -190,11 +200,11 @@ pub fn explore(
         Kind::Contacts { count } => 2 * count,
     };
     if y0.len() != expected {
-        return Err(ExploreError::Shape(format!(
-            "the state of '{}' has {expected} components, got {}",
-            model.info().name,
-            y0.len()
-        )));
+        return Err(ExploreError::StateLength {
+            model: model.info().name,
+            expected,
+            got: y0.len(),
+        });
     }
     let name = model.info().name;
     let runs = HamiltonianRuns {
@@ -203,20 +213,18 @@ pub fn explore(
         y0,
         settings,
     };
-    match (model.kind(), expected) {
-        (Kind::Hamiltonian { .. }, _) => {
-            crate::registry::with_fixed(handle, runs).unwrap_or_else(|| {
-                Err(ExploreError::Shape(format!(
-                    "'{name}' is not a generated Hamiltonian model"
-                )))
-            })
-        }
-        (Kind::Contacts { .. }, 2) => contacts::<1, 2>(model, params, y0, settings),
-        (Kind::Contacts { .. }, 4) => contacts::<2, 4>(model, params, y0, settings),
-        (Kind::Contacts { .. }, 6) => contacts::<3, 6>(model, params, y0, settings),
-        _ => Err(ExploreError::Shape(format!(
-            "states of length {expected} are not supported"
-        ))),
+    // A Hamiltonian model at its own size; otherwise a contact model.
+    if let Some(result) = crate::registry::with_fixed(handle, runs) {
+        return result;
+    }
+    match expected {
+        2 => contacts::<1, 2>(model, params, y0, settings),
+        4 => contacts::<2, 4>(model, params, y0, settings),
+        6 => contacts::<3, 6>(model, params, y0, settings),
+        _ => Err(ExploreError::TooManyContacts {
+            model: name,
+            points: expected / 2,
+        }),
     }
 }
 
@@ -252,13 +260,14 @@ impl WithFixed for HamiltonianRuns<'_> {
         let exact_system = fixed.exact(params);
         let exact =
             Integrator::new(settings.method)?.advance_sampled(&exact_system, 0.0, &y0, &times)?;
-        let (found, not_searched) = match equilibria(model, params) {
-            Ok(found) => (found, None),
-            Err(reason) => (Vec::new(), Some(reason)),
+        let (found, search, not_searched) = match equilibria(model, params) {
+            Ok((found, search)) => (found, Some(search), None),
+            Err(reason) => (Vec::new(), None, Some(reason)),
         };
         let mut out = Exploration {
             exact: exact.iter().map(|y| y.to_vec()).collect(),
             equilibria: found,
+            equilibria_search_sampled: search.filter(Search::sampled),
             equilibria_not_searched: not_searched,
             ..Default::default()
         };
@@ -355,7 +364,7 @@ fn contacts<const C: usize, const M: usize>(
 pub fn equilibria(
     model: &dyn DynamicModel,
     params: &[f64],
-) -> Result<Vec<Equilibrium>, NotSearched> {
+) -> Result<(Vec<Equilibrium>, Search), NotSearched> {
     use crate::analysis::equilibria::{newton, starts, wrapped, Convergence};
     let periodic = model.periodic();
     let n = periodic.len();
@@ -406,7 +415,8 @@ pub fn equilibria(
         nalgebra::DMatrix::from_row_slice(n, n, &h)
     };
     let mut found: Vec<Equilibrium> = Vec::new();
-    for start in starts(&periodic) {
+    let starts = starts(&periodic);
+    for start in starts.points {
         // The differences' noise floor: a root is where the gradient is
         // below 10⁻⁷.
         let convergence = Convergence::Noisy { gradient: 1e-7 };
@@ -478,7 +488,7 @@ pub fn equilibria(
             None => found.push(equilibrium),
         }
     }
-    Ok(found)
+    Ok((found, starts.search))
 }
 
 /// The momenta along which the mass matrix A is singular at q: H is

@@ -55,9 +55,24 @@ pub fn parameter_knobs(
 /// Why a scene could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// Bad command line.
-    #[error("{0}")]
-    Usage(String),
+    #[error("{flag} needs a value")]
+    MissingValue { flag: String },
+    #[error("--set {pair}: expected name=value")]
+    NotAPair { pair: String },
+    #[error("--set {knob}: unknown knob for scene {scene} (known: {})", known.join(", "))]
+    UnknownKnob {
+        knob: String,
+        scene: &'static str,
+        known: Vec<&'static str>,
+    },
+    #[error("unexpected argument '{argument}' (see --help)")]
+    UnexpectedArgument { argument: String },
+    /// Knob values that are each valid but do not fit together.
+    #[error("{knobs}: {reason}")]
+    Inconsistent {
+        knobs: &'static str,
+        reason: &'static str,
+    },
     /// A `--set` value that does not parse or is out of range.
     #[error("--set {name}={value}: {reason}")]
     BadValue {
@@ -96,6 +111,15 @@ pub enum SceneError {
     Section(#[from] crate::analysis::section::SectionError),
     #[error(transparent)]
     Continuation(#[from] crate::analysis::continuation::ContinuationError),
+    /// A request of the studio (the server answers it with this error).
+    #[error(transparent)]
+    Studio(#[from] crate::studio::StudioError),
+    /// The studio's server could not listen, or stopped.
+    #[error("the studio cannot serve on {address}: {source}")]
+    Serve {
+        address: std::net::SocketAddr,
+        source: std::io::Error,
+    },
     /// Another scene, run by this one, could not start or failed.
     #[error("cannot run scene {scene}: {source}")]
     Spawn {
@@ -175,22 +199,24 @@ impl Scene {
             let next = || {
                 args.get(i + 1)
                     .cloned()
-                    .ok_or_else(|| SceneError::Usage(format!("{} needs a value", args[i])))
+                    .ok_or_else(|| SceneError::MissingValue {
+                        flag: args[i].clone(),
+                    })
             };
             match args[i].as_str() {
                 "--set" => {
                     let pair = next()?;
-                    let (key, value) = pair.split_once('=').ok_or_else(|| {
-                        SceneError::Usage(format!("--set {pair}: expected name=value"))
-                    })?;
+                    let (key, value) = pair
+                        .split_once('=')
+                        .ok_or_else(|| SceneError::NotAPair { pair: pair.clone() })?;
                     match values.iter_mut().find(|(k, _)| k == key) {
                         Some(slot) => slot.1 = value.to_string(),
                         None => {
-                            let known: Vec<&str> = knobs.iter().map(|k| k.name).collect();
-                            return Err(SceneError::Usage(format!(
-                                "--set {key}: unknown knob for scene {name} (known: {})",
-                                known.join(", ")
-                            )));
+                            return Err(SceneError::UnknownKnob {
+                                knob: key.to_string(),
+                                scene: name,
+                                known: knobs.iter().map(|k| k.name).collect(),
+                            });
                         }
                     }
                     i += 2;
@@ -202,9 +228,9 @@ impl Scene {
                 // `cargo bench` passes it to a benchmark run as a scene.
                 "--bench" => i += 1,
                 other => {
-                    return Err(SceneError::Usage(format!(
-                        "unexpected argument '{other}' (see --help)"
-                    )))
+                    return Err(SceneError::UnexpectedArgument {
+                        argument: other.to_string(),
+                    })
                 }
             }
         }
@@ -530,10 +556,38 @@ impl Progress {
     }
 }
 
+/// The stack of every thread that runs an analysis: the integrators keep
+/// their stages in arrays of the state's size, which for the variational
+/// equations of a 16-link chain (32 + 32² numbers a state) pass the 2 MiB
+/// of a thread's default stack. Only the pages a thread touches are
+/// committed.
+pub const STACK_BYTES: usize = 256 << 20;
+
 /// Runs a scene's body and turns an error into a message and exit code 2.
-pub fn run(body: impl FnOnce() -> Result<(), SceneError>) {
-    if let Err(e) = body() {
-        eprintln!("error: {e}");
-        std::process::exit(2);
+/// The body runs on a thread of [`STACK_BYTES`], and so do rayon's workers.
+pub fn run(body: impl FnOnce() -> Result<(), SceneError> + Send) {
+    // Fails only if the pool was built already, with the stacks it has.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .stack_size(STACK_BYTES)
+        .build_global();
+    let outcome = std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("scene".into())
+            .stack_size(STACK_BYTES)
+            .spawn_scoped(scope, body)
+            .map(|thread| thread.join())
+    });
+    match outcome {
+        Ok(Ok(Ok(()))) => {}
+        Ok(Ok(Err(e))) => {
+            eprintln!("error: {e}");
+            std::process::exit(2);
+        }
+        // The panic has printed its message.
+        Ok(Err(_)) => std::process::exit(101),
+        Err(e) => {
+            eprintln!("error: cannot start the scene's thread: {e}");
+            std::process::exit(2);
+        }
     }
 }

@@ -7,35 +7,27 @@
 //! `cargo run --release --example studio` then open the printed address;
 //! `-- --set port=8080` for another port (0: any free one).
 
-use mechlab::scene::{knob, Scene, SceneError};
-use mechlab_studio::StudioSceneError;
+use mechlab::scene::{knob, run, Scene, SceneError};
 
-/// As `mechlab::scene::run`, with the server's errors beside the scene's.
 fn main() {
-    if let Err(e) = serve() {
-        eprintln!("error: {e}");
-        std::process::exit(2);
-    }
-}
-
-fn serve() -> Result<(), StudioSceneError> {
-    let scene = Scene::from_args(
-        "studio",
-        "the interactive studio: a local web server on 127.0.0.1",
-        &[knob(
-            "port",
-            "8737",
-            "the port to listen on (0: any free port)",
-        )],
-    )?;
-    let port = scene
-        .text("port")
-        .parse::<u16>()
-        .map_err(|_| SceneError::BadValue {
-            name: "port".into(),
-            value: scene.text("port").into(),
-            reason: "a port is a whole number from 0 to 65535".into(),
-        })?;
-    mechlab_studio::run(mechlab::models::MODELS, port)?;
-    Ok(())
+    run(|| {
+        let scene = Scene::from_args(
+            "studio",
+            "the interactive studio: a local web server on 127.0.0.1",
+            &[knob(
+                "port",
+                "8737",
+                "the port to listen on (0: any free port)",
+            )],
+        )?;
+        let port = scene
+            .text("port")
+            .parse::<u16>()
+            .map_err(|_| SceneError::BadValue {
+                name: "port".into(),
+                value: scene.text("port").into(),
+                reason: "a port is a whole number from 0 to 65535".into(),
+            })?;
+        mechlab_studio::run(mechlab::models::MODELS, port)
+    });
 }

@@ -40,27 +40,6 @@ const PAGE: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/studio.js");
 const STYLE: &str = include_str!("page/studio.css");
 
-/// Why the studio cannot serve.
-#[derive(Debug, thiserror::Error)]
-pub enum ServeError {
-    #[error("cannot listen on {addr}: {source}")]
-    Bind {
-        addr: SocketAddr,
-        source: std::io::Error,
-    },
-    #[error("the server stopped: {0}")]
-    Io(#[from] std::io::Error),
-}
-
-/// Why the scene `studio` stopped: its knobs, or the server.
-#[derive(Debug, thiserror::Error)]
-pub enum StudioSceneError {
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    #[error(transparent)]
-    Serve(#[from] ServeError),
-}
-
 /// Why one request failed: a 4xx or 5xx answer with `{"error": message}`.
 #[derive(Debug, thiserror::Error)]
 pub enum ApiError {
@@ -143,24 +122,30 @@ fn asset(content_type: &'static str, text: &'static str) -> Response {
 
 /// Serves the studio on 127.0.0.1:`port` (0: any free port) until Ctrl-C,
 /// printing its address once listening.
-pub fn run(catalog: Catalog, port: u16) -> Result<(), ServeError> {
-    let runtime = tokio::runtime::Runtime::new()?;
+pub fn run(catalog: Catalog, port: u16) -> Result<(), SceneError> {
+    let address = SocketAddr::from(([127, 0, 0, 1], port));
+    let failed = |source| SceneError::Serve { address, source };
+    // Requests run their analyses on the runtime's blocking threads.
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .thread_stack_size(mechlab_runtime::scene::STACK_BYTES)
+        .enable_all()
+        .build()
+        .map_err(failed)?;
     runtime.block_on(async {
-        let addr = SocketAddr::from(([127, 0, 0, 1], port));
-        let listener = tokio::net::TcpListener::bind(addr)
+        let listener = tokio::net::TcpListener::bind(address)
             .await
-            .map_err(|source| ServeError::Bind { addr, source })?;
+            .map_err(failed)?;
         println!(
             "studio: http://{}/  (Ctrl-C stops it)",
-            listener.local_addr()?
+            listener.local_addr().map_err(failed)?
         );
         axum::serve(listener, router(catalog))
             .with_graceful_shutdown(async {
                 // Without a signal handler the server runs until killed.
                 let _ = tokio::signal::ctrl_c().await;
             })
-            .await?;
-        Ok(())
+            .await
+            .map_err(failed)
     })
 }
 

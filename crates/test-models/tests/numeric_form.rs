@@ -469,11 +469,11 @@ fn too_large_models_are_refused_with_a_reason() {
         }
         text
     };
-    let error = mechlab::model::Model::parse("models/chain.toml", &chain(12, "")).unwrap_err();
+    let error = mechlab::model::Model::parse("models/chain.toml", &chain(17, "")).unwrap_err();
     assert_eq!(error.file, "models/chain.toml");
     assert_eq!(error.key, "coordinates");
     assert!(
-        error.reason.contains("12 degrees of freedom") && error.reason.contains("at most 8"),
+        error.reason.contains("17 degrees of freedom") && error.reason.contains("at most 16"),
         "{error}"
     );
     let error =

@@ -339,9 +339,10 @@ pub fn params_from_scene(scene: &crate::scene::Scene) -> Result<Params, crate::s
         && p.mu2 >= 0.0
         && p.nu >= 0.0)
     {
-        return Err(crate::scene::SceneError::Usage(
-            "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0".into(),
-        ));
+        return Err(crate::scene::SceneError::Inconsistent {
+            knobs: "d, l, eps, k, nu, mu1, mu2",
+            reason: "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0",
+        });
     }
     Ok(p)
 }

@@ -13,13 +13,60 @@ use std::f64::consts::PI;
 /// these values.
 const LENGTHS: [f64; 7] = [-2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0];
 
-/// The starts of the search. Up to 3 degrees of freedom, 12 values per
+/// The whole grid of starts is searched up to this many (4⁸: an 8-link
+/// chain).
+pub const GRID_STARTS: usize = 65_536;
+
+/// Beyond [`GRID_STARTS`], this many starts are sampled from the grid, so
+/// that the search costs the same at any number of degrees of freedom.
+pub const SAMPLED_STARTS: usize = 4_096;
+
+/// The starts of a search, and the grid they come from.
+#[derive(Clone, Debug)]
+pub struct Starts {
+    pub points: Vec<Vec<f64>>,
+    pub search: Search,
+}
+
+/// How much of the grid of starts a search covered.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Search {
+    /// Starts searched from.
+    pub starts: usize,
+    /// Points of the whole grid (its size in `f64`, which 12 values per
+    /// coordinate overflow in `usize` beyond 17 coordinates).
+    pub grid: f64,
+}
+
+impl Search {
+    /// Whether the starts were a sample of the grid: equilibria may have
+    /// been missed.
+    pub fn sampled(&self) -> bool {
+        (self.starts as f64) < self.grid
+    }
+}
+
+impl std::fmt::Display for Search {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.sampled() {
+            write!(
+                f,
+                "{} starts sampled from a grid of {:.3e} (every angle at 0 and −π among them): equilibria elsewhere may be missed",
+                self.starts, self.grid
+            )
+        } else {
+            write!(f, "the whole grid of {} starts", self.starts)
+        }
+    }
+}
+
+/// The grid of starts. Up to 3 degrees of freedom, 12 values per
 /// coordinate: angles at −π + 2πk/12, others at −2 + 4k/12 (0 and −π among
 /// them, where symmetric models have their equilibria; a vibrated triple
 /// pendulum has over a hundred). Beyond, each angle at the multiples of
-/// 2π/4 and each other coordinate at [`LENGTHS`], so that an 8-link chain
-/// has 4⁸ starts rather than 12⁸.
-pub fn starts(periodic: &[bool]) -> Vec<Vec<f64>> {
+/// 2π/4 and each other coordinate at [`LENGTHS`]. A grid larger than
+/// [`GRID_STARTS`] is sampled ([`sample`]).
+pub fn starts(periodic: &[bool]) -> Starts {
     let axis: Vec<Vec<f64>> = periodic
         .iter()
         .map(|&p| match (periodic.len() <= 3, p) {
@@ -33,18 +80,83 @@ pub fn starts(periodic: &[bool]) -> Vec<Vec<f64>> {
             (false, false) => LENGTHS.to_vec(),
         })
         .collect();
-    let total: usize = axis.iter().map(Vec::len).product();
-    (0..total)
-        .map(|mut k| {
-            axis.iter()
-                .map(|values| {
-                    let x = values[k % values.len()];
-                    k /= values.len();
-                    x
-                })
-                .collect()
-        })
-        .collect()
+    let grid: f64 = axis.iter().map(|a| a.len() as f64).product();
+    let points: Vec<Vec<f64>> = if grid <= GRID_STARTS as f64 {
+        let total = grid as usize;
+        (0..total)
+            .map(|mut k| {
+                axis.iter()
+                    .map(|values| {
+                        let x = values[k % values.len()];
+                        k /= values.len();
+                        x
+                    })
+                    .collect()
+            })
+            .collect()
+    } else {
+        sample(&axis, periodic, SAMPLED_STARTS)
+    };
+    Starts {
+        search: Search {
+            starts: points.len(),
+            grid,
+        },
+        points,
+    }
+}
+
+/// `count` starts from the grid `axis`, the same on every run: half of them
+/// with every angle at 0 or −π and every other coordinate at 0 (all such
+/// corners where they are fewer, else all angles at 0, all at −π and a
+/// sample: the equilibria of chains and other symmetric models), the rest
+/// anywhere on the grid.
+fn sample(axis: &[Vec<f64>], periodic: &[bool], count: usize) -> Vec<Vec<f64>> {
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = move || {
+        // SplitMix64.
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    let angles = periodic.iter().filter(|p| **p).count();
+    let corner = |bits: u64| -> Vec<f64> {
+        let mut k = 0;
+        periodic
+            .iter()
+            .map(|&p| {
+                if !p {
+                    return 0.0;
+                }
+                let up = bits >> k & 1 == 0;
+                k += 1;
+                if up {
+                    0.0
+                } else {
+                    -PI
+                }
+            })
+            .collect()
+    };
+    let corners = 1_u64.checked_shl(angles as u32).unwrap_or(u64::MAX);
+    let mut points: Vec<Vec<f64>> = if corners <= (count / 2) as u64 {
+        (0..corners).map(corner).collect()
+    } else {
+        // Every angle at 0 and every one at −π first.
+        let mut some = vec![corner(0), corner(u64::MAX)];
+        some.extend((2..count / 2).map(|_| corner(next())));
+        some
+    };
+    while points.len() < count {
+        let point = axis
+            .iter()
+            .map(|values| values[(next() % values.len() as u64) as usize])
+            .collect();
+        points.push(point);
+    }
+    points
 }
 
 /// When Newton's iterate is a root.

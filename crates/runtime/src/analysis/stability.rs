@@ -39,7 +39,15 @@ pub struct Settings {
     pub edge_tolerance: f64,
     /// Integration method of the monodromy matrices.
     pub method: Method,
+    /// At most this many equilibria get an exact window (a sweep of Floquet
+    /// multipliers each): those with the lowest thresholds, then those the
+    /// vibration moves; the others say why they have none.
+    pub max_windows: usize,
 }
+
+/// The default of [`Settings::max_windows`]: every equilibrium of a chain of
+/// up to 6 links.
+pub const MAX_WINDOWS: usize = 64;
 
 /// What the analysis says about one equilibrium.
 #[derive(Clone, Debug, Serialize)]
@@ -82,6 +90,10 @@ pub struct Stability {
     /// Why `equilibria` is empty, when it is.
     #[serde(serialize_with = "as_text")]
     pub none_because: Option<NoEquilibria>,
+    /// The search for equilibria, where it sampled its grid of starts (more
+    /// than 8 degrees of freedom): equilibria may be missing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub search_sampled: Option<super::equilibria::Search>,
 }
 
 /// An equilibrium without vibration that the vibration moves, and the
@@ -192,13 +204,20 @@ impl WithFixed for Analysis<'_> {
             equilibria: Vec::new(),
             moved_by_vibration: Vec::new(),
             none_because: None,
+            search_sampled: None,
         };
-        let (found, starts) = equilibria_without_vibration(model, self.params);
+        let (found, search) = equilibria_without_vibration(model, self.params);
+        result.search_sampled = search.sampled().then_some(search);
         // The exact system is probed at the given amplitude (1 where it is 0).
         let mut probe = self.params.to_vec();
         if probe[amplitude] == 0.0 {
             probe[amplitude] = 1.0;
         }
+        // Cheap verdicts first; the exact windows and the moved equilibria's
+        // orbits (each a sweep of Floquet multipliers) after, for at most
+        // `max_windows` equilibria: those with the lowest thresholds a*,
+        // then those the vibration moves.
+        let mut moved: Vec<([f64; D], bool)> = Vec::new();
         for q in &found {
             if let Some(along) = singular_chart(model, self.params, q) {
                 // One entry per pole: the same point at every value of the
@@ -215,95 +234,155 @@ impl WithFixed for Analysis<'_> {
             let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
             let averaged = stays_in_averaged_system(model, self.params, q);
             if !averaged || moved_by_vibration(model, &probe, &y0) {
-                let a_max = self.settings.a_max.unwrap_or(3.0 * probe[amplitude]);
-                let branch = averaged.then(|| {
-                    let mut at_rest = probe.clone();
-                    at_rest[amplitude] = 0.0;
-                    let method = self.settings.method;
-                    orbit_branch(model, &at_rest, amplitude, method, &y0, (0.0, a_max))
-                });
-                // Newton at the probed amplitude from the branch's nearest
-                // point (from (q, 0) where the branch could not be had).
-                let near: [f64; S] = match &branch {
-                    Some(Ok(b)) => b
-                        .states
-                        .iter()
-                        .min_by(|x, y| {
-                            (x.0 - probe[amplitude])
-                                .abs()
-                                .total_cmp(&(y.0 - probe[amplitude]).abs())
-                        })
-                        .map_or(y0, |(_, y)| std::array::from_fn(|i| y[i])),
-                    _ => y0,
-                };
-                let orbit = if averaged {
-                    periodic_orbit_near::<F, D, S, T, V>(
-                        model,
-                        &probe,
-                        &near,
-                        &self.settings.method,
-                    )
-                } else {
-                    None
-                };
-                let (exact_window, exact_reason) = match branch {
-                    None => (None, Some("the averaged system moves it too".to_string())),
-                    Some(Ok(OrbitBranch {
-                        window: Some(window),
-                        ..
-                    })) => (Some(window), None),
-                    Some(Ok(_)) => (
-                        None,
-                        Some(format!(
-                            "its orbit is not stable for any amplitude up to {a_max}"
-                        )),
-                    ),
-                    Some(Err(e)) => (
-                        None,
-                        Some(format!(
-                            "its orbit could not be followed from amplitude 0: {e}"
-                        )),
-                    ),
-                };
-                let (periodic_orbit, multipliers, verdict) = match orbit {
-                    Some((y, m)) => {
-                        let multipliers = floquet_multipliers(&m);
-                        let verdict = super::floquet::Verdict::from_multipliers(&multipliers, 1e-7);
-                        (Some(y.to_vec()), multipliers, Some(verdict.name()))
-                    }
-                    None => (None, Vec::new(), None),
-                };
-                result.moved_by_vibration.push(MovedEquilibrium {
-                    q: q.to_vec(),
-                    amplitude: probe[amplitude],
-                    periodic_orbit,
-                    multipliers,
-                    verdict,
-                    exact_window,
-                    exact_reason,
-                });
+                moved.push((*q, averaged));
                 continue;
             }
-            let q = *q;
-            let mut analysed = averaged_verdict(model, self.params, amplitude, &q);
-            exact_window(
-                model,
-                self.params,
-                amplitude,
-                &q,
-                self.settings,
-                &mut analysed,
-            )?;
-            result.equilibria.push(analysed);
+            result
+                .equilibria
+                .push(averaged_verdict(model, self.params, amplitude, q));
+        }
+        let mut with_threshold: Vec<usize> = (0..result.equilibria.len())
+            .filter(|&k| result.equilibria[k].a_star.is_some())
+            .collect();
+        with_threshold.sort_by(|&x, &y| {
+            let a = |k: usize| result.equilibria[k].a_star.unwrap_or(f64::INFINITY);
+            a(x).total_cmp(&a(y))
+        });
+        let budget = self.settings.max_windows;
+        let costly = with_threshold.len() + moved.len();
+        let skipped = format!(
+            "not computed: {costly} equilibria need an exact sweep, and the {budget} with the lowest thresholds come first (--set max_windows=N for more)"
+        );
+        for (rank, &k) in with_threshold.iter().enumerate() {
+            let e = &mut result.equilibria[k];
+            if rank >= budget {
+                e.exact_reason = Some(skipped.clone());
+                continue;
+            }
+            let q: [f64; D] = std::array::from_fn(|i| e.q[i]);
+            exact_window(model, self.params, amplitude, &q, self.settings, e)?;
+        }
+        for e in result.equilibria.iter_mut() {
+            if e.a_star.is_none() && e.exact_reason.is_none() {
+                let q: [f64; D] = std::array::from_fn(|i| e.q[i]);
+                exact_window(model, self.params, amplitude, &q, self.settings, e)?;
+            }
+        }
+        for (rank, (q, averaged)) in moved.into_iter().enumerate() {
+            result
+                .moved_by_vibration
+                .push(if with_threshold.len() + rank >= budget {
+                    MovedEquilibrium {
+                        q: q.to_vec(),
+                        amplitude: probe[amplitude],
+                        periodic_orbit: None,
+                        multipliers: Vec::new(),
+                        verdict: None,
+                        exact_window: None,
+                        exact_reason: Some(skipped.clone()),
+                    }
+                } else {
+                    moved_equilibrium(model, &probe, amplitude, self.settings, &q, averaged)
+                });
         }
         if result.equilibria.is_empty() {
             result.none_because = Some(if found.is_empty() {
-                NoEquilibria::NoneFound { starts }
+                NoEquilibria::NoneFound {
+                    starts: search.starts,
+                }
             } else {
                 NoEquilibria::AllMoved
             });
         }
         Ok(result)
+    }
+}
+
+/// An equilibrium without vibration that the vibration moves: its orbit's
+/// branch from amplitude 0 and the periodic orbit near it at the probed
+/// amplitude `probe` (`averaged`: whether the averaged system keeps it).
+fn moved_equilibrium<
+    F: Fixed<D, S, T, V>,
+    const D: usize,
+    const S: usize,
+    const T: usize,
+    const V: usize,
+>(
+    model: &'static F,
+    probe: &[f64],
+    amplitude: usize,
+    settings: &Settings,
+    q: &[f64; D],
+    averaged: bool,
+) -> MovedEquilibrium {
+    let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+    let a_max = settings.a_max.unwrap_or(3.0 * probe[amplitude]);
+    let branch = averaged.then(|| {
+        let mut at_rest = probe.to_vec();
+        at_rest[amplitude] = 0.0;
+        orbit_branch(
+            model,
+            &at_rest,
+            amplitude,
+            settings.method,
+            &y0,
+            (0.0, a_max),
+        )
+    });
+    // Newton at the probed amplitude from the branch's nearest point (from
+    // (q, 0) where the branch could not be had).
+    let near: [f64; S] = match &branch {
+        Some(Ok(b)) => b
+            .states
+            .iter()
+            .min_by(|x, y| {
+                (x.0 - probe[amplitude])
+                    .abs()
+                    .total_cmp(&(y.0 - probe[amplitude]).abs())
+            })
+            .map_or(y0, |(_, y)| std::array::from_fn(|i| y[i])),
+        _ => y0,
+    };
+    let orbit = if averaged {
+        periodic_orbit_near::<F, D, S, T, V>(model, probe, &near, &settings.method)
+    } else {
+        None
+    };
+    let (exact_window, exact_reason) = match branch {
+        None => (None, Some("the averaged system moves it too".to_string())),
+        Some(Ok(OrbitBranch {
+            window: Some(window),
+            ..
+        })) => (Some(window), None),
+        Some(Ok(_)) => (
+            None,
+            Some(format!(
+                "its orbit is not stable for any amplitude up to {a_max}"
+            )),
+        ),
+        Some(Err(e)) => (
+            None,
+            Some(format!(
+                "its orbit could not be followed from amplitude 0: {e}"
+            )),
+        ),
+    };
+    let (periodic_orbit, multipliers, verdict) = match orbit {
+        Some((y, m)) => {
+            let multipliers = floquet_multipliers(&m);
+            let verdict = super::floquet::Verdict::from_multipliers(&multipliers, 1e-7);
+            (Some(y.to_vec()), multipliers, Some(verdict.name()))
+        }
+        None => (None, Vec::new(), None),
+    };
+    MovedEquilibrium {
+        q: q.to_vec(),
+        amplitude: probe[amplitude],
+        periodic_orbit,
+        multipliers,
+        verdict,
+        exact_window,
+        exact_reason,
     }
 }
 
@@ -370,7 +449,8 @@ impl WithFixed for AtEquilibrium<'_> {
 
 /// Equilibria of the potential V without vibration: the shared finder
 /// ([`super::equilibria`]) on the generated ∂V/∂q with the generated C;
-/// duplicates merged (angles modulo 2π). Also the number of starts.
+/// duplicates merged (angles modulo 2π). Also how much of the grid of
+/// starts was searched.
 fn equilibria_without_vibration<
     F: Fixed<D, S, T, V>,
     const D: usize,
@@ -380,7 +460,7 @@ fn equilibria_without_vibration<
 >(
     model: &F,
     params: &[f64],
-) -> (Vec<[f64; D]>, usize) {
+) -> (Vec<[f64; D]>, super::equilibria::Search) {
     use super::equilibria::{newton, starts, wrapped, Convergence};
     let periodic = model.periodic();
     let at = |q: &[f64]| -> [f64; D] { std::array::from_fn(|i| q[i]) };
@@ -391,7 +471,7 @@ fn equilibria_without_vibration<
     };
     let starts = starts(&periodic);
     let mut found: Vec<[f64; D]> = Vec::new();
-    for start in &starts {
+    for start in &starts.points {
         let Some(q) = newton(gradient, hessian, start.clone(), Convergence::Exact) else {
             continue;
         };
@@ -417,7 +497,7 @@ fn equilibria_without_vibration<
             .find(|o| o.is_ne())
             .unwrap_or(std::cmp::Ordering::Equal)
     });
-    (found, starts.len())
+    (found, starts.search)
 }
 
 /// Whether ∇(V + V_vibr) vanishes at q too (central differences of the
@@ -470,9 +550,14 @@ fn singular_chart<
     q: &[f64; D],
 ) -> Option<Vec<usize>> {
     let a = model.mass_matrix(params, q);
-    let m = DMatrix::from_fn(D, D, |i, j| a[i][j]);
+    let m = DMatrix::from_fn(D, D, |i, j| 0.5 * (a[i][j] + a[j][i]));
     let scale = 1.0 + m.amax();
-    (m.determinant().abs() <= 1e-12 * scale.powi(D as i32))
+    // Its smallest eigenvalue against its largest: the determinant against
+    // scaleᴰ would call a long chain's regular mass matrix singular (det 1
+    // against 13¹² for 12 links).
+    let eigenvalues = m.symmetric_eigenvalues();
+    let largest = eigenvalues.amax();
+    (eigenvalues.amin() <= 1e-12 * largest)
         .then(|| (0..D).filter(|&i| a[i][i].abs() <= 1e-12 * scale).collect())
 }
 

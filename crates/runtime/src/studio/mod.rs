@@ -645,6 +645,7 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
     };
     let field = contour::Field::sample(ranges, grid, value);
     let equilibria: Vec<EquilibriumMark> = crate::explore::equilibria(model, params)
+        .map(|(found, _)| found)
         .unwrap_or_default()
         .into_iter()
         .map(|e| {

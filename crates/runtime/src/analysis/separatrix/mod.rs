@@ -547,6 +547,7 @@ impl Map {
 /// −π up (the branch the search follows first).
 fn saddles(model: &dyn DynamicModel, params: &[f64]) -> Vec<[f64; 2]> {
     let mut saddles: Vec<[f64; 2]> = crate::explore::equilibria(model, params)
+        .map(|(found, _)| found)
         .unwrap_or_default()
         .into_iter()
         .filter(|e| e.hessian_eigenvalues.iter().all(|&h| h < 0.0))
