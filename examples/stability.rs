@@ -56,51 +56,13 @@ fn main() {
             max_windows: scene.count("max_windows")?,
         };
         let result = stability(model, &params, &settings)?;
-        for moved in &result.moved_by_vibration {
-            match (&moved.periodic_orbit, moved.verdict) {
-                (Some(orbit), Some(verdict)) => eprintln!(
-                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}; stable for amplitudes {:?} {}",
-                    moved.q,
-                    moved.amplitude,
-                    moved.multipliers,
-                    moved.exact_window,
-                    moved.exact_reason.as_deref().unwrap_or(""),
-                ),
-                _ => eprintln!(
-                    "q = {:?}: moved by the vibration, no periodic orbit found near it ({})",
-                    moved.q,
-                    moved.exact_reason.as_deref().unwrap_or("Newton did not converge"),
-                ),
-            }
+        for line in result.report(32) {
+            eprintln!("{line}");
         }
-        if let Some(reason) = &result.none_because {
-            eprintln!("no equilibrium analysed: {reason}");
-        }
-        if let Some(search) = &result.search_sampled {
-            eprintln!("equilibria searched from {search}");
-        }
-        const PRINTED: usize = 32;
-        if result.equilibria.len() > PRINTED {
-            let more = result.equilibria.len() - PRINTED;
-            eprintln!("{more} equilibria beyond the first {PRINTED} are in summary.json");
-        }
-        for e in result.equilibria.iter().take(PRINTED) {
-            let reason = e.reason.as_deref().unwrap_or("");
-            let exact_reason = e.exact_reason.as_deref().unwrap_or("");
-            eprintln!(
-                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?} {exact_reason}",
-                e.q, e.lambdas, e.a_star, e.exact_window
-            );
-        }
-        let rows = result
-            .equilibria
-            .iter()
-            .enumerate()
-            .flat_map(|(k, e)| e.spectral_radius.iter().map(move |p| (k, p[0], p[1])));
         scene.write_csv(
             "spectral_radius.csv",
             &["equilibrium", "amplitude", "spectral_radius"],
-            rows,
+            result.spectral_radius_rows(),
         )?;
         if let Some(figure) = result.figure() {
             scene.save_figure(&figure, "spectral_radius.png")?;
@@ -115,21 +77,18 @@ fn main() {
                 }
                 chart => chart?,
             };
-            let rows = chart
-                .boundaries
-                .iter()
-                .zip(&chart.x_values)
-                .flat_map(|(edges, x)| edges.iter().map(move |y| (*x, *y)));
             scene.write_csv(
                 "chart_boundaries.csv",
                 &[chart.x.as_str(), chart.y.as_str()],
-                rows,
+                chart.boundary_rows(),
             )?;
             scene.save_figure(&chart.figure(), "chart.png")?;
-            scene.write_text(
-                "chart.json",
-                &serde_json::to_string_pretty(&chart).unwrap_or_default(),
-            )?;
+            let json =
+                serde_json::to_string_pretty(&chart).map_err(|source| SceneError::Summary {
+                    scene: "stability",
+                    source,
+                })?;
+            scene.write_text("chart.json", &json)?;
         }
         scene.write_summary(&result)?;
         Ok(())

@@ -4,8 +4,9 @@
 # model, pick their settings from the model's own scales, or skip with a
 # printed reason. This adds model files written for the check (those of
 # benches/edit_loop/, one of them without an `amplitude` key, and the
-# 6-link chain of models/extra/) to models/, runs the test command, and
-# restores models/ however it ends.
+# 6- and 12-link chains of models/extra/) to models/, runs the test
+# command, checks the 12-link chain's threshold from `stability` against
+# its closed form, and restores models/ however it ends.
 #
 #   bash benches/added_models/run.sh     # CI runs this after the edit loop
 #
@@ -35,12 +36,21 @@ add_model() {
     added+=("models/$name.toml")
 }
 
-for f in benches/edit_loop/*.toml models/extra/six_link_pendulum.toml; do
+for f in benches/edit_loop/*.toml models/extra/six_link_pendulum.toml \
+    models/extra/twelve_link_pendulum.toml; do
     add_model "$f"
 done
 echo "added to models/: ${added[*]}"
 cargo test --release
 echo "cargo test --release passed with ${#added[@]} model files added"
+
+# A model past 8 degrees of freedom gets its analyses too (the equilibria
+# from a sample of the grid of starts): the upright chain's threshold
+# against the hanging chain's normal modes. The binary is the one the
+# tests built (`cargo run` would build it again with other features).
+target/release/examples/stability --set model=twelve_link_pendulum \
+    --out out/added_models/stability >/dev/null
+python3 benches/added_models/chain_threshold.py 12 out/added_models/stability/summary.json
 
 # The documented command writes every derived expression of each new model
 # as a snapshot for review (and fails, as insta does, until they are

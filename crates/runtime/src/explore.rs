@@ -121,6 +121,134 @@ pub struct Exploration {
     pub switches: Vec<String>,
 }
 
+/// The start a scene uses when none is given: q = 0.3, 0.5, …, p = 0; for
+/// a contact model s = 0, −0.3, …, s' = 1.
+pub fn default_start(model: &dyn DynamicModel) -> Vec<f64> {
+    match model.kind() {
+        Kind::Hamiltonian { dof, .. } => (0..dof)
+            .map(|i| 0.3 + 0.2 * i as f64)
+            .chain((0..dof).map(|_| 0.0))
+            .collect(),
+        Kind::Contacts { count } => (0..count)
+            .map(|i| -0.3 * i as f64)
+            .chain((0..count).map(|_| 1.0))
+            .collect(),
+    }
+}
+
+/// What a run of `explore` reports in its `summary.json`.
+#[derive(Debug, serde::Serialize)]
+pub struct Summary<'a> {
+    pub model: &'static str,
+    pub params: std::collections::BTreeMap<&'static str, f64>,
+    pub y0: &'a [f64],
+    pub final_state: Option<&'a Vec<f64>>,
+    pub equilibria: &'a [Equilibrium],
+    pub equilibria_not_searched: &'a Option<NotSearched>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub equilibria_search_sampled: Option<Search>,
+    pub energy: EnergyChange,
+    pub switches: &'a [String],
+}
+
+/// The largest change of the conserved (or averaged) energy along a run.
+#[derive(Debug, serde::Serialize)]
+pub struct EnergyChange {
+    pub label: &'static str,
+    pub max_abs_change: f64,
+}
+
+impl Exploration {
+    /// The summary of this run of `info`'s model from `y0`.
+    pub fn summary<'a>(&'a self, info: &ModelInfo, params: &[f64], y0: &'a [f64]) -> Summary<'a> {
+        Summary {
+            model: info.name,
+            params: info
+                .parameter_names
+                .iter()
+                .copied()
+                .zip(params.iter().copied())
+                .collect(),
+            y0,
+            final_state: self.exact.last(),
+            equilibria: &self.equilibria,
+            equilibria_not_searched: &self.equilibria_not_searched,
+            equilibria_search_sampled: self.equilibria_search_sampled,
+            energy: EnergyChange {
+                label: self.energy_label,
+                max_abs_change: self
+                    .energy_change
+                    .iter()
+                    .fold(0.0f64, |m, e| m.max(e.abs())),
+            },
+            switches: &self.switches,
+        }
+    }
+
+    /// The columns of the time series: t, the exact state, the averaged one.
+    pub fn series_header(&self) -> Vec<String> {
+        let size = self.exact.first().map_or(0, Vec::len);
+        let averaged = if self.averaged.is_some() { size } else { 0 };
+        std::iter::once("t".to_string())
+            .chain((0..size).map(|k| format!("exact_{k}")))
+            .chain((0..averaged).map(|k| format!("averaged_{k}")))
+            .collect()
+    }
+
+    /// The rows of the time series, as [`Exploration::series_header`] names them.
+    pub fn series_rows(&self) -> impl Iterator<Item = Vec<f64>> + '_ {
+        self.times.iter().enumerate().map(|(k, t)| {
+            std::iter::once(*t)
+                .chain(self.exact[k].iter().copied())
+                .chain(self.averaged.iter().flat_map(|a| a[k].iter().copied()))
+                .collect()
+        })
+    }
+
+    /// What a scene prints: the first `limit` equilibria with their
+    /// verdicts (and how many more there are), why none were searched or
+    /// how the search sampled, the switches, the energy's change.
+    pub fn report(&self, coordinates: &[&str], limit: usize) -> Vec<String> {
+        let mut lines: Vec<String> = self
+            .equilibria
+            .iter()
+            .take(limit)
+            .map(|e| {
+                let family: Vec<&str> = e.family_along.iter().map(|&i| coordinates[i]).collect();
+                let family = match family.is_empty() {
+                    true => String::new(),
+                    false => format!(" (a family along {}, judged reduced)", family.join(", ")),
+                };
+                let pole = match e.pole {
+                    true => " (a pole of the chart: singular only along the family)",
+                    false => "",
+                };
+                format!(
+                    "equilibrium q = {:?}{family}{pole}: Hessian eigenvalues {:?}: {}",
+                    e.q, e.hessian_eigenvalues, e.verdict
+                )
+            })
+            .collect();
+        if self.equilibria.len() > limit {
+            let more = self.equilibria.len() - limit;
+            lines.push(format!("… and {more} more equilibria in summary.json"));
+        }
+        if let Some(reason) = &self.equilibria_not_searched {
+            lines.push(format!("equilibria not searched: {reason}"));
+        }
+        if let Some(search) = &self.equilibria_search_sampled {
+            lines.push(format!("equilibria searched from {search}"));
+        }
+        lines.extend(self.switches.iter().cloned());
+        let change = self
+            .energy_change
+            .iter()
+            .fold(0.0f64, |m, e| m.max(e.abs()));
+        lines.push(format!("{}: max |change| {change:.3e}", self.energy_label));
+        lines
+    }
+}
+
 /// Why an exploration failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ExploreError {
@@ -383,30 +511,7 @@ pub fn equilibria(
             })
             .collect()
     };
-    // Cyclic coordinates: H does not depend on them (probed at scattered
-    // states and times), so their momenta are conserved and equilibria come
-    // in families along them.
-    let probes: Vec<(f64, Vec<f64>)> = (0..8)
-        .map(|k| {
-            let y = (0..2 * n)
-                .map(|i| (1.7 * (k * 2 * n + i) as f64 + 0.3).sin() * 1.3)
-                .collect();
-            (0.37 * k as f64, y)
-        })
-        .collect();
-    let cyclic: Vec<usize> = (0..n)
-        .filter(|&i| {
-            probes.iter().all(|(t, y)| {
-                let h = 1e-5;
-                let (mut a, mut b) = (y.clone(), y.clone());
-                a[i] += h;
-                b[i] -= h;
-                let slope =
-                    (model.energy(params, *t, &a) - model.energy(params, *t, &b)) / (2.0 * h);
-                slope.abs() < 1e-8
-            })
-        })
-        .collect();
+    let cyclic = cyclic_coordinates(model, params, n);
     let kept: Vec<usize> = (0..n).filter(|i| !cyclic.contains(i)).collect();
     let hessian = |q: &[f64]| {
         let h = model
@@ -489,6 +594,33 @@ pub fn equilibria(
         }
     }
     Ok((found, starts.search))
+}
+
+/// The cyclic coordinates: H does not depend on them (probed at scattered
+/// states and times), so their momenta are conserved and equilibria come
+/// in families along them.
+fn cyclic_coordinates(model: &dyn DynamicModel, params: &[f64], n: usize) -> Vec<usize> {
+    let probes: Vec<(f64, Vec<f64>)> = (0..8)
+        .map(|k| {
+            let y = (0..2 * n)
+                .map(|i| (1.7 * (k * 2 * n + i) as f64 + 0.3).sin() * 1.3)
+                .collect();
+            (0.37 * k as f64, y)
+        })
+        .collect();
+    (0..n)
+        .filter(|&i| {
+            probes.iter().all(|(t, y)| {
+                let h = 1e-5;
+                let (mut a, mut b) = (y.clone(), y.clone());
+                a[i] += h;
+                b[i] -= h;
+                let slope =
+                    (model.energy(params, *t, &a) - model.energy(params, *t, &b)) / (2.0 * h);
+                slope.abs() < 1e-8
+            })
+        })
+        .collect()
 }
 
 /// The momenta along which the mass matrix A is singular at q: H is

@@ -96,6 +96,63 @@ pub struct Stability {
     pub search_sampled: Option<super::equilibria::Search>,
 }
 
+impl Stability {
+    /// What a scene prints: the equilibria the vibration moves, why none
+    /// was analysed or how the search sampled, and the first `limit`
+    /// equilibria with their thresholds and windows (or why they have none).
+    pub fn report(&self, limit: usize) -> Vec<String> {
+        let mut lines: Vec<String> = self
+            .moved_by_vibration
+            .iter()
+            .map(|moved| match (&moved.periodic_orbit, moved.verdict) {
+                (Some(orbit), Some(verdict)) => format!(
+                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}; stable for amplitudes {:?} {}",
+                    moved.q,
+                    moved.amplitude,
+                    moved.multipliers,
+                    moved.exact_window,
+                    moved.exact_reason.as_deref().unwrap_or(""),
+                ),
+                _ => format!(
+                    "q = {:?}: moved by the vibration, no periodic orbit found near it ({})",
+                    moved.q,
+                    moved.exact_reason.as_deref().unwrap_or("Newton did not converge"),
+                ),
+            })
+            .collect();
+        if let Some(reason) = &self.none_because {
+            lines.push(format!("no equilibrium analysed: {reason}"));
+        }
+        if let Some(search) = &self.search_sampled {
+            lines.push(format!("equilibria searched from {search}"));
+        }
+        if self.equilibria.len() > limit {
+            let more = self.equilibria.len() - limit;
+            lines.push(format!(
+                "{more} equilibria beyond the first {limit} are in summary.json"
+            ));
+        }
+        lines.extend(self.equilibria.iter().take(limit).map(|e| {
+            let reason = e.reason.as_deref().unwrap_or("");
+            let exact_reason = e.exact_reason.as_deref().unwrap_or("");
+            format!(
+                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?} {exact_reason}",
+                e.q, e.lambdas, e.a_star, e.exact_window
+            )
+        }));
+        lines
+    }
+
+    /// (equilibrium's index, amplitude, spectral radius) wherever a
+    /// monodromy matrix was computed.
+    pub fn spectral_radius_rows(&self) -> impl Iterator<Item = (usize, f64, f64)> + '_ {
+        self.equilibria
+            .iter()
+            .enumerate()
+            .flat_map(|(k, e)| e.spectral_radius.iter().map(move |p| (k, p[0], p[1])))
+    }
+}
+
 /// An equilibrium without vibration that the vibration moves, and the
 /// periodic orbit of the exact system near it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -1011,6 +1068,16 @@ pub struct StabilityChart {
     pub stable: Vec<Vec<bool>>,
     /// [x]: the boundaries in y, ascending.
     pub boundaries: Vec<Vec<f64>>,
+}
+
+impl StabilityChart {
+    /// (x, y) of every boundary.
+    pub fn boundary_rows(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.boundaries
+            .iter()
+            .zip(&self.x_values)
+            .flat_map(|(edges, x)| edges.iter().map(move |y| (*x, *y)))
+    }
 }
 
 /// The stability chart of `model` (see [`StabilityChart`]).
