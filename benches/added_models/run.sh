@@ -48,8 +48,12 @@ echo "cargo test --release passed with ${#added[@]} model files added"
 # from a sample of the grid of starts): the upright chain's threshold
 # against the hanging chain's normal modes. The binary is the one the
 # tests built (`cargo run` would build it again with other features).
-target/release/examples/stability --set model=twelve_link_pendulum \
-    --out out/added_models/stability >/dev/null
+mkdir -p out/added_models
+if ! target/release/examples/stability --set model=twelve_link_pendulum \
+    --out out/added_models/stability >out/added_models/stability.log 2>&1; then
+    tail -20 out/added_models/stability.log >&2
+    exit 1
+fi
 python3 benches/added_models/chain_threshold.py 12 out/added_models/stability/summary.json
 
 # The documented command writes every derived expression of each new model

@@ -59,7 +59,7 @@ pub const SYMBOLIC_INVERSE_MAX_DOF: usize = 2;
 /// equilibrium search samples its grid beyond 8 degrees of freedom), but
 /// the generated code grows like N³ (derivatives through the mass matrix's
 /// solve): a 12-link chain adds about 2.5 minutes to a build on 2 cores
-/// and a 16-link one about 6.
+/// and a 16-link one about 7.5.
 pub const MAX_DOF: usize = 16;
 
 /// How the generated code gets the velocities from the momenta.
@@ -470,7 +470,7 @@ impl ModelFile {
             return Err(err(
                 "coordinates",
                 format!(
-                    "{} degrees of freedom: at most {MAX_DOF} are built (the generated code grows like N³: a 12-link chain adds about 2.5 minutes to a build on 2 cores, a 16-link one about 6)",
+                    "{} degrees of freedom: at most {MAX_DOF} are built (the generated code grows like N³: a 12-link chain adds about 2.5 minutes to a build on 2 cores, a 16-link one about 7.5)",
                     self.coordinates.len()
                 ),
             ));
