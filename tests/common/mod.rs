@@ -122,7 +122,7 @@ pub fn assert_tangent_recurrences_differentiate<S: System<N>, const N: usize>(
 /// sweep's last local slopes have not settled (a coordinate whose leading
 /// term is small at the model's own frequencies) or settled on a fraction,
 /// the sweep is run again at frequencies 8 and 64 times higher before
-/// giving up.
+/// giving up, with the reason.
 pub fn asymptotic_slopes(
     model: &Model,
     params: &[f64],
@@ -163,12 +163,20 @@ pub fn asymptotic_slopes(
         .zip(&last.local_slopes)
         .zip(&last.coordinates)
         .map(|((s, local), c)| {
-            s.ok_or_else(|| {
-                format!(
-                    "{c}: the local slopes {local:.2?} have not settled by ν = {:.3e}",
-                    last.frequencies.last().unwrap()
-                )
-            })
+            let top = last.frequencies.last().unwrap();
+            match s {
+                Some(s) if whole(&Some(*s)) => Ok(*s),
+                // Settled on a fraction as far up as the sweep went: the
+                // deviation is not yet c/ν^k there (a chaotic start's, on
+                // its way down from saturation), so there is no exponent
+                // to check; the dedicated tests hold the known models'.
+                Some(s) => Err(format!(
+                    "{c}: the local slopes {local:.2?} settled on {s:.2}, a fraction, up to ν = {top:.3e}: not yet the asymptotic regime"
+                )),
+                None => Err(format!(
+                    "{c}: the local slopes {local:.2?} have not settled by ν = {top:.3e}"
+                )),
+            }
         })
         .collect())
 }
