@@ -176,13 +176,17 @@ impl Exploration {
             equilibria_search_sampled: self.equilibria_search_sampled,
             energy: EnergyChange {
                 label: self.energy_label,
-                max_abs_change: self
-                    .energy_change
-                    .iter()
-                    .fold(0.0f64, |m, e| m.max(e.abs())),
+                max_abs_change: self.max_energy_change(),
             },
             switches: &self.switches,
         }
+    }
+
+    /// The largest |change| of the energy along the run.
+    pub fn max_energy_change(&self) -> f64 {
+        self.energy_change
+            .iter()
+            .fold(0.0f64, |m, e| m.max(e.abs()))
     }
 
     /// The columns of the time series: t, the exact state, the averaged one.
@@ -240,10 +244,7 @@ impl Exploration {
             lines.push(format!("equilibria searched from {search}"));
         }
         lines.extend(self.switches.iter().cloned());
-        let change = self
-            .energy_change
-            .iter()
-            .fold(0.0f64, |m, e| m.max(e.abs()));
+        let change = self.max_energy_change();
         lines.push(format!("{}: max |change| {change:.3e}", self.energy_label));
         lines
     }
