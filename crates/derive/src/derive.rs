@@ -94,6 +94,11 @@ pub struct NumericForm {
     pub potential_series: Vec<(crate::lie::Harmonic, String)>,
     /// P̄ = mean of the forces over the phase, in q and the velocities.
     pub mean_forces: Vec<String>,
+    /// The nonzero ∂A_ij/∂q_k, i ≤ j, as (k, i, j, text): ∂W/∂q by the
+    /// adjoint of the solves (see `numeric.rs`).
+    pub mass_slopes: Vec<(usize, usize, usize, String)>,
+    /// The nonzero ∂(g_s)_i/∂q_k as (k, s, i, text).
+    pub mode_slopes: Vec<(usize, usize, usize, String)>,
 }
 
 /// An expression of the model (the Lagrangian, a dissipation function) with
@@ -706,6 +711,43 @@ struct Pieces {
 
 /// The numeric-solve form: no inverse of A is formed symbolically, so the
 /// computer algebra stays polynomial in the size of the model.
+/// The nonzero slopes ∂A_ij/∂q_k (i ≤ j) and ∂(g_s)_i/∂q_k, for ∂W/∂q by
+/// the adjoint of the solves: a chain's A_ij depends on q_i and q_j alone,
+/// so their number, and the gradient's code, grows like N², where forward
+/// mode through a solve per direction grows like N³.
+#[allow(clippy::type_complexity)]
+fn slopes(
+    q: &[String],
+    mass: &[Vec<Atom>],
+    modes: &[((i64, i64), Vec<Atom>)],
+) -> (
+    Vec<(usize, usize, usize, String)>,
+    Vec<(usize, usize, usize, String)>,
+) {
+    let mut mass_slopes = Vec::new();
+    let mut mode_slopes = Vec::new();
+    for (k, qk) in q.iter().enumerate() {
+        let qk = symbol!(qk.as_str());
+        for (i, row) in mass.iter().enumerate() {
+            for (j, entry) in row.iter().enumerate().skip(i) {
+                let slope = entry.derivative(qk).expand();
+                if !is_zero(&slope) {
+                    mass_slopes.push((k, i, j, slope.to_string()));
+                }
+            }
+        }
+        for (s, (_, g)) in modes.iter().enumerate() {
+            for (i, component) in g.iter().enumerate() {
+                let slope = component.derivative(qk).expand();
+                if !is_zero(&slope) {
+                    mode_slopes.push((k, s, i, slope.to_string()));
+                }
+            }
+        }
+    }
+    (mass_slopes, mode_slopes)
+}
+
 fn numeric_form(
     model: &Model,
     pieces: Pieces,
@@ -761,6 +803,8 @@ fn numeric_form(
         mode_exponents: Vec::new(),
         potential_series: Vec::new(),
         mean_forces: Vec::new(),
+        mass_slopes: Vec::new(),
+        mode_slopes: Vec::new(),
     };
     let mean_potential = match &phase {
         Some(th) => {
@@ -812,6 +856,7 @@ fn numeric_form(
                 let (numerator, denominator) = monomial_mean(a, b);
                 numerator as f64 / denominator as f64
             };
+            (form.mass_slopes, form.mode_slopes) = slopes(&q, &mass, &modes);
             form.mode_exponents = modes.iter().map(|(k, _)| *k).collect();
             form.mode_means = modes.iter().map(|((a, b), _)| mean(*a, *b)).collect();
             form.mode_products = modes

@@ -55,6 +55,9 @@ pub enum Inputs {
     Params,
     /// Coordinates only (`q: &[f64; N]`).
     Coordinates,
+    /// Coordinates as hyper-dual numbers, for second derivatives at run
+    /// time.
+    HyperDualCoordinates,
     /// Coordinates and velocities, at time t.
     CoordinatesVelocities,
     /// The Hamiltonian state `y = [q, p]` at time t.
@@ -63,6 +66,11 @@ pub enum Inputs {
     AveragedState,
     /// That state as hyper-dual numbers (`crate::ode::HyperDual`), for
     /// derivatives at run time.
+    HyperDualAveragedState,
+    /// The Hamiltonian state as dual numbers (`crate::ode::Dual`), for the
+    /// Jacobian at run time.
+    DualState,
+    /// The averaged system's state as dual numbers.
     DualAveragedState,
     /// `y = [s, s']` of a contact model (sliding coordinates, velocities).
     ContactState,
@@ -126,9 +134,14 @@ impl Context<'_> {
         let mut prelude = Vec::new();
         let args = match inputs {
             Inputs::Params => "params: &Params".to_string(),
-            Inputs::Coordinates => {
+            Inputs::Coordinates | Inputs::HyperDualCoordinates => {
                 prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
-                format!("q: &[f64; {n}], params: &Params")
+                match inputs {
+                    Inputs::HyperDualCoordinates => {
+                        format!("q: &[crate::ode::HyperDual; {n}], params: &Params")
+                    }
+                    _ => format!("q: &[f64; {n}], params: &Params"),
+                }
             }
             Inputs::CoordinatesVelocities => {
                 prelude.push(format!(
@@ -142,21 +155,35 @@ impl Context<'_> {
                 prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
                 format!("y: &[f64; {}], params: &Params", 2 * n)
             }
-            Inputs::State | Inputs::AveragedState | Inputs::DualAveragedState => {
+            Inputs::State
+            | Inputs::AveragedState
+            | Inputs::HyperDualAveragedState
+            | Inputs::DualState
+            | Inputs::DualAveragedState => {
                 let mut names = self.coordinates();
                 names.extend(self.momenta());
                 prelude.push(format!("let [{}] = *y;", names.join(", ")));
+                let m = 2 * n;
                 match inputs {
-                    Inputs::State => format!("{time}: f64, y: &[f64; {}], params: &Params", 2 * n),
-                    Inputs::DualAveragedState => {
-                        format!("y: &[crate::ode::HyperDual; {}], params: &Params", 2 * n)
+                    Inputs::State => format!("{time}: f64, y: &[f64; {m}], params: &Params"),
+                    Inputs::DualState => {
+                        format!("{time}: f64, y: &[crate::ode::Dual; {m}], params: &Params")
                     }
-                    _ => format!("y: &[f64; {}], params: &Params", 2 * n),
+                    Inputs::HyperDualAveragedState => {
+                        format!("y: &[crate::ode::HyperDual; {m}], params: &Params")
+                    }
+                    Inputs::DualAveragedState => {
+                        format!("y: &[crate::ode::Dual; {m}], params: &Params")
+                    }
+                    _ => format!("y: &[f64; {m}], params: &Params"),
                 }
             }
         };
         prelude.push(params_line);
-        if matches!(inputs, Inputs::State | Inputs::CoordinatesVelocities) {
+        if matches!(
+            inputs,
+            Inputs::State | Inputs::DualState | Inputs::CoordinatesVelocities
+        ) {
             prelude.extend(phase_line);
         }
         (args, prelude)
@@ -188,10 +215,25 @@ impl Context<'_> {
     ) -> Result<Function, DeriveError> {
         let (args, mut body) = self.signature_and_prelude(inputs);
         let mut emitter = Emitter::default();
-        if matches!(inputs, Inputs::DualAveragedState) {
-            emitter.lift = Some("crate::ode::HyperDual::from");
-        }
-        let result = emitter.lifted(result);
+        emitter.lift = match inputs {
+            Inputs::HyperDualAveragedState | Inputs::HyperDualCoordinates => {
+                Some("crate::ode::HyperDual::from")
+            }
+            Inputs::DualState | Inputs::DualAveragedState => Some("crate::ode::Dual::from"),
+            _ => None,
+        };
+        // A vector's entries are lifted one by one (an entry may be a
+        // constant f64).
+        let result = match result.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+            Some(entries) => {
+                let lifted: Vec<String> = entries
+                    .split(", ")
+                    .map(|e| emitter.lifted(e.to_string()))
+                    .collect();
+                format!("[{}]", lifted.join(", "))
+            }
+            None => emitter.lifted(result),
+        };
         for step in steps {
             emitter.apply(step).map_err(|e| e.in_function(name))?;
         }
@@ -518,6 +560,7 @@ pub(crate) fn taylor_functions(
         cx,
         (&exact, &rhs_names),
         averaged.as_ref().map(|(s, n)| (&s[..], &n[..])),
+        Tangents::WrittenOut,
     )?;
     if cx.model.coordinates.len() == 1 && cx.model.fast_phase.is_some() {
         functions.push(action_taylor(cx, derivation, &exact, &rhs_names)?);
@@ -568,6 +611,7 @@ pub fn taylor_set(
     cx: &Context,
     exact: (&[Step], &[String]),
     averaged: Option<(&[Step], &[String])>,
+    tangents: Tangents,
 ) -> Result<Vec<TaylorFunction>, DeriveError> {
     let mut state = cx.coordinates();
     state.extend(cx.momenta());
@@ -587,6 +631,9 @@ pub fn taylor_set(
             state.clone(),
         )?);
     }
+    if tangents == Tangents::DualNumbers {
+        return Ok(functions);
+    }
     let mut with_tangent = state.clone();
     with_tangent.extend(state.iter().map(|s| format!("tangent_{s}")));
     functions.push(cx.taylor_steps(
@@ -597,6 +644,19 @@ pub fn taylor_set(
         with_tangent,
     )?);
     Ok(functions)
+}
+
+/// How a model's derivatives are computed: its Jacobians, its variational
+/// recurrences and the Hessian of its effective potential.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tangents {
+    /// Written out by forward mode through the derivation's DAG at build
+    /// time (closed forms: the code stays small).
+    WrittenOut,
+    /// At run time, by dual numbers through the generated recurrences
+    /// (`crate::ode::dual` in the runtime): for models whose mass matrix is
+    /// solved at run time, whose written-out derivatives grow like N³.
+    DualNumbers,
 }
 
 /// The steps that define the names the texts of a
@@ -689,7 +749,7 @@ pub fn second_order_functions(
         functions.push(cx.function_steps(
             "averaged2_hamiltonian_dual",
             "K̄ over hyper-dual numbers: its gradient and Hessian at run time (`crate::ode::hyperdual`).",
-            Inputs::DualAveragedState,
+            Inputs::HyperDualAveragedState,
             "crate::ode::HyperDual".into(),
             &k_steps,
             "k__".into(),

@@ -77,7 +77,7 @@ pub fn render(
         .collect();
     for f in &functions {
         if f.args.starts_with("q: ") {
-            for line in &f.body[2..] {
+            for line in f.body.iter().skip(2) {
                 if let Some(bad) = forbidden.iter().find(|s| {
                     line.split(|c: char| !c.is_alphanumeric() && c != '_')
                         .any(|w| w == s.as_str())
@@ -105,6 +105,8 @@ pub fn render(
     );
     context.insert("momenta", &cx.momenta());
     context.insert("has_phase", &model.fast_phase.is_some());
+    // The numeric form's derivatives run over dual numbers (`Tangents`).
+    context.insert("tangents_by_dual_numbers", &derivation.numeric.is_some());
     // Every model with a fast phase: in closed form, or (numeric solves,
     // up to `numeric::SECOND_ORDER_MAX_DOF`) with the series in the DAG.
     context.insert(
@@ -162,6 +164,7 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
     context.insert("name", &model.name);
     context.insert("description", &model.description);
     context.insert("source_file", source_file);
+    context.insert("tangents_by_dual_numbers", &false);
     // The file's text as a raw string literal, with enough `#` to hold it.
     let text = std::fs::read_to_string(source_file).unwrap_or_default();
     let hashes = "#".repeat(

@@ -14,15 +14,19 @@
 //! - averaged field: q' = A⁻¹(p − b̄), p' = ∂L̄₀/∂q + P̄ − ∂W/∂q with
 //!   W = V_vibr − ½ b̄ᵀA⁻¹b̄ (so that H̄ = ½(p − b̄)ᵀA⁻¹(p − b̄) + V̄ + W,
 //!   the mean of H over the phase);
-//! - Jacobians, ∂W/∂q and the Hessian of V + V_vibr as forward-mode
-//!   derivatives through the solves (δX = A⁻¹(δR − δA X)), so no quantity
-//!   is approximated by finite differences.
+//! - ∂W/∂q as forward-mode derivatives through the solves
+//!   (δX = A⁻¹(δR − δA X)), so no quantity is approximated by finite
+//!   differences;
+//! - the Jacobians, the variational recurrences and the Hessian of
+//!   V + V_vibr at run time, by dual and hyper-dual numbers through the
+//!   generated recurrences and potential: written out here, they grew like
+//!   N³ (60 % of a 12-link chain's code).
 
 use crate::derive::{Derivation, NumericForm};
 use crate::emit::Step;
 use crate::error::DeriveError;
 use crate::functions::{
-    common_functions, matrix, taylor_set, Context, Function, Inputs, TaylorFunction,
+    common_functions, taylor_set, Context, Function, Inputs, Tangents, TaylorFunction,
 };
 
 /// The name of entry (i, j) of a symmetric matrix `prefix` (upper triangle).
@@ -149,7 +153,6 @@ fn averaged_steps(
 ) -> (Vec<Step>, Vec<String>) {
     let n = cx.n();
     let momenta = cx.momenta();
-    let coordinates = cx.coordinates();
     let mut steps = vibrational_steps(derivation, form);
     let shifted: Vec<(String, String)> = (0..n)
         .map(|i| {
@@ -169,13 +172,7 @@ fn averaged_steps(
         "w__".into(),
         dynamic_potential(n, form),
     )]));
-    steps.push(Step::Derivatives(
-        coordinates
-            .iter()
-            .enumerate()
-            .map(|(k, q)| (format!("dw__{k}"), "w__".to_string(), vec![q.clone()]))
-            .collect(),
-    ));
+    steps.push(Step::Values(dynamic_potential_gradient(n, form)));
     let mut field: Vec<(String, String)> = cx
         .velocities()
         .into_iter()
@@ -193,14 +190,10 @@ fn averaged_steps(
     (steps, outputs)
 }
 
-/// W = V_vibr − ½ b̄ᵀA⁻¹b̄ = ½ Σ (M_st − m_s m_t) g_s·x_t, the part of H̄
-/// besides V̄ that depends on q alone.
-fn dynamic_potential(n: usize, form: &NumericForm) -> String {
-    if form.mode_means.iter().all(|m| *m == 0.0) {
-        return "v_vibr__".into();
-    }
-    let weights: Vec<Vec<f64>> = form
-        .mode_products
+/// The weights w_st = M_st − m_s m_t of W = V_vibr − ½ b̄ᵀA⁻¹b̄ =
+/// ½ Σ w_st g_s·x_t, the part of H̄ besides V̄ that depends on q alone.
+fn dynamic_weights(form: &NumericForm) -> Vec<Vec<f64>> {
+    form.mode_products
         .iter()
         .zip(&form.mode_means)
         .map(|(row, ms)| {
@@ -209,36 +202,60 @@ fn dynamic_potential(n: usize, form: &NumericForm) -> String {
                 .map(|(mst, mt)| mst - ms * mt)
                 .collect()
         })
-        .collect();
-    mode_quadratic_form(n, &weights)
+        .collect()
 }
 
-/// Named derivatives ∂out_i/∂var_k of a vector field: a Jacobian.
-fn jacobian(prefix: &str, outputs: &[String], variables: &[String]) -> (Step, String) {
-    let names: Vec<Vec<String>> = outputs
-        .iter()
+/// W as text (V_vibr itself where b̄ = 0).
+fn dynamic_potential(n: usize, form: &NumericForm) -> String {
+    if form.mode_means.iter().all(|m| *m == 0.0) {
+        return "v_vibr__".into();
+    }
+    mode_quadratic_form(n, &dynamic_weights(form))
+}
+
+/// ∂W/∂q_k by the adjoint of the solves x_t = A⁻¹g_t (A symmetric, w
+/// symmetric): ∂_k W = Σ_st w_st (∂_k g_s)·x_t − ½ Σ_st w_st x_sᵀ(∂_k A)x_t.
+/// No solve per direction, and only the nonzero slopes of A and g appear.
+fn dynamic_potential_gradient(n: usize, form: &NumericForm) -> Vec<(String, String)> {
+    let weights = dynamic_weights(form);
+    let mut terms: Vec<Vec<String>> = vec![Vec::new(); n];
+    let x = |t: usize, i: usize| format!("solved{t}__{i}");
+    for (k, s, i, slope) in &form.mode_slopes {
+        for (t, &w) in weights[*s].iter().enumerate() {
+            if w != 0.0 {
+                terms[*k].push(format!("({w:?})*({slope})*{}", x(t, *i)));
+            }
+        }
+    }
+    for (k, i, j, slope) in &form.mass_slopes {
+        for (s, row) in weights.iter().enumerate() {
+            for (t, &w) in row.iter().enumerate() {
+                if w == 0.0 {
+                    continue;
+                }
+                let pair = if i == j {
+                    format!("{}*{}", x(s, *i), x(t, *i))
+                } else if s == t {
+                    format!("2*{}*{}", x(s, *i), x(s, *j))
+                } else {
+                    format!("({}*{}+{}*{})", x(s, *i), x(t, *j), x(s, *j), x(t, *i))
+                };
+                terms[*k].push(format!("({:?})*({slope})*{pair}", -w / 2.0));
+            }
+        }
+    }
+    terms
+        .into_iter()
         .enumerate()
-        .map(|(i, _)| {
-            (0..variables.len())
-                .map(|k| format!("{prefix}__{i}_{k}"))
-                .collect()
+        .map(|(k, t)| {
+            let text = if t.is_empty() {
+                "0".into()
+            } else {
+                t.join("+")
+            };
+            (format!("dw__{k}"), text)
         })
-        .collect();
-    let list = outputs
-        .iter()
-        .enumerate()
-        .flat_map(|(i, out)| {
-            variables
-                .iter()
-                .enumerate()
-                .map(move |(k, v)| (format!("{prefix}__{i}_{k}"), out.clone(), vec![v.clone()]))
-        })
-        .collect();
-    let rows: Vec<String> = names
-        .iter()
-        .map(|r| format!("[{}]", r.join(", ")))
-        .collect();
-    (Step::Derivatives(list), format!("[{}]", rows.join(", ")))
+        .collect()
 }
 
 /// A vector field of the numeric form: its steps and outputs, and what its
@@ -257,11 +274,29 @@ struct Field<'a> {
     hamiltonian: String,
 }
 
+/// `<prefix>_jacobian`: `<prefix>_rhs_dual`, the field over dual numbers,
+/// one column a pass (`crate::ode::dual::jacobian`). Written out by forward
+/// mode through the solves, the Jacobians grew like N³: 1 of a 12-link
+/// chain's 3.9 MB of code.
+fn jacobian_by_dual_numbers(prefix: &str, doc: &str, m: usize) -> Function {
+    let (args, time) = match prefix {
+        "exact" => ("time__: f64, ", "time__, "),
+        _ => ("", ""),
+    };
+    Function {
+        name: format!("{prefix}_jacobian"),
+        doc: format!("{doc} By dual numbers through `{prefix}_rhs_dual`, one column a pass."),
+        args: format!("{args}y: &[f64; {m}], params: &Params"),
+        ret: format!("[[f64; {m}]; {m}]"),
+        body: Vec::new(),
+        result: format!("crate::ode::dual::jacobian(y, |y| {prefix}_rhs_dual({time}y, params))"),
+    }
+}
+
 /// The field's function, its Jacobian and its Hamiltonian.
 fn field_functions(
     cx: &Context,
     field: Field,
-    state: &[String],
     functions: &mut Vec<Function>,
 ) -> Result<(), DeriveError> {
     let m = 2 * cx.n();
@@ -273,17 +308,19 @@ fn field_functions(
         field.steps,
         format!("[{}]", field.outputs.join(", ")),
     )?);
-    let (derivatives, result) = jacobian("j", field.outputs, state);
-    let mut steps = field.steps.to_vec();
-    steps.push(derivatives);
+    let over_duals = match field.inputs {
+        Inputs::State => Inputs::DualState,
+        _ => Inputs::DualAveragedState,
+    };
     functions.push(cx.function_steps(
-        &format!("{}_jacobian", field.prefix),
-        field.docs[1],
-        field.inputs,
-        format!("[[f64; {m}]; {m}]"),
-        &steps,
-        result,
+        &format!("{}_rhs_dual", field.prefix),
+        "The field over dual numbers, for its Jacobian.",
+        over_duals,
+        format!("[crate::ode::Dual; {m}]"),
+        field.steps,
+        format!("[{}]", field.outputs.join(", ")),
     )?);
+    functions.push(jacobian_by_dual_numbers(field.prefix, field.docs[1], m));
     let mut steps = field.steps[..field.hamiltonian_steps].to_vec();
     steps.push(Step::Values(vec![("h__".into(), field.hamiltonian)]));
     let name = match field.prefix {
@@ -308,8 +345,6 @@ pub fn functions(
     form: &NumericForm,
 ) -> Result<(Vec<Function>, Vec<TaylorFunction>), DeriveError> {
     let n = cx.n();
-    let mut state = cx.coordinates();
-    state.extend(cx.momenta());
     let mut functions = common_functions(cx, derivation)?;
     let (exact, exact_outputs) = exact_steps(cx, derivation, form);
     functions.push(cx.function_steps(
@@ -333,7 +368,7 @@ pub fn functions(
             inputs: Inputs::State,
             docs: [
                 "Hamilton's equations with forces: [q', p'] with A q' = p − b solved numerically, p' = ∂L/∂q + Q.",
-                "Jacobian ∂(q', p')/∂(q, p) of the exact field (forward mode through the solve).",
+                "Jacobian ∂(q', p')/∂(q, p) of the exact field.",
                 "Hamiltonian H(q, p, t) = ½ (p − b)ᵀq' + V.",
             ],
             steps: &exact,
@@ -341,12 +376,11 @@ pub fn functions(
             hamiltonian_steps: 2,
             hamiltonian,
         },
-        &state,
         &mut functions,
     )?;
     let averaged = match cx.model.fast_phase {
         Some(_) => {
-            let field = averaged_functions(cx, derivation, form, &state, &mut functions)?;
+            let field = averaged_functions(cx, derivation, form, &mut functions)?;
             if has_second_order(derivation, cx.model) {
                 let (second, steps) = second_order(cx, derivation, form);
                 functions.extend(crate::functions::second_order_functions(
@@ -361,6 +395,7 @@ pub fn functions(
         cx,
         (&exact, &exact_outputs),
         averaged.as_ref().map(|(s, o)| (&s[..], &o[..])),
+        Tangents::DualNumbers,
     )?;
     Ok((functions, taylor))
 }
@@ -371,7 +406,6 @@ fn averaged_functions(
     cx: &Context,
     derivation: &Derivation,
     form: &NumericForm,
-    state: &[String],
     functions: &mut Vec<Function>,
 ) -> Result<(Vec<Step>, Vec<String>), DeriveError> {
     let n = cx.n();
@@ -397,27 +431,22 @@ fn averaged_functions(
         &effective,
         "v__".into(),
     )?);
-    let coordinates = cx.coordinates();
-    let hessian: Vec<(String, String, Vec<String>)> = (0..n)
-        .flat_map(|i| (0..n).map(move |j| (i, j)))
-        .map(|(i, j)| {
-            (
-                format!("b__{i}_{j}"),
-                "v__".to_string(),
-                vec![coordinates[i].clone(), coordinates[j].clone()],
-            )
-        })
-        .collect();
-    effective.push(Step::Derivatives(hessian));
-    let (_, result) = matrix("b", &vec![vec![String::new(); n]; n]);
     functions.push(cx.function_steps(
-        "effective_potential_hessian",
-        "∂²(V + V_vibr)/∂q² (forward mode through the solves).",
-        Inputs::Coordinates,
-        format!("[[f64; {n}]; {n}]"),
+        "effective_potential_dual",
+        "V + V_vibr over hyper-dual numbers, for its Hessian.",
+        Inputs::HyperDualCoordinates,
+        "crate::ode::HyperDual".into(),
         &effective,
-        result,
+        "v__".into(),
     )?);
+    functions.push(Function {
+        name: "effective_potential_hessian".into(),
+        doc: "∂²(V + V_vibr)/∂q²: hyper-dual numbers through `effective_potential_dual`, one pass an entry of the upper triangle.".into(),
+        args: format!("q: &[f64; {n}], params: &Params"),
+        ret: format!("[[f64; {n}]; {n}]"),
+        body: Vec::new(),
+        result: "crate::ode::hyperdual::hessian(|q| effective_potential_dual(q, params), q)".into(),
+    });
     let (averaged, outputs) = averaged_steps(cx, derivation, form);
     let shifted: Vec<String> = (0..n).map(|i| format!("residual_mean__{i}")).collect();
     let hamiltonian = format!(
@@ -432,7 +461,7 @@ fn averaged_functions(
             inputs: Inputs::AveragedState,
             docs: [
                 "Averaged equations: q' = A⁻¹(p − b̄), p' = ∂L̄₀/∂q + P̄ − ∂W/∂q.",
-                "Jacobian of the averaged field (forward mode through the solves).",
+                "Jacobian of the averaged field.",
                 "Averaged Hamiltonian H̄(q, p) = ½ (p − b̄)ᵀA⁻¹(p − b̄) + V̄ + W.",
             ],
             steps: &averaged,
@@ -440,7 +469,6 @@ fn averaged_functions(
             hamiltonian_steps: averaged.len() - 2,
             hamiltonian,
         },
-        state,
         functions,
     )?;
     Ok((averaged, outputs))

@@ -9,6 +9,7 @@
 mod dop853;
 mod double_double;
 mod driver;
+pub mod dual;
 mod erased;
 mod events;
 mod gauss;
@@ -22,6 +23,7 @@ pub mod taylor;
 mod taylor_lanes;
 
 pub use double_double::DoubleDouble;
+pub use dual::Dual;
 pub use erased::{DynSystem, ErasedSystem};
 pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
 pub use hyperdual::HyperDual;

@@ -25,7 +25,8 @@ use super::{TaylorWork, LANES};
 /// a bound `f64: Mul<Num>` would shadow `f64: Mul<f64>` in the generated
 /// functions' constants.
 pub trait Scalar:
-    Copy
+    'static
+    + Copy
     + Default
     + From<f64>
     + Add<Output = Self>
