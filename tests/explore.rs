@@ -53,6 +53,42 @@ fn every_model_can_be_explored() {
     }
 }
 
+/// Every equilibrium the explorer reports is a critical point of the
+/// effective potential, checked by differences of its own at the reported
+/// point, for every model with one.
+#[test]
+fn every_reported_equilibrium_is_a_critical_point() {
+    for info in models::ALL {
+        let model = mechlab::models::by_name(info.name).expect("every model is listed");
+        let params = model.dynamic.defaults();
+        let Ok((equilibria, _)) = mechlab::explore::equilibria(model.dynamic, &params) else {
+            continue;
+        };
+        let v = |q: &[f64]| model.dynamic.effective_potential(&params, q).unwrap();
+        for e in &equilibria {
+            let gradient: f64 = (0..e.q.len())
+                .map(|i| {
+                    let (mut a, mut b) = (e.q.clone(), e.q.clone());
+                    a[i] += 1e-5;
+                    b[i] -= 1e-5;
+                    ((v(&a) - v(&b)) / 2e-5).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
+            let scale = 1.0
+                + e.hessian_eigenvalues
+                    .iter()
+                    .fold(0.0_f64, |m, h| m.max(h.abs()));
+            assert!(
+                gradient < 1e-6 * scale,
+                "{}: |∇V| = {gradient:e} at the reported equilibrium {:?}",
+                info.name,
+                e.q
+            );
+        }
+    }
+}
+
 #[test]
 fn a_state_of_the_wrong_length_is_an_error() {
     let handle = mechlab::models::by_name("kapitza").unwrap();

@@ -501,7 +501,12 @@ pub fn equilibria(
         return Err(NotSearched::NoPotential);
     }
     let v = |q: &[f64]| model.effective_potential(params, q).unwrap_or(f64::NAN);
+    // At the angles wrapped into [−π, π): Newton may wander many turns
+    // away, where a step of 10⁻⁶·|q| is no longer small and the
+    // differences of a periodic V vanish by aliasing (the triple
+    // pendulum's search reported 123 points with |∇V| ≈ 1 as equilibria).
     let gradient = |q: &[f64]| -> Vec<f64> {
+        let q = wrapped(q.to_vec(), &periodic);
         (0..n)
             .map(|i| {
                 let h = 1e-6 * (1.0 + q[i].abs());
