@@ -55,9 +55,8 @@ pub enum Inputs {
     Params,
     /// Coordinates only (`q: &[f64; N]`).
     Coordinates,
-    /// Coordinates as hyper-dual numbers, for second derivatives at run
-    /// time.
-    HyperDualCoordinates,
+    /// Coordinates as dual numbers, for first derivatives at run time.
+    DualCoordinates,
     /// Coordinates and velocities, at time t.
     CoordinatesVelocities,
     /// The Hamiltonian state `y = [q, p]` at time t.
@@ -134,11 +133,11 @@ impl Context<'_> {
         let mut prelude = Vec::new();
         let args = match inputs {
             Inputs::Params => "params: &Params".to_string(),
-            Inputs::Coordinates | Inputs::HyperDualCoordinates => {
+            Inputs::Coordinates | Inputs::DualCoordinates => {
                 prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
                 match inputs {
-                    Inputs::HyperDualCoordinates => {
-                        format!("q: &[crate::ode::HyperDual; {n}], params: &Params")
+                    Inputs::DualCoordinates => {
+                        format!("q: &[crate::ode::Dual; {n}], params: &Params")
                     }
                     _ => format!("q: &[f64; {n}], params: &Params"),
                 }
@@ -216,10 +215,10 @@ impl Context<'_> {
         let (args, mut body) = self.signature_and_prelude(inputs);
         let mut emitter = Emitter::default();
         emitter.lift = match inputs {
-            Inputs::HyperDualAveragedState | Inputs::HyperDualCoordinates => {
-                Some("crate::ode::HyperDual::from")
+            Inputs::HyperDualAveragedState => Some("crate::ode::HyperDual::from"),
+            Inputs::DualState | Inputs::DualAveragedState | Inputs::DualCoordinates => {
+                Some("crate::ode::Dual::from")
             }
-            Inputs::DualState | Inputs::DualAveragedState => Some("crate::ode::Dual::from"),
             _ => None,
         };
         // A vector's entries are lifted one by one (an entry may be a

@@ -14,13 +14,15 @@
 //! - averaged field: q' = A⁻¹(p − b̄), p' = ∂L̄₀/∂q + P̄ − ∂W/∂q with
 //!   W = V_vibr − ½ b̄ᵀA⁻¹b̄ (so that H̄ = ½(p − b̄)ᵀA⁻¹(p − b̄) + V̄ + W,
 //!   the mean of H over the phase);
-//! - ∂W/∂q as forward-mode derivatives through the solves
-//!   (δX = A⁻¹(δR − δA X)), so no quantity is approximated by finite
-//!   differences;
+//! - ∂W/∂q and ∂V_vibr/∂q by the adjoint of the solves
+//!   (Σ w_st (∂g_s)·x_t − ½ Σ w_st x_sᵀ(∂A)x_t, with the nonzero slopes of
+//!   A and g from the derivation), so no quantity is approximated by
+//!   finite differences and no solve is repeated per direction;
 //! - the Jacobians, the variational recurrences and the Hessian of
-//!   V + V_vibr at run time, by dual and hyper-dual numbers through the
-//!   generated recurrences and potential: written out here, they grew like
-//!   N³ (60 % of a 12-link chain's code).
+//!   V + V_vibr at run time, by dual numbers through the generated fields,
+//!   recurrences and gradient: written out by forward mode through the
+//!   solves, they and ∂W/∂q grew like N³ (a 12-link chain's module was
+//!   3.9 MB, now 1.3).
 
 use crate::derive::{Derivation, NumericForm};
 use crate::emit::Step;
@@ -172,7 +174,10 @@ fn averaged_steps(
         "w__".into(),
         dynamic_potential(n, form),
     )]));
-    steps.push(Step::Values(dynamic_potential_gradient(n, form)));
+    let weights = dynamic_weights(form);
+    steps.push(Step::Values(quadratic_form_gradient(
+        n, form, &weights, "dw",
+    )));
     let mut field: Vec<(String, String)> = cx
         .velocities()
         .into_iter()
@@ -213,11 +218,16 @@ fn dynamic_potential(n: usize, form: &NumericForm) -> String {
     mode_quadratic_form(n, &dynamic_weights(form))
 }
 
-/// ∂W/∂q_k by the adjoint of the solves x_t = A⁻¹g_t (A symmetric, w
-/// symmetric): ∂_k W = Σ_st w_st (∂_k g_s)·x_t − ½ Σ_st w_st x_sᵀ(∂_k A)x_t.
+/// The gradient of ½ Σ_st w_st g_s·x_t (W, or V_vibr with w = M) as
+/// `{prefix}__k`, by the adjoint of the solves x_t = A⁻¹g_t (A and w
+/// symmetric): ∂_k = Σ_st w_st (∂_k g_s)·x_t − ½ Σ_st w_st x_sᵀ(∂_k A)x_t.
 /// No solve per direction, and only the nonzero slopes of A and g appear.
-fn dynamic_potential_gradient(n: usize, form: &NumericForm) -> Vec<(String, String)> {
-    let weights = dynamic_weights(form);
+fn quadratic_form_gradient(
+    n: usize,
+    form: &NumericForm,
+    weights: &[Vec<f64>],
+    prefix: &str,
+) -> Vec<(String, String)> {
     let mut terms: Vec<Vec<String>> = vec![Vec::new(); n];
     let x = |t: usize, i: usize| format!("solved{t}__{i}");
     for (k, s, i, slope) in &form.mode_slopes {
@@ -253,7 +263,7 @@ fn dynamic_potential_gradient(n: usize, form: &NumericForm) -> Vec<(String, Stri
             } else {
                 t.join("+")
             };
-            (format!("dw__{k}"), text)
+            (format!("{prefix}__{k}"), text)
         })
         .collect()
 }
@@ -431,21 +441,39 @@ fn averaged_functions(
         &effective,
         "v__".into(),
     )?);
+    let mut gradient = vibrational_steps(derivation, form);
+    gradient.push(Step::Values(quadratic_form_gradient(
+        n,
+        form,
+        &form.mode_products,
+        "dv_vibr",
+    )));
+    gradient.push(Step::Values(
+        (0..n)
+            .map(|k| {
+                (
+                    format!("g__{k}"),
+                    format!("({})+dv_vibr__{k}", derivation.potential_gradient[k]),
+                )
+            })
+            .collect(),
+    ));
+    let names: Vec<String> = (0..n).map(|k| format!("g__{k}")).collect();
     functions.push(cx.function_steps(
-        "effective_potential_dual",
-        "V + V_vibr over hyper-dual numbers, for its Hessian.",
-        Inputs::HyperDualCoordinates,
-        "crate::ode::HyperDual".into(),
-        &effective,
-        "v__".into(),
+        "effective_potential_gradient_dual",
+        "∇(V + V_vibr) over dual numbers (∇V_vibr by the adjoint of the solves), for the Hessian.",
+        Inputs::DualCoordinates,
+        format!("[crate::ode::Dual; {n}]"),
+        &gradient,
+        format!("[{}]", names.join(", ")),
     )?);
     functions.push(Function {
         name: "effective_potential_hessian".into(),
-        doc: "∂²(V + V_vibr)/∂q²: hyper-dual numbers through `effective_potential_dual`, one pass an entry of the upper triangle.".into(),
+        doc: "∂²(V + V_vibr)/∂q²: the Jacobian of `effective_potential_gradient_dual` by dual numbers, one column a pass.".into(),
         args: format!("q: &[f64; {n}], params: &Params"),
         ret: format!("[[f64; {n}]; {n}]"),
         body: Vec::new(),
-        result: "crate::ode::hyperdual::hessian(|q| effective_potential_dual(q, params), q)".into(),
+        result: "crate::ode::dual::jacobian(q, |q| effective_potential_gradient_dual(q, params))".into(),
     });
     let (averaged, outputs) = averaged_steps(cx, derivation, form);
     let shifted: Vec<String> = (0..n).map(|i| format!("residual_mean__{i}")).collect();

@@ -797,6 +797,8 @@ struct Orders {
 /// pattern and count, and the locals a part may read.
 struct Slots {
     pattern: String,
+    /// The slots' names, in order.
+    names: Vec<String>,
     count: usize,
     locals: Vec<Local>,
 }
@@ -1192,6 +1194,7 @@ impl Writer<'_> {
         let slot_names: Vec<&str> = varying.iter().map(|&k| self.names[k].as_str()).collect();
         let slots = Slots {
             pattern: format!("[{}]", slot_names.join(", ")),
+            names: slot_names.iter().map(|s| s.to_string()).collect(),
             count: varying.len(),
             locals: self.locals(&live, dim, variational),
         };
@@ -1316,15 +1319,26 @@ impl Writer<'_> {
         lines.push("for n in 1..order {".into());
         for run in runs {
             let name = format!("{}_part_{}", self.function, parts.len() + 1);
-            let mut body = vec![format!("let {} = slots;", slots.pattern)];
-            body.extend(run);
-            let read: std::collections::HashSet<&str> = body
+            let read: std::collections::HashSet<&str> = run
                 .iter()
                 .flat_map(|line| {
                     line.split(|c: char| !(c.is_alphanumeric() || c == '_'))
                         .filter(|word| !word.is_empty())
                 })
                 .collect();
+            // Only the slots this part reads get a name: a large model has
+            // thousands, and every part binding all of them grew the code
+            // like N⁴ (4 of a 20-link chain's 6.5 MB).
+            let pattern: Vec<&str> = slots
+                .names
+                .iter()
+                .map(|name| match read.contains(name.as_str()) {
+                    true => name.as_str(),
+                    false => "_",
+                })
+                .collect();
+            let mut body = vec![format!("let [{}] = slots;", pattern.join(", "))];
+            body.extend(run.iter().cloned());
             let used: Vec<&Local> = slots
                 .locals
                 .iter()

@@ -56,11 +56,11 @@ pub const MAX_EXPRESSION_CHARS: usize = 10_000;
 pub const SYMBOLIC_INVERSE_MAX_DOF: usize = 2;
 
 /// The largest model the build accepts. The analyses run at any size (the
-/// equilibrium search samples its grid beyond 8 degrees of freedom), but
-/// the generated code grows like N³ (derivatives through the mass matrix's
-/// solve): a 12-link chain adds about 2.5 minutes to a build on 2 cores
-/// and a 16-link one about 7.5.
-pub const MAX_DOF: usize = 16;
+/// equilibrium search samples its grid beyond 8 degrees of freedom), and
+/// the generated code of a chain grows like N² (derivatives run at run
+/// time over dual numbers), but the build still grows: a 12-link chain
+/// adds about 1 minute to a build on 2 cores and a 20-link one about 4.5.
+pub const MAX_DOF: usize = 24;
 
 /// How the generated code gets the velocities from the momenta.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -470,7 +470,7 @@ impl ModelFile {
             return Err(err(
                 "coordinates",
                 format!(
-                    "{} degrees of freedom: at most {MAX_DOF} are built (the generated code grows like N³: a 12-link chain adds about 2.5 minutes to a build on 2 cores, a 16-link one about 7.5)",
+                    "{} degrees of freedom: at most {MAX_DOF} are built (a 12-link chain adds about 1 minute to a build on 2 cores, a 20-link one about 4.5)",
                     self.coordinates.len()
                 ),
             ));

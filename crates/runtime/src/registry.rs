@@ -363,18 +363,18 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
 
 /// A Hamiltonian model at its own size, for [`with_fixed`]. The analyses
 /// are compiled ahead, in this crate, for 1 to 4 degrees of freedom; a
-/// model of 5 to 16 brings its own (see [`crate::large_models`]).
+/// model of 5 to 24 brings its own (see [`crate::large_models`]).
 #[derive(Clone, Copy)]
 pub enum Sized {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
     Dof4(&'static Erased<4, 8, 16, 72>),
-    /// 5 to 16 degrees of freedom: a [`crate::large_models::LargeHandle`].
+    /// 5 to 24 degrees of freedom: a [`crate::large_models::LargeHandle`].
     Large(LargeHandleRef),
 }
 
-/// A work that also runs on a model of 5 to 16 degrees of freedom, whose
+/// A work that also runs on a model of 5 to 24 degrees of freedom, whose
 /// analyses are compiled in the models package at its size
 /// ([`crate::large_models`] implements it for every analysis's work).
 pub trait LargeWork: WithFixed {
@@ -382,7 +382,7 @@ pub trait LargeWork: WithFixed {
     fn on_large(self, model: LargeHandleRef) -> Self::Output;
 }
 
-/// A model of 5 to 16 degrees of freedom, type-erased: the registry holds it
+/// A model of 5 to 24 degrees of freedom, type-erased: the registry holds it
 /// without naming the analyses (which import the registry), and
 /// [`crate::large_models`], above both, reads it back.
 pub type LargeHandleRef = &'static (dyn std::any::Any + Send + Sync);

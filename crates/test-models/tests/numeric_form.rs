@@ -469,11 +469,18 @@ fn too_large_models_are_refused_with_a_reason() {
         }
         text
     };
-    let error = mechlab::model::Model::parse("models/chain.toml", &chain(17, "")).unwrap_err();
+    let too_many = mechlab::model::MAX_DOF + 1;
+    let error =
+        mechlab::model::Model::parse("models/chain.toml", &chain(too_many, "")).unwrap_err();
     assert_eq!(error.file, "models/chain.toml");
     assert_eq!(error.key, "coordinates");
     assert!(
-        error.reason.contains("17 degrees of freedom") && error.reason.contains("at most 16"),
+        error
+            .reason
+            .contains(&format!("{too_many} degrees of freedom"))
+            && error
+                .reason
+                .contains(&format!("at most {}", mechlab::model::MAX_DOF)),
         "{error}"
     );
     let error =

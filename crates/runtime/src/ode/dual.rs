@@ -3,9 +3,11 @@
 //!
 //! A model whose mass matrix is solved at run time (the numeric form, four
 //! or more degrees of freedom) gets its derivatives here rather than
-//! written out: its Jacobians are its fields generated over dual numbers,
-//! one column a pass, and its variational recurrences are its Taylor
-//! recurrences over dual numbers, seeded with one tangent vector a pass.
+//! written out: its Jacobians (and the Hessian of its effective potential,
+//! the Jacobian of its gradient) are its fields generated over dual
+//! numbers, one column a pass, and its variational recurrences are its
+//! Taylor recurrences over dual numbers, seeded with one tangent vector a
+//! pass.
 //! Written out by forward mode through every solve at build time, they
 //! grew like N³ in code: 1.5 of a 12-link chain's 3.9 MB. A batch's
 //! tangents run lane by lane ([`lane_by_lane`]).
