@@ -94,6 +94,10 @@ pub struct Emitter {
     /// other than f64: there, parameter expressions stay f64 while the
     /// state's are of that type, and an array needs one type.
     pub lift: Option<&'static str>,
+    /// The type that factorises the solves' matrices, where not
+    /// `crate::linalg::Cholesky` (dual numbers have one of their own, which
+    /// factorises the values once).
+    pub factorisation: Option<&'static str>,
 }
 
 /// `let &Params { fields } = params;`, the prelude of a generated function
@@ -776,7 +780,8 @@ impl Emitter {
                     })
                     .collect();
                 self.lines.push(format!(
-                    "let {name} = crate::linalg::Cholesky::new([{}]);",
+                    "let {name} = {}::new([{}]);",
+                    self.factorisation.unwrap_or("crate::linalg::Cholesky"),
                     rows.join(", ")
                 ));
                 self.factors.insert(matrix.clone(), name.clone());

@@ -217,6 +217,7 @@ impl Context<'_> {
         emitter.lift = match inputs {
             Inputs::HyperDualAveragedState => Some("crate::ode::HyperDual::from"),
             Inputs::DualState | Inputs::DualAveragedState | Inputs::DualCoordinates => {
+                emitter.factorisation = Some("crate::ode::dual::Cholesky");
                 Some("crate::ode::Dual::from")
             }
             _ => None,

@@ -261,6 +261,48 @@ impl<S: Scalar> Scalar for Dual<S> {
     }
 }
 
+/// A x = b over dual numbers with the values factorised alone:
+/// x = A⁻¹b and x' = A⁻¹(b' − A'x), the derivative of the solve, where
+/// factorising over dual numbers would differentiate the factor too (three
+/// times the work, for the same x').
+pub struct Cholesky<const N: usize> {
+    value: crate::linalg::Cholesky<f64, N>,
+    /// A' (its lower triangle is read, as the factorisation reads A's).
+    slope: [[f64; N]; N],
+}
+
+impl<const N: usize> Cholesky<N> {
+    #[inline]
+    pub fn new(a: [[Dual; N]; N]) -> Self {
+        Cholesky {
+            value: crate::linalg::Cholesky::new(a.map(|row| row.map(|x| x.re))),
+            slope: a.map(|row| row.map(|x| x.du)),
+        }
+    }
+
+    #[inline]
+    pub fn solve(&self, b: [Dual; N]) -> [Dual; N] {
+        let x = self.value.solve(b.map(|v| v.re));
+        let residual: [f64; N] = std::array::from_fn(|i| {
+            let mut ax = 0.0;
+            for (j, xj) in x.iter().enumerate() {
+                let slope = if i >= j {
+                    self.slope[i][j]
+                } else {
+                    self.slope[j][i]
+                };
+                ax += slope * xj;
+            }
+            b[i].du - ax
+        });
+        let dx = self.value.solve(residual);
+        std::array::from_fn(|i| Dual {
+            re: x[i],
+            du: dx[i],
+        })
+    }
+}
+
 thread_local! {
     /// One Taylor workspace per dual number type and thread: a model's
     /// recurrences over dual numbers take megabytes of coefficients, too
