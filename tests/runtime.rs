@@ -256,6 +256,19 @@ fn dual_jacobian_and_lane_by_lane() {
             assert!((j[i][k] - exact[i][k]).abs() < 1e-15, "{i} {k}");
         }
     }
+    // A larger one: f_i = v_i·v_{i+1} (cyclic) over 11 variables.
+    let y: [f64; 11] = std::array::from_fn(|i| 0.3 + i as f64);
+    let j = jacobian(&y, |v| std::array::from_fn(|i| v[i] * v[(i + 1) % 11]));
+    for i in 0..11 {
+        for k in 0..11 {
+            let exact = match k {
+                k if k == i => y[(i + 1) % 11],
+                k if k == (i + 1) % 11 => y[i],
+                _ => 0.0,
+            };
+            assert_eq!(j[i][k], exact, "{i} {k}");
+        }
+    }
     let z: Vec<Lanes> = (0..3)
         .map(|i| Lanes(std::array::from_fn(|l| (i * 10 + l) as f64)))
         .collect();
