@@ -30,6 +30,13 @@ pub struct TaylorFunction {
     parts: Vec<TaylorPart>,
 }
 
+impl TaylorFunction {
+    /// Whether these are tangent recurrences (written out, see [`Tangents`]).
+    pub(crate) fn is_variational(&self) -> bool {
+        self.variational
+    }
+}
+
 #[derive(Serialize)]
 pub struct TaylorPart {
     name: String,

@@ -105,8 +105,12 @@ pub fn render(
     );
     context.insert("momenta", &cx.momenta());
     context.insert("has_phase", &model.fast_phase.is_some());
-    // The numeric form's derivatives run over dual numbers (`Tangents`).
-    context.insert("tangents_by_dual_numbers", &derivation.numeric.is_some());
+    // Without written-out tangent recurrences (`Tangents::DualNumbers`),
+    // the template runs the exact ones over dual numbers.
+    context.insert(
+        "tangents_by_dual_numbers",
+        &!taylor_functions.iter().any(|f| f.is_variational()),
+    );
     // Every model with a fast phase: in closed form, or (numeric solves,
     // up to `numeric::SECOND_ORDER_MAX_DOF`) with the series in the DAG.
     context.insert(

@@ -1,7 +1,7 @@
 //! Dual numbers x = a + b ε (ε² = 0) over any [`Scalar`]: f(x) carries f
 //! and its derivative along the seeded direction, exact to round-off.
 //!
-//! A model whose mass matrix is solved at run time (the numeric form, four
+//! A model whose mass matrix is solved at run time (the numeric form, three
 //! or more degrees of freedom) gets its derivatives here rather than
 //! written out: its Jacobians (and the Hessian of its effective potential,
 //! the Jacobian of its gradient) are its fields generated over dual
@@ -13,8 +13,8 @@
 //! tangents run lane by lane ([`lane_by_lane`]).
 //!
 //! (num-dual has dual numbers; this one exists for the same reason as
-//! [`super::HyperDual`]: the generated code needs them as a [`Scalar`], and
-//! over lanes too.)
+//! [`super::HyperDual`]: the generated code needs them as a [`Scalar`],
+//! over whichever number type its recurrences run in.)
 
 use super::series::Scalar;
 use super::{Lanes, TaylorWork, LANES};
@@ -311,7 +311,7 @@ thread_local! {
 }
 
 /// Runs `f` with this thread's Taylor workspace for dual numbers over `S`.
-fn with_workspace<S: Scalar + 'static, R>(f: impl FnOnce(&mut TaylorWork<Dual<S>>) -> R) -> R {
+fn with_workspace<S: Scalar, R>(f: impl FnOnce(&mut TaylorWork<Dual<S>>) -> R) -> R {
     WORKSPACES.with(|cell| {
         // Taken out while `f` runs, so that a nested call gets a fresh one.
         let taken = cell.borrow_mut().remove(&TypeId::of::<S>());
@@ -347,7 +347,7 @@ pub fn jacobian<const N: usize>(
 /// state's recurrences with y seeded along v_k (the series of y(t; y₀ + ε
 /// v_k) is the series of y plus ε times the tangent's).
 #[inline]
-pub fn variational<Num: Scalar + 'static, const N: usize>(
+pub fn variational<Num: Scalar, const N: usize>(
     z: &[Num],
     order: usize,
     out: &mut [Num],
