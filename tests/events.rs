@@ -3,7 +3,8 @@
 //! already zero at the start, and two crossings inside one step.
 
 use mechlab::ode::{
-    Direction, Event, EventSettings, Integrator, Method, OdeError, Scalar, System, TaylorWork,
+    states_at, Direction, Event, EventSettings, Integrator, Method, OdeError, Options, Scalar,
+    System, TaylorWork,
 };
 use std::f64::consts::PI;
 
@@ -77,7 +78,14 @@ fn dense_output_is_as_accurate_as_the_steps() {
     ] {
         let mut integrator = Integrator::new(Method::parse(name, tol).unwrap()).unwrap();
         let states = integrator
-            .advance_sampled(&Oscillator, 0.0, &[1.0, 0.0], &times)
+            .solve(
+                &Oscillator,
+                0.0,
+                &[1.0, 0.0],
+                times.last().copied().unwrap_or(0.0),
+                Options::default().times(&times),
+            )
+            .map(|run| run.samples)
             .unwrap();
         let steps = integrator.stats.steps;
         assert!(
@@ -108,20 +116,24 @@ fn dense_output_between_steps_is_as_good_as_at_the_steps() {
         let mut ends = vec![0.0];
         Integrator::new(Method::parse(name, tol).unwrap())
             .unwrap()
-            .advance_observed(&Oscillator, 0.0, &[1.0, 0.0], 30.0, &mut |t, y| {
-                at_steps = at_steps.max(exact_error(t, y));
-                ends.push(t);
-            })
+            .solve(
+                &Oscillator,
+                0.0,
+                &[1.0, 0.0],
+                30.0,
+                Options::default().observe(&mut |t, y| {
+                    at_steps = at_steps.max(exact_error(t, y));
+                    ends.push(t);
+                }),
+            )
             .unwrap();
         // Sample at 1/3 and 2/3 of every step.
         let times: Vec<f64> = ends
             .windows(2)
             .flat_map(|w| [w[0] + (w[1] - w[0]) / 3.0, w[0] + 2.0 * (w[1] - w[0]) / 3.0])
             .collect();
-        let states = Integrator::new(Method::parse(name, tol).unwrap())
-            .unwrap()
-            .advance_sampled(&Oscillator, 0.0, &[1.0, 0.0], &times)
-            .unwrap();
+        let method = Method::parse(name, tol).unwrap();
+        let states = states_at(method, &Oscillator, 0.0, &[1.0, 0.0], &times).unwrap();
         let between = times
             .iter()
             .zip(&states)
@@ -145,7 +157,13 @@ fn crossings_are_located_on_the_far_side_of_the_root() {
         };
         let run = Integrator::new(method)
             .unwrap()
-            .advance_with_events(&Oscillator, 0.0, &[1.0, 0.0], 10.0, &events, settings)
+            .solve(
+                &Oscillator,
+                0.0,
+                &[1.0, 0.0],
+                10.0,
+                Options::default().events(&events, settings),
+            )
             .unwrap();
         assert!(!run.terminated);
         let roots: Vec<f64> = run.hits.iter().map(|h| h.t).collect();
@@ -176,13 +194,12 @@ fn a_terminal_event_stops_and_the_run_restarts_cleanly() {
         let mut integrator = Integrator::new(method).unwrap();
         let events = [Event::new(&g)];
         let first = integrator
-            .advance_with_events(
+            .solve(
                 &Oscillator,
                 0.0,
                 &[1.0, 0.0],
                 10.0,
-                &events,
-                EventSettings::default(),
+                Options::default().events(&events, EventSettings::default()),
             )
             .unwrap();
         assert!(first.terminated);
@@ -194,13 +211,12 @@ fn a_terminal_event_stops_and_the_run_restarts_cleanly() {
         );
         // Restart from the reported state: the same root is not found again.
         let second = integrator
-            .advance_with_events(
+            .solve(
                 &Oscillator,
                 first.t,
                 &first.y,
                 10.0,
-                &events,
-                EventSettings::default(),
+                Options::default().events(&events, EventSettings::default()),
             )
             .unwrap();
         assert!(second.terminated && second.hits.len() == 1 && second.hits[0].rising);
@@ -220,13 +236,12 @@ fn a_condition_zero_at_the_start_is_not_an_event() {
     let events = [Event::new(&g)];
     let run = Integrator::new(Method::parse("dop853", 1e-12).unwrap())
         .unwrap()
-        .advance_with_events(
+        .solve(
             &Oscillator,
             0.0,
             &[1.0, 0.0],
             10.0,
-            &events,
-            EventSettings::default(),
+            Options::default().events(&events, EventSettings::default()),
         )
         .unwrap();
     assert!((run.t - PI).abs() < 1e-10, "{}", run.t);
@@ -250,7 +265,13 @@ fn close_and_simultaneous_events_are_reported_in_order() {
     ] {
         let run = Integrator::new(method)
             .unwrap()
-            .advance_with_events(&Clock, 0.0, &[0.0], 2.0, &events, EventSettings::default())
+            .solve(
+                &Clock,
+                0.0,
+                &[0.0],
+                2.0,
+                Options::default().events(&events, EventSettings::default()),
+            )
             .unwrap();
         let order: Vec<usize> = run.hits.iter().map(|h| h.event).collect();
         assert_eq!(order.len(), 3, "{}: {:?}", method.name(), run.hits);
@@ -270,16 +291,18 @@ fn two_crossings_inside_one_step_are_found_by_the_interior_samples() {
     let run = |samples: usize| {
         Integrator::new(Method::Rk4 { step: 0.9 })
             .unwrap()
-            .advance_with_events(
+            .solve(
                 &Clock,
                 0.0,
                 &[0.0],
                 2.7,
-                &events,
-                EventSettings {
-                    interior_samples: samples,
-                    ..Default::default()
-                },
+                Options::default().events(
+                    &events,
+                    EventSettings {
+                        interior_samples: samples,
+                        ..Default::default()
+                    },
+                ),
             )
             .unwrap()
             .hits
@@ -300,18 +323,79 @@ fn bad_event_settings_are_errors() {
     let events = [Event::new(&g)];
     let error = Integrator::new(Method::Rk4 { step: 0.1 })
         .unwrap()
-        .advance_with_events(
+        .solve(
             &Clock,
             0.0,
             &[0.0],
             2.0,
-            &events,
-            EventSettings {
-                time_tolerance: 0.0,
-                ..Default::default()
-            },
+            Options::default().events(
+                &events,
+                EventSettings {
+                    time_tolerance: 0.0,
+                    ..Default::default()
+                },
+            ),
         )
         .unwrap_err();
     assert!(matches!(error, OdeError::InvalidSetting { .. }));
     assert!(error.to_string().contains("event time tolerance"));
+}
+
+#[test]
+fn one_run_gives_output_times_events_and_steps_together() {
+    // A terminal event at the first root of cos t (t = π/2) ends the
+    // samples there; every sample and step end is on the exact solution.
+    let g = |_: f64, y: &[f64; 2]| y[0];
+    let events = [Event::new(&g)];
+    let times: Vec<f64> = (0..=40).map(|i| i as f64 * 0.1).collect();
+    let mut steps = 0;
+    let mut worst_step = 0.0f64;
+    let mut observe = |t: f64, y: &[f64; 2]| {
+        steps += 1;
+        worst_step = worst_step.max((y[0] - t.cos()).abs());
+    };
+    let options = Options::default()
+        .times(&times)
+        .events(&events, EventSettings::default())
+        .observe(&mut observe);
+    let run = Integrator::new(Method::parse("dop853", 1e-12).unwrap())
+        .unwrap()
+        .solve(&Oscillator, 0.0, &[1.0, 0.0], 4.0, options)
+        .unwrap();
+    assert!(
+        run.terminated && (run.t - 0.5 * PI).abs() < 1e-10,
+        "{}",
+        run.t
+    );
+    assert_eq!(run.samples.len(), 16, "0, 0.1, …, 1.5 come before π/2");
+    for (t, y) in times.iter().zip(&run.samples) {
+        assert!((y[0] - t.cos()).abs() < 1e-10 && (y[1] + t.sin()).abs() < 1e-10);
+    }
+    assert!(
+        steps > 0 && worst_step < 1e-10,
+        "{steps} steps, {worst_step:e}"
+    );
+    let backwards = Integrator::new(Method::parse("dop853", 1e-12).unwrap())
+        .unwrap()
+        .solve(
+            &Oscillator,
+            0.0,
+            &[1.0, 0.0],
+            -1.0,
+            Options::default().times(&[0.0, -0.5, -1.0]),
+        )
+        .unwrap();
+    for (t, y) in [0.0f64, -0.5, -1.0].iter().zip(&backwards.samples) {
+        assert!((y[0] - t.cos()).abs() < 1e-10, "{t}: {y:?}");
+    }
+    let unordered = Integrator::new(Method::parse("dop853", 1e-12).unwrap())
+        .unwrap()
+        .solve(
+            &Oscillator,
+            0.0,
+            &[1.0, 0.0],
+            1.0,
+            Options::default().times(&[0.5, 0.2]),
+        );
+    assert!(matches!(unordered, Err(OdeError::InvalidSetting { .. })));
 }

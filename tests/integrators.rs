@@ -5,7 +5,7 @@ use mechlab::analysis::floquet::{floquet_multipliers, monodromy, Verdict};
 use mechlab::analysis::lyapunov::lyapunov_spectrum;
 use mechlab::analysis::period_map::{orbit, wrap_angle};
 use mechlab::models::kapitza;
-use mechlab::ode::{Integrator, Method, OdeError, System};
+use mechlab::ode::{Integrator, Method, OdeError, Options, System};
 use std::f64::consts::PI;
 
 /// y'' = −y as a first-order system: exact solution (cos t, −sin t).
@@ -121,14 +121,20 @@ fn gauss_legendre_keeps_the_energy_bounded_where_rk4_drifts() {
         let mut worst = 0.0f64;
         let mut n = 0u64;
         integrator
-            .advance_observed(&system, 0.0, &y0, h * steps as f64, &mut |_, y| {
-                let e = (kapitza::averaged_hamiltonian(y, &params) - h0).abs();
-                n += 1;
-                worst = worst.max(e);
-                if n <= steps / 10 {
-                    worst_first_tenth = worst_first_tenth.max(e);
-                }
-            })
+            .solve(
+                &system,
+                0.0,
+                &y0,
+                h * steps as f64,
+                Options::default().observe(&mut |_, y| {
+                    let e = (kapitza::averaged_hamiltonian(y, &params) - h0).abs();
+                    n += 1;
+                    worst = worst.max(e);
+                    if n <= steps / 10 {
+                        worst_first_tenth = worst_first_tenth.max(e);
+                    }
+                }),
+            )
             .unwrap();
         (worst_first_tenth, worst)
     };

@@ -206,7 +206,7 @@ fn a_stream_ends_each_orbit_with_its_scalar_segments() {
     let mut scalar = Integrator::new(TAYLOR).unwrap();
     for (k, start) in starts.iter().enumerate() {
         let mut samples = Vec::new();
-        let expected = scalar.advance_segments(&BlowUp, start, 0.2, segments(k), &mut |y| {
+        let expected = scalar.stream(&BlowUp, start, 0.2, segments(k), &mut |y| {
             samples.push(*y);
             y[0] *= 1.5;
             true
@@ -384,7 +384,7 @@ fn nan_coefficients_stop_the_run_where_they_appear() {
         true
     });
     let mut scalar = Integrator::new(TAYLOR).unwrap();
-    let expected = scalar.advance_segments(&NanSeries, &[1.0], 0.5, 3, &mut |_| true);
+    let expected = scalar.stream(&NanSeries, &[1.0], 0.5, 3, &mut |_| true);
     assert_eq!(errors[0], expected.err());
     assert!(
         matches!(errors[0], Some(OdeError::NonFinite { t, .. }) if t == 0.0),

@@ -21,7 +21,7 @@ use crate::analysis::vibrational_stability::{
 };
 use crate::models::double_pendulum::Averaged;
 use crate::models::double_pendulum::{self as model, Exact, Params};
-use crate::ode::{Integrator, Method, OdeError};
+use crate::ode::{states_at, Integrator, Method, OdeError};
 use crate::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
 use crate::scene::{Knob, Scene, SceneError};
 use rayon::prelude::*;
@@ -447,7 +447,7 @@ fn limiting_run(
 ) -> Result<Vec<Vec<(f64, f64)>>, OdeError> {
     let grid: Vec<f64> = (0..=3000).map(|i| t_long * i as f64 / 3000.0).collect();
     let system = Averaged { params: *params };
-    let states = Integrator::new(method)?.advance_sampled(&system, 0.0, y0, &grid)?;
+    let states = states_at(method, &system, 0.0, y0, &grid)?;
     Ok([phi.0, phi.1]
         .iter()
         .enumerate()

@@ -55,7 +55,7 @@ pub fn assert_streams_equal_scalar<S: System<N>, const N: usize>(orbits: &[Orbit
     for (k, orbit) in orbits.iter().enumerate() {
         let mut end = None;
         let expected = scalar
-            .advance_segments(orbit.system, &orbit.start, orbit.end, 1, &mut |y| {
+            .stream(orbit.system, &orbit.start, orbit.end, 1, &mut |y| {
                 end = Some(*y);
                 false
             })

@@ -808,105 +808,18 @@ fn numeric_form(
     };
     let mean_potential = match &phase {
         Some(th) => {
-            let depends_on_phase = |e: &Atom| !is_zero(&e.derivative(symbol!(th.as_str())));
-            if mass.iter().flatten().any(depends_on_phase) {
-                return Err(DeriveError::Model {
-                    key: "lagrangian".into(),
-                    reason: format!("the mass matrix depends on the fast phase '{th}': averaging with a numeric solve of A needs A(q) alone"),
-                });
-            }
-            for (i, f) in forces.iter().enumerate() {
-                for v in &qd {
-                    let slope = f.derivative(symbol!(v.as_str()));
-                    let nonlinear = qd
-                        .iter()
-                        .any(|w| !is_zero(&slope.derivative(symbol!(w.as_str()))));
-                    if nonlinear || depends_on_phase(&slope) {
-                        return Err(DeriveError::Model {
-                            key: format!("forces.{}", q[i]),
-                            reason: format!("averaging with a numeric solve of A needs forces linear in the velocities with coefficients free of the phase '{th}'"),
-                        });
-                    }
-                }
-            }
-            let mean_linear: Vec<Atom> = linear
-                .iter()
-                .map(|b| phase_mean(b, th).map(|m| m.expand()))
-                .collect::<Result<_, _>>()?;
-            for (i, b) in mean_linear.iter().enumerate() {
-                form.mean_linear_term.push(rec.record(
-                    format!("mean_linear_term[{i}]"),
-                    "b̄ = mean of b over the phase",
-                    b,
-                )?);
-            }
-            let modes = phase_modes(&linear, th)?;
-            for (s_index, ((a, b), g)) in modes.iter().enumerate() {
-                let mut texts = Vec::new();
-                for (i, component) in g.iter().enumerate() {
-                    texts.push(rec.record(
-                        format!("linear_term_modes[{s_index}][{i}]"),
-                        format!("b = Σ_s h_s(θ) g_s(q): g_{s_index}, the coefficient of sin(θ)^{a} cos(θ)^{b}"),
-                        component,
-                    )?);
-                }
-                form.modes.push(texts);
-            }
-            let mean = |a: i64, b: i64| {
-                let (numerator, denominator) = monomial_mean(a, b);
-                numerator as f64 / denominator as f64
+            check_numeric_averaging(&q, &qd, &mass, &forces, th)?;
+            let averaging = Averaging {
+                q: &q,
+                qd: &qd,
+                p: &p,
+                mass: &mass,
+                linear: &linear,
+                potential: &potential,
+                forces: &forces,
+                th,
             };
-            (form.mass_slopes, form.mode_slopes) = slopes(&q, &mass, &modes);
-            form.mode_exponents = modes.iter().map(|(k, _)| *k).collect();
-            form.mode_means = modes.iter().map(|((a, b), _)| mean(*a, *b)).collect();
-            form.mode_products = modes
-                .iter()
-                .map(|((a, b), _)| modes.iter().map(|((c, d), _)| mean(a + c, b + d)).collect())
-                .collect();
-            let mean_potential = phase_mean(&potential, th)?.expand();
-            let mut reduced = -mean_potential.clone();
-            for i in 0..n {
-                reduced += &mean_linear[i] * var(&qd[i]);
-                for j in 0..n {
-                    reduced += &mass[i][j] * var(&qd[i]) * var(&qd[j]) / num(2);
-                }
-            }
-            for (h, coefficient) in crate::deprit::fourier(&potential, th)? {
-                let (label, what) = match h {
-                    crate::lie::Harmonic::Cos(0) => (
-                        "cos0".to_string(),
-                        format!("the mean of V(q, {th}) over {th}"),
-                    ),
-                    crate::lie::Harmonic::Cos(k) => (
-                        format!("cos{k}"),
-                        format!("the coefficient of cos({k}{th}) in V(q, {th})"),
-                    ),
-                    crate::lie::Harmonic::Sin(k) => (
-                        format!("sin{k}"),
-                        format!("the coefficient of sin({k}{th}) in V(q, {th})"),
-                    ),
-                };
-                let text = rec.record(
-                    format!("potential_harmonics[{label}]"),
-                    format!("{what}, for second-order averaging"),
-                    &coefficient.expand(),
-                )?;
-                form.potential_series.push((h, text));
-            }
-            for i in 0..n {
-                let force = phase_mean(&forces[i], th)?;
-                form.mean_forces.push(force.to_string());
-                let rate_i = (reduced.derivative(symbol!(q[i].as_str())) + force).expand();
-                form.averaged_momentum_rates.push(rec.record(
-                    format!("averaged_momentum_rates[{i}]"),
-                    format!(
-                        "d{}/dt of the averaged system without −∂V_vibr/∂{}: ∂L̄₀/∂{} + P̄, L̄₀ = ½ q'ᵀAq' + b̄ᵀq' − V̄, at q' = A⁻¹(p − b̄)",
-                        p[i], q[i], q[i]
-                    ),
-                    &rate_i,
-                )?);
-            }
-            mean_potential
+            averaging.record(&mut rec, &mut form)?
         }
         None => potential.clone(),
     };
@@ -918,4 +831,158 @@ fn numeric_form(
     derivation.numeric = Some(form);
     derivation.derived = rec.finish();
     Ok(derivation)
+}
+
+/// Averaging with a numeric solve of A needs A(q) free of the phase and
+/// forces linear in the velocities with phase-free coefficients.
+fn check_numeric_averaging(
+    q: &[String],
+    qd: &[String],
+    mass: &[Vec<Atom>],
+    forces: &[Atom],
+    th: &str,
+) -> Result<(), DeriveError> {
+    let depends_on_phase = |e: &Atom| !is_zero(&e.derivative(symbol!(th)));
+    if mass.iter().flatten().any(depends_on_phase) {
+        return Err(DeriveError::Model {
+            key: "lagrangian".into(),
+            reason: format!("the mass matrix depends on the fast phase '{th}': averaging with a numeric solve of A needs A(q) alone"),
+        });
+    }
+    for (i, f) in forces.iter().enumerate() {
+        for v in qd {
+            let slope = f.derivative(symbol!(v.as_str()));
+            let nonlinear = qd
+                .iter()
+                .any(|w| !is_zero(&slope.derivative(symbol!(w.as_str()))));
+            if nonlinear || depends_on_phase(&slope) {
+                return Err(DeriveError::Model {
+                    key: format!("forces.{}", q[i]),
+                    reason: format!("averaging with a numeric solve of A needs forces linear in the velocities with coefficients free of the phase '{th}'"),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What the averaged numeric form is built from.
+struct Averaging<'a> {
+    q: &'a [String],
+    qd: &'a [String],
+    p: &'a [String],
+    mass: &'a [Vec<Atom>],
+    linear: &'a [Atom],
+    potential: &'a Atom,
+    forces: &'a [Atom],
+    /// The fast phase.
+    th: &'a str,
+}
+
+impl Averaging<'_> {
+    /// Records the phase means, the modes of b and their products and
+    /// slopes, V's harmonics and the averaged momentum rates in `form`;
+    /// returns the mean potential V̄.
+    fn record(&self, rec: &mut Recorder, form: &mut NumericForm) -> Result<Atom, DeriveError> {
+        let Averaging {
+            q,
+            qd,
+            p,
+            mass,
+            linear,
+            potential,
+            forces,
+            th,
+        } = *self;
+        let n = q.len();
+        let mean_linear: Vec<Atom> = linear
+            .iter()
+            .map(|b| phase_mean(b, th).map(|m| m.expand()))
+            .collect::<Result<_, _>>()?;
+        for (i, b) in mean_linear.iter().enumerate() {
+            form.mean_linear_term.push(rec.record(
+                format!("mean_linear_term[{i}]"),
+                "b̄ = mean of b over the phase",
+                b,
+            )?);
+        }
+        let modes = phase_modes(linear, th)?;
+        for (s_index, ((a, b), g)) in modes.iter().enumerate() {
+            let mut texts = Vec::new();
+            for (i, component) in g.iter().enumerate() {
+                texts.push(rec.record(
+                    format!("linear_term_modes[{s_index}][{i}]"),
+                    format!("b = Σ_s h_s(θ) g_s(q): g_{s_index}, the coefficient of sin(θ)^{a} cos(θ)^{b}"),
+                    component,
+                )?);
+            }
+            form.modes.push(texts);
+        }
+        let mean = |a: i64, b: i64| {
+            let (numerator, denominator) = monomial_mean(a, b);
+            numerator as f64 / denominator as f64
+        };
+        (form.mass_slopes, form.mode_slopes) = slopes(q, mass, &modes);
+        form.mode_exponents = modes.iter().map(|(k, _)| *k).collect();
+        form.mode_means = modes.iter().map(|((a, b), _)| mean(*a, *b)).collect();
+        form.mode_products = modes
+            .iter()
+            .map(|((a, b), _)| modes.iter().map(|((c, d), _)| mean(a + c, b + d)).collect())
+            .collect();
+        let mean_potential = phase_mean(potential, th)?.expand();
+        let mut reduced = -mean_potential.clone();
+        for i in 0..n {
+            reduced += &mean_linear[i] * var(&qd[i]);
+            for j in 0..n {
+                reduced += &mass[i][j] * var(&qd[i]) * var(&qd[j]) / num(2);
+            }
+        }
+        form.potential_series = potential_series(rec, potential, th)?;
+        for i in 0..n {
+            let force = phase_mean(&forces[i], th)?;
+            form.mean_forces.push(force.to_string());
+            let rate_i = (reduced.derivative(symbol!(q[i].as_str())) + force).expand();
+            form.averaged_momentum_rates.push(rec.record(
+                format!("averaged_momentum_rates[{i}]"),
+                format!(
+                    "d{}/dt of the averaged system without −∂V_vibr/∂{}: ∂L̄₀/∂{} + P̄, L̄₀ = ½ q'ᵀAq' + b̄ᵀq' − V̄, at q' = A⁻¹(p − b̄)",
+                    p[i], q[i], q[i]
+                ),
+                &rate_i,
+            )?);
+        }
+        Ok(mean_potential)
+    }
+}
+
+/// V(q, θ)'s Fourier coefficients in θ, recorded for second-order averaging.
+fn potential_series(
+    rec: &mut Recorder,
+    potential: &Atom,
+    th: &str,
+) -> Result<Vec<(crate::lie::Harmonic, String)>, DeriveError> {
+    let mut series = Vec::new();
+    for (h, coefficient) in crate::deprit::fourier(potential, th)? {
+        let (label, what) = match h {
+            crate::lie::Harmonic::Cos(0) => (
+                "cos0".to_string(),
+                format!("the mean of V(q, {th}) over {th}"),
+            ),
+            crate::lie::Harmonic::Cos(k) => (
+                format!("cos{k}"),
+                format!("the coefficient of cos({k}{th}) in V(q, {th})"),
+            ),
+            crate::lie::Harmonic::Sin(k) => (
+                format!("sin{k}"),
+                format!("the coefficient of sin({k}{th}) in V(q, {th})"),
+            ),
+        };
+        let text = rec.record(
+            format!("potential_harmonics[{label}]"),
+            format!("{what}, for second-order averaging"),
+            &coefficient.expand(),
+        )?;
+        series.push((h, text));
+    }
+    Ok(series)
 }

@@ -570,78 +570,18 @@ impl ModelFile {
         };
         let inverse = self.check_name_and_size(&err)?;
         self.declare_names(&err)?;
-
-        let coordinates: Vec<String> = self.coordinates.iter().map(|c| c.name.clone()).collect();
-        let velocities: Vec<String> = self
-            .coordinates
-            .iter()
-            .map(|c| c.velocity.clone())
-            .collect();
-        let parameters: Vec<String> = self.parameters.iter().map(|p| p.name.clone()).collect();
-        let phase: Vec<String> = self.fast_phase.iter().map(|p| p.name.clone()).collect();
-        let definitions: Vec<String> = self.definitions.keys().cloned().collect();
-        // With a fast phase, explicit time enters only through it (so averaging is well defined).
-        let time: Vec<String> = if self.fast_phase.is_some() {
-            vec![]
-        } else {
-            vec![self.time.clone()]
+        let reader = Reader::new(&self, file);
+        let names = &reader.names;
+        let parse = |key: &str, text: &str, allowed: &[&Vec<String>], dot_allowed: bool| {
+            reader.parse(key, text, allowed, dot_allowed)
         };
-
-        let parse = |key: &str,
-                     text: &str,
-                     allowed: &[&Vec<String>],
-                     dot_allowed: bool|
-         -> Result<Expr, ModelError> {
-            let length = text.chars().count();
-            if length > MAX_EXPRESSION_CHARS {
-                return Err(err(
-                    key,
-                    format!("{length} characters: an expression may have at most {MAX_EXPRESSION_CHARS}"),
-                ));
-            }
-            let expr = Expr::parse(text).map_err(|e| {
-                let quoted: String = text.chars().take(60).collect();
-                let more = if length > 60 { "…" } else { "" };
-                err(key, format!("cannot parse '{quoted}{more}': {e}"))
-            })?;
-            expr.check_calls()
-                .map_err(|reason| err(key, reason.to_string()))?;
-            for symbol in expr.symbols() {
-                if !allowed.iter().any(|set| set.contains(&symbol)) {
-                    let hint = if self.fast_phase.is_some() && symbol == self.time {
-                        format!(" (time enters only through the fast phase '{}')", phase[0])
-                    } else {
-                        String::new()
-                    };
-                    return Err(err(key, format!("unknown symbol '{symbol}'{hint}")));
-                }
-            }
-            let mut dot_problem = None;
-            expr.rewrite_calls(&mut |name, args| {
-                if name == "dot" && dot_problem.is_none() {
-                    dot_problem = match (&args[0], dot_allowed) {
-                        (_, false) => Some("dot() is only allowed in the Lagrangian".to_string()),
-                        (Expr::Sym(s), true)
-                            if definitions.contains(s) || coordinates.contains(s) =>
-                        {
-                            None
-                        }
-                        (arg, true) => Some(format!(
-                            "dot() takes the name of a definition or coordinate, not '{arg}'"
-                        )),
-                    };
-                }
-                None
-            });
-            match dot_problem {
-                Some(reason) => Err(err(key, reason)),
-                None => Ok(expr),
-            }
-        };
-
         let fast_phase = match &self.fast_phase {
             Some(p) => {
-                if let Some(a) = p.amplitude.as_ref().filter(|a| !parameters.contains(a)) {
+                if let Some(a) = p
+                    .amplitude
+                    .as_ref()
+                    .filter(|a| !names.parameters.contains(a))
+                {
                     return Err(err(
                         "fast_phase.amplitude",
                         format!("'{a}' is not a parameter of the model"),
@@ -649,46 +589,37 @@ impl ModelFile {
                 }
                 Some(FastPhase {
                     name: p.name.clone(),
-                    rate: parse("fast_phase.rate", &p.rate, &[&parameters], false)?,
+                    rate: parse("fast_phase.rate", &p.rate, &[&names.parameters], false)?,
                     amplitude: p.amplitude.clone(),
                     description: p.description.clone(),
                 })
             }
             None => None,
         };
-
         // Definitions are positions: no velocities, and no cycles.
         let mut parsed_defs = BTreeMap::new();
         for (name, text) in &self.definitions {
-            let key = format!("definitions.{name}");
-            let e = parse(
-                &key,
-                text,
-                &[&coordinates, &parameters, &phase, &time, &definitions],
-                false,
-            )?;
+            let positions = [
+                &names.coordinates,
+                &names.parameters,
+                &names.phase,
+                &names.time,
+                &names.definitions,
+            ];
+            let e = parse(&format!("definitions.{name}"), text, &positions, false)?;
             parsed_defs.insert(name.clone(), e);
         }
-        let ordered = order_definitions(&parsed_defs, &err)?;
-
-        let all = [
-            &coordinates,
-            &velocities,
-            &parameters,
-            &phase,
-            &time,
-            &definitions,
-        ];
+        let definitions = order_definitions(&parsed_defs, &err)?;
+        let all = names.all();
         let lagrangian = parse("lagrangian", &self.lagrangian, &all, true)?;
-        for name in self.forces.keys() {
-            if !coordinates.contains(name) {
-                return Err(err(
-                    &format!("forces.{name}"),
-                    format!("'{name}' is not a coordinate"),
-                ));
-            }
+        if let Some(name) = self.forces.keys().find(|n| !names.coordinates.contains(n)) {
+            return Err(err(
+                &format!("forces.{name}"),
+                format!("'{name}' is not a coordinate"),
+            ));
         }
-        let forces = coordinates
+        let forces = names
+            .coordinates
             .iter()
             .map(|c| match self.forces.get(c) {
                 Some(text) => parse(&format!("forces.{c}"), text, &all, false),
@@ -699,40 +630,16 @@ impl ModelFile {
             Some(text) => parse("rayleigh", text, &all, true)?,
             None => Expr::num(0),
         };
-        let contacts = self.validate_contacts(file, &coordinates, &parameters, &parse)?;
-
+        let contacts =
+            self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
         let model = Model {
             name: self.name,
             description: self.description,
             time: self.time,
-            coordinates: self
-                .coordinates
-                .into_iter()
-                .map(|c| Coordinate {
-                    name: c.name,
-                    velocity: c.velocity,
-                    periodic: c.periodic,
-                    description: c.description,
-                    latex: c.latex,
-                })
-                .collect(),
-            parameters: self
-                .parameters
-                .into_iter()
-                .map(|p| Parameter {
-                    range: p
-                        .range
-                        .as_deref()
-                        .map_or(Ok(Range::ALL), Range::parse)
-                        .expect("checked above"),
-                    name: p.name,
-                    default: p.default,
-                    description: p.description,
-                    latex: p.latex,
-                })
-                .collect(),
+            coordinates: self.coordinates.into_iter().map(Coordinate::from).collect(),
+            parameters: self.parameters.into_iter().map(Parameter::from).collect(),
             fast_phase,
-            definitions: ordered,
+            definitions,
             lagrangian,
             forces,
             rayleigh,
@@ -743,6 +650,168 @@ impl ModelFile {
             .check_numerically()
             .map_err(|(key, reason)| err(&key, reason))?;
         Ok(model)
+    }
+}
+
+impl From<CoordinateSpec> for Coordinate {
+    fn from(c: CoordinateSpec) -> Coordinate {
+        Coordinate {
+            name: c.name,
+            velocity: c.velocity,
+            periodic: c.periodic,
+            description: c.description,
+            latex: c.latex,
+        }
+    }
+}
+
+impl From<ParameterSpec> for Parameter {
+    /// (The range was checked by `check_name_and_size`.)
+    fn from(p: ParameterSpec) -> Parameter {
+        Parameter {
+            range: p
+                .range
+                .as_deref()
+                .map_or(Ok(Range::ALL), Range::parse)
+                .expect("checked above"),
+            name: p.name,
+            default: p.default,
+            description: p.description,
+            latex: p.latex,
+        }
+    }
+}
+
+/// The names a model file declares, by kind: what its expressions may use.
+struct Names {
+    coordinates: Vec<String>,
+    velocities: Vec<String>,
+    parameters: Vec<String>,
+    phase: Vec<String>,
+    /// The time's name, unless there is a fast phase: explicit time then
+    /// enters only through it (so averaging is well defined).
+    time: Vec<String>,
+    definitions: Vec<String>,
+}
+
+impl Names {
+    /// Every kind: what the Lagrangian, forces and Rayleigh function may use.
+    fn all(&self) -> [&Vec<String>; 6] {
+        [
+            &self.coordinates,
+            &self.velocities,
+            &self.parameters,
+            &self.phase,
+            &self.time,
+            &self.definitions,
+        ]
+    }
+}
+
+/// Parses the expressions of one model file against its declared names.
+struct Reader<'f> {
+    file: &'f str,
+    names: Names,
+    /// The time's name, for the hint when a fast phase hides it.
+    time_name: &'f str,
+}
+
+impl<'f> Reader<'f> {
+    fn new(spec: &'f ModelFile, file: &'f str) -> Reader<'f> {
+        Reader {
+            file,
+            names: Names {
+                coordinates: spec.coordinates.iter().map(|c| c.name.clone()).collect(),
+                velocities: spec
+                    .coordinates
+                    .iter()
+                    .map(|c| c.velocity.clone())
+                    .collect(),
+                parameters: spec.parameters.iter().map(|p| p.name.clone()).collect(),
+                phase: spec.fast_phase.iter().map(|p| p.name.clone()).collect(),
+                time: match spec.fast_phase {
+                    Some(_) => vec![],
+                    None => vec![spec.time.clone()],
+                },
+                definitions: spec.definitions.keys().cloned().collect(),
+            },
+            time_name: &spec.time,
+        }
+    }
+
+    fn error(&self, key: &str, reason: String) -> ModelError {
+        ModelError {
+            file: self.file.to_string(),
+            key: key.to_string(),
+            reason,
+        }
+    }
+
+    /// One expression of the file at `key`: its length, syntax, calls and
+    /// symbols (from the `allowed` sets), and where `dot()` may appear.
+    fn parse(
+        &self,
+        key: &str,
+        text: &str,
+        allowed: &[&Vec<String>],
+        dot_allowed: bool,
+    ) -> Result<Expr, ModelError> {
+        let length = text.chars().count();
+        if length > MAX_EXPRESSION_CHARS {
+            return Err(self.error(
+                key,
+                format!(
+                    "{length} characters: an expression may have at most {MAX_EXPRESSION_CHARS}"
+                ),
+            ));
+        }
+        let expr = Expr::parse(text).map_err(|e| {
+            let quoted: String = text.chars().take(60).collect();
+            let more = if length > 60 { "…" } else { "" };
+            self.error(key, format!("cannot parse '{quoted}{more}': {e}"))
+        })?;
+        expr.check_calls()
+            .map_err(|reason| self.error(key, reason.to_string()))?;
+        if let Some(symbol) = expr
+            .symbols()
+            .into_iter()
+            .find(|symbol| !allowed.iter().any(|set| set.contains(symbol)))
+        {
+            let hint = match self.names.phase.first() {
+                Some(phase) if symbol == self.time_name => {
+                    format!(" (time enters only through the fast phase '{phase}')")
+                }
+                _ => String::new(),
+            };
+            return Err(self.error(key, format!("unknown symbol '{symbol}'{hint}")));
+        }
+        match self.dot_problem(&expr, dot_allowed) {
+            Some(reason) => Err(self.error(key, reason)),
+            None => Ok(expr),
+        }
+    }
+
+    /// Why a `dot()` in `expr` is not allowed, if one is not.
+    fn dot_problem(&self, expr: &Expr, dot_allowed: bool) -> Option<String> {
+        let mut problem = None;
+        expr.rewrite_calls(&mut |name, args| {
+            if name == "dot" && problem.is_none() {
+                problem = match (&args[0], dot_allowed) {
+                    (_, false) => Some("dot() is only allowed in the Lagrangian".to_string()),
+                    (Expr::Sym(s), true)
+                        if self.names.definitions.contains(s)
+                            || self.names.coordinates.contains(s) =>
+                    {
+                        None
+                    }
+                    (arg, true) => Some(format!(
+                        "dot() takes the name of a definition or coordinate, not '{arg}'"
+                    )),
+                };
+            }
+            None
+        });
+        problem
     }
 }
 

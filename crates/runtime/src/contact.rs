@@ -18,7 +18,9 @@
 //! switching inside a short time window (chattering) is an error, never a
 //! hang.
 
-use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, Stats, System};
+use crate::ode::{
+    Direction, Event, EventSettings, Integrator, Method, OdeError, Options, Stats, System,
+};
 use std::fmt;
 
 /// A model with C Coulomb contacts, state `[s; s']` of length M = 2C; the
@@ -224,16 +226,11 @@ impl StickSlip {
                 .collect();
             let mut integrator = Integrator::new(self.method)?;
             let system = Smooth { model, modes };
-            let (end, samples) = integrator.advance_with_events_sampled(
-                &system,
-                t,
-                &y,
-                t_end,
-                &events,
-                self.events,
-                times,
-            )?;
-            run.samples.extend(samples);
+            // (The times up to t were sampled by the phases before.)
+            let later = &times[times.partition_point(|&s| s <= t)..];
+            let options = Options::default().times(later).events(&events, self.events);
+            let end = integrator.solve(&system, t, &y, t_end, options)?;
+            run.samples.extend(later.iter().copied().zip(end.samples));
             run.phases.push(Phase {
                 t0: t,
                 t1: end.t,

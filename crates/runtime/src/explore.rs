@@ -11,7 +11,7 @@
 
 use crate::analysis::equilibria::Search;
 use crate::contact::{ContactError, ContactModel, StickSlip};
-use crate::ode::{Integrator, Method, OdeError};
+use crate::ode::{states_at, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
 use crate::registry::{display_name, DynamicModel, Fixed, Kind, Model, ModelInfo, WithFixed};
 
@@ -387,8 +387,7 @@ impl WithFixed for HamiltonianRuns<'_> {
         let y0: [f64; S] = to_array(self.y0);
         let times = grid(settings.t_end, settings.samples);
         let exact_system = fixed.exact(params);
-        let exact =
-            Integrator::new(settings.method)?.advance_sampled(&exact_system, 0.0, &y0, &times)?;
+        let exact = states_at(settings.method, &exact_system, 0.0, &y0, &times)?;
         let (found, search, not_searched) = match equilibria(model, params) {
             Ok((found, search)) => (found, Some(search), None),
             Err(reason) => (Vec::new(), None, Some(reason)),
@@ -402,12 +401,7 @@ impl WithFixed for HamiltonianRuns<'_> {
         };
         match (fixed.phase_period(params), fixed.averaged(params)) {
             (Some(period), Some(averaged_system)) => {
-                let averaged = Integrator::new(settings.method)?.advance_sampled(
-                    &averaged_system,
-                    0.0,
-                    &y0,
-                    &times,
-                )?;
+                let averaged = states_at(settings.method, &averaged_system, 0.0, &y0, &times)?;
                 let h0 = model.averaged_energy(params, &y0).unwrap_or(0.0);
                 out.energy_change = averaged
                     .iter()
@@ -417,12 +411,7 @@ impl WithFixed for HamiltonianRuns<'_> {
                 out.averaged = Some(averaged.iter().map(|y| y.to_vec()).collect());
                 let map_times: Vec<f64> =
                     (0..=settings.periods).map(|k| k as f64 * period).collect();
-                let map = Integrator::new(settings.method)?.advance_sampled(
-                    &exact_system,
-                    0.0,
-                    &y0,
-                    &map_times,
-                )?;
+                let map = states_at(settings.method, &exact_system, 0.0, &y0, &map_times)?;
                 out.period_map = Some(map.iter().map(|y| y.to_vec()).collect());
             }
             _ => {

@@ -5,7 +5,7 @@
 use super::{
     class_example, reduced, DeformationEquation, DeformationEquilibrium, Params, GRAPH_CLASSES,
 };
-use crate::ode::{Integrator, Method, OdeError};
+use crate::ode::{states_at, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, RED};
 
 /// One portrait's equation and its equilibria.
@@ -51,8 +51,7 @@ fn trajectories(
                 x0 + (x1 - x0) * (i as f64 + 0.5) / starts as f64,
                 y0 + (y1 - y0) * (j as f64 + 0.5) / starts as f64,
             ];
-            let states = Integrator::new(Method::parse("dop853", 1e-9)?)?
-                .advance_sampled(eq, 0.0, &start, &times)?;
+            let states = states_at(Method::parse("dop853", 1e-9)?, eq, 0.0, &start, &times)?;
             let inside = |y: &[f64; 2]| {
                 y[0] >= x0 - (x1 - x0)
                     && y[0] <= x1 + (x1 - x0)

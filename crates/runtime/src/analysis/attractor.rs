@@ -9,7 +9,7 @@ use super::dimension::{bounds, box_counting, kaplan_yorke_dimension};
 use super::lyapunov::lyapunov_history;
 use super::period_map::orbit;
 use crate::analysis::Refusal;
-use crate::ode::{ErasedSystem, Integrator, Method, OdeError, System};
+use crate::ode::{ErasedSystem, Integrator, Method, OdeError, Options, System};
 use crate::plot::{ColorMap, Figure, PanelSpec, Rgb};
 use crate::registry::{Fixed, Model, Sized};
 use std::collections::BTreeMap;
@@ -233,7 +233,15 @@ fn mean_divergence(
             rtol: 1e-10,
             atol: 1e-10,
         })?;
-        let states = integrator.advance_sampled(system, 0.0, y0, &times)?;
+        let states = integrator
+            .solve(
+                system,
+                0.0,
+                y0,
+                times.last().copied().unwrap_or(0.0),
+                Options::default().times(&times),
+            )?
+            .samples;
         let h = period / INTERVALS as f64;
         let mut sum = trace(0.0, y0);
         for (k, (t, y)) in times.iter().zip(&states).enumerate() {

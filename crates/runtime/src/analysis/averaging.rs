@@ -8,7 +8,7 @@
 
 use super::fit::{log_log, LineFit};
 use crate::analysis::Refusal;
-use crate::ode::{Integrator, Method, OdeError, System};
+use crate::ode::{states_at, Method, OdeError, System};
 use crate::registry::Model;
 use rayon::prelude::*;
 
@@ -52,8 +52,8 @@ pub fn compare<E: System<N>, A: System<N>, const N: usize>(
     y0: &[f64; N],
     times: &[f64],
 ) -> Result<Comparison<N>, OdeError> {
-    let exact_states = Integrator::new(method)?.advance_sampled(exact, 0.0, y0, times)?;
-    let averaged_states = Integrator::new(method)?.advance_sampled(averaged, 0.0, y0, times)?;
+    let exact_states = states_at(method, exact, 0.0, y0, times)?;
+    let averaged_states = states_at(method, averaged, 0.0, y0, times)?;
     Ok(Comparison {
         times: times.to_vec(),
         exact: exact_states,
@@ -245,10 +245,8 @@ pub fn second_order_deviation<
     let shift0 = model.averaged2_shift(params, 0.0, y0)?;
     let start: [f64; S] = std::array::from_fn(|i| y0[i] - shift0[i]);
     let run = || -> Result<Vec<f64>, OdeError> {
-        let exact =
-            Integrator::new(method)?.advance_sampled(&model.exact(params), 0.0, y0, times)?;
-        let transformed =
-            Integrator::new(method)?.advance_sampled(&averaged, 0.0, &start, times)?;
+        let exact = states_at(method, &model.exact(params), 0.0, y0, times)?;
+        let transformed = states_at(method, &averaged, 0.0, &start, times)?;
         let mut worst = vec![0.0f64; D];
         for ((t, e), y) in times.iter().zip(&exact).zip(&transformed) {
             let shift = model.averaged2_shift(params, *t, y).unwrap_or([0.0; S]);

@@ -106,7 +106,7 @@ pub fn fast_lyapunov_indicator<S: System<N>, const N: usize, const M: usize>(
     let variational = Variational::<S, N, M>::new(system);
     let z = Variational::<S, N, M>::pack(y0, &[*w0]);
     let mut fli = Fli::<N, M>::new(w0);
-    integrator.advance_segments(&variational, &z, period, periods, &mut |z| {
+    integrator.stream(&variational, &z, period, periods, &mut |z| {
         fli.after_segment(z);
         true
     })?;

@@ -36,7 +36,7 @@ pub fn period_map<S: System<N>, const N: usize>(
 /// `periods` iterates of the period map from `y0` (y0 first), with the
 /// coordinates flagged in `wrap` given in [−π, π) (exact: the field is
 /// 2π-periodic in them). With the Taylor method the steps run across the
-/// periods' ends (see [`Integrator::advance_segments`]); the state itself is
+/// periods' ends (see [`Integrator::stream`]); the state itself is
 /// brought back only once it is past ±3π, a change that restarts the step
 /// there, so an orbit about π is not cut at every period.
 pub fn orbit<S: System<N>, const N: usize>(
@@ -50,7 +50,7 @@ pub fn orbit<S: System<N>, const N: usize>(
     orbit_budget(1, periods, N)?;
     let mut points = Vec::with_capacity(periods + 1);
     points.push(*y0);
-    integrator.advance_segments(system, y0, period, periods, &mut |y| {
+    integrator.stream(system, y0, period, periods, &mut |y| {
         points.push(wrapped_point(y, wrap));
         true
     })?;

@@ -16,7 +16,7 @@
 //! H = E and from the plane.
 
 use crate::analysis::Refusal;
-use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError};
+use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options};
 use crate::registry::{Fixed, Model, Sized, WithFixed};
 use rayon::prelude::*;
 
@@ -428,13 +428,12 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
         let chunk = (s.t_max / 64.0).max(1.0);
         while orbit.crossings < s.crossings && t < s.t_max {
             let t1 = (t + chunk).min(s.t_max);
-            let run = match integrator.advance_with_events(
+            let run = match integrator.solve(
                 self.system,
                 t,
                 &y,
                 t1,
-                &events,
-                EventSettings::default(),
+                Options::default().events(&events, EventSettings::default()),
             ) {
                 Ok(run) => run,
                 Err(error) => return Ok(self.ended(orbit, error)),
@@ -532,7 +531,16 @@ impl<Y: crate::ode::System<S> + Sync, const S: usize> OrbitRun<'_, Y, S> {
             let times: Vec<f64> = (1..=count)
                 .map(|k| stroboscope.start + (done + k) as f64 * stroboscope.period)
                 .collect();
-            let states = match integrator.advance_sampled(self.system, t, &y, &times) {
+            let states = match integrator
+                .solve(
+                    self.system,
+                    t,
+                    &y,
+                    times.last().copied().unwrap_or(t),
+                    Options::default().times(&times),
+                )
+                .map(|run| run.samples)
+            {
                 Ok(states) => states,
                 Err(error) => return Ok(self.ended(orbit, error)),
             };

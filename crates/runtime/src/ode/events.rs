@@ -88,18 +88,6 @@ pub struct EventHit<const N: usize> {
     pub rising: bool,
 }
 
-/// The end of an integration with events.
-#[derive(Clone, Debug, PartialEq)]
-pub struct EventRun<const N: usize> {
-    /// Where the integration stopped: at the final time, or at a terminal event.
-    pub t: f64,
-    pub y: [f64; N],
-    /// All crossings in time order (simultaneous ones share their time).
-    pub hits: Vec<EventHit<N>>,
-    /// True if a terminal event stopped the run.
-    pub terminated: bool,
-}
-
 /// Per-event memory: the last nonzero sign and where it was seen.
 #[derive(Clone, Copy)]
 struct Tracker {

@@ -19,16 +19,18 @@ mod lanes;
 mod radau5;
 mod rk4;
 pub mod series;
+mod solve;
 pub mod taylor;
 mod taylor_lanes;
 
 pub use double_double::DoubleDouble;
 pub use dual::Dual;
 pub use erased::{DynSystem, ErasedSystem};
-pub use events::{Direction, Event, EventHit, EventRun, EventSettings};
+pub use events::{Direction, Event, EventHit, EventSettings};
 pub use hyperdual::HyperDual;
 pub use lanes::{per_lane, Lanes, LANES};
 pub use series::Scalar;
+pub use solve::{states_at, Options, Solution};
 pub use taylor::{order_for_tolerance, DoubleDoubleTaylor, TaylorWork};
 pub use taylor_lanes::{LaneIntegrator, LaneResult, Orbit};
 
@@ -370,7 +372,8 @@ impl Integrator {
         self.method
     }
 
-    /// Advances `y0` at `t0` to `t1` (t1 > t0 or t1 < t0).
+    /// Advances `y0` at `t0` to `t1` (t1 > t0 or t1 < t0): [`Integrator::solve`]
+    /// without options, the end state alone.
     pub fn advance<S: System<N>, const N: usize>(
         &mut self,
         system: &S,
@@ -379,78 +382,6 @@ impl Integrator {
         t1: f64,
     ) -> Result<[f64; N], OdeError> {
         Ok(self.run(system, t0, y0, t1, &mut |_| Ok(Flow::Continue))?.1)
-    }
-
-    /// Like [`Integrator::advance`], calling `observe(t, y)` after every accepted step.
-    pub fn advance_observed<S: System<N>, const N: usize>(
-        &mut self,
-        system: &S,
-        t0: f64,
-        y0: &[f64; N],
-        t1: f64,
-        observe: &mut dyn FnMut(f64, &[f64; N]),
-    ) -> Result<[f64; N], OdeError> {
-        let mut each_step = |step: &mut dyn Step<N>| {
-            let (t, y) = step.end();
-            observe(t, y);
-            Ok(Flow::Continue)
-        };
-        Ok(self.run(system, t0, y0, t1, &mut each_step)?.1)
-    }
-
-    /// Advances `y0` from `t0` to the last of `times` (increasing, or decreasing
-    /// for a backward run), returning the state at each of them from the
-    /// method's interpolant: the step sizes stay those the accuracy needs.
-    pub fn advance_sampled<S: System<N>, const N: usize>(
-        &mut self,
-        system: &S,
-        t0: f64,
-        y0: &[f64; N],
-        times: &[f64],
-    ) -> Result<Vec<[f64; N]>, OdeError> {
-        let Some(&t1) = times.last() else {
-            return Ok(Vec::new());
-        };
-        let forward = t1 >= t0;
-        let ordered = times
-            .windows(2)
-            .all(|w| if forward { w[1] >= w[0] } else { w[1] <= w[0] });
-        let inside = times
-            .iter()
-            .all(|&t| if forward { t >= t0 } else { t <= t0 });
-        if !ordered || !inside || times.iter().any(|t| !t.is_finite()) {
-            return Err(OdeError::InvalidSetting {
-                what: "sample times (must be finite, ordered and on one side of t0)",
-                value: t1,
-            });
-        }
-        let mut states = Vec::with_capacity(times.len());
-        let mut next = 0;
-        while next < times.len() && times[next] == t0 {
-            states.push(*y0);
-            next += 1;
-        }
-        self.run(system, t0, y0, t1, &mut |step| {
-            let (t_end, y_end) = step.end();
-            let y_end = *y_end;
-            while next < times.len()
-                && (if forward {
-                    times[next] <= t_end
-                } else {
-                    times[next] >= t_end
-                })
-            {
-                let y = if times[next] == t_end {
-                    y_end
-                } else {
-                    step.state_at(times[next])?
-                };
-                states.push(y);
-                next += 1;
-            }
-            Ok(Flow::Continue)
-        })?;
-        Ok(states)
     }
 
     /// Runs one orbit from (0, y0) over `segments` segments of time
@@ -464,7 +395,7 @@ impl Integrator {
     /// [`LaneIntegrator::stream`] does lane by lane; the other methods
     /// advance segment by segment, their step grids being the segment's.
     /// Segments of length 0 leave nothing to run.
-    pub fn advance_segments<S: System<N>, const N: usize>(
+    pub fn stream<S: System<N>, const N: usize>(
         &mut self,
         system: &S,
         y0: &[f64; N],
@@ -525,68 +456,8 @@ impl Integrator {
         Ok(())
     }
 
-    /// Advances `y0` from `t0` towards `t1`, locating the zero crossings of
-    /// the events; stops at the first terminal one. A later call from the
-    /// returned state restarts cleanly (the reported state is past the root).
-    pub fn advance_with_events<S: System<N>, const N: usize>(
-        &mut self,
-        system: &S,
-        t0: f64,
-        y0: &[f64; N],
-        t1: f64,
-        events: &[Event<'_, N>],
-        settings: EventSettings,
-    ) -> Result<EventRun<N>, OdeError> {
-        Ok(self
-            .advance_with_events_sampled(system, t0, y0, t1, events, settings, &[])?
-            .0)
-    }
-
-    /// Like [`Integrator::advance_with_events`], and also returns the states
-    /// at those of `times` (increasing, after t0) that the run reaches
-    /// before it stops, from the method's interpolant.
-    #[allow(clippy::too_many_arguments)]
-    pub fn advance_with_events_sampled<S: System<N>, const N: usize>(
-        &mut self,
-        system: &S,
-        t0: f64,
-        y0: &[f64; N],
-        t1: f64,
-        events: &[Event<'_, N>],
-        settings: EventSettings,
-        times: &[f64],
-    ) -> Result<(EventRun<N>, Vec<(f64, [f64; N])>), OdeError> {
-        check_initial(t0, y0, t1)?;
-        let mut locator = events::Locator::new(events, settings, t0, y0)?;
-        let mut samples = Vec::new();
-        let mut next = times.partition_point(|&t| t <= t0);
-        let (t, y) = self.run(system, t0, y0, t1, &mut |step| {
-            let flow = locator.scan(step)?;
-            let limit = match flow {
-                Flow::Stop { t, .. } => t,
-                // (The event locator never retimes.)
-                Flow::Continue | Flow::Retime { .. } => step.end().0,
-            };
-            while next < times.len() && times[next] <= limit {
-                samples.push((times[next], step.state_at(times[next])?));
-                next += 1;
-            }
-            Ok(flow)
-        })?;
-        let terminated = t != t1;
-        Ok((
-            EventRun {
-                t,
-                y,
-                hits: locator.hits,
-                terminated,
-            },
-            samples,
-        ))
-    }
-
-    /// Every entry point goes through here, and every method through
-    /// [`driver::drive`].
+    /// `advance`, `solve` and `stream` go through here, and every method
+    /// through [`driver::drive`].
     fn run<S: System<N>, const N: usize>(
         &mut self,
         system: &S,

@@ -125,7 +125,7 @@ impl LaneIntegrator {
     /// time restarting at 0 after each (as a period map's does: the field
     /// must be the same there), [`LANES`] orbits at a time, each lane
     /// exactly as the scalar
-    /// [`Integrator::advance_segments`](super::Integrator::advance_segments)
+    /// [`Integrator::stream`](super::Integrator::stream)
     /// would: the steps run across the segments' ends, and the state at
     /// each end is sampled from the step's polynomial (as heyoka's
     /// `propagate_grid` does), so no step is cut short to land on one.

@@ -459,7 +459,7 @@ impl WithFixed for OrbitWork<'_> {
         };
         let (mut done, mut cancelled) = (0, false);
         let sink = self.sink;
-        let run = integrator.advance_segments(&system, &y, period, self.periods, &mut |y| {
+        let run = integrator.stream(&system, &y, period, self.periods, &mut |y| {
             chunk.push(project(&wrapped_point(y, &periodic)));
             done += 1;
             if chunk.len() >= CHUNK_POINTS || last_sent.elapsed() >= CHUNK_INTERVAL {

@@ -21,7 +21,7 @@ mod symmetric;
 use crate::analysis::floquet::monodromy;
 use crate::analysis::Refusal;
 use crate::ode::{
-    DoubleDouble, DoubleDoubleTaylor, ErasedSystem, Integrator, Method, OdeError, System,
+    DoubleDouble, DoubleDoubleTaylor, ErasedSystem, Integrator, Method, OdeError, Options, System,
 };
 use crate::registry::{DynamicModel, Fixed, Model, Sized};
 use rayon::prelude::*;
@@ -1653,7 +1653,17 @@ fn averaged_separatrix(
         atol: 1e-14,
     })?;
     let mut path = vec![start];
-    path.extend(integrator.advance_sampled(&field, 0.0, &start, &times)?);
+    path.extend(
+        integrator
+            .solve(
+                &field,
+                0.0,
+                &start,
+                times.last().copied().unwrap_or(0.0),
+                Options::default().times(&times),
+            )?
+            .samples,
+    );
     Ok((path, step))
 }
 
