@@ -7,7 +7,7 @@
 
 use mechlab::models::{self, kapitza};
 use mechlab::ode::{DoubleDouble, DoubleDoubleTaylor, Integrator, Method, Scalar};
-use mechlab::registry::{Fixed, Sized};
+use mechlab::registry::{Fixed, FixedSize};
 use proptest::prelude::*;
 
 fn dd(hi: f64, lo: f64) -> DoubleDouble {
@@ -203,7 +203,7 @@ fn the_pendulum_keeps_its_energy_to_1e_28_in_double_double() {
 #[test]
 fn the_period_map_in_double_double_equals_double_precision() {
     let model = models::by_name("kapitza").unwrap();
-    let Some(Sized::Dof1(fixed)) = model.sized else {
+    let Some(FixedSize::Dof1(fixed)) = model.sized else {
         panic!("kapitza has one degree of freedom")
     };
     let params = kapitza::Params {
@@ -241,7 +241,7 @@ fn the_period_map_in_double_double_equals_double_precision() {
 #[test]
 fn a_larger_model_has_no_double_double_recurrences() {
     let model = models::by_name("double_pendulum").unwrap();
-    let Some(Sized::Dof2(fixed)) = model.sized else {
+    let Some(FixedSize::Dof2(fixed)) = model.sized else {
         panic!("two degrees of freedom")
     };
     let system = fixed.exact(&model.dynamic.defaults());

@@ -392,15 +392,15 @@ fn systems_without_recurrences_and_bad_tolerances_are_errors() {
 /// chose, through the same compiled code the analyses reach.
 #[test]
 fn every_model_s_tangent_recurrences_differentiate_its_solution_s() {
-    use mechlab::registry::{Fixed, Sized};
+    use mechlab::registry::{Fixed, FixedSize};
     for model in mechlab::models::MODELS {
         let (name, params) = (model.info.name, model.dynamic.defaults());
         match model.sized {
-            Some(Sized::Dof1(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
-            Some(Sized::Dof2(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
-            Some(Sized::Dof3(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
-            Some(Sized::Dof4(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
-            Some(Sized::Large(_)) => eprintln!(
+            Some(FixedSize::Dof1(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
+            Some(FixedSize::Dof2(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
+            Some(FixedSize::Dof3(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
+            Some(FixedSize::Dof4(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
+            Some(FixedSize::Large(_)) => eprintln!(
                 "{name}: skipped (5 to 16 degrees of freedom: this test's instances are compiled for 1 to 4)"
             ),
             None => eprintln!("{name}: skipped (a contact model has no tangent recurrences)"),

@@ -47,6 +47,33 @@ fn error(reason: String) -> DeriveError {
     }
 }
 
+/// The mass matrix must not couple a contact's coordinates to any other,
+/// nor depend on the configuration: point masses on guides.
+fn check_point_masses(lagrangian: &Atom, coordinates: &[(&str, &str)]) -> Result<(), DeriveError> {
+    for (a, va) in coordinates {
+        for (b, vb) in coordinates {
+            let entry = lagrangian
+                .derivative(symbol!(*va))
+                .derivative(symbol!(*vb))
+                .expand();
+            if a != b && !is_zero(&entry) {
+                return Err(error(format!(
+                    "the mass matrix couples '{a}' and '{b}'; contacts need point masses on guides (a diagonal mass matrix)"
+                )));
+            }
+            let moving = coordinates
+                .iter()
+                .any(|(c, _)| !is_zero(&entry.derivative(symbol!(*c))));
+            if a == b && moving {
+                return Err(error(format!(
+                    "the mass of '{a}' depends on the configuration; contacts need constant masses"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
     let coordinates: Vec<(&str, &str)> = model
         .coordinates
@@ -70,28 +97,7 @@ pub fn derive(model: &Model) -> Result<ContactDerivation, DeriveError> {
         ));
     }
 
-    // The mass matrix must not couple a contact's coordinates to any other.
-    for (a, va) in &coordinates {
-        for (b, vb) in &coordinates {
-            let entry = lagrangian
-                .derivative(symbol!(*va))
-                .derivative(symbol!(*vb))
-                .expand();
-            if a != b && !is_zero(&entry) {
-                return Err(error(format!(
-                    "the mass matrix couples '{a}' and '{b}'; contacts need point masses on guides (a diagonal mass matrix)"
-                )));
-            }
-            let moving = coordinates
-                .iter()
-                .any(|(c, _)| !is_zero(&entry.derivative(symbol!(*c))));
-            if a == b && moving {
-                return Err(error(format!(
-                    "the mass of '{a}' depends on the configuration; contacts need constant masses"
-                )));
-            }
-        }
-    }
+    check_point_masses(&lagrangian, &coordinates)?;
 
     // Lagrange's expression without the acceleration term, for coordinate c.
     let lagrange = |c: &str| -> Atom {

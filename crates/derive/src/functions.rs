@@ -416,7 +416,6 @@ pub(crate) fn symbolic_functions(
 ) -> Result<(Vec<Function>, Vec<TaylorFunction>), DeriveError> {
     let n = cx.n();
     let m = 2 * n;
-    let model = cx.model;
     let velocity_stage: Vec<(String, String)> = cx
         .velocities()
         .into_iter()
@@ -459,68 +458,8 @@ pub(crate) fn symbolic_functions(
         "h__".into(),
     )?);
 
-    if model.fast_phase.is_some() {
-        functions.push(cx.function(
-            "vibrational_potential",
-            "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b).",
-            Inputs::Coordinates,
-            "f64".into(),
-            &[vec![(
-                "w__".into(),
-                derivation.vibrational_potential.clone(),
-            )]],
-            "w__".into(),
-        )?);
-        let effective = format!(
-            "({}) + ({})",
-            derivation.potential, derivation.vibrational_potential
-        );
-        functions.push(cx.function(
-            "effective_potential",
-            "Effective potential V + V_vibr of the averaged system.",
-            Inputs::Coordinates,
-            "f64".into(),
-            &[vec![("v__".into(), effective)]],
-            "v__".into(),
-        )?);
-        let (outs, result) = matrix("b", &derivation.effective_potential_hessian);
-        functions.push(cx.function(
-            "effective_potential_hessian",
-            "∂²(V + V_vibr)/∂q².",
-            Inputs::Coordinates,
-            format!("[[f64; {n}]; {n}]"),
-            &[outs],
-            result,
-        )?);
-        let (outs, result) = vector("f", &derivation.averaged_rhs);
-        functions.push(cx.function(
-            "averaged_rhs",
-            "Averaged equations: q' = ∂H̄/∂p, p' = −∂H̄/∂q + P̄.",
-            Inputs::AveragedState,
-            format!("[f64; {m}]"),
-            &[outs],
-            result,
-        )?);
-        let (outs, result) = matrix("j", &derivation.averaged_jacobian);
-        functions.push(cx.function(
-            "averaged_jacobian",
-            "Jacobian of the averaged field.",
-            Inputs::AveragedState,
-            format!("[[f64; {m}]; {m}]"),
-            &[outs],
-            result,
-        )?);
-        functions.push(cx.function(
-            "averaged_hamiltonian",
-            "Averaged Hamiltonian H̄(q, p).",
-            Inputs::AveragedState,
-            "f64".into(),
-            &[vec![(
-                "h__".into(),
-                derivation.averaged_hamiltonian.clone(),
-            )]],
-            "h__".into(),
-        )?);
+    if cx.model.fast_phase.is_some() {
+        functions.extend(symbolic_averaged_functions(cx, derivation)?);
     }
 
     if let Some(second) = &derivation.second_order {
@@ -532,6 +471,78 @@ pub(crate) fn symbolic_functions(
     }
     let taylor_functions = taylor_functions(cx, derivation, &velocity_stage)?;
     Ok((functions, taylor_functions))
+}
+
+/// The symbolic-inverse form's averaged functions: V_vibr, V + V_vibr and
+/// its Hessian, the averaged field, its Jacobian and H̄.
+fn symbolic_averaged_functions(
+    cx: &Context,
+    derivation: &Derivation,
+) -> Result<Vec<Function>, DeriveError> {
+    let (n, m) = (cx.n(), 2 * cx.n());
+    let mut functions = Vec::new();
+    functions.push(cx.function(
+        "vibrational_potential",
+        "Vibrational potential V_vibr(q) = ½ mean(bᵀA⁻¹b).",
+        Inputs::Coordinates,
+        "f64".into(),
+        &[vec![(
+            "w__".into(),
+            derivation.vibrational_potential.clone(),
+        )]],
+        "w__".into(),
+    )?);
+    let effective = format!(
+        "({}) + ({})",
+        derivation.potential, derivation.vibrational_potential
+    );
+    functions.push(cx.function(
+        "effective_potential",
+        "Effective potential V + V_vibr of the averaged system.",
+        Inputs::Coordinates,
+        "f64".into(),
+        &[vec![("v__".into(), effective)]],
+        "v__".into(),
+    )?);
+    let (outs, result) = matrix("b", &derivation.effective_potential_hessian);
+    functions.push(cx.function(
+        "effective_potential_hessian",
+        "∂²(V + V_vibr)/∂q².",
+        Inputs::Coordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = vector("f", &derivation.averaged_rhs);
+    functions.push(cx.function(
+        "averaged_rhs",
+        "Averaged equations: q' = ∂H̄/∂p, p' = −∂H̄/∂q + P̄.",
+        Inputs::AveragedState,
+        format!("[f64; {m}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = matrix("j", &derivation.averaged_jacobian);
+    functions.push(cx.function(
+        "averaged_jacobian",
+        "Jacobian of the averaged field.",
+        Inputs::AveragedState,
+        format!("[[f64; {m}]; {m}]"),
+        &[outs],
+        result,
+    )?);
+    functions.push(cx.function(
+        "averaged_hamiltonian",
+        "Averaged Hamiltonian H̄(q, p).",
+        Inputs::AveragedState,
+        "f64".into(),
+        &[vec![(
+            "h__".into(),
+            derivation.averaged_hamiltonian.clone(),
+        )]],
+        "h__".into(),
+    )?);
+    Ok(functions)
 }
 
 /// The exact field as stages (velocities, then momentum rates) and the names
@@ -691,6 +702,76 @@ pub(crate) fn first_line(mut f: Function, line: String) -> Function {
     f
 }
 
+const DOC_K2: &str = "Averaged Hamiltonian to second order, K̄ = H̄ + εK̄₁ + ε²K̄₂ with ε = 1/rate.";
+const DOC_RHS2: &str = "Second-order averaged equations: q' = ∂K̄/∂p, p' = −∂K̄/∂q + P̄.";
+const DOC_HESSIAN2: &str =
+    "Hessian ∂²K̄/∂y² of the second-order averaged Hamiltonian in the state y = [q; p].";
+
+/// K̄, the second-order field and its Hessian with K̄'s derivatives taken
+/// at run time over hyper-dual numbers: K̄ is generated once (`k_steps`),
+/// the field adds the forces (`rhs_steps`) to J∇K̄.
+fn by_hyper_duals(
+    cx: &Context,
+    k_steps: &[Step],
+    rhs_steps: &[Step],
+    rhs_result: String,
+) -> Result<Vec<Function>, DeriveError> {
+    let m = 2 * cx.n();
+    // K̄ itself as the value part of the hyper-dual one: one copy of
+    // the code, the largest function of these models.
+    let k = cx.function_steps(
+        "averaged2_hamiltonian",
+        DOC_K2,
+        Inputs::AveragedState,
+        "f64".into(),
+        &[],
+        "k__".into(),
+    )?;
+    let mut functions = vec![first_line(
+        k,
+        "let k__ = averaged2_hamiltonian_dual(&y.map(crate::ode::HyperDual::from), params).re;"
+            .into(),
+    )];
+    functions.push(cx.function_steps(
+        "averaged2_hamiltonian_dual",
+        "K̄ over hyper-dual numbers: its gradient and Hessian at run time (`crate::ode::hyperdual`).",
+        Inputs::HyperDualAveragedState,
+        "crate::ode::HyperDual".into(),
+        k_steps,
+        "k__".into(),
+    )?);
+    let dual_k = "|y| averaged2_hamiltonian_dual(y, params)";
+    let rhs = cx.function_steps(
+        "averaged2_rhs",
+        DOC_RHS2,
+        Inputs::AveragedState,
+        format!("[f64; {m}]"),
+        rhs_steps,
+        rhs_result,
+    )?;
+    let names: Vec<String> = (0..m).map(|i| format!("dk__{i}")).collect();
+    functions.push(first_line(
+        rhs,
+        format!(
+            "let [{}] = crate::ode::hyperdual::gradient({dual_k}, y);",
+            names.join(", ")
+        ),
+    ));
+    let hessian = cx.function_steps(
+        "averaged2_hessian",
+        DOC_HESSIAN2,
+        Inputs::AveragedState,
+        format!("[[f64; {m}]; {m}]"),
+        &[],
+        "hessian__".into(),
+    )?;
+    functions.push(first_line(
+        hessian,
+        format!("let hessian__ = crate::ode::hyperdual::hessian({dual_k}, y);"),
+    ));
+    Ok(functions)
+}
+
 /// The second-order averaged system: K̄ = H̄ + εK̄₁ + ε²K̄₂ (ε = 1/rate), its
 /// field, its Hessian in the state and the first-order map's shift.
 pub fn second_order_functions(
@@ -732,68 +813,15 @@ pub fn second_order_functions(
         prelude.iter().chain(steps).cloned().collect()
     };
     let k_steps = with(&before.hamiltonian, std::slice::from_ref(&k_bar));
-    let doc_k = "Averaged Hamiltonian to second order, K̄ = H̄ + εK̄₁ + ε²K̄₂ with ε = 1/rate.";
-    let doc_rhs = "Second-order averaged equations: q' = ∂K̄/∂p, p' = −∂K̄/∂q + P̄.";
-    let doc_hessian =
-        "Hessian ∂²K̄/∂y² of the second-order averaged Hamiltonian in the state y = [q; p].";
     let mut functions = Vec::new();
     if before.run_time_derivatives {
-        // K̄ itself as the value part of the hyper-dual one: one copy of
-        // the code, the largest function of these models.
-        let k = cx.function_steps(
-            "averaged2_hamiltonian",
-            doc_k,
-            Inputs::AveragedState,
-            "f64".into(),
-            &[],
-            "k__".into(),
-        )?;
-        functions.push(first_line(
-            k,
-            "let k__ = averaged2_hamiltonian_dual(&y.map(crate::ode::HyperDual::from), params).re;"
-                .into(),
-        ));
-        functions.push(cx.function_steps(
-            "averaged2_hamiltonian_dual",
-            "K̄ over hyper-dual numbers: its gradient and Hessian at run time (`crate::ode::hyperdual`).",
-            Inputs::HyperDualAveragedState,
-            "crate::ode::HyperDual".into(),
-            &k_steps,
-            "k__".into(),
-        )?);
-        let dual_k = "|y| averaged2_hamiltonian_dual(y, params)";
-        let rhs = cx.function_steps(
-            "averaged2_rhs",
-            doc_rhs,
-            Inputs::AveragedState,
-            format!("[f64; {m}]"),
-            &with(&before.forces, &[forces]),
-            symplectic("dk", &|i| format!(" + force__{i}")),
-        )?;
-        let names: Vec<String> = (0..m).map(|i| format!("dk__{i}")).collect();
-        functions.push(first_line(
-            rhs,
-            format!(
-                "let [{}] = crate::ode::hyperdual::gradient({dual_k}, y);",
-                names.join(", ")
-            ),
-        ));
-        let hessian = cx.function_steps(
-            "averaged2_hessian",
-            doc_hessian,
-            Inputs::AveragedState,
-            format!("[[f64; {m}]; {m}]"),
-            &[],
-            "hessian__".into(),
-        )?;
-        functions.push(first_line(
-            hessian,
-            format!("let hessian__ = crate::ode::hyperdual::hessian({dual_k}, y);"),
-        ));
+        let rhs_steps = with(&before.forces, &[forces]);
+        let rhs_result = symplectic("dk", &|i| format!(" + force__{i}"));
+        functions.extend(by_hyper_duals(cx, &k_steps, &rhs_steps, rhs_result)?);
     } else {
         functions.push(cx.function_steps(
             "averaged2_hamiltonian",
-            doc_k,
+            DOC_K2,
             Inputs::AveragedState,
             "f64".into(),
             &k_steps,
@@ -804,7 +832,7 @@ pub fn second_order_functions(
         field.extend([forces, gradient("k__", "dk")]);
         functions.push(cx.function_steps(
             "averaged2_rhs",
-            doc_rhs,
+            DOC_RHS2,
             Inputs::AveragedState,
             format!("[f64; {m}]"),
             &field,
@@ -825,7 +853,7 @@ pub fn second_order_functions(
         let (_, hessian_result) = matrix("k", &vec![vec![String::new(); m]; m]);
         functions.push(cx.function_steps(
             "averaged2_hessian",
-            doc_hessian,
+            DOC_HESSIAN2,
             Inputs::AveragedState,
             format!("[[f64; {m}]; {m}]"),
             &with(&before.hamiltonian, &[k_bar, hessian]),

@@ -666,29 +666,7 @@ pub fn second_order(
         })
         .collect();
     let eps = format!("(1/({}))", derivation.phase_rate);
-    let residuals: Vec<(String, String)> = (0..n)
-        .map(|i| {
-            (
-                format!("residual_mean__{i}"),
-                format!("{}-({})", momenta[i], form.mean_linear_term[i]),
-            )
-        })
-        .collect();
-    // The forces P̄ read the velocities q' = A⁻¹(p − b̄), if there are any.
-    let frictionless = form.mean_forces.iter().all(|f| f == "0");
-    let velocities = if frictionless {
-        Vec::new()
-    } else {
-        vec![
-            Step::Values(upper("mass", &derivation.mass_matrix)),
-            Step::Values(residuals),
-            Step::Solve {
-                matrix: names("mass", n),
-                columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
-                names: vec![cx.velocities()],
-            },
-        ]
-    };
+    let velocities = averaged_velocity_steps(cx, derivation, form);
     let mut hamiltonian = base.clone();
     hamiltonian.extend(alg.steps);
     (
@@ -710,4 +688,32 @@ pub fn second_order(
             run_time_derivatives: true,
         },
     )
+}
+
+/// The steps that solve the velocities q' = A⁻¹(p − b̄) for the forces P̄
+/// of the averaged system (none when the model has no forces).
+fn averaged_velocity_steps(cx: &Context, derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
+    let (n, momenta) = (cx.n(), cx.momenta());
+    let residuals: Vec<(String, String)> = (0..n)
+        .map(|i| {
+            (
+                format!("residual_mean__{i}"),
+                format!("{}-({})", momenta[i], form.mean_linear_term[i]),
+            )
+        })
+        .collect();
+    // The forces P̄ read the velocities q' = A⁻¹(p − b̄), if there are any.
+    let frictionless = form.mean_forces.iter().all(|f| f == "0");
+    if frictionless {
+        return Vec::new();
+    }
+    vec![
+        Step::Values(upper("mass", &derivation.mass_matrix)),
+        Step::Values(residuals),
+        Step::Solve {
+            matrix: names("mass", n),
+            columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
+            names: vec![cx.velocities()],
+        },
+    ]
 }

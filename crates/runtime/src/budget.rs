@@ -38,3 +38,12 @@ pub fn check(
         }),
     }
 }
+
+/// A square map of `pixels` × `pixels` values of f64.
+pub fn check_map(pixels: usize) -> Result<(), TooLarge> {
+    check(
+        || format!("a map of {pixels} × {pixels} pixels"),
+        pixels as u128 * pixels as u128,
+        std::mem::size_of::<f64>(),
+    )
+}

@@ -680,6 +680,43 @@ fn panel_titles(result: &Exploration, info: &ModelInfo, contacts: bool) -> Vec<S
     titles
 }
 
+/// The panels of degree of freedom `i` of `n`: its time series, its phase
+/// portrait, and its period map (or its velocity).
+fn degree_panels<'a>(
+    result: &Exploration,
+    averaged: &[Vec<f64>],
+    [i, n]: [usize; 2],
+    titles: &'a [String],
+    name: &'a str,
+    t_range: (f64, f64),
+) -> [PanelSpec<'a>; 3] {
+    let column = |k: usize, rows: &[Vec<f64>]| rows.iter().map(move |y| y[k]).collect::<Vec<f64>>();
+    let q: Vec<f64> = column(i, &result.exact)
+        .into_iter()
+        .chain(column(i, averaged))
+        .collect();
+    let p: Vec<f64> = column(n + i, &result.exact)
+        .into_iter()
+        .chain(column(n + i, averaged))
+        .collect();
+    let (q_range, p_range) = (range(q.iter().copied()), range(p.iter().copied()));
+    let third = match &result.period_map {
+        Some(map) => PanelSpec::new(
+            &titles[3 * i + 2],
+            name,
+            "",
+            range(column(i, map).into_iter()),
+            range(column(n + i, map).into_iter()),
+        ),
+        None => PanelSpec::new(&titles[3 * i + 2], "t", "", t_range, p_range),
+    };
+    [
+        PanelSpec::new(&titles[3 * i], "t", name, t_range, q_range),
+        PanelSpec::new(&titles[3 * i + 1], name, "", q_range, p_range),
+        third,
+    ]
+}
+
 /// The figure: per degree of freedom the time series, the phase portrait
 /// and the period map (or the velocity), then the energy change and the
 /// exact−averaged deviation.
@@ -692,50 +729,20 @@ pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Fig
     let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
     let coordinate_names: Vec<&str> = names.iter().map(String::as_str).collect();
     let titles = panel_titles(result, info, contacts);
-    let column = |k: usize, rows: &[Vec<f64>]| rows.iter().map(move |y| y[k]).collect::<Vec<f64>>();
-    let mut specs = Vec::new();
     let t_range = (0.0, t_end);
     let averaged = result.averaged.clone().unwrap_or_default();
-    for i in 0..n {
-        let q: Vec<f64> = column(i, &result.exact)
-            .into_iter()
-            .chain(column(i, &averaged))
-            .collect();
-        let p: Vec<f64> = column(n + i, &result.exact)
-            .into_iter()
-            .chain(column(n + i, &averaged))
-            .collect();
-        specs.push(PanelSpec::new(
-            &titles[3 * i],
-            "t",
-            coordinate_names[i],
-            t_range,
-            range(q.iter().copied()),
-        ));
-        specs.push(PanelSpec::new(
-            &titles[3 * i + 1],
-            coordinate_names[i],
-            "",
-            range(q.iter().copied()),
-            range(p.iter().copied()),
-        ));
-        match &result.period_map {
-            Some(map) => specs.push(PanelSpec::new(
-                &titles[3 * i + 2],
+    let mut specs: Vec<PanelSpec> = (0..n)
+        .flat_map(|i| {
+            degree_panels(
+                result,
+                &averaged,
+                [i, n],
+                &titles,
                 coordinate_names[i],
-                "",
-                range(column(i, map).into_iter()),
-                range(column(n + i, map).into_iter()),
-            )),
-            None => specs.push(PanelSpec::new(
-                &titles[3 * i + 2],
-                "t",
-                "",
                 t_range,
-                range(p.iter().copied()),
-            )),
-        }
-    }
+            )
+        })
+        .collect();
     specs.push(PanelSpec::new(
         &titles[3 * n],
         "t",

@@ -56,7 +56,7 @@ pub struct AtSize<const D: usize, const S: usize, const T: usize, const V: usize
     pub &'static Erased<D, S, T, V>,
 );
 
-/// What [`crate::registry::Sized::Large`] holds (as a
+/// What [`crate::registry::FixedSize::Large`] holds (as a
 /// [`LargeHandleRef`]): the model's analyses at its size.
 pub struct LargeHandle(pub &'static dyn LargeModel);
 
@@ -67,6 +67,6 @@ impl LargeHandle {
     fn of(model: LargeHandleRef) -> &'static LargeHandle {
         model
             .downcast_ref::<LargeHandle>()
-            .expect("Sized::Large holds a large_models::LargeHandle")
+            .expect("FixedSize::Large holds a large_models::LargeHandle")
     }
 }

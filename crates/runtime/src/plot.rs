@@ -572,27 +572,7 @@ where
                 values,
                 map,
                 ..
-            } => {
-                let (x0, x1) = panel.x_range;
-                let (y0, y1) = panel.y_range;
-                let (dx, dy) = ((x1 - x0) / *columns as f64, (y1 - y0) / *rows as f64);
-                chart
-                    .draw_series(
-                        (0..*rows)
-                            .flat_map(|j| (0..*columns).map(move |i| (i, j)))
-                            .filter_map(|(i, j)| {
-                                let v = values[j * columns + i];
-                                v.is_finite().then(|| {
-                                    let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
-                                    Rectangle::new(
-                                        [(x, y), (x + dx, y + dy)],
-                                        map.color(v).filled(),
-                                    )
-                                })
-                            }),
-                    )
-                    .map_err(err)?;
-            }
+            } => draw_map(chart, panel, [*columns, *rows], values, *map)?,
             Layer::Points(pts, color, size) => {
                 let c = rgb(*color);
                 if *size <= 1 {
@@ -642,31 +622,79 @@ where
                     }
                 }
             }
-            Layer::Legend(entries, bottom) => {
-                for (text, color) in entries {
-                    let c = rgb(*color);
-                    chart
-                        .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
-                        .map_err(err)?
-                        .label(text.as_str())
-                        .legend(move |(x, y)| {
-                            Rectangle::new([(x, y - 4), (x + 12, y + 4)], c.filled())
-                        });
-                }
-                chart
-                    .configure_series_labels()
-                    .position(if *bottom {
-                        SeriesLabelPosition::LowerLeft
-                    } else {
-                        SeriesLabelPosition::UpperLeft
-                    })
-                    .label_font((FONT, 12))
-                    .background_style(WHITE_COLOR.mix(0.85))
-                    .border_style(RGBColor(180, 180, 180))
-                    .draw()
-                    .map_err(err)?;
-            }
+            Layer::Legend(entries, bottom) => draw_legend(chart, entries, *bottom)?,
         }
     }
+    Ok(())
+}
+
+/// A map layer: `values` (row-major, `columns` × `rows`) as cells filling
+/// the panel, non-finite ones left blank.
+fn draw_map<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    panel: &Panel,
+    [columns, rows]: [usize; 2],
+    values: &[f64],
+    map: ColorMap,
+) -> Result<(), PlotFailure>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotFailure::from(e);
+    let (x0, x1) = panel.x_range;
+    let (y0, y1) = panel.y_range;
+    let (dx, dy) = ((x1 - x0) / columns as f64, (y1 - y0) / rows as f64);
+    chart
+        .draw_series(
+            (0..rows)
+                .flat_map(|j| (0..columns).map(move |i| (i, j)))
+                .filter_map(|(i, j)| {
+                    let v = values[j * columns + i];
+                    v.is_finite().then(|| {
+                        let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
+                        Rectangle::new([(x, y), (x + dx, y + dy)], map.color(v).filled())
+                    })
+                }),
+        )
+        .map_err(err)?;
+    Ok(())
+}
+
+/// A legend layer: a coloured box per entry, at the lower or upper left.
+fn draw_legend<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    entries: &[(String, Rgb)],
+    bottom: bool,
+) -> Result<(), PlotFailure>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotFailure::from(e);
+    for (text, color) in entries {
+        let c = rgb(*color);
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(err)?
+            .label(text.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 12, y + 4)], c.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(if bottom {
+            SeriesLabelPosition::LowerLeft
+        } else {
+            SeriesLabelPosition::UpperLeft
+        })
+        .label_font((FONT, 12))
+        .background_style(WHITE_COLOR.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .draw()
+        .map_err(err)?;
     Ok(())
 }

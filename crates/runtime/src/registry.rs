@@ -365,7 +365,7 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
 /// are compiled ahead, in this crate, for 1 to 4 degrees of freedom; a
 /// model of 5 to 24 brings its own (see [`crate::large_models`]).
 #[derive(Clone, Copy)]
-pub enum Sized {
+pub enum FixedSize {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
@@ -394,7 +394,7 @@ pub struct Model {
     pub info: &'static ModelInfo,
     pub dynamic: &'static dyn DynamicModel,
     /// None for a contact model.
-    pub sized: Option<Sized>,
+    pub sized: Option<FixedSize>,
 }
 
 impl fmt::Debug for Model {
@@ -453,11 +453,11 @@ pub trait WithFixed {
 /// for larger sizes that its model files have.
 pub fn with_fixed<W: LargeWork>(model: &Model, work: W) -> Option<W::Output> {
     model.sized.map(|sized| match sized {
-        Sized::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
-        Sized::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
-        Sized::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
-        Sized::Dof4(m) => work.run::<_, 4, 8, 16, 72>(m),
-        Sized::Large(m) => work.on_large(m),
+        FixedSize::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
+        FixedSize::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
+        FixedSize::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
+        FixedSize::Dof4(m) => work.run::<_, 4, 8, 16, 72>(m),
+        FixedSize::Large(m) => work.on_large(m),
     })
 }
 

@@ -510,9 +510,7 @@ pub fn separatrix_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use crate::analysis::separatrix::{
-        separatrix_splitting, splitting_sweep, Precision, SplittingSettings,
-    };
+    use crate::analysis::separatrix::{separatrix_splitting, Precision, SplittingSettings};
     let (model, scene) = generic_scene(
         catalog,
         scene_name,
@@ -589,7 +587,29 @@ pub fn separatrix_scene(
         .into_iter()
         .flat_map(|(curve, points)| points.iter().map(move |y| (curve, y[0], y[1])));
     scene.write_csv("manifolds.csv", &["curve", "q_lifted", "p"], rows)?;
-    let sweep = match scene.text("sweep") {
+    let sweep = splitting_sweep_of(&scene, model, &params, &settings)?;
+    #[derive(serde::Serialize)]
+    struct Summary<'a> {
+        splitting: &'a crate::analysis::separatrix::Splitting,
+        sweep: Option<&'a crate::analysis::separatrix::SplittingSweep>,
+    }
+    scene.write_summary(&Summary {
+        splitting: &splitting,
+        sweep: sweep.as_ref(),
+    })?;
+    Ok(())
+}
+
+/// The separatrix scene's sweep of `sweep_parameter` when `sweep` asks for
+/// one, with its figure and table.
+fn splitting_sweep_of(
+    scene: &Scene,
+    model: &Model,
+    params: &[f64],
+    settings: &crate::analysis::separatrix::SplittingSettings,
+) -> Result<Option<crate::analysis::separatrix::SplittingSweep>, SceneError> {
+    use crate::analysis::separatrix::splitting_sweep;
+    Ok(match scene.text("sweep") {
         "none" => None,
         _ => {
             let values = geometric_progression(&scene.numbers("sweep")?).map_err(|reason| {
@@ -606,10 +626,10 @@ pub fn separatrix_scene(
             );
             let sweep = splitting_sweep(
                 model,
-                &params,
+                params,
                 scene.text("sweep_parameter"),
                 &values,
-                &settings,
+                settings,
             )?;
             scene.save_figure(&sweep.figure(), "lobe_area_sweep.png")?;
             let rows = sweep.rows.iter().map(|r| {
@@ -638,17 +658,7 @@ pub fn separatrix_scene(
             )?;
             Some(sweep)
         }
-    };
-    #[derive(serde::Serialize)]
-    struct Summary<'a> {
-        splitting: &'a crate::analysis::separatrix::Splitting,
-        sweep: Option<&'a crate::analysis::separatrix::SplittingSweep>,
-    }
-    scene.write_summary(&Summary {
-        splitting: &splitting,
-        sweep: sweep.as_ref(),
-    })?;
-    Ok(())
+    })
 }
 
 /// Scene `attractor`: the attractor of the period map of a forced, damped
@@ -707,7 +717,7 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
 /// Scene `continuation`: the periodic orbits of a model's period map
 /// followed in one parameter, their bifurcations, and the orbit diagram.
 pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use crate::analysis::continuation::{continuation, ContinuationSettings, DiagramSettings};
+    use crate::analysis::continuation::continuation;
     // The parameter defaults to the model file's [fast_phase] amplitude.
     let named = Scene::peek("model").unwrap_or_else(|| "duffing".into());
     let amplitude = crate::registry::lookup(catalog, &named)
@@ -742,6 +752,31 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
             ("coordinate", "0", "the state component drawn (0 = first coordinate)"),
         ],
     )?;
+    let params = scene.parameter_values(model.info)?;
+    let settings = continuation_settings(model, &scene, &params)?;
+    let coordinate = scene.whole("coordinate")?;
+    let states = model.info.state_names().len();
+    if coordinate >= states {
+        return Err(SceneError::BadValue {
+            name: "coordinate".into(),
+            value: coordinate.to_string(),
+            reason: format!("the state has {states} components"),
+        });
+    }
+    eprintln!("continuing in {} …", settings.parameter);
+    let result = continuation(model, &params, &settings)?;
+    write_continuation(&scene, &result, coordinate)?;
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
+/// The `continuation` scene's knobs as the analysis's settings.
+fn continuation_settings(
+    model: &Model,
+    scene: &Scene,
+    params: &[f64],
+) -> Result<crate::analysis::continuation::ContinuationSettings, SceneError> {
+    use crate::analysis::continuation::{ContinuationSettings, DiagramSettings};
     let switch_branch_points = match scene.text("switch") {
         "yes" => true,
         "no" => false,
@@ -754,7 +789,6 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
         }
     };
     let values = scene.whole("diagram")?;
-    let params = scene.parameter_values(model.info)?;
     let parameter = scene.text("parameter").to_string();
     // (A contact model is refused by the analysis, by name.)
     if parameter == "none" && model.sized.is_some() {
@@ -782,7 +816,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
         }
         _ => scene.number("to")?,
     };
-    let settings = ContinuationSettings {
+    Ok(ContinuationSettings {
         parameter,
         to,
         start: scene.numbers("start")?,
@@ -794,7 +828,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
         step: scene.positive("step")?,
         min_step: scene.positive("min_step")?,
         max_step: scene.positive("max_step")?,
-        method: method_from(&scene)?,
+        method: method_from(scene)?,
         diagram: (values > 0)
             .then(|| -> Result<DiagramSettings, SceneError> {
                 Ok(DiagramSettings {
@@ -804,18 +838,16 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
                 })
             })
             .transpose()?,
-    };
-    let coordinate = scene.whole("coordinate")?;
-    let states = model.info.state_names().len();
-    if coordinate >= states {
-        return Err(SceneError::BadValue {
-            name: "coordinate".into(),
-            value: coordinate.to_string(),
-            reason: format!("the state has {states} components"),
-        });
-    }
-    eprintln!("continuing in {} …", settings.parameter);
-    let result = continuation(model, &params, &settings)?;
+    })
+}
+
+/// The `continuation` scene's figure and tables (branches, bifurcations,
+/// the orbit diagram), drawn in state component `coordinate`.
+fn write_continuation(
+    scene: &Scene,
+    result: &crate::analysis::continuation::Continuation,
+    coordinate: usize,
+) -> Result<(), SceneError> {
     scene.save_figure(&result.figure(coordinate), "continuation.png")?;
     let rows = result.branches.iter().enumerate().flat_map(|(b, branch)| {
         branch.points.iter().map(move |p| {
@@ -872,7 +904,6 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
             d.points.iter().map(|(p, y)| (*p, y[coordinate])),
         )?;
     }
-    scene.write_summary(&result)?;
     Ok(())
 }
 
@@ -883,62 +914,7 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         parse_plane, section, seeds_across, SectionError, SectionSettings,
     };
     let model = model_from_args(catalog, Defaults(&[]).get("model", "henon_heiles"))?;
-    let mut knobs = vec![
-        knob(
-            "model",
-            model.info.name,
-            "the model (a file models/<name>.toml) of 2 degrees of freedom (with a fast phase: a slice of its period map)",
-        ),
-        knob(
-            "energy",
-            "0.125",
-            "the energy H = E of every orbit's seed (H̄, averaged, with a fast phase)",
-        ),
-        knob(
-            "plane",
-            model.info.coordinates[0],
-            "the plane: a linear function of the coordinates (\"x\", \"q1 - q2\", \"x + 0.5*y\") equal to `value`",
-        ),
-        knob("value", "0", "the plane's value"),
-        knob(
-            "direction",
-            "rising",
-            "crossings with the plane's function increasing (rising) or decreasing (falling)",
-        ),
-        knob(
-            "orbits",
-            "24",
-            "orbits, seeded evenly across the accessible part of the other coordinate",
-        ),
-        knob("extent", "2", "seeds are searched for in [-extent, extent]"),
-        knob("crossings", "400", "points per orbit"),
-        knob(
-            "t_max",
-            "20000",
-            "an orbit stops at this time, however few its crossings",
-        ),
-        knob(
-            "tol",
-            "1e-12",
-            "DOP853's tolerance (the map's Taylor method uses it too)",
-        ),
-        knob(
-            "map",
-            "0",
-            "pixels per side of a MEGNO chaos map of the section (0: none)",
-        ),
-        knob("map_time", "2000", "the time each orbit of the map runs"),
-        knob(
-            "phase",
-            "0",
-            "with a fast phase: the forcing's phase 2πt/T at which the period map samples",
-        ),
-        knob(
-            "slab",
-            "0.05",
-            "with a fast phase: points of the period map within this of the plane are kept",
-        ),
-    ];
+    let mut knobs = section_knobs(model);
     knobs.extend(parameter_knobs(model.info, &[]));
     let scene = Scene::from_args("section", "Poincaré section at a fixed energy", &knobs)?;
     let rising = match scene.text("direction") {
@@ -996,7 +972,88 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
             o.points[0], o.crossings, settings.crossings
         );
     }
-    let map = match scene.whole("map")? {
+    let map = section_megno_map(&scene, model, &params, &settings)?;
+    #[derive(serde::Serialize)]
+    struct Summary<'a> {
+        section: &'a crate::analysis::section::Section,
+        megno_map: Option<&'a crate::analysis::section_map::SectionMap>,
+    }
+    scene.write_summary(&Summary {
+        section: &result,
+        megno_map: map.as_ref(),
+    })?;
+    Ok(())
+}
+
+/// The `section` scene's knobs for `model` (its parameters not included).
+fn section_knobs(model: &Model) -> Vec<Knob> {
+    vec![
+        knob(
+            "model",
+            model.info.name,
+            "the model (a file models/<name>.toml) of 2 degrees of freedom (with a fast phase: a slice of its period map)",
+        ),
+        knob(
+            "energy",
+            "0.125",
+            "the energy H = E of every orbit's seed (H̄, averaged, with a fast phase)",
+        ),
+        knob(
+            "plane",
+            model.info.coordinates[0],
+            "the plane: a linear function of the coordinates (\"x\", \"q1 - q2\", \"x + 0.5*y\") equal to `value`",
+        ),
+        knob("value", "0", "the plane's value"),
+        knob(
+            "direction",
+            "rising",
+            "crossings with the plane's function increasing (rising) or decreasing (falling)",
+        ),
+        knob(
+            "orbits",
+            "24",
+            "orbits, seeded evenly across the accessible part of the other coordinate",
+        ),
+        knob("extent", "2", "seeds are searched for in [-extent, extent]"),
+        knob("crossings", "400", "points per orbit"),
+        knob(
+            "t_max",
+            "20000",
+            "an orbit stops at this time, however few its crossings",
+        ),
+        knob(
+            "tol",
+            "1e-12",
+            "DOP853's tolerance (the map's Taylor method uses it too)",
+        ),
+        knob(
+            "map",
+            "0",
+            "pixels per side of a MEGNO chaos map of the section (0: none)",
+        ),
+        knob("map_time", "2000", "the time each orbit of the map runs"),
+        knob(
+            "phase",
+            "0",
+            "with a fast phase: the forcing's phase 2πt/T at which the period map samples",
+        ),
+        knob(
+            "slab",
+            "0.05",
+            "with a fast phase: points of the period map within this of the plane are kept",
+        ),
+    ]
+}
+
+/// The `section` scene's MEGNO map of the section when `map` asks for one,
+/// with its figure and table.
+fn section_megno_map(
+    scene: &Scene,
+    model: &Model,
+    params: &[f64],
+    settings: &crate::analysis::section::SectionSettings,
+) -> Result<Option<crate::analysis::section_map::SectionMap>, SceneError> {
+    Ok(match scene.whole("map")? {
         0 => None,
         pixels => {
             use crate::analysis::section_map::{section_map, SectionMapSettings};
@@ -1007,7 +1064,7 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
                 t_max: scene.positive("map_time")?,
                 extent: scene.positive("extent")?,
             };
-            let map = section_map(model, &params, &map_settings)?;
+            let map = section_map(model, params, &map_settings)?;
             scene.save_figure(&map.figure(), "section_megno.png")?;
             let window = map.window;
             let at = move |k: usize, range: [f64; 2]| {
@@ -1025,15 +1082,5 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
             )?;
             Some(map)
         }
-    };
-    #[derive(serde::Serialize)]
-    struct Summary<'a> {
-        section: &'a crate::analysis::section::Section,
-        megno_map: Option<&'a crate::analysis::section_map::SectionMap>,
-    }
-    scene.write_summary(&Summary {
-        section: &result,
-        megno_map: map.as_ref(),
-    })?;
-    Ok(())
+    })
 }

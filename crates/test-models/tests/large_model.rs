@@ -1,10 +1,10 @@
 //! A model of 5 degrees of freedom reaches the analyses through the models
-//! package's own instantiation at its size (`registry::Sized::Large`), and
+//! package's own instantiation at its size (`registry::FixedSize::Large`), and
 //! they give its closed-form normal modes.
 
 use mechlab::explore::{explore, Settings};
 use mechlab::ode::Method;
-use mechlab::registry::Sized;
+use mechlab::registry::FixedSize;
 use mechlab_test_models::spring_chain5;
 use std::f64::consts::PI;
 
@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 #[test]
 fn a_five_degree_chain_oscillates_in_its_closed_form_normal_modes() {
     let handle = &spring_chain5::MODEL;
-    assert!(matches!(handle.sized, Some(Sized::Large(_))));
+    assert!(matches!(handle.sized, Some(FixedSize::Large(_))));
     let k = 2.0;
     let settings = Settings {
         method: Method::parse("dop853", 1e-11).unwrap(),

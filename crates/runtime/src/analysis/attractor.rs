@@ -11,7 +11,7 @@ use super::period_map::orbit;
 use crate::analysis::Refusal;
 use crate::ode::{ErasedSystem, Integrator, Method, OdeError, Options, System};
 use crate::plot::{ColorMap, Figure, PanelSpec, Rgb};
-use crate::registry::{Fixed, Model, Sized};
+use crate::registry::{Fixed, FixedSize, Model};
 use std::collections::BTreeMap;
 
 /// What to compute.
@@ -93,7 +93,7 @@ pub fn attractor(
 ) -> Result<Attractor, AttractorError> {
     let name = model.info.name.to_string();
     let fixed = match model.sized {
-        Some(Sized::Dof1(fixed)) => fixed,
+        Some(FixedSize::Dof1(fixed)) => fixed,
         Some(_) => {
             return Err(AttractorError::NotPlanar {
                 model: name,
@@ -110,25 +110,7 @@ pub fn attractor(
         model: name.clone(),
         reason: reason.into(),
     };
-    if settings.points < 100 || settings.lyapunov_periods < 10 || settings.pixels < 10 {
-        return Err(settings_error(
-            "points ≥ 100, lyapunov_periods ≥ 10 and pixels ≥ 10",
-        ));
-    }
-    if !settings.start.iter().all(|x| x.is_finite()) {
-        return Err(settings_error("the start must be finite"));
-    }
-    crate::budget::check(
-        || {
-            format!(
-                "{} points of the attractor and {1} × {1} pixels",
-                settings.points, settings.pixels
-            )
-        },
-        settings.points as u128 + settings.pixels as u128 * settings.pixels as u128,
-        2 * std::mem::size_of::<f64>(),
-    )
-    .map_err(OdeError::from)?;
+    check_settings(settings, &name)?;
     let named = model
         .info
         .named_values(params)
@@ -209,6 +191,34 @@ pub fn attractor(
         pixels: settings.pixels,
         axes: [model.info.coordinates[0], model.info.momenta[0]],
     })
+}
+
+/// The settings' sanity and the memory they ask for, as named errors.
+fn check_settings(settings: &AttractorSettings, name: &str) -> Result<(), AttractorError> {
+    let settings_error = |reason: &str| AttractorError::Settings {
+        model: name.into(),
+        reason: reason.into(),
+    };
+    if settings.points < 100 || settings.lyapunov_periods < 10 || settings.pixels < 10 {
+        return Err(settings_error(
+            "points ≥ 100, lyapunov_periods ≥ 10 and pixels ≥ 10",
+        ));
+    }
+    if !settings.start.iter().all(|x| x.is_finite()) {
+        return Err(settings_error("the start must be finite"));
+    }
+    crate::budget::check(
+        || {
+            format!(
+                "{} points of the attractor and {1} × {1} pixels",
+                settings.points, settings.pixels
+            )
+        },
+        settings.points as u128 + settings.pixels as u128 * settings.pixels as u128,
+        2 * std::mem::size_of::<f64>(),
+    )
+    .map_err(OdeError::from)?;
+    Ok(())
 }
 
 /// ∫₀ᵀ tr ∂f/∂y dt from each of `starts` along one period (Simpson's rule

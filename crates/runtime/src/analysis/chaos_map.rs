@@ -7,7 +7,7 @@ use super::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators, fli_sha
 use super::tiles::{fingerprint, run_tiles};
 pub use super::tiles::{TileError, Tiles};
 use crate::analysis::Refusal;
-use crate::ode::{Integrator, LaneIntegrator, Method, OdeError};
+use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, System};
 use crate::registry::{Fixed, Model, WithFixed};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -140,21 +140,8 @@ impl WithFixed for Map<'_> {
             })?,
             None => [0.0; S],
         };
-        let periodic = model.periodic();
-        let ranges: [(f64, f64); 2] = std::array::from_fn(|k| {
-            let axis = settings.axes[k];
-            settings.ranges[k].unwrap_or(if axis < D && periodic[axis] {
-                (-PI, PI)
-            } else {
-                (-settings.p_max, settings.p_max)
-            })
-        });
-        crate::budget::check(
-            || format!("a map of {0} × {0} pixels", settings.pixels),
-            settings.pixels as u128 * settings.pixels as u128,
-            std::mem::size_of::<f64>(),
-        )
-        .map_err(OdeError::from)?;
+        let ranges = plane_ranges(settings, &model.periodic());
+        crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
         let system = model.exact(self.params);
         // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
         let w0 = [(1.0 / S as f64).sqrt(); S];
@@ -166,9 +153,7 @@ impl WithFixed for Map<'_> {
             y0[settings.axes[1]] = y;
             y0
         };
-        // The FLI values of a block of rows and their f-evaluations, with
-        // an integrator of its own. The Taylor method streams the block's
-        // orbits through its LANES lanes.
+        // The FLI values of a block of rows and their f-evaluations.
         let stopped = std::sync::atomic::AtomicBool::new(false);
         let block = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
             if stopped.load(std::sync::atomic::Ordering::Relaxed) {
@@ -177,43 +162,8 @@ impl WithFixed for Map<'_> {
             let starts: Vec<[f64; S]> = (rows.start * pixels..rows.end * pixels)
                 .map(start_of)
                 .collect();
-            let (values, f_evals) = match settings.method {
-                Method::Taylor { .. } => {
-                    let mut integrator = LaneIntegrator::new(settings.method)?;
-                    let values = fast_lyapunov_indicators::<_, S, T>(
-                        &mut integrator,
-                        &system,
-                        period,
-                        &starts,
-                        &w0,
-                        settings.periods,
-                    )
-                    .into_iter()
-                    .map(pixel_value)
-                    .collect::<Result<_, _>>()?;
-                    (values, integrator.stats.f_evals)
-                }
-                _ => {
-                    let mut integrator = Integrator::new(settings.method)?;
-                    let mut values = Vec::with_capacity(pixels);
-                    for y0 in &starts {
-                        let fli = fast_lyapunov_indicator::<_, S, T>(
-                            &mut integrator,
-                            &system,
-                            period,
-                            y0,
-                            &w0,
-                            settings.periods,
-                        );
-                        if fli.is_err() {
-                            // A clean state for the next orbit.
-                            integrator = Integrator::new(settings.method)?;
-                        }
-                        values.push(pixel_value(fli)?);
-                    }
-                    (values, integrator.stats.f_evals)
-                }
-            };
+            let (values, f_evals) =
+                fli_of_starts::<_, S, T>(&system, settings, period, &starts, &w0)?;
             for _ in rows {
                 if !(self.row_done)() {
                     stopped.store(true, std::sync::atomic::Ordering::Relaxed);
@@ -281,6 +231,71 @@ impl WithFixed for Map<'_> {
             shades: shading.shades,
         })
     }
+}
+
+/// The ranges of the map's axes: the settings', or [−π, π] for an angle
+/// and [−p_max, p_max] for any other component.
+fn plane_ranges<const D: usize>(
+    settings: &ChaosMapSettings,
+    periodic: &[bool; D],
+) -> [(f64, f64); 2] {
+    std::array::from_fn(|k| {
+        let axis = settings.axes[k];
+        settings.ranges[k].unwrap_or(if axis < D && periodic[axis] {
+            (-PI, PI)
+        } else {
+            (-settings.p_max, settings.p_max)
+        })
+    })
+}
+
+/// The FLI of each start after `settings.periods` periods and the
+/// f-evaluations spent, with an integrator of its own: the Taylor method
+/// streams the orbits through its lanes, the others run them one by one.
+fn fli_of_starts<Sys: System<S>, const S: usize, const T: usize>(
+    system: &Sys,
+    settings: &ChaosMapSettings,
+    period: f64,
+    starts: &[[f64; S]],
+    w0: &[f64; S],
+) -> Result<(Vec<f64>, u64), OdeError> {
+    Ok(match settings.method {
+        Method::Taylor { .. } => {
+            let mut integrator = LaneIntegrator::new(settings.method)?;
+            let values = fast_lyapunov_indicators::<_, S, T>(
+                &mut integrator,
+                system,
+                period,
+                starts,
+                w0,
+                settings.periods,
+            )
+            .into_iter()
+            .map(pixel_value)
+            .collect::<Result<_, _>>()?;
+            (values, integrator.stats.f_evals)
+        }
+        _ => {
+            let mut integrator = Integrator::new(settings.method)?;
+            let mut values = Vec::with_capacity(starts.len());
+            for y0 in starts {
+                let fli = fast_lyapunov_indicator::<_, S, T>(
+                    &mut integrator,
+                    system,
+                    period,
+                    y0,
+                    w0,
+                    settings.periods,
+                );
+                if fli.is_err() {
+                    // A clean state for the next orbit.
+                    integrator = Integrator::new(settings.method)?;
+                }
+                values.push(pixel_value(fli)?);
+            }
+            (values, integrator.stats.f_evals)
+        }
+    })
 }
 
 /// A pixel's FLI; an orbit that left the model's domain or ran into a

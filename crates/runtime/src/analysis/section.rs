@@ -17,7 +17,7 @@
 
 use crate::analysis::Refusal;
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options};
-use crate::registry::{Fixed, Model, Sized, WithFixed};
+use crate::registry::{Fixed, FixedSize, Model, WithFixed};
 use rayon::prelude::*;
 
 /// Where the section lies and how far each orbit is followed.
@@ -219,7 +219,7 @@ pub fn section(
     // instances at the other sizes were compile time for nothing.
     let name = model.info.name.to_string();
     match model.sized {
-        Some(Sized::Dof2(fixed)) => work.run::<_, 2, 4, 8, 20>(fixed),
+        Some(FixedSize::Dof2(fixed)) => work.run::<_, 2, 4, 8, 20>(fixed),
         Some(_) if has_fast_phase(model) => Err(SectionError::FastPhase(name)),
         Some(_) => Err(SectionError::Dimension {
             model: name,

@@ -9,7 +9,7 @@ use super::section::{on_plane, Chart, SectionError, SectionSettings};
 use crate::analysis::Refusal;
 use crate::ode::{LaneIntegrator, Method, OdeError};
 use crate::plot::{ColorMap, Figure, PanelSpec};
-use crate::registry::{Fixed, Model, Sized};
+use crate::registry::{Fixed, FixedSize, Model};
 use rayon::prelude::*;
 
 /// What a section's chaos map computes.
@@ -65,7 +65,7 @@ pub fn section_map(
 ) -> Result<SectionMap, SectionError> {
     let name = model.info.name.to_string();
     let fixed = match model.sized {
-        Some(Sized::Dof2(fixed)) => fixed,
+        Some(FixedSize::Dof2(fixed)) => fixed,
         Some(_) => {
             return Err(SectionError::Dimension {
                 model: name,
@@ -82,32 +82,13 @@ pub fn section_map(
     if settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
         return Err(bad("pixels ≥ 2, t_max and extent positive"));
     }
-    crate::budget::check(
-        || format!("a map of {0} × {0} pixels", settings.pixels),
-        settings.pixels as u128 * settings.pixels as u128,
-        std::mem::size_of::<f64>(),
-    )
-    .map_err(OdeError::from)?;
+    crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
     let chart = Chart::new(s, 2, &fixed.periodic())
         .ok_or_else(|| bad("the plane's coefficients are 0 or not finite"))?;
     let method = Method::Taylor { tol: s.tol };
     method.validate()?;
-    // MEGNO's samples every 2 time units, or with a fast phase every whole
-    // number of periods nearest 2 (the lanes restart the time at 0 after
-    // each: the field must be the same there), the orbits from phase 0.
-    let chunk = match fixed.has_fast_phase() {
-        false => 2.0,
-        true => match fixed.phase_period(params) {
-            Some(period) if period > 0.0 && s.phase == 0.0 => {
-                (2.0 / period).round().max(1.0) * period
-            }
-            _ => {
-                return Err(bad(
-                    "with a fast phase the map starts its orbits at phase 0",
-                ))
-            }
-        },
-    };
+    let chunk = megno_interval(fixed.has_fast_phase(), fixed.phase_period(params), s.phase)
+        .ok_or_else(|| bad("with a fast phase the map starts its orbits at phase 0"))?;
     let start = std::time::Instant::now();
     let energy = super::section::seed_energy(model, params)
         .ok_or_else(|| bad("its averaged Hamiltonian is not derived"))?;
@@ -187,6 +168,19 @@ pub fn section_map(
         seconds: start.elapsed().as_secs_f64(),
         megno,
     })
+}
+
+/// The time between MEGNO's samples: 2, or with a fast phase the whole
+/// number of periods nearest 2 (the lanes restart the time at 0 after
+/// each: the field must be the same there), the orbits from phase 0.
+fn megno_interval(fast_phase: bool, period: Option<f64>, phase: f64) -> Option<f64> {
+    match (fast_phase, period) {
+        (false, _) => Some(2.0),
+        (true, Some(period)) if period > 0.0 && phase == 0.0 => {
+            Some((2.0 / period).round().max(1.0) * period)
+        }
+        (true, _) => None,
+    }
 }
 
 /// The region of the plane where H = E is accessible (the least H below

@@ -120,6 +120,61 @@ enum Clock {
     },
 }
 
+impl Clock {
+    #[inline(always)]
+    fn new(schedule: Schedule, t0: f64, t1: f64, max_steps: u64) -> Result<Clock, OdeError> {
+        Ok(match schedule {
+            Schedule::Fixed { max_step } => {
+                let (steps, h) = fixed_steps(t0, t1, max_step, max_steps)?;
+                Clock::Fixed {
+                    t0,
+                    h,
+                    steps,
+                    taken: 0,
+                }
+            }
+            Schedule::Adaptive {
+                snap,
+                compensated,
+                underflow,
+            } => Clock::Adaptive {
+                snap,
+                compensated,
+                underflow,
+                carry: 0.0,
+            },
+        })
+    }
+
+    /// The end of a step of signed size `signed` from t (t1 for the last),
+    /// and the compensation it leaves if accepted.
+    #[inline(always)]
+    fn end_of_step(&self, t: f64, signed: f64, last: bool, t1: f64) -> (f64, f64) {
+        match *self {
+            _ if last => (t1, 0.0),
+            Clock::Fixed { t0, h, taken, .. } => (t0 + (taken + 1) as f64 * h, 0.0),
+            Clock::Adaptive {
+                compensated: true,
+                carry,
+                ..
+            } => {
+                let mut carry = carry;
+                (compensated_sum(t, signed, &mut carry), carry)
+            }
+            Clock::Adaptive { .. } => (t + signed, 0.0),
+        }
+    }
+
+    /// A step was accepted, leaving the compensation `carry`.
+    #[inline(always)]
+    fn accept(&mut self, carry_new: f64) {
+        match self {
+            Clock::Fixed { taken, .. } => *taken += 1,
+            Clock::Adaptive { carry, .. } => *carry = carry_new,
+        }
+    }
+}
+
 /// Integrates from (t0, y0) to t1 with `stepper`, calling `observe` after
 /// every accepted step. `next_step` is the size to start with and, on
 /// return, the one to try next (adaptive methods): the proposal, not a last
@@ -138,27 +193,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
 ) -> Result<(f64, [f64; N]), OdeError> {
     let direction = (t1 - t0).signum();
     let span = (t1 - t0).abs();
-    let mut clock = match stepper.schedule() {
-        Schedule::Fixed { max_step } => {
-            let (steps, h) = fixed_steps(t0, t1, max_step, max_steps)?;
-            Clock::Fixed {
-                t0,
-                h,
-                steps,
-                taken: 0,
-            }
-        }
-        Schedule::Adaptive {
-            snap,
-            compensated,
-            underflow,
-        } => Clock::Adaptive {
-            snap,
-            compensated,
-            underflow,
-            carry: 0.0,
-        },
-    };
+    let mut clock = Clock::new(stepper.schedule(), t0, t1, max_steps)?;
     let mut h = stepper
         .begin(system, t0, y0, t1, *next_step, stats)?
         .min(span);
@@ -192,20 +227,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
             }
         };
         let size = signed.abs();
-        // The end of the step, and the compensation it leaves if accepted.
-        let (t_new, carry_new) = match clock {
-            _ if last => (t1, 0.0),
-            Clock::Fixed { t0, h, taken, .. } => (t0 + (taken + 1) as f64 * h, 0.0),
-            Clock::Adaptive {
-                compensated: true,
-                carry,
-                ..
-            } => {
-                let mut carry = carry;
-                (compensated_sum(t, signed, &mut carry), carry)
-            }
-            Clock::Adaptive { .. } => (t + signed, 0.0),
-        };
+        let (t_new, carry_new) = clock.end_of_step(t, signed, last, t1);
         let (y_new, next) = match stepper.attempt(system, t, &y, signed, t_new, stats)? {
             Attempt::Rejected { retry } => {
                 stats.rejected += 1;
@@ -218,10 +240,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
             Attempt::Accepted { y, next } => (y, next),
         };
         after_rejection = false;
-        match &mut clock {
-            Clock::Fixed { taken, .. } => *taken += 1,
-            Clock::Adaptive { carry, .. } => *carry = carry_new,
-        }
+        clock.accept(carry_new);
         check_finite(t_new, &y_new)?;
         if !last && t_new == t {
             return Err(OdeError::StepSizeUnderflow {

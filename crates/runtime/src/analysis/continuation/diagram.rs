@@ -98,26 +98,7 @@ impl Continuation {
         let parameter = crate::registry::display_name(&self.parameter);
         let coordinate_name = name(coordinate);
         let x_range = (self.from.min(self.to), self.from.max(self.to));
-        let mut values: Vec<f64> = self
-            .branches
-            .iter()
-            .flat_map(|b| {
-                b.points
-                    .iter()
-                    .flat_map(|p| p.cycle.iter().map(|y| y[coordinate]))
-            })
-            .collect();
-        if let Some(d) = &self.diagram {
-            values.extend(d.points.iter().map(|(_, y)| y[coordinate]));
-        }
-        let (lo, hi) = values
-            .iter()
-            .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-        let pad = 0.05 * (hi - lo).max(1e-3);
-        let y_range = (lo - pad, hi + pad);
+        let y_range = self.coordinate_range(coordinate);
         let branches_title = format!("{} branches of periodic orbits", self.branches.len());
         let diagram_title = match self.flow {
             true => "no period map: no orbit diagram".to_string(),
@@ -156,6 +137,60 @@ impl Continuation {
                 ),
             ],
         );
+        self.draw_branches(&mut figure, coordinate);
+        // Where stability is lost: the unit circle for multipliers, the
+        // imaginary axis for eigenvalues.
+        let edge: Vec<(f64, f64)> = match self.flow {
+            true => vec![(0.0, -2.0), (0.0, 2.0)],
+            false => (0..=200)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / 200.0;
+                    (a.cos(), a.sin())
+                })
+                .collect(),
+        };
+        figure.line(2, &edge, Rgb(120, 120, 120));
+        self.mark_bifurcations(&mut figure, coordinate);
+        if let Some(d) = &self.diagram {
+            figure.points(
+                1,
+                d.points.iter().map(|(p, y)| (*p, y[coordinate])),
+                Rgb(20, 20, 60),
+                1,
+            );
+        }
+        figure
+    }
+
+    /// The range of state component `coordinate` over the branches and
+    /// the orbit diagram, padded by 5 %.
+    fn coordinate_range(&self, coordinate: usize) -> (f64, f64) {
+        let mut values: Vec<f64> = self
+            .branches
+            .iter()
+            .flat_map(|b| {
+                b.points
+                    .iter()
+                    .flat_map(|p| p.cycle.iter().map(|y| y[coordinate]))
+            })
+            .collect();
+        if let Some(d) = &self.diagram {
+            values.extend(d.points.iter().map(|(_, y)| y[coordinate]));
+        }
+        let (lo, hi) = values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let pad = 0.05 * (hi - lo).max(1e-3);
+        (lo - pad, hi + pad)
+    }
+
+    /// Each branch in its colour: every point of its cycle against the
+    /// parameter (stable runs solid, unstable dashed) in panel 0, its
+    /// multipliers in panel 2.
+    fn draw_branches(&self, figure: &mut Figure, coordinate: usize) {
         for (b, branch) in self.branches.iter().enumerate() {
             let color = palette(b);
             // Each point of the cycle is a curve; stable runs solid,
@@ -170,13 +205,13 @@ impl Continuation {
                     );
                     if stable.is_some_and(|s| s != point.stable) {
                         run.push(xy);
-                        draw_run(&mut figure, &run, stable == Some(true), color);
+                        draw_run(figure, &run, stable == Some(true), color);
                         run.clear();
                     }
                     stable = Some(point.stable);
                     run.push(xy);
                 }
-                draw_run(&mut figure, &run, stable == Some(true), color);
+                draw_run(figure, &run, stable == Some(true), color);
             }
             figure.points(
                 2,
@@ -188,18 +223,10 @@ impl Continuation {
                 2,
             );
         }
-        // Where stability is lost: the unit circle for multipliers, the
-        // imaginary axis for eigenvalues.
-        let edge: Vec<(f64, f64)> = match self.flow {
-            true => vec![(0.0, -2.0), (0.0, 2.0)],
-            false => (0..=200)
-                .map(|i| {
-                    let a = std::f64::consts::TAU * i as f64 / 200.0;
-                    (a.cos(), a.sin())
-                })
-                .collect(),
-        };
-        figure.line(2, &edge, Rgb(120, 120, 120));
+    }
+
+    /// The bifurcations of each kind marked on panel 0, with the legend.
+    fn mark_bifurcations(&self, figure: &mut Figure, coordinate: usize) {
         let mut legend = Vec::new();
         for (kind, label, color) in KINDS {
             let marks: Vec<(f64, f64)> = self
@@ -221,15 +248,6 @@ impl Continuation {
         }
         legend.push(("stable solid, unstable dashed".into(), Rgb(90, 90, 90)));
         figure.legend(0, &legend);
-        if let Some(d) = &self.diagram {
-            figure.points(
-                1,
-                d.points.iter().map(|(p, y)| (*p, y[coordinate])),
-                Rgb(20, 20, 60),
-                1,
-            );
-        }
-        figure
     }
 }
 

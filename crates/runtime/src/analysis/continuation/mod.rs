@@ -560,22 +560,7 @@ fn run(
     guess.resize(n, 0.0);
     let forward = settings.to > p0;
     let bounds = (p0.min(settings.to), p0.max(settings.to));
-    let first =
-        branch::first_point(map, settings.period, &guess, p0, forward).map_err(|e| match e {
-            ContinuationError::Ode(source) => ContinuationError::Start {
-                model: model.into(),
-                guess: guess.clone(),
-                parameter: p0,
-                source,
-            },
-            other => other,
-        })?;
-    // An area-preserving map has det M = 1, a Hamiltonian flow trace J = 0.
-    let dissipative = if map.flow() {
-        first.monodromy.trace().abs() > 1e-8 * (1.0 + first.monodromy.amax())
-    } else {
-        (first.monodromy.determinant() - 1.0).abs() > 1e-6
-    };
+    let (first, dissipative) = first_orbit(map, settings.period, &guess, p0, forward, model)?;
     let steps = Steps {
         initial: settings.step,
         min: settings.min_step,
@@ -636,38 +621,15 @@ fn run(
         }
         let changes = branch::sign_changes(&followed.points, dissipative, job.born_at.is_some());
         for (i, kind, test) in changes {
-            let (a, b) = (&followed.points[i], &followed.points[i + 1]);
-            let (point, located) = branch::locate(map, k, a, b, test);
-            let at = bifurcations.len();
-            let before = &a.tangent;
-            let stable = |s: &Solution| branch_point(s).stable;
-            let sides = [(a.p, stable(a)), (b.p, stable(b))];
-            for (period, start) in switch(k, &point, before, kind, settings, &branches, &jobs) {
-                let origin = if period == k {
-                    Origin::BranchPoint
-                } else {
-                    Origin::PeriodDoubling
-                };
-                jobs.push_back(Job {
-                    period,
-                    start,
-                    born_at: Some(at),
-                    origin,
-                    sides,
-                });
-            }
-            bifurcations.push(Bifurcation {
-                kind,
+            let pair = [&followed.points[i], &followed.points[i + 1]];
+            let at = Located {
+                map,
+                k,
                 branch: index,
-                period: k,
-                parameter: point.p,
-                state: point.y.iter().copied().collect(),
-                multipliers: multipliers_of(&point.monodromy),
-                residual: residual(&point, kind),
-                located,
-                switched_to: None,
-                criticality: None,
-            });
+                kind,
+                test,
+            };
+            at.record(pair, settings, &branches, &mut jobs, &mut bifurcations);
         }
         branches.push(Branch {
             period: k,
@@ -704,6 +666,92 @@ fn run(
         diagram,
         state_names: Vec::new(),
     })
+}
+
+/// A bifurcation between two points of branch `branch` (of period `k`),
+/// found by the sign change of `test`.
+struct Located<'a> {
+    map: &'a dyn FamilyMap,
+    k: usize,
+    branch: usize,
+    kind: BifurcationKind,
+    test: branch::TestFunction,
+}
+
+impl Located<'_> {
+    /// Locates the bifurcation between the points `[a, b]`, queues the
+    /// branches to switch to and records it.
+    fn record(
+        &self,
+        [a, b]: [&Solution; 2],
+        settings: &ContinuationSettings,
+        branches: &[Branch],
+        jobs: &mut std::collections::VecDeque<Job>,
+        bifurcations: &mut Vec<Bifurcation>,
+    ) {
+        let Located {
+            map, k, kind, test, ..
+        } = *self;
+        let (point, located) = branch::locate(map, k, a, b, test);
+        let at = bifurcations.len();
+        let before = &a.tangent;
+        let stable = |s: &Solution| branch_point(s).stable;
+        let sides = [(a.p, stable(a)), (b.p, stable(b))];
+        for (period, start) in switch(k, &point, before, kind, settings, branches, jobs) {
+            let origin = if period == k {
+                Origin::BranchPoint
+            } else {
+                Origin::PeriodDoubling
+            };
+            jobs.push_back(Job {
+                period,
+                start,
+                born_at: Some(at),
+                origin,
+                sides,
+            });
+        }
+        bifurcations.push(Bifurcation {
+            kind,
+            branch: self.branch,
+            period: k,
+            parameter: point.p,
+            state: point.y.iter().copied().collect(),
+            multipliers: multipliers_of(&point.monodromy),
+            residual: residual(&point, kind),
+            located,
+            switched_to: None,
+            criticality: None,
+        });
+    }
+}
+
+/// The first periodic orbit (of period `period`), from the user's `guess`
+/// at `p0`, and whether the map is dissipative there.
+fn first_orbit(
+    map: &dyn FamilyMap,
+    period: usize,
+    guess: &[f64],
+    p0: f64,
+    forward: bool,
+    model: &str,
+) -> Result<(Solution, bool), ContinuationError> {
+    let first = branch::first_point(map, period, guess, p0, forward).map_err(|e| match e {
+        ContinuationError::Ode(source) => ContinuationError::Start {
+            model: model.into(),
+            guess: guess.to_vec(),
+            parameter: p0,
+            source,
+        },
+        other => other,
+    })?;
+    // An area-preserving map has det M = 1, a Hamiltonian flow trace J = 0.
+    let dissipative = if map.flow() {
+        first.monodromy.trace().abs() > 1e-8 * (1.0 + first.monodromy.amax())
+    } else {
+        (first.monodromy.determinant() - 1.0).abs() > 1e-6
+    };
+    Ok((first, dissipative))
 }
 
 /// The settings' sanity, as named errors.

@@ -23,7 +23,7 @@ use crate::analysis::Refusal;
 use crate::ode::{
     DoubleDouble, DoubleDoubleTaylor, ErasedSystem, Integrator, Method, OdeError, Options, System,
 };
-use crate::registry::{DynamicModel, Fixed, Model, Sized};
+use crate::registry::{DynamicModel, Fixed, FixedSize, Model};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -472,7 +472,7 @@ fn prepare(
 ) -> Result<(Map, Vec<[f64; 2]>, BTreeMap<String, f64>), SplittingError> {
     let name = model.info.name.to_string();
     let fixed = match model.sized {
-        Some(Sized::Dof1(fixed)) => fixed,
+        Some(FixedSize::Dof1(fixed)) => fixed,
         Some(_) => {
             return Err(SplittingError::NotPlanar {
                 model: name,
