@@ -792,17 +792,28 @@ mod browser {
 
         client.goto(&studio).await.unwrap();
         wait_for(&client, "window.studio && studio.ready", 30).await;
-        select_model(&client, "kapitza").await;
+        orbits_follow_the_slider(&client).await;
+        let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("studio");
+        std::fs::create_dir_all(&folder).unwrap();
+        manifolds_and_a_branch_point(&client, &folder).await;
+        sections_without_a_fast_phase(&client, &folder).await;
+        a_slice_of_the_period_map(&client, &folder).await;
+        client.close().await.unwrap();
+    }
+
+    /// Three clicked orbits of the Kapitza map, redrawn when the A slider moves.
+    async fn orbits_follow_the_slider(client: &Client) {
+        select_model(client, "kapitza").await;
         let periods = client.find(Locator::Id("periods")).await.unwrap();
         periods.clear().await.unwrap();
         periods.send_keys("400").await.unwrap();
 
         let canvas = client.find(Locator::Id("plane")).await.unwrap();
         for (x, y) in [(-250.0, 60.0), (120.0, -140.0), (300.0, 200.0)] {
-            click_at(&client, &canvas, x, y).await;
+            click_at(client, &canvas, x, y).await;
         }
         let before = orbits_when(
-            &client,
+            client,
             "studio.orbits.length === 3 && studio.orbits.every(o => o.done)",
         )
         .await;
@@ -816,9 +827,9 @@ mod browser {
 
         // Move the A slider: every orbit is redrawn for the new value.
         let slider = client.find(Locator::Id("param-A")).await.unwrap();
-        click_at(&client, &slider, 30.0, 0.0).await;
+        click_at(client, &slider, 30.0, 0.0).await;
         let after = orbits_when(
-            &client,
+            client,
             "studio.params.A !== 1.5 && studio.orbits.every(o => o.done && o.params.A === studio.params.A)",
         )
         .await;
@@ -827,7 +838,10 @@ mod browser {
             assert_eq!(b["seed"], a["seed"]);
             assert_ne!(b["second"], a["second"], "A moved, the orbit did not");
         }
+    }
 
+    /// The manifolds overlay at A = 1, and a shift-click continuing the upright in A.
+    async fn manifolds_and_a_branch_point(client: &Client, folder: &std::path::Path) {
         // The manifolds overlay at A = 1 (a saddle at the upright): W^u and
         // W^s drawn, a lobe area in the note.
         client
@@ -839,13 +853,13 @@ mod browser {
             .await
             .unwrap();
         wait_for(
-            &client,
+            client,
             "studio.params.A === 1 && studio.manifolds && studio.manifolds.unstable.length > 100",
             60,
         )
         .await;
         wait_for(
-            &client,
+            client,
             "document.getElementById('manifolds-note').textContent.includes('lobe area')",
             10,
         )
@@ -864,7 +878,7 @@ mod browser {
             )
             .await
             .unwrap();
-        wait_for(&client, "studio.branches !== null", 60).await;
+        wait_for(client, "studio.branches !== null", 60).await;
         let at = client
             .execute(
                 "return studio.branches.bifurcations.filter(b => b.kind === 'branch_point').map(b => b.parameter);",
@@ -876,21 +890,22 @@ mod browser {
         assert_eq!(at.len(), 1, "{at:?}");
         assert!((at[0] - 1.4203816679).abs() < 1e-6, "{at:?}");
         assert_eq!(
-            orbits(&client).await.len(),
+            orbits(client).await.len(),
             3,
             "a shift-click seeds no orbit"
         );
         tokio::time::sleep(Duration::from_millis(300)).await;
 
         let png = client.screenshot().await.unwrap();
-        let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("studio");
-        std::fs::create_dir_all(&folder).unwrap();
         std::fs::write(folder.join("browser.png"), png).unwrap();
         eprintln!("screenshot: {}", folder.join("browser.png").display());
+    }
 
+    /// Hénon–Heiles: its section with the MEGNO map behind, then a tilted plane.
+    async fn sections_without_a_fast_phase(client: &Client, folder: &std::path::Path) {
         // Hénon–Heiles has no fast phase: its Poincaré section at
         // E = 1/8, a clicked orbit's crossings drawn, the MEGNO map behind.
-        select_model(&client, "henon_heiles").await;
+        select_model(client, "henon_heiles").await;
         client
             .execute(
                 "document.getElementById('show-section').click(); document.getElementById('show-megno').click(); return true;",
@@ -898,7 +913,7 @@ mod browser {
             )
             .await
             .unwrap();
-        wait_for(&client, "studio.section && studio.megno !== null", 60).await;
+        wait_for(client, "studio.section && studio.megno !== null", 60).await;
         client
             .execute("studio.sectionSeed(0.1, 0.0); return true;", vec![])
             .await
@@ -907,7 +922,7 @@ mod browser {
         // orbit is done): a crossing not drawn times out.
         let crossing = "studio.orbits[0].points[20]";
         read_when(
-            &client,
+            client,
             &format!(
                 "{ONE_LONG_ORBIT} && {}",
                 painted(&format!("{crossing}[0]"), &format!("{crossing}[1]"))
@@ -929,16 +944,19 @@ mod browser {
             )
             .await
             .unwrap();
-        wait_for(&client, ONE_LONG_ORBIT, 60).await;
+        wait_for(client, ONE_LONG_ORBIT, 60).await;
         let axes = client
             .execute("return studio.sectionAxes;", vec![])
             .await
             .unwrap();
         assert_eq!(axes, serde_json::json!(["y", "p_y − 0.5·p_x"]));
+    }
 
+    /// The shaken double pendulum: a section that is a slice of its period map.
+    async fn a_slice_of_the_period_map(client: &Client, folder: &std::path::Path) {
         // The shaken double pendulum has a fast phase: its section is a
         // slice of the period map, at the averaged energy H̄.
-        select_model(&client, "double_pendulum").await;
+        select_model(client, "double_pendulum").await;
         let label = client
             .execute(
                 "const m = document.getElementById('show-megno'); if (m.checked) m.click(); \
@@ -951,7 +969,7 @@ mod browser {
             .await
             .unwrap();
         assert_eq!(label, serde_json::json!(["", "H̄"]));
-        wait_for(&client, "studio.section", 30).await;
+        wait_for(client, "studio.section", 30).await;
         client
             .execute(
                 "studio.sectionSeed(Math.PI + 0.3, 0.0); return true;",
@@ -967,7 +985,7 @@ mod browser {
             painted("studio.orbits[0].points[3][0]", "studio.orbits[0].points[3][1]")
         );
         let about_pi = read_when(
-            &client,
+            client,
             &drawn,
             "return studio.orbits[0].points.every(([q]) => q > 0);",
             60,
@@ -976,6 +994,5 @@ mod browser {
         assert_eq!(about_pi, serde_json::json!(true));
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("section_slice.png"), png).unwrap();
-        client.close().await.unwrap();
     }
 }

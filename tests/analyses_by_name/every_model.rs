@@ -21,80 +21,13 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         let model = mechlab::models::by_name(info.name).unwrap().dynamic;
         let params = model.defaults();
         let Kind::Hamiltonian { dof: n, fast_phase } = model.kind() else {
-            // One refusal, the same value from every analysis.
-            let refused = mechlab::analysis::Refusal::ContactModel {
-                model: info.name.to_string(),
-            };
-            let (a, b, c) = (
-                stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err(),
-                convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err(),
-                chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err(),
-            );
-            assert!(
-                matches!(a, StabilityError::Refused(ref r) if *r == refused),
-                "{a}"
-            );
-            assert!(
-                matches!(b, AveragingError::Refused(ref r) if *r == refused),
-                "{b}"
-            );
-            assert!(
-                matches!(c, ChaosMapError::Refused(ref r) if *r == refused),
-                "{c}"
-            );
-            let e =
-                stability(model_of(info.name), &params, &stability_settings("mu1")).unwrap_err();
-            assert!(
-                matches!(
-                    e,
-                    StabilityError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
-                ) && e.to_string().contains("contact model")
-            );
-            let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
-            assert!(matches!(
-                e,
-                AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
-            ));
-            let e =
-                chaos_map(model_of(info.name), &params, &map_settings(5), &|| true).unwrap_err();
-            assert!(matches!(
-                e,
-                ChaosMapError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
-            ));
-            assert!(portrait(model_of(info.name), &params, &portrait_settings(1)).is_err());
+            contact_model_is_refused(info.name, &params);
             continue;
         };
         // A model without a fast phase has no period map and nothing to
         // average: each analysis says so.
         if !fast_phase {
-            let e = stability(model_of(info.name), &params, &stability_settings("x")).unwrap_err();
-            assert!(
-                matches!(
-                    e,
-                    StabilityError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
-                ),
-                "{}: {e}",
-                info.name
-            );
-            let e = convergence(model_of(info.name), &params, &averaging_settings()).unwrap_err();
-            assert!(
-                matches!(
-                    e,
-                    AveragingError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
-                ),
-                "{}: {e}",
-                info.name
-            );
-            let e =
-                chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap_err();
-            assert!(
-                matches!(
-                    e,
-                    ChaosMapError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
-                ),
-                "{}: {e}",
-                info.name
-            );
+            no_fast_phase_is_refused(info.name, &params);
             continue;
         }
         // The amplitude is optional in a model file: without one, the
@@ -124,49 +57,96 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         if crate::common::assert_whole_power_slopes(info.name, &slopes, -1.0) {
             averaging_checked += 1;
         }
-        // The FLI is a maximum over the iterations: more periods never lower it.
-        let (short, long) = (
-            chaos_map(model_of(info.name), &params, &map_settings(4), &|| true).unwrap(),
-            chaos_map(model_of(info.name), &params, &map_settings(8), &|| true).unwrap(),
-        );
-        assert_eq!(short.fli.len(), 9);
-        // A pixel whose orbit left the model's domain (+∞: the elastic
-        // pendulum's plane crosses r = 0) stays so.
-        for (a, b) in short.fli.iter().zip(&long.fli) {
-            assert!(
-                *b >= *a && !a.is_nan(),
-                "{}: FLI {a} after 4 periods, {b} after 8",
-                info.name
-            );
-        }
-        assert_eq!(
-            short.diverged,
-            short.fli.iter().filter(|f| f.is_infinite()).count()
-        );
-        // Orbits start at their seeds; angles stay in [−π, π).
-        let orbits = portrait(model_of(info.name), &params, &portrait_settings(n)).unwrap();
-        let periodic = model.periodic();
-        for (seed, orbit) in orbits.seeds.iter().zip(&orbits.orbits) {
-            if orbit.is_empty() {
-                continue; // stopped (listed in `failed` with its reason)
-            }
-            assert_eq!(orbit.len(), 21);
-            assert_eq!(orbit[0], (seed[0], seed[n]));
-            if periodic[0] {
-                assert!(
-                    orbit.iter().all(|p| (-PI..PI).contains(&p.0)),
-                    "{}",
-                    info.name
-                );
-            }
-        }
-        let stopped = orbits.orbits.iter().filter(|o| o.is_empty()).count();
-        assert_eq!(orbits.failed.len(), stopped);
+        check_chaos_map_and_portrait(info.name, &params, n, &model.periodic());
     }
     assert!(
         averaging_checked > 0,
         "no model's averaging exponent was checked"
     );
+}
+
+/// One refusal, the same value from every analysis, naming the contact model.
+fn contact_model_is_refused(name: &str, params: &[f64]) {
+    let refused = mechlab::analysis::Refusal::ContactModel {
+        model: name.to_string(),
+    };
+    let (a, b, c) = (
+        stability(model_of(name), params, &stability_settings("mu1")).unwrap_err(),
+        convergence(model_of(name), params, &averaging_settings()).unwrap_err(),
+        chaos_map(model_of(name), params, &map_settings(5), &|| true).unwrap_err(),
+    );
+    assert!(
+        matches!(a, StabilityError::Refused(ref r) if *r == refused)
+            && a.to_string().contains("contact model"),
+        "{a}"
+    );
+    assert!(
+        matches!(b, AveragingError::Refused(ref r) if *r == refused),
+        "{b}"
+    );
+    assert!(
+        matches!(c, ChaosMapError::Refused(ref r) if *r == refused),
+        "{c}"
+    );
+    assert!(portrait(model_of(name), params, &portrait_settings(1)).is_err());
+}
+
+/// Without a fast phase there is no period map and nothing to average.
+fn no_fast_phase_is_refused(name: &str, params: &[f64]) {
+    use mechlab::analysis::Refusal::NoFastPhase;
+    let e = stability(model_of(name), params, &stability_settings("x")).unwrap_err();
+    assert!(
+        matches!(e, StabilityError::Refused(NoFastPhase { .. })),
+        "{name}: {e}"
+    );
+    let e = convergence(model_of(name), params, &averaging_settings()).unwrap_err();
+    assert!(
+        matches!(e, AveragingError::Refused(NoFastPhase { .. })),
+        "{name}: {e}"
+    );
+    let e = chaos_map(model_of(name), params, &map_settings(4), &|| true).unwrap_err();
+    assert!(
+        matches!(e, ChaosMapError::Refused(NoFastPhase { .. })),
+        "{name}: {e}"
+    );
+}
+
+/// The FLI never falls with more periods; portraits start at their seeds
+/// with angles in [−π, π).
+fn check_chaos_map_and_portrait(name: &str, params: &[f64], n: usize, periodic: &[bool]) {
+    // The FLI is a maximum over the iterations: more periods never lower it.
+    let (short, long) = (
+        chaos_map(model_of(name), params, &map_settings(4), &|| true).unwrap(),
+        chaos_map(model_of(name), params, &map_settings(8), &|| true).unwrap(),
+    );
+    assert_eq!(short.fli.len(), 9);
+    // A pixel whose orbit left the model's domain (+∞: the elastic
+    // pendulum's plane crosses r = 0) stays so.
+    for (a, b) in short.fli.iter().zip(&long.fli) {
+        assert!(
+            *b >= *a && !a.is_nan(),
+            "{}: FLI {a} after 4 periods, {b} after 8",
+            name
+        );
+    }
+    assert_eq!(
+        short.diverged,
+        short.fli.iter().filter(|f| f.is_infinite()).count()
+    );
+    // Orbits start at their seeds; angles stay in [−π, π).
+    let orbits = portrait(model_of(name), params, &portrait_settings(n)).unwrap();
+    for (seed, orbit) in orbits.seeds.iter().zip(&orbits.orbits) {
+        if orbit.is_empty() {
+            continue; // stopped (listed in `failed` with its reason)
+        }
+        assert_eq!(orbit.len(), 21);
+        assert_eq!(orbit[0], (seed[0], seed[n]));
+        if periodic[0] {
+            assert!(orbit.iter().all(|p| (-PI..PI).contains(&p.0)), "{}", name);
+        }
+    }
+    let stopped = orbits.orbits.iter().filter(|o| o.is_empty()).count();
+    assert_eq!(orbits.failed.len(), stopped);
 }
 
 /// Each reported equilibrium is one of V + V_vibr, has n roots λ, and where
