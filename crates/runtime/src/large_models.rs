@@ -1,7 +1,8 @@
-//! Models of 5 to 24 degrees of freedom: their analyses are compiled in the
+//! Models of 4 to 24 degrees of freedom: their analyses are compiled in the
 //! models package, at the sizes its model files have, instead of here for
 //! every size (at sizes 5 to 8 they were half the runtime's compile time,
-//! for sizes no model in `models/` needs).
+//! at size 4 more than a quarter of what remained),
+//! for sizes no model in `models/` needs.
 //!
 //! This module sits above the analyses and the registry: it names every
 //! analysis's work once ([`LargeModel`] gets a method per work) and gives
@@ -15,7 +16,7 @@ use crate::registry::{Erased, LargeHandleRef, LargeWork, WithFixed};
 /// work, [`AtSize`] implements it, and each work [`LargeWork`] calling it.
 macro_rules! large_works {
     ($($method:ident: $work:path => $output:ty;)*) => {
-        /// The analyses of one model of 5 to 24 degrees of freedom, compiled
+        /// The analyses of one model of 4 to 24 degrees of freedom, compiled
         /// in the models package for the sizes its model files have.
         pub trait LargeModel: Sync {
             $(fn $method(&self, work: $work) -> $output;)*
@@ -49,7 +50,7 @@ large_works! {
     continuation: crate::analysis::continuation::Work<'_> => Result<crate::analysis::continuation::Continuation, crate::analysis::continuation::ContinuationError>;
 }
 
-/// A model of 5 to 24 degrees of freedom as a [`LargeModel`]: the models
+/// A model of 4 to 24 degrees of freedom as a [`LargeModel`]: the models
 /// package makes one per such model, which compiles the analyses there at
 /// that size.
 pub struct AtSize<const D: usize, const S: usize, const T: usize, const V: usize>(

@@ -362,19 +362,18 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
 }
 
 /// A Hamiltonian model at its own size, for [`with_fixed`]. The analyses
-/// are compiled ahead, in this crate, for 1 to 4 degrees of freedom; a
-/// model of 5 to 24 brings its own (see [`crate::large_models`]).
+/// are compiled ahead, in this crate, for 1 to 3 degrees of freedom; a
+/// model of 4 to 24 brings its own (see [`crate::large_models`]).
 #[derive(Clone, Copy)]
 pub enum FixedSize {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
-    Dof4(&'static Erased<4, 8, 16, 72>),
-    /// 5 to 24 degrees of freedom: a [`crate::large_models::LargeHandle`].
+    /// 4 to 24 degrees of freedom: a [`crate::large_models::LargeHandle`].
     Large(LargeHandleRef),
 }
 
-/// A work that also runs on a model of 5 to 24 degrees of freedom, whose
+/// A work that also runs on a model of 4 to 24 degrees of freedom, whose
 /// analyses are compiled in the models package at its size
 /// ([`crate::large_models`] implements it for every analysis's work).
 pub trait LargeWork: WithFixed {
@@ -382,7 +381,7 @@ pub trait LargeWork: WithFixed {
     fn on_large(self, model: LargeHandleRef) -> Self::Output;
 }
 
-/// A model of 5 to 24 degrees of freedom, type-erased: the registry holds it
+/// A model of 4 to 24 degrees of freedom, type-erased: the registry holds it
 /// without naming the analyses (which import the registry), and
 /// [`crate::large_models`], above both, reads it back.
 pub type LargeHandleRef = &'static (dyn std::any::Any + Send + Sync);
@@ -449,14 +448,13 @@ pub trait WithFixed {
 
 /// Runs `work` on a Hamiltonian model at its own sizes (None for a
 /// contact model). The analyses are compiled once per size, whatever the
-/// models are: here for 1 to 4 degrees of freedom, in the models package
+/// models are: here for 1 to 3 degrees of freedom, in the models package
 /// for larger sizes that its model files have.
 pub fn with_fixed<W: LargeWork>(model: &Model, work: W) -> Option<W::Output> {
     model.sized.map(|sized| match sized {
         FixedSize::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
         FixedSize::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
         FixedSize::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
-        FixedSize::Dof4(m) => work.run::<_, 4, 8, 16, 72>(m),
         FixedSize::Large(m) => work.on_large(m),
     })
 }
