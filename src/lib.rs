@@ -5,10 +5,11 @@
 //! `mechlab-model`) → `build.rs` (runs `mechlab-derive`, with Symbolica,
 //! build time only) → the generated modules in [`models`] (this crate) →
 //! `mechlab-runtime`: [`ode`] (integrators), [`analysis`] (period map,
-//! Floquet, Lyapunov, averaging), [`scene`], [`studio`], [`plot`] →
+//! Floquet, Lyapunov, averaging), [`studio`], [`plot`] → `mechlab-scenes`:
+//! [`scene`] (the scene framework) and [`scenes`] (shared scene bodies) →
 //! `examples/` (scenes). This crate holds only what depends on the models:
 //! the generated modules and the three [`studies`]; it re-exports the
-//! runtime, so `mechlab::ode` is `mechlab_runtime::ode`.
+//! runtime and the scenes, so `mechlab::ode` is `mechlab_runtime::ode`.
 //!
 //! ```
 //! use mechlab::models::kapitza;
@@ -27,8 +28,9 @@
 
 pub use mechlab_runtime::{
     analysis, budget, contact, explore, large_models, linalg, mathml, model, ode, plot, registry,
-    report, scene, scenes, studio, study,
+    report, studio, study,
 };
+pub use mechlab_scenes::{scene, scenes};
 
 pub mod models;
 pub mod studies;

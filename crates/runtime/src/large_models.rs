@@ -1,7 +1,7 @@
 //! Models of 4 to 24 degrees of freedom: their analyses are compiled in the
 //! models package, at the sizes its model files have, instead of here for
 //! every size (at sizes 5 to 8 they were half the runtime's compile time,
-//! at size 4 more than a quarter of what remained),
+//! at size 4 about an eighth of what remained),
 //! for sizes no model in `models/` needs.
 //!
 //! This module sits above the analyses and the registry: it names every

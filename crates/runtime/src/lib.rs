@@ -1,10 +1,13 @@
 //! mechlab's runtime: everything that does not depend on any one model.
 //!
 //! Integrators ([`ode`]), analyses by name ([`analysis`], [`explore`]) over
-//! models behind trait objects ([`registry`]), scenes ([`scene`],
-//! [`scenes`]), the studio ([`studio`]), figures ([`plot`]) and reports.
+//! models behind trait objects ([`registry`]), the studio's calls
+//! ([`studio`]), figures ([`plot`]) and reports. The scenes (the command
+//! line's knobs and the files a run writes) are the `mechlab-scenes`
+//! crate above this one.
 //! The generated models live in the `mechlab` package, which compiles
-//! against this crate and hands it its models with [`registry::install`]:
+//! against this crate and hands its models to the analyses as a
+//! [`registry::Catalog`]:
 //! editing a model file never recompiles this crate.
 
 pub use mechlab_model as model;
@@ -20,7 +23,5 @@ pub mod ode;
 pub mod plot;
 pub mod registry;
 pub mod report;
-pub mod scene;
-pub mod scenes;
 pub mod studio;
 pub mod study;

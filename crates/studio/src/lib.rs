@@ -29,7 +29,7 @@ use axum::routing::{get, post};
 use axum::Router;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::registry::Catalog;
-use mechlab_runtime::scene::SceneError;
+use mechlab_scenes::scene::SceneError;
 use mechlab_runtime::studio::{
     self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError,
 };
@@ -127,7 +127,7 @@ pub fn run(catalog: Catalog, port: u16) -> Result<(), SceneError> {
     let failed = |source| SceneError::Serve { address, source };
     // Requests run their analyses on the runtime's blocking threads.
     let runtime = tokio::runtime::Builder::new_multi_thread()
-        .thread_stack_size(mechlab_runtime::scene::STACK_BYTES)
+        .thread_stack_size(mechlab_scenes::scene::STACK_BYTES)
         .enable_all()
         .build()
         .map_err(failed)?;

@@ -2,16 +2,16 @@
 //! the study scenes that are its presets (the same knobs with other
 //! defaults, the same files): knobs → one library call → figures.
 
-use crate::analysis::chaos_map::{chaos_map, ChaosMap, ChaosMapError, ChaosMapSettings};
-use crate::ode::Method;
-use crate::registry::{Catalog, Model};
 use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError};
+use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMap, ChaosMapError, ChaosMapSettings};
+use mechlab_runtime::ode::Method;
+use mechlab_runtime::registry::{Catalog, Model};
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
 /// clear error listing the known ones.
 pub fn model_from_args(catalog: Catalog, default: &str) -> Result<&'static Model, SceneError> {
     let name = Scene::peek("model").unwrap_or_else(|| default.into());
-    Ok(crate::registry::lookup(catalog, &name)?)
+    Ok(mechlab_runtime::registry::lookup(catalog, &name)?)
 }
 
 /// A preset's defaults: its value of a knob, or the generic scene's.
@@ -206,7 +206,7 @@ pub trait TileSharing {
 pub fn tiles_from(
     scene: &Scene,
     [size, only]: [&str; 2],
-) -> Result<Option<crate::analysis::tiles::Tiles>, SceneError> {
+) -> Result<Option<mechlab_runtime::analysis::tiles::Tiles>, SceneError> {
     if scene.number(size)? == 0.0 {
         return Ok(None);
     }
@@ -229,7 +229,7 @@ pub fn tiles_from(
                 .collect::<Result<_, _>>()?,
         ),
     };
-    Ok(Some(crate::analysis::tiles::Tiles {
+    Ok(Some(mechlab_runtime::analysis::tiles::Tiles {
         folder: scene.out.with_extension("tiles"),
         rows: scene.count(size)?,
         only,
@@ -245,7 +245,7 @@ pub fn averaging_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use crate::analysis::averaging::{convergence, ConvergenceSettings};
+    use mechlab_runtime::analysis::averaging::{convergence, ConvergenceSettings};
     let (model, scene) = generic_scene(
         catalog,
         scene_name,
@@ -344,10 +344,10 @@ fn geometric_progression(parts: &[f64]) -> Result<Vec<f64>, &'static str> {
 
 /// Max deviation against ν (log–log, with the fits) and ν × max deviation.
 fn averaging_figure(
-    result: &crate::analysis::averaging::AveragingConvergence,
-) -> crate::plot::Figure {
-    use crate::plot::{palette, Figure, PanelSpec};
-    use crate::registry::display_name;
+    result: &mechlab_runtime::analysis::averaging::AveragingConvergence,
+) -> mechlab_runtime::plot::Figure {
+    use mechlab_runtime::plot::{palette, Figure, PanelSpec};
+    use mechlab_runtime::registry::display_name;
     let range = |values: &mut dyn Iterator<Item = f64>| {
         let (lo, hi) = values
             .filter(|v| *v > 0.0)
@@ -441,7 +441,7 @@ pub fn period_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use crate::analysis::period_map::{portrait, PortraitSettings};
+    use mechlab_runtime::analysis::period_map::{portrait, PortraitSettings};
     let (model, scene) = generic_scene(
         catalog,
         scene_name,
@@ -510,7 +510,9 @@ pub fn separatrix_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use crate::analysis::separatrix::{separatrix_splitting, Precision, SplittingSettings};
+    use mechlab_runtime::analysis::separatrix::{
+        separatrix_splitting, Precision, SplittingSettings,
+    };
     let (model, scene) = generic_scene(
         catalog,
         scene_name,
@@ -590,8 +592,8 @@ pub fn separatrix_scene(
     let sweep = splitting_sweep_of(&scene, model, &params, &settings)?;
     #[derive(serde::Serialize)]
     struct Summary<'a> {
-        splitting: &'a crate::analysis::separatrix::Splitting,
-        sweep: Option<&'a crate::analysis::separatrix::SplittingSweep>,
+        splitting: &'a mechlab_runtime::analysis::separatrix::Splitting,
+        sweep: Option<&'a mechlab_runtime::analysis::separatrix::SplittingSweep>,
     }
     scene.write_summary(&Summary {
         splitting: &splitting,
@@ -606,9 +608,9 @@ fn splitting_sweep_of(
     scene: &Scene,
     model: &Model,
     params: &[f64],
-    settings: &crate::analysis::separatrix::SplittingSettings,
-) -> Result<Option<crate::analysis::separatrix::SplittingSweep>, SceneError> {
-    use crate::analysis::separatrix::splitting_sweep;
+    settings: &mechlab_runtime::analysis::separatrix::SplittingSettings,
+) -> Result<Option<mechlab_runtime::analysis::separatrix::SplittingSweep>, SceneError> {
+    use mechlab_runtime::analysis::separatrix::splitting_sweep;
     Ok(match scene.text("sweep") {
         "none" => None,
         _ => {
@@ -664,7 +666,7 @@ fn splitting_sweep_of(
 /// Scene `attractor`: the attractor of the period map of a forced, damped
 /// 1-degree model by name, its Lyapunov spectrum and dimensions.
 pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use crate::analysis::attractor::{attractor, AttractorSettings};
+    use mechlab_runtime::analysis::attractor::{attractor, AttractorSettings};
     let (model, scene) = generic_scene(
         catalog,
         "attractor",
@@ -717,10 +719,10 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
 /// Scene `continuation`: the periodic orbits of a model's period map
 /// followed in one parameter, their bifurcations, and the orbit diagram.
 pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use crate::analysis::continuation::continuation;
+    use mechlab_runtime::analysis::continuation::continuation;
     // The parameter defaults to the model file's [fast_phase] amplitude.
     let named = Scene::peek("model").unwrap_or_else(|| "duffing".into());
-    let amplitude = crate::registry::lookup(catalog, &named)
+    let amplitude = mechlab_runtime::registry::lookup(catalog, &named)
         .ok()
         .and_then(|m| m.info.amplitude)
         .unwrap_or("none");
@@ -775,8 +777,8 @@ fn continuation_settings(
     model: &Model,
     scene: &Scene,
     params: &[f64],
-) -> Result<crate::analysis::continuation::ContinuationSettings, SceneError> {
-    use crate::analysis::continuation::{ContinuationSettings, DiagramSettings};
+) -> Result<mechlab_runtime::analysis::continuation::ContinuationSettings, SceneError> {
+    use mechlab_runtime::analysis::continuation::{ContinuationSettings, DiagramSettings};
     let switch_branch_points = match scene.text("switch") {
         "yes" => true,
         "no" => false,
@@ -845,13 +847,13 @@ fn continuation_settings(
 /// the orbit diagram), drawn in state component `coordinate`.
 fn write_continuation(
     scene: &Scene,
-    result: &crate::analysis::continuation::Continuation,
+    result: &mechlab_runtime::analysis::continuation::Continuation,
     coordinate: usize,
 ) -> Result<(), SceneError> {
     scene.save_figure(&result.figure(coordinate), "continuation.png")?;
     let rows = result.branches.iter().enumerate().flat_map(|(b, branch)| {
         branch.points.iter().map(move |p| {
-            let radius = crate::analysis::floquet::spectral_radius(&p.multipliers);
+            let radius = mechlab_runtime::analysis::floquet::spectral_radius(&p.multipliers);
             (
                 b,
                 branch.period,
@@ -910,7 +912,7 @@ fn write_continuation(
 /// Scene `section`: the Poincaré section of an autonomous model of two
 /// degrees of freedom at a fixed energy.
 pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use crate::analysis::section::{
+    use mechlab_runtime::analysis::section::{
         parse_plane, section, seeds_across, SectionError, SectionSettings,
     };
     let model = model_from_args(catalog, Defaults(&[]).get("model", "henon_heiles"))?;
@@ -975,8 +977,8 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
     let map = section_megno_map(&scene, model, &params, &settings)?;
     #[derive(serde::Serialize)]
     struct Summary<'a> {
-        section: &'a crate::analysis::section::Section,
-        megno_map: Option<&'a crate::analysis::section_map::SectionMap>,
+        section: &'a mechlab_runtime::analysis::section::Section,
+        megno_map: Option<&'a mechlab_runtime::analysis::section_map::SectionMap>,
     }
     scene.write_summary(&Summary {
         section: &result,
@@ -1051,12 +1053,12 @@ fn section_megno_map(
     scene: &Scene,
     model: &Model,
     params: &[f64],
-    settings: &crate::analysis::section::SectionSettings,
-) -> Result<Option<crate::analysis::section_map::SectionMap>, SceneError> {
+    settings: &mechlab_runtime::analysis::section::SectionSettings,
+) -> Result<Option<mechlab_runtime::analysis::section_map::SectionMap>, SceneError> {
     Ok(match scene.whole("map")? {
         0 => None,
         pixels => {
-            use crate::analysis::section_map::{section_map, SectionMapSettings};
+            use mechlab_runtime::analysis::section_map::{section_map, SectionMapSettings};
             eprintln!("MEGNO map, {pixels}² orbits …");
             let map_settings = SectionMapSettings {
                 section: settings.clone(),

@@ -35,7 +35,7 @@ impl Drop for Scene {
 /// Knobs for every parameter of a generated model, with the defaults of its
 /// model file except those `overrides` gives.
 pub fn parameter_knobs(
-    info: &'static crate::registry::ModelInfo,
+    info: &'static mechlab_runtime::registry::ModelInfo,
     overrides: &[(&'static str, &'static str)],
 ) -> Vec<Knob> {
     info.parameter_names
@@ -86,34 +86,34 @@ pub enum SceneError {
         source: std::io::Error,
     },
     #[error(transparent)]
-    Ode(#[from] crate::ode::OdeError),
+    Ode(#[from] mechlab_runtime::ode::OdeError),
     #[error(transparent)]
-    Contact(#[from] crate::contact::ContactError),
+    Contact(#[from] mechlab_runtime::contact::ContactError),
     #[error(transparent)]
-    Parameter(#[from] crate::registry::ParameterError),
+    Parameter(#[from] mechlab_runtime::registry::ParameterError),
     #[error(transparent)]
-    UnknownModel(#[from] crate::registry::UnknownModel),
+    UnknownModel(#[from] mechlab_runtime::registry::UnknownModel),
     #[error(transparent)]
-    Study(#[from] crate::study::StudyError),
+    Study(#[from] mechlab_runtime::study::StudyError),
     #[error(transparent)]
-    Explore(#[from] crate::explore::ExploreError),
+    Explore(#[from] mechlab_runtime::explore::ExploreError),
     #[error(transparent)]
-    Stability(#[from] crate::analysis::stability::StabilityError),
+    Stability(#[from] mechlab_runtime::analysis::stability::StabilityError),
     #[error(transparent)]
-    Averaging(#[from] crate::analysis::averaging::AveragingError),
+    Averaging(#[from] mechlab_runtime::analysis::averaging::AveragingError),
     #[error(transparent)]
-    PeriodMap(#[from] crate::analysis::period_map::PeriodMapError),
+    PeriodMap(#[from] mechlab_runtime::analysis::period_map::PeriodMapError),
     #[error(transparent)]
-    Splitting(#[from] crate::analysis::separatrix::SplittingError),
+    Splitting(#[from] mechlab_runtime::analysis::separatrix::SplittingError),
     #[error(transparent)]
-    Attractor(#[from] crate::analysis::attractor::AttractorError),
+    Attractor(#[from] mechlab_runtime::analysis::attractor::AttractorError),
     #[error(transparent)]
-    Section(#[from] crate::analysis::section::SectionError),
+    Section(#[from] mechlab_runtime::analysis::section::SectionError),
     #[error(transparent)]
-    Continuation(#[from] crate::analysis::continuation::ContinuationError),
+    Continuation(#[from] mechlab_runtime::analysis::continuation::ContinuationError),
     /// A request of the studio (the server answers it with this error).
     #[error(transparent)]
-    Studio(#[from] crate::studio::StudioError),
+    Studio(#[from] mechlab_runtime::studio::StudioError),
     /// The studio's server could not listen, or stopped.
     #[error("the studio cannot serve on {address}: {source}")]
     Serve {
@@ -259,7 +259,7 @@ impl Scene {
     /// The values of the knobs of [`parameter_knobs`], in declaration order.
     pub fn parameter_values(
         &self,
-        info: &crate::registry::ModelInfo,
+        info: &mechlab_runtime::registry::ModelInfo,
     ) -> Result<Vec<f64>, SceneError> {
         info.parameter_names
             .iter()
@@ -404,7 +404,7 @@ impl Scene {
     /// map, few points), the same figure as SVG beside it.
     pub fn save_figure(
         &self,
-        figure: &crate::plot::Figure,
+        figure: &mechlab_runtime::plot::Figure,
         file: &str,
     ) -> Result<PathBuf, SceneError> {
         let path = self.path(file)?;
