@@ -324,10 +324,7 @@ pub fn explore(
     settings: &Settings,
 ) -> Result<Exploration, ExploreError> {
     let model = handle.dynamic;
-    let expected = match model.kind() {
-        Kind::Hamiltonian { dof, .. } => 2 * dof,
-        Kind::Contacts { count } => 2 * count,
-    };
+    let expected = model.periodic_state().len();
     if y0.len() != expected {
         return Err(ExploreError::StateLength {
             model: model.info().name,

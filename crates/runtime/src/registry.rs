@@ -124,6 +124,15 @@ pub trait DynamicModel: Sync {
     fn defaults(&self) -> Vec<f64>;
     /// Which coordinates are angles.
     fn periodic(&self) -> Vec<bool>;
+    /// Which components of the state are angles; its length is the
+    /// state's dimension (a Hamiltonian model's [q; p], a contact model's
+    /// [s; s']: the coordinates, then as many rates).
+    #[inline]
+    fn periodic_state(&self) -> Vec<bool> {
+        let mut periodic = self.periodic();
+        periodic.resize(2 * periodic.len(), false);
+        periodic
+    }
     /// The exact system with its action S = ∫ (p·q' − H) dt and the fast
     /// phase θ as third and fourth state components (models of one degree
     /// of freedom with a fast phase).
@@ -253,6 +262,16 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     fn has_fast_phase(&self) -> bool;
     /// Which coordinates are angles.
     fn periodic(&self) -> [bool; D];
+    /// Which components of the state are angles (wrapped into [−π, π)):
+    /// the state's layout as the model states it, which the analyses that
+    /// work on any state (period maps, chaos maps, continuation, the
+    /// studio's orbits) read instead of assuming [q; p]. A Hamiltonian
+    /// model's state is its coordinates, then their momenta.
+    #[inline]
+    fn periodic_state(&self) -> [bool; S] {
+        let periodic = self.periodic();
+        std::array::from_fn(|i| i < D && periodic[i])
+    }
     fn exact(&self, params: &[f64]) -> Self::Exact;
     fn averaged(&self, params: &[f64]) -> Option<Self::Averaged>;
     /// The period of the fast phase.

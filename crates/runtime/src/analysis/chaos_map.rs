@@ -140,7 +140,7 @@ impl WithFixed for Map<'_> {
             })?,
             None => [0.0; S],
         };
-        let ranges = plane_ranges(settings, &model.periodic());
+        let ranges = plane_ranges(settings, &model.periodic_state());
         crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
         let system = model.exact(self.params);
         // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
@@ -235,13 +235,10 @@ impl WithFixed for Map<'_> {
 
 /// The ranges of the map's axes: the settings', or [−π, π] for an angle
 /// and [−p_max, p_max] for any other component.
-fn plane_ranges<const D: usize>(
-    settings: &ChaosMapSettings,
-    periodic: &[bool; D],
-) -> [(f64, f64); 2] {
+fn plane_ranges(settings: &ChaosMapSettings, periodic: &[bool]) -> [(f64, f64); 2] {
     std::array::from_fn(|k| {
         let axis = settings.axes[k];
-        settings.ranges[k].unwrap_or(if axis < D && periodic[axis] {
+        settings.ranges[k].unwrap_or(if periodic.get(axis) == Some(&true) {
             (-PI, PI)
         } else {
             (-settings.p_max, settings.p_max)

@@ -214,8 +214,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
             _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
         };
         let axes = info.plane(settings.axes).map_err(|e| bad(e.to_string()))?;
-        let periodic = model.periodic();
-        let wrap: Vec<bool> = (0..S).map(|i| i < D && periodic[i]).collect();
+        let wrap = model.periodic_state();
         let seeds: Vec<[f64; S]> = match &settings.seeds {
             Some(seeds) => seeds
                 .iter()

@@ -119,8 +119,7 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
         Kind::Hamiltonian { dof, fast_phase } => ("hamiltonian", dof, fast_phase),
         Kind::Contacts { count } => ("contacts", count, false),
     };
-    let mut periodic = model.periodic();
-    periodic.resize(2 * dof, false);
+    let periodic = model.periodic_state();
     let state = info.state_names();
     let default_axes = [0, dof.min(state.len().saturating_sub(1))];
     let default_ranges = default_axes.map(|a| {
@@ -278,7 +277,7 @@ impl Setup {
         }
         let method = Method::parse(&self.method, self.tol)?;
         method.validate()?;
-        let states = 2 * dof;
+        let states = model.periodic_state().len();
         let axes = self.axes.unwrap_or([0, dof]);
         if axes[0] == axes[1] || axes.iter().any(|&a| a >= states) {
             return Err(bad(RequestProblem::Axes { components: states }));
@@ -437,11 +436,11 @@ impl WithFixed for OrbitWork<'_> {
             .phase_period(&setup.params)
             .ok_or_else(|| StudioError::Refused(Refusal::no_fast_phase(setup.info.name)))?;
         let system = model.exact(&setup.params);
-        let periodic = model.periodic();
+        let periodic = model.periodic_state();
         let y: [f64; S] = std::array::from_fn(|k| self.seed[k]);
         let project = |y: &[f64; S]| {
             setup.axes.map(|a| {
-                if a < D && periodic[a] {
+                if periodic[a] {
                     wrap_angle(y[a])
                 } else {
                     y[a]

@@ -425,13 +425,12 @@ impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const
     /// The model at `params`, its parameter `index` free: a map if it has
     /// a fast phase, a flow if not.
     fn new(model: &'static F, params: &[f64], index: usize, method: Method) -> Self {
-        let periodic = model.periodic();
         AtModel {
             model,
             params: params.to_vec(),
             index,
             method,
-            periodic: (0..S).map(|i| i < D && periodic[i]).collect(),
+            periodic: model.periodic_state().to_vec(),
             evaluations: AtomicU64::new(0),
             flow: !model.has_fast_phase(),
         }
