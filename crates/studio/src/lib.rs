@@ -29,10 +29,10 @@ use axum::routing::{get, post};
 use axum::Router;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::registry::Catalog;
-use mechlab_scenes::scene::SceneError;
 use mechlab_runtime::studio::{
     self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError,
 };
+use mechlab_scenes::scene::SceneError;
 use serde::Serialize;
 use std::net::SocketAddr;
 

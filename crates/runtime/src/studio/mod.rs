@@ -439,13 +439,9 @@ impl WithFixed for OrbitWork<'_> {
         let periodic = model.periodic_state();
         let y: [f64; S] = std::array::from_fn(|k| self.seed[k]);
         let project = |y: &[f64; S]| {
-            setup.axes.map(|a| {
-                if periodic[a] {
-                    wrap_angle(y[a])
-                } else {
-                    y[a]
-                }
-            })
+            setup
+                .axes
+                .map(|a| if periodic[a] { wrap_angle(y[a]) } else { y[a] })
         };
         let mut integrator = Integrator::new(setup.method)?;
         let mut chunk = vec![project(&y)];
