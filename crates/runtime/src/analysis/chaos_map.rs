@@ -130,7 +130,12 @@ impl WithFixed for Map<'_> {
         let params = info
             .named_values(self.params)
             .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
-        let axes = info.plane(settings.axes).map_err(|e| bad(e.to_string()))?;
+        let axes = info
+            .plane(settings.axes)
+            .map_err(|source| ChaosMapError::Plane {
+                model: info.name.into(),
+                source,
+            })?;
         let through: [f64; S] = match &settings.through {
             Some(y) => y.as_slice().try_into().map_err(|_| {
                 bad(format!(

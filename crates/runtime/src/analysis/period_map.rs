@@ -159,6 +159,13 @@ pub enum PeriodMapError {
     Refused(#[from] crate::analysis::Refusal),
     #[error("model '{model}': {reason}")]
     Request { model: String, reason: String },
+    /// The plane's axes are not two different state components.
+    #[error("model '{model}': {source}")]
+    Plane {
+        model: String,
+        #[source]
+        source: crate::registry::PlaneError,
+    },
     /// Only some tiles of a map were asked for: they are written, there is
     /// no map to return.
     #[error("the tiles asked for are written; run without `only` to merge them into the map")]
@@ -213,7 +220,12 @@ impl crate::registry::WithFixed for Portraits<'_> {
             Some(t) if model.has_fast_phase() => t,
             _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
         };
-        let axes = info.plane(settings.axes).map_err(|e| bad(e.to_string()))?;
+        let axes = info
+            .plane(settings.axes)
+            .map_err(|source| PeriodMapError::Plane {
+                model: info.name.into(),
+                source,
+            })?;
         let wrap = model.periodic_state();
         let seeds: Vec<[f64; S]> = match &settings.seeds {
             Some(seeds) => seeds
