@@ -111,32 +111,28 @@ pub struct Map<'a> {
     row_done: &'a (dyn Fn() -> bool + Sync),
 }
 
-impl WithFixed for Map<'_> {
-    type Output = Result<ChaosMap, ChaosMapError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let info = model.info();
+impl Map<'_> {
+    /// The request read against the model: its parameters by name, the
+    /// plane's axes and the state the plane passes through.
+    #[allow(clippy::type_complexity)]
+    fn request<const S: usize>(
+        &self,
+        info: &'static crate::registry::ModelInfo,
+    ) -> Result<(BTreeMap<String, f64>, [String; 2], [f64; S]), ChaosMapError> {
         let bad = |reason: String| ChaosMapError::Request {
             model: info.name.into(),
             reason,
-        };
-        let settings = self.settings;
-        let period = match model.phase_period(self.params) {
-            Some(t) if model.has_fast_phase() => t,
-            _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
         };
         let params = info
             .named_values(self.params)
             .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
         let axes = info
-            .plane(settings.axes)
+            .plane(self.settings.axes)
             .map_err(|source| ChaosMapError::Plane {
                 model: info.name.into(),
                 source,
             })?;
-        let through: [f64; S] = match &settings.through {
+        let through: [f64; S] = match &self.settings.through {
             Some(y) => y.as_slice().try_into().map_err(|_| {
                 bad(format!(
                     "the state to pass through has {} components, not {S}",
@@ -145,6 +141,23 @@ impl WithFixed for Map<'_> {
             })?,
             None => [0.0; S],
         };
+        Ok((params, axes, through))
+    }
+}
+
+impl WithFixed for Map<'_> {
+    type Output = Result<ChaosMap, ChaosMapError>;
+    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
+        self,
+        model: &'static F,
+    ) -> Self::Output {
+        let info = model.info();
+        let settings = self.settings;
+        let period = match model.phase_period(self.params) {
+            Some(t) if model.has_fast_phase() => t,
+            _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
+        };
+        let (params, axes, through) = self.request::<S>(info)?;
         let ranges = plane_ranges(settings, &model.periodic_state());
         crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
         let system = model.exact(self.params);
