@@ -66,7 +66,7 @@ pub fn compare<E: System<N>, A: System<N>, const N: usize>(
 /// the frequency (−1 where Theorem 2 holds). `systems(ν)` builds both systems.
 pub struct Convergence {
     pub frequencies: Vec<f64>,
-    /// [coordinate][frequency]
+    /// `[coordinate][frequency]`
     pub max_deviation: Vec<Vec<f64>>,
     pub fits: Vec<LineFit>,
 }
@@ -160,16 +160,16 @@ pub struct AveragingConvergence {
     pub t_obs: f64,
     /// The order of the averaged system compared (1 or 2).
     pub order: usize,
-    /// [coordinate][value]
+    /// `[coordinate][value]`
     pub max_deviation: Vec<Vec<f64>>,
-    /// ν × max deviation, [coordinate][value]: levels off where the
+    /// ν × max deviation, `[coordinate][value]`: levels off where the
     /// deviation is c/ν.
     pub frequency_times_deviation: Vec<Vec<f64>>,
     /// The fitted exponent of each coordinate's deviation against ν.
     pub slope: Vec<f64>,
     /// The fitted level c in deviation ≈ c ν^slope.
     pub level: Vec<f64>,
-    /// The slope between each two neighbouring frequencies, [coordinate][k].
+    /// The slope between each two neighbouring frequencies, `[coordinate][k]`.
     pub local_slopes: Vec<Vec<f64>>,
     /// The asymptotic exponent, where the sweep has reached it: the last
     /// three local slopes agree to [`SETTLED`]. None where the deviation

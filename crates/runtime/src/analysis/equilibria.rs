@@ -64,8 +64,8 @@ impl std::fmt::Display for Search {
 /// coordinate: angles at −π + 2πk/12, others at −2 + 4k/12 (0 and −π among
 /// them, where symmetric models have their equilibria; a vibrated triple
 /// pendulum has over a hundred). Beyond, each angle at the multiples of
-/// 2π/4 and each other coordinate at [`LENGTHS`]. A grid larger than
-/// [`GRID_STARTS`] is sampled ([`sample`]).
+/// 2π/4 and each other coordinate at `LENGTHS`. A grid larger than
+/// [`GRID_STARTS`] is sampled (`sample`).
 pub fn starts(periodic: &[bool]) -> Starts {
     let axis: Vec<Vec<f64>> = periodic
         .iter()

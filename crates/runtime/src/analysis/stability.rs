@@ -1066,7 +1066,7 @@ pub struct StabilityChart {
     pub y_values: Vec<f64>,
     /// [x][y sample]: stable (spectral radius ≤ 1 + 1e-6).
     pub stable: Vec<Vec<bool>>,
-    /// [x]: the boundaries in y, ascending.
+    /// \[x\]: the boundaries in y, ascending.
     pub boundaries: Vec<Vec<f64>>,
 }
 

@@ -8,7 +8,7 @@
 //! products for |x| < 2^19·π/2) and evaluates fdlibm's kernels on
 //! [−π/4, π/4] (Remez polynomials, error below one ulp); larger or
 //! non-finite arguments go to libm. `log2` and `exp2` give the step rule's
-//! ρ = min_k (M/‖y^[k]‖)^{1/k} as 2^{min_k log2(M/‖y^[k]‖)/k} to 10⁻¹²
+//! ρ = min_k (M/‖y^\[k\]‖)^{1/k} as 2^{min_k log2(M/‖y^\[k\]‖)/k} to 10⁻¹²
 //! relative, plenty for a step size (the rule itself is a heuristic).
 //!
 //! The constants are written with the digits fdlibm prints, so that they
@@ -34,7 +34,7 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     }
 }
 
-/// The branch-free part of [`sin_cos`]: valid for |x| ≤ [`REDUCTION_LIMIT`].
+/// The branch-free part of [`sin_cos`]: valid for |x| ≤ `REDUCTION_LIMIT`.
 #[inline(always)]
 pub fn reduced_sin_cos(x: f64) -> (f64, f64) {
     const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;

@@ -180,7 +180,7 @@ impl Scalar for Lanes {
     fn recip(self) -> Lanes {
         self.map(|a| 1.0 / a)
     }
-    /// Written out as [`Lanes::zip`] is (not `array::from_fn`): every
+    /// Written out as `Lanes::zip` is (not `array::from_fn`): every
     /// Cauchy-sum term of a model is one, and as loops they would go
     /// through LLVM's loop passes in every model's compile.
     #[inline(always)]

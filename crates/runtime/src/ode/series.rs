@@ -2,7 +2,7 @@
 //! `*_taylor` functions (see `crates/derive/src/taylor.rs`).
 //!
 //! Every node u of a right-hand side keeps its normalised coefficients
-//! u^[k] = u^(k)(t0)/k! in a [`Coefficients`] array; each kernel returns the
+//! u^\[k\] = u^(k)(t0)/k! in a [`Coefficients`] array; each kernel returns the
 //! order-n coefficient of its node from orders ≤ n of its arguments (and
 //! < n of itself). The sums are split over four accumulators: shorter
 //! rounding chains (a form of pairwise summation) and independent
@@ -230,7 +230,7 @@ pub const INVERSES: Coefficients = {
     w
 };
 
-/// The weights j = 0, 1, 2, … of the derivative sums Σ j u^[j] (…).
+/// The weights j = 0, 1, 2, … of the derivative sums Σ j u^\[j\] (…).
 const WEIGHTS: Coefficients = {
     let mut w = [0.0; COEFFICIENTS];
     let mut j = 0;
@@ -241,7 +241,7 @@ const WEIGHTS: Coefficients = {
     w
 };
 
-/// Σ_{j=1..n−1} j u^[j] x^[n−j] for two x sharing the weighted u: the
+/// Σ_{j=1..n−1} j u^\[j\] x^\[n−j\] for two x sharing the weighted u: the
 /// derivative sums without their order-n term.
 #[inline(always)]
 fn derivative_dots<L: Scalar>(
@@ -272,9 +272,9 @@ fn derivative_dots<L: Scalar>(
     (a + b, c + d)
 }
 
-/// (a·b)^[n] = Σ_{j=0..n} a^[n−j] b^[j]. The two terms with order-n
+/// (a·b)^\[n\] = Σ_{j=0..n} a^\[n−j\] b^\[j\]. The two terms with order-n
 /// coefficients come last: the rest depends on earlier orders only, so the
-/// processor can sum it before a^[n] and b^[n] are known, and the chain from
+/// processor can sum it before a^\[n\] and b^\[n\] are known, and the chain from
 /// one node's order n to the next is one multiply-add long.
 #[inline(always)]
 pub fn product<L: Scalar>(a: &Coefficients<L>, b: &Coefficients<L>, n: usize) -> L {
@@ -282,15 +282,15 @@ pub fn product<L: Scalar>(a: &Coefficients<L>, b: &Coefficients<L>, n: usize) ->
     a[0].mul_add(b[n], a[n].mul_add(b[0], earlier))
 }
 
-/// Σ_{k=1..n} a^[k] x^[n−k]: the product's order-n sum without the term
-/// a^[0] x^[n], for the recurrence of a linear solve A x = r, whose order n
-/// is x^[n] = (A^[0])⁻¹ (r^[n] − Σ_{k=1..n} A^[k] x^[n−k]).
+/// Σ_{k=1..n} a^\[k\] x^\[n−k\]: the product's order-n sum without the term
+/// a^\[0\] x^\[n\], for the recurrence of a linear solve A x = r, whose order n
+/// is x^\[n\] = (A^\[0\])⁻¹ (r^\[n\] − Σ_{k=1..n} A^\[k\] x^\[n−k\]).
 #[inline(always)]
 pub fn product_tail<L: Scalar>(a: &Coefficients<L>, x: &Coefficients<L>, n: usize) -> L {
     a[n].mul_add(x[0], reversed_dot(&a[1..n], &x[1..n]))
 }
 
-/// (a²)^[n], using the symmetry of the Cauchy sum.
+/// (a²)^\[n\], using the symmetry of the Cauchy sum.
 #[inline(always)]
 pub fn square<L: Scalar>(a: &Coefficients<L>, n: usize) -> L {
     let h = (n - 1) / 2;
@@ -303,8 +303,8 @@ pub fn square<L: Scalar>(a: &Coefficients<L>, n: usize) -> L {
     pairs * 2.0 + middle + a[0] * 2.0 * a[n]
 }
 
-/// (a/b)^[n] = (a^[n] − Σ_{j=1..n} w^[n−j] b^[j]) / b^[0], with w = a/b
-/// known below order n and `a_n` = a^[n] (0 for a constant numerator).
+/// (a/b)^\[n\] = (a^\[n\] − Σ_{j=1..n} w^\[n−j\] b^\[j\]) / b^\[0\], with w = a/b
+/// known below order n and `a_n` = a^\[n\] (0 for a constant numerator).
 #[inline(always)]
 pub fn quotient<L: Scalar>(w: &Coefficients<L>, a_n: L, b: &Coefficients<L>, n: usize) -> L {
     let earlier = reversed_dot(&w[1..n], &b[1..n]);
@@ -312,16 +312,16 @@ pub fn quotient<L: Scalar>(w: &Coefficients<L>, a_n: L, b: &Coefficients<L>, n: 
     (a_n - earlier - w[0] * b[n]) * inverse
 }
 
-/// (√b)^[n] from w = √b below order n and `b_n` = b^[n]:
-/// (b^[n] − Σ_{j=1..n−1} w^[n−j] w^[j]) / (2 w^[0]).
+/// (√b)^\[n\] from w = √b below order n and `b_n` = b^\[n\]:
+/// (b^\[n\] − Σ_{j=1..n−1} w^\[n−j\] w^\[j\]) / (2 w^\[0\]).
 #[inline(always)]
 pub fn sqrt<L: Scalar>(w: &Coefficients<L>, b_n: L, n: usize) -> L {
     let inner = reversed_dot(&w[1..n], &w[1..n]);
     (b_n - inner) * (w[0].recip() * 0.5)
 }
 
-/// (b^α)^[n] = Σ_{j=0..n−1} (nα − j(α+1)) b^[n−j] w^[j] / (n b^[0]) for a
-/// constant real α (integer powers are products instead: this divides by b^[0]).
+/// (b^α)^\[n\] = Σ_{j=0..n−1} (nα − j(α+1)) b^\[n−j\] w^\[j\] / (n b^\[0\]) for a
+/// constant real α (integer powers are products instead: this divides by b^\[0\]).
 #[inline(always)]
 pub fn power<L: Scalar>(w: &Coefficients<L>, b: &Coefficients<L>, alpha: f64, n: usize) -> L {
     let nf = n as f64;
@@ -332,14 +332,14 @@ pub fn power<L: Scalar>(w: &Coefficients<L>, b: &Coefficients<L>, alpha: f64, n:
     (sum + b[n] * (nf * alpha) * w[0]) / (b[0] * nf)
 }
 
-/// (e^u)^[n] = (1/n) Σ_{j=1..n} j u^[j] w^[n−j], w = e^u below order n.
+/// (e^u)^\[n\] = (1/n) Σ_{j=1..n} j u^\[j\] w^\[n−j\], w = e^u below order n.
 #[inline(always)]
 pub fn exp<L: Scalar>(w: &Coefficients<L>, u: &Coefficients<L>, n: usize) -> L {
     let earlier = derivative_dots(u, w, w, n).0;
     u[n].mul_add(w[0], earlier * L::inverse(n))
 }
 
-/// (ln u)^[n] = (u^[n] − (1/n) Σ_{j=1..n−1} j w^[j] u^[n−j]) / u^[0].
+/// (ln u)^\[n\] = (u^\[n\] − (1/n) Σ_{j=1..n−1} j w^\[j\] u^\[n−j\]) / u^\[0\].
 #[inline(always)]
 pub fn ln<L: Scalar>(w: &Coefficients<L>, u: &Coefficients<L>, n: usize) -> L {
     let mut sum = L::default();
@@ -349,8 +349,8 @@ pub fn ln<L: Scalar>(w: &Coefficients<L>, u: &Coefficients<L>, n: usize) -> L {
     (u[n] - sum / n as f64) / u[0]
 }
 
-/// (sin u, cos u)^[n] from s = sin u, c = cos u below order n:
-/// s^[n] = (1/n) Σ j u^[j] c^[n−j], c^[n] = −(1/n) Σ j u^[j] s^[n−j].
+/// (sin u, cos u)^\[n\] from s = sin u, c = cos u below order n:
+/// s^\[n\] = (1/n) Σ j u^\[j\] c^\[n−j\], c^\[n\] = −(1/n) Σ j u^\[j\] s^\[n−j\].
 #[inline(always)]
 pub fn sin_cos<L: Scalar>(
     s: &Coefficients<L>,

@@ -5,7 +5,7 @@
 //! build time from the right-hand side's DAG) and sums the series. The
 //! order follows from the tolerance, p = ⌈−ln(tol)/κ + 1⌉, and the step
 //! from the last two coefficient norms (Jorba and Zou's rule as heyoka uses
-//! it): ρ = min_k (M/‖y^[k]‖)^{1/k} over k = p−1, p with M = max(1, ‖y‖∞)
+//! it): ρ = min_k (M/‖y^\[k\]‖)^{1/k} over k = p−1, p with M = max(1, ‖y‖∞)
 //! (absolute below 1, relative above), h = ρ e^{−κ} e^{−0.7/(p−1)}, with
 //! κ = [`SAFETY_EXPONENT`]. There is no error estimate and no rejected
 //! step. The polynomial of the step is the dense output.
@@ -103,7 +103,7 @@ pub(super) fn step_from_norms(
     step_from_exponent(step_exponent(y_norm, top_norms, p), safety)
 }
 
-/// log2 ρ = min_k log2(M/‖y^[k]‖)/k over k = p−1, p with M = max(1, ‖y‖∞);
+/// log2 ρ = min_k log2(M/‖y^\[k\]‖)/k over k = p−1, p with M = max(1, ‖y‖∞);
 /// +∞ when both norms vanish, NaN when both are NaN. Branch-free, so that the batch method
 /// computes it for all lanes at once.
 #[inline(always)]

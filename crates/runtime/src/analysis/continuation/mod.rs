@@ -9,7 +9,7 @@
 //! branch points; beside it the brute-force orbit diagram, the attractor of
 //! P against the parameter, for comparison.
 //!
-//! The numerics (`branch`) see the model only through [`FamilyMap`], one
+//! The numerics (`branch`) see the model only through `FamilyMap`, one
 //! period of the map and its monodromy matrix at a parameter value, so
 //! they are compiled once, not once per model size.
 
