@@ -114,11 +114,10 @@ pub struct Map<'a> {
 impl Map<'_> {
     /// The request read against the model: its parameters by name, the
     /// plane's axes and the state the plane passes through.
-    #[allow(clippy::type_complexity)]
     fn request<const S: usize>(
         &self,
         info: &'static crate::registry::ModelInfo,
-    ) -> Result<(BTreeMap<String, f64>, [String; 2], [f64; S]), ChaosMapError> {
+    ) -> Result<Request<S>, ChaosMapError> {
         let bad = |reason: String| ChaosMapError::Request {
             model: info.name.into(),
             reason,
@@ -141,8 +140,19 @@ impl Map<'_> {
             })?,
             None => [0.0; S],
         };
-        Ok((params, axes, through))
+        Ok(Request {
+            params,
+            axes,
+            through,
+        })
     }
+}
+
+/// A chaos map's request as the model reads it.
+struct Request<const S: usize> {
+    params: BTreeMap<String, f64>,
+    axes: [String; 2],
+    through: [f64; S],
 }
 
 impl WithFixed for Map<'_> {
@@ -157,7 +167,11 @@ impl WithFixed for Map<'_> {
             Some(t) if model.has_fast_phase() => t,
             _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
         };
-        let (params, axes, through) = self.request::<S>(info)?;
+        let Request {
+            params,
+            axes,
+            through,
+        } = self.request::<S>(info)?;
         let ranges = plane_ranges(settings, &model.periodic_state());
         crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
         let system = model.exact(self.params);
