@@ -1,10 +1,7 @@
 //! The generic analyses by model name (`stability`, `averaging`,
-//! `chaos_map`, the period-map portrait) in one test binary: each analysis
-//! is instantiated for every model of `models/`, and one binary compiles
-//! those instances once rather than once per file.
+//! `chaos_map`, the period-map portrait), run on the models of `models/`.
 
-mod common;
-use common::model_of;
+use crate::common::model_of;
 
 #[path = "analyses_by_name/averaging.rs"]
 mod averaging;

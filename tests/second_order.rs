@@ -2,8 +2,7 @@
 //! closed form derived by hand, the thresholds against the Mathieu series
 //! and the exact (Floquet) edges, and their order in ε.
 
-mod common;
-use common::model_of;
+use crate::common::model_of;
 use mechlab::analysis::stability::{stability, Settings};
 use mechlab::models::{double_pendulum as dp, kapitza};
 use mechlab::ode::Method;
@@ -281,10 +280,10 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             .iter()
             .map(|d| d.parse().unwrap())
             .collect();
-        match common::asymptotic_slopes(model_of(info.name), &defaults, &settings) {
+        match crate::common::asymptotic_slopes(model_of(info.name), &defaults, &settings) {
             Ok(slopes) => {
                 // −2, or −3 for a coordinate whose 1/ν² term vanishes.
-                if common::assert_whole_power_slopes(info.name, &slopes, -2.0) {
+                if crate::common::assert_whole_power_slopes(info.name, &slopes, -2.0) {
                     checked.push(info.name);
                 }
             }

@@ -11,8 +11,7 @@ use mechlab::ode::{order_for_tolerance, Integrator, Method, OdeError, System, Ta
 use mechlab::registry::DynamicModel;
 use std::f64::consts::PI;
 
-mod common;
-use common::{assert_tangent_recurrences_differentiate, Rng};
+use crate::common::{assert_tangent_recurrences_differentiate, Rng};
 
 const ORDER: usize = 14;
 

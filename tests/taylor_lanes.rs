@@ -11,8 +11,7 @@ use mechlab::ode::{
     Integrator, LaneIntegrator, Lanes, Method, OdeError, Orbit, Scalar, System, TaylorWork, LANES,
 };
 
-mod common;
-use common::assert_streams_equal_scalar;
+use crate::common::assert_streams_equal_scalar;
 
 const TAYLOR: Method = Method::Taylor { tol: 1e-10 };
 

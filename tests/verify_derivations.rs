@@ -3,8 +3,7 @@
 use mechlab::models::{double_pendulum as dp, kapitza};
 use mechlab::ode::{Integrator, Method, Options, System};
 
-mod common;
-use common::{close, Rng};
+use crate::common::{close, Rng};
 
 /// Study 1 (docs/studies.md) with our phase convention y = A ε cos θ, which gives the cross
 /// term with a minus sign: H = p²/2 − A p sin q sin θ + (A²/2) sin²q sin²θ + cos q.

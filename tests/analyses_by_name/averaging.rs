@@ -1,7 +1,7 @@
 //! Theorem 2 on any model by name: the deviation between the exact and the
 //! averaged runs from the same state falls like 1/ν.
 
-use crate::model_of;
+use super::model_of;
 use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
 use mechlab::ode::Method;
 

@@ -1,7 +1,7 @@
 //! The FLI chaos map of any model by name against the direct computation
 //! of `kapitza_chaos_map` and of a plane of the double pendulum.
 
-use crate::model_of;
+use super::model_of;
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings, TileError, Tiles};
 use mechlab::analysis::lyapunov::fast_lyapunov_indicator;
 use mechlab::analysis::row_blocks;
@@ -280,7 +280,7 @@ fn tiles_resume_and_merge_bit_for_bit() {
     assert_eq!(bits(&resumed.fli), bits(&whole.fli));
     assert_eq!(resumed.f_evals, whole.f_evals);
 
-    let sweep = crate::sweep_folder(folder.path());
+    let sweep = super::sweep_folder(folder.path());
     let tile = sweep.join("tile_2.bin");
     let bytes = std::fs::read(&tile).unwrap();
     std::fs::write(&tile, &bytes[..bytes.len() - 3]).unwrap();

@@ -1,7 +1,7 @@
 //! Every generic analysis on every model file in `models/`: a result with
 //! properties that hold for any model, or a typed refusal with its reason.
 
-use crate::model_of;
+use super::model_of;
 use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
 use mechlab::analysis::chaos_map::{chaos_map, ChaosMapError, ChaosMapSettings};
 use mechlab::analysis::period_map::{portrait, PortraitSettings};

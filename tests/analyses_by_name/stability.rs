@@ -1,7 +1,7 @@
 //! The `stability` analysis on any model by name, against the closed forms
 //! and the study-specific computations it generalises.
 
-use crate::model_of;
+use super::model_of;
 use mechlab::analysis::floquet::{first_stability_onset, jury_margin, monodromy};
 use mechlab::analysis::stability::{stability, EquilibriumStability, Settings, StabilityError};
 use mechlab::models::{self, kapitza};
@@ -407,7 +407,7 @@ fn chart_tiles_resume_and_merge_bit_for_bit() {
     };
     let first = stability_chart(model_of("kapitza"), &params, &tiled(Some(vec![1, 3])));
     assert!(matches!(first, Err(StabilityError::Partial)), "{first:?}");
-    let sweep = crate::sweep_folder(folder.path());
+    let sweep = super::sweep_folder(folder.path());
     let files = || {
         let mut names: Vec<String> = std::fs::read_dir(&sweep)
             .unwrap()

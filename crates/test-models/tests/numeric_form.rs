@@ -540,7 +540,7 @@ fn every_test_model_s_tangent_recurrences_differentiate_its_solution_s() {
         quadruple_pendulum,
         rotating_hoop,
         spherical_pendulum,
-        spring_chain5,
+        spring_chain4,
         spring_double_pendulum,
         van_der_pol
     );

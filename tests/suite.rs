@@ -1,0 +1,33 @@
+//! mechlab's tests, one module per file of `tests/`, in one binary (the
+//! studio's and the derivations' snapshots have their own): one binary
+//! compiles the integrators' and analyses' instances once and links the
+//! models once. `cargo test --release NAME` runs the tests whose path
+//! contains NAME, e.g. `cargo test --release section::`.
+
+mod common;
+
+mod analyses_by_name;
+mod attractor;
+mod bad_input;
+mod continuation;
+mod dimension;
+mod docs_commands;
+mod double_double;
+mod events;
+mod explore;
+mod integrators;
+mod model_errors;
+mod report;
+mod runtime;
+mod scene_output;
+mod second_order;
+mod section;
+mod separatrix;
+mod simplify_forms;
+mod source_layout;
+mod studies;
+mod study2;
+mod study3;
+mod taylor;
+mod taylor_lanes;
+mod verify_derivations;
