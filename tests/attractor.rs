@@ -2,6 +2,7 @@
 //! oscillator x'' + k x' + x³ = B cos t (k = 0.05, B = 7.5).
 
 use mechlab::analysis::attractor::{attractor, AttractorError, AttractorSettings};
+use mechlab::analysis::Refusal;
 use mechlab::models;
 use mechlab::ode::Method;
 
@@ -64,7 +65,7 @@ fn models_without_a_planar_period_map_get_named_errors() {
     let double = models::by_name("double_pendulum").unwrap();
     assert!(matches!(
         attractor(double, &double.dynamic.defaults(), &settings()),
-        Err(AttractorError::NotPlanar { dof: 2, .. })
+        Err(AttractorError::Refused(Refusal::Dimension { dof: 2, .. }))
     ));
     let ueda = models::by_name("ueda").unwrap();
     let none = AttractorSettings {
@@ -73,6 +74,6 @@ fn models_without_a_planar_period_map_get_named_errors() {
     };
     assert!(matches!(
         attractor(ueda, &ueda.dynamic.defaults(), &none),
-        Err(AttractorError::Settings { .. })
+        Err(AttractorError::Refused(Refusal::Setting { .. }))
     ));
 }

@@ -6,8 +6,10 @@
 use mechlab::analysis::continuation::{
     continuation, BifurcationKind, ContinuationError, ContinuationSettings, Criticality,
 };
+use mechlab::analysis::Refusal;
 use mechlab::models;
 use mechlab::ode::Method;
+use mechlab::registry::ParameterError;
 use mechlab_test_models::forced_oscillator::MODEL as FORCED;
 use nalgebra::{DMatrix, DVector};
 
@@ -372,7 +374,10 @@ fn bad_requests_are_named() {
     let defaults = duffing.dynamic.defaults();
     let err = continuation(duffing, &defaults, &settings("kappa", 1.0, &[1.0])).unwrap_err();
     assert!(
-        matches!(err, ContinuationError::UnknownParameter { .. }),
+        matches!(
+            err,
+            ContinuationError::Refused(Refusal::Parameter(ParameterError::Unknown { .. }))
+        ),
         "{err}"
     );
     assert!(err.to_string().contains("gamma"), "{err}");
@@ -427,7 +432,10 @@ fn bad_requests_are_named() {
     let mut s = settings("gamma", 0.3, &[1.0, 0.0]);
     s.min_step = 0.0;
     let err = continuation(duffing, &defaults, &s).unwrap_err();
-    assert!(matches!(err, ContinuationError::Settings { .. }), "{err}");
+    assert!(
+        matches!(err, ContinuationError::Refused(Refusal::Setting { .. })),
+        "{err}"
+    );
 }
 
 /// A pendulum whose pivot runs round an ellipse (vertical semi-axis A,

@@ -6,7 +6,9 @@
 use mechlab::analysis::separatrix::{
     hyperbolic_fixed_point, separatrix_splitting, Precision, SplittingError, SplittingSettings,
 };
+use mechlab::analysis::Refusal;
 use mechlab::models::{self, kapitza};
+use mechlab::registry::ParameterError;
 use std::f64::consts::{PI, TAU};
 
 /// Coarser than the scene's defaults, enough for the tests' bounds; in
@@ -99,7 +101,7 @@ fn models_without_a_saddle_get_named_errors() {
     let defaults = double.dynamic.defaults();
     assert!(matches!(
         separatrix_splitting(double, &defaults, &settings),
-        Err(SplittingError::NotPlanar { dof: 2, .. })
+        Err(SplittingError::Refused(Refusal::Dimension { dof: 2, .. }))
     ));
     let kapitza = models::by_name("kapitza").unwrap();
     let stable_upright = kapitza::Params {
@@ -200,7 +202,7 @@ fn double_double_needs_a_reversor_and_says_so() {
     let defaults = model.dynamic.defaults();
     assert!(matches!(
         separatrix_splitting(model, &defaults, &in_double_double()),
-        Err(SplittingError::NoReversor(_))
+        Err(SplittingError::NoReversor { .. })
     ));
     let auto = SplittingSettings {
         precision: Precision::Auto,
@@ -254,7 +256,12 @@ fn the_exponential_fit_is_exact_on_its_own_law_and_sweeps_check_their_values() {
         &[0.2, -0.1],
         &SplittingSettings::default(),
     );
-    assert!(matches!(refused, Err(SplittingError::Request { .. })));
+    assert!(matches!(
+        refused,
+        Err(SplittingError::Refused(Refusal::Parameter(
+            ParameterError::OutOfRange { .. }
+        )))
+    ));
 }
 
 /// The first-order Melnikov lobe area of Kapitza's pendulum in closed form,
@@ -299,7 +306,7 @@ fn the_numerical_melnikov_integral_equals_kapitzas_closed_form() {
     // Where it cancels below its own accuracy, it is refused, not guessed.
     assert!(matches!(
         melnikov_lobe_area(model, &kapitza_at(0.03)),
-        Err(SplittingError::Request { .. })
+        Err(SplittingError::MelnikovCancels { .. })
     ));
     // At another amplitude, where the short form does not apply.
     let params = kapitza::Params {

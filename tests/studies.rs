@@ -3,6 +3,7 @@
 use mechlab::models::double_pendulum as dp;
 use mechlab::models::kapitza::Params;
 use mechlab::ode::Method;
+use mechlab::registry::ParameterError;
 use mechlab::studies::kapitza::{
     attractor, single_orbit, upper_position, AttractorSettings, UpperPositionSettings,
 };
@@ -124,6 +125,18 @@ fn bad_parameters_are_typed_errors() {
         mu: 0.0,
     };
     let error = single_orbit(params, [0.1, 0.0], 10, dop853(1e-8), 1).unwrap_err();
-    assert!(matches!(error, StudyError::Settings { .. }), "{error}");
-    assert!(error.to_string().contains("ε > 0"), "{error}");
+    assert!(
+        matches!(&error, StudyError::Parameter(ParameterError::OutOfRange { name, .. }) if name == "eps"),
+        "{error}"
+    );
+    let negative = Params {
+        A: -1.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    let error = single_orbit(negative, [0.1, 0.0], 10, dop853(1e-8), 1).unwrap_err();
+    assert!(
+        matches!(error, StudyError::Settings { setting: "A", .. }),
+        "{error}"
+    );
 }

@@ -703,9 +703,8 @@ pub fn friction(s: &FrictionSettings) -> Result<Friction, StudyError> {
     let eigenvalues = linearization_eigenvalues(&model::averaged_jacobian(&y_eq, &params));
     let max_re = eigenvalues.iter().fold(f64::MIN, |m, (re, _)| m.max(*re));
     if !max_re.is_finite() {
-        return Err(StudyError::Settings {
-            setting: "equilibrium",
-            reason: format!("the averaged linearisation at {phi:?} has no finite eigenvalues"),
+        return Err(StudyError::NoFiniteEigenvalues {
+            equilibrium: vec![phi.0, phi.1],
         });
     }
     let y0 = [phi.0 + s.offset, phi.1 - s.offset, 0.0, 0.0];

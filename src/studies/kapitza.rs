@@ -23,15 +23,15 @@ pub fn period(params: &Params) -> f64 {
 
 /// The pendulum needs ε > 0, A ≥ 0 and μ ≥ 0.
 pub fn check(params: &Params) -> Result<(), StudyError> {
-    if params.eps > 0.0 && params.A >= 0.0 && params.mu >= 0.0 {
+    for (name, value) in kapitza::INFO.parameter_names.iter().zip(params.values()) {
+        kapitza::INFO.check_parameter(name, value)?;
+    }
+    if params.A >= 0.0 {
         return Ok(());
     }
     Err(StudyError::Settings {
-        setting: "kapitza parameters",
-        reason: format!(
-            "need ε > 0, A ≥ 0 and μ ≥ 0 (got ε = {}, A = {}, μ = {})",
-            params.eps, params.A, params.mu
-        ),
+        setting: "A",
+        requirement: "the study's amplitude is at least 0 (−A is A a half period later)",
     })
 }
 

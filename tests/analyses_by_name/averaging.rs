@@ -2,8 +2,12 @@
 //! averaged runs from the same state falls like 1/ν.
 
 use super::model_of;
-use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
+use mechlab::analysis::averaging::{
+    convergence, AveragingError, ConvergenceSettings, SweepProblem,
+};
+use mechlab::analysis::Refusal;
 use mechlab::ode::Method;
+use mechlab::registry::ParameterError;
 
 fn settings(parameter: Option<&str>, values: &[f64]) -> ConvergenceSettings {
     ConvergenceSettings {
@@ -79,10 +83,7 @@ fn bad_requests_are_typed_errors() {
     )
     .unwrap_err();
     assert!(
-        matches!(
-            e,
-            AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
-        ),
+        matches!(e, AveragingError::Refused(Refusal::ContactModel { .. })),
         "{e}"
     );
     let e = convergence(
@@ -91,7 +92,13 @@ fn bad_requests_are_typed_errors() {
         &settings(Some("nu"), &[1.0]),
     )
     .unwrap_err();
-    assert!(e.to_string().contains("no parameter 'nu'"), "{e}");
+    assert!(
+        matches!(
+            &e,
+            AveragingError::Refused(Refusal::Parameter(ParameterError::Unknown { name, .. })) if name == "nu"
+        ),
+        "{e}"
+    );
     let e = convergence(
         model_of("kapitza"),
         &defaults("kapitza"),
@@ -99,7 +106,10 @@ fn bad_requests_are_typed_errors() {
     )
     .unwrap_err();
     assert!(
-        e.to_string().contains("does not change the frequency"),
+        matches!(
+            &e,
+            AveragingError::Sweep { parameter, problem: SweepProblem::FrequencyUnchanged, .. } if parameter == "A"
+        ),
         "{e}"
     );
     let mut bad_state = settings(None, &[100.0]);
@@ -113,11 +123,11 @@ fn bad_requests_are_typed_errors() {
     assert!(
         matches!(
             e,
-            AveragingError::State {
-                got: 2,
+            AveragingError::Refused(Refusal::StateLength {
+                given: 2,
                 expected: 4,
                 ..
-            }
+            })
         ),
         "{e}"
     );

@@ -26,10 +26,19 @@ pub enum StudyError {
         value: f64,
         source: crate::contact::ContactError,
     },
-    /// Settings that do not fit together.
-    #[error("{setting}: {reason}")]
+    /// A setting outside what the study accepts; `requirement` says what
+    /// it accepts.
+    #[error("{setting}: {requirement}")]
     Settings {
         setting: &'static str,
-        reason: String,
+        requirement: &'static str,
     },
+    /// A parameter outside the model file's range.
+    #[error(transparent)]
+    Parameter(#[from] crate::registry::ParameterError),
+    /// The averaged system's linearisation at an equilibrium has no finite
+    /// eigenvalues (a singular mass matrix there, or a parameter out of
+    /// its physical range).
+    #[error("equilibrium {equilibrium:?}: the averaged linearisation has no finite eigenvalues")]
+    NoFiniteEigenvalues { equilibrium: Vec<f64> },
 }

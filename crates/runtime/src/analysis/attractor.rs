@@ -37,10 +37,6 @@ pub enum AttractorError {
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
     Refused(#[from] crate::analysis::Refusal),
-    #[error("model '{model}' has {dof} degrees of freedom: the attractor is drawn for one (a period map of the plane)")]
-    NotPlanar { model: String, dof: usize },
-    #[error("attractor of '{model}': {reason}")]
-    Settings { model: String, reason: String },
     #[error(transparent)]
     Ode(#[from] OdeError),
 }
@@ -95,10 +91,13 @@ pub fn attractor(
     let fixed = match model.sized {
         Some(FixedSize::Dof1(fixed)) => fixed,
         Some(_) => {
-            return Err(AttractorError::NotPlanar {
+            return Err(Refusal::Dimension {
                 model: name,
                 dof: model.info.coordinates.len(),
-            })
+                analysis: "the attractor",
+                supported: "one degree of freedom (a period map of the plane)",
+            }
+            .into())
         }
         None => return Err(AttractorError::Refused(Refusal::contact_model(name))),
     };
@@ -106,15 +105,8 @@ pub fn attractor(
         Some(t) if fixed.has_fast_phase() => t,
         _ => return Err(AttractorError::Refused(Refusal::no_fast_phase(name))),
     };
-    let settings_error = |reason: &str| AttractorError::Settings {
-        model: name.clone(),
-        reason: reason.into(),
-    };
     check_settings(settings, &name)?;
-    let named = model
-        .info
-        .named_values(params)
-        .ok_or_else(|| settings_error("wrong number of parameter values"))?;
+    let named = Refusal::named_values(model.info, params)?;
     let system = fixed.exact(params);
     let periodic = model.dynamic.periodic()[0];
     let wrap = [periodic, false];
@@ -195,17 +187,12 @@ pub fn attractor(
 
 /// The settings' sanity and the memory they ask for, as named errors.
 fn check_settings(settings: &AttractorSettings, name: &str) -> Result<(), AttractorError> {
-    let settings_error = |reason: &str| AttractorError::Settings {
-        model: name.into(),
-        reason: reason.into(),
-    };
+    let settings_error = |requirement: &'static str| Refusal::setting(name, requirement);
     if settings.points < 100 || settings.lyapunov_periods < 10 || settings.pixels < 10 {
-        return Err(settings_error(
-            "points ≥ 100, lyapunov_periods ≥ 10 and pixels ≥ 10",
-        ));
+        return Err(settings_error("points ≥ 100, lyapunov_periods ≥ 10 and pixels ≥ 10").into());
     }
     if !settings.start.iter().all(|x| x.is_finite()) {
-        return Err(settings_error("the start must be finite"));
+        return Err(settings_error("the start must be finite").into());
     }
     crate::budget::check(
         || {

@@ -211,18 +211,28 @@ pub enum AveragingError {
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
     Refused(#[from] crate::analysis::Refusal),
-    #[error("model '{model}': {reason}")]
-    Parameter { model: String, reason: String },
-    #[error("model '{model}': the initial state has {got} components, the model {expected}")]
-    State {
+    /// The swept parameter's values give no fit: `problem` says why.
+    #[error("model '{model}': sweeping '{parameter}' {problem}")]
+    Sweep {
         model: String,
-        got: usize,
-        expected: usize,
+        parameter: String,
+        problem: SweepProblem,
     },
     #[error("model '{0}': the averaged system of order {1} is not derived (order 1 is for every model with a fast phase, order 2 too except for models with a numeric solve of more than 4 degrees of freedom, whose code would grow like n⁴)")]
     Order(String, usize),
     #[error(transparent)]
     Ode(#[from] OdeError),
+}
+
+/// Why a swept parameter's values give no fit of the averaging error.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SweepProblem {
+    #[error("changes the frequency of the phase neither in proportion nor in inverse proportion: give the values to sweep")]
+    NotProportional,
+    #[error("to {value} gives no finite period of the phase")]
+    NoPeriod { value: f64 },
+    #[error("does not change the frequency of the phase (or fewer than two values were given): nothing to fit against")]
+    FrequencyUnchanged,
 }
 
 /// The deviation of each coordinate over `times` between the exact run
@@ -298,22 +308,15 @@ impl crate::registry::WithFixed for Sweep<'_> {
         model: &'static F,
     ) -> Self::Output {
         let info = model.info();
-        let bad = |reason: String| AveragingError::Parameter {
-            model: info.name.into(),
-            reason,
-        };
         if !model.has_fast_phase() {
             return Err(AveragingError::Refused(Refusal::no_fast_phase(info.name)));
         }
-        if info.named_values(self.params).is_none() {
-            return Err(bad(format!("{} parameter values", self.params.len())));
-        }
+        Refusal::named_values(info, self.params)?;
         let y0: [f64; S] = match &self.settings.y0 {
-            Some(y) => y.as_slice().try_into().map_err(|_| AveragingError::State {
-                model: info.name.into(),
-                got: y.len(),
-                expected: S,
-            })?,
+            Some(y) => y
+                .as_slice()
+                .try_into()
+                .map_err(|_| Refusal::state_length(info.name, "initial state", y.len(), S))?,
             None => std::array::from_fn(|i| match i {
                 i if i < D && i % 2 == 0 => 0.2,
                 i if i < D => -0.1,
@@ -417,26 +420,21 @@ fn swept<
     settings: &ConvergenceSettings,
 ) -> Result<(String, usize, Vec<f64>, Vec<f64>), AveragingError> {
     let info = model.info();
-    let bad = |reason: String| AveragingError::Parameter {
-        model: info.name.into(),
-        reason,
-    };
     let parameter = match &settings.parameter {
         Some(p) => p.clone(),
         None => rate_parameter(info).ok_or_else(|| {
-            bad("the phase rate depends on more than one parameter: name the one to sweep".into())
+            Refusal::setting(
+                info.name,
+                "the phase rate depends on more than one parameter: name the one to sweep",
+            )
         })?,
     };
-    let index = info
-        .parameter_names
-        .iter()
-        .position(|p| *p == parameter)
-        .ok_or_else(|| {
-            bad(format!(
-                "no parameter '{parameter}' (parameters: {})",
-                info.parameter_names.join(", ")
-            ))
-        })?;
+    let index = Refusal::parameter_index(info, &parameter)?;
+    let bad = |problem: SweepProblem| AveragingError::Sweep {
+        model: info.name.into(),
+        parameter: parameter.clone(),
+        problem,
+    };
     let with = |value: f64| {
         let mut p = params.to_vec();
         p[index] = value;
@@ -460,27 +458,19 @@ fn swept<
             } else if (ratio - 0.5).abs() < 1e-9 {
                 factors.map(|k| p0 / k).to_vec()
             } else {
-                return Err(bad(format!(
-                    "the frequency is not proportional or inversely proportional to '{parameter}': give the values"
-                )));
+                return Err(bad(SweepProblem::NotProportional));
             }
         }
     };
     let mut frequencies = Vec::new();
     for &value in &values {
-        frequencies.push(frequency(value).ok_or_else(|| {
-            bad(format!(
-                "{parameter} = {value} gives no finite period of the phase"
-            ))
-        })?);
+        frequencies.push(frequency(value).ok_or_else(|| bad(SweepProblem::NoPeriod { value }))?);
     }
     let distinct = frequencies
         .iter()
         .any(|f| (f - frequencies[0]).abs() > 1e-12 * f.abs());
     if !distinct {
-        return Err(bad(format!(
-            "'{parameter}' does not change the frequency of the phase (or fewer than two values): nothing to fit against"
-        )));
+        return Err(bad(SweepProblem::FrequencyUnchanged));
     }
     Ok((parameter, index, values, frequencies))
 }

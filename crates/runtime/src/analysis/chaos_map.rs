@@ -118,13 +118,7 @@ impl Map<'_> {
         &self,
         info: &'static crate::registry::ModelInfo,
     ) -> Result<Request<S>, ChaosMapError> {
-        let bad = |reason: String| ChaosMapError::Request {
-            model: info.name.into(),
-            reason,
-        };
-        let params = info
-            .named_values(self.params)
-            .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
+        let params = Refusal::named_values(info, self.params)?;
         let axes = info
             .plane(self.settings.axes)
             .map_err(|source| ChaosMapError::Plane {
@@ -133,10 +127,7 @@ impl Map<'_> {
             })?;
         let through: [f64; S] = match &self.settings.through {
             Some(y) => y.as_slice().try_into().map_err(|_| {
-                bad(format!(
-                    "the state to pass through has {} components, not {S}",
-                    y.len()
-                ))
+                Refusal::state_length(info.name, "state the plane passes through", y.len(), S)
             })?,
             None => [0.0; S],
         };

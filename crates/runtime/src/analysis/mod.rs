@@ -26,8 +26,8 @@ pub mod vibrational_stability;
 
 use std::ops::Range;
 
-/// Why an analysis does not apply to a model, the same for every analysis
-/// (each analysis's error wraps it as `Refused`).
+/// Why an analysis does not apply to a model or to a request, the same for
+/// every analysis (each analysis's error wraps it as `Refused`).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum Refusal {
     /// A model of points on rough guides: it has no Hamiltonian form,
@@ -38,6 +38,50 @@ pub enum Refusal {
     /// No `[fast_phase]` in its model file: no period map, nothing to average.
     #[error("model '{model}' has no fast phase ([fast_phase] in its model file): it has no period map and nothing to average")]
     NoFastPhase { model: String },
+    /// A fast phase where the analysis is of autonomous models; `instead`
+    /// names what answers the question for this model.
+    #[error("model '{model}' has a fast phase: {instead}")]
+    FastPhase {
+        model: String,
+        instead: &'static str,
+    },
+    /// Not a number of degrees of freedom the analysis is computed for.
+    #[error(
+        "model '{model}' has {dof} degrees of freedom: {analysis} is computed for {supported}"
+    )]
+    Dimension {
+        model: String,
+        dof: usize,
+        analysis: &'static str,
+        supported: &'static str,
+    },
+    /// Not one value per parameter of the model.
+    #[error("model '{model}' has {expected} parameters, and {given} values were given")]
+    ParameterCount {
+        model: String,
+        given: usize,
+        expected: usize,
+    },
+    /// A state (a start, a seed, a point a plane passes through) of
+    /// another length than the model's.
+    #[error("model '{model}': the {what} has {given} components, the model's state {expected}")]
+    StateLength {
+        model: String,
+        what: &'static str,
+        given: usize,
+        expected: usize,
+    },
+    /// A setting outside what the analysis accepts; `requirement` says
+    /// what it accepts.
+    #[error("model '{model}': {requirement}")]
+    Setting {
+        model: String,
+        requirement: &'static str,
+    },
+    /// A parameter named that the model does not have, or a value it does
+    /// not accept.
+    #[error(transparent)]
+    Parameter(#[from] crate::registry::ParameterError),
 }
 
 impl Refusal {
@@ -50,6 +94,60 @@ impl Refusal {
     pub fn no_fast_phase(model: impl Into<String>) -> Refusal {
         Refusal::NoFastPhase {
             model: model.into(),
+        }
+    }
+
+    /// [`Refusal::Setting`].
+    pub fn setting(model: impl Into<String>, requirement: &'static str) -> Refusal {
+        Refusal::Setting {
+            model: model.into(),
+            requirement,
+        }
+    }
+
+    /// The model's parameters by name (the values in declaration order), or
+    /// [`Refusal::ParameterCount`].
+    pub fn named_values(
+        info: &crate::registry::ModelInfo,
+        values: &[f64],
+    ) -> Result<std::collections::BTreeMap<String, f64>, Refusal> {
+        info.named_values(values).ok_or(Refusal::ParameterCount {
+            model: info.name.into(),
+            given: values.len(),
+            expected: info.parameter_names.len(),
+        })
+    }
+
+    /// The index of the model's parameter `name`, or
+    /// [`Refusal::Parameter`] naming the ones it has.
+    pub fn parameter_index(
+        info: &crate::registry::ModelInfo,
+        name: &str,
+    ) -> Result<usize, Refusal> {
+        info.parameter_names
+            .iter()
+            .position(|p| *p == name)
+            .ok_or_else(|| {
+                Refusal::Parameter(crate::registry::ParameterError::Unknown {
+                    model: info.name,
+                    name: name.into(),
+                    known: info.parameter_names,
+                })
+            })
+    }
+
+    /// [`Refusal::StateLength`].
+    pub fn state_length(
+        model: impl Into<String>,
+        what: &'static str,
+        given: usize,
+        expected: usize,
+    ) -> Refusal {
+        Refusal::StateLength {
+            model: model.into(),
+            what,
+            given,
+            expected,
         }
     }
 }

@@ -157,8 +157,6 @@ pub enum PeriodMapError {
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
     Refused(#[from] crate::analysis::Refusal),
-    #[error("model '{model}': {reason}")]
-    Request { model: String, reason: String },
     /// The plane's axes are not two different state components.
     #[error("model '{model}': {source}")]
     Plane {
@@ -209,13 +207,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
     ) -> Self::Output {
         let info = model.info();
         let settings = self.settings;
-        let bad = |reason: String| PeriodMapError::Request {
-            model: info.name.into(),
-            reason,
-        };
-        let params = info
-            .named_values(self.params)
-            .ok_or_else(|| bad(format!("{} parameter values", self.params.len())))?;
+        let params = Refusal::named_values(info, self.params)?;
         let period = match model.phase_period(self.params) {
             Some(t) if model.has_fast_phase() => t,
             _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
@@ -233,7 +225,7 @@ impl crate::registry::WithFixed for Portraits<'_> {
                 .map(|s| {
                     s.as_slice()
                         .try_into()
-                        .map_err(|_| bad(format!("a seed has {} components, not {S}", s.len())))
+                        .map_err(|_| Refusal::state_length(info.name, "seed", s.len(), S))
                 })
                 .collect::<Result<_, _>>()?,
             None => {

@@ -175,12 +175,6 @@ pub enum SectionError {
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
     Refused(#[from] crate::analysis::Refusal),
-    #[error("model {0} has a fast phase: its section is the period map (scenes period_map, chaos_map); slices of it are drawn for 2 degrees of freedom")]
-    FastPhase(String),
-    #[error("model {model} has {dof} degrees of freedom: sections are drawn for 2")]
-    Dimension { model: String, dof: usize },
-    #[error("model {model}: {reason}")]
-    Settings { model: String, reason: String },
     /// No seed: where the scene looked, the energy is nowhere accessible on
     /// the plane (or the plane is a singular point of the chart).
     #[error("model {model}: no seeds on the plane (is the energy accessible there, and is the plane not a singular point of the coordinates?)")]
@@ -197,7 +191,7 @@ pub enum SectionError {
     #[error("seed ({}, {}): H is not quadratic and convex in the momentum there (a singular point of the chart?)", seed[0], seed[1])]
     Singular { seed: [f64; 2] },
     #[error(transparent)]
-    Plane(#[from] PlaneError),
+    Plane(#[from] PlaneTextError),
     #[error("method: {0}")]
     Method(#[from] OdeError),
 }
@@ -220,14 +214,32 @@ pub fn section(
     let name = model.info.name.to_string();
     match model.sized {
         Some(FixedSize::Dof2(fixed)) => work.run::<_, 2, 4, 8, 20>(fixed),
-        Some(_) if has_fast_phase(model) => Err(SectionError::FastPhase(name)),
-        Some(_) => Err(SectionError::Dimension {
+        Some(_) if has_fast_phase(model) => Err(Refusal::FastPhase {
+            model: name,
+            instead: FAST_PHASE_SECTION,
+        }
+        .into()),
+        Some(_) => Err(Refusal::Dimension {
             model: name,
             dof: model.info.coordinates.len(),
-        }),
+            analysis: "a section",
+            supported: "2",
+        }
+        .into()),
         None => Err(SectionError::Refused(Refusal::contact_model(name))),
     }
 }
+
+/// The plane's coefficients as a section accepts them.
+pub(super) const PLANE_COEFFICIENTS: &str =
+    "the plane's coefficients must be finite and not both 0";
+
+/// Why a model with a fast phase gets no seeds by energy.
+pub(super) const NO_AVERAGED_HAMILTONIAN: &str =
+    "its averaged Hamiltonian, which places seeds at an energy, is not derived";
+
+/// Where a model with a fast phase has its section.
+const FAST_PHASE_SECTION: &str = "its section is the period map (scenes period_map, chaos_map); slices of it are drawn for 2 degrees of freedom";
 
 pub(super) fn has_fast_phase(model: &Model) -> bool {
     matches!(
@@ -282,23 +294,23 @@ impl WithFixed for Sections<'_> {
         let info = fixed.info();
         let name = info.name.to_string();
         if D != 2 {
-            return Err(SectionError::Dimension {
+            return Err(Refusal::Dimension {
                 model: name,
                 dof: D,
-            });
+                analysis: "a section",
+                supported: "2",
+            }
+            .into());
         }
         let s = self.settings;
-        let bad = |reason: String| SectionError::Settings {
-            model: name.clone(),
-            reason,
-        };
+        let bad =
+            |requirement: &'static str| SectionError::from(Refusal::setting(&name, requirement));
         if !(s.tol > 0.0 && s.t_max > 0.0 && s.energy.is_finite() && s.value.is_finite()) {
             return Err(bad(
-                "the tolerance and t_max must be positive, the energy and value finite".into(),
+                "the tolerance and t_max must be positive, the energy and value finite",
             ));
         }
-        let chart = Chart::new(s, D, &fixed.periodic())
-            .ok_or_else(|| bad(format!("the plane's coefficients {:?}", s.plane)))?;
+        let chart = Chart::new(s, D, &fixed.periodic()).ok_or_else(|| bad(PLANE_COEFFICIENTS))?;
         let stroboscope = match fixed.has_fast_phase() {
             false => None,
             true => match fixed.phase_period(self.params) {
@@ -309,11 +321,11 @@ impl WithFixed for Sections<'_> {
                         slab: s.slab,
                     })
                 }
-                _ => return Err(bad("a positive slab and a finite phase".into())),
+                _ => return Err(bad("a positive slab and a finite phase")),
             },
         };
-        let energy = seed_energy(self.model, self.params)
-            .ok_or_else(|| bad("its averaged Hamiltonian is not derived".into()))?;
+        let energy =
+            seed_energy(self.model, self.params).ok_or_else(|| bad(NO_AVERAGED_HAMILTONIAN))?;
         let energy = |y: &[f64; S]| energy(y);
         let chart = chart.centred(|q| chart.least_energy(&[q, 0.0], &energy), s.energy);
         if self.seeds.is_empty() {
@@ -725,10 +737,10 @@ fn plane_name(a: [f64; 2], names: &[&str]) -> String {
 
 /// A plane written as a linear function of the coordinates' names, as in
 /// "x", "q1 - q2", "x + 0.5*y" or "-2*y", as its coefficients.
-pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneError> {
-    let bad = |reason: &str| PlaneError {
+pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneTextError> {
+    let bad = |problem: PlaneTextProblem| PlaneTextError {
         text: text.to_string(),
-        reason: reason.to_string(),
+        problem,
     };
     let mut a = [0.0; 2];
     // Split into signed terms at + or − that do not follow an exponent's e.
@@ -752,7 +764,7 @@ pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneError> {
         let (factor, name) = match body.split_once('*') {
             Some((k, name)) => (
                 k.parse::<f64>()
-                    .map_err(|_| bad("a coefficient is not a number"))?,
+                    .map_err(|_| bad(PlaneTextProblem::Coefficient))?,
                 name,
             ),
             None => (1.0, body),
@@ -760,21 +772,32 @@ pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneError> {
         let index = names
             .iter()
             .position(|n| *n == name)
-            .ok_or_else(|| bad("a term is not a coordinate's name (write k*name)"))?;
+            .ok_or_else(|| bad(PlaneTextProblem::Term))?;
         a[index] += sign * factor;
     }
     if !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
-        return Err(bad("no coordinate with a finite coefficient other than 0"));
+        return Err(bad(PlaneTextProblem::Zero));
     }
     Ok(a)
 }
 
 /// A plane's text that [`parse_plane`] cannot read.
 #[derive(Debug, thiserror::Error)]
-#[error("plane {text:?}: {reason}")]
-pub struct PlaneError {
+#[error("plane {text:?}: {problem}")]
+pub struct PlaneTextError {
     pub text: String,
-    pub reason: String,
+    pub problem: PlaneTextProblem,
+}
+
+/// What is wrong in a plane's text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PlaneTextProblem {
+    #[error("a coefficient is not a number")]
+    Coefficient,
+    #[error("a term is not a coordinate's name (write k*name)")]
+    Term,
+    #[error("no coordinate with a finite coefficient other than 0")]
+    Zero,
 }
 
 /// x to six significant digits at most (π as 3.14159).

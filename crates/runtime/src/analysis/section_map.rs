@@ -67,31 +67,31 @@ pub fn section_map(
     let fixed = match model.sized {
         Some(FixedSize::Dof2(fixed)) => fixed,
         Some(_) => {
-            return Err(SectionError::Dimension {
+            return Err(Refusal::Dimension {
                 model: name,
                 dof: model.info.coordinates.len(),
-            })
+                analysis: "a section's MEGNO map",
+                supported: "2",
+            }
+            .into())
         }
         None => return Err(SectionError::Refused(Refusal::contact_model(name))),
     };
     let s = &settings.section;
-    let bad = |reason: &str| SectionError::Settings {
-        model: name.clone(),
-        reason: reason.into(),
-    };
+    let bad = |requirement: &'static str| SectionError::from(Refusal::setting(&name, requirement));
     if settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
         return Err(bad("pixels ≥ 2, t_max and extent positive"));
     }
     crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
     let chart = Chart::new(s, 2, &fixed.periodic())
-        .ok_or_else(|| bad("the plane's coefficients are 0 or not finite"))?;
+        .ok_or_else(|| bad(super::section::PLANE_COEFFICIENTS))?;
     let method = Method::Taylor { tol: s.tol };
     method.validate()?;
     let chunk = megno_interval(fixed.has_fast_phase(), fixed.phase_period(params), s.phase)
         .ok_or_else(|| bad("with a fast phase the map starts its orbits at phase 0"))?;
     let start = std::time::Instant::now();
     let energy = super::section::seed_energy(model, params)
-        .ok_or_else(|| bad("its averaged Hamiltonian is not derived"))?;
+        .ok_or_else(|| bad(super::section::NO_AVERAGED_HAMILTONIAN))?;
     let energy = |y: &[f64; 4]| energy(y);
     // The least H over the solved momentum at a point of the plane.
     let least = |q: f64, p: f64| chart.least_energy(&[q, p], &energy);

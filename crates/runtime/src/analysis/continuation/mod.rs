@@ -73,14 +73,6 @@ pub enum ContinuationError {
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
     Refused(#[from] crate::analysis::Refusal),
-    #[error("model '{model}' has no parameter '{name}' (parameters: {known})")]
-    UnknownParameter {
-        model: String,
-        name: String,
-        known: String,
-    },
-    #[error("continuation of '{model}': {reason}")]
-    Settings { model: String, reason: String },
     /// M − I is singular at the start: the guess sits on a bifurcation (or a
     /// degenerate orbit), where the branch's direction is not defined.
     #[error("the Jacobian P'(y) − I is singular at the start (parameter {parameter}): start off the bifurcation, at another parameter value")]
@@ -287,21 +279,8 @@ impl WithFixed for Work<'_> {
     ) -> Self::Output {
         let info = model.info();
         let name = info.name.to_string();
-        let index = info
-            .parameter_names
-            .iter()
-            .position(|p| *p == self.settings.parameter)
-            .ok_or_else(|| ContinuationError::UnknownParameter {
-                model: name.clone(),
-                name: self.settings.parameter.clone(),
-                known: info.parameter_names.join(", "),
-            })?;
-        let named = info
-            .named_values(self.params)
-            .ok_or_else(|| ContinuationError::Settings {
-                model: name.clone(),
-                reason: format!("{} parameter values given", self.params.len()),
-            })?;
+        let index = Refusal::parameter_index(info, &self.settings.parameter)?;
+        let named = Refusal::named_values(info, self.params)?;
         let map = AtModel::<F, D, S, T, V>::new(model, self.params, index, self.settings.method);
         let mut result = run(&map, self.params[index], self.settings, &name)?;
         result.params = named;
@@ -760,12 +739,7 @@ fn check(
     n: usize,
     model: &str,
 ) -> Result<(), ContinuationError> {
-    let bad = |reason: &str| {
-        Err(ContinuationError::Settings {
-            model: model.into(),
-            reason: reason.into(),
-        })
-    };
+    let bad = |requirement: &'static str| Err(Refusal::setting(model, requirement).into());
     if !settings.to.is_finite() || settings.to == p0 {
         return bad("`to` must be finite and differ from the parameter's value");
     }

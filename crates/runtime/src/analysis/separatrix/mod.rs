@@ -271,10 +271,8 @@ pub enum SplittingError {
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
     Refused(#[from] crate::analysis::Refusal),
-    #[error("model '{model}' has {dof} degrees of freedom: separatrix splitting is measured for one (a period map of the plane)")]
-    NotPlanar { model: String, dof: usize },
-    #[error("model '{0}': the averaged system has no saddle (no maximum of V + V_vibr) to start Newton from; give a guess of the fixed point")]
-    NoSaddle(String),
+    #[error("model '{model}': the averaged system has no saddle (no maximum of V + V_vibr) to start Newton from; give a guess of the fixed point")]
+    NoSaddle { model: String },
     #[error("model '{model}': Newton for a fixed point of the period map did not converge from {start:?}")]
     FixedPoint { model: String, start: [f64; 2] },
     #[error("model '{model}': the fixed point {point:?} is not hyperbolic with positive multipliers (multipliers {multipliers})")]
@@ -291,10 +289,16 @@ pub enum SplittingError {
     },
     #[error("model '{model}': Newton for the homoclinic point near {near:?} did not converge (where the averaged system has two saddles, as Kapitza's above A = √2, their connections are heteroclinic, which are not measured yet)")]
     Homoclinic { model: String, near: [f64; 2] },
-    #[error("model '{0}': no reversor of the period map at phase 0 ((q, p) ↦ (c − q, p) or (q, −p) with time reversed) maps W^u onto W^s, which double-double needs to find the homoclinic orbits; use precision=double")]
-    NoReversor(String),
-    #[error("model '{model}': {reason}")]
-    Request { model: String, reason: String },
+    #[error("model '{model}': no reversor of the period map at phase 0 ((q, p) ↦ (c − q, p) or (q, −p) with time reversed) maps W^u onto W^s, which double-double needs to find the homoclinic orbits; use precision=double")]
+    NoReversor { model: String },
+    /// The Melnikov integral is smaller than the accuracy of its terms
+    /// (`relative` of their magnitude): it would be noise, so it is not given.
+    #[error("model '{model}': the Melnikov integral cancels below the accuracy of its terms ({relative:.1e} of them)")]
+    MelnikovCancels { model: String, relative: f64 },
+    /// Double-double precision needs the model's recurrences in action–angle
+    /// form, which models of one degree of freedom with a closed-form field have.
+    #[error("model '{model}': double-double needs the model's action recurrences, which models of one degree of freedom with a closed-form field have; use precision=double")]
+    NoActionRecurrences { model: String },
     #[error(transparent)]
     Ode(#[from] OdeError),
 }
@@ -329,7 +333,9 @@ pub fn separatrix_splitting(
                 (Ok(precise), Ok(double)) => with_polygon(precise, &double),
                 (Ok(precise), Err(_)) => precise,
                 (Err(_), Ok(double)) => double,
-                (Err(SplittingError::NoReversor(_)), Err(e)) | (Err(e), Err(_)) => return Err(e),
+                (Err(SplittingError::NoReversor { .. }), Err(e)) | (Err(e), Err(_)) => {
+                    return Err(e)
+                }
             }
         }
     };
@@ -474,35 +480,34 @@ fn prepare(
     let fixed = match model.sized {
         Some(FixedSize::Dof1(fixed)) => fixed,
         Some(_) => {
-            return Err(SplittingError::NotPlanar {
+            return Err(Refusal::Dimension {
                 model: name,
                 dof: model.info.coordinates.len(),
-            })
+                analysis: "separatrix splitting",
+                supported: "one degree of freedom (a period map of the plane)",
+            }
+            .into())
         }
         None => return Err(SplittingError::Refused(Refusal::contact_model(name))),
     };
-    let Some(named) = model.info.named_values(params) else {
-        return Err(SplittingError::Request {
-            model: name,
-            reason: format!("{} parameter values", params.len()),
-        });
-    };
+    let named = Refusal::named_values(model.info, params)?;
     let period = match fixed.phase_period(params) {
         Some(t) if fixed.has_fast_phase() => t,
         _ => return Err(SplittingError::Refused(Refusal::no_fast_phase(name))),
     };
     if !(settings.spacing > 0.0 && settings.p_max > 0.0 && settings.lobe_points >= 8) {
-        return Err(SplittingError::Request {
-            model: name,
-            reason: "spacing and p_max must be positive, lobe_points at least 8".into(),
-        });
+        return Err(Refusal::setting(
+            name,
+            "spacing and p_max must be positive, lobe_points at least 8",
+        )
+        .into());
     }
     let guesses = match settings.guess {
         Some(g) => vec![g],
         None => saddles(model.dynamic, params),
     };
     if guesses.is_empty() {
-        return Err(SplittingError::NoSaddle(name));
+        return Err(SplittingError::NoSaddle { model: name });
     }
     let map = Map {
         system: fixed.exact(params),
@@ -1407,18 +1412,13 @@ pub fn splitting_sweep(
     settings: &SplittingSettings,
 ) -> Result<SplittingSweep, SplittingError> {
     let info = model.info;
-    let index = info.parameter_names.iter().position(|n| *n == parameter);
-    let parameter_error = |value: f64| info.check_parameter(parameter, value).err();
-    let (Some(index), None) = (index, values.iter().find_map(|&v| parameter_error(v))) else {
-        let reason = match values.iter().find_map(|&v| parameter_error(v)) {
-            Some(e) => e.to_string(),
-            None => format!("no parameter '{parameter}'"),
-        };
-        return Err(SplittingError::Request {
-            model: info.name.into(),
-            reason,
-        });
-    };
+    let index = Refusal::parameter_index(info, parameter)?;
+    if let Some(e) = values
+        .iter()
+        .find_map(|&v| info.check_parameter(parameter, v).err())
+    {
+        return Err(Refusal::Parameter(e).into());
+    }
     let start = std::time::Instant::now();
     let mut rows = Vec::with_capacity(values.len());
     for &value in values {
@@ -1627,7 +1627,7 @@ fn averaged_separatrix(
     let (tr, det) = (m[0][0] + m[1][1], m[0][0] * m[1][1] - m[0][1] * m[1][0]);
     let rate = tr / 2.0 + (tr * tr / 4.0 - det).max(0.0).sqrt();
     if !(rate > 1e-9) {
-        return Err(SplittingError::NoSaddle(name));
+        return Err(SplittingError::NoSaddle { model: name });
     }
     let row = [m[0][0] - rate, m[0][1]];
     let v = if row[0].hypot(row[1]) > 0.0 {
@@ -1715,12 +1715,9 @@ fn melnikov_along(
     // against Kapitza's closed form): below 10⁻⁸ of them the result would
     // be less accurate than 10⁻⁴, so it is not given.
     if re.hypot(im) < 1e-8 * magnitude {
-        return Err(SplittingError::Request {
+        return Err(SplittingError::MelnikovCancels {
             model: dynamic.info().name.into(),
-            reason: format!(
-                "the Melnikov integral cancels below the accuracy of its terms ({:.1e} of them)",
-                re.hypot(im) / magnitude
-            ),
+            relative: re.hypot(im) / magnitude,
         });
     }
     Ok(4.0 * eps * re.hypot(im))

@@ -106,15 +106,16 @@ pub(super) fn in_double_double(
     averaged: Option<[f64; 2]>,
 ) -> Result<Splitting, SplittingError> {
     let name = model.info.name.to_string();
-    let flow = ActionFlow::new(model, params, true).ok_or_else(|| SplittingError::Request {
-        model: name.clone(),
-        reason: "double-double needs the model's action recurrences, which models of one degree of freedom with a closed-form field have".into(),
+    let flow = ActionFlow::new(model, params, true).ok_or_else(|| {
+        SplittingError::NoActionRecurrences {
+            model: name.clone(),
+        }
     })?;
     let star = refined_fixed_point(map, saddle, flow.period)?;
     let periodic = model.dynamic.periodic()[0];
     let symmetries = symmetries(map, saddle, star, periodic, flow.period)?;
     if symmetries.is_empty() {
-        return Err(SplittingError::NoReversor(name));
+        return Err(SplittingError::NoReversor { model: name });
     }
     // Each branch of W^u as drawn, and the copy of y* its averaged
     // separatrix goes to: a symmetry pairs it with W^s of that copy (W^s of
@@ -147,7 +148,7 @@ pub(super) fn in_double_double(
             }
         }
     }
-    Err(first_error.unwrap_or(SplittingError::NoReversor(name)))
+    Err(first_error.unwrap_or(SplittingError::NoReversor { model: name }))
 }
 
 /// The shift in q of the copy of the averaged saddle (itself, or ± 2π for
