@@ -120,11 +120,12 @@ pub struct TaylorBody {
     pub parts: Vec<Part>,
 }
 
-/// A run of the order-n recurrences as a function of its own, called once
-/// per order: `fn name<Num>(n, params, slots, args…)`.
+/// A run of the recurrences as a function of its own, called once per
+/// order (or once, with n = 0, for a run of order 0): `fn name<Num>(n,
+/// params, args…)`, its arguments the slots and locals it reads.
 pub struct Part {
     pub name: String,
-    /// The arguments after `n, params, slots`, as declared (`k3: Num, …`).
+    /// The arguments after `n, params`, as declared (`w3: &mut Coefficients<Num>, k3: Num, …`).
     pub args: String,
     /// Its body after the `params` line.
     pub lines: Vec<String>,
@@ -138,6 +139,23 @@ pub struct Part {
 /// averaged recurrences took two minutes to optimise. A call per part and
 /// order costs nothing beside the part's own Cauchy sums.
 const PART_LINES: usize = 48;
+
+/// The longest order 0 left in one function when its order-n loop is in
+/// parts. A large model's order 0 evaluates every node once (13,000 lines
+/// for a 20-link chain's averaged field), and one function of it took LLVM
+/// as long as all the parts of the loop: past this it goes in parts too
+/// (the 20-link chain's build 287 s → 215 s with its slots passed one by
+/// one, [`NAMED_SLOTS`]). Below it order 0 stays whole: in parts, the
+/// double pendulum's chaos map ran 1.54–1.61 s instead of 1.21–1.37 s.
+const ZERO_PART_LINES: usize = 1000;
+
+/// The most slots a part takes as one array, naming those it reads in a
+/// destructuring pattern of them all. A large model has thousands, and
+/// those patterns were most of a 20-link chain's generated code (3.9 of
+/// 6.3 MB) and of rustc's front end on it (45 s of 210); past this the
+/// parts take their slots one by one. Below it the array stays: passed one
+/// by one, the double pendulum's slots cost its chaos map about 10 %.
+const NAMED_SLOTS: usize = 1000;
 
 /// Names the generated Taylor functions use for themselves (arguments,
 /// loop variables, the kernels' module): no node is named so. The time
@@ -817,6 +835,23 @@ impl Slots {
     fn bind(&self) -> String {
         format!("let {} = work.slots::<{}>();", self.pattern, self.count)
     }
+
+    /// Whether parts take the slots they read one by one (past
+    /// [`NAMED_SLOTS`]) rather than the array of all of them.
+    fn by_name(&self) -> bool {
+        self.count > NAMED_SLOTS
+    }
+}
+
+/// The identifiers (and numbers) a run of lines mentions.
+fn words(lines: &[String]) -> std::collections::HashSet<&str> {
+    lines
+        .iter()
+        .flat_map(|line| {
+            line.split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .filter(|word| !word.is_empty())
+        })
+        .collect()
 }
 
 impl Orders {
@@ -1212,7 +1247,7 @@ impl Writer<'_> {
             .chain(&tangent_orders)
             .any(|o| o.recurrence_lines() > PART_LINES);
         // Unsplit, the slots are bound to their names once; split, each
-        // run of orders binds them again (the parts borrow all of them).
+        // run of orders binds them again (its parts are passed them).
         if !split {
             lines.push(slots.bind());
         }
@@ -1258,7 +1293,10 @@ impl Writer<'_> {
             kind: kind.to_string(),
             pass,
         };
-        let mut locals = vec![local(self.time, "Num", self.time.to_string())];
+        let mut locals = vec![
+            local(self.time, "Num", self.time.to_string()),
+            local("order", "usize", "order".into()),
+        ];
         for &k in live {
             if self.constant(k) && !matches!(self.ops[k], Op::Literal(_) | Op::Parameter(_)) {
                 locals.push(local(&self.names[k], "Num", self.names[k].clone()));
@@ -1284,7 +1322,8 @@ impl Writer<'_> {
 
     /// Writes one run of orders: order 0, then the loop over orders n, its
     /// recurrences inline or, past [`PART_LINES`], in parts called in turn
-    /// (the last one also storing the state's next order).
+    /// (the last one also storing the state's next order). A very long
+    /// order 0 goes in parts too, called once.
     fn emit_orders(
         &self,
         orders: Orders,
@@ -1293,11 +1332,15 @@ impl Writer<'_> {
         lines: &mut Vec<String>,
         parts: &mut Vec<Part>,
     ) {
+        let long = orders.recurrence_lines() > PART_LINES;
         if split {
             lines.push(slots.bind());
         }
-        let long = orders.recurrence_lines() > PART_LINES;
-        lines.extend(orders.zero);
+        if long && slots.by_name() && orders.zero.len() > ZERO_PART_LINES {
+            self.emit_zero_in_parts(orders.zero, slots, lines, parts);
+        } else {
+            lines.extend(orders.zero);
+        }
         if !long {
             lines.push("for n in 1..order {".into());
             lines.extend(orders.recurrences.into_iter().flatten());
@@ -1315,20 +1358,81 @@ impl Writer<'_> {
             }
         }
         runs.last_mut().expect("one run").extend(orders.store);
-        lines.push(format!("let slots = work.slots::<{}>();", slots.count));
+        if !slots.by_name() {
+            lines.push(format!("let slots = work.slots::<{}>();", slots.count));
+        }
         lines.push("for n in 1..order {".into());
         for run in runs {
             let name = format!("{}_part_{}", self.function, parts.len() + 1);
-            let read: std::collections::HashSet<&str> = run
-                .iter()
-                .flat_map(|line| {
-                    line.split(|c: char| !(c.is_alphanumeric() || c == '_'))
-                        .filter(|word| !word.is_empty())
-                })
-                .collect();
-            // Only the slots this part reads get a name: a large model has
-            // thousands, and every part binding all of them grew the code
-            // like N⁴ (4 of a 20-link chain's 6.5 MB).
+            let (call, part) = Self::part(name, run, slots);
+            lines.push(call);
+            parts.push(part);
+        }
+        lines.push("}".into());
+    }
+
+    /// Order 0 in parts of at most [`PART_LINES`] lines, called in turn
+    /// with n = 0 (past [`ZERO_PART_LINES`]). The declarations
+    /// (`let` factorisations, which later parts and the loop read) stay in
+    /// the function.
+    fn emit_zero_in_parts(
+        &self,
+        zero: Vec<String>,
+        slots: &Slots,
+        lines: &mut Vec<String>,
+        parts: &mut Vec<Part>,
+    ) {
+        let mut run: Vec<String> = Vec::new();
+        let mut flush = |run: &mut Vec<String>, lines: &mut Vec<String>| {
+            if run.is_empty() {
+                return;
+            }
+            let name = format!("{}_zero_part_{}", self.function, parts.len() + 1);
+            let (call, part) = Self::part(name, std::mem::take(run), slots);
+            lines.push(call.replacen("(n, ", "(0, ", 1));
+            parts.push(part);
+        };
+        for line in zero {
+            if line.starts_with("let ") {
+                flush(&mut run, lines);
+                lines.push(line);
+            } else {
+                if run.len() >= PART_LINES {
+                    flush(&mut run, lines);
+                }
+                run.push(line);
+            }
+        }
+        flush(&mut run, lines);
+    }
+
+    /// A run of lines as a part `name`, and the line that calls it with
+    /// the slots and the locals the run reads. A part takes the array of
+    /// slots and names those it reads in a pattern; past [`NAMED_SLOTS`]
+    /// slots it takes them one by one, as the function bound them.
+    fn part(name: String, run: Vec<String>, slots: &Slots) -> (String, Part) {
+        let read = words(&run);
+        let named: Vec<&str> = slots
+            .names
+            .iter()
+            .map(String::as_str)
+            .filter(|name| read.contains(name))
+            .collect();
+        let used: Vec<&Local> = slots
+            .locals
+            .iter()
+            .filter(|l| read.contains(l.name.as_str()))
+            .collect();
+        let mut call = vec!["n".to_string(), "params".into()];
+        let (mut args, mut body) = (Vec::new(), Vec::new());
+        if slots.by_name() {
+            args.extend(
+                named
+                    .iter()
+                    .map(|name| format!("{name}: &mut crate::ode::series::Coefficients<Num>")),
+            );
+            call.extend(named.iter().map(|name| name.to_string()));
+        } else {
             let pattern: Vec<&str> = slots
                 .names
                 .iter()
@@ -1337,28 +1441,23 @@ impl Writer<'_> {
                     false => "_",
                 })
                 .collect();
-            let mut body = vec![format!("let [{}] = slots;", pattern.join(", "))];
-            body.extend(run.iter().cloned());
-            let used: Vec<&Local> = slots
-                .locals
-                .iter()
-                .filter(|l| read.contains(l.name.as_str()))
-                .collect();
-            let mut args = vec![format!(
+            args.push(format!(
                 "slots: &mut [crate::ode::series::Coefficients<Num>; {}]",
                 slots.count
-            )];
-            args.extend(used.iter().map(|l| format!("{}: {}", l.name, l.kind)));
-            let mut call = vec!["n".to_string(), "params".into(), "slots".into()];
-            call.extend(used.iter().map(|l| l.pass.clone()));
-            lines.push(format!("{name}({});", call.join(", ")));
-            parts.push(Part {
-                name,
-                args: args.join(", "),
-                lines: body,
-            });
+            ));
+            call.push("slots".into());
+            body.push(format!("let [{}] = slots;", pattern.join(", ")));
         }
-        lines.push("}".into());
+        args.extend(used.iter().map(|l| format!("{}: {}", l.name, l.kind)));
+        call.extend(used.iter().map(|l| l.pass.clone()));
+        body.extend(run);
+        let call = format!("{name}({});", call.join(", "));
+        let part = Part {
+            name,
+            args: args.join(", "),
+            lines: body,
+        };
+        (call, part)
     }
 
     /// Order 0, then orders 1..order of the nodes `nodes` (in evaluation
