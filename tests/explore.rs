@@ -348,3 +348,67 @@ fn a_four_link_chain_gets_its_equilibria_judged_as_stability_judges_them() {
     // Each link up or down is an equilibrium of the shaken chain too.
     assert!(found.len() >= 16, "{} equilibria", found.len());
 }
+
+/// Every Hamiltonian model's Taylor recurrences, exact and averaged, give
+/// the runs DOP853 gives: the recurrences are generated code of their own
+/// (in parts for long models, their slots passed one by one past a size),
+/// and a wrong coefficient would part the two runs at once. Models added
+/// to `models/` are checked too (CI adds a 12-link chain, whose
+/// recurrences take both large-model forms).
+#[test]
+fn every_model_s_taylor_runs_agree_with_dop853() {
+    let settings = |name: &str| Settings {
+        method: Method::parse(name, 1e-13).unwrap(),
+        t_end: 0.5,
+        samples: 6,
+        periods: 0,
+    };
+    for info in models::ALL {
+        let handle = mechlab::models::by_name(info.name).expect("every model is listed");
+        if let Kind::Contacts { .. } = handle.dynamic.kind() {
+            eprintln!(
+                "{}: skipped (a contact model has no Taylor recurrences)",
+                info.name
+            );
+            continue;
+        }
+        let y0 = mechlab::explore::default_start(handle.dynamic);
+        let params = handle.dynamic.defaults();
+        let runs = (
+            explore(handle, &params, &y0, &settings("taylor")),
+            explore(handle, &params, &y0, &settings("dop853")),
+        );
+        let (taylor, dop853) = match runs {
+            (Ok(t), Ok(d)) => (t, d),
+            (t, d) => {
+                eprintln!(
+                    "{}: skipped (a run from the default start failed: {:?} {:?})",
+                    info.name,
+                    t.err(),
+                    d.err()
+                );
+                continue;
+            }
+        };
+        let pairs = [
+            ("exact", Some(&taylor.exact), Some(&dop853.exact)),
+            (
+                "averaged",
+                taylor.averaged.as_ref(),
+                dop853.averaged.as_ref(),
+            ),
+        ];
+        for (kind, a, b) in pairs {
+            let (Some(a), Some(b)) = (a, b) else { continue };
+            for (t, (x, y)) in taylor.times.iter().zip(a.iter().zip(b)) {
+                for (i, (u, v)) in x.iter().zip(y).enumerate() {
+                    assert!(
+                        (u - v).abs() <= 1e-8 * (1.0 + v.abs()),
+                        "{} {kind}, t = {t}, component {i}: taylor {u}, dop853 {v}",
+                        info.name
+                    );
+                }
+            }
+        }
+    }
+}
