@@ -27,8 +27,8 @@
 //! ```
 
 pub use mechlab_runtime::{
-    analysis, budget, contact, explore, large_models, linalg, mathml, model, ode, plot, registry,
-    report, studio, study,
+    analysis, budget, contact, explore, large_models, linalg, mathml, ode, plot, registry, report,
+    studio, study,
 };
 pub use mechlab_scenes::{scene, scenes};
 

@@ -1,8 +1,8 @@
 //! Bad input never panics: random and mutated model files, and random
 //! command lines, end in a typed error or a success.
 
-use mechlab::model::Model;
 use mechlab::scene::{knob, Scene};
+use mechlab_model::Model;
 use proptest::prelude::*;
 
 const SHIPPED: [&str; 3] = [

@@ -1,7 +1,7 @@
 //! Malformed model files give errors naming the file, the key and the reason.
 //! The library compiles the same reader as `build.rs`.
 
-use mechlab::model::{Model, ModelError};
+use mechlab_model::{Model, ModelError};
 
 const GOOD: &str = r#"
 name = "toy"
@@ -54,7 +54,7 @@ fn the_shipped_models_are_accepted() {
     let model = Model::parse(file, text).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         (model.dof(), model.inverse),
-        (6, mechlab::model::Inverse::Numeric)
+        (6, mechlab_model::Inverse::Numeric)
     );
 }
 
@@ -347,7 +347,7 @@ fn oversized_and_deeply_nested_models_are_errors() {
 /// inside it, and values outside it refused with both named.
 #[test]
 fn parameter_ranges() {
-    use mechlab::model::Range;
+    use mechlab_model::Range;
     let with = |range: &str, default: &str| {
         GOOD.replace(
             "default = 1.0",

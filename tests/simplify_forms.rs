@@ -1,7 +1,7 @@
 //! The readable-forms stage of the derivation (`crates/simplify`), tested
 //! directly: it is plain Rust (no Symbolica, so a test may run it).
 
-use mechlab::model;
+use mechlab_model as model;
 use mechlab_simplify as simplify;
 
 use model::Expr;

@@ -14,7 +14,7 @@ struct Param {
     name: String,
     default: String,
     description: String,
-    /// The parameter's range as a Rust expression of `crate::model::Range`.
+    /// The parameter's range as a Rust expression of `crate::registry::Range`.
     range: String,
 }
 
@@ -30,7 +30,7 @@ fn range_literal(range: &crate::model::Range) -> String {
         }
     };
     format!(
-        "crate::model::Range {{ min: {}, max: {}, min_open: {}, max_open: {} }}",
+        "crate::registry::Range {{ min: {}, max: {}, min_open: {}, max_open: {} }}",
         end(range.min),
         end(range.max),
         range.min_open,
@@ -187,6 +187,18 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
             .and_then(|f| f.amplitude.clone())
             .unwrap_or_default(),
     );
+    // The parameter the phase's rate depends on, if exactly one: the one
+    // the averaging analysis sweeps unless told otherwise.
+    let rate_symbols = model
+        .fast_phase
+        .as_ref()
+        .map(|f| f.rate.symbols())
+        .unwrap_or_default();
+    let rate_parameter = match rate_symbols.len() {
+        1 => rate_symbols.into_iter().next().unwrap_or_default(),
+        _ => String::new(),
+    };
+    context.insert("rate_parameter", &rate_parameter);
     context
 }
 

@@ -10,8 +10,6 @@
 //! [`registry::Catalog`]:
 //! editing a model file never recompiles this crate.
 
-pub use mechlab_model as model;
-
 pub mod analysis;
 pub mod budget;
 pub mod contact;

@@ -4,6 +4,7 @@
 use std::fmt;
 
 use crate::ode::{DynSystem, ErasedSystem};
+pub use mechlab_range::Range;
 
 /// One derived expression in its readable form (checked at build time
 /// against Symbolica's result), as text and LaTeX.
@@ -30,10 +31,13 @@ pub struct ModelInfo {
     pub parameter_defaults: &'static [&'static str],
     pub parameter_descriptions: &'static [&'static str],
     /// The values each parameter may take.
-    pub parameter_ranges: &'static [crate::model::Range],
+    pub parameter_ranges: &'static [Range],
     /// The parameter that scales the vibration, if the model file names one
     /// (`[fast_phase] amplitude`).
     pub amplitude: Option<&'static str>,
+    /// The parameter the fast phase's rate depends on, if exactly one (ν
+    /// for the rate `nu`, ε for `1/eps`).
+    pub rate_parameter: Option<&'static str>,
     pub derivations: &'static [DerivedExpression],
     /// Cost of the right-hand sides after CSE (arithmetic operations,
     /// transcendental calls weighted 20, divisions 4): (function, as derived
@@ -204,7 +208,7 @@ pub enum ParameterError {
         model: &'static str,
         name: String,
         value: f64,
-        range: crate::model::Range,
+        range: Range,
     },
 }
 

@@ -469,9 +469,8 @@ fn too_large_models_are_refused_with_a_reason() {
         }
         text
     };
-    let too_many = mechlab::model::MAX_DOF + 1;
-    let error =
-        mechlab::model::Model::parse("models/chain.toml", &chain(too_many, "")).unwrap_err();
+    let too_many = mechlab_model::MAX_DOF + 1;
+    let error = mechlab_model::Model::parse("models/chain.toml", &chain(too_many, "")).unwrap_err();
     assert_eq!(error.file, "models/chain.toml");
     assert_eq!(error.key, "coordinates");
     assert!(
@@ -480,27 +479,26 @@ fn too_large_models_are_refused_with_a_reason() {
             .contains(&format!("{too_many} degrees of freedom"))
             && error
                 .reason
-                .contains(&format!("at most {}", mechlab::model::MAX_DOF)),
+                .contains(&format!("at most {}", mechlab_model::MAX_DOF)),
         "{error}"
     );
     let error =
-        mechlab::model::Model::parse("models/chain.toml", &chain(4, "inverse = \"symbolic\"\n"))
+        mechlab_model::Model::parse("models/chain.toml", &chain(4, "inverse = \"symbolic\"\n"))
             .unwrap_err();
     assert_eq!(error.key, "inverse");
-    let error =
-        mechlab::model::Model::parse("models/chain.toml", &chain(2, "inverse = \"fast\"\n"))
-            .unwrap_err();
+    let error = mechlab_model::Model::parse("models/chain.toml", &chain(2, "inverse = \"fast\"\n"))
+        .unwrap_err();
     assert!(error.reason.contains("'fast'"), "{error}");
-    let ok = mechlab::model::Model::parse("models/chain.toml", &chain(8, "")).unwrap();
-    assert_eq!(ok.inverse, mechlab::model::Inverse::Numeric);
-    let ok = mechlab::model::Model::parse("models/chain.toml", &chain(2, "")).unwrap();
-    assert_eq!(ok.inverse, mechlab::model::Inverse::Symbolic);
+    let ok = mechlab_model::Model::parse("models/chain.toml", &chain(8, "")).unwrap();
+    assert_eq!(ok.inverse, mechlab_model::Inverse::Numeric);
+    let ok = mechlab_model::Model::parse("models/chain.toml", &chain(2, "")).unwrap();
+    assert_eq!(ok.inverse, mechlab_model::Inverse::Symbolic);
 }
 
 /// The parameters a model file's `[forces]` and Rayleigh function name
 /// (friction, a drive given as a force), whatever they are called.
 fn non_conservative(info: &mechlab::registry::ModelInfo) -> Vec<usize> {
-    let file = mechlab::model::Model::parse(info.source_file, info.source)
+    let file = mechlab_model::Model::parse(info.source_file, info.source)
         .unwrap_or_else(|e| panic!("{} does not parse: {e}", info.name));
     let mut names = file.rayleigh.symbols();
     for force in &file.forces {

@@ -286,15 +286,6 @@ pub struct Sweep<'a> {
     settings: &'a ConvergenceSettings,
 }
 
-/// The parameter the model file's phase rate depends on, if exactly one.
-fn rate_parameter(info: &crate::registry::ModelInfo) -> Option<String> {
-    let model = crate::model::Model::parse(info.source_file, info.source).ok()?;
-    let symbols = model.fast_phase?.rate.symbols();
-    (symbols.len() == 1)
-        .then(|| symbols.into_iter().next())
-        .flatten()
-}
-
 impl crate::registry::WithFixed for Sweep<'_> {
     type Output = Result<AveragingConvergence, AveragingError>;
     fn run<
@@ -422,7 +413,7 @@ fn swept<
     let info = model.info();
     let parameter = match &settings.parameter {
         Some(p) => p.clone(),
-        None => rate_parameter(info).ok_or_else(|| {
+        None => info.rate_parameter.map(str::to_string).ok_or_else(|| {
             Refusal::setting(
                 info.name,
                 "the phase rate depends on more than one parameter: name the one to sweep",
