@@ -1364,7 +1364,7 @@ impl Writer<'_> {
         lines.push("for n in 1..order {".into());
         for run in runs {
             let name = format!("{}_part_{}", self.function, parts.len() + 1);
-            let (call, part) = Self::part(name, run, slots);
+            let (call, part) = Self::part(name, run, slots, "n");
             lines.push(call);
             parts.push(part);
         }
@@ -1388,8 +1388,8 @@ impl Writer<'_> {
                 return;
             }
             let name = format!("{}_zero_part_{}", self.function, parts.len() + 1);
-            let (call, part) = Self::part(name, std::mem::take(run), slots);
-            lines.push(call.replacen("(n, ", "(0, ", 1));
+            let (call, part) = Self::part(name, std::mem::take(run), slots, "0");
+            lines.push(call);
             parts.push(part);
         };
         for line in zero {
@@ -1406,11 +1406,11 @@ impl Writer<'_> {
         flush(&mut run, lines);
     }
 
-    /// A run of lines as a part `name`, and the line that calls it with
-    /// the slots and the locals the run reads. A part takes the array of
+    /// A run of lines as a part `name`, and the line that calls it at
+    /// order `n` with the slots and the locals the run reads. A part takes the array of
     /// slots and names those it reads in a pattern; past [`NAMED_SLOTS`]
     /// slots it takes them one by one, as the function bound them.
-    fn part(name: String, run: Vec<String>, slots: &Slots) -> (String, Part) {
+    fn part(name: String, run: Vec<String>, slots: &Slots, n: &str) -> (String, Part) {
         let read = words(&run);
         let named: Vec<&str> = slots
             .names
@@ -1423,7 +1423,7 @@ impl Writer<'_> {
             .iter()
             .filter(|l| read.contains(l.name.as_str()))
             .collect();
-        let mut call = vec!["n".to_string(), "params".into()];
+        let mut call = vec![n.to_string(), "params".into()];
         let (mut args, mut body) = (Vec::new(), Vec::new());
         if slots.by_name() {
             args.extend(
