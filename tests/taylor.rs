@@ -398,7 +398,7 @@ fn every_model_s_tangent_recurrences_differentiate_its_solution_s() {
             Some(FixedSize::Dof1(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
             Some(FixedSize::Dof2(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
             Some(FixedSize::Dof3(m)) => assert_tangent_recurrences_differentiate(&m.exact(&params), name),
-            Some(FixedSize::Large(_)) => eprintln!(
+            Some(FixedSize::Large(..)) => eprintln!(
                 "{name}: skipped (4 to 24 degrees of freedom: this test's instances are compiled for 1 to 3)"
             ),
             None => eprintln!("{name}: skipped (a contact model has no tangent recurrences)"),

@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::ode::{DynSystem, ErasedSystem};
+use crate::ode::{AnySystem, DynSystem, ErasedSystem, SizedSystem};
 pub use mechlab_range::Range;
 
 /// One derived expression in its readable form (checked at build time
@@ -384,6 +384,45 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
     }
 }
 
+/// A Hamiltonian model's systems and functions with states as slices: what
+/// the analyses compiled once for every size use (see
+/// [`crate::ode::any_size`]). Parameters are values in declaration order.
+pub trait Systems: Sync {
+    fn info(&self) -> &'static ModelInfo;
+    fn has_fast_phase(&self) -> bool;
+    /// Which components of the state are angles; its length is the state's.
+    fn periodic_state(&self) -> Vec<bool>;
+    /// The period of the fast phase.
+    fn phase_period(&self, params: &[f64]) -> Option<f64>;
+    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
+    /// None without a fast phase.
+    fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>>;
+}
+
+impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
+    for Erased<D, S, T, V>
+{
+    fn info(&self) -> &'static ModelInfo {
+        self.0.info()
+    }
+    fn has_fast_phase(&self) -> bool {
+        Fixed::has_fast_phase(self)
+    }
+    fn periodic_state(&self) -> Vec<bool> {
+        Fixed::periodic_state(self).to_vec()
+    }
+    fn phase_period(&self, params: &[f64]) -> Option<f64> {
+        self.0.phase_period(params)
+    }
+    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
+        Box::new(SizedSystem(Fixed::exact(self, params)))
+    }
+    fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>> {
+        let averaged = Fixed::averaged(self, params)?;
+        Some(Box::new(SizedSystem(averaged)))
+    }
+}
+
 /// A Hamiltonian model at its own size, for [`with_fixed`]. The analyses
 /// are compiled ahead, in this crate, for 1 to 3 degrees of freedom; a
 /// model of 4 to 24 brings its own (see [`crate::large_models`]).
@@ -392,8 +431,9 @@ pub enum FixedSize {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
-    /// 4 to 24 degrees of freedom: a [`crate::large_models::LargeHandle`].
-    Large(LargeHandleRef),
+    /// 4 to 24 degrees of freedom: a [`crate::large_models::LargeHandle`],
+    /// and the model's [`Systems`] (compiled in the models package).
+    Large(LargeHandleRef, &'static dyn Systems),
 }
 
 /// A work that also runs on a model of 4 to 24 degrees of freedom, whose
@@ -417,6 +457,18 @@ pub struct Model {
     pub dynamic: &'static dyn DynamicModel,
     /// None for a contact model.
     pub sized: Option<FixedSize>,
+}
+
+impl Model {
+    /// The model's [`Systems`] (None for a contact model).
+    pub fn systems(&self) -> Option<&'static dyn Systems> {
+        Some(match self.sized? {
+            FixedSize::Dof1(m) => m,
+            FixedSize::Dof2(m) => m,
+            FixedSize::Dof3(m) => m,
+            FixedSize::Large(_, m) => m,
+        })
+    }
 }
 
 impl fmt::Debug for Model {
@@ -478,7 +530,7 @@ pub fn with_fixed<W: LargeWork>(model: &Model, work: W) -> Option<W::Output> {
         FixedSize::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
         FixedSize::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
         FixedSize::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
-        FixedSize::Large(m) => work.on_large(m),
+        FixedSize::Large(m, _) => work.on_large(m),
     })
 }
 

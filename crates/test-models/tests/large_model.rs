@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 #[test]
 fn a_four_degree_chain_oscillates_in_its_closed_form_normal_modes() {
     let handle = &spring_chain4::MODEL;
-    assert!(matches!(handle.sized, Some(FixedSize::Large(_))));
+    assert!(matches!(handle.sized, Some(FixedSize::Large(..))));
     let k = 2.0;
     let settings = Settings {
         method: Method::parse("dop853", 1e-11).unwrap(),

@@ -1,7 +1,7 @@
 //! The period map of a T-periodic system and its orbits.
 
 use crate::analysis::Refusal;
-use crate::ode::{Integrator, Method, OdeError, Stats, System};
+use crate::ode::{AnySystem, Integrator, Method, OdeError, Stats, System};
 use crate::registry::Model;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -62,7 +62,14 @@ pub fn orbit<S: System<N>, const N: usize>(
 /// the state restarts the Taylor step: see [`orbit`]).
 pub fn wrapped_point<const N: usize>(y: &mut [f64; N], wrap: &[bool]) -> [f64; N] {
     let mut point = *y;
-    for ((x, p), w) in y.iter_mut().zip(&mut point).zip(wrap) {
+    wrap_point(y, wrap, &mut point);
+    point
+}
+
+/// [`wrapped_point`] of a state of any length, written into `point`.
+pub fn wrap_point(y: &mut [f64], wrap: &[bool], point: &mut [f64]) {
+    point.copy_from_slice(y);
+    for ((x, p), w) in y.iter_mut().zip(point).zip(wrap) {
         if *w {
             *p = wrap_angle(*p);
             if x.abs() > 3.0 * std::f64::consts::PI {
@@ -70,7 +77,27 @@ pub fn wrapped_point<const N: usize>(y: &mut [f64; N], wrap: &[bool]) -> [f64; N
             }
         }
     }
-    point
+}
+
+/// [`orbit`] of a system of any size, each point (y0 first) handed to
+/// `point` instead of kept; `point` says whether to go on.
+pub fn stream_orbit(
+    integrator: &mut Integrator,
+    system: &dyn AnySystem,
+    period: f64,
+    y0: &[f64],
+    periods: usize,
+    wrap: &[bool],
+    point: &mut dyn FnMut(&[f64]) -> bool,
+) -> Result<(), OdeError> {
+    if !point(y0) {
+        return Ok(());
+    }
+    let mut wrapped = y0.to_vec();
+    system.stream(integrator, y0, period, periods, &mut |y| {
+        wrap_point(y, wrap, &mut wrapped);
+        point(&wrapped)
+    })
 }
 
 /// Orbits of many initial conditions in parallel, in input order, each with its statistics.
@@ -183,102 +210,97 @@ pub fn portrait(
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    crate::registry::with_fixed(model, Portraits { params, settings })
-        .ok_or_else(|| PeriodMapError::Refused(Refusal::contact_model(model.info.name)))?
-}
-
-/// The work of [`portrait`] at one size.
-pub struct Portraits<'a> {
-    params: &'a [f64],
-    settings: &'a PortraitSettings,
-}
-
-impl crate::registry::WithFixed for Portraits<'_> {
-    type Output = Result<Portrait, PeriodMapError>;
-    fn run<
-        F: crate::registry::Fixed<D, S, T, V>,
-        const D: usize,
-        const S: usize,
-        const T: usize,
-        const V: usize,
-    >(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let info = model.info();
-        let settings = self.settings;
-        let params = Refusal::named_values(info, self.params)?;
-        let period = match model.phase_period(self.params) {
-            Some(t) if model.has_fast_phase() => t,
-            _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
-        };
-        let axes = info
-            .plane(settings.axes)
-            .map_err(|source| PeriodMapError::Plane {
-                model: info.name.into(),
-                source,
-            })?;
-        let wrap = model.periodic_state();
-        let seeds: Vec<[f64; S]> = match &settings.seeds {
-            Some(seeds) => seeds
-                .iter()
-                .map(|s| {
-                    s.as_slice()
-                        .try_into()
-                        .map_err(|_| Refusal::state_length(info.name, "seed", s.len(), S))
-                })
-                .collect::<Result<_, _>>()?,
-            None => {
-                let axis = settings.axes[0];
-                let (lo, hi) = if wrap[axis] {
-                    (-PI, PI)
-                } else {
-                    (-settings.p_max, settings.p_max)
-                };
-                (0..settings.count)
-                    .map(|k| {
-                        let mut y = [0.0; S];
-                        y[axis] = lo + (hi - lo) * (k as f64 + 0.5) / settings.count.max(1) as f64;
-                        y
-                    })
-                    .collect()
-            }
-        };
-        let start = std::time::Instant::now();
-        let runs = orbits(
-            settings.method,
-            &model.exact(self.params),
-            period,
-            &seeds,
-            settings.periods,
-            &wrap,
-        )?;
-        let (mut projected, mut failed) = (Vec::new(), Vec::new());
-        for (k, run) in runs.into_iter().enumerate() {
-            match run {
-                Ok((points, _)) => projected.push(
-                    points
-                        .iter()
-                        .map(|y| (y[settings.axes[0]], y[settings.axes[1]]))
-                        .collect(),
-                ),
-                Err(e) => {
-                    failed.push(Stopped { orbit: k, error: e });
-                    projected.push(Vec::new());
-                }
+    let systems = model
+        .systems()
+        .ok_or_else(|| Refusal::contact_model(model.info.name))?;
+    let info = systems.info();
+    let named = Refusal::named_values(info, params)?;
+    let period = match systems.phase_period(params) {
+        Some(t) if systems.has_fast_phase() => t,
+        _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
+    };
+    let axes = info
+        .plane(settings.axes)
+        .map_err(|source| PeriodMapError::Plane {
+            model: info.name.into(),
+            source,
+        })?;
+    let wrap = systems.periodic_state();
+    let seeds = portrait_seeds(info.name, settings, &wrap)?;
+    orbit_budget(seeds.len(), settings.periods, wrap.len())?;
+    let start = std::time::Instant::now();
+    let system = systems.exact(params);
+    let runs: Vec<Result<Vec<(f64, f64)>, OdeError>> = seeds
+        .par_iter()
+        .map(|y0| {
+            let mut integrator = Integrator::new(settings.method)?;
+            let mut points = Vec::with_capacity(settings.periods + 1);
+            let [a, b] = settings.axes;
+            let mut keep = |y: &[f64]| {
+                points.push((y[a], y[b]));
+                true
+            };
+            stream_orbit(
+                &mut integrator,
+                &*system,
+                period,
+                y0,
+                settings.periods,
+                &wrap,
+                &mut keep,
+            )?;
+            Ok(points)
+        })
+        .collect();
+    let (mut projected, mut failed) = (Vec::new(), Vec::new());
+    for (k, run) in runs.into_iter().enumerate() {
+        match run {
+            Ok(points) => projected.push(points),
+            Err(e) => {
+                failed.push(Stopped { orbit: k, error: e });
+                projected.push(Vec::new());
             }
         }
-        Ok(Portrait {
-            model: info.name.into(),
-            params,
-            axes,
-            seeds: seeds.iter().map(|s| s.to_vec()).collect(),
-            periods: settings.periods,
-            failed,
-            seconds: start.elapsed().as_secs_f64(),
-            orbits: projected,
-        })
     }
+    Ok(Portrait {
+        model: info.name.into(),
+        params: named,
+        axes,
+        seeds,
+        periods: settings.periods,
+        failed,
+        seconds: start.elapsed().as_secs_f64(),
+        orbits: projected,
+    })
+}
+
+/// The seeds a portrait asks for (each of the state's length), or `count`
+/// of them on a line along the first axis.
+fn portrait_seeds(
+    model: &'static str,
+    settings: &PortraitSettings,
+    wrap: &[bool],
+) -> Result<Vec<Vec<f64>>, Refusal> {
+    let n = wrap.len();
+    if let Some(seeds) = &settings.seeds {
+        return match seeds.iter().find(|s| s.len() != n) {
+            Some(s) => Err(Refusal::state_length(model, "seed", s.len(), n)),
+            None => Ok(seeds.clone()),
+        };
+    }
+    let axis = settings.axes[0];
+    let (lo, hi) = if wrap[axis] {
+        (-PI, PI)
+    } else {
+        (-settings.p_max, settings.p_max)
+    };
+    Ok((0..settings.count)
+        .map(|k| {
+            let mut y = vec![0.0; n];
+            y[axis] = lo + (hi - lo) * (k as f64 + 0.5) / settings.count.max(1) as f64;
+            y
+        })
+        .collect())
 }
 
 impl Portrait {

@@ -6,6 +6,7 @@
 //! accepted step size) and the run's [`Stats`], reported like Hairer's codes.
 //! States are `[f64; N]`: no allocation per step.
 
+pub mod any_size;
 mod dop853;
 mod double_double;
 mod driver;
@@ -23,6 +24,7 @@ mod solve;
 pub mod taylor;
 mod taylor_lanes;
 
+pub use any_size::{AnyEvent, AnyHit, AnyOptions, AnySolution, AnySystem, SizedSystem};
 pub use double_double::DoubleDouble;
 pub use dual::Dual;
 pub use erased::{DynSystem, ErasedSystem};
@@ -335,6 +337,9 @@ pub enum OdeError {
     NoConvergence { t: f64, h: f64, y: Vec<f64> },
     #[error("method 'taylor' needs Taylor recurrences, which only the generated models' systems (exact, averaged, and their variational equations) have")]
     TaylorUnavailable,
+    /// A state of another length than the system's.
+    #[error("a state of {given} numbers given to a system of {expected}")]
+    StateLength { given: usize, expected: usize },
     /// Only the Taylor method integrates batches of orbits.
     #[error("method '{0}' has no batch mode (only 'taylor' integrates {lanes} orbits at once)", lanes = LANES)]
     NoBatchMode(&'static str),

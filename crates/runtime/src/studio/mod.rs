@@ -10,11 +10,11 @@
 pub mod contour;
 
 use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
-use crate::analysis::period_map::{wrap_angle, wrapped_point, PeriodMapError};
+use crate::analysis::period_map::{stream_orbit, wrap_angle, PeriodMapError};
 use crate::analysis::Refusal;
 use crate::ode::{Integrator, Method, OdeError};
 use crate::registry::{
-    Catalog, DynamicModel, Fixed, Kind, Model, ModelInfo, ParameterError, WithFixed,
+    Catalog, DynamicModel, Kind, Model, ModelInfo, ParameterError,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -406,75 +406,61 @@ pub fn orbit(
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
 ) -> Result<OrbitEnd, StudioError> {
     let setup = request.check(catalog)?;
-    let work = OrbitWork {
-        setup: &setup,
-        seed: &request.seed,
-        periods: request.periods,
-        sink,
+    let systems = setup
+        .handle
+        .systems()
+        .ok_or_else(|| StudioError::Refused(Refusal::contact_model(setup.info.name)))?;
+    let started = Instant::now();
+    let period = systems
+        .phase_period(&setup.params)
+        .ok_or_else(|| StudioError::Refused(Refusal::no_fast_phase(setup.info.name)))?;
+    let system = systems.exact(&setup.params);
+    let periodic = systems.periodic_state();
+    let project = |y: &[f64]| {
+        setup
+            .axes
+            .map(|a| if periodic[a] { wrap_angle(y[a]) } else { y[a] })
     };
-    crate::registry::with_fixed(setup.handle, work)
-        .ok_or_else(|| StudioError::Refused(Refusal::contact_model(setup.info.name)))?
-}
-
-/// The work of [`orbit`] at one size.
-pub struct OrbitWork<'a> {
-    setup: &'a Resolved,
-    seed: &'a [f64],
-    periods: usize,
-    sink: &'a mut dyn FnMut(OrbitChunk) -> bool,
-}
-
-impl WithFixed for OrbitWork<'_> {
-    type Output = Result<OrbitEnd, StudioError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let setup = self.setup;
-        let started = Instant::now();
-        let period = model
-            .phase_period(&setup.params)
-            .ok_or_else(|| StudioError::Refused(Refusal::no_fast_phase(setup.info.name)))?;
-        let system = model.exact(&setup.params);
-        let periodic = model.periodic_state();
-        let y: [f64; S] = std::array::from_fn(|k| self.seed[k]);
-        let project = |y: &[f64; S]| {
-            setup
-                .axes
-                .map(|a| if periodic[a] { wrap_angle(y[a]) } else { y[a] })
-        };
-        let mut integrator = Integrator::new(setup.method)?;
-        let mut chunk = vec![project(&y)];
-        let mut last_sent = Instant::now();
-        let end = |periods, cancelled, integrator: &Integrator| OrbitEnd {
-            periods,
-            cancelled,
-            f_evals: integrator.stats.f_evals,
-            seconds: started.elapsed().as_secs_f64(),
-        };
-        let (mut done, mut cancelled) = (0, false);
-        let sink = self.sink;
-        let run = integrator.stream(&system, &y, period, self.periods, &mut |y| {
-            chunk.push(project(&wrapped_point(y, &periodic)));
-            done += 1;
-            if chunk.len() >= CHUNK_POINTS || last_sent.elapsed() >= CHUNK_INTERVAL {
+    let mut integrator = Integrator::new(setup.method)?;
+    let mut chunk = Vec::new();
+    let mut last_sent = Instant::now();
+    // The seed, then one per period.
+    let (mut points, mut cancelled) = (0usize, false);
+    let run = stream_orbit(
+        &mut integrator,
+        &*system,
+        period,
+        &request.seed,
+        request.periods,
+        &periodic,
+        &mut |y| {
+            chunk.push(project(y));
+            points += 1;
+            if points > 1 && (chunk.len() >= CHUNK_POINTS || last_sent.elapsed() >= CHUNK_INTERVAL)
+            {
                 let points = std::mem::take(&mut chunk);
                 cancelled = !sink(OrbitChunk { points });
                 last_sent = Instant::now();
             }
             !cancelled
-        });
-        if let Err(error) = run {
-            // The points before the failure are the page's to keep.
-            sink(OrbitChunk { points: chunk });
-            return Err(error.into());
-        }
-        if cancelled {
-            return Ok(end(done, true, &integrator));
-        }
-        let listening = chunk.is_empty() || sink(OrbitChunk { points: chunk });
-        Ok(end(self.periods, !listening, &integrator))
+        },
+    );
+    let end = |periods, cancelled, integrator: &Integrator| OrbitEnd {
+        periods,
+        cancelled,
+        f_evals: integrator.stats.f_evals,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    if let Err(error) = run {
+        // The points before the failure are the page's to keep.
+        sink(OrbitChunk { points: chunk });
+        return Err(error.into());
     }
+    if cancelled {
+        return Ok(end(points - 1, true, &integrator));
+    }
+    let listening = chunk.is_empty() || sink(OrbitChunk { points: chunk });
+    Ok(end(request.periods, !listening, &integrator))
 }
 
 /// The chaos map of the current view, coarse first.

@@ -1,0 +1,191 @@
+//! Systems whose state's length is known at run time.
+//!
+//! The integrators work on `[f64; N]`, so that a step allocates nothing and
+//! the compiler unrolls the stage sums. An analysis need not: it holds an
+//! [`AnySystem`] (a system at its own N behind a trait object) and states
+//! as slices, so it is compiled once for every model, whatever the length
+//! of the model's state, while each run's loops (the steps, the Taylor
+//! recurrences) still run at the system's own size. The cost is one
+//! indirect call and a copy of the state per request (a period, a run),
+//! not per step.
+
+use super::{Direction, Event, EventSettings, Integrator, OdeError, Options, System};
+
+/// A system behind a trait object whose state is a slice of [`AnySystem::dim`]
+/// numbers. Every method refuses a state of another length with
+/// [`OdeError::StateLength`].
+pub trait AnySystem: Sync {
+    /// The length of the state.
+    fn dim(&self) -> usize;
+    /// y' at (t, y).
+    fn rhs(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError>;
+    /// [`Integrator::solve`]: from (t0, y0) towards t1 with the options.
+    fn solve(
+        &self,
+        integrator: &mut Integrator,
+        t0: f64,
+        y0: &[f64],
+        t1: f64,
+        options: AnyOptions<'_, '_>,
+    ) -> Result<AnySolution, OdeError>;
+    /// [`Integrator::stream`]: `segments` segments of time `segment` from
+    /// (0, y0), `after` called with each end's state (which it may change)
+    /// and saying whether to go on.
+    fn stream(
+        &self,
+        integrator: &mut Integrator,
+        y0: &[f64],
+        segment: f64,
+        segments: usize,
+        after: &mut dyn FnMut(&mut [f64]) -> bool,
+    ) -> Result<(), OdeError>;
+}
+
+/// A zero crossing to watch for, its condition on a state slice (as
+/// [`Event`]).
+pub struct AnyEvent<'a> {
+    pub condition: &'a dyn Fn(f64, &[f64]) -> f64,
+    pub direction: Direction,
+    pub terminal: bool,
+}
+
+/// [`Options`] with states as slices.
+#[derive(Default)]
+pub struct AnyOptions<'o, 'e> {
+    times: &'o [f64],
+    events: &'o [AnyEvent<'e>],
+    event_settings: EventSettings,
+    observer: Option<&'o mut dyn FnMut(f64, &[f64])>,
+}
+
+impl<'o, 'e> AnyOptions<'o, 'e> {
+    /// [`Options::times`].
+    pub fn times(mut self, times: &'o [f64]) -> Self {
+        self.times = times;
+        self
+    }
+
+    /// [`Options::events`].
+    pub fn events(mut self, events: &'o [AnyEvent<'e>], settings: EventSettings) -> Self {
+        self.events = events;
+        self.event_settings = settings;
+        self
+    }
+
+    /// [`Options::observe`].
+    pub fn observe(mut self, observer: &'o mut dyn FnMut(f64, &[f64])) -> Self {
+        self.observer = Some(observer);
+        self
+    }
+}
+
+/// [`super::Solution`] with states as vectors.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnySolution {
+    pub t: f64,
+    pub y: Vec<f64>,
+    pub samples: Vec<Vec<f64>>,
+    /// Each crossing: the event's index, its time, its state, whether rising.
+    pub hits: Vec<AnyHit>,
+    pub terminated: bool,
+}
+
+/// [`super::EventHit`] with its state as a vector.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnyHit {
+    pub event: usize,
+    pub t: f64,
+    pub y: Vec<f64>,
+    pub rising: bool,
+}
+
+/// A [`System`] at its own size N as an [`AnySystem`].
+pub struct SizedSystem<S, const N: usize>(pub S);
+
+/// The state `y` at length N, or the error naming both lengths.
+pub fn fixed_state<const N: usize>(y: &[f64]) -> Result<[f64; N], OdeError> {
+    y.try_into().map_err(|_| OdeError::StateLength {
+        given: y.len(),
+        expected: N,
+    })
+}
+
+impl<S: System<N> + Sync, const N: usize> AnySystem for SizedSystem<S, N> {
+    fn dim(&self) -> usize {
+        N
+    }
+
+    fn rhs(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
+        Ok(self.0.rhs(t, &fixed_state::<N>(y)?).to_vec())
+    }
+
+    fn solve(
+        &self,
+        integrator: &mut Integrator,
+        t0: f64,
+        y0: &[f64],
+        t1: f64,
+        options: AnyOptions<'_, '_>,
+    ) -> Result<AnySolution, OdeError> {
+        let y0 = fixed_state::<N>(y0)?;
+        let AnyOptions {
+            times,
+            events,
+            event_settings,
+            observer,
+        } = options;
+        let conditions: Vec<_> = events
+            .iter()
+            .map(|e| move |t: f64, y: &[f64; N]| (e.condition)(t, y))
+            .collect();
+        let fixed_events: Vec<Event<'_, N>> = events
+            .iter()
+            .zip(&conditions)
+            .map(|(e, condition)| Event {
+                condition,
+                direction: e.direction,
+                terminal: e.terminal,
+            })
+            .collect();
+        let mut fixed_observer;
+        let mut fixed = Options::default().times(times);
+        if !events.is_empty() {
+            fixed = fixed.events(&fixed_events, event_settings);
+        }
+        if let Some(observe) = observer {
+            fixed_observer = move |t: f64, y: &[f64; N]| observe(t, y);
+            fixed = fixed.observe(&mut fixed_observer);
+        }
+        let solution = integrator.solve(&self.0, t0, &y0, t1, fixed)?;
+        Ok(AnySolution {
+            t: solution.t,
+            y: solution.y.to_vec(),
+            samples: solution.samples.iter().map(|y| y.to_vec()).collect(),
+            hits: solution
+                .hits
+                .into_iter()
+                .map(|h| AnyHit {
+                    event: h.event,
+                    t: h.t,
+                    y: h.y.to_vec(),
+                    rising: h.rising,
+                })
+                .collect(),
+            terminated: solution.terminated,
+        })
+    }
+
+    fn stream(
+        &self,
+        integrator: &mut Integrator,
+        y0: &[f64],
+        segment: f64,
+        segments: usize,
+        after: &mut dyn FnMut(&mut [f64]) -> bool,
+    ) -> Result<(), OdeError> {
+        let y0 = fixed_state::<N>(y0)?;
+        integrator.stream(&self.0, &y0, segment, segments, &mut |y: &mut [f64; N]| {
+            after(y)
+        })
+    }
+}
