@@ -23,3 +23,4 @@ pub mod registry;
 pub mod report;
 pub mod studio;
 pub mod study;
+pub mod tangent;

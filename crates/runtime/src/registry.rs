@@ -3,7 +3,9 @@
 
 use std::fmt;
 
-use crate::ode::{AnySystem, DynSystem, ErasedSystem, SizedSystem};
+use crate::ode::any_size::fixed_state;
+use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem};
+use crate::tangent::lyapunov::fli_of_starts;
 pub use mechlab_range::Range;
 
 /// One derived expression in its readable form (checked at build time
@@ -397,7 +399,23 @@ pub trait Systems: Sync {
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
     /// None without a fast phase.
     fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>>;
+    /// The fast Lyapunov indicator of the exact system's period map from
+    /// each start (`starts` holds them one after the other) with the
+    /// tangent vector `w0`, and the f-evaluations spent (see
+    /// [`crate::tangent::lyapunov::fli_of_starts`]).
+    fn fli(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        w0: &[f64],
+        periods: usize,
+    ) -> Result<FliValues, OdeError>;
 }
+
+/// Each orbit's FLI (or why it stopped) and the f-evaluations spent.
+pub type FliValues = (Vec<Result<f64, OdeError>>, u64);
 
 impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
     for Erased<D, S, T, V>
@@ -420,6 +438,23 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
     fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>> {
         let averaged = Fixed::averaged(self, params)?;
         Some(Box::new(SizedSystem(averaged)))
+    }
+    fn fli(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        w0: &[f64],
+        periods: usize,
+    ) -> Result<FliValues, OdeError> {
+        let starts: Vec<[f64; S]> = starts
+            .chunks(S)
+            .map(fixed_state::<S>)
+            .collect::<Result<_, _>>()?;
+        let w0 = fixed_state::<S>(w0)?;
+        let system = Fixed::exact(self, params);
+        fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
     }
 }
 

@@ -3,12 +3,12 @@
 //! state) shaded by the fast Lyapunov indicator of its orbit. For one degree
 //! of freedom the plane is the cylinder (q, p).
 
-use super::lyapunov::{fast_lyapunov_indicator, fast_lyapunov_indicators, fli_shading};
+use super::lyapunov::fli_shading;
 use super::tiles::{fingerprint, run_tiles};
 pub use super::tiles::{TileError, Tiles};
 use crate::analysis::Refusal;
-use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, System};
-use crate::registry::{Fixed, Model, WithFixed};
+use crate::ode::{Method, OdeError};
+use crate::registry::Model;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -95,165 +95,152 @@ pub fn chaos_map(
     settings: &ChaosMapSettings,
     row_done: &(dyn Fn() -> bool + Sync),
 ) -> Result<ChaosMap, ChaosMapError> {
-    let work = Map {
-        params,
-        settings,
-        row_done,
+    let systems = model
+        .systems()
+        .ok_or_else(|| ChaosMapError::Refused(Refusal::contact_model(model.info.name)))?;
+    let info = systems.info();
+    let period = match systems.phase_period(params) {
+        Some(t) if systems.has_fast_phase() => t,
+        _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
     };
-    crate::registry::with_fixed(model, work)
-        .ok_or_else(|| ChaosMapError::Refused(Refusal::contact_model(model.info.name)))?
-}
-
-/// The work of [`chaos_map`] at one size.
-pub struct Map<'a> {
-    params: &'a [f64],
-    settings: &'a ChaosMapSettings,
-    row_done: &'a (dyn Fn() -> bool + Sync),
-}
-
-impl Map<'_> {
-    /// The request read against the model: its parameters by name, the
-    /// plane's axes and the state the plane passes through.
-    fn request<const S: usize>(
-        &self,
-        info: &'static crate::registry::ModelInfo,
-    ) -> Result<Request<S>, ChaosMapError> {
-        let params = Refusal::named_values(info, self.params)?;
-        let axes = info
-            .plane(self.settings.axes)
-            .map_err(|source| ChaosMapError::Plane {
-                model: info.name.into(),
-                source,
-            })?;
-        let through: [f64; S] = match &self.settings.through {
-            Some(y) => y.as_slice().try_into().map_err(|_| {
-                Refusal::state_length(info.name, "state the plane passes through", y.len(), S)
-            })?,
-            None => [0.0; S],
-        };
-        Ok(Request {
+    let periodic = systems.periodic_state();
+    let Request {
+        params: named,
+        axes,
+        through,
+    } = request(info, params, settings, periodic.len())?;
+    let ranges = plane_ranges(settings, &periodic);
+    crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
+    let n = through.len();
+    // √(1/n): for n = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
+    let w0 = vec![(1.0 / n as f64).sqrt(); n];
+    let pixels = settings.pixels;
+    // The FLI values of a block of rows and their f-evaluations.
+    let stopped = std::sync::atomic::AtomicBool::new(false);
+    let block = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
+        if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok((Vec::new(), 0));
+        }
+        let mut starts = Vec::with_capacity(rows.len() * pixels * n);
+        for k in rows.start * pixels..rows.end * pixels {
+            let (x, y) = pixel_centre(&ranges, pixels, k);
+            let at = starts.len();
+            starts.extend_from_slice(&through);
+            starts[at + settings.axes[0]] = x;
+            starts[at + settings.axes[1]] = y;
+        }
+        let (values, f_evals) = systems.fli(
             params,
-            axes,
-            through,
-        })
-    }
+            settings.method,
+            period,
+            &starts,
+            &w0,
+            settings.periods,
+        )?;
+        let values = values.into_iter().map(pixel_value).collect::<Result<_, _>>()?;
+        for _ in rows {
+            if !row_done() {
+                stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        Ok((values, f_evals))
+    };
+    // Rows in blocks ([`super::row_blocks`]); a lane equals its orbit's
+    // scalar run bit for bit, so the map does not depend on how the rows
+    // are grouped (nor on tiles).
+    let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), ChaosMapError> {
+        let rows: Vec<(Vec<f64>, u64)> = super::row_blocks(range, pixels)
+            .into_par_iter()
+            .map(block)
+            .collect::<Result<_, _>>()?;
+        if stopped.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(ChaosMapError::Cancelled);
+        }
+        Ok(rows
+            .into_iter()
+            .fold((Vec::new(), 0), |(mut all, evals), (values, e)| {
+                all.extend(values);
+                (all, evals + e)
+            }))
+    };
+    let start = std::time::Instant::now();
+    let (fli, f_evals) = match &settings.tiles {
+        None => rows_of(0..pixels)?,
+        Some(tiles) => {
+            let key = format!(
+                "{} {:?} {:?} {:?} {:?} {} {} {:?} {}",
+                info.name,
+                params,
+                settings.axes,
+                ranges,
+                through,
+                pixels,
+                settings.periods,
+                settings.method,
+                tiles.rows
+            );
+            match run_tiles(tiles, fingerprint(&key), (pixels, pixels, "rows"), &rows_of)? {
+                Some(map) => map,
+                None => return Err(ChaosMapError::Partial),
+            }
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let shading = fli_shading(&fli, settings.periods);
+    Ok(ChaosMap {
+        model: info.name.into(),
+        params: named,
+        axes,
+        ranges,
+        through,
+        pixels,
+        periods: settings.periods,
+        method: settings.method.name(),
+        chaotic_fraction: shading.chaotic_fraction,
+        diverged: fli.iter().filter(|f| f.is_infinite()).count(),
+        fli_regular_level: shading.regular_level,
+        seconds,
+        f_evals,
+        fli,
+        shades: shading.shades,
+    })
+}
+
+/// The request read against the model: its parameters by name, the
+/// plane's axes and the state (of `n` numbers) the plane passes through.
+fn request(
+    info: &'static crate::registry::ModelInfo,
+    params: &[f64],
+    settings: &ChaosMapSettings,
+    n: usize,
+) -> Result<Request, ChaosMapError> {
+    let named = Refusal::named_values(info, params)?;
+    let axes = info
+        .plane(settings.axes)
+        .map_err(|source| ChaosMapError::Plane {
+            model: info.name.into(),
+            source,
+        })?;
+    let through = match &settings.through {
+        Some(y) if y.len() != n => {
+            let what = "state the plane passes through";
+            return Err(Refusal::state_length(info.name, what, y.len(), n).into());
+        }
+        Some(y) => y.clone(),
+        None => vec![0.0; n],
+    };
+    Ok(Request {
+        params: named,
+        axes,
+        through,
+    })
 }
 
 /// A chaos map's request as the model reads it.
-struct Request<const S: usize> {
+struct Request {
     params: BTreeMap<String, f64>,
     axes: [String; 2],
-    through: [f64; S],
-}
-
-impl WithFixed for Map<'_> {
-    type Output = Result<ChaosMap, ChaosMapError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let info = model.info();
-        let settings = self.settings;
-        let period = match model.phase_period(self.params) {
-            Some(t) if model.has_fast_phase() => t,
-            _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
-        };
-        let Request {
-            params,
-            axes,
-            through,
-        } = self.request::<S>(info)?;
-        let ranges = plane_ranges(settings, &model.periodic_state());
-        crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
-        let system = model.exact(self.params);
-        // √(1/S): for S = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
-        let w0 = [(1.0 / S as f64).sqrt(); S];
-        let pixels = settings.pixels;
-        let start_of = |k: usize| {
-            let (x, y) = pixel_centre(&ranges, pixels, k);
-            let mut y0 = through;
-            y0[settings.axes[0]] = x;
-            y0[settings.axes[1]] = y;
-            y0
-        };
-        // The FLI values of a block of rows and their f-evaluations.
-        let stopped = std::sync::atomic::AtomicBool::new(false);
-        let block = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
-            if stopped.load(std::sync::atomic::Ordering::Relaxed) {
-                return Ok((Vec::new(), 0));
-            }
-            let starts: Vec<[f64; S]> = (rows.start * pixels..rows.end * pixels)
-                .map(start_of)
-                .collect();
-            let (values, f_evals) =
-                fli_of_starts::<_, S, T>(&system, settings, period, &starts, &w0)?;
-            for _ in rows {
-                if !(self.row_done)() {
-                    stopped.store(true, std::sync::atomic::Ordering::Relaxed);
-                }
-            }
-            Ok((values, f_evals))
-        };
-        // Rows in blocks ([`super::row_blocks`]); a lane equals its orbit's
-        // scalar run bit for bit, so the map does not depend on how the rows
-        // are grouped (nor on tiles).
-        let rows_of = |range: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), ChaosMapError> {
-            let rows: Vec<(Vec<f64>, u64)> = super::row_blocks(range, pixels)
-                .into_par_iter()
-                .map(block)
-                .collect::<Result<_, _>>()?;
-            if stopped.load(std::sync::atomic::Ordering::Relaxed) {
-                return Err(ChaosMapError::Cancelled);
-            }
-            Ok(rows
-                .into_iter()
-                .fold((Vec::new(), 0), |(mut all, evals), (values, e)| {
-                    all.extend(values);
-                    (all, evals + e)
-                }))
-        };
-        let start = std::time::Instant::now();
-        let (fli, f_evals) = match &settings.tiles {
-            None => rows_of(0..pixels)?,
-            Some(tiles) => {
-                let key = format!(
-                    "{} {:?} {:?} {:?} {:?} {} {} {:?} {}",
-                    info.name,
-                    self.params,
-                    settings.axes,
-                    ranges,
-                    through,
-                    pixels,
-                    settings.periods,
-                    settings.method,
-                    tiles.rows
-                );
-                match run_tiles(tiles, fingerprint(&key), (pixels, pixels, "rows"), &rows_of)? {
-                    Some(map) => map,
-                    None => return Err(ChaosMapError::Partial),
-                }
-            }
-        };
-        let seconds = start.elapsed().as_secs_f64();
-        let shading = fli_shading(&fli, settings.periods);
-        Ok(ChaosMap {
-            model: info.name.into(),
-            params,
-            axes,
-            ranges,
-            through: through.to_vec(),
-            pixels,
-            periods: settings.periods,
-            method: settings.method.name(),
-            chaotic_fraction: shading.chaotic_fraction,
-            diverged: fli.iter().filter(|f| f.is_infinite()).count(),
-            fli_regular_level: shading.regular_level,
-            seconds,
-            f_evals,
-            fli,
-            shades: shading.shades,
-        })
-    }
+    through: Vec<f64>,
 }
 
 /// The ranges of the map's axes: the settings', or [−π, π] for an angle
@@ -266,55 +253,6 @@ fn plane_ranges(settings: &ChaosMapSettings, periodic: &[bool]) -> [(f64, f64); 
         } else {
             (-settings.p_max, settings.p_max)
         })
-    })
-}
-
-/// The FLI of each start after `settings.periods` periods and the
-/// f-evaluations spent, with an integrator of its own: the Taylor method
-/// streams the orbits through its lanes, the others run them one by one.
-fn fli_of_starts<Sys: System<S>, const S: usize, const T: usize>(
-    system: &Sys,
-    settings: &ChaosMapSettings,
-    period: f64,
-    starts: &[[f64; S]],
-    w0: &[f64; S],
-) -> Result<(Vec<f64>, u64), OdeError> {
-    Ok(match settings.method {
-        Method::Taylor { .. } => {
-            let mut integrator = LaneIntegrator::new(settings.method)?;
-            let values = fast_lyapunov_indicators::<_, S, T>(
-                &mut integrator,
-                system,
-                period,
-                starts,
-                w0,
-                settings.periods,
-            )
-            .into_iter()
-            .map(pixel_value)
-            .collect::<Result<_, _>>()?;
-            (values, integrator.stats.f_evals)
-        }
-        _ => {
-            let mut integrator = Integrator::new(settings.method)?;
-            let mut values = Vec::with_capacity(starts.len());
-            for y0 in starts {
-                let fli = fast_lyapunov_indicator::<_, S, T>(
-                    &mut integrator,
-                    system,
-                    period,
-                    y0,
-                    w0,
-                    settings.periods,
-                );
-                if fli.is_err() {
-                    // A clean state for the next orbit.
-                    integrator = Integrator::new(settings.method)?;
-                }
-                values.push(pixel_value(fli)?);
-            }
-            (values, integrator.stats.f_evals)
-        }
     })
 }
 

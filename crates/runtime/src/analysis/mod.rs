@@ -13,7 +13,6 @@ pub mod dimension;
 pub mod equilibria;
 pub mod fit;
 pub mod floquet;
-pub mod lyapunov;
 pub mod period_map;
 pub mod section;
 pub mod section_map;
@@ -21,8 +20,10 @@ pub mod separatrix;
 pub mod stability;
 pub mod standard_map;
 pub mod tiles;
-pub mod variational;
 pub mod vibrational_stability;
+
+/// The tangent kernels, where the analyses have always found them.
+pub use crate::tangent::{lyapunov, variational};
 
 use std::ops::Range;
 

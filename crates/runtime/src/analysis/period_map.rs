@@ -6,21 +6,7 @@ use crate::registry::Model;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// Wraps an angle into [−π, π).
-pub fn wrap_angle(x: f64) -> f64 {
-    // Already in range: unchanged (the shift by π would round it).
-    if (-PI..PI).contains(&x) {
-        return x;
-    }
-    let two_pi = std::f64::consts::TAU;
-    let w = (x + std::f64::consts::PI).rem_euclid(two_pi) - std::f64::consts::PI;
-    // rem_euclid can return two_pi for tiny negative inputs.
-    if w >= std::f64::consts::PI {
-        w - two_pi
-    } else {
-        w
-    }
-}
+pub use crate::ode::wrap_angle;
 
 /// Advances `y` by one forcing period. The system is T-periodic, so every
 /// period is integrated over [0, T]: no large times, no loss of phase accuracy.

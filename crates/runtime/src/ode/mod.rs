@@ -501,6 +501,23 @@ impl Integrator {
     }
 }
 
+/// Wraps an angle into [−π, π).
+pub fn wrap_angle(x: f64) -> f64 {
+    // Already in range: unchanged (the shift by π would round it).
+    use std::f64::consts::PI;
+    if (-PI..PI).contains(&x) {
+        return x;
+    }
+    let two_pi = std::f64::consts::TAU;
+    let w = (x + PI).rem_euclid(two_pi) - PI;
+    // rem_euclid can return two_pi for tiny negative inputs.
+    if w >= PI {
+        w - two_pi
+    } else {
+        w
+    }
+}
+
 /// The tolerances of the adaptive methods (DOP853, Radau 5).
 #[derive(Clone, Copy, Debug)]
 struct Tolerances {

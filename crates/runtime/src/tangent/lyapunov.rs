@@ -1,9 +1,9 @@
 //! Lyapunov exponents of a period map (per iteration) and the fast Lyapunov
 //! indicator (FLI) used to shade chaos maps.
 
-use super::period_map::wrap_angle;
+use crate::ode::wrap_angle;
 use super::variational::Variational;
-use crate::ode::{Integrator, LaneIntegrator, OdeError, Orbit, System};
+use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, Orbit, System};
 use nalgebra::DMatrix;
 
 /// The full Lyapunov spectrum of the period map (exponents per period, in
@@ -137,6 +137,54 @@ pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
         periods,
         Fli::<N, M>::new(w0),
     )
+}
+
+/// The FLI of each start after `periods` periods of `system` (or the
+/// orbit's error) and the f-evaluations spent, with an integrator of its
+/// own: the Taylor method streams the orbits through its lanes, the others
+/// run them one by one. M = 2N.
+pub fn fli_of_starts<S: System<N>, const N: usize, const M: usize>(
+    system: &S,
+    method: Method,
+    period: f64,
+    starts: &[[f64; N]],
+    w0: &[f64; N],
+    periods: usize,
+) -> Result<(Vec<Result<f64, OdeError>>, u64), OdeError> {
+    Ok(match method {
+        Method::Taylor { .. } => {
+            let mut integrator = LaneIntegrator::new(method)?;
+            let values = fast_lyapunov_indicators::<_, N, M>(
+                &mut integrator,
+                system,
+                period,
+                starts,
+                w0,
+                periods,
+            );
+            (values, integrator.stats.f_evals)
+        }
+        _ => {
+            let mut integrator = Integrator::new(method)?;
+            let mut values = Vec::with_capacity(starts.len());
+            for y0 in starts {
+                let fli = fast_lyapunov_indicator::<_, N, M>(
+                    &mut integrator,
+                    system,
+                    period,
+                    y0,
+                    w0,
+                    periods,
+                );
+                if fli.is_err() {
+                    // A clean state for the next orbit.
+                    integrator = Integrator::new(method)?;
+                }
+                values.push(fli);
+            }
+            (values, integrator.stats.f_evals)
+        }
+    })
 }
 
 /// MEGNO ⟨Y⟩ (Cincotta and Simó) of every orbit started at `starts` over
