@@ -44,7 +44,6 @@ large_works! {
     at_equilibrium: crate::analysis::stability::AtEquilibrium<'_> => Result<crate::analysis::stability::EquilibriumStability, crate::analysis::stability::StabilityError>;
     stability_chart: crate::analysis::stability::Chart<'_> => Result<crate::analysis::stability::StabilityChart, crate::analysis::stability::StabilityError>;
     averaging: crate::analysis::averaging::Sweep<'_> => Result<crate::analysis::averaging::AveragingConvergence, crate::analysis::averaging::AveragingError>;
-    continuation: crate::analysis::continuation::Work<'_> => Result<crate::analysis::continuation::Continuation, crate::analysis::continuation::ContinuationError>;
 }
 
 /// A model of 4 to 24 degrees of freedom as a [`LargeModel`]: the models

@@ -6,6 +6,7 @@ use std::fmt;
 use crate::ode::any_size::fixed_state;
 use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem};
 use crate::tangent::lyapunov::fli_of_starts;
+use crate::tangent::monodromy::monodromy;
 pub use mechlab_range::Range;
 
 /// One derived expression in its readable form (checked at build time
@@ -265,6 +266,8 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     /// again where [`Fixed::averaged2`] gives None).
     type Averaged2: crate::ode::System<S> + Sync;
     fn info(&self) -> &'static ModelInfo;
+    /// The same model with states as slices.
+    fn systems(&'static self) -> &'static dyn Systems;
     fn has_fast_phase(&self) -> bool;
     /// Which coordinates are angles.
     fn periodic(&self) -> [bool; D];
@@ -333,6 +336,9 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
     type Averaged2 = ErasedSystem<S>;
     fn info(&self) -> &'static ModelInfo {
         self.0.info()
+    }
+    fn systems(&'static self) -> &'static dyn Systems {
+        self
     }
     fn has_fast_phase(&self) -> bool {
         self.0.averaged().is_some()
@@ -412,6 +418,15 @@ pub trait Systems: Sync {
         w0: &[f64],
         periods: usize,
     ) -> Result<FliValues, OdeError>;
+    /// The exact system's state after `period` from `y0` and the monodromy
+    /// matrix ∂y(T)/∂y(0) (see [`crate::tangent::monodromy::monodromy`]).
+    fn monodromy(
+        &self,
+        params: &[f64],
+        integrator: &mut crate::ode::Integrator,
+        period: f64,
+        y0: &[f64],
+    ) -> Result<(Vec<f64>, nalgebra::DMatrix<f64>), OdeError>;
 }
 
 /// Each orbit's FLI (or why it stopped) and the f-evaluations spent.
@@ -455,6 +470,18 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
         let w0 = fixed_state::<S>(w0)?;
         let system = Fixed::exact(self, params);
         fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
+    }
+    fn monodromy(
+        &self,
+        params: &[f64],
+        integrator: &mut crate::ode::Integrator,
+        period: f64,
+        y0: &[f64],
+    ) -> Result<(Vec<f64>, nalgebra::DMatrix<f64>), OdeError> {
+        let y0 = fixed_state::<S>(y0)?;
+        let system = Fixed::exact(self, params);
+        let (image, m) = monodromy::<_, S, V>(integrator, &system, period, &y0)?;
+        Ok((image.to_vec(), nalgebra::DMatrix::from_fn(S, S, |i, k| m[i][k])))
     }
 }
 

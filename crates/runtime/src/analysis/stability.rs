@@ -378,7 +378,7 @@ fn moved_equilibrium<
         let mut at_rest = probe.to_vec();
         at_rest[amplitude] = 0.0;
         orbit_branch(
-            model,
+            model.systems(),
             &at_rest,
             amplitude,
             settings.method,

@@ -9,6 +9,8 @@
 //! indirect call and a copy of the state per request (a period, a run),
 //! not per step.
 
+use nalgebra::DMatrix;
+
 use super::{Direction, Event, EventSettings, Integrator, OdeError, Options, System};
 
 /// A system behind a trait object whose state is a slice of [`AnySystem::dim`]
@@ -19,6 +21,8 @@ pub trait AnySystem: Sync {
     fn dim(&self) -> usize;
     /// y' at (t, y).
     fn rhs(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError>;
+    /// ∂y'/∂y at (t, y), when the system knows it.
+    fn jacobian(&self, t: f64, y: &[f64]) -> Result<Option<DMatrix<f64>>, OdeError>;
     /// [`Integrator::solve`]: from (t0, y0) towards t1 with the options.
     fn solve(
         &self,
@@ -117,6 +121,11 @@ impl<S: System<N> + Sync, const N: usize> AnySystem for SizedSystem<S, N> {
 
     fn rhs(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
         Ok(self.0.rhs(t, &fixed_state::<N>(y)?).to_vec())
+    }
+
+    fn jacobian(&self, t: f64, y: &[f64]) -> Result<Option<DMatrix<f64>>, OdeError> {
+        let j = self.0.jacobian(t, &fixed_state::<N>(y)?);
+        Ok(j.map(|j| DMatrix::from_fn(N, N, |i, k| j[i][k])))
     }
 
     fn solve(

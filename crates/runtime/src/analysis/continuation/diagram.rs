@@ -3,8 +3,8 @@
 //! batch lanes) and the figure of a continuation.
 
 use super::{BifurcationKind, Continuation, DiagramSettings, FamilyMap};
-use crate::analysis::period_map::orbit;
-use crate::ode::{Integrator, Method, OdeError, System};
+use crate::analysis::period_map::stream_orbit;
+use crate::ode::{AnySystem, Integrator, Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, Rgb};
 use rayon::prelude::*;
 
@@ -59,11 +59,11 @@ pub(super) fn orbit_diagram(
 /// cores. (The batch lanes would be 2–3× faster, but their instances for
 /// the plain field at every size cost the runtime's compile more than the
 /// diagram's seconds are worth.)
-pub(super) fn iterates<S: System<N> + Sync, const N: usize>(
+pub(super) fn iterates(
     method: Method,
-    problems: &[(S, Result<f64, OdeError>)],
-    start: &[f64; N],
-    wrap: &[bool; N],
+    problems: &[(Box<dyn AnySystem>, Result<f64, OdeError>)],
+    start: &[f64],
+    wrap: &[bool],
     transient: usize,
     iterates: usize,
 ) -> Vec<Result<Vec<Vec<f64>>, OdeError>> {
@@ -72,16 +72,18 @@ pub(super) fn iterates<S: System<N> + Sync, const N: usize>(
         .map(|(system, period)| {
             let period = period.clone()?;
             let mut integrator = Integrator::new(method)?;
-            // `orbit` keeps the angles in [−π, π).
-            let states = orbit(
-                &mut integrator,
-                system,
-                period,
-                start,
-                transient + iterates,
-                wrap,
-            )?;
-            Ok(states[transient + 1..].iter().map(|y| y.to_vec()).collect())
+            // The start, then one point a period (angles in [−π, π)).
+            let (mut seen, mut states) = (0, Vec::with_capacity(iterates));
+            let mut keep = |y: &[f64]| {
+                if seen > transient {
+                    states.push(y.to_vec());
+                }
+                seen += 1;
+                true
+            };
+            let periods = transient + iterates;
+            stream_orbit(&mut integrator, &**system, period, start, periods, wrap, &mut keep)?;
+            Ok(states)
         })
         .collect()
 }

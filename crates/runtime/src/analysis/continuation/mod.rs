@@ -19,10 +19,10 @@ mod diagram;
 pub use branch::BranchEnd;
 pub use diagram::OrbitDiagram;
 
-use crate::analysis::floquet::{monodromy, multipliers_of, Verdict};
+use crate::analysis::floquet::{multipliers_of, Verdict};
 use crate::analysis::Refusal;
-use crate::ode::{Integrator, Method, OdeError, System};
-use crate::registry::{Fixed, Model, WithFixed};
+use crate::ode::{AnyOptions, Integrator, Method, OdeError};
+use crate::registry::{Model, Systems};
 use branch::{Origin, Solution, Steps};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeMap;
@@ -261,32 +261,18 @@ pub fn continuation(
     params: &[f64],
     settings: &ContinuationSettings,
 ) -> Result<Continuation, ContinuationError> {
-    crate::registry::with_fixed(model, Work { params, settings })
-        .ok_or_else(|| ContinuationError::Refused(Refusal::contact_model(model.info.name)))?
-}
-
-/// The work of [`continuation`] at one model's sizes.
-pub struct Work<'a> {
-    params: &'a [f64],
-    settings: &'a ContinuationSettings,
-}
-
-impl WithFixed for Work<'_> {
-    type Output = Result<Continuation, ContinuationError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let info = model.info();
-        let name = info.name.to_string();
-        let index = Refusal::parameter_index(info, &self.settings.parameter)?;
-        let named = Refusal::named_values(info, self.params)?;
-        let map = AtModel::<F, D, S, T, V>::new(model, self.params, index, self.settings.method);
-        let mut result = run(&map, self.params[index], self.settings, &name)?;
-        result.params = named;
-        result.state_names = info.state_names();
-        Ok(result)
-    }
+    let systems = model
+        .systems()
+        .ok_or_else(|| ContinuationError::Refused(Refusal::contact_model(model.info.name)))?;
+    let info = systems.info();
+    let name = info.name.to_string();
+    let index = Refusal::parameter_index(info, &settings.parameter)?;
+    let named = Refusal::named_values(info, params)?;
+    let map = AtModel::new(systems, params, index, settings.method);
+    let mut result = run(&map, params[index], settings, &name)?;
+    result.params = named;
+    result.state_names = info.state_names();
+    Ok(result)
 }
 
 /// A periodic orbit followed in one parameter for `stability`: the states
@@ -304,21 +290,15 @@ pub(crate) struct OrbitBranch {
 /// followed down to `bounds.0` and up to `bounds.1`, and its window. For
 /// the orbits of `stability` that the vibration moves off an equilibrium,
 /// followed from amplitude 0, where the equilibrium is one.
-pub(crate) fn orbit_branch<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &'static F,
+pub(crate) fn orbit_branch(
+    model: &'static dyn Systems,
     params: &[f64],
     index: usize,
     method: Method,
     start: &[f64],
     bounds: (f64, f64),
 ) -> Result<OrbitBranch, ContinuationError> {
-    let map = AtModel::<F, D, S, T, V>::new(model, params, index, method);
+    let map = AtModel::new(model, params, index, method);
     let p0 = params[index];
     let name = model.info().name;
     // (parameter, stable, state) along the branch, and the located changes.
@@ -387,9 +367,9 @@ pub(crate) fn orbit_branch<
     })
 }
 
-/// A model of sizes (D, S) at fixed values of all parameters but one.
-struct AtModel<F: 'static, const D: usize, const S: usize, const T: usize, const V: usize> {
-    model: &'static F,
+/// A model at fixed values of all parameters but one.
+struct AtModel {
+    model: &'static dyn Systems,
     params: Vec<f64>,
     index: usize,
     method: Method,
@@ -398,18 +378,16 @@ struct AtModel<F: 'static, const D: usize, const S: usize, const T: usize, const
     flow: bool,
 }
 
-impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>
-    AtModel<F, D, S, T, V>
-{
+impl AtModel {
     /// The model at `params`, its parameter `index` free: a map if it has
     /// a fast phase, a flow if not.
-    fn new(model: &'static F, params: &[f64], index: usize, method: Method) -> Self {
+    fn new(model: &'static dyn Systems, params: &[f64], index: usize, method: Method) -> Self {
         AtModel {
             model,
             params: params.to_vec(),
             index,
             method,
-            periodic: model.periodic_state().to_vec(),
+            periodic: model.periodic_state(),
             evaluations: AtomicU64::new(0),
             flow: !model.has_fast_phase(),
         }
@@ -432,9 +410,7 @@ impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const
     }
 }
 
-impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize> FamilyMap
-    for AtModel<F, D, S, T, V>
-{
+impl FamilyMap for AtModel {
     fn periodic(&self) -> &[bool] {
         &self.periodic
     }
@@ -446,13 +422,11 @@ impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const
     fn field(&self, y: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>) {
         self.evaluations.fetch_add(1, Ordering::Relaxed);
         let system = self.model.exact(&self.with(p));
-        let y: [f64; S] = std::array::from_fn(|i| y[i]);
-        let f = system.rhs(0.0, &y);
-        let jacobian = match system.jacobian(0.0, &y) {
-            Some(j) => DMatrix::from_fn(S, S, |i, k| j[i][k]),
-            None => DMatrix::from_element(S, S, f64::NAN),
-        };
-        (f.to_vec(), jacobian)
+        let n = system.dim();
+        let f = system.rhs(0.0, y).expect("a state of the model's length");
+        let jacobian = system.jacobian(0.0, y).expect("a state of the model's length");
+        let jacobian = jacobian.unwrap_or_else(|| DMatrix::from_element(n, n, f64::NAN));
+        (f, jacobian)
     }
 
     fn parameter_allowed(&self, p: f64) -> bool {
@@ -470,16 +444,14 @@ impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const
         self.evaluations.fetch_add(1, Ordering::Relaxed);
         let params = self.with(p);
         let period = self.period(&params)?;
-        let system = self.model.exact(&params);
-        let y0: [f64; S] = std::array::from_fn(|i| y[i]);
         let mut integrator = Integrator::new(self.method)?;
         if jacobian {
-            let (image, m) = monodromy::<_, S, V>(&mut integrator, &system, period, &y0)?;
-            let m = DMatrix::from_fn(S, S, |i, k| m[i][k]);
-            Ok((image.to_vec(), Some(m)))
+            let (image, m) = self.model.monodromy(&params, &mut integrator, period, y)?;
+            Ok((image, Some(m)))
         } else {
-            let image = integrator.advance(&system, 0.0, &y0, period)?;
-            Ok((image.to_vec(), None))
+            let system = self.model.exact(&params);
+            let end = system.solve(&mut integrator, 0.0, y, period, AnyOptions::default())?;
+            Ok((end.y, None))
         }
     }
 
@@ -498,13 +470,12 @@ impl<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const
                 (self.model.exact(&params), period)
             })
             .collect();
-        let start: [f64; S] = std::array::from_fn(|i| start[i]);
-        let wrap: [bool; S] = std::array::from_fn(|i| self.periodic[i]);
         self.evaluations.fetch_add(
             (values.len() * (transient + iterates)) as u64,
             Ordering::Relaxed,
         );
-        diagram::iterates(self.method, &problems, &start, &wrap, transient, iterates)
+        let wrap = &self.periodic;
+        diagram::iterates(self.method, &problems, start, wrap, transient, iterates)
     }
 
     fn evaluations(&self) -> u64 {
