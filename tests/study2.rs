@@ -7,7 +7,7 @@ use mechlab::analysis::vibrational_stability::{
     linearization_eigenvalues, positive_definite, Stabilization,
 };
 use mechlab::models::double_pendulum::{self as model, Averaged, Exact, Params};
-use mechlab::ode::Method;
+use mechlab::ode::{AnySystem, Method, SizedSystem};
 use mechlab::studies::double_pendulum::{
     analyse_equilibrium, exact_multipliers, exact_stability_window, threshold_closed_form,
     EQUILIBRIA,
@@ -81,7 +81,9 @@ fn deviation_falls_like_one_over_nu() {
     let params = Params::default();
     let systems = |nu: f64| {
         let p = Params { nu, ..params };
-        (Exact { params: p }, Averaged { params: p })
+        let exact: Box<dyn AnySystem> = Box::new(SizedSystem(Exact { params: p }));
+        let averaged: Box<dyn AnySystem> = Box::new(SizedSystem(Averaged { params: p }));
+        (exact, averaged)
     };
     let result = deviation_against_frequency(
         Method::parse("dop853", 1e-11).unwrap(),

@@ -43,7 +43,6 @@ large_works! {
     stability: crate::analysis::stability::Analysis<'_> => Result<crate::analysis::stability::Stability, crate::analysis::stability::StabilityError>;
     at_equilibrium: crate::analysis::stability::AtEquilibrium<'_> => Result<crate::analysis::stability::EquilibriumStability, crate::analysis::stability::StabilityError>;
     stability_chart: crate::analysis::stability::Chart<'_> => Result<crate::analysis::stability::StabilityChart, crate::analysis::stability::StabilityError>;
-    averaging: crate::analysis::averaging::Sweep<'_> => Result<crate::analysis::averaging::AveragingConvergence, crate::analysis::averaging::AveragingError>;
 }
 
 /// A model of 4 to 24 degrees of freedom as a [`LargeModel`]: the models

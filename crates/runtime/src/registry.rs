@@ -405,6 +405,11 @@ pub trait Systems: Sync {
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
     /// None without a fast phase.
     fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>>;
+    /// The system averaged to second order in ε = 1/rate, where derived.
+    fn averaged2(&self, params: &[f64]) -> Option<Box<dyn AnySystem>>;
+    /// The first-order map's shift y − y′ at time t (where the second
+    /// order is derived).
+    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64]) -> Option<Vec<f64>>;
     /// The fast Lyapunov indicator of the exact system's period map from
     /// each start (`starts` holds them one after the other) with the
     /// tangent vector `w0`, and the f-evaluations spent (see
@@ -453,6 +458,14 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
     fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>> {
         let averaged = Fixed::averaged(self, params)?;
         Some(Box::new(SizedSystem(averaged)))
+    }
+    fn averaged2(&self, params: &[f64]) -> Option<Box<dyn AnySystem>> {
+        let averaged = Fixed::averaged2(self, params)?;
+        Some(Box::new(SizedSystem(averaged)))
+    }
+    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64]) -> Option<Vec<f64>> {
+        let y = fixed_state::<S>(y).ok()?;
+        Some(self.0.averaged2_shift(params, t, &y)?.to_vec())
     }
     fn fli(
         &self,

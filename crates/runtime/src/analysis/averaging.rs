@@ -8,8 +8,8 @@
 
 use super::fit::{log_log, LineFit};
 use crate::analysis::Refusal;
-use crate::ode::{states_at, Method, OdeError, System};
-use crate::registry::Model;
+use crate::ode::{states_at, AnyOptions, AnySystem, Integrator, Method, OdeError, System};
+use crate::registry::{Model, Systems};
 use rayon::prelude::*;
 
 /// Both systems on one time grid, from the same initial state.
@@ -71,27 +71,48 @@ pub struct Convergence {
     pub fits: Vec<LineFit>,
 }
 
-pub fn deviation_against_frequency<E, A, const N: usize>(
+pub fn deviation_against_frequency(
     method: Method,
-    systems: &(dyn Fn(f64) -> (E, A) + Sync),
-    y0: &[f64; N],
+    systems: &(dyn Fn(f64) -> (Box<dyn AnySystem>, Box<dyn AnySystem>) + Sync),
+    y0: &[f64],
     t_obs: f64,
     frequencies: &[f64],
     coordinates: usize,
-) -> Result<Convergence, OdeError>
-where
-    E: System<N>,
-    A: System<N>,
-{
+) -> Result<Convergence, OdeError> {
     let per_frequency: Vec<Vec<f64>> = frequencies
         .par_iter()
         .map(|&nu| {
             let (exact, averaged) = systems(nu);
             let grid = time_grid(t_obs, 2.0 * std::f64::consts::PI / nu, 32, 2000);
-            compare(method, &exact, &averaged, y0, &grid).map(|c| c.max_deviation(0..coordinates))
+            let exact = samples(method, &*exact, y0, &grid)?;
+            let averaged = samples(method, &*averaged, y0, &grid)?;
+            Ok((0..coordinates)
+                .map(|i| {
+                    exact
+                        .iter()
+                        .zip(&averaged)
+                        .map(|(e, a)| (e[i] - a[i]).abs())
+                        .fold(0.0, f64::max)
+                })
+                .collect())
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<_, OdeError>>()?;
     Ok(fit_deviations(frequencies, per_frequency, coordinates))
+}
+
+/// The states at `times` of a fresh run of `method` from (0, y0) (as
+/// [`states_at`]).
+fn samples(
+    method: Method,
+    system: &dyn AnySystem,
+    y0: &[f64],
+    times: &[f64],
+) -> Result<Vec<Vec<f64>>, OdeError> {
+    let t1 = times.last().copied().unwrap_or(0.0);
+    let options = AnyOptions::default().times(times);
+    Ok(system
+        .solve(&mut Integrator::new(method)?, 0.0, y0, t1, options)?
+        .samples)
 }
 
 /// Per coordinate, the deviations against the frequencies and their
@@ -238,28 +259,25 @@ pub enum SweepProblem {
 /// The deviation of each coordinate over `times` between the exact run
 /// from `y0` and the second-order averaged run from the transformed state,
 /// mapped back: y(t) ≈ y′(t) + shift(y′(t), t), y′(0) = y0 − shift(y0, 0).
-pub fn second_order_deviation<
-    F: crate::registry::Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+pub fn second_order_deviation(
+    model: &dyn Systems,
     params: &[f64],
     method: Method,
-    y0: &[f64; S],
+    y0: &[f64],
     times: &[f64],
 ) -> Option<Result<Vec<f64>, OdeError>> {
     let averaged = model.averaged2(params)?;
     let shift0 = model.averaged2_shift(params, 0.0, y0)?;
-    let start: [f64; S] = std::array::from_fn(|i| y0[i] - shift0[i]);
+    let start: Vec<f64> = y0.iter().zip(&shift0).map(|(y, s)| y - s).collect();
+    let dof = model.info().coordinates.len();
     let run = || -> Result<Vec<f64>, OdeError> {
-        let exact = states_at(method, &model.exact(params), 0.0, y0, times)?;
-        let transformed = states_at(method, &averaged, 0.0, &start, times)?;
-        let mut worst = vec![0.0f64; D];
+        let exact = samples(method, &*model.exact(params), y0, times)?;
+        let transformed = samples(method, &*averaged, &start, times)?;
+        let mut worst = vec![0.0f64; dof];
         for ((t, e), y) in times.iter().zip(&exact).zip(&transformed) {
-            let shift = model.averaged2_shift(params, *t, y).unwrap_or([0.0; S]);
+            let shift = model
+                .averaged2_shift(params, *t, y)
+                .unwrap_or_else(|| vec![0.0; y.len()]);
             for (i, w) in worst.iter_mut().enumerate() {
                 *w = w.max((e[i] - y[i] - shift[i]).abs());
             }
@@ -276,137 +294,112 @@ pub fn convergence(
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
-    crate::registry::with_fixed(model, Sweep { params, settings })
-        .ok_or_else(|| AveragingError::Refused(Refusal::contact_model(model.info.name)))?
-}
-
-/// The work of [`convergence`] at one size.
-pub struct Sweep<'a> {
-    params: &'a [f64],
-    settings: &'a ConvergenceSettings,
-}
-
-impl crate::registry::WithFixed for Sweep<'_> {
-    type Output = Result<AveragingConvergence, AveragingError>;
-    fn run<
-        F: crate::registry::Fixed<D, S, T, V>,
-        const D: usize,
-        const S: usize,
-        const T: usize,
-        const V: usize,
-    >(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let info = model.info();
-        if !model.has_fast_phase() {
-            return Err(AveragingError::Refused(Refusal::no_fast_phase(info.name)));
+    let model = model
+        .systems()
+        .ok_or_else(|| AveragingError::Refused(Refusal::contact_model(model.info.name)))?;
+    let info = model.info();
+    if !model.has_fast_phase() {
+        return Err(AveragingError::Refused(Refusal::no_fast_phase(info.name)));
+    }
+    Refusal::named_values(info, params)?;
+    let dof = info.coordinates.len();
+    let y0 = initial_state(model, settings)?;
+    let (parameter, index, values, frequencies) = swept(model, params, settings)?;
+    let with = |value: f64| {
+        let mut p = params.to_vec();
+        p[index] = value;
+        p
+    };
+    let run = match settings.order {
+        1 => {
+            let systems = |nu: f64| {
+                let k = frequencies.iter().position(|f| *f == nu).unwrap_or(0);
+                let p = with(values[k]);
+                let averaged = model
+                    .averaged(&p)
+                    .expect("a model with a fast phase has an averaged system");
+                (model.exact(&p), averaged)
+            };
+            let (method, t_obs) = (settings.method, settings.t_obs);
+            deviation_against_frequency(method, &systems, &y0, t_obs, &frequencies, dof)?
         }
-        Refusal::named_values(info, self.params)?;
-        let y0: [f64; S] = match &self.settings.y0 {
-            Some(y) => y
-                .as_slice()
-                .try_into()
-                .map_err(|_| Refusal::state_length(info.name, "initial state", y.len(), S))?,
-            None => std::array::from_fn(|i| match i {
-                i if i < D && i % 2 == 0 => 0.2,
-                i if i < D => -0.1,
-                _ => 0.0,
-            }),
-        };
-        let (parameter, index, values, frequencies) = swept(model, self.params, self.settings)?;
-        let with = |value: f64| {
-            let mut p = self.params.to_vec();
-            p[index] = value;
-            p
-        };
-        let run = match self.settings.order {
-            1 => {
-                let systems = |nu: f64| {
-                    let k = frequencies.iter().position(|f| *f == nu).unwrap_or(0);
-                    let p = with(values[k]);
-                    let averaged = model
-                        .averaged(&p)
-                        .expect("a model with a fast phase has an averaged system");
-                    (model.exact(&p), averaged)
-                };
-                deviation_against_frequency(
-                    self.settings.method,
-                    &systems,
-                    &y0,
-                    self.settings.t_obs,
-                    &frequencies,
-                    D,
-                )?
+        2 => {
+            if model.averaged2(params).is_none() {
+                return Err(AveragingError::Order(info.name.into(), 2));
             }
-            2 => {
-                if model.averaged2(self.params).is_none() {
-                    return Err(AveragingError::Order(info.name.into(), 2));
-                }
-                let per_frequency: Vec<Vec<f64>> = frequencies
-                    .par_iter()
-                    .zip(&values)
-                    .map(|(&nu, &value)| {
-                        let grid = time_grid(
-                            self.settings.t_obs,
-                            2.0 * std::f64::consts::PI / nu,
-                            32,
-                            2000,
-                        );
-                        second_order_deviation(
-                            model,
-                            &with(value),
-                            self.settings.method,
-                            &y0,
-                            &grid,
-                        )
+            let per_frequency: Vec<Vec<f64>> = frequencies
+                .par_iter()
+                .zip(&values)
+                .map(|(&nu, &value)| {
+                    let fast_period = 2.0 * std::f64::consts::PI / nu;
+                    let grid = time_grid(settings.t_obs, fast_period, 32, 2000);
+                    second_order_deviation(model, &with(value), settings.method, &y0, &grid)
                         .expect("checked above")
-                    })
-                    .collect::<Result<_, _>>()?;
-                fit_deviations(&frequencies, per_frequency, D)
-            }
-            order => return Err(AveragingError::Order(info.name.into(), order)),
-        };
-        let local: Vec<Vec<f64>> = run
-            .max_deviation
-            .iter()
-            .map(|d| local_slopes(&frequencies, d))
-            .collect();
-        let frequency_times_deviation = run
-            .max_deviation
-            .iter()
-            .map(|d| d.iter().zip(&frequencies).map(|(d, nu)| d * nu).collect())
-            .collect();
-        Ok(AveragingConvergence {
-            model: info.name.into(),
-            parameter,
-            values: values.clone(),
-            frequencies,
-            coordinates: info.coordinates.iter().map(|c| c.to_string()).collect(),
-            y0: y0.to_vec(),
-            t_obs: self.settings.t_obs,
-            order: self.settings.order,
-            frequency_times_deviation,
-            max_deviation: run.max_deviation,
-            slope: run.fits.iter().map(|f| f.slope).collect(),
-            level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
-            settled_slope: local.iter().map(|l| settled(l)).collect(),
-            local_slopes: local,
-        })
+                })
+                .collect::<Result<_, _>>()?;
+            fit_deviations(&frequencies, per_frequency, dof)
+        }
+        order => return Err(AveragingError::Order(info.name.into(), order)),
+    };
+    let local: Vec<Vec<f64>> = run
+        .max_deviation
+        .iter()
+        .map(|d| local_slopes(&frequencies, d))
+        .collect();
+    let frequency_times_deviation = run
+        .max_deviation
+        .iter()
+        .map(|d| d.iter().zip(&frequencies).map(|(d, nu)| d * nu).collect())
+        .collect();
+    Ok(AveragingConvergence {
+        model: info.name.into(),
+        parameter,
+        values: values.clone(),
+        frequencies,
+        coordinates: info.coordinates.iter().map(|c| c.to_string()).collect(),
+        y0,
+        t_obs: settings.t_obs,
+        order: settings.order,
+        frequency_times_deviation,
+        max_deviation: run.max_deviation,
+        slope: run.fits.iter().map(|f| f.slope).collect(),
+        level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
+        settled_slope: local.iter().map(|l| settled(l)).collect(),
+        local_slopes: local,
+    })
+}
+
+/// The start of both runs: the settings', or 0.2, −0.1, 0.2, … in the
+/// coordinates and 0 in the momenta.
+fn initial_state(
+    model: &dyn Systems,
+    settings: &ConvergenceSettings,
+) -> Result<Vec<f64>, Refusal> {
+    let info = model.info();
+    let (dof, n) = (info.coordinates.len(), model.periodic_state().len());
+    match &settings.y0 {
+        Some(y) if y.len() != n => Err(Refusal::state_length(
+            info.name,
+            "initial state",
+            y.len(),
+            n,
+        )),
+        Some(y) => Ok(y.clone()),
+        None => Ok((0..n)
+            .map(|i| match i {
+                i if i < dof && i % 2 == 0 => 0.2,
+                i if i < dof => -0.1,
+                _ => 0.0,
+            })
+            .collect()),
     }
 }
 
 /// The swept parameter, its index, its values and the phase's frequency at
 /// each (checked to change).
 #[allow(clippy::type_complexity)]
-fn swept<
-    F: crate::registry::Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn swept(
+    model: &dyn Systems,
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<(String, usize, Vec<f64>, Vec<f64>), AveragingError> {
