@@ -27,8 +27,7 @@
 //! ```
 
 pub use mechlab_runtime::{
-    analysis, budget, contact, explore, large_models, linalg, mathml, ode, plot, registry, report,
-    studio, study,
+    analysis, budget, contact, explore, linalg, mathml, ode, plot, registry, report, studio, study,
 };
 pub use mechlab_scenes::{scene, scenes};
 

@@ -11,9 +11,9 @@
 
 use crate::analysis::equilibria::Search;
 use crate::contact::{ContactError, ContactModel, StickSlip};
-use crate::ode::{states_at, Method, OdeError};
+use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
-use crate::registry::{display_name, DynamicModel, Fixed, Kind, Model, ModelInfo, WithFixed};
+use crate::registry::{display_name, DynamicModel, Kind, Model, ModelInfo, Systems};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -333,15 +333,9 @@ pub fn explore(
         });
     }
     let name = model.info().name;
-    let runs = HamiltonianRuns {
-        model,
-        params,
-        y0,
-        settings,
-    };
-    // A Hamiltonian model at its own size; otherwise a contact model.
-    if let Some(result) = crate::registry::with_fixed(handle, runs) {
-        return result;
+    // A Hamiltonian model; otherwise a contact model.
+    if let Some(systems) = handle.systems() {
+        return hamiltonian_runs(systems, model, params, y0, settings);
     }
     match expected {
         2 => contacts::<1, 2>(model, params, y0, settings),
@@ -360,70 +354,55 @@ fn grid(t_end: f64, samples: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The runs of a Hamiltonian model at its own sizes, on its generated
-/// systems (so every method, `taylor` included, is available).
-pub struct HamiltonianRuns<'a> {
-    model: &'a dyn DynamicModel,
-    params: &'a [f64],
-    y0: &'a [f64],
-    settings: &'a Settings,
-}
-
-impl WithFixed for HamiltonianRuns<'_> {
-    type Output = Result<Exploration, ExploreError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        fixed: &'static F,
-    ) -> Self::Output {
-        let HamiltonianRuns {
-            model,
-            params,
-            settings,
-            ..
-        } = self;
-        let y0: [f64; S] = to_array(self.y0);
-        let times = grid(settings.t_end, settings.samples);
-        let exact_system = fixed.exact(params);
-        let exact = states_at(settings.method, &exact_system, 0.0, &y0, &times)?;
-        let (found, search, not_searched) = match equilibria(model, params) {
-            Ok((found, search)) => (found, Some(search), None),
-            Err(reason) => (Vec::new(), None, Some(reason)),
-        };
-        let mut out = Exploration {
-            exact: exact.iter().map(|y| y.to_vec()).collect(),
-            equilibria: found,
-            equilibria_search_sampled: search.filter(Search::sampled),
-            equilibria_not_searched: not_searched,
-            ..Default::default()
-        };
-        match (fixed.phase_period(params), fixed.averaged(params)) {
-            (Some(period), Some(averaged_system)) => {
-                let averaged = states_at(settings.method, &averaged_system, 0.0, &y0, &times)?;
-                let h0 = model.averaged_energy(params, &y0).unwrap_or(0.0);
-                out.energy_change = averaged
-                    .iter()
-                    .map(|y| model.averaged_energy(params, y).unwrap_or(0.0) - h0)
-                    .collect();
-                out.energy_label = "averaged Hamiltonian: change along the averaged run";
-                out.averaged = Some(averaged.iter().map(|y| y.to_vec()).collect());
-                let map_times: Vec<f64> =
-                    (0..=settings.periods).map(|k| k as f64 * period).collect();
-                let map = states_at(settings.method, &exact_system, 0.0, &y0, &map_times)?;
-                out.period_map = Some(map.iter().map(|y| y.to_vec()).collect());
-            }
-            _ => {
-                let h0 = model.energy(params, 0.0, &y0);
-                out.energy_change = times
-                    .iter()
-                    .zip(&exact)
-                    .map(|(t, y)| model.energy(params, *t, y) - h0)
-                    .collect();
-                out.energy_label = "H(t) − H(0) along the exact run";
-            }
+/// The runs of a Hamiltonian model on its generated systems (so every
+/// method, `taylor` included, is available).
+fn hamiltonian_runs(
+    systems: &dyn Systems,
+    model: &dyn DynamicModel,
+    params: &[f64],
+    y0: &[f64],
+    settings: &Settings,
+) -> Result<Exploration, ExploreError> {
+    let times = grid(settings.t_end, settings.samples);
+    let exact_system = systems.exact(params);
+    let exact = exact_system.states_at(settings.method, 0.0, y0, &times)?;
+    let (found, search, not_searched) = match equilibria(model, params) {
+        Ok((found, search)) => (found, Some(search), None),
+        Err(reason) => (Vec::new(), None, Some(reason)),
+    };
+    let mut out = Exploration {
+        equilibria: found,
+        equilibria_search_sampled: search.filter(Search::sampled),
+        equilibria_not_searched: not_searched,
+        ..Default::default()
+    };
+    match (systems.phase_period(params), systems.averaged(params)) {
+        (Some(period), Some(averaged_system)) => {
+            let averaged = averaged_system.states_at(settings.method, 0.0, y0, &times)?;
+            let h0 = model.averaged_energy(params, y0).unwrap_or(0.0);
+            out.energy_change = averaged
+                .iter()
+                .map(|y| model.averaged_energy(params, y).unwrap_or(0.0) - h0)
+                .collect();
+            out.energy_label = "averaged Hamiltonian: change along the averaged run";
+            out.averaged = Some(averaged);
+            let map_times: Vec<f64> = (0..=settings.periods).map(|k| k as f64 * period).collect();
+            let map = exact_system.states_at(settings.method, 0.0, y0, &map_times)?;
+            out.period_map = Some(map);
         }
-        out.times = times;
-        Ok(out)
+        _ => {
+            let h0 = model.energy(params, 0.0, y0);
+            out.energy_change = times
+                .iter()
+                .zip(&exact)
+                .map(|(t, y)| model.energy(params, *t, y) - h0)
+                .collect();
+            out.energy_label = "H(t) − H(0) along the exact run";
+        }
     }
+    out.exact = exact;
+    out.times = times;
+    Ok(out)
 }
 
 fn contacts<const C: usize, const M: usize>(

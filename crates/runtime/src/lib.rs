@@ -14,7 +14,6 @@ pub mod analysis;
 pub mod budget;
 pub mod contact;
 pub mod explore;
-pub mod large_models;
 pub mod linalg;
 pub mod mathml;
 pub mod ode;

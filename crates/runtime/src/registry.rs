@@ -4,10 +4,11 @@
 use std::fmt;
 
 use crate::ode::any_size::fixed_state;
-use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem};
+use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem, Stats};
 use crate::tangent::lyapunov::fli_of_starts;
-use crate::tangent::monodromy::monodromy;
+use crate::tangent::monodromy::{monodromies, monodromy};
 pub use mechlab_range::Range;
+use nalgebra::DMatrix;
 
 /// One derived expression in its readable form (checked at build time
 /// against Symbolica's result), as text and LaTeX.
@@ -251,10 +252,11 @@ impl std::error::Error for ParameterError {}
 /// A generated Hamiltonian model at its own sizes: D degrees of freedom, a
 /// state of S = 2D, T = 2S for the state with one tangent vector and
 /// V = S + S² with a full set (stable Rust cannot compute them from D, so
-/// [`with_fixed`] states all four). Analyses are written once over this
-/// trait; its one implementation, [`Erased`], reaches the model's compiled
-/// code through a trait object, so they are compiled once per size and not
-/// again when a model file changes.
+/// the generated code states all four). Its one implementation, [`Erased`],
+/// reaches the model's compiled code through a trait object; it is what
+/// [`Systems`] runs the integrations of a model on at the model's size, and
+/// what the analyses defined for one size only (sections of two degrees of
+/// freedom, separatrices of one) take.
 pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     Sync + 'static
 {
@@ -266,8 +268,6 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     /// again where [`Fixed::averaged2`] gives None).
     type Averaged2: crate::ode::System<S> + Sync;
     fn info(&self) -> &'static ModelInfo;
-    /// The same model with states as slices.
-    fn systems(&'static self) -> &'static dyn Systems;
     fn has_fast_phase(&self) -> bool;
     /// Which coordinates are angles.
     fn periodic(&self) -> [bool; D];
@@ -336,9 +336,6 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
     type Averaged2 = ErasedSystem<S>;
     fn info(&self) -> &'static ModelInfo {
         self.0.info()
-    }
-    fn systems(&'static self) -> &'static dyn Systems {
-        self
     }
     fn has_fast_phase(&self) -> bool {
         self.0.averaged().is_some()
@@ -423,6 +420,21 @@ pub trait Systems: Sync {
         w0: &[f64],
         periods: usize,
     ) -> Result<FliValues, OdeError>;
+    /// The mass matrix A(q).
+    fn mass_matrix(&self, params: &[f64], q: &[f64]) -> DMatrix<f64>;
+    /// ∂V/∂q and C = ∂²V/∂q² of the potential averaged over the phase.
+    fn potential_gradient(&self, params: &[f64], q: &[f64]) -> Vec<f64>;
+    fn potential_hessian(&self, params: &[f64], q: &[f64]) -> DMatrix<f64>;
+    /// V + V_vibr (V without a fast phase) and its Hessian.
+    fn effective_potential(&self, params: &[f64], q: &[f64]) -> f64;
+    fn effective_potential_hessian(&self, params: &[f64], q: &[f64]) -> DMatrix<f64>;
+    /// ∂²K̄/∂y² of the second-order averaged Hamiltonian, where derived.
+    fn averaged2_hessian(&self, params: &[f64], y: &[f64]) -> Option<DMatrix<f64>>;
+    /// The exact system's end state and monodromy matrix over one period
+    /// from `y0`, at each (parameter values, period) of a sweep, and the
+    /// sweep's statistics (see [`crate::tangent::monodromy::monodromies`]:
+    /// the Taylor method runs them in its lanes).
+    fn monodromies(&self, method: Method, problems: &[(Vec<f64>, f64)], y0: &[f64]) -> Monodromies;
     /// The exact system's state after `period` from `y0` and the monodromy
     /// matrix ∂y(T)/∂y(0) (see [`crate::tangent::monodromy::monodromy`]).
     fn monodromy(
@@ -436,6 +448,21 @@ pub trait Systems: Sync {
 
 /// Each orbit's FLI (or why it stopped) and the f-evaluations spent.
 pub type FliValues = (Vec<Result<f64, OdeError>>, u64);
+
+/// Each problem's end state and monodromy matrix (or why it stopped), and
+/// the statistics of their runs.
+pub type Monodromies = (Vec<Result<(Vec<f64>, DMatrix<f64>), OdeError>>, Stats);
+
+/// The coordinates `q` at the model's number D (the analyses check a
+/// user's equilibrium's length before they ask).
+fn coordinates<const D: usize>(q: &[f64]) -> [f64; D] {
+    fixed_state::<D>(q).expect("coordinates of the model's length")
+}
+
+/// A fixed-size matrix as a dynamic one.
+fn matrix<const N: usize>(m: &[[f64; N]; N]) -> DMatrix<f64> {
+    DMatrix::from_fn(N, N, |i, k| m[i][k])
+}
 
 impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
     for Erased<D, S, T, V>
@@ -484,6 +511,47 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
         let system = Fixed::exact(self, params);
         fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
     }
+    fn mass_matrix(&self, params: &[f64], q: &[f64]) -> DMatrix<f64> {
+        matrix(&self.0.mass_matrix(params, &coordinates::<D>(q)))
+    }
+    fn potential_gradient(&self, params: &[f64], q: &[f64]) -> Vec<f64> {
+        self.0
+            .potential_gradient(params, &coordinates::<D>(q))
+            .to_vec()
+    }
+    fn potential_hessian(&self, params: &[f64], q: &[f64]) -> DMatrix<f64> {
+        matrix(&self.0.potential_hessian(params, &coordinates::<D>(q)))
+    }
+    fn effective_potential(&self, params: &[f64], q: &[f64]) -> f64 {
+        self.0.effective_potential(params, &coordinates::<D>(q))
+    }
+    fn effective_potential_hessian(&self, params: &[f64], q: &[f64]) -> DMatrix<f64> {
+        matrix(
+            &self
+                .0
+                .effective_potential_hessian(params, &coordinates::<D>(q)),
+        )
+    }
+    fn averaged2_hessian(&self, params: &[f64], y: &[f64]) -> Option<DMatrix<f64>> {
+        let y = fixed_state::<S>(y).ok()?;
+        Some(matrix(&self.0.averaged2_hessian(params, &y)?))
+    }
+    fn monodromies(&self, method: Method, problems: &[(Vec<f64>, f64)], y0: &[f64]) -> Monodromies {
+        let y0 = match fixed_state::<S>(y0) {
+            Ok(y0) => y0,
+            Err(e) => return (vec![Err(e); problems.len()], Stats::default()),
+        };
+        let problems: Vec<_> = problems
+            .iter()
+            .map(|(params, period)| (Fixed::exact(self, params), *period, y0))
+            .collect();
+        let (results, stats) = monodromies::<_, S, V>(method, &problems);
+        let results = results
+            .into_iter()
+            .map(|r| r.map(|(end, m)| (end.to_vec(), matrix(&m))))
+            .collect();
+        (results, stats)
+    }
     fn monodromy(
         &self,
         params: &[f64],
@@ -494,35 +562,21 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
         let y0 = fixed_state::<S>(y0)?;
         let system = Fixed::exact(self, params);
         let (image, m) = monodromy::<_, S, V>(integrator, &system, period, &y0)?;
-        Ok((image.to_vec(), nalgebra::DMatrix::from_fn(S, S, |i, k| m[i][k])))
+        Ok((image.to_vec(), matrix(&m)))
     }
 }
 
-/// A Hamiltonian model at its own size, for [`with_fixed`]. The analyses
-/// are compiled ahead, in this crate, for 1 to 3 degrees of freedom; a
-/// model of 4 to 24 brings its own (see [`crate::large_models`]).
+/// A Hamiltonian model at its own size: for 1 to 3 degrees of freedom the
+/// runtime's instances (the analyses of one size, sections and separatrices,
+/// read them), for more the model's [`Systems`], compiled in the models
+/// package at the model's size.
 #[derive(Clone, Copy)]
 pub enum FixedSize {
     Dof1(&'static Erased<1, 2, 4, 6>),
     Dof2(&'static Erased<2, 4, 8, 20>),
     Dof3(&'static Erased<3, 6, 12, 42>),
-    /// 4 to 24 degrees of freedom: a [`crate::large_models::LargeHandle`],
-    /// and the model's [`Systems`] (compiled in the models package).
-    Large(LargeHandleRef, &'static dyn Systems),
+    Large(&'static dyn Systems),
 }
-
-/// A work that also runs on a model of 4 to 24 degrees of freedom, whose
-/// analyses are compiled in the models package at its size
-/// ([`crate::large_models`] implements it for every analysis's work).
-pub trait LargeWork: WithFixed {
-    /// Runs on the model behind `model`, a [`crate::large_models::LargeHandle`].
-    fn on_large(self, model: LargeHandleRef) -> Self::Output;
-}
-
-/// A model of 4 to 24 degrees of freedom, type-erased: the registry holds it
-/// without naming the analyses (which import the registry), and
-/// [`crate::large_models`], above both, reads it back.
-pub type LargeHandleRef = &'static (dyn std::any::Any + Send + Sync);
 
 /// One generated model: what it is, its dynamically sized interface, and
 /// for Hamiltonian models the same at its own sizes.
@@ -541,7 +595,7 @@ impl Model {
             FixedSize::Dof1(m) => m,
             FixedSize::Dof2(m) => m,
             FixedSize::Dof3(m) => m,
-            FixedSize::Large(_, m) => m,
+            FixedSize::Large(m) => m,
         })
     }
 }
@@ -585,28 +639,6 @@ pub fn lookup(catalog: Catalog, name: &str) -> Result<&'static Model, UnknownMod
             name: name.to_string(),
             known: catalog.iter().map(|m| m.info.name).collect(),
         })
-}
-
-/// Work to run on one model at its own sizes (see [`Fixed`]).
-pub trait WithFixed {
-    type Output;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output;
-}
-
-/// Runs `work` on a Hamiltonian model at its own sizes (None for a
-/// contact model). The analyses are compiled once per size, whatever the
-/// models are: here for 1 to 3 degrees of freedom, in the models package
-/// for larger sizes that its model files have.
-pub fn with_fixed<W: LargeWork>(model: &Model, work: W) -> Option<W::Output> {
-    model.sized.map(|sized| match sized {
-        FixedSize::Dof1(m) => work.run::<_, 1, 2, 4, 6>(m),
-        FixedSize::Dof2(m) => work.run::<_, 2, 4, 8, 20>(m),
-        FixedSize::Dof3(m) => work.run::<_, 3, 6, 12, 42>(m),
-        FixedSize::Large(m, _) => work.on_large(m),
-    })
 }
 
 /// A name of a model file in the notation of the figures: Greek names as

@@ -7,6 +7,6 @@
 // The paths the generated modules name (`crate::ode`, ...); a folder
 // without contact models leaves `contact` unused.
 #[allow(unused_imports)]
-use mechlab_runtime::{contact, large_models, linalg, ode, registry};
+use mechlab_runtime::{contact, linalg, ode, registry};
 
 include!(concat!(env!("OUT_DIR"), "/generated/mod.rs"));

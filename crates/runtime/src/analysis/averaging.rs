@@ -8,7 +8,7 @@
 
 use super::fit::{log_log, LineFit};
 use crate::analysis::Refusal;
-use crate::ode::{states_at, AnyOptions, AnySystem, Integrator, Method, OdeError, System};
+use crate::ode::{states_at, AnySystem, Method, OdeError, System};
 use crate::registry::{Model, Systems};
 use rayon::prelude::*;
 
@@ -84,8 +84,8 @@ pub fn deviation_against_frequency(
         .map(|&nu| {
             let (exact, averaged) = systems(nu);
             let grid = time_grid(t_obs, 2.0 * std::f64::consts::PI / nu, 32, 2000);
-            let exact = samples(method, &*exact, y0, &grid)?;
-            let averaged = samples(method, &*averaged, y0, &grid)?;
+            let exact = exact.states_at(method, 0.0, y0, &grid)?;
+            let averaged = averaged.states_at(method, 0.0, y0, &grid)?;
             Ok((0..coordinates)
                 .map(|i| {
                     exact
@@ -98,21 +98,6 @@ pub fn deviation_against_frequency(
         })
         .collect::<Result<_, OdeError>>()?;
     Ok(fit_deviations(frequencies, per_frequency, coordinates))
-}
-
-/// The states at `times` of a fresh run of `method` from (0, y0) (as
-/// [`states_at`]).
-fn samples(
-    method: Method,
-    system: &dyn AnySystem,
-    y0: &[f64],
-    times: &[f64],
-) -> Result<Vec<Vec<f64>>, OdeError> {
-    let t1 = times.last().copied().unwrap_or(0.0);
-    let options = AnyOptions::default().times(times);
-    Ok(system
-        .solve(&mut Integrator::new(method)?, 0.0, y0, t1, options)?
-        .samples)
 }
 
 /// Per coordinate, the deviations against the frequencies and their
@@ -271,8 +256,8 @@ pub fn second_order_deviation(
     let start: Vec<f64> = y0.iter().zip(&shift0).map(|(y, s)| y - s).collect();
     let dof = model.info().coordinates.len();
     let run = || -> Result<Vec<f64>, OdeError> {
-        let exact = samples(method, &*model.exact(params), y0, times)?;
-        let transformed = samples(method, &*averaged, &start, times)?;
+        let exact = model.exact(params).states_at(method, 0.0, y0, times)?;
+        let transformed = averaged.states_at(method, 0.0, &start, times)?;
         let mut worst = vec![0.0f64; dof];
         for ((t, e), y) in times.iter().zip(&exact).zip(&transformed) {
             let shift = model
@@ -371,10 +356,7 @@ pub fn convergence(
 
 /// The start of both runs: the settings', or 0.2, −0.1, 0.2, … in the
 /// coordinates and 0 in the momenta.
-fn initial_state(
-    model: &dyn Systems,
-    settings: &ConvergenceSettings,
-) -> Result<Vec<f64>, Refusal> {
+fn initial_state(model: &dyn Systems, settings: &ConvergenceSettings) -> Result<Vec<f64>, Refusal> {
     let info = model.info();
     let (dof, n) = (info.coordinates.len(), model.periodic_state().len());
     match &settings.y0 {

@@ -137,7 +137,10 @@ pub fn chaos_map(
             &w0,
             settings.periods,
         )?;
-        let values = values.into_iter().map(pixel_value).collect::<Result<_, _>>()?;
+        let values = values
+            .into_iter()
+            .map(pixel_value)
+            .collect::<Result<_, _>>()?;
         for _ in rows {
             if !row_done() {
                 stopped.store(true, std::sync::atomic::Ordering::Relaxed);

@@ -17,7 +17,7 @@
 
 use crate::analysis::Refusal;
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options};
-use crate::registry::{Fixed, FixedSize, Model, WithFixed};
+use crate::registry::{Fixed, FixedSize, Model};
 use rayon::prelude::*;
 
 /// Where the section lies and how far each orbit is followed.
@@ -285,12 +285,12 @@ pub struct Sections<'a> {
     settings: &'a SectionSettings,
 }
 
-impl WithFixed for Sections<'_> {
-    type Output = Result<Section, SectionError>;
+impl Sections<'_> {
+    /// The section on the model at its size (called at 2 degrees of freedom).
     fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
         self,
         fixed: &'static F,
-    ) -> Self::Output {
+    ) -> Result<Section, SectionError> {
         let info = fixed.info();
         let name = info.name.to_string();
         if D != 2 {

@@ -13,13 +13,13 @@
 //! quadratic dependence is checked (else the reason is given).
 
 use super::continuation::{orbit_branch, OrbitBranch};
-use super::floquet::{floquet_multipliers, monodromies, spectral_radius, window_in_batches};
+use super::floquet::{multipliers_of, spectral_radius, window_in_batches};
 use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
-use super::vibrational_stability::generalized_eigenvalues;
+use super::vibrational_stability::generalized_eigenvalues_of;
 use crate::analysis::period_map::wrap_angle;
 use crate::analysis::Refusal;
-use crate::ode::{Method, OdeError, System};
-use crate::registry::{Fixed, Model, WithFixed};
+use crate::ode::{Method, OdeError};
+use crate::registry::{Model, Systems};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::cell::RefCell;
@@ -234,39 +234,36 @@ pub fn stability(
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
-    crate::registry::with_fixed(model, Analysis { params, settings })
-        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?
+    let model = model
+        .systems()
+        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
+    analyse(model, params, settings)
 }
 
-/// The work of [`stability`]: equilibria, thresholds and windows at one size.
-pub struct Analysis<'a> {
-    params: &'a [f64],
-    settings: &'a Settings,
-}
-
-impl WithFixed for Analysis<'_> {
-    type Output = Result<Stability, StabilityError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
+/// [`stability`] on the model's systems.
+fn analyse(
+    model: &'static dyn Systems,
+    params: &[f64],
+    settings: &Settings,
+) -> Result<Stability, StabilityError> {
+    {
         let info = model.info();
-        let params = vibrating_model(model, self.params)?;
-        let amplitude = parameter_index(info, &self.settings.amplitude)?;
+        let named = vibrating_model(model, params)?;
+        let amplitude = parameter_index(info, &settings.amplitude)?;
         let mut result = Stability {
             model: info.name.into(),
             coordinates: info.coordinates,
-            amplitude: self.settings.amplitude.clone(),
-            params,
+            amplitude: settings.amplitude.clone(),
+            params: named,
             equilibria: Vec::new(),
             moved_by_vibration: Vec::new(),
             none_because: None,
             search_sampled: None,
         };
-        let (found, search) = equilibria_without_vibration(model, self.params);
+        let (found, search) = equilibria_without_vibration(model, params);
         result.search_sampled = search.sampled().then_some(search);
         // The exact system is probed at the given amplitude (1 where it is 0).
-        let mut probe = self.params.to_vec();
+        let mut probe = params.to_vec();
         if probe[amplitude] == 0.0 {
             probe[amplitude] = 1.0;
         }
@@ -274,29 +271,29 @@ impl WithFixed for Analysis<'_> {
         // orbits (each a sweep of Floquet multipliers) after, for at most
         // `max_windows` equilibria: those with the lowest thresholds a*,
         // then those the vibration moves.
-        let mut moved: Vec<([f64; D], bool)> = Vec::new();
+        let mut moved: Vec<(Vec<f64>, bool)> = Vec::new();
         for q in &found {
-            if let Some(along) = singular_chart(model, self.params, q) {
+            if let Some(along) = singular_chart(model, params, q) {
                 // One entry per pole: the same point at every value of the
                 // coordinates the chart loses there.
                 let same_pole = |e: &EquilibriumStability| {
                     e.reason.as_deref() == Some(SINGULAR_CHART)
-                        && (0..D).all(|i| along.contains(&i) || (e.q[i] - q[i]).abs() < 1e-9)
+                        && (0..q.len()).all(|i| along.contains(&i) || (e.q[i] - q[i]).abs() < 1e-9)
                 };
                 if !result.equilibria.iter().any(same_pole) {
                     result.equilibria.push(at_singular_chart(q));
                 }
                 continue;
             }
-            let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
-            let averaged = stays_in_averaged_system(model, self.params, q);
+            let y0 = at_rest(q);
+            let averaged = stays_in_averaged_system(model, params, q);
             if !averaged || moved_by_vibration(model, &probe, &y0) {
-                moved.push((*q, averaged));
+                moved.push((q.clone(), averaged));
                 continue;
             }
             result
                 .equilibria
-                .push(averaged_verdict(model, self.params, amplitude, q));
+                .push(averaged_verdict(model, params, amplitude, q));
         }
         let mut with_threshold: Vec<usize> = (0..result.equilibria.len())
             .filter(|&k| result.equilibria[k].a_star.is_some())
@@ -305,7 +302,7 @@ impl WithFixed for Analysis<'_> {
             let a = |k: usize| result.equilibria[k].a_star.unwrap_or(f64::INFINITY);
             a(x).total_cmp(&a(y))
         });
-        let budget = self.settings.max_windows;
+        let budget = settings.max_windows;
         let costly = with_threshold.len() + moved.len();
         let skipped = format!(
             "not computed: {costly} equilibria need an exact sweep, and the {budget} with the lowest thresholds come first (--set max_windows=N for more)"
@@ -316,13 +313,13 @@ impl WithFixed for Analysis<'_> {
                 e.exact_reason = Some(skipped.clone());
                 continue;
             }
-            let q: [f64; D] = std::array::from_fn(|i| e.q[i]);
-            exact_window(model, self.params, amplitude, &q, self.settings, e)?;
+            let q = e.q.clone();
+            exact_window(model, params, amplitude, &q, settings, e)?;
         }
         for e in result.equilibria.iter_mut() {
             if e.a_star.is_none() && e.exact_reason.is_none() {
-                let q: [f64; D] = std::array::from_fn(|i| e.q[i]);
-                exact_window(model, self.params, amplitude, &q, self.settings, e)?;
+                let q = e.q.clone();
+                exact_window(model, params, amplitude, &q, settings, e)?;
             }
         }
         for (rank, (q, averaged)) in moved.into_iter().enumerate() {
@@ -339,7 +336,7 @@ impl WithFixed for Analysis<'_> {
                         exact_reason: Some(skipped.clone()),
                     }
                 } else {
-                    moved_equilibrium(model, &probe, amplitude, self.settings, &q, averaged)
+                    moved_equilibrium(model, &probe, amplitude, settings, &q, averaged)
                 });
         }
         if result.equilibria.is_empty() {
@@ -358,27 +355,21 @@ impl WithFixed for Analysis<'_> {
 /// An equilibrium without vibration that the vibration moves: its orbit's
 /// branch from amplitude 0 and the periodic orbit near it at the probed
 /// amplitude `probe` (`averaged`: whether the averaged system keeps it).
-fn moved_equilibrium<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &'static F,
+fn moved_equilibrium(
+    model: &'static dyn Systems,
     probe: &[f64],
     amplitude: usize,
     settings: &Settings,
-    q: &[f64; D],
+    q: &[f64],
     averaged: bool,
 ) -> MovedEquilibrium {
-    let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+    let y0 = at_rest(q);
     let a_max = settings.a_max.unwrap_or(3.0 * probe[amplitude]);
     let branch = averaged.then(|| {
         let mut at_rest = probe.to_vec();
         at_rest[amplitude] = 0.0;
         orbit_branch(
-            model.systems(),
+            model,
             &at_rest,
             amplitude,
             settings.method,
@@ -388,7 +379,7 @@ fn moved_equilibrium<
     });
     // Newton at the probed amplitude from the branch's nearest point (from
     // (q, 0) where the branch could not be had).
-    let near: [f64; S] = match &branch {
+    let near: Vec<f64> = match &branch {
         Some(Ok(b)) => b
             .states
             .iter()
@@ -397,11 +388,11 @@ fn moved_equilibrium<
                     .abs()
                     .total_cmp(&(y.0 - probe[amplitude]).abs())
             })
-            .map_or(y0, |(_, y)| std::array::from_fn(|i| y[i])),
-        _ => y0,
+            .map_or(y0.clone(), |(_, y)| y.clone()),
+        _ => y0.clone(),
     };
     let orbit = if averaged {
-        periodic_orbit_near::<F, D, S, T, V>(model, probe, &near, &settings.method)
+        periodic_orbit_near(model, probe, &near, &settings.method)
     } else {
         None
     };
@@ -426,9 +417,9 @@ fn moved_equilibrium<
     };
     let (periodic_orbit, multipliers, verdict) = match orbit {
         Some((y, m)) => {
-            let multipliers = floquet_multipliers(&m);
+            let multipliers = multipliers_of(&m);
             let verdict = super::floquet::Verdict::from_multipliers(&multipliers, 1e-7);
-            (Some(y.to_vec()), multipliers, Some(verdict.name()))
+            (Some(y), multipliers, Some(verdict.name()))
         }
         None => (None, Vec::new(), None),
     };
@@ -469,72 +460,40 @@ pub fn averaged_stability(
     amplitude: &str,
     q: &[f64],
 ) -> Result<EquilibriumStability, StabilityError> {
-    crate::registry::with_fixed(
-        model,
-        AtEquilibrium {
-            params,
-            amplitude,
-            q,
-        },
-    )
-    .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?
-}
-
-/// The work of [`averaged_stability`]: one equilibrium judged at one size.
-pub struct AtEquilibrium<'a> {
-    params: &'a [f64],
-    amplitude: &'a str,
-    q: &'a [f64],
-}
-
-impl WithFixed for AtEquilibrium<'_> {
-    type Output = Result<EquilibriumStability, StabilityError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
-        let info = model.info();
-        vibrating_model(model, self.params)?;
-        let amplitude = parameter_index(info, self.amplitude)?;
-        let q: [f64; D] = self
-            .q
-            .try_into()
-            .map_err(|_| StabilityError::ParameterCount(self.q.len(), info.name.into()))?;
-        Ok(averaged_verdict(model, self.params, amplitude, &q))
+    let model = model
+        .systems()
+        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
+    let info = model.info();
+    vibrating_model(model, params)?;
+    let amplitude = parameter_index(info, amplitude)?;
+    if q.len() != info.coordinates.len() {
+        return Err(StabilityError::ParameterCount(q.len(), info.name.into()));
     }
+    Ok(averaged_verdict(model, params, amplitude, q))
 }
 
 /// Equilibria of the potential V without vibration: the shared finder
 /// ([`super::equilibria`]) on the generated ∂V/∂q with the generated C;
 /// duplicates merged (angles modulo 2π). Also how much of the grid of
 /// starts was searched.
-fn equilibria_without_vibration<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn equilibria_without_vibration(
+    model: &dyn Systems,
     params: &[f64],
-) -> (Vec<[f64; D]>, super::equilibria::Search) {
+) -> (Vec<Vec<f64>>, super::equilibria::Search) {
     use super::equilibria::{newton, starts, wrapped, Convergence};
-    let periodic = model.periodic();
-    let at = |q: &[f64]| -> [f64; D] { std::array::from_fn(|i| q[i]) };
-    let gradient = |q: &[f64]| model.potential_gradient(params, &at(q)).to_vec();
-    let hessian = |q: &[f64]| {
-        let h = model.potential_hessian(params, &at(q));
-        DMatrix::from_fn(D, D, |i, j| h[i][j])
-    };
-    let starts = starts(&periodic);
-    let mut found: Vec<[f64; D]> = Vec::new();
+    let dof = model.info().coordinates.len();
+    let periodic = &model.periodic_state()[..dof];
+    let gradient = |q: &[f64]| model.potential_gradient(params, q);
+    let hessian = |q: &[f64]| model.potential_hessian(params, q);
+    let starts = starts(periodic);
+    let mut found: Vec<Vec<f64>> = Vec::new();
     for start in &starts.points {
         let Some(q) = newton(gradient, hessian, start.clone(), Convergence::Exact) else {
             continue;
         };
-        let q = at(&wrapped(q, &periodic));
-        let same = |e: &[f64; D]| {
-            (0..D).all(|i| {
+        let q = wrapped(q, periodic);
+        let same = |e: &Vec<f64>| {
+            (0..dof).all(|i| {
                 let d = if periodic[i] {
                     wrap_angle(e[i] - q[i])
                 } else {
@@ -559,27 +518,16 @@ fn equilibria_without_vibration<
 
 /// Whether ∇(V + V_vibr) vanishes at q too (central differences of the
 /// generated V + V_vibr, relative to its Hessian's scale).
-fn stays_in_averaged_system<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
-    params: &[f64],
-    q: &[f64; D],
-) -> bool {
+fn stays_in_averaged_system(model: &dyn Systems, params: &[f64], q: &[f64]) -> bool {
     let scale = 1.0
         + model
             .effective_potential_hessian(params, q)
             .iter()
-            .flatten()
             .map(|x| x.abs())
             .fold(0.0, f64::max);
-    (0..D).all(|i| {
+    (0..q.len()).all(|i| {
         let h = 1e-5;
-        let (mut up, mut down) = (*q, *q);
+        let (mut up, mut down) = (q.to_vec(), q.to_vec());
         up[i] += h;
         down[i] -= h;
         let slope = (model.effective_potential(params, &up)
@@ -595,31 +543,25 @@ const SINGULAR_CHART: &str = "singular chart: the mass matrix is singular here (
 /// The coordinates along which the mass matrix vanishes at q (a zero
 /// diagonal entry: the azimuth at a pole of spherical coordinates), if its
 /// determinant vanishes there; None where it is regular.
-fn singular_chart<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
-    params: &[f64],
-    q: &[f64; D],
-) -> Option<Vec<usize>> {
+fn singular_chart(model: &dyn Systems, params: &[f64], q: &[f64]) -> Option<Vec<usize>> {
     let a = model.mass_matrix(params, q);
-    let m = DMatrix::from_fn(D, D, |i, j| 0.5 * (a[i][j] + a[j][i]));
+    let d = q.len();
+    let m = DMatrix::from_fn(d, d, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
     let scale = 1.0 + m.amax();
     // Its smallest eigenvalue against its largest: the determinant against
     // scaleᴰ would call a long chain's regular mass matrix singular (det 1
     // against 13¹² for 12 links).
     let eigenvalues = m.symmetric_eigenvalues();
     let largest = eigenvalues.amax();
-    (eigenvalues.amin() <= 1e-12 * largest)
-        .then(|| (0..D).filter(|&i| a[i][i].abs() <= 1e-12 * scale).collect())
+    (eigenvalues.amin() <= 1e-12 * largest).then(|| {
+        (0..d)
+            .filter(|&i| a[(i, i)].abs() <= 1e-12 * scale)
+            .collect()
+    })
 }
 
 /// The entry of an equilibrium at a singular point of the chart.
-fn at_singular_chart<const D: usize>(q: &[f64; D]) -> EquilibriumStability {
+fn at_singular_chart(q: &[f64]) -> EquilibriumStability {
     EquilibriumStability {
         q: q.to_vec(),
         lambdas: Vec::new(),
@@ -634,22 +576,14 @@ fn at_singular_chart<const D: usize>(q: &[f64; D]) -> EquilibriumStability {
 }
 
 /// The roots λ, the verdict without vibration and a* from C + a²K.
-fn averaged_verdict<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn averaged_verdict(
+    model: &dyn Systems,
     params: &[f64],
     amplitude: usize,
-    q: &[f64; D],
+    q: &[f64],
 ) -> EquilibriumStability {
     let c = model.potential_hessian(params, q);
-    let lambdas = generalized_eigenvalues(&model.mass_matrix(params, q), &c)
-        .map(|l| l.to_vec())
-        .unwrap_or_default();
+    let lambdas = generalized_eigenvalues_of(&model.mass_matrix(params, q), &c).unwrap_or_default();
     let stable_without_vibration = !lambdas.is_empty() && lambdas.iter().all(|l| *l > 0.0);
     let (a_star, reason) = threshold(model, params, amplitude, q, stable_without_vibration);
     let a_star_second_order =
@@ -667,23 +601,16 @@ fn averaged_verdict<
     }
 }
 
-fn hessian_at<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn hessian_at(
+    model: &dyn Systems,
     params: &[f64],
     amplitude: usize,
     a: f64,
-    q: &[f64; D],
+    q: &[f64],
 ) -> DMatrix<f64> {
     let mut p = params.to_vec();
     p[amplitude] = a;
-    let h = model.effective_potential_hessian(&p, q);
-    let m = DMatrix::from_fn(D, D, |i, j| h[i][j]);
+    let m = model.effective_potential_hessian(&p, q);
     (&m + m.transpose()) * 0.5
 }
 
@@ -692,17 +619,11 @@ fn positive_definite(m: &DMatrix<f64>) -> bool {
 }
 
 /// a* with C + a*²K on the edge of positive definiteness, or why none.
-fn threshold<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn threshold(
+    model: &dyn Systems,
     params: &[f64],
     amplitude: usize,
-    q: &[f64; D],
+    q: &[f64],
     stable_without_vibration: bool,
 ) -> (Option<f64>, Option<String>) {
     let name = model.info().parameter_names[amplitude];
@@ -734,7 +655,7 @@ fn threshold<
         let l_inv = cholesky
             .l()
             .try_inverse()
-            .unwrap_or_else(|| DMatrix::zeros(D, D));
+            .unwrap_or_else(|| DMatrix::zeros(q.len(), q.len()));
         let m = &l_inv * (-&c) * l_inv.transpose();
         let m = (&m + m.transpose()) * 0.5;
         let mu = m.symmetric_eigenvalues().max();
@@ -773,27 +694,17 @@ fn threshold<
 /// Newton on its field; it moves by O(ε²) where K̄ has terms odd in p), and
 /// whether K̄'s Hessian is positive definite there; None where the
 /// second-order system is not derived or Newton does not converge.
-fn second_order_stable<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
-    params: &[f64],
-    q: &[f64; D],
-) -> Option<bool> {
+fn second_order_stable(model: &dyn Systems, params: &[f64], q: &[f64]) -> Option<bool> {
     let system = model.averaged2(params)?;
-    let mut y = [0.0; S];
-    y[..D].copy_from_slice(q);
-    let mut hessian = DMatrix::zeros(S, S);
+    let (d, n) = (q.len(), system.dim());
+    let mut y = at_rest(q);
+    let mut hessian = DMatrix::zeros(n, n);
     for _ in 0..20 {
         let h = model.averaged2_hessian(params, &y)?;
-        hessian = DMatrix::from_fn(S, S, |i, j| 0.5 * (h[i][j] + h[j][i]));
+        hessian = DMatrix::from_fn(n, n, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
         // The field is J∇K̄ (+ forces): ∇K̄ = −J f without forces.
-        let f = system.rhs(0.0, &y);
-        let gradient = DVector::from_fn(S, |i, _| if i < D { -f[D + i] } else { f[i - D] });
+        let f = system.rhs(0.0, &y).ok()?;
+        let gradient = DVector::from_fn(n, |i, _| if i < d { -f[d + i] } else { f[i - d] });
         if gradient.amax() < 1e-13 * (1.0 + hessian.amax()) {
             return Some(positive_definite(&hessian));
         }
@@ -808,17 +719,11 @@ fn second_order_stable<
 /// The amplitude at which the second-order averaged system's equilibrium
 /// near (q, 0) becomes stable (K̄'s Hessian positive definite), by
 /// bisection in [a*/2, 2a*] to 1e-13.
-fn second_order_threshold<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn second_order_threshold(
+    model: &dyn Systems,
     params: &[f64],
     amplitude: usize,
-    q: &[f64; D],
+    q: &[f64],
     a_star: f64,
 ) -> Option<f64> {
     let stable = |a: f64| {
@@ -841,6 +746,13 @@ fn second_order_threshold<
     Some(high)
 }
 
+/// The state at rest at the coordinates q: (q, 0).
+fn at_rest(q: &[f64]) -> Vec<f64> {
+    let mut y = q.to_vec();
+    y.resize(2 * q.len(), 0.0);
+    y
+}
+
 /// Multipliers within this of the unit circle count as stable (the
 /// integration error of a conservative system's monodromy matrix).
 const STABLE_SLACK: f64 = 1e-6;
@@ -849,16 +761,10 @@ const STABLE_SLACK: f64 = 1e-6;
 /// period of the phase from `y0`, at each parameter point of `points` (a
 /// sweep): on all cores, in batches of the method's width (the lanes of the
 /// batch Taylor method; each as its own scalar run, bit for bit).
-fn spectral_radii_at<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn spectral_radii_at(
+    model: &dyn Systems,
     points: &[Vec<f64>],
-    y0: &[f64; S],
+    y0: &[f64],
     method: Method,
 ) -> Result<Vec<f64>, OdeError> {
     use rayon::prelude::*;
@@ -874,15 +780,13 @@ fn spectral_radii_at<
         .map(|chunk| {
             let problems: Vec<_> = chunk
                 .iter()
-                .map(|p| {
-                    let period = model.phase_period(p).unwrap_or(f64::NAN);
-                    (model.exact(p), period, *y0)
-                })
+                .map(|p| (p.clone(), model.phase_period(p).unwrap_or(f64::NAN)))
                 .collect();
-            monodromies::<_, S, V>(method, &problems)
+            model
+                .monodromies(method, &problems, y0)
                 .0
                 .into_iter()
-                .map(|result| result.map(|(_, m)| spectral_radius(&floquet_multipliers(&m))))
+                .map(|result| result.map(|(_, m)| spectral_radius(&multipliers_of(&m))))
                 .collect()
         })
         .collect::<Result<_, _>>()?;
@@ -891,14 +795,8 @@ fn spectral_radii_at<
 
 /// The parameters by name of a model with a fast phase, or why it cannot be
 /// analysed (no phase, a wrong number of values).
-fn vibrating_model<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn vibrating_model(
+    model: &dyn Systems,
     params: &[f64],
 ) -> Result<BTreeMap<String, f64>, StabilityError> {
     let info = model.info();
@@ -912,17 +810,11 @@ fn vibrating_model<
 /// The exact system's stability window in the amplitude at (q, 0), from
 /// the spectral radius of its monodromy matrix over one period of the
 /// phase, if (q, 0) is a solution of the exact system for every amplitude.
-fn exact_window<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn exact_window(
+    model: &dyn Systems,
     params: &[f64],
     amplitude: usize,
-    q: &[f64; D],
+    q: &[f64],
     settings: &Settings,
     out: &mut EquilibriumStability,
 ) -> Result<(), OdeError> {
@@ -930,7 +822,7 @@ fn exact_window<
         out.exact_reason = Some("no threshold in the averaged system".into());
         return Ok(());
     };
-    let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+    let y0 = at_rest(q);
     let with = |a: f64| {
         let mut p = params.to_vec();
         p[amplitude] = a;
@@ -970,63 +862,47 @@ fn exact_window<
 
 /// Whether the exact system at parameter values `params` moves the state
 /// `y0`: its field, at eight phases of a period, is not zero.
-fn moved_by_vibration<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
-    params: &[f64],
-    y0: &[f64; S],
-) -> bool {
+fn moved_by_vibration(model: &dyn Systems, params: &[f64], y0: &[f64]) -> bool {
     let period = model.phase_period(params).unwrap_or(f64::NAN);
     let exact = model.exact(params);
     (0..8).any(|k| {
         let f = exact.rhs(period * k as f64 / 8.0, y0);
-        f.iter().map(|x| x.abs()).fold(0.0, f64::max) > 1e-9
+        f.map_or(true, |f| {
+            f.iter().map(|x| x.abs()).fold(0.0, f64::max) > 1e-9
+        })
     })
 }
 
 /// The periodic orbit of the exact system near `y0`: Newton on P(y) − y
 /// with the monodromy matrix M (solving (M − I) δ = −(P(y) − y)), at most
 /// 30 steps and within 1 of `y0`; the orbit's start and its M, or None.
-fn periodic_orbit_near<
-    F: Fixed<D, S, T, V>,
-    const D: usize,
-    const S: usize,
-    const T: usize,
-    const V: usize,
->(
-    model: &F,
+fn periodic_orbit_near(
+    model: &dyn Systems,
     params: &[f64],
-    y0: &[f64; S],
+    y0: &[f64],
     method: &Method,
-) -> Option<([f64; S], [[f64; S]; S])> {
+) -> Option<(Vec<f64>, DMatrix<f64>)> {
     let period = model.phase_period(params)?;
-    let system = model.exact(params);
-    let mut y = *y0;
+    let n = y0.len();
+    let mut y = y0.to_vec();
     for _ in 0..30 {
         let mut integrator = crate::ode::Integrator::new(*method).ok()?;
-        let (image, m) =
-            super::floquet::monodromy::<_, S, V>(&mut integrator, &system, period, &y).ok()?;
-        let a = DMatrix::from_fn(S, S, |i, k| m[i][k] - f64::from(u8::from(i == k)));
-        let r = DVector::from_fn(S, |i, _| image[i] - y[i]);
+        let (image, m) = model.monodromy(params, &mut integrator, period, &y).ok()?;
+        let a = DMatrix::from_fn(n, n, |i, k| m[(i, k)] - f64::from(u8::from(i == k)));
+        let r = DVector::from_fn(n, |i, _| image[i] - y[i]);
         let step = a.lu().solve(&r)?;
-        for i in 0..S {
+        for i in 0..n {
             y[i] -= step[i];
         }
         // An orbit more than 1 away is not the one near the equilibrium
         // (and a runaway Newton step would integrate far out).
-        let away = (0..S).map(|i| (y[i] - y0[i]).abs()).fold(0.0, f64::max);
+        let away = (0..n).map(|i| (y[i] - y0[i]).abs()).fold(0.0, f64::max);
         if !(away <= 1.0) {
             return None;
         }
         if step.norm() < 1e-12 * (1.0 + y.iter().map(|x| x.abs()).fold(0.0, f64::max)) {
             let mut integrator = crate::ode::Integrator::new(*method).ok()?;
-            let (_, m) =
-                super::floquet::monodromy::<_, S, V>(&mut integrator, &system, period, &y).ok()?;
+            let (_, m) = model.monodromy(params, &mut integrator, period, &y).ok()?;
             return Some((y, m));
         }
     }
@@ -1086,38 +962,34 @@ pub fn stability_chart(
     params: &[f64],
     settings: &ChartSettings,
 ) -> Result<StabilityChart, StabilityError> {
-    crate::registry::with_fixed(model, Chart { params, settings })
-        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?
+    let model = model
+        .systems()
+        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
+    chart(model, params, settings)
 }
 
-/// The work of [`stability_chart`] at one size.
-pub struct Chart<'a> {
-    params: &'a [f64],
-    settings: &'a ChartSettings,
-}
-
-impl WithFixed for Chart<'_> {
-    type Output = Result<StabilityChart, StabilityError>;
-    fn run<F: Fixed<D, S, T, V>, const D: usize, const S: usize, const T: usize, const V: usize>(
-        self,
-        model: &'static F,
-    ) -> Self::Output {
+/// [`stability_chart`] on the model's systems.
+fn chart(
+    model: &'static dyn Systems,
+    params: &[f64],
+    settings: &ChartSettings,
+) -> Result<StabilityChart, StabilityError> {
+    {
         let info = model.info();
-        let settings = self.settings;
-        vibrating_model(model, self.params)?;
+        vibrating_model(model, params)?;
         let (ix, iy) = (
             parameter_index(info, &settings.x)?,
             parameter_index(info, &settings.y)?,
         );
-        let q: [f64; D] = settings.q.as_slice().try_into().map_err(|_| {
-            StabilityError::ParameterCount(
+        if settings.q.len() != info.coordinates.len() {
+            return Err(StabilityError::ParameterCount(
                 settings.q.len(),
                 format!("{} (coordinates of the equilibrium)", info.name),
-            )
-        })?;
-        let y0: [f64; S] = std::array::from_fn(|i| if i < D { q[i] } else { 0.0 });
+            ));
+        }
+        let y0 = at_rest(&settings.q);
         // Probed at the chart's corner of the largest y (the amplitude).
-        let mut corner = self.params.to_vec();
+        let mut corner = params.to_vec();
         corner[ix] = settings.x_values.last().copied().unwrap_or(corner[ix]);
         corner[iy] = settings.y_max;
         if moved_by_vibration(model, &corner, &y0) {
@@ -1130,7 +1002,7 @@ impl WithFixed for Chart<'_> {
             let points: Vec<Vec<f64>> = xy
                 .iter()
                 .map(|&(x, y)| {
-                    let mut p = self.params.to_vec();
+                    let mut p = params.to_vec();
                     (p[ix], p[iy]) = (x, y);
                     p
                 })
@@ -1160,7 +1032,7 @@ impl WithFixed for Chart<'_> {
                 let key = format!(
                     "chart {} {:?} {:?} {} {:?} {} {} {} {} {:?} {}",
                     info.name,
-                    self.params,
+                    params,
                     settings.q,
                     settings.x,
                     settings.x_values,

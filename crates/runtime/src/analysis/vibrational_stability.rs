@@ -9,7 +9,7 @@
 //! a² > g²/(mean(h²)|λᵢ|). The binding root is the negative one smallest in
 //! modulus, λ*.
 
-use nalgebra::SMatrix;
+use nalgebra::{DMatrix, SMatrix};
 
 /// The roots λ of det(C − λA) = 0 for symmetric C and positive definite A,
 /// ascending; None if A is not positive definite.
@@ -17,14 +17,20 @@ pub fn generalized_eigenvalues<const N: usize>(
     a: &[[f64; N]; N],
     c: &[[f64; N]; N],
 ) -> Option<[f64; N]> {
-    let a = SMatrix::<f64, N, N>::from_fn(|i, j| a[i][j]);
-    let c = SMatrix::<f64, N, N>::from_fn(|i, j| c[i][j]);
+    let a = DMatrix::from_fn(N, N, |i, j| a[i][j]);
+    let c = DMatrix::from_fn(N, N, |i, j| c[i][j]);
+    generalized_eigenvalues_of(&a, &c)?.try_into().ok()
+}
+
+/// [`generalized_eigenvalues`] of matrices of any size.
+pub fn generalized_eigenvalues_of(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Option<Vec<f64>> {
+    let n = a.nrows();
     // A = L Lᵀ; the roots are the eigenvalues of L⁻¹ C L⁻ᵀ (symmetric).
-    let l = a.cholesky()?.l();
+    let l = a.clone().cholesky()?.l();
     let l_inv = l.try_inverse()?;
-    let m = l_inv * c * l_inv.transpose();
-    let m = nalgebra::DMatrix::from_fn(N, N, |i, j| 0.5 * (m[(i, j)] + m[(j, i)]));
-    let mut values: [f64; N] = m.symmetric_eigenvalues().as_slice().try_into().ok()?;
+    let m = &l_inv * c * l_inv.transpose();
+    let m = DMatrix::from_fn(n, n, |i, j| 0.5 * (m[(i, j)] + m[(j, i)]));
+    let mut values: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
     values.sort_by(f64::total_cmp);
     Some(values)
 }

@@ -11,7 +11,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{Direction, Event, EventSettings, Integrator, OdeError, Options, System};
+use super::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options, System};
 
 /// A system behind a trait object whose state is a slice of [`AnySystem::dim`]
 /// numbers. Every method refuses a state of another length with
@@ -32,6 +32,20 @@ pub trait AnySystem: Sync {
         t1: f64,
         options: AnyOptions<'_, '_>,
     ) -> Result<AnySolution, OdeError>;
+    /// [`super::states_at`]: the states at `times` of a fresh run of
+    /// `method` from (t0, y0), up to the last of them.
+    fn states_at(
+        &self,
+        method: Method,
+        t0: f64,
+        y0: &[f64],
+        times: &[f64],
+    ) -> Result<Vec<Vec<f64>>, OdeError> {
+        let t1 = times.last().copied().unwrap_or(t0);
+        let options = AnyOptions::default().times(times);
+        let mut integrator = Integrator::new(method)?;
+        Ok(self.solve(&mut integrator, t0, y0, t1, options)?.samples)
+    }
     /// [`Integrator::stream`]: `segments` segments of time `segment` from
     /// (0, y0), `after` called with each end's state (which it may change)
     /// and saying whether to go on.

@@ -13,9 +13,7 @@ use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
 use crate::analysis::period_map::{stream_orbit, wrap_angle, PeriodMapError};
 use crate::analysis::Refusal;
 use crate::ode::{Integrator, Method, OdeError};
-use crate::registry::{
-    Catalog, DynamicModel, Kind, Model, ModelInfo, ParameterError,
-};
+use crate::registry::{Catalog, DynamicModel, Kind, Model, ModelInfo, ParameterError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;

@@ -1,8 +1,8 @@
 //! Lyapunov exponents of a period map (per iteration) and the fast Lyapunov
 //! indicator (FLI) used to shade chaos maps.
 
-use crate::ode::wrap_angle;
 use super::variational::Variational;
+use crate::ode::wrap_angle;
 use crate::ode::{Integrator, LaneIntegrator, Method, OdeError, Orbit, System};
 use nalgebra::DMatrix;
 

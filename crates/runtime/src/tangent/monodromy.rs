@@ -95,4 +95,3 @@ fn split<S: System<N>, const N: usize, const M: usize>(z: &[f64; M]) -> ([f64; N
     }
     (Variational::<S, N, M>::state(z), m)
 }
-

@@ -82,7 +82,15 @@ pub(super) fn iterates(
                 true
             };
             let periods = transient + iterates;
-            stream_orbit(&mut integrator, &**system, period, start, periods, wrap, &mut keep)?;
+            stream_orbit(
+                &mut integrator,
+                &**system,
+                period,
+                start,
+                periods,
+                wrap,
+                &mut keep,
+            )?;
             Ok(states)
         })
         .collect()

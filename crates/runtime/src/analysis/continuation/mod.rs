@@ -424,7 +424,9 @@ impl FamilyMap for AtModel {
         let system = self.model.exact(&self.with(p));
         let n = system.dim();
         let f = system.rhs(0.0, y).expect("a state of the model's length");
-        let jacobian = system.jacobian(0.0, y).expect("a state of the model's length");
+        let jacobian = system
+            .jacobian(0.0, y)
+            .expect("a state of the model's length");
         let jacobian = jacobian.unwrap_or_else(|| DMatrix::from_element(n, n, f64::NAN));
         (f, jacobian)
     }
