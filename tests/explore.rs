@@ -61,7 +61,9 @@ fn every_reported_equilibrium_is_a_critical_point() {
     for info in models::ALL {
         let model = mechlab::models::by_name(info.name).expect("every model is listed");
         let params = model.dynamic.defaults();
-        let Ok((equilibria, _)) = mechlab::explore::equilibria(model.dynamic, &params) else {
+        let Ok((equilibria, _)) =
+            mechlab::analysis::equilibria::effective_equilibria(model.dynamic, &params)
+        else {
             continue;
         };
         let v = |q: &[f64]| model.dynamic.effective_potential(&params, q).unwrap();
@@ -104,7 +106,7 @@ fn kapitza_equilibria_match_the_closed_form() {
     let a: f64 = 1.5;
     let mut params = model.defaults();
     params[0] = a;
-    let (found, _) = mechlab::explore::equilibria(model, &params).unwrap();
+    let (found, _) = mechlab::analysis::equilibria::effective_equilibria(model, &params).unwrap();
     assert_eq!(found.len(), 4, "{found:?}");
     let at = |q: f64| {
         found
@@ -158,7 +160,7 @@ fn explore_runs_with_taylor() {
 /// empty list of equilibria says why.
 #[test]
 fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
-    use mechlab::explore::{equilibria, NotSearched, Verdict};
+    use mechlab::analysis::equilibria::{effective_equilibria, NotSearched, Verdict};
     assert_eq!(Verdict::of(&[0.5, 2.0]), Verdict::Stable);
     assert_eq!(Verdict::of(&[-0.5, 2.0]), Verdict::Unstable);
     // x⁴ at 0: a Hessian of round-off, not an instability.
@@ -169,7 +171,7 @@ fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
     );
     // Hénon–Heiles: the minimum at 0 and three saddles at V = 1/6.
     let hh = models::by_name("henon_heiles").unwrap();
-    let (found, _) = equilibria(hh.dynamic, &[1.0]).unwrap();
+    let (found, _) = effective_equilibria(hh.dynamic, &[1.0]).unwrap();
     let stable: Vec<_> = found
         .iter()
         .filter(|e| e.verdict == Verdict::Stable)
@@ -186,7 +188,7 @@ fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
     // A contact model has no potential to search.
     let contact = models::by_name("painleve_klein").unwrap();
     assert_eq!(
-        equilibria(contact.dynamic, &contact.dynamic.defaults()).unwrap_err(),
+        effective_equilibria(contact.dynamic, &contact.dynamic.defaults()).unwrap_err(),
         NotSearched::NoPotential
     );
 }
@@ -199,11 +201,11 @@ fn equilibria_are_judged_at_second_order_or_said_inconclusive() {
 /// the hanging rest state keeps its verdict.
 #[test]
 fn a_singular_point_of_the_chart_is_named_not_judged() {
-    use mechlab::explore::{equilibria, Verdict};
+    use mechlab::analysis::equilibria::{effective_equilibria, Verdict};
     use mechlab_test_models::spring_double_pendulum::{Params, DYNAMIC};
     let mut params = Params::default();
     params.set("k", 0.25).unwrap();
-    let (found, _) = equilibria(&DYNAMIC, &params.values()).unwrap();
+    let (found, _) = effective_equilibria(&DYNAMIC, &params.values()).unwrap();
     let at_pole: Vec<_> = found.iter().filter(|e| e.q[2].abs() < 1e-6).collect();
     assert!(!at_pole.is_empty(), "{found:#?}");
     assert!(
@@ -242,10 +244,10 @@ fn a_singular_point_of_the_chart_is_named_not_judged() {
 /// nothing.
 #[test]
 fn a_family_along_a_cyclic_angle_is_reported_once_and_judged_reduced() {
-    use mechlab::explore::{equilibria, Verdict};
+    use mechlab::analysis::equilibria::{effective_equilibria, Verdict};
     use mechlab_test_models::central_spring::{Params, DYNAMIC};
     let params = Params::default().values();
-    let (found, _) = equilibria(&DYNAMIC, &params).unwrap();
+    let (found, _) = effective_equilibria(&DYNAMIC, &params).unwrap();
     let at_rest: Vec<_> = found
         .iter()
         .filter(|e| (e.q[0] - 1.0).abs() < 1e-6)
@@ -267,10 +269,10 @@ fn a_family_along_a_cyclic_angle_is_reported_once_and_judged_reduced() {
 /// eigenvalue of φ, never a singular chart that decides nothing.
 #[test]
 fn a_spherical_pendulums_upright_is_judged_at_the_pole_on_the_reduced_system() {
-    use mechlab::explore::{equilibria, Verdict};
+    use mechlab::analysis::equilibria::{effective_equilibria, Verdict};
     use mechlab_test_models::spherical_pendulum::DYNAMIC;
     for (a, verdict) in [(1.6, Verdict::Stable), (1.2, Verdict::Unstable)] {
-        let (found, _) = equilibria(&DYNAMIC, &[a, 0.1]).unwrap();
+        let (found, _) = effective_equilibria(&DYNAMIC, &[a, 0.1]).unwrap();
         let upright: Vec<_> = found.iter().filter(|e| e.q[0].abs() < 1e-6).collect();
         assert_eq!(upright.len(), 1, "A = {a}: {found:#?}");
         let upright = upright[0];
@@ -323,11 +325,11 @@ fn stability_names_the_spherical_pendulums_poles_once_as_a_singular_chart() {
 /// at the same amplitude: stable exactly when a exceeds a*.
 #[test]
 fn a_four_link_chain_gets_its_equilibria_judged_as_stability_judges_them() {
+    use mechlab::analysis::equilibria::{effective_equilibria, Verdict};
     use mechlab::analysis::stability::averaged_stability;
-    use mechlab::explore::{equilibria, Verdict};
     use mechlab_test_models::quadruple_pendulum::{Params, DYNAMIC, MODEL};
     let params = Params::default().values();
-    let (found, _) = equilibria(&DYNAMIC, &params).unwrap();
+    let (found, _) = effective_equilibria(&DYNAMIC, &params).unwrap();
     let at = |target: f64| {
         found.iter().find(|e| {
             e.q.iter()

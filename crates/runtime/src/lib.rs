@@ -14,7 +14,6 @@ pub mod analysis;
 pub mod budget;
 pub mod contact;
 pub mod explore;
-pub mod linalg;
 pub mod mathml;
 pub mod ode;
 pub mod plot;
@@ -23,3 +22,6 @@ pub mod report;
 pub mod studio;
 pub mod study;
 pub mod tangent;
+
+/// Fixed-size linear algebra, where the generated code reaches it.
+pub use ode::linalg;

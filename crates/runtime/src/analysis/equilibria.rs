@@ -5,7 +5,8 @@
 //! search the same starts with Newton's method, stopped as their
 //! gradient's kind allows ([`Convergence`]), and judge what they find.
 
-use crate::analysis::period_map::wrap_angle;
+use crate::ode::wrap_angle;
+use crate::registry::DynamicModel;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
@@ -239,4 +240,238 @@ pub fn wrapped(mut q: Vec<f64>, periodic: &[bool]) -> Vec<f64> {
         }
     }
     q
+}
+
+/// An equilibrium of the effective potential (V + V_vibr, or V).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Equilibrium {
+    pub q: Vec<f64>,
+    /// Eigenvalues of the Hessian, ascending: of the reduced system where
+    /// the equilibrium is one of a family along cyclic coordinates.
+    pub hessian_eigenvalues: Vec<f64>,
+    pub verdict: Verdict,
+    /// The cyclic coordinates (indices) along which this equilibrium is one
+    /// of a family: reported once, judged on the system reduced by them
+    /// (Routh's reduction with their conserved momenta at 0, where the
+    /// amended potential is V itself).
+    pub family_along: Vec<usize>,
+    /// The mass matrix is singular here only along cyclic coordinates (the
+    /// pole of spherical coordinates, where the azimuth degenerates): the
+    /// chart is singular, but the reduced system is regular and judges it.
+    pub pole: bool,
+}
+
+/// What the second-order test of the effective potential says of an
+/// equilibrium. An eigenvalue within round-off of zero (10⁻⁸ of the
+/// largest) decides nothing: a degenerate minimum such as x⁴, or a family
+/// of equilibria along a cyclic coordinate, is never called unstable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// A strict minimum: every eigenvalue positive.
+    Stable,
+    /// A direction of negative curvature.
+    Unstable,
+    /// No negative eigenvalue, but one within round-off of zero.
+    InconclusiveAtSecondOrder,
+    /// The mass matrix is singular there (a pole of polar or spherical
+    /// coordinates): the chart cannot judge it; other coordinates can.
+    SingularChart,
+}
+
+impl Verdict {
+    /// The verdict of a Hessian with these eigenvalues.
+    pub fn of(eigenvalues: &[f64]) -> Verdict {
+        let scale = eigenvalues.iter().fold(1.0f64, |m, l| m.max(l.abs()));
+        let round_off = 1e-8 * scale;
+        if eigenvalues.iter().any(|&l| l < -round_off) {
+            Verdict::Unstable
+        } else if eigenvalues.iter().all(|&l| l > round_off) {
+            Verdict::Stable
+        } else {
+            Verdict::InconclusiveAtSecondOrder
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Verdict::Stable => "stable",
+            Verdict::Unstable => "unstable",
+            Verdict::InconclusiveAtSecondOrder => "inconclusive at second order",
+            Verdict::SingularChart => {
+                "singular chart (the mass matrix is singular here: judge it in other coordinates)"
+            }
+        })
+    }
+}
+
+/// Why no equilibria were searched for.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, thiserror::Error)]
+pub enum NotSearched {
+    #[error("the model has no effective potential (a contact model)")]
+    NoPotential,
+}
+
+/// Equilibria of the effective potential: this finder (the starts and
+/// steps `stability` uses)
+/// on its gradient by central differences with the generated Hessian, at
+/// any number of degrees of freedom; duplicates (angles modulo 2π, and
+/// along cyclic coordinates) merged.
+pub fn effective_equilibria(
+    model: &dyn DynamicModel,
+    params: &[f64],
+) -> Result<(Vec<Equilibrium>, Search), NotSearched> {
+    let periodic = model.periodic();
+    let n = periodic.len();
+    if model.effective_potential(params, &vec![0.0; n]).is_none() {
+        return Err(NotSearched::NoPotential);
+    }
+    let v = |q: &[f64]| model.effective_potential(params, q).unwrap_or(f64::NAN);
+    // At the angles wrapped into [−π, π): Newton may wander many turns
+    // away, where a step of 10⁻⁶·|q| is no longer small and the
+    // differences of a periodic V vanish by aliasing (the triple
+    // pendulum's search reported 123 points with |∇V| ≈ 1 as equilibria).
+    let gradient = |q: &[f64]| -> Vec<f64> {
+        let q = wrapped(q.to_vec(), &periodic);
+        (0..n)
+            .map(|i| {
+                let h = 1e-6 * (1.0 + q[i].abs());
+                let (mut a, mut b) = (q.to_vec(), q.to_vec());
+                a[i] += h;
+                b[i] -= h;
+                (v(&a) - v(&b)) / (2.0 * h)
+            })
+            .collect()
+    };
+    let cyclic = cyclic_coordinates(model, params, n);
+    let kept: Vec<usize> = (0..n).filter(|i| !cyclic.contains(i)).collect();
+    let hessian = |q: &[f64]| {
+        let h = model
+            .effective_potential_hessian(params, q)
+            .unwrap_or_else(|| vec![f64::NAN; n * n]);
+        nalgebra::DMatrix::from_row_slice(n, n, &h)
+    };
+    let mut found: Vec<Equilibrium> = Vec::new();
+    let starts = starts(&periodic);
+    for start in starts.points {
+        // The differences' noise floor: a root is where the gradient is
+        // below 10⁻⁷.
+        let convergence = Convergence::Noisy { gradient: 1e-7 };
+        let Some(q) = newton(gradient, hessian, start, convergence) else {
+            continue;
+        };
+        let mut q = wrapped(q, &periodic);
+        let hm = hessian(&q);
+        let sym = (&hm + hm.transpose()) * 0.5;
+        // The reduced system's Hessian: the rows and columns of the cyclic
+        // coordinates dropped.
+        let reduced =
+            nalgebra::DMatrix::from_fn(kept.len(), kept.len(), |a, b| sym[(kept[a], kept[b])]);
+        let mut eigenvalues: Vec<f64> = reduced.symmetric_eigenvalues().iter().copied().collect();
+        eigenvalues.sort_by(f64::total_cmp);
+        // At the singular point itself the Hamiltonian's 1/sin²θ terms make
+        // every curvature 0·∞; a step of 10⁻⁶ off it along the kept
+        // coordinates tells which momenta the singularity is along.
+        let singular = !singular_momenta(model, params, &q).is_empty();
+        let near: Vec<f64> = (0..n)
+            .map(|i| q[i] + if cyclic.contains(&i) { 0.0 } else { 1e-6 })
+            .collect();
+        let along = singular_momenta(model, params, &near);
+        let pole = singular && !along.is_empty() && along.iter().all(|i| cyclic.contains(i));
+        let verdict = if !singular || pole {
+            Verdict::of(&eigenvalues)
+        } else {
+            Verdict::SingularChart
+        };
+        // Newton converges only linearly on a degenerate equilibrium (x⁴
+        // gives the gradient x³) and the gradient's differences have a noise
+        // floor, so its starts end up to 10⁻³ apart: one equilibrium, kept
+        // where the gradient is least.
+        let radius = match verdict {
+            Verdict::InconclusiveAtSecondOrder => 1e-3,
+            _ => 1e-6,
+        };
+        let norm = |q: &[f64]| gradient(q).iter().map(|x| x * x).sum::<f64>().sqrt();
+        let same = found.iter().position(|e| {
+            let along = |i: &usize| !cyclic.contains(i);
+            e.q.iter()
+                .zip(&q)
+                .zip(&periodic)
+                .enumerate()
+                .filter(|(i, _)| along(i))
+                .all(|(_, ((a, b), p))| {
+                    let d = if *p { wrap_angle(a - b) } else { a - b };
+                    d.abs() < radius * (1.0 + b.abs())
+                })
+        });
+        // A family's representative: its cyclic coordinates at 0.
+        for &i in &cyclic {
+            q[i] = 0.0;
+        }
+        let equilibrium = Equilibrium {
+            q,
+            verdict,
+            hessian_eigenvalues: eigenvalues,
+            family_along: cyclic.clone(),
+            pole,
+        };
+        match same {
+            Some(k) if norm(&equilibrium.q) < norm(&found[k].q) => found[k] = equilibrium,
+            Some(_) => {}
+            None => found.push(equilibrium),
+        }
+    }
+    Ok((found, starts.search))
+}
+
+/// The cyclic coordinates: H does not depend on them (probed at scattered
+/// states and times), so their momenta are conserved and equilibria come
+/// in families along them.
+fn cyclic_coordinates(model: &dyn DynamicModel, params: &[f64], n: usize) -> Vec<usize> {
+    let probes: Vec<(f64, Vec<f64>)> = (0..8)
+        .map(|k| {
+            let y = (0..2 * n)
+                .map(|i| (1.7 * (k * 2 * n + i) as f64 + 0.3).sin() * 1.3)
+                .collect();
+            (0.37 * k as f64, y)
+        })
+        .collect();
+    (0..n)
+        .filter(|&i| {
+            probes.iter().all(|(t, y)| {
+                let h = 1e-5;
+                let (mut a, mut b) = (y.clone(), y.clone());
+                a[i] += h;
+                b[i] -= h;
+                let slope =
+                    (model.energy(params, *t, &a) - model.energy(params, *t, &b)) / (2.0 * h);
+                slope.abs() < 1e-8
+            })
+        })
+        .collect()
+}
+
+/// The momenta along which the mass matrix A is singular at q: H is
+/// ½ pᵀA⁻¹p + …, so the curvature of H along each momentum, read from
+/// three energies, is A⁻¹'s diagonal, which blows up where A is singular.
+fn singular_momenta(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> Vec<usize> {
+    let n = q.len();
+    let energy = |p: &[f64]| {
+        let mut y = q.to_vec();
+        y.extend_from_slice(p);
+        model.energy(params, 0.0, &y)
+    };
+    let zero = energy(&vec![0.0; n]);
+    (0..n)
+        .filter(|&i| {
+            let mut p = vec![0.0; n];
+            p[i] = 1.0;
+            let plus = energy(&p);
+            p[i] = -1.0;
+            let curvature = 0.5 * (plus + energy(&p)) - zero;
+            !(curvature.is_finite() && curvature.abs() < 1e10)
+        })
+        .collect()
 }

@@ -266,7 +266,7 @@ impl<S: Scalar> Scalar for Dual<S> {
 /// factorising over dual numbers would differentiate the factor too (three
 /// times the work, for the same x').
 pub struct Cholesky<const N: usize> {
-    value: crate::linalg::Cholesky<f64, N>,
+    value: super::linalg::Cholesky<f64, N>,
     /// A' (its lower triangle is read, as the factorisation reads A's).
     slope: [[f64; N]; N],
 }
@@ -275,7 +275,7 @@ impl<const N: usize> Cholesky<N> {
     #[inline]
     pub fn new(a: [[Dual; N]; N]) -> Self {
         Cholesky {
-            value: crate::linalg::Cholesky::new(a.map(|row| row.map(|x| x.re))),
+            value: super::linalg::Cholesky::new(a.map(|row| row.map(|x| x.re))),
             slope: a.map(|row| row.map(|x| x.du)),
         }
     }

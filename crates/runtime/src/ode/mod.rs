@@ -17,6 +17,7 @@ mod gauss;
 pub mod hyperdual;
 pub mod kernels;
 mod lanes;
+pub mod linalg;
 mod radau5;
 mod rk4;
 pub mod series;

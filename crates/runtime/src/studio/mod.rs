@@ -623,41 +623,42 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
         value.unwrap_or(f64::NAN)
     };
     let field = contour::Field::sample(ranges, grid, value);
-    let equilibria: Vec<EquilibriumMark> = crate::explore::equilibria(model, params)
-        .map(|(found, _)| found)
-        .unwrap_or_default()
-        .into_iter()
-        .map(|e| {
-            let mut state = e.q.clone();
-            state.resize(2 * setup.dof, 0.0);
-            let periodic = model.periodic();
-            let same = |k: usize| {
-                let d = state[k] - setup.through[k];
-                let d = if periodic.get(k).copied().unwrap_or(false) {
-                    wrap_angle(d)
-                } else {
-                    d
+    let equilibria: Vec<EquilibriumMark> =
+        crate::analysis::equilibria::effective_equilibria(model, params)
+            .map(|(found, _)| found)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|e| {
+                let mut state = e.q.clone();
+                state.resize(2 * setup.dof, 0.0);
+                let periodic = model.periodic();
+                let same = |k: usize| {
+                    let d = state[k] - setup.through[k];
+                    let d = if periodic.get(k).copied().unwrap_or(false) {
+                        wrap_angle(d)
+                    } else {
+                        d
+                    };
+                    d.abs() < 1e-9
                 };
-                d.abs() < 1e-9
-            };
-            let point = setup.axes.map(|a| {
-                if periodic.get(a).copied().unwrap_or(false) {
-                    wrap_angle(state[a])
-                } else {
-                    state[a]
+                let point = setup.axes.map(|a| {
+                    if periodic.get(a).copied().unwrap_or(false) {
+                        wrap_angle(state[a])
+                    } else {
+                        state[a]
+                    }
+                });
+                EquilibriumMark {
+                    on_plane: (0..state.len())
+                        .filter(|k| !setup.axes.contains(k))
+                        .all(same),
+                    point,
+                    stable: e.verdict == crate::analysis::equilibria::Verdict::Stable,
+                    hessian_eigenvalues: e.hessian_eigenvalues,
+                    q: e.q,
                 }
-            });
-            EquilibriumMark {
-                on_plane: (0..state.len())
-                    .filter(|k| !setup.axes.contains(k))
-                    .all(same),
-                point,
-                stable: e.verdict == crate::explore::Verdict::Stable,
-                hessian_eigenvalues: e.hessian_eigenvalues,
-                q: e.q,
-            }
-        })
-        .collect();
+            })
+            .collect();
     let mut levels: Vec<LevelSet> = field
         .quantiles(count)
         .into_iter()

@@ -48,12 +48,12 @@ impl Solution {
             // A flow has no period doubling.
             (TestFunction::MinusOne, true) => 1.0,
             (TestFunction::UnitPair, false) => {
-                let b = crate::linalg::bialternate(&self.monodromy);
+                let b = crate::ode::linalg::bialternate(&self.monodromy);
                 let m = b.nrows();
                 (b - DMatrix::<f64>::identity(m, m)).determinant()
             }
             (TestFunction::UnitPair, true) => {
-                crate::linalg::bialternate_sum(&self.monodromy).determinant()
+                crate::ode::linalg::bialternate_sum(&self.monodromy).determinant()
             }
             (TestFunction::Turning, _) => self.tangent[n],
         }

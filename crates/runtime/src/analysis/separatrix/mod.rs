@@ -551,13 +551,14 @@ impl Map {
 /// Starts for Newton: the maxima of the averaged potential, at rest, from
 /// −π up (the branch the search follows first).
 fn saddles(model: &dyn DynamicModel, params: &[f64]) -> Vec<[f64; 2]> {
-    let mut saddles: Vec<[f64; 2]> = crate::explore::equilibria(model, params)
-        .map(|(found, _)| found)
-        .unwrap_or_default()
-        .into_iter()
-        .filter(|e| e.hessian_eigenvalues.iter().all(|&h| h < 0.0))
-        .map(|e| [e.q[0], 0.0])
-        .collect();
+    let mut saddles: Vec<[f64; 2]> =
+        crate::analysis::equilibria::effective_equilibria(model, params)
+            .map(|(found, _)| found)
+            .unwrap_or_default()
+            .into_iter()
+            .filter(|e| e.hessian_eigenvalues.iter().all(|&h| h < 0.0))
+            .map(|e| [e.q[0], 0.0])
+            .collect();
     saddles.sort_by(|a, b| a[0].total_cmp(&b[0]));
     saddles
 }

@@ -8,7 +8,7 @@
 //! registers (nalgebra's would do the same work through its generic
 //! storage, with checks the generated code does not need).
 
-use crate::ode::series::Scalar;
+use super::series::Scalar;
 
 /// The Cholesky factor L (A = L Lᵀ) of a symmetric positive definite
 /// matrix, with the reciprocals of its diagonal; over f64, or over
