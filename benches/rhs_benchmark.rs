@@ -110,10 +110,11 @@ fn compare<const N: usize>(
             .zip(&b)
             .all(|(x, z)| (x - z).abs() < 1e-8 * (1.0 + z.abs()))
         {
-            return Err(SceneError::BadValue {
-                name: name.into(),
-                value: format!("{y:?}"),
-                reason: format!("generated {a:?} but hand-written {b:?}"),
+            return Err(SceneError::Disagreement {
+                what: format!("{name}: the generated right-hand side"),
+                at: y.to_vec(),
+                got: a.to_vec(),
+                expected: b.to_vec(),
             });
         }
     }

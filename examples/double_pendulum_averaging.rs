@@ -8,7 +8,7 @@
 //! which differ by O(1) at the fast time scale: the velocities converge only
 //! weakly, not uniformly.
 
-use mechlab::scene::{knob, run, Scene, SceneError};
+use mechlab::scene::{knob, run, Scene, SceneError, ValueProblem};
 use mechlab::scenes::{method_from, method_knobs};
 use mechlab::studies::double_pendulum::{
     averaging_cases, parameter_knobs, params_from_scene, AveragingSettings,
@@ -38,7 +38,10 @@ fn main() {
             return Err(SceneError::BadValue {
                 name: "phi2_starts".into(),
                 value: scene.text("phi2_starts").into(),
-                reason: format!("needs as many values as phi1_starts ({})", phi1.len()),
+                reason: ValueProblem::AsManyAs {
+                    knob: "phi1_starts",
+                    count: phi1.len(),
+                },
             });
         }
         let result = averaging_cases(&AveragingSettings {

@@ -5,7 +5,7 @@
 //! Static, no network: open it from the disk.
 
 use mechlab::report::{index_html, links, scene_command, SECTIONS};
-use mechlab::scene::{knob, run, write_atomic, Scene, SceneError};
+use mechlab::scene::{knob, run, write_atomic, Scene, SceneError, ValueProblem};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -33,7 +33,7 @@ fn main() {
             return Err(SceneError::BadValue {
                 name: "run".into(),
                 value: mode,
-                reason: "use missing, all or none".into(),
+                reason: ValueProblem::Requirement("use missing, all or none"),
             });
         }
         let mut scenes: Vec<&str> = SECTIONS.iter().map(|s| s.scene).collect();

@@ -13,7 +13,7 @@
 use mechlab::analysis::stability::{
     stability, stability_chart, ChartSettings, Settings, StabilityError,
 };
-use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError};
+use mechlab::scene::{knob, parameter_knobs, run, Scene, SceneError, ValueProblem};
 use mechlab::scenes::{method_from, method_knobs, model_from_args, tiles_from};
 
 fn main() {
@@ -101,10 +101,10 @@ fn chart_settings(
     settings: &Settings,
     dof: usize,
 ) -> Result<ChartSettings, SceneError> {
-    let bad = |name: &str, reason: &str| SceneError::BadValue {
+    let bad = |name: &str, reason: &'static str| SceneError::BadValue {
         name: name.into(),
         value: scene.text(name).into(),
-        reason: reason.into(),
+        reason: ValueProblem::Requirement(reason),
     };
     let Some((x, y)) = scene.text("chart").split_once(',') else {
         return Err(bad("chart", "two parameter names x,y"));

@@ -52,6 +52,29 @@ pub fn parameter_knobs(
         .collect()
 }
 
+/// What is wrong with a `--set` value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ValueProblem {
+    /// A requirement the value failed, as the knob states it.
+    #[error("{0}")]
+    Requirement(&'static str),
+    /// Not one of the names the knob takes.
+    #[error("one of {}", .0.join(", "))]
+    OneOf(&'static [&'static str]),
+    /// A list of another length than the knob it goes with.
+    #[error("needs as many values as {knob} ({count})")]
+    AsManyAs { knob: &'static str, count: usize },
+    /// An index of a state component past the state's length.
+    #[error("the state has {0} components")]
+    StateComponents(usize),
+    /// `parameter=none` where the model names no amplitude to continue in.
+    #[error("model '{model}' names no [fast_phase] amplitude: choose the parameter to continue in ({})", known.join(", "))]
+    NoAmplitude {
+        model: &'static str,
+        known: &'static [&'static str],
+    },
+}
+
 /// Why a scene could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
@@ -78,7 +101,16 @@ pub enum SceneError {
     BadValue {
         name: String,
         value: String,
-        reason: String,
+        reason: ValueProblem,
+    },
+    /// A computed result against an independent one (a benchmark's check
+    /// before it times them): `what` at the state `at`.
+    #[error("{what} at {at:?}: {got:?}, but the independent form gives {expected:?}")]
+    Disagreement {
+        what: String,
+        at: Vec<f64>,
+        got: Vec<f64>,
+        expected: Vec<f64>,
     },
     #[error("{}: {source}", path.display())]
     Io {
@@ -289,7 +321,7 @@ impl Scene {
             _ => Err(SceneError::BadValue {
                 name: name.into(),
                 value: text.into(),
-                reason: "not a finite number".into(),
+                reason: ValueProblem::Requirement("not a finite number"),
             }),
         }
     }
@@ -303,7 +335,7 @@ impl Scene {
             Err(SceneError::BadValue {
                 name: name.into(),
                 value: self.text(name).into(),
-                reason: "must be positive".into(),
+                reason: ValueProblem::Requirement("must be positive"),
             })
         }
     }
@@ -317,7 +349,7 @@ impl Scene {
             Err(SceneError::BadValue {
                 name: name.into(),
                 value: self.text(name).into(),
-                reason: "must not be negative".into(),
+                reason: ValueProblem::Requirement("must not be negative"),
             })
         }
     }
@@ -330,7 +362,7 @@ impl Scene {
             _ => Err(SceneError::BadValue {
                 name: name.into(),
                 value: text.into(),
-                reason: "not a positive whole number".into(),
+                reason: ValueProblem::Requirement("not a positive whole number"),
             }),
         }
     }
@@ -343,7 +375,7 @@ impl Scene {
             .map_err(|_| SceneError::BadValue {
                 name: name.into(),
                 value: text.into(),
-                reason: "not a whole number".into(),
+                reason: ValueProblem::Requirement("not a whole number"),
             })
     }
 
@@ -359,7 +391,7 @@ impl Scene {
             _ => Err(SceneError::BadValue {
                 name: name.into(),
                 value: text.into(),
-                reason: "not a comma-separated list of finite numbers".into(),
+                reason: ValueProblem::Requirement("not a comma-separated list of finite numbers"),
             }),
         }
     }

@@ -2,7 +2,7 @@
 //! the study scenes that are its presets (the same knobs with other
 //! defaults, the same files): knobs → one library call → figures.
 
-use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError};
+use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError, ValueProblem};
 use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMap, ChaosMapError, ChaosMapSettings};
 use mechlab_runtime::ode::Method;
 use mechlab_runtime::registry::{Catalog, Model};
@@ -35,7 +35,7 @@ fn axes_from(scene: &Scene) -> Result<[usize; 2], SceneError> {
         _ => Err(SceneError::BadValue {
             name: "axes".into(),
             value: scene.text("axes").into(),
-            reason: "two indices of state components".into(),
+            reason: ValueProblem::Requirement("two indices of state components"),
         }),
     }
 }
@@ -223,7 +223,9 @@ pub fn tiles_from(
                         .ok_or_else(|| SceneError::BadValue {
                             name: only_name.into(),
                             value: scene.text(only_name).into(),
-                            reason: "tile indices are whole numbers from 0".into(),
+                            reason: ValueProblem::Requirement(
+                                "tile indices are whole numbers from 0",
+                            ),
                         })
                 })
                 .collect::<Result<_, _>>()?,
@@ -314,10 +316,10 @@ fn values_from(scene: &Scene) -> Result<Option<Vec<f64>>, SceneError> {
     let Some(spec) = text.strip_prefix("geometric:") else {
         return scene.numbers("values").map(Some);
     };
-    let bad = |reason: &str| SceneError::BadValue {
+    let bad = |reason: &'static str| SceneError::BadValue {
         name: "values".into(),
         value: text.into(),
-        reason: reason.into(),
+        reason: ValueProblem::Requirement(reason),
     };
     let parts: Vec<f64> = spec
         .split(',')
@@ -471,7 +473,7 @@ pub fn period_map_scene(
                 .map_err(|_| SceneError::BadValue {
                     name: "seeds".into(),
                     value: text.into(),
-                    reason: "numbers separated by ',' and states by ';'".into(),
+                    reason: ValueProblem::Requirement("numbers separated by ',' and states by ';'"),
                 })?,
         ),
     };
@@ -558,7 +560,7 @@ pub fn separatrix_scene(
         Precision::parse(scene.text("precision")).ok_or_else(|| SceneError::BadValue {
             name: "precision".into(),
             value: scene.text("precision").into(),
-            reason: format!("one of {}", Precision::NAMES.join(", ")),
+            reason: ValueProblem::OneOf(&Precision::NAMES),
         })?;
     let settings = SplittingSettings {
         method: method_from(&scene)?,
@@ -618,7 +620,7 @@ fn splitting_sweep_of(
                 SceneError::BadValue {
                     name: "sweep".into(),
                     value: scene.text("sweep").into(),
-                    reason: reason.into(),
+                    reason: ValueProblem::Requirement(reason),
                 }
             })?;
             eprintln!(
@@ -762,7 +764,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
         return Err(SceneError::BadValue {
             name: "coordinate".into(),
             value: coordinate.to_string(),
-            reason: format!("the state has {states} components"),
+            reason: ValueProblem::StateComponents(states),
         });
     }
     eprintln!("continuing in {} …", settings.parameter);
@@ -786,7 +788,7 @@ fn continuation_settings(
             return Err(SceneError::BadValue {
                 name: "switch".into(),
                 value: other.into(),
-                reason: "yes or no".into(),
+                reason: ValueProblem::Requirement("yes or no"),
             })
         }
     };
@@ -797,11 +799,10 @@ fn continuation_settings(
         return Err(SceneError::BadValue {
             name: "parameter".into(),
             value: parameter,
-            reason: format!(
-                "model '{}' names no [fast_phase] amplitude: choose the parameter to continue in ({})",
-                model.info.name,
-                model.info.parameter_names.join(", ")
-            ),
+            reason: ValueProblem::NoAmplitude {
+                model: model.info.name,
+                known: model.info.parameter_names,
+            },
         });
     }
     let to = match scene.text("to") {
@@ -926,7 +927,7 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
             return Err(SceneError::BadValue {
                 name: "direction".into(),
                 value: other.into(),
-                reason: "rising or falling".into(),
+                reason: ValueProblem::Requirement("rising or falling"),
             })
         }
     };

@@ -26,7 +26,9 @@ fn main() {
             .map_err(|_| SceneError::BadValue {
                 name: "port".into(),
                 value: scene.text("port").into(),
-                reason: "a port is a whole number from 0 to 65535".into(),
+                reason: mechlab::scene::ValueProblem::Requirement(
+                    "a port is a whole number from 0 to 65535",
+                ),
             })?;
         mechlab_studio::run(mechlab::models::MODELS, port)
     });

@@ -47,16 +47,20 @@ pub enum ApiError {
     Studio(#[from] StudioError),
     #[error("the request is not valid JSON for this route: {0}")]
     Json(#[from] serde_json::Error),
-    #[error("no route {0}")]
-    NotFound(String),
+    #[error("no route {path}")]
+    NotFound { path: String },
+    /// A request's work panicked (a bug): its message; the server goes on.
+    #[error("internal error (the server goes on): the request's work panicked: {message}")]
+    Panicked { message: String },
+    /// The blocking task that ran the request could not be joined.
     #[error("internal error (the server goes on): {0}")]
-    Internal(String),
+    Join(#[from] tokio::task::JoinError),
 }
 
 impl ApiError {
     fn status(&self) -> StatusCode {
         match self {
-            ApiError::Studio(StudioError::UnknownModel(_)) | ApiError::NotFound(_) => {
+            ApiError::Studio(StudioError::UnknownModel(_)) | ApiError::NotFound { .. } => {
                 StatusCode::NOT_FOUND
             }
             ApiError::Studio(
@@ -66,7 +70,7 @@ impl ApiError {
                 | StudioError::Section(_),
             ) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
-            ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
+            ApiError::Panicked { .. } | ApiError::Join(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
     }
 }
@@ -112,7 +116,11 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/continuation", post(continuation))
         .route("/api/section", post(section))
         .route("/api/section_map", post(section_map))
-        .fallback(|uri: axum::http::Uri| async move { ApiError::NotFound(uri.to_string()) })
+        .fallback(|uri: axum::http::Uri| async move {
+            ApiError::NotFound {
+                path: uri.to_string(),
+            }
+        })
         .with_state(catalog)
 }
 
@@ -220,18 +228,19 @@ async fn blocking<R: Send + 'static>(
 ) -> Result<R, ApiError> {
     tokio::task::spawn_blocking(move || {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
-            .unwrap_or_else(|panic| Err(ApiError::Internal(panic_text(&panic))))
+            .unwrap_or_else(|panic| Err(panicked(&panic)))
     })
-    .await
-    .map_err(|e| ApiError::Internal(e.to_string()))?
+    .await?
 }
 
-fn panic_text(panic: &Box<dyn std::any::Any + Send>) -> String {
-    panic
+/// The error of a panic, with its message (a panic's payload is its text).
+fn panicked(panic: &Box<dyn std::any::Any + Send>) -> ApiError {
+    let message = panic
         .downcast_ref::<&str>()
         .map(|s| s.to_string())
         .or_else(|| panic.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic".into())
+        .unwrap_or_else(|| "a panic".into());
+    ApiError::Panicked { message }
 }
 
 /// An NDJSON answer: `work` runs on a blocking thread and sends lines with
@@ -256,7 +265,7 @@ fn stream(
         let error = match outcome {
             Ok(Ok(()) | Err(StudioError::PeriodMap(PeriodMapError::Cancelled))) => return,
             Ok(Err(e)) => ApiError::Studio(e),
-            Err(panic) => ApiError::Internal(panic_text(&panic)),
+            Err(panic) => panicked(&panic),
         };
         send(&ErrorBody {
             error: error.to_string(),
