@@ -77,6 +77,24 @@ measure chain4_horizontal "add: chain4_horizontal (4)" 40
 add_model models/extra/six_link_pendulum.toml six_link_pendulum
 measure six_link_pendulum "add: six_link_pendulum (6)" 90
 
+# Each copy's generated module is its original's but for the name: a
+# model's code depends on its file alone, not on which other models were
+# derived before it (each is derived in a process of its own).
+same_code_as_originals() {
+    local generated copy original k
+    generated=$(dirname "$(ls -t target/release/build/mechlab-*/out/generated/other_0.rs | head -1)")
+    for ((k = 0; k < made; k++)); do
+        copy=other_$k
+        original=$(basename "${others[$((k % ${#others[@]}))]}" .toml)
+        # (Compared without white space: rustfmt breaks lines by length.)
+        if [ "$(sed "s/\b$copy\b/$original/g" "$generated/$copy.rs" | tr -d '[:space:]')" != \
+            "$(tr -d '[:space:]' <"$generated/$original.rs")" ]; then
+            echo "$copy: its generated code differs from $original's beyond the name" >&2
+            exit 1
+        fi
+    done
+}
+
 # The same with 10, then 20, other models in models/ (copies of the
 # shipped ones under other names), built first and not timed.
 others=(models/kapitza.toml models/circle_pendulum.toml models/elastic_pendulum.toml
@@ -88,6 +106,7 @@ for count in 10 20; do
         made=$((made + 1))
     done
     cargo build --release --quiet --example explore
+    same_code_as_originals
     add_model "$here/slider_pendulum.toml" "slider_with_$count"
     measure "slider_with_$count" "add: a 1-degree model with $count other models added" 20
 done

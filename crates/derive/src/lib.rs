@@ -11,7 +11,10 @@
 //!
 //! Each model's generated module is cached under a hash of its file and of
 //! the derivation code, so editing or adding one model file derives that
-//! model only.
+//! model only. Each model is derived in a process of its own (the build
+//! script run again for that one file): Symbolica orders a product's
+//! factors by when their symbols were first made, so in a shared process a
+//! model's code would depend on which other models were derived before it.
 
 use mechlab_model as model;
 
@@ -51,6 +54,9 @@ fn fail(message: String) -> ! {
 /// model file and the reason. The derivation code is a dependency of the
 /// build script, so cargo reruns it when that changes.
 pub fn build_models(root: &str, folder: &str) {
+    if let (Ok(file), Ok(out)) = (std::env::var(DERIVE_FILE), std::env::var(DERIVE_OUT)) {
+        return on_derivation_thread(move || derive_one(&file, Path::new(&out)));
+    }
     let root = std::fs::canonicalize(root)
         .unwrap_or_else(|e| fail(format!("cannot find the workspace at {root}: {e}")));
     for watched in [folder, "templates"] {
@@ -61,15 +67,41 @@ pub fn build_models(root: &str, folder: &str) {
     std::env::set_current_dir(&root)
         .unwrap_or_else(|e| fail(format!("cannot enter {}: {e}", root.display())));
     let _only_derivation = symbolica_lock();
-    let folder = folder.to_string();
+    run(folder);
+}
+
+/// The variables that make the build script derive one model file into one
+/// module (the file, then where to write the module): set for the
+/// processes [`build_model`] starts.
+const DERIVE_FILE: &str = "MECHLAB_DERIVE_FILE";
+const DERIVE_OUT: &str = "MECHLAB_DERIVE_OUT";
+
+/// Runs `work` on a thread with the derivation's stack.
+fn on_derivation_thread(work: impl FnOnce() + Send + 'static) {
     let worker = std::thread::Builder::new()
         .name("derivations".into())
         .stack_size(STACK_BYTES)
-        .spawn(move || run(&folder))
+        .spawn(work)
         .unwrap_or_else(|e| fail(format!("cannot start the derivation thread: {e}")));
     if worker.join().is_err() {
         fail("the derivation thread panicked (see above)".into());
     }
+}
+
+/// In a process of its own: derives the model `file` and writes its
+/// formatted module to `out`.
+fn derive_one(file: &str, out: &Path) {
+    let tera =
+        tera::Tera::new("templates/*.tera").unwrap_or_else(|e| fail(format!("templates: {e:?}")));
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| fail(format!("{file}: {e}")));
+    let model = model::Model::parse(file, &text).unwrap_or_else(|e| fail(e.to_string()));
+    let derivation = std::panic::AssertUnwindSafe(|| generate_model(&tera, &model, file));
+    let code = std::panic::catch_unwind(derivation).unwrap_or_else(|_| {
+        fail(format!(
+            "{file}: the derivation stopped on an internal error (above); please report it with this model file"
+        ))
+    });
+    write_formatted(out, &code);
 }
 
 /// Symbolica's restricted mode aborts when two processes of one user use
@@ -107,7 +139,7 @@ fn run(folder: &str) {
     let mut models = Vec::new();
     for path in model_files(folder) {
         let started = Instant::now();
-        let (model, hit) = build_model(&path, &tera, &cache, &generated, code_version);
+        let (model, hit) = build_model(&path, &cache, &generated, code_version);
         if !names.insert(model.name.clone()) {
             fail(format!(
                 "{}: key `name`: '{}' is also the name of another model",
@@ -147,7 +179,6 @@ fn model_files(dir: &str) -> Vec<PathBuf> {
 /// Returns the model and whether the cache had it.
 fn build_model(
     path: &Path,
-    tera: &tera::Tera,
     cache: &Path,
     generated: &Path,
     code_version: u64,
@@ -172,16 +203,10 @@ fn build_model(
     ));
     let hit = cached.is_file();
     if !hit {
-        let derivation = std::panic::AssertUnwindSafe(|| generate_model(tera, &model, &file));
-        let code = std::panic::catch_unwind(derivation).unwrap_or_else(|_| {
-            fail(format!(
-                "{file}: the derivation stopped on an internal error (above); please report it with this model file"
-            ))
-        });
         // Written beside and renamed: an interrupted build never leaves a
         // half-written module under a valid key.
         let partial = cached.with_extension("partial");
-        write_formatted(&partial, &code);
+        derive_in_own_process(&file, &partial);
         std::fs::rename(&partial, &cached)
             .unwrap_or_else(|e| fail(format!("cannot write {}: {e}", cached.display())));
         prune_cache(cache, &model.name, &cached);
@@ -189,6 +214,22 @@ fn build_model(
     std::fs::copy(&cached, generated.join(format!("{}.rs", model.name)))
         .unwrap_or_else(|e| fail(format!("cannot copy {}: {e}", cached.display())));
     (model, hit)
+}
+
+/// Derives the model `file` into `out` in a process of its own (this build
+/// script again; see the crate's comment), which says what went wrong on
+/// its standard error.
+fn derive_in_own_process(file: &str, out: &Path) {
+    let script = std::env::current_exe()
+        .unwrap_or_else(|e| fail(format!("cannot find the build script to run again: {e}")));
+    let status = Command::new(script)
+        .env(DERIVE_FILE, file)
+        .env(DERIVE_OUT, out)
+        .status()
+        .unwrap_or_else(|e| fail(format!("{file}: cannot start its derivation: {e}")));
+    if !status.success() {
+        fail(format!("{file}: its derivation failed (above)"));
+    }
 }
 
 /// Removes the model's other cached versions (earlier texts or code).
