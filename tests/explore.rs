@@ -288,13 +288,19 @@ fn a_spherical_pendulums_upright_is_judged_at_the_pole_on_the_reduced_system() {
     }
 }
 
-/// `stability` on the same pendulum names the poles as singular points of
-/// the chart, once each (not once per azimuth of its grid), and never
-/// calls them unstable or unstabilisable.
+/// `stability` on the same pendulum decides at the poles what `explore`
+/// decides: each pole once (not once per azimuth of its grid), judged on
+/// the system reduced by the azimuth. The upright's reduced C is −1 and
+/// its V_vibr adds A²/2, so a* = √2 (closed form), on either side of which
+/// `explore` calls it unstable (A = 1.2) and stable (A = 1.6); the hanging
+/// pole (C = +1) is stable without vibration. Neither gets an exact
+/// window: the exact system is singular at a pole in these coordinates.
 #[test]
-fn stability_names_the_spherical_pendulums_poles_once_as_a_singular_chart() {
+fn stability_judges_the_spherical_pendulums_poles_as_explore_does() {
+    use mechlab::analysis::equilibria::{effective_equilibria, Verdict};
     use mechlab::analysis::stability::{stability, Settings};
     use mechlab::ode::Method;
+    use mechlab_test_models::spherical_pendulum::{DYNAMIC, MODEL};
     let settings = Settings {
         amplitude: "A".into(),
         a_max: None,
@@ -303,18 +309,37 @@ fn stability_names_the_spherical_pendulums_poles_once_as_a_singular_chart() {
         method: Method::Taylor { tol: 1e-12 },
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
     };
-    let model = &mechlab_test_models::spherical_pendulum::MODEL;
-    let found = stability(model, &[1.6, 0.1], &settings).unwrap();
-    let poles: Vec<_> = found
-        .equilibria
-        .iter()
-        .filter(|e| e.q[0].abs() < 1e-9 || (e.q[0].abs() - std::f64::consts::PI).abs() < 1e-9)
-        .collect();
-    assert_eq!(poles.len(), 2, "{:#?}", found.equilibria);
-    for pole in poles {
-        let reason = pole.reason.as_deref().unwrap();
-        assert!(reason.starts_with("singular chart"), "{reason}");
-        assert!(pole.a_star.is_none() && pole.exact_window.is_none());
+    let found = stability(&MODEL, &[1.6, 0.1], &settings).unwrap();
+    let pole = |theta: f64| {
+        let at: Vec<_> = found
+            .equilibria
+            .iter()
+            .filter(|e| (e.q[0].abs() - theta).abs() < 1e-9)
+            .collect();
+        assert_eq!(at.len(), 1, "θ = {theta}: {:#?}", found.equilibria);
+        at[0].clone()
+    };
+    let upright = pole(0.0);
+    assert_eq!(upright.reduced_by, vec![1], "{upright:?}");
+    assert_eq!(upright.lambdas.len(), 1);
+    assert!((upright.lambdas[0] + 1.0).abs() < 1e-9, "{upright:?}");
+    let a_star = upright.a_star.expect("the upright pole has a threshold");
+    assert!((a_star - 2f64.sqrt()).abs() < 1e-9, "a* = {a_star}");
+    assert!(upright.exact_window.is_none());
+    assert!(upright.exact_reason.as_deref().unwrap().contains("pole"));
+    let hanging = pole(std::f64::consts::PI);
+    assert_eq!(hanging.reduced_by, vec![1]);
+    assert!(hanging.stable_without_vibration, "{hanging:?}");
+    assert!((hanging.lambdas[0] - 1.0).abs() < 1e-9, "{hanging:?}");
+    for a in [1.2, 1.6] {
+        let (equilibria, _) = effective_equilibria(&DYNAMIC, &[a, 0.1]).unwrap();
+        let explored = equilibria.iter().find(|e| e.q[0].abs() < 1e-6).unwrap();
+        let expected = if a > a_star {
+            Verdict::Stable
+        } else {
+            Verdict::Unstable
+        };
+        assert_eq!(explored.verdict, expected, "A = {a}");
     }
 }
 

@@ -429,7 +429,7 @@ pub fn effective_equilibria(
 /// The cyclic coordinates: H does not depend on them (probed at scattered
 /// states and times), so their momenta are conserved and equilibria come
 /// in families along them.
-fn cyclic_coordinates(model: &dyn DynamicModel, params: &[f64], n: usize) -> Vec<usize> {
+pub(crate) fn cyclic_coordinates(model: &dyn DynamicModel, params: &[f64], n: usize) -> Vec<usize> {
     let probes: Vec<(f64, Vec<f64>)> = (0..8)
         .map(|k| {
             let y = (0..2 * n)

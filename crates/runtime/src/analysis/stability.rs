@@ -13,13 +13,14 @@
 //! quadratic dependence is checked (else the reason is given).
 
 use super::continuation::{orbit_branch, OrbitBranch};
+use super::equilibria::cyclic_coordinates;
 use super::floquet::{multipliers_of, spectral_radius, window_in_batches};
 use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues_of;
 use crate::analysis::period_map::wrap_angle;
 use crate::analysis::Refusal;
 use crate::ode::{Method, OdeError};
-use crate::registry::{Model, Systems};
+use crate::registry::{DynamicModel, Model, Systems};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::cell::RefCell;
@@ -71,6 +72,14 @@ pub struct EquilibriumStability {
     pub exact_reason: Option<String>,
     /// (a, spectral radius of the monodromy matrix) where it was computed.
     pub spectral_radius: Vec<[f64; 2]>,
+    /// At a pole of the chart (the mass matrix singular along cyclic
+    /// coordinates only, as the azimuth at a pole of spherical
+    /// coordinates): those coordinates, whose rows and columns are dropped
+    /// from A, C and K. Their momenta are conserved, and at 0 the reduced
+    /// system's potential is V + V_vibr itself, so the roots, a* and the
+    /// verdict are the reduced system's, the ones `explore` gives.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reduced_by: Vec<usize>,
 }
 
 /// The result (and summary) of the analysis.
@@ -135,8 +144,12 @@ impl Stability {
         lines.extend(self.equilibria.iter().take(limit).map(|e| {
             let reason = e.reason.as_deref().unwrap_or("");
             let exact_reason = e.exact_reason.as_deref().unwrap_or("");
+            let pole = match e.reduced_by.is_empty() {
+                true => String::new(),
+                false => format!(" (a pole: reduced by the coordinates {:?})", e.reduced_by),
+            };
             format!(
-                "q = {:?}: λ = {:?}, a* = {:?} {reason}, exact window {:?} {exact_reason}",
+                "q = {:?}{pole}: λ = {:?}, a* = {:?} {reason}, exact window {:?} {exact_reason}",
                 e.q, e.lambdas, e.a_star, e.exact_window
             )
         }));
@@ -234,15 +247,18 @@ pub fn stability(
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
+    let dynamic = model.dynamic;
     let model = model
         .systems()
         .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
-    analyse(model, params, settings)
+    analyse(model, dynamic, params, settings)
 }
 
-/// [`stability`] on the model's systems.
+/// [`stability`] on the model's systems (`dynamic` tells its cyclic
+/// coordinates).
 fn analyse(
     model: &'static dyn Systems,
+    dynamic: &dyn DynamicModel,
     params: &[f64],
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
@@ -277,11 +293,16 @@ fn analyse(
                 // One entry per pole: the same point at every value of the
                 // coordinates the chart loses there.
                 let same_pole = |e: &EquilibriumStability| {
-                    e.reason.as_deref() == Some(SINGULAR_CHART)
+                    (e.reason.as_deref() == Some(SINGULAR_CHART) || !e.reduced_by.is_empty())
                         && (0..q.len()).all(|i| along.contains(&i) || (e.q[i] - q[i]).abs() < 1e-9)
                 };
                 if !result.equilibria.iter().any(same_pole) {
-                    result.equilibria.push(at_singular_chart(q));
+                    let cyclic = cyclic_coordinates(dynamic, params, q.len());
+                    let pole = !along.is_empty() && along.iter().all(|i| cyclic.contains(i));
+                    result.equilibria.push(match pole {
+                        true => at_pole(model, params, amplitude, q, cyclic),
+                        false => at_singular_chart(q),
+                    });
                 }
                 continue;
             }
@@ -296,7 +317,10 @@ fn analyse(
                 .push(averaged_verdict(model, params, amplitude, q));
         }
         let mut with_threshold: Vec<usize> = (0..result.equilibria.len())
-            .filter(|&k| result.equilibria[k].a_star.is_some())
+            .filter(|&k| {
+                let e = &result.equilibria[k];
+                e.a_star.is_some() && e.exact_reason.is_none()
+            })
             .collect();
         with_threshold.sort_by(|&x, &y| {
             let a = |k: usize| result.equilibria[k].a_star.unwrap_or(f64::INFINITY);
@@ -538,7 +562,7 @@ fn stays_in_averaged_system(model: &dyn Systems, params: &[f64], q: &[f64]) -> b
 }
 
 /// Why an equilibrium at a singular point of the chart gets no verdict.
-const SINGULAR_CHART: &str = "singular chart: the mass matrix is singular here (a pole of the coordinates), so C + a²K and the exact system's orbits in this chart say nothing; `explore` judges a pole along a cyclic coordinate on the reduced system, other coordinates judge it in full";
+const SINGULAR_CHART: &str = "singular chart: the mass matrix is singular here along a coordinate that is not cyclic, so C + a²K and the exact system's orbits in this chart say nothing; other coordinates judge it";
 
 /// The coordinates along which the mass matrix vanishes at q (a zero
 /// diagonal entry: the azimuth at a pole of spherical coordinates), if its
@@ -572,6 +596,7 @@ fn at_singular_chart(q: &[f64]) -> EquilibriumStability {
         exact_window: None,
         exact_reason: Some(SINGULAR_CHART.into()),
         spectral_radius: Vec::new(),
+        reduced_by: Vec::new(),
     }
 }
 
@@ -582,12 +607,29 @@ fn averaged_verdict(
     amplitude: usize,
     q: &[f64],
 ) -> EquilibriumStability {
-    let c = model.potential_hessian(params, q);
-    let lambdas = generalized_eigenvalues_of(&model.mass_matrix(params, q), &c).unwrap_or_default();
+    let all: Vec<usize> = (0..q.len()).collect();
+    reduced_verdict(model, params, amplitude, q, &all)
+}
+
+/// [`averaged_verdict`] on the coordinates `kept` (A, C and K with the
+/// other rows and columns dropped); the second-order threshold on the
+/// whole system only.
+fn reduced_verdict(
+    model: &dyn Systems,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64],
+    kept: &[usize],
+) -> EquilibriumStability {
+    let c = reduce(&model.potential_hessian(params, q), kept);
+    let a = reduce(&model.mass_matrix(params, q), kept);
+    let lambdas = generalized_eigenvalues_of(&a, &c).unwrap_or_default();
     let stable_without_vibration = !lambdas.is_empty() && lambdas.iter().all(|l| *l > 0.0);
-    let (a_star, reason) = threshold(model, params, amplitude, q, stable_without_vibration);
-    let a_star_second_order =
-        a_star.and_then(|a| second_order_threshold(model, params, amplitude, q, a));
+    let (a_star, reason) = threshold(model, params, amplitude, q, kept, stable_without_vibration);
+    let whole = kept.len() == q.len();
+    let a_star_second_order = a_star
+        .filter(|_| whole)
+        .and_then(|a| second_order_threshold(model, params, amplitude, q, a));
     EquilibriumStability {
         q: q.to_vec(),
         lambdas,
@@ -598,7 +640,36 @@ fn averaged_verdict(
         exact_window: None,
         exact_reason: None,
         spectral_radius: Vec::new(),
+        reduced_by: Vec::new(),
     }
+}
+
+/// Why a pole has no exact window.
+const POLE_EXACT: &str = "a pole of the chart: the exact system is singular here in these coordinates, so it has no monodromy matrix; the averaged verdict is the reduced system's";
+
+/// The verdict at a pole of the chart, on the system reduced by the cyclic
+/// coordinates `cyclic` (taken at 0, as `explore` reports the family).
+fn at_pole(
+    model: &dyn Systems,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64],
+    cyclic: Vec<usize>,
+) -> EquilibriumStability {
+    let mut q = q.to_vec();
+    for &i in &cyclic {
+        q[i] = 0.0;
+    }
+    let kept: Vec<usize> = (0..q.len()).filter(|i| !cyclic.contains(i)).collect();
+    let mut verdict = reduced_verdict(model, params, amplitude, &q, &kept);
+    verdict.exact_reason = Some(POLE_EXACT.into());
+    verdict.reduced_by = cyclic;
+    verdict
+}
+
+/// The rows and columns `kept` of a square matrix.
+fn reduce(m: &DMatrix<f64>, kept: &[usize]) -> DMatrix<f64> {
+    DMatrix::from_fn(kept.len(), kept.len(), |i, j| m[(kept[i], kept[j])])
 }
 
 fn hessian_at(
@@ -607,10 +678,11 @@ fn hessian_at(
     amplitude: usize,
     a: f64,
     q: &[f64],
+    kept: &[usize],
 ) -> DMatrix<f64> {
     let mut p = params.to_vec();
     p[amplitude] = a;
-    let m = model.effective_potential_hessian(&p, q);
+    let m = reduce(&model.effective_potential_hessian(&p, q), kept);
     (&m + m.transpose()) * 0.5
 }
 
@@ -624,12 +696,13 @@ fn threshold(
     params: &[f64],
     amplitude: usize,
     q: &[f64],
+    kept: &[usize],
     stable_without_vibration: bool,
 ) -> (Option<f64>, Option<String>) {
     let name = model.info().parameter_names[amplitude];
-    let c = hessian_at(model, params, amplitude, 0.0, q);
-    let k = hessian_at(model, params, amplitude, 1.0, q) - &c;
-    let k2 = hessian_at(model, params, amplitude, 2.0, q) - &c;
+    let c = hessian_at(model, params, amplitude, 0.0, q, kept);
+    let k = hessian_at(model, params, amplitude, 1.0, q, kept) - &c;
+    let k2 = hessian_at(model, params, amplitude, 2.0, q, kept) - &c;
     let scale = 1.0 + c.amax() + k.amax();
     if (&k2 - &k * 4.0).amax() > 1e-8 * scale {
         return (
@@ -655,7 +728,7 @@ fn threshold(
         let l_inv = cholesky
             .l()
             .try_inverse()
-            .unwrap_or_else(|| DMatrix::zeros(q.len(), q.len()));
+            .unwrap_or_else(|| DMatrix::zeros(kept.len(), kept.len()));
         let m = &l_inv * (-&c) * l_inv.transpose();
         let m = (&m + m.transpose()) * 0.5;
         let mu = m.symmetric_eigenvalues().max();
