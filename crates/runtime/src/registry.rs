@@ -397,6 +397,12 @@ pub trait Systems: Sync {
     fn has_fast_phase(&self) -> bool;
     /// Which components of the state are angles; its length is the state's.
     fn periodic_state(&self) -> Vec<bool>;
+    /// The state at rest at the coordinates `q` (for [q; p], p = 0).
+    fn at_rest(&self, q: &[f64]) -> Vec<f64> {
+        let mut y = q.to_vec();
+        y.resize(self.periodic_state().len(), 0.0);
+        y
+    }
     /// The period of the fast phase.
     fn phase_period(&self, params: &[f64]) -> Option<f64>;
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;

@@ -306,7 +306,7 @@ fn analyse(
                 }
                 continue;
             }
-            let y0 = at_rest(q);
+            let y0 = model.at_rest(q);
             let averaged = stays_in_averaged_system(model, params, q);
             if !averaged || moved_by_vibration(model, &probe, &y0) {
                 moved.push((q.clone(), averaged));
@@ -387,7 +387,7 @@ fn moved_equilibrium(
     q: &[f64],
     averaged: bool,
 ) -> MovedEquilibrium {
-    let y0 = at_rest(q);
+    let y0 = model.at_rest(q);
     let a_max = settings.a_max.unwrap_or(3.0 * probe[amplitude]);
     let branch = averaged.then(|| {
         let mut at_rest = probe.to_vec();
@@ -770,7 +770,7 @@ fn threshold(
 fn second_order_stable(model: &dyn Systems, params: &[f64], q: &[f64]) -> Option<bool> {
     let system = model.averaged2(params)?;
     let (d, n) = (q.len(), system.dim());
-    let mut y = at_rest(q);
+    let mut y = model.at_rest(q);
     let mut hessian = DMatrix::zeros(n, n);
     for _ in 0..20 {
         let h = model.averaged2_hessian(params, &y)?;
@@ -817,13 +817,6 @@ fn second_order_threshold(
         }
     }
     Some(high)
-}
-
-/// The state at rest at the coordinates q: (q, 0).
-fn at_rest(q: &[f64]) -> Vec<f64> {
-    let mut y = q.to_vec();
-    y.resize(2 * q.len(), 0.0);
-    y
 }
 
 /// Multipliers within this of the unit circle count as stable (the
@@ -895,7 +888,7 @@ fn exact_window(
         out.exact_reason = Some("no threshold in the averaged system".into());
         return Ok(());
     };
-    let y0 = at_rest(q);
+    let y0 = model.at_rest(q);
     let with = |a: f64| {
         let mut p = params.to_vec();
         p[amplitude] = a;
@@ -1060,7 +1053,7 @@ fn chart(
                 format!("{} (coordinates of the equilibrium)", info.name),
             ));
         }
-        let y0 = at_rest(&settings.q);
+        let y0 = model.at_rest(&settings.q);
         // Probed at the chart's corner of the largest y (the amplitude).
         let mut corner = params.to_vec();
         corner[ix] = settings.x_values.last().copied().unwrap_or(corner[ix]);
