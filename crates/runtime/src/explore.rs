@@ -3,11 +3,10 @@
 //! integrator for a contact model), the period map, the equilibria of the
 //! effective potential with their stability, and the energy change.
 //!
-//! The models are reached through [`DynamicModel`] (slices, any size); the
-//! integrators are fixed-size, so the state length is dispatched once to a
-//! const-generic instance (2, 4 or 6: up to three degrees of freedom or
-//! three contacts). The slice conversions cost an allocation per call: the
-//! explorer is for looking, the study scenes for measuring.
+//! A Hamiltonian model runs through its [`Systems`] (states as slices, any
+//! size; each run at the model's own size). A contact model's stick–slip
+//! integrator is fixed-size, so its state length is dispatched once to a
+//! const-generic instance (2, 4 or 6: up to three contacts).
 
 use crate::analysis::equilibria::{effective_equilibria, Search};
 pub use crate::analysis::equilibria::{Equilibrium, NotSearched, Verdict};

@@ -585,7 +585,8 @@ pub enum FixedSize {
 }
 
 /// One generated model: what it is, its dynamically sized interface, and
-/// for Hamiltonian models the same at its own sizes.
+/// for Hamiltonian models the model at its own sizes, whose [`Systems`]
+/// ([`Model::systems`]) the analyses run.
 #[derive(Clone, Copy)]
 pub struct Model {
     pub info: &'static ModelInfo,

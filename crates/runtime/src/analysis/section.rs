@@ -277,7 +277,7 @@ struct Stroboscope {
     slab: f64,
 }
 
-/// The work of [`section`] at one size.
+/// The work of [`section`], run at 2 degrees of freedom.
 pub struct Sections<'a> {
     model: &'a Model,
     params: &'a [f64],
