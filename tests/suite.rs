@@ -15,6 +15,7 @@ mod docs_commands;
 mod double_double;
 mod events;
 mod explore;
+mod holonomic;
 mod integrators;
 mod model_errors;
 mod report;

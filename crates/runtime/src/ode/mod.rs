@@ -14,6 +14,7 @@ pub mod dual;
 mod erased;
 mod events;
 mod gauss;
+pub mod holonomic;
 pub mod hyperdual;
 pub mod kernels;
 mod lanes;
