@@ -4,7 +4,9 @@
 //! rod's tension m(l θ̇² + g cos θ), and projection lands on the manifold
 //! by the nearest point in the metric of M.
 
-use mechlab::ode::holonomic::{accelerations, project, ConstraintError, Holonomic};
+use mechlab::ode::holonomic::{
+    accelerations, project, restricted_monodromy, tangent_basis, ConstraintError, Holonomic,
+};
 use mechlab::ode::{states_at, Integrator, Method, System};
 use nalgebra::{DMatrix, DVector};
 
@@ -163,5 +165,59 @@ fn degenerate_constraints_and_wrong_states_are_named_errors() {
             given: 3,
             coordinates: 2
         })
+    );
+}
+
+/// At the hanging equilibrium, the monodromy of the Cartesian ODE over a
+/// time T (by central differences of its flow) has four multipliers: the
+/// pendulum's e^{±iωT}, ω = √(g/l), and two at 1 from the directions
+/// across the manifold (the constraint's drift). Restricted to the
+/// constrained phase space it has exactly the physical two.
+#[test]
+fn floquet_multipliers_on_the_manifold_are_the_physical_ones() {
+    let l = PENDULUM.l;
+    let period = 1.3;
+    let at_rest = [0.0, -l, 0.0, 0.0];
+    let method = Method::parse("dop853", 1e-14).unwrap();
+    let flow = |y: [f64; 4]| {
+        Integrator::new(method)
+            .unwrap()
+            .advance(&PENDULUM, 0.0, &y, period)
+            .unwrap()
+    };
+    let h = 1e-5;
+    let full = DMatrix::from_fn(4, 4, |i, j| {
+        let (mut up, mut down) = (at_rest, at_rest);
+        up[j] += h;
+        down[j] -= h;
+        (flow(up)[i] - flow(down)[i]) / (2.0 * h)
+    });
+    // ∂[g; G q̇]/∂y at rest: [[x, y, 0, 0], [ẋ, ẏ, x, y]].
+    let c = DMatrix::from_row_slice(2, 4, &[0.0, -l, 0.0, 0.0, 0.0, 0.0, 0.0, -l]);
+    let basis = tangent_basis(&c).expect("the rod's constraint has full rank");
+    assert_eq!(basis.shape(), (4, 2));
+    assert!((&c * &basis).amax() < 1e-15);
+    let restricted = restricted_monodromy(&full, &basis);
+    let omega_t = (PENDULUM.g / l).sqrt() * period;
+    let mut physical = mechlab::analysis::floquet::multipliers_of(&restricted);
+    physical.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let s = omega_t.sin().abs();
+    let expected = [(omega_t.cos(), -s), (omega_t.cos(), s)];
+    for (got, want) in physical.iter().zip(expected) {
+        assert!(
+            (got.0 - want.0).abs() < 1e-7 && (got.1 - want.1).abs() < 1e-7,
+            "{physical:?} against {expected:?}"
+        );
+    }
+    let at_one = full
+        .complex_eigenvalues()
+        .iter()
+        .filter(|z| (z.re - 1.0).abs() < 1e-4 && z.im.abs() < 1e-4)
+        .count();
+    assert_eq!(
+        at_one,
+        2,
+        "the full matrix's multipliers: {:?}",
+        full.complex_eigenvalues()
     );
 }

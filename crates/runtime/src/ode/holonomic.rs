@@ -137,3 +137,37 @@ pub fn project(
         velocity_residual: (&g * velocity + g_t).amax(),
     })
 }
+
+/// An orthonormal basis (as columns) of the tangent space of the
+/// constrained phase space at a state: the kernel of the Jacobian `c`
+/// (2k × 2n) of the state's constraints [g; G q̇ + g_t]. None where `c`
+/// does not have full rank 2k (degenerate constraints).
+pub fn tangent_basis(c: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let (rows, n) = c.shape();
+    if rows >= n {
+        return None;
+    }
+    // The full SVD's right singular vectors: the last n − rows span the
+    // kernel when the first `rows` singular values are not zero.
+    let svd = nalgebra::linalg::SVD::new(c.clone().insert_rows(rows, n - rows, 0.0), false, true);
+    let v_t = svd.v_t?;
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+    let largest = svd.singular_values[order[0]];
+    if !(svd.singular_values[order[rows - 1]] > 1e-12 * largest) {
+        return None;
+    }
+    Some(DMatrix::from_fn(n, n - rows, |i, j| {
+        v_t[(order[rows + j], i)]
+    }))
+}
+
+/// A monodromy matrix of the unconstrained ODE (2n × 2n) restricted to
+/// the constrained phase space, whose orthonormal basis at the orbit's
+/// start is `basis` (from [`tangent_basis`]): Zᵀ M Z, whose 2(n − k)
+/// eigenvalues are the physical Floquet multipliers. The full matrix has
+/// 2k more, from the directions across the manifold (the drift of the
+/// constraints, multipliers at 1), which mean nothing for the motion.
+pub fn restricted_monodromy(monodromy: &DMatrix<f64>, basis: &DMatrix<f64>) -> DMatrix<f64> {
+    basis.transpose() * monodromy * basis
+}
