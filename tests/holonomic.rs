@@ -5,7 +5,8 @@
 //! by the nearest point in the metric of M.
 
 use mechlab::ode::holonomic::{
-    accelerations, project, restricted_monodromy, tangent_basis, ConstraintError, Holonomic,
+    accelerations, project, restricted_monodromy, tangent_basis, tangent_inverse_mass,
+    tangent_stability, vibrational_potential, ConstraintError, Holonomic,
 };
 use mechlab::ode::{states_at, Integrator, Method, System};
 use nalgebra::{DMatrix, DVector};
@@ -220,4 +221,66 @@ fn floquet_multipliers_on_the_manifold_are_the_physical_ones() {
         "the full matrix's multipliers: {:?}",
         full.complex_eigenvalues()
     );
+}
+
+/// Averaging with a constraint, in redundant coordinates: a point of mass
+/// m on a rod of length l held upright (y up, V = m g y) on a pivot
+/// vibrating vertically with velocity amplitude a. V_vibr = ½ mean⟨P β, β⟩
+/// with β = m ẇ e_y, and the tangent-space test with the manifold's
+/// curvature (μ ∇²g), give C_T / A_T = −g/l + a²/(2l²): the angle
+/// model's (V + V_vibr)''/A, so the threshold a*² = 2 g l (Kapitza's).
+/// Without the curvature term C_T would be a²m/(2l²) ≥ 0: never unstable.
+#[test]
+fn averaging_with_a_constraint_gives_kapitzas_threshold() {
+    let (m, l, g) = (PENDULUM.m, PENDULUM.l, PENDULUM.g);
+    let upright = [0.0, l];
+    let jacobian = |q: &[f64]| DMatrix::from_row_slice(1, 2, q);
+    let mass = DMatrix::identity(2, 2) * m;
+    for a in [0.0, 3.0, 7.0] {
+        let phases = 8;
+        let betas: Vec<DVector<f64>> = (0..phases)
+            .map(|k| {
+                let w_dot = a * (std::f64::consts::TAU * k as f64 / phases as f64).cos();
+                DVector::from_column_slice(&[0.0, m * w_dot])
+            })
+            .collect();
+        let v_vibr = |q: &[f64]| {
+            let p = tangent_inverse_mass(&mass, &jacobian(q), q).unwrap();
+            vibrational_potential(&p, &betas)
+        };
+        // Its closed form off the equilibrium too: m a² x² / (4 |q|²).
+        let q = [0.4, 1.1];
+        let closed = m * a * a * q[0] * q[0] / (4.0 * (q[0] * q[0] + q[1] * q[1]));
+        assert!((v_vibr(&q) - closed).abs() < 1e-14 * (1.0 + closed));
+        // U = m g y + V_vibr: its gradient and Hessian at the upright point
+        // (V_vibr's by central differences).
+        let h = 1e-4;
+        let hessian = DMatrix::from_fn(2, 2, |i, j| {
+            let at = |di: f64, dj: f64| {
+                let mut q = upright;
+                q[i] += di;
+                q[j] += dj;
+                v_vibr(&q)
+            };
+            (at(h, h) - at(h, -h) - at(-h, h) + at(-h, -h)) / (4.0 * h * h)
+        });
+        let gradient = DVector::from_column_slice(&[0.0, m * g]);
+        let test = tangent_stability(
+            &mass,
+            &jacobian(&upright),
+            &gradient,
+            &hessian,
+            &[DMatrix::identity(2, 2)],
+        )
+        .unwrap();
+        assert!((test.multipliers[0] - m * g / l).abs() < 1e-12);
+        let ratio = test.stiffness[(0, 0)] / test.mass[(0, 0)];
+        let angle_model = -g / l + a * a / (2.0 * l * l);
+        assert!(
+            (ratio - angle_model).abs() < 1e-6 * (1.0 + angle_model.abs()),
+            "a = {a}: C_T/A_T = {ratio}, the angle model's {angle_model}"
+        );
+    }
+    // a* = √(2 g l) = 5.05 for these numbers: 3 is below it, 7 above.
+    assert!((2.0 * g * l).sqrt() > 3.0 && (2.0 * g * l).sqrt() < 7.0);
 }

@@ -15,7 +15,7 @@
 //! exactly, q̇ ← q̇ − M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ (G q̇ + g_t). A partial start (any
 //! positions and velocities near the manifold) is made consistent the same way.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
 /// What a holonomically constrained system gives at (t, q).
 pub trait Holonomic {
@@ -54,18 +54,27 @@ pub struct Projection {
     pub velocity_residual: f64,
 }
 
-/// The correction −M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ r of a residual r at q.
-fn correction(
-    m: &DMatrix<f64>,
-    g: &DMatrix<f64>,
-    r: &DVector<f64>,
-    q: &[f64],
-) -> Result<DVector<f64>, ConstraintError> {
-    let singular = || ConstraintError::Singular { q: q.to_vec() };
-    let m = m.clone().cholesky().ok_or_else(singular)?;
-    let m_inv_gt = m.solve(&g.transpose());
-    let schur = (g * &m_inv_gt).cholesky().ok_or_else(singular)?;
-    Ok(-(m_inv_gt * schur.solve(r)))
+/// At q: M's Cholesky factor, M⁻¹Gᵀ and the factor of the Schur
+/// complement G M⁻¹ Gᵀ, or why they do not exist.
+struct Factors {
+    m: Cholesky<f64, Dyn>,
+    m_inv_gt: DMatrix<f64>,
+    schur: Cholesky<f64, Dyn>,
+}
+
+impl Factors {
+    fn at(m: &DMatrix<f64>, g: &DMatrix<f64>, q: &[f64]) -> Result<Factors, ConstraintError> {
+        let singular = || ConstraintError::Singular { q: q.to_vec() };
+        let m = m.clone().cholesky().ok_or_else(singular)?;
+        let m_inv_gt = m.solve(&g.transpose());
+        let schur = (g * &m_inv_gt).cholesky().ok_or_else(singular)?;
+        Ok(Factors { m, m_inv_gt, schur })
+    }
+
+    /// The correction −M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ r of a residual r.
+    fn correction(&self, r: &DVector<f64>) -> DVector<f64> {
+        -(&self.m_inv_gt * self.schur.solve(r))
+    }
 }
 
 /// The accelerations q̈ and multipliers λ at a state, from the mass matrix
@@ -77,13 +86,10 @@ pub fn accelerations(
     h: &DVector<f64>,
     q: &[f64],
 ) -> Result<(DVector<f64>, DVector<f64>), ConstraintError> {
-    let singular = || ConstraintError::Singular { q: q.to_vec() };
-    let m = m.clone().cholesky().ok_or_else(singular)?;
-    let m_inv_f = m.solve(f);
-    let m_inv_gt = m.solve(&g.transpose());
-    let schur = (g * &m_inv_gt).cholesky().ok_or_else(singular)?;
-    let lambda = schur.solve(&(-h - g * &m_inv_f));
-    Ok((m_inv_f + m_inv_gt * &lambda, lambda))
+    let factors = Factors::at(m, g, q)?;
+    let m_inv_f = factors.m.solve(f);
+    let lambda = factors.schur.solve(&(-h - g * &m_inv_f));
+    Ok((m_inv_f + &factors.m_inv_gt * &lambda, lambda))
 }
 
 /// Projects the state `y` = [q; q̇] at time t onto the manifold g = 0,
@@ -118,7 +124,7 @@ pub fn project(
             });
         }
         let (g, _) = system.jacobian(t, q);
-        let step = correction(&system.mass(t, q), &g, &residual, q)?;
+        let step = Factors::at(&system.mass(t, q), &g, q)?.correction(&residual);
         for (x, d) in q.iter_mut().zip(step.iter()) {
             *x += d;
         }
@@ -126,7 +132,7 @@ pub fn project(
     };
     let (g, g_t) = system.jacobian(t, q);
     let velocity = DVector::from_column_slice(v);
-    let step = correction(&system.mass(t, q), &g, &(&g * &velocity + &g_t), q)?;
+    let step = Factors::at(&system.mass(t, q), &g, q)?.correction(&(&g * &velocity + &g_t));
     for (x, d) in v.iter_mut().zip(step.iter()) {
         *x += d;
     }
@@ -170,4 +176,60 @@ pub fn tangent_basis(c: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 /// constraints, multipliers at 1), which mean nothing for the motion.
 pub fn restricted_monodromy(monodromy: &DMatrix<f64>, basis: &DMatrix<f64>) -> DMatrix<f64> {
     basis.transpose() * monodromy * basis
+}
+
+/// P = M⁻¹ − M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ G M⁻¹ at q: the inverse mass matrix on the
+/// tangent space of the constraints (J A⁻¹ Jᵀ for any parametrisation
+/// q = φ(u), J = ∂φ/∂u, A = Jᵀ M J), which averaging needs without one.
+pub fn tangent_inverse_mass(
+    m: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &[f64],
+) -> Result<DMatrix<f64>, ConstraintError> {
+    let factors = Factors::at(m, g, q)?;
+    let correction = &factors.m_inv_gt * factors.schur.solve(&factors.m_inv_gt.transpose());
+    Ok(factors.m.inverse() - correction)
+}
+
+/// The vibrational potential V_vibr = ½ mean⟨P β, β⟩ (Study 2's in
+/// redundant coordinates) from β = ∂⟨m r, ẇ⟩/∂q sampled at equally
+/// spaced phases of a period (exact for β linear in the base's velocity
+/// with three or more samples).
+pub fn vibrational_potential(p: &DMatrix<f64>, betas: &[DVector<f64>]) -> f64 {
+    let sum: f64 = betas.iter().map(|b| b.dot(&(p * b))).sum();
+    0.5 * sum / betas.len().max(1) as f64
+}
+
+/// The second-order test at an equilibrium q* of a potential U on the
+/// manifold (∇U = Gᵀμ there): the multipliers μ and the matrices
+/// A_T = Zᵀ M Z and C_T = Zᵀ (∇²U − Σ μᵢ ∇²gᵢ) Z on an orthonormal basis Z
+/// of ker G. The multiplier term is the manifold's curvature: without it
+/// a point on a rod held upright would look neutral instead of unstable.
+pub struct TangentStability {
+    pub multipliers: DVector<f64>,
+    pub mass: DMatrix<f64>,
+    pub stiffness: DMatrix<f64>,
+}
+
+/// [`TangentStability`] from M, G, ∇U, ∇²U and each constraint's Hessian
+/// ∇²gᵢ at q*. None where G is rank-deficient.
+pub fn tangent_stability(
+    m: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    gradient: &DVector<f64>,
+    hessian: &DMatrix<f64>,
+    constraint_hessians: &[DMatrix<f64>],
+) -> Option<TangentStability> {
+    let z = tangent_basis(g)?;
+    // μ from Gᵀμ = ∇U, by least squares (exact at an equilibrium).
+    let multipliers = (g * g.transpose()).cholesky()?.solve(&(g * gradient));
+    let mut curvature = hessian.clone();
+    for (mu, h) in multipliers.iter().zip(constraint_hessians) {
+        curvature -= h * *mu;
+    }
+    Some(TangentStability {
+        mass: z.transpose() * m * &z,
+        stiffness: z.transpose() * curvature * &z,
+        multipliers,
+    })
 }
