@@ -159,6 +159,26 @@ fn degenerate_constraints_and_wrong_states_are_named_errors() {
         project(&PENDULUM, 0.0, &mut at_origin, 1e-15),
         Err(ConstraintError::Singular { .. })
     ));
+    // No constraint: the whole space; as many as coordinates: none left.
+    assert_eq!(
+        tangent_basis(&DMatrix::zeros(0, 3)),
+        Some(DMatrix::identity(3, 3))
+    );
+    assert_eq!(tangent_basis(&DMatrix::identity(2, 2)), None);
+    // Rank-deficient: two equal rows.
+    assert_eq!(
+        tangent_basis(&DMatrix::from_row_slice(
+            2,
+            3,
+            &[1.0, 2.0, 3.0, 1.0, 2.0, 3.0]
+        )),
+        None
+    );
+    let mut y = [0.9, -1.5, 0.4, 0.8];
+    assert_eq!(
+        project(&PENDULUM, 0.0, &mut y, 0.0),
+        Err(ConstraintError::Tolerance { value: 0.0 })
+    );
     let mut short = [1.0, 0.0, 0.0];
     assert_eq!(
         project(&PENDULUM, 0.0, &mut short, 1e-15),

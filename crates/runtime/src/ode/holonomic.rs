@@ -40,6 +40,9 @@ pub enum ConstraintError {
     /// degenerate here, or M is not positive definite.
     #[error("the constraints are redundant or degenerate at q = {q:?} (G M⁻¹ Gᵀ is singular), or the mass matrix is not positive definite there")]
     Singular { q: Vec<f64> },
+    /// A projection's tolerance that is not finite and positive.
+    #[error("the projection's tolerance must be finite and positive, got {value}")]
+    Tolerance { value: f64 },
     /// A state of another length than 2n.
     #[error("a state of {given} numbers for a system of {coordinates} coordinates (2 per coordinate expected)")]
     StateLength { given: usize, coordinates: usize },
@@ -102,6 +105,9 @@ pub fn project(
     tolerance: f64,
 ) -> Result<Projection, ConstraintError> {
     let n = system.coordinates();
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(ConstraintError::Tolerance { value: tolerance });
+    }
     if y.len() != 2 * n {
         return Err(ConstraintError::StateLength {
             given: y.len(),
@@ -150,6 +156,9 @@ pub fn project(
 /// does not have full rank 2k (degenerate constraints).
 pub fn tangent_basis(c: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let (rows, n) = c.shape();
+    if rows == 0 {
+        return Some(DMatrix::identity(n, n));
+    }
     if rows >= n {
         return None;
     }
@@ -212,7 +221,8 @@ pub struct TangentStability {
 }
 
 /// [`TangentStability`] from M, G, ∇U, ∇²U and each constraint's Hessian
-/// ∇²gᵢ at q*. None where G is rank-deficient.
+/// ∇²gᵢ at q*. None where G is rank-deficient or the Hessians are not one
+/// per constraint.
 pub fn tangent_stability(
     m: &DMatrix<f64>,
     g: &DMatrix<f64>,
@@ -220,6 +230,9 @@ pub fn tangent_stability(
     hessian: &DMatrix<f64>,
     constraint_hessians: &[DMatrix<f64>],
 ) -> Option<TangentStability> {
+    if constraint_hessians.len() != g.nrows() {
+        return None;
+    }
     let z = tangent_basis(g)?;
     // μ from Gᵀμ = ∇U, by least squares (exact at an equilibrium).
     let multipliers = (g * g.transpose()).cholesky()?.solve(&(g * gradient));
