@@ -11,7 +11,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options, System};
+use super::{Integrator, Method, OdeError, Options, System};
 
 /// A system behind a trait object whose state is a slice of [`AnySystem::dim`]
 /// numbers. Every method refuses a state of another length with
@@ -30,7 +30,7 @@ pub trait AnySystem: Sync {
         t0: f64,
         y0: &[f64],
         t1: f64,
-        options: AnyOptions<'_, '_>,
+        options: AnyOptions<'_>,
     ) -> Result<AnySolution, OdeError>;
     /// [`super::states_at`]: the states at `times` of a fresh run of
     /// `method` from (t0, y0), up to the last of them.
@@ -59,40 +59,18 @@ pub trait AnySystem: Sync {
     ) -> Result<(), OdeError>;
 }
 
-/// A zero crossing to watch for, its condition on a state slice (as
-/// [`Event`]).
-pub struct AnyEvent<'a> {
-    pub condition: &'a dyn Fn(f64, &[f64]) -> f64,
-    pub direction: Direction,
-    pub terminal: bool,
-}
-
-/// [`Options`] with states as slices.
+/// [`Options`] with states as slices: the output times. (Events and
+/// observers, which the fixed-size [`Options`] also take, are not asked
+/// for through this interface yet.)
 #[derive(Default)]
-pub struct AnyOptions<'o, 'e> {
+pub struct AnyOptions<'o> {
     times: &'o [f64],
-    events: &'o [AnyEvent<'e>],
-    event_settings: EventSettings,
-    observer: Option<&'o mut dyn FnMut(f64, &[f64])>,
 }
 
-impl<'o, 'e> AnyOptions<'o, 'e> {
+impl<'o> AnyOptions<'o> {
     /// [`Options::times`].
     pub fn times(mut self, times: &'o [f64]) -> Self {
         self.times = times;
-        self
-    }
-
-    /// [`Options::events`].
-    pub fn events(mut self, events: &'o [AnyEvent<'e>], settings: EventSettings) -> Self {
-        self.events = events;
-        self.event_settings = settings;
-        self
-    }
-
-    /// [`Options::observe`].
-    pub fn observe(mut self, observer: &'o mut dyn FnMut(f64, &[f64])) -> Self {
-        self.observer = Some(observer);
         self
     }
 }
@@ -103,18 +81,6 @@ pub struct AnySolution {
     pub t: f64,
     pub y: Vec<f64>,
     pub samples: Vec<Vec<f64>>,
-    /// Each crossing: the event's index, its time, its state, whether rising.
-    pub hits: Vec<AnyHit>,
-    pub terminated: bool,
-}
-
-/// [`super::EventHit`] with its state as a vector.
-#[derive(Clone, Debug, PartialEq)]
-pub struct AnyHit {
-    pub event: usize,
-    pub t: f64,
-    pub y: Vec<f64>,
-    pub rising: bool,
 }
 
 /// A [`System`] at its own size N as an [`AnySystem`].
@@ -148,53 +114,15 @@ impl<S: System<N> + Sync, const N: usize> AnySystem for SizedSystem<S, N> {
         t0: f64,
         y0: &[f64],
         t1: f64,
-        options: AnyOptions<'_, '_>,
+        options: AnyOptions<'_>,
     ) -> Result<AnySolution, OdeError> {
         let y0 = fixed_state::<N>(y0)?;
-        let AnyOptions {
-            times,
-            events,
-            event_settings,
-            observer,
-        } = options;
-        let conditions: Vec<_> = events
-            .iter()
-            .map(|e| move |t: f64, y: &[f64; N]| (e.condition)(t, y))
-            .collect();
-        let fixed_events: Vec<Event<'_, N>> = events
-            .iter()
-            .zip(&conditions)
-            .map(|(e, condition)| Event {
-                condition,
-                direction: e.direction,
-                terminal: e.terminal,
-            })
-            .collect();
-        let mut fixed_observer;
-        let mut fixed = Options::default().times(times);
-        if !events.is_empty() {
-            fixed = fixed.events(&fixed_events, event_settings);
-        }
-        if let Some(observe) = observer {
-            fixed_observer = move |t: f64, y: &[f64; N]| observe(t, y);
-            fixed = fixed.observe(&mut fixed_observer);
-        }
-        let solution = integrator.solve(&self.0, t0, &y0, t1, fixed)?;
+        let options = Options::default().times(options.times);
+        let solution = integrator.solve(&self.0, t0, &y0, t1, options)?;
         Ok(AnySolution {
             t: solution.t,
             y: solution.y.to_vec(),
             samples: solution.samples.iter().map(|y| y.to_vec()).collect(),
-            hits: solution
-                .hits
-                .into_iter()
-                .map(|h| AnyHit {
-                    event: h.event,
-                    t: h.t,
-                    y: h.y.to_vec(),
-                    rising: h.rising,
-                })
-                .collect(),
-            terminated: solution.terminated,
         })
     }
 

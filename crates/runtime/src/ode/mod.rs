@@ -26,7 +26,7 @@ mod solve;
 pub mod taylor;
 mod taylor_lanes;
 
-pub use any_size::{AnyEvent, AnyHit, AnyOptions, AnySolution, AnySystem, SizedSystem};
+pub use any_size::{AnyOptions, AnySolution, AnySystem, SizedSystem};
 pub use double_double::DoubleDouble;
 pub use dual::Dual;
 pub use erased::{DynSystem, ErasedSystem};
