@@ -285,19 +285,10 @@ pub trait Fixed<const D: usize, const S: usize, const T: usize, const V: usize>:
     fn averaged(&self, params: &[f64]) -> Option<Self::Averaged>;
     /// The period of the fast phase.
     fn phase_period(&self, params: &[f64]) -> Option<f64>;
-    /// The second-order averaged system, its Hessian ∂²K̄/∂y² and the
-    /// first-order map's shift y − y′ at time t: None where it is not
-    /// derived (no fast phase, or the numeric-solve form).
+    /// The second-order averaged system: None where it is not derived (no
+    /// fast phase, or the numeric-solve form).
     fn averaged2(&self, params: &[f64]) -> Option<Self::Averaged2>;
-    fn averaged2_hessian(&self, params: &[f64], y: &[f64; S]) -> Option<[[f64; S]; S]>;
-    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64; S]) -> Option<[f64; S]>;
     fn mass_matrix(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
-    /// ∂V/∂q and C = ∂²V/∂q² of the potential averaged over the phase.
-    fn potential_gradient(&self, params: &[f64], q: &[f64; D]) -> [f64; D];
-    fn potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
-    /// V + V_vibr (V without a fast phase) and its Hessian.
-    fn effective_potential(&self, params: &[f64], q: &[f64; D]) -> f64;
-    fn effective_potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D];
 }
 
 /// What a generated Hamiltonian model gives at its own sizes, as a trait
@@ -366,26 +357,8 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
             params: params.to_vec(),
         })
     }
-    fn averaged2_hessian(&self, params: &[f64], y: &[f64; S]) -> Option<[[f64; S]; S]> {
-        self.0.averaged2_hessian(params, y)
-    }
-    fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64; S]) -> Option<[f64; S]> {
-        self.0.averaged2_shift(params, t, y)
-    }
     fn mass_matrix(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D] {
         self.0.mass_matrix(params, q)
-    }
-    fn potential_gradient(&self, params: &[f64], q: &[f64; D]) -> [f64; D] {
-        self.0.potential_gradient(params, q)
-    }
-    fn potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D] {
-        self.0.potential_hessian(params, q)
-    }
-    fn effective_potential(&self, params: &[f64], q: &[f64; D]) -> f64 {
-        self.0.effective_potential(params, q)
-    }
-    fn effective_potential_hessian(&self, params: &[f64], q: &[f64; D]) -> [[f64; D]; D] {
-        self.0.effective_potential_hessian(params, q)
     }
 }
 
