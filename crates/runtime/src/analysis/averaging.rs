@@ -279,9 +279,7 @@ pub fn convergence(
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
-    let model = model
-        .systems()
-        .ok_or_else(|| AveragingError::Refused(Refusal::contact_model(model.info.name)))?;
+    let model = crate::analysis::hamiltonian(model)?;
     let info = model.info();
     if !model.has_fast_phase() {
         return Err(AveragingError::Refused(Refusal::no_fast_phase(info.name)));

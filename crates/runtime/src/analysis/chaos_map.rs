@@ -95,14 +95,9 @@ pub fn chaos_map(
     settings: &ChaosMapSettings,
     row_done: &(dyn Fn() -> bool + Sync),
 ) -> Result<ChaosMap, ChaosMapError> {
-    let systems = model
-        .systems()
-        .ok_or_else(|| ChaosMapError::Refused(Refusal::contact_model(model.info.name)))?;
+    let systems = crate::analysis::hamiltonian(model)?;
     let info = systems.info();
-    let period = match systems.phase_period(params) {
-        Some(t) if systems.has_fast_phase() => t,
-        _ => return Err(ChaosMapError::Refused(Refusal::no_fast_phase(info.name))),
-    };
+    let period = super::period_map::fast_phase_period(systems, params)?;
     let periodic = systems.periodic_state();
     let Request {
         params: named,
@@ -218,12 +213,7 @@ fn request(
     n: usize,
 ) -> Result<Request, ChaosMapError> {
     let named = Refusal::named_values(info, params)?;
-    let axes = info
-        .plane(settings.axes)
-        .map_err(|source| ChaosMapError::Plane {
-            model: info.name.into(),
-            source,
-        })?;
+    let axes = super::period_map::plane_names(info, settings.axes)?;
     let through = match &settings.through {
         Some(y) if y.len() != n => {
             let what = "state the plane passes through";

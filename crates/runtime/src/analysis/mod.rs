@@ -85,6 +85,15 @@ pub enum Refusal {
     Parameter(#[from] crate::registry::ParameterError),
 }
 
+/// The model's systems, or the refusal of a contact model (which has none).
+pub(crate) fn hamiltonian(
+    model: &crate::registry::Model,
+) -> Result<&'static dyn crate::registry::Systems, Refusal> {
+    model
+        .systems()
+        .ok_or_else(|| Refusal::contact_model(model.info.name))
+}
+
 impl Refusal {
     pub fn contact_model(model: impl Into<String>) -> Refusal {
         Refusal::ContactModel {

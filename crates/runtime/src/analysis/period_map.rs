@@ -196,21 +196,11 @@ pub fn portrait(
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    let systems = model
-        .systems()
-        .ok_or_else(|| Refusal::contact_model(model.info.name))?;
+    let systems = crate::analysis::hamiltonian(model)?;
     let info = systems.info();
     let named = Refusal::named_values(info, params)?;
-    let period = match systems.phase_period(params) {
-        Some(t) if systems.has_fast_phase() => t,
-        _ => return Err(PeriodMapError::Refused(Refusal::no_fast_phase(info.name))),
-    };
-    let axes = info
-        .plane(settings.axes)
-        .map_err(|source| PeriodMapError::Plane {
-            model: info.name.into(),
-            source,
-        })?;
+    let period = fast_phase_period(systems, params)?;
+    let axes = plane_names(info, settings.axes)?;
     let wrap = systems.periodic_state();
     let seeds = portrait_seeds(info.name, settings, &wrap)?;
     orbit_budget(seeds.len(), settings.periods, wrap.len())?;
@@ -257,6 +247,30 @@ pub fn portrait(
         failed,
         seconds: start.elapsed().as_secs_f64(),
         orbits: projected,
+    })
+}
+
+/// The period of the model's fast phase, or the refusal of a model
+/// without one (no period map).
+pub(crate) fn fast_phase_period(
+    systems: &dyn crate::registry::Systems,
+    params: &[f64],
+) -> Result<f64, Refusal> {
+    match systems.phase_period(params) {
+        Some(t) if systems.has_fast_phase() => Ok(t),
+        _ => Err(Refusal::no_fast_phase(systems.info().name)),
+    }
+}
+
+/// The names of a plane's two state components, or the error naming the
+/// model.
+pub(crate) fn plane_names(
+    info: &crate::registry::ModelInfo,
+    axes: [usize; 2],
+) -> Result<[String; 2], PeriodMapError> {
+    info.plane(axes).map_err(|source| PeriodMapError::Plane {
+        model: info.name.into(),
+        source,
     })
 }
 

@@ -248,9 +248,7 @@ pub fn stability(
     settings: &Settings,
 ) -> Result<Stability, StabilityError> {
     let dynamic = model.dynamic;
-    let model = model
-        .systems()
-        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
+    let model = crate::analysis::hamiltonian(model)?;
     analyse(model, dynamic, params, settings)
 }
 
@@ -484,9 +482,7 @@ pub fn averaged_stability(
     amplitude: &str,
     q: &[f64],
 ) -> Result<EquilibriumStability, StabilityError> {
-    let model = model
-        .systems()
-        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
+    let model = crate::analysis::hamiltonian(model)?;
     let info = model.info();
     vibrating_model(model, params)?;
     let amplitude = parameter_index(info, amplitude)?;
@@ -1028,9 +1024,7 @@ pub fn stability_chart(
     params: &[f64],
     settings: &ChartSettings,
 ) -> Result<StabilityChart, StabilityError> {
-    let model = model
-        .systems()
-        .ok_or_else(|| StabilityError::Refused(Refusal::contact_model(model.info.name)))?;
+    let model = crate::analysis::hamiltonian(model)?;
     chart(model, params, settings)
 }
 

@@ -404,10 +404,7 @@ pub fn orbit(
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
 ) -> Result<OrbitEnd, StudioError> {
     let setup = request.check(catalog)?;
-    let systems = setup
-        .handle
-        .systems()
-        .ok_or_else(|| StudioError::Refused(Refusal::contact_model(setup.info.name)))?;
+    let systems = crate::analysis::hamiltonian(setup.handle)?;
     let started = Instant::now();
     let period = systems
         .phase_period(&setup.params)

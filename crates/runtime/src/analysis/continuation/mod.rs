@@ -261,9 +261,7 @@ pub fn continuation(
     params: &[f64],
     settings: &ContinuationSettings,
 ) -> Result<Continuation, ContinuationError> {
-    let systems = model
-        .systems()
-        .ok_or_else(|| ContinuationError::Refused(Refusal::contact_model(model.info.name)))?;
+    let systems = crate::analysis::hamiltonian(model)?;
     let info = systems.info();
     let name = info.name.to_string();
     let index = Refusal::parameter_index(info, &settings.parameter)?;
