@@ -167,7 +167,8 @@ fn check_stability(name: &str, params: &[f64], amplitude: &str, n: usize) {
         DMatrix::from_row_slice(n, n, &model.effective_potential_hessian(&p, q).unwrap())
     };
     for e in &result.equilibria {
-        assert_eq!(e.lambdas.len(), n, "{name}");
+        // (At a pole, the roots are the reduced system's.)
+        assert_eq!(e.lambdas.len(), n - e.reduced_by.len(), "{name}");
         let v = |q: &[f64]| model.effective_potential(params, q).unwrap();
         for i in 0..n {
             let h = 1e-5;
@@ -198,6 +199,16 @@ fn check_stability(name: &str, params: &[f64], amplitude: &str, n: usize) {
                 );
             }
             None => assert!(e.reason.is_some(), "{name}: no a* and no reason"),
+        }
+    }
+    // A moved equilibrium's window lies on the amplitudes searched, in order.
+    for moved in &result.moved_by_vibration {
+        if let Some([lower, upper]) = moved.exact_window {
+            let lower = lower.expect("a window has its lower edge");
+            assert!(lower >= 0.0, "{name} {:?}: {lower}", moved.q);
+            if let Some(upper) = upper {
+                assert!(upper >= lower, "{name} {:?}: [{lower}, {upper}]", moved.q);
+            }
         }
     }
 }

@@ -330,6 +330,12 @@ pub(crate) fn orbit_branch(
         );
         changes.extend(result.bifurcations.iter().map(|b| b.parameter));
     }
+    // Only the branch within the bounds: past a fold it may go on below
+    // the lower bound (to negative amplitudes), where a stability change
+    // is no edge of the window on (bounds.0, bounds.1].
+    let inside = |p: f64| (bounds.0..=bounds.1).contains(&p);
+    along.retain(|p| inside(p.0));
+    changes.retain(|&p| inside(p));
     along.sort_by(|a, b| a.0.total_cmp(&b.0));
     changes.sort_by(f64::total_cmp);
     // The change between two points of the branch (their midpoint if none
