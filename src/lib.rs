@@ -27,7 +27,8 @@
 //! ```
 
 pub use mechlab_runtime::{
-    analysis, budget, contact, explore, linalg, mathml, ode, plot, registry, report, studio, study,
+    analysis, budget, constrained, contact, explore, linalg, mathml, ode, plot, registry, report,
+    studio, study,
 };
 pub use mechlab_scenes::{scene, scenes};
 

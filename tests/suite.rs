@@ -15,6 +15,7 @@ mod docs_commands;
 mod double_double;
 mod events;
 mod explore;
+mod constrained;
 mod holonomic;
 mod integrators;
 mod model_errors;

@@ -66,6 +66,8 @@ pub enum Inputs {
     DualCoordinates,
     /// Coordinates and velocities, at time t.
     CoordinatesVelocities,
+    /// Coordinates at time t.
+    TimeCoordinates,
     /// The Hamiltonian state `y = [q, p]` at time t.
     State,
     /// The state of the autonomous averaged system.
@@ -157,6 +159,10 @@ impl Context<'_> {
                 ));
                 format!("{time}: f64, q: &[f64; {n}], qd: &[f64; {n}], params: &Params")
             }
+            Inputs::TimeCoordinates => {
+                prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
+                format!("{time}: f64, q: &[f64; {n}], params: &Params")
+            }
             Inputs::ContactState => {
                 prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
                 format!("y: &[f64; {}], params: &Params", 2 * n)
@@ -188,7 +194,10 @@ impl Context<'_> {
         prelude.push(params_line);
         if matches!(
             inputs,
-            Inputs::State | Inputs::DualState | Inputs::CoordinatesVelocities
+            Inputs::State
+                | Inputs::DualState
+                | Inputs::CoordinatesVelocities
+                | Inputs::TimeCoordinates
         ) {
             prelude.extend(phase_line);
         }

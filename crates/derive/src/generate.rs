@@ -2,10 +2,11 @@
 //! it through the tera templates in `templates/`.
 
 use crate::algebra::Derived;
+use crate::constraints::ConstrainedDerivation;
 use crate::contacts::ContactDerivation;
 use crate::derive::Derivation;
 use crate::error::DeriveError;
-use crate::functions::{named, symbolic_functions, vector, Context, Inputs};
+use crate::functions::{matrix, named, symbolic_functions, vector, Context, Inputs};
 use crate::model::Model;
 use serde::Serialize;
 
@@ -283,6 +284,156 @@ pub fn render_contacts(
         })
 }
 
+/// Renders the generated module of a model with ideal constraints.
+pub fn render_constrained(
+    tera: &tera::Tera,
+    model: &Model,
+    derivation: &ConstrainedDerivation,
+    source_file: &str,
+) -> Result<String, DeriveError> {
+    let n = model.dof();
+    let k = model.constraints.len();
+    let cx = Context {
+        model,
+        n,
+        contact_state: Vec::new(),
+        model_phase_rate: String::new(),
+    };
+    let mut functions = Vec::new();
+    if let Some(rate) = &derivation.phase_rate {
+        functions.push(cx.function(
+            "phase_rate",
+            "dθ/dt of the fast phase θ.",
+            Inputs::Params,
+            "f64".into(),
+            &[vec![("rate__".into(), rate.clone())]],
+            "rate__".into(),
+        )?);
+    }
+    let (outs, result) = vector("q", &derivation.starts);
+    functions.push(cx.function(
+        "start",
+        "The coordinates' starts of the model file (consistent at t = 0 with the default parameters).",
+        Inputs::Params,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = matrix("m", &derivation.mass_matrix);
+    functions.push(cx.function(
+        "mass_matrix",
+        "Mass matrix M = ∂²L/∂q'².",
+        Inputs::TimeCoordinates,
+        format!("[[f64; {n}]; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = vector("f", &derivation.free_forces);
+    functions.push(cx.function(
+        "free_forces",
+        "Free generalised force F: M q'' = F + Gᵀλ.",
+        Inputs::CoordinatesVelocities,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = vector("g", &derivation.residuals);
+    functions.push(cx.function(
+        "position_residuals",
+        "g of each position constraint (0 for a velocity constraint).",
+        Inputs::TimeCoordinates,
+        format!("[f64; {k}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = matrix("jac", &derivation.jacobian);
+    functions.push(cx.function(
+        "constraint_jacobian",
+        "G = ∂c/∂q' of each constraint's velocity form c = G q' + c_t.",
+        Inputs::TimeCoordinates,
+        format!("[[f64; {n}]; {k}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = vector("ct", &derivation.rates);
+    functions.push(cx.function(
+        "constraint_rates",
+        "c_t of each constraint's velocity form c = G q' + c_t.",
+        Inputs::TimeCoordinates,
+        format!("[f64; {k}]"),
+        &[outs],
+        result,
+    )?);
+    let (outs, result) = vector("h", &derivation.bias);
+    functions.push(cx.function(
+        "constraint_bias",
+        "h: d/dt c = G q'' + h.",
+        Inputs::CoordinatesVelocities,
+        format!("[f64; {k}]"),
+        &[outs],
+        result,
+    )?);
+    functions.push(cx.function(
+        "energy",
+        "Energy function E = Σ q'∂L/∂q' − L.",
+        Inputs::CoordinatesVelocities,
+        "f64".into(),
+        &[vec![("e__".into(), derivation.energy.clone())]],
+        "e__".into(),
+    )?);
+    let mut context = base_context(model, source_file, &derivation.derived);
+    context.insert("dof", &n);
+    context.insert("constraints", &k);
+    context.insert("state_dim", &(2 * n));
+    context.insert(
+        "coordinates",
+        &model
+            .coordinates
+            .iter()
+            .map(|c| c.name.clone())
+            .collect::<Vec<_>>(),
+    );
+    context.insert(
+        "velocities",
+        &model
+            .coordinates
+            .iter()
+            .map(|c| c.velocity.clone())
+            .collect::<Vec<_>>(),
+    );
+    context.insert(
+        "periodic",
+        &model
+            .coordinates
+            .iter()
+            .map(|c| c.periodic)
+            .collect::<Vec<_>>(),
+    );
+    context.insert(
+        "constraint_names",
+        &model
+            .constraints
+            .iter()
+            .map(|c| c.name.clone())
+            .collect::<Vec<_>>(),
+    );
+    context.insert(
+        "holonomic",
+        &model
+            .constraints
+            .iter()
+            .map(|c| matches!(c.kind, crate::model::ConstraintKind::Position(_)))
+            .collect::<Vec<_>>(),
+    );
+    context.insert("has_phase", &derivation.phase_rate.is_some());
+    context.insert("functions", &functions);
+    tera.render("constrained_model.rs.tera", &context)
+        .map_err(|source| DeriveError::Template {
+            template: "constrained_model.rs.tera",
+            source,
+        })
+}
+
 /// Renders the registry module listing every model.
 pub fn render_registry(
     tera: &tera::Tera,
@@ -301,7 +452,11 @@ pub fn render_registry(
         .map(|m| Entry {
             name: m.name.clone(),
             doc: format!("{:?}", m.description),
-            dof: if m.contacts.is_empty() { m.dof() } else { 0 },
+            dof: if m.contacts.is_empty() && m.constraints.is_empty() {
+                m.dof()
+            } else {
+                0
+            },
         })
         .collect();
     let mut context = tera::Context::new();

@@ -19,6 +19,7 @@
 use mechlab_model as model;
 
 mod algebra;
+mod constraints;
 mod contacts;
 mod deprit;
 mod derive;
@@ -256,12 +257,15 @@ fn prune_cache(cache: &Path, name: &str, keep: &Path) {
 
 /// Derives one model and renders its module; errors name the file.
 fn generate_model(tera: &tera::Tera, model: &model::Model, file: &str) -> String {
-    let generated = if model.contacts.is_empty() {
-        derive::derive(model)
-            .and_then(|derivation| generate::render(tera, model, &derivation, file))
-    } else {
+    let generated = if !model.contacts.is_empty() {
         contacts::derive(model)
             .and_then(|derivation| generate::render_contacts(tera, model, &derivation, file))
+    } else if !model.constraints.is_empty() {
+        constraints::derive(model)
+            .and_then(|derivation| generate::render_constrained(tera, model, &derivation, file))
+    } else {
+        derive::derive(model)
+            .and_then(|derivation| generate::render(tera, model, &derivation, file))
     };
     generated.unwrap_or_else(|e| fail(format!("{file}: {e}")))
 }

@@ -37,6 +37,11 @@ pub struct ModelFile {
     /// Coulomb contacts: points sliding along rough guides.
     #[serde(default)]
     pub contacts: Vec<ContactSpec>,
+    /// Constraints on the coordinates, ideal (their reactions do no work
+    /// along the motions they allow): closed loops, rods between points,
+    /// moving guides, rolling.
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSpec>,
     /// How q' = A⁻¹(p − b) is computed: "symbolic" (cofactors) or
     /// "numeric" (A(q) emitted, solved by Cholesky in the generated code).
     /// Default: symbolic up to [`SYMBOLIC_INVERSE_MAX_DOF`] degrees of freedom.
@@ -89,6 +94,28 @@ pub struct ContactSpec {
     pub description: String,
 }
 
+/// An ideal constraint: exactly one of `position` (holonomic, an expression
+/// of the positions, time and the fast phase that vanishes) and `velocity`
+/// (nonholonomic, an expression linear in the velocities that vanishes).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSpec {
+    /// Names the constraint's reaction (its Lagrange multiplier).
+    pub name: String,
+    pub position: Option<String>,
+    pub velocity: Option<String>,
+    #[serde(default)]
+    pub description: String,
+}
+
+/// A number in a model file: a value, or an expression in the parameters.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum NumberSpec {
+    Value(f64),
+    Expression(String),
+}
+
 fn default_time() -> String {
     "t".into()
 }
@@ -105,6 +132,10 @@ pub struct CoordinateSpec {
     /// LaTeX of the name, when the default (Greek names, digits as
     /// subscripts) does not fit.
     pub latex: Option<String>,
+    /// The coordinate's value in a configuration that satisfies the
+    /// constraints at t = 0 with the default parameters (models with
+    /// constraints need one for every coordinate).
+    pub start: Option<NumberSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -157,6 +188,9 @@ pub struct Coordinate {
     pub description: String,
     /// Explicit LaTeX name, if the model file gives one.
     pub latex: Option<String>,
+    /// Its value in the consistent start (models with constraints), an
+    /// expression in the parameters.
+    pub start: Option<Expr>,
 }
 
 #[derive(Clone, Debug)]
@@ -198,7 +232,33 @@ pub struct Model {
     /// The Rayleigh dissipation function (zero if none); `dot()` as in L.
     pub rayleigh: Expr,
     pub contacts: Vec<Contact>,
+    pub constraints: Vec<Constraint>,
     pub inverse: Inverse,
+}
+
+/// A validated ideal constraint.
+#[derive(Clone, Debug)]
+pub struct Constraint {
+    pub name: String,
+    pub kind: ConstraintKind,
+    pub description: String,
+}
+
+/// What vanishes along the motion.
+#[derive(Clone, Debug)]
+pub enum ConstraintKind {
+    /// g(q, t) = 0: holonomic (`dot` not allowed).
+    Position(Expr),
+    /// a(q, t)·q' + b(q, t) = 0: nonholonomic (velocities and `dot` allowed).
+    Velocity(Expr),
+}
+
+impl ConstraintKind {
+    pub fn expression(&self) -> &Expr {
+        match self {
+            ConstraintKind::Position(e) | ConstraintKind::Velocity(e) => e,
+        }
+    }
 }
 
 /// A validated Coulomb contact.
@@ -525,11 +585,17 @@ impl ModelFile {
         };
         let contacts =
             self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
+        let (constraints, starts) = self.validate_constraints(file, names, &parse)?;
+        let mut coordinates: Vec<Coordinate> =
+            self.coordinates.into_iter().map(Coordinate::from).collect();
+        for (c, start) in coordinates.iter_mut().zip(starts) {
+            c.start = start;
+        }
         let model = Model {
             name: self.name,
             description: self.description,
             time: self.time,
-            coordinates: self.coordinates.into_iter().map(Coordinate::from).collect(),
+            coordinates,
             parameters: self.parameters.into_iter().map(Parameter::from).collect(),
             fast_phase,
             definitions,
@@ -537,10 +603,12 @@ impl ModelFile {
             forces,
             rayleigh,
             contacts,
+            constraints,
             inverse,
         };
         model
             .check_numerically()
+            .and_then(|()| model.check_constraints_numerically())
             .map_err(|(key, reason)| err(&key, reason))?;
         Ok(model)
     }
@@ -554,6 +622,7 @@ impl From<CoordinateSpec> for Coordinate {
             periodic: c.periodic,
             description: c.description,
             latex: c.latex,
+            start: None,
         }
     }
 }
@@ -690,7 +759,7 @@ impl<'f> Reader<'f> {
         expr.rewrite_calls(&mut |name, args| {
             if name == "dot" && problem.is_none() {
                 problem = match (&args[0], dot_allowed) {
-                    (_, false) => Some("dot() is only allowed in the Lagrangian".to_string()),
+                    (_, false) => Some("dot() is only allowed in the Lagrangian, the Rayleigh function and velocity constraints".to_string()),
                     (Expr::Sym(s), true)
                         if self.names.definitions.contains(s)
                             || self.names.coordinates.contains(s) =>
@@ -775,6 +844,108 @@ impl ModelFile {
     }
 }
 
+impl ModelFile {
+    /// Constraints: each a position or a velocity expression, named once;
+    /// fewer than the coordinates; not with contacts; and a start for
+    /// every coordinate. Returns them and the coordinates' starts.
+    fn validate_constraints(
+        &self,
+        file: &str,
+        names: &Names,
+        parse: &ExprParser,
+    ) -> Result<(Vec<Constraint>, Vec<Option<Expr>>), ModelError> {
+        let err = |key: String, reason: String| ModelError {
+            file: file.to_string(),
+            key,
+            reason,
+        };
+        let starts = self
+            .coordinates
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let key = format!("coordinates[{i}].start");
+                match &c.start {
+                    None if !self.constraints.is_empty() => Err(err(key, format!("a model with constraints needs a start for '{}': its value in a configuration that satisfies the constraints at t = 0 with the default parameters", c.name))),
+                    None => Ok(None),
+                    Some(NumberSpec::Value(v)) if !v.is_finite() => {
+                        Err(err(key, format!("the start of '{}' is not finite", c.name)))
+                    }
+                    Some(NumberSpec::Value(v)) => Ok(Some(Expr::Num(format!("{v:?}")))),
+                    Some(NumberSpec::Expression(text)) => {
+                        parse(&key, text, &[&names.parameters], false).map(Some)
+                    }
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if self.constraints.is_empty() {
+            return Ok((Vec::new(), starts));
+        }
+        if !self.contacts.is_empty() {
+            return Err(err(
+                "constraints".into(),
+                "constraints and contacts cannot be combined (a contact's guide is its constraint)"
+                    .into(),
+            ));
+        }
+        let (k, n) = (self.constraints.len(), self.coordinates.len());
+        if k >= n {
+            return Err(err(
+                "constraints".into(),
+                format!("{k} constraints on {n} coordinates leave no motion: a model needs fewer constraints than coordinates"),
+            ));
+        }
+        let positions = [
+            &names.coordinates,
+            &names.parameters,
+            &names.phase,
+            &names.time,
+            &names.definitions,
+        ];
+        let mut constraints = Vec::new();
+        for (i, c) in self.constraints.iter().enumerate() {
+            if !is_identifier(&c.name) {
+                return Err(err(
+                    format!("constraints[{i}].name"),
+                    format!("'{}' is not an identifier", c.name),
+                ));
+            }
+            if self.constraints[..i].iter().any(|d| d.name == c.name) {
+                return Err(err(
+                    format!("constraints[{i}].name"),
+                    format!("'{}' names two constraints", c.name),
+                ));
+            }
+            let kind = match (&c.position, &c.velocity) {
+                (Some(text), None) => ConstraintKind::Position(parse(
+                    &format!("constraints[{i}].position"),
+                    text,
+                    &positions,
+                    false,
+                )?),
+                (None, Some(text)) => ConstraintKind::Velocity(parse(
+                    &format!("constraints[{i}].velocity"),
+                    text,
+                    &names.all(),
+                    true,
+                )?),
+                _ => {
+                    return Err(err(
+                        format!("constraints[{i}]"),
+                        "give exactly one of `position` (an expression of the positions that vanishes) and `velocity` (one linear in the velocities that vanishes)".into(),
+                    ))
+                }
+            };
+            constraints.push(Constraint {
+                name: c.name.clone(),
+                kind,
+                description: c.description.clone(),
+            });
+        }
+        Ok((constraints, starts))
+    }
+}
+
 impl Model {
     pub fn dof(&self) -> usize {
         self.coordinates.len()
@@ -784,6 +955,12 @@ impl Model {
     /// total time derivative: Σ ∂x/∂q_i q'_i + rate ∂x/∂θ + ∂x/∂t.
     /// Unsimplified; used for numerical checks (the build derives it again with Symbolica).
     pub fn expanded_lagrangian(&self) -> Expr {
+        self.expanded(&self.lagrangian)
+    }
+
+    /// An expression of the file with definitions substituted and `dot`
+    /// expanded as in [`Model::expanded_lagrangian`].
+    pub fn expanded(&self, e: &Expr) -> Expr {
         let resolved = self.resolved_definitions();
         let lookup = |s: &str| {
             resolved
@@ -814,14 +991,13 @@ impl Model {
             }
             Expr::sum(terms)
         };
-        self.lagrangian
-            .rewrite_calls(&mut |name, args| match (name, &args[0]) {
-                ("dot", Expr::Sym(s)) => Some(total_derivative(
-                    &lookup(s).unwrap_or_else(|| Expr::Sym(s.clone())),
-                )),
-                _ => None,
-            })
-            .substitute(&lookup)
+        e.rewrite_calls(&mut |name, args| match (name, &args[0]) {
+            ("dot", Expr::Sym(s)) => Some(total_derivative(
+                &lookup(s).unwrap_or_else(|| Expr::Sym(s.clone())),
+            )),
+            _ => None,
+        })
+        .substitute(&lookup)
     }
 
     /// Definitions with every other definition substituted.
@@ -936,6 +1112,249 @@ impl Model {
         }
         Ok(())
     }
+}
+
+/// A model's expressions evaluated at coordinates, velocities, phase and
+/// time with the default parameters (for the numerical checks).
+struct Sample<'m> {
+    model: &'m Model,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    phase: f64,
+    time: f64,
+}
+
+impl Sample<'_> {
+    fn value(&self, s: &str) -> Option<f64> {
+        let model = self.model;
+        if let Some(i) = model.coordinates.iter().position(|c| c.name == s) {
+            return Some(self.q[i]);
+        }
+        if let Some(i) = model.coordinates.iter().position(|c| c.velocity == s) {
+            return Some(self.v[i]);
+        }
+        if model.fast_phase.as_ref().is_some_and(|p| p.name == s) {
+            return Some(self.phase);
+        }
+        if s == model.time {
+            return Some(self.time);
+        }
+        model
+            .parameters
+            .iter()
+            .find(|p| p.name == s)
+            .map(|p| p.default)
+    }
+
+    fn eval(&self, e: &Expr) -> f64 {
+        e.eval(&|s| self.value(s)).unwrap_or(f64::NAN)
+    }
+}
+
+impl Model {
+    /// At the starts (t = 0, default parameters): every position
+    /// constraint vanishes, every velocity constraint is linear in the
+    /// velocities and not integrable, and together their rows
+    /// (∂g/∂q for a position constraint, ∂c/∂q' for a velocity one) have
+    /// full rank: none is redundant or inconsistent with the others.
+    fn check_constraints_numerically(&self) -> Result<(), (String, String)> {
+        if self.constraints.is_empty() {
+            return Ok(());
+        }
+        let n = self.dof();
+        let defaults = |s: &str| {
+            self.parameters
+                .iter()
+                .find(|p| p.name == s)
+                .map(|p| p.default)
+        };
+        let mut start = Vec::new();
+        for (i, c) in self.coordinates.iter().enumerate() {
+            let value = c
+                .start
+                .as_ref()
+                .map(|e| e.eval(&defaults))
+                .transpose()
+                .map_err(|e| (format!("coordinates[{i}].start"), e.to_string()))?
+                .unwrap_or(f64::NAN);
+            if !value.is_finite() {
+                return Err((
+                    format!("coordinates[{i}].start"),
+                    format!("the start of '{}' is {value} with the default parameters", c.name),
+                ));
+            }
+            start.push(value);
+        }
+        let at_start = Sample {
+            model: self,
+            q: start.clone(),
+            v: vec![0.0; n],
+            phase: 0.0,
+            time: 0.0,
+        };
+        let size = 1.0 + start.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let mut rows = Vec::new();
+        for (r, constraint) in self.constraints.iter().enumerate() {
+            let expanded = self.expanded(constraint.kind.expression());
+            let row: Vec<Expr> = match &constraint.kind {
+                ConstraintKind::Position(_) => self
+                    .coordinates
+                    .iter()
+                    .map(|c| expanded.derivative(&c.name))
+                    .collect(),
+                ConstraintKind::Velocity(_) => self
+                    .coordinates
+                    .iter()
+                    .map(|c| expanded.derivative(&c.velocity))
+                    .collect(),
+            };
+            let values: Vec<f64> = row.iter().map(|e| at_start.eval(e)).collect();
+            let gradient = values.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            match &constraint.kind {
+                ConstraintKind::Position(_) => {
+                    let residual = at_start.eval(&expanded);
+                    if !(residual.abs() <= 1e-9 * size * gradient.max(1.0)) {
+                        return Err((
+                            format!("constraints[{r}].position"),
+                            format!("the coordinates' starts violate '{}': its value there is {residual:e} (t = 0, default parameters); give starts that satisfy every position constraint", constraint.name),
+                        ));
+                    }
+                }
+                ConstraintKind::Velocity(_) => {
+                    self.check_velocity_constraint(r, &expanded, &row, &at_start)?
+                }
+            }
+            rows.push(values);
+        }
+        let rank = rank(rows.clone());
+        if rank < rows.len() {
+            return Err((
+                "constraints".into(),
+                format!("the constraints are redundant or inconsistent at the starts: their rows (∂g/∂q of a position constraint, ∂c/∂q' of a velocity one) have rank {rank}, not {}; remove the dependent ones", rows.len()),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A velocity constraint c = a(q)·q' + b: linear in the velocities, and
+    /// not integrable (the 1-form a·dq has a·dq ∧ d(a·dq) ≠ 0 somewhere
+    /// near the start; otherwise it is a position constraint in disguise).
+    fn check_velocity_constraint(
+        &self,
+        r: usize,
+        expanded: &Expr,
+        row: &[Expr],
+        at_start: &Sample,
+    ) -> Result<(), (String, String)> {
+        let key = format!("constraints[{r}].velocity");
+        let name = &self.constraints[r].name;
+        let n = self.dof();
+        let mut seed = 0x2545_F491_4F6C_DD1D_u64;
+        let mut random = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut integrable = true;
+        for sample in 0..4 {
+            let q: Vec<f64> = at_start
+                .q
+                .iter()
+                .map(|x| if sample == 0 { *x } else { x + 0.3 * random() })
+                .collect();
+            let v: Vec<f64> = (0..n).map(|_| random()).collect();
+            let along = |s: f64| {
+                Sample {
+                    model: self,
+                    q: q.clone(),
+                    v: v.iter().map(|x| s * x).collect(),
+                    phase: 0.0,
+                    time: 0.0,
+                }
+                .eval(expanded)
+            };
+            let c: Vec<f64> = [-1.0, 0.0, 1.0].iter().map(|&s| along(s)).collect();
+            let scale = c.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
+            if !((c[2] - 2.0 * c[1] + c[0]).abs() <= 1e-9 * scale) {
+                return Err((
+                    key,
+                    format!("'{name}' is not linear in the velocities (a velocity constraint is a(q, t)·q' + b(q, t))"),
+                ));
+            }
+            let point = Sample {
+                model: self,
+                q,
+                v: vec![0.0; n],
+                phase: 0.0,
+                time: 0.0,
+            };
+            let a: Vec<f64> = row.iter().map(|e| point.eval(e)).collect();
+            let da: Vec<Vec<f64>> = row
+                .iter()
+                .map(|e| {
+                    self.coordinates
+                        .iter()
+                        .map(|c| point.eval(&e.derivative(&c.name)))
+                        .collect()
+                })
+                .collect();
+            // a·dq ∧ d(a·dq), component (i, j, k): a_i (∂_j a_k − ∂_k a_j) + cyclic.
+            for i in 0..n {
+                for j in i + 1..n {
+                    for k in j + 1..n {
+                        let terms = [
+                            a[i] * (da[k][j] - da[j][k]),
+                            a[j] * (da[i][k] - da[k][i]),
+                            a[k] * (da[j][i] - da[i][j]),
+                        ];
+                        let total: f64 = terms.iter().sum();
+                        let scale: f64 = terms.iter().map(|t| t.abs()).sum();
+                        if total.abs() > 1e-9 * scale {
+                            integrable = false;
+                        }
+                    }
+                }
+            }
+        }
+        if integrable {
+            return Err((
+                key,
+                format!("'{name}' is integrable (its 1-form a·dq has a·dq ∧ d(a·dq) = 0 near the start): it holds a function of the positions constant, so write that function as a `position` constraint"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The numerical rank of a matrix given by rows (Gaussian elimination with
+/// partial pivoting, relative tolerance 1e-9).
+fn rank(mut rows: Vec<Vec<f64>>) -> usize {
+    let scale = rows
+        .iter()
+        .flatten()
+        .fold(0.0_f64, |m, x| m.max(x.abs()));
+    let columns = rows.first().map_or(0, Vec::len);
+    let mut rank = 0;
+    for column in 0..columns {
+        let Some(pivot) = (rank..rows.len())
+            .max_by(|&a, &b| rows[a][column].abs().total_cmp(&rows[b][column].abs()))
+        else {
+            break;
+        };
+        if !(rows[pivot][column].abs() > 1e-9 * scale) {
+            continue;
+        }
+        rows.swap(rank, pivot);
+        for r in rank + 1..rows.len() {
+            let factor = rows[r][column] / rows[rank][column];
+            for c in column..columns {
+                rows[r][c] -= factor * rows[rank][c];
+            }
+        }
+        rank += 1;
+    }
+    rank
 }
 
 fn cholesky_ok(a: &[Vec<f64>]) -> bool {

@@ -6,5 +6,5 @@ pub mod file;
 
 pub use expr::Expr;
 pub use file::{
-    Contact, Inverse, Model, ModelError, Range, RangeError, MAX_DOF, SYMBOLIC_INVERSE_MAX_DOF,
+    Constraint, ConstraintKind, Contact, Inverse, Model, ModelError, Range, RangeError, MAX_DOF, SYMBOLIC_INVERSE_MAX_DOF,
 };

@@ -13,6 +13,7 @@ pub use crate::analysis::equilibria::{Equilibrium, NotSearched, Verdict};
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
+use crate::constrained::ConstrainedSystems;
 use crate::registry::{display_name, DynamicModel, Kind, Model, ModelInfo, Systems};
 
 /// What to run.
@@ -50,7 +51,8 @@ pub struct Exploration {
 }
 
 /// The start a scene uses when none is given: q = 0.3, 0.5, …, p = 0; for
-/// a contact model s = 0, −0.3, …, s' = 1.
+/// a contact model s = 0, −0.3, …, s' = 1; for a constrained model its
+/// file's start at rest (which the run makes consistent).
 pub fn default_start(model: &dyn DynamicModel) -> Vec<f64> {
     match model.kind() {
         Kind::Hamiltonian { dof, .. } => (0..dof)
@@ -61,6 +63,9 @@ pub fn default_start(model: &dyn DynamicModel) -> Vec<f64> {
             .map(|i| -0.3 * i as f64)
             .chain((0..count).map(|_| 1.0))
             .collect(),
+        Kind::Constrained { coordinates, .. } => model
+            .start(&model.defaults())
+            .unwrap_or_else(|| vec![0.0; 2 * coordinates]),
     }
 }
 
@@ -185,6 +190,8 @@ pub enum ExploreError {
     Ode(#[from] OdeError),
     #[error(transparent)]
     Contact(#[from] ContactError),
+    #[error(transparent)]
+    Constrained(#[from] crate::constrained::ConstrainedError),
     #[error("the state of '{model}' has {expected} components, got {got}")]
     StateLength {
         model: &'static str,
@@ -265,6 +272,9 @@ pub fn explore(
     if let Some(systems) = handle.systems() {
         return hamiltonian_runs(systems, model, params, y0, settings);
     }
+    if let Some(constrained) = handle.constrained {
+        return constrained_runs(constrained, params, y0, settings);
+    }
     match expected {
         2 => contacts::<1, 2>(model, params, y0, settings),
         4 => contacts::<2, 4>(model, params, y0, settings),
@@ -333,6 +343,47 @@ fn hamiltonian_runs(
     Ok(out)
 }
 
+/// The run of a constrained model on its constraints (projected at each
+/// sample), and its period map if it has a fast phase.
+fn constrained_runs(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    y0: &[f64],
+    settings: &Settings,
+) -> Result<Exploration, ExploreError> {
+    let times = grid(settings.t_end, settings.samples);
+    let run = crate::constrained::run(model, params, Some(y0), settings.method, &times)?;
+    let e0 = run.energy.first().copied().unwrap_or(0.0);
+    let period_map = match model.phase_period(params) {
+        Some(period) if settings.periods > 0 => {
+            let map_times: Vec<f64> = (0..=settings.periods).map(|k| k as f64 * period).collect();
+            let map = crate::constrained::run(model, params, Some(y0), settings.method, &map_times)?;
+            Some(map.states)
+        }
+        _ => None,
+    };
+    Ok(Exploration {
+        energy_change: run.energy.iter().map(|e| e - e0).collect(),
+        energy_label: match period_map {
+            Some(_) => "E(t) − E(0) on the constraints (the vibration does work)",
+            None => "E(t) − E(0) on the constraints",
+        },
+        period_map,
+        equilibria_not_searched: Some(NotSearched::OnConstraints),
+        switches: vec![format!(
+            "constraints ({}): largest residual |g| {:.1e}, |G q' + c_t| {:.1e} after projection; {:.1e}, {:.1e} before",
+            run.constraint_names.join(", "),
+            run.largest_residual.0,
+            run.largest_residual.1,
+            run.largest_drift.0,
+            run.largest_drift.1
+        )],
+        exact: run.states,
+        times: run.times,
+        ..Default::default()
+    })
+}
+
 fn contacts<const C: usize, const M: usize>(
     model: &dyn DynamicModel,
     params: &[f64],
@@ -391,10 +442,10 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// The panel titles, in the model's notation (φ₁, p_φ₁, x₁′).
-fn panel_titles(result: &Exploration, info: &ModelInfo, contacts: bool) -> Vec<String> {
+fn panel_titles(result: &Exploration, info: &ModelInfo, velocities: bool) -> Vec<String> {
     let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
     let velocity = |i: usize| {
-        if contacts {
+        if velocities {
             format!("{}′", names[i])
         } else {
             display_name(info.momenta[i])
@@ -459,13 +510,15 @@ fn degree_panels<'a>(
 /// exact−averaged deviation.
 pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Figure {
     let info = model.info();
-    let (n, contacts) = match model.kind() {
+    // The state's second half: momenta, or velocities.
+    let (n, velocities) = match model.kind() {
         Kind::Hamiltonian { dof, .. } => (dof, false),
         Kind::Contacts { count } => (count, true),
+        Kind::Constrained { coordinates, .. } => (coordinates, true),
     };
     let names: Vec<String> = info.coordinates.iter().map(|c| display_name(c)).collect();
     let coordinate_names: Vec<&str> = names.iter().map(String::as_str).collect();
-    let titles = panel_titles(result, info, contacts);
+    let titles = panel_titles(result, info, velocities);
     let t_range = (0.0, t_end);
     let averaged = result.averaged.clone().unwrap_or_default();
     let mut specs: Vec<PanelSpec> = (0..n)

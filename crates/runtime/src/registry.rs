@@ -120,6 +120,13 @@ pub enum Kind {
     Hamiltonian { dof: usize, fast_phase: bool },
     /// Points on rough guides, state [s; s'], integrated with stick–slip switching.
     Contacts { count: usize },
+    /// Coordinates under ideal constraints, state [q; q'], integrated on
+    /// the constraints ([`crate::constrained`]).
+    Constrained {
+        coordinates: usize,
+        constraints: usize,
+        fast_phase: bool,
+    },
 }
 
 /// Any generated model with dynamically sized states and parameters in
@@ -140,6 +147,12 @@ pub trait DynamicModel: Sync {
         let mut periodic = self.periodic();
         periodic.resize(2 * periodic.len(), false);
         periodic
+    }
+    /// The model file's start at rest, for a constrained model (whose
+    /// coordinates must satisfy its constraints).
+    #[inline]
+    fn start(&self, _params: &[f64]) -> Option<Vec<f64>> {
+        None
     }
     /// The exact system with its action S = ∫ (p·q' − H) dt and the fast
     /// phase θ as third and fourth state components (models of one degree
@@ -564,8 +577,10 @@ pub enum FixedSize {
 pub struct Model {
     pub info: &'static ModelInfo,
     pub dynamic: &'static dyn DynamicModel,
-    /// None for a contact model.
+    /// None for a contact or a constrained model.
     pub sized: Option<FixedSize>,
+    /// A constrained model's equations and projections.
+    pub constrained: Option<&'static dyn crate::constrained::ConstrainedSystems>,
 }
 
 impl Model {

@@ -5,8 +5,9 @@
 //! symbolic-inverse form.
 
 // The paths the generated modules name (`crate::ode`, ...); a folder
-// without contact models leaves `contact` unused.
+// without contact or constrained models leaves `contact` or `constrained`
+// unused.
 #[allow(unused_imports)]
-use mechlab_runtime::{contact, linalg, ode, registry};
+use mechlab_runtime::{constrained, contact, linalg, ode, registry};
 
 include!(concat!(env!("OUT_DIR"), "/generated/mod.rs"));

@@ -312,6 +312,9 @@ impl std::fmt::Display for Verdict {
 pub enum NotSearched {
     #[error("the model has no effective potential (a contact model)")]
     NoPotential,
+    /// A constrained model: its equilibria lie on the constraints.
+    #[error("the model is constrained: its equilibria lie on the constraints, where no effective potential is searched yet")]
+    OnConstraints,
 }
 
 /// Equilibria of the effective potential: this finder (the starts and

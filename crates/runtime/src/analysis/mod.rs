@@ -36,6 +36,10 @@ pub enum Refusal {
     /// switching).
     #[error("'{model}' is a contact model: it has no Hamiltonian form, period map or averaged system (`explore` runs it with its stick–slip switching)")]
     ContactModel { model: String },
+    /// A model with constraints: this analysis does not run on a
+    /// constraint manifold yet.
+    #[error("'{model}' is a constrained model: this analysis does not run on its constraints yet (`explore` runs it on them)")]
+    Constrained { model: String },
     /// No `[fast_phase]` in its model file: no period map, nothing to average.
     #[error("model '{model}' has no fast phase ([fast_phase] in its model file): it has no period map and nothing to average")]
     NoFastPhase { model: String },
@@ -85,13 +89,17 @@ pub enum Refusal {
     Parameter(#[from] crate::registry::ParameterError),
 }
 
-/// The model's systems, or the refusal of a contact model (which has none).
+/// The model's systems, or the refusal of a contact or a constrained
+/// model (which have none).
 pub(crate) fn hamiltonian(
     model: &crate::registry::Model,
 ) -> Result<&'static dyn crate::registry::Systems, Refusal> {
-    model
-        .systems()
-        .ok_or_else(|| Refusal::contact_model(model.info.name))
+    model.systems().ok_or_else(|| match model.constrained {
+        Some(_) => Refusal::Constrained {
+            model: model.info.name.into(),
+        },
+        None => Refusal::contact_model(model.info.name),
+    })
 }
 
 impl Refusal {

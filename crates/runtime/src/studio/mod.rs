@@ -116,6 +116,11 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
     let (kind, dof, fast_phase) = match model.kind() {
         Kind::Hamiltonian { dof, fast_phase } => ("hamiltonian", dof, fast_phase),
         Kind::Contacts { count } => ("contacts", count, false),
+        Kind::Constrained {
+            coordinates,
+            fast_phase,
+            ..
+        } => ("constrained", coordinates, fast_phase),
     };
     let periodic = model.periodic_state();
     let state = info.state_names();
@@ -265,6 +270,11 @@ impl Setup {
             Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
             Kind::Contacts { .. } => {
                 return Err(StudioError::Refused(Refusal::contact_model(info.name)))
+            }
+            Kind::Constrained { .. } => {
+                return Err(StudioError::Refused(Refusal::Constrained {
+                    model: info.name.into(),
+                }))
             }
         };
         let mut params = model.defaults();
