@@ -68,3 +68,48 @@ fn a_point_on_a_vibrating_rod_moves_as_kapitzas_pendulum() {
         assert!(points.largest_residual.0 < 1e-13 && points.largest_residual.1 < 1e-13);
     }
 }
+
+/// The upright pendulum on the vibrating pivot is a periodic orbit of both
+/// forms; the monodromy restricted to the constraints' tangent space has
+/// the angle model's multipliers (its trace and determinant), and the full
+/// 4 × 4 one has two more, spurious, at 1.
+#[test]
+fn floquet_multipliers_on_the_constraints_are_the_angle_models() {
+    for (a, mu) in [(1.5, 0.0), (1.2, 0.1), (2.0, 0.0)] {
+        let eps = 0.1;
+        let period = std::f64::consts::TAU * eps;
+        let params = [a, eps, mu];
+        let mut integrator = mechlab::ode::Integrator::new(TIGHT).unwrap();
+        let angle = kapitza::MODEL.systems().unwrap();
+        let (_, m) = angle
+            .monodromy(&params, &mut integrator, period, &[0.0, 0.0])
+            .unwrap();
+        let y0 = [0.0, a * eps + 1.0, 0.0, 0.0];
+        let model = &cartesian_kapitza::SYSTEMS;
+        let (end, restricted) =
+            mechlab::constrained::monodromy_on_constraints(model, &params, TIGHT, period, &y0)
+                .unwrap();
+        assert_eq!(restricted.shape(), (2, 2));
+        assert!((end[1] - y0[1]).abs() < 1e-12, "the orbit closes");
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-10 * (1.0 + y.abs());
+        assert!(
+            close(restricted.trace(), m.trace()),
+            "A = {a}: trace {} against {}",
+            restricted.trace(),
+            m.trace()
+        );
+        assert!(close(restricted.determinant(), m.determinant()));
+        // The damping fixes the determinant: e^{−μT}.
+        assert!(close(m.determinant(), (-mu * period).exp()));
+        let mut integrator = mechlab::ode::Integrator::new(TIGHT).unwrap();
+        let (_, full) = model
+            .monodromy(&params, &mut integrator, period, &y0)
+            .unwrap();
+        let ones = full
+            .complex_eigenvalues()
+            .iter()
+            .filter(|z| (z.re - 1.0).abs() < 1e-6 && z.im.abs() < 1e-6)
+            .count();
+        assert!(ones >= 2, "A = {a}: {:?}", full.complex_eigenvalues());
+    }
+}

@@ -410,3 +410,114 @@ fn a_scene_refuses_a_parameter_outside_its_range() {
     params.set("eps", 0.2).unwrap();
     assert_eq!(params.eps, 0.2);
 }
+
+/// A point on a rod of length l about the origin, in Cartesian coordinates.
+const ROD: &str = r#"
+name = "toy"
+description = "a point on a rod"
+lagrangian = "(dot(x)^2 + dot(y)^2)/2 - g*y"
+
+[[coordinates]]
+name = "x"
+velocity = "xd"
+start = 0.6
+
+[[coordinates]]
+name = "y"
+velocity = "yd"
+start = "-0.8*l"
+
+[[constraints]]
+name = "rod"
+position = "x^2 + y^2 - l^2"
+
+[[parameters]]
+name = "g"
+default = 1.0
+description = "gravity"
+
+[[parameters]]
+name = "l"
+default = 1.0
+description = "rod length"
+"#;
+
+#[test]
+fn a_constrained_model_is_accepted() {
+    let model = Model::parse("models/toy.toml", ROD).unwrap();
+    assert_eq!((model.dof(), model.constraints.len()), (2, 1));
+}
+
+#[test]
+fn starts_that_violate_a_constraint_are_named_with_the_residual() {
+    let text = ROD.replace("start = 0.6", "start = 0.5");
+    // 0.25 + 0.64 − 1 = −0.11.
+    assert_error(&text, "constraints[0].position", "its value there is -1.1");
+}
+
+#[test]
+fn a_constrained_model_needs_a_start_for_every_coordinate() {
+    let text = ROD.replace("start = 0.6\n", "");
+    assert_error(&text, "coordinates[0].start", "needs a start for 'x'");
+}
+
+#[test]
+fn redundant_constraints_are_named_with_their_rank() {
+    let text = ROD.replace("- g*y", "+ dot(z)^2/2 - g*y").replace(
+        "[[parameters]]\nname = \"g\"",
+        "[[constraints]]\nname = \"again\"\nposition = \"2*(x^2 + y^2 - l^2)\"\n\n[[coordinates]]\nname = \"z\"\nvelocity = \"zd\"\nstart = 0\n\n[[parameters]]\nname = \"g\"",
+    );
+    assert_error(&text, "constraints", "rank 1, not 2");
+}
+
+#[test]
+fn as_many_constraints_as_coordinates_leave_no_motion() {
+    let text = ROD.replace(
+        "[[parameters]]\nname = \"g\"",
+        "[[constraints]]\nname = \"level\"\nposition = \"y + 0.8*l\"\n\n[[parameters]]\nname = \"g\"",
+    );
+    assert_error(&text, "constraints", "leave no motion");
+}
+
+#[test]
+fn a_constraint_gives_exactly_one_form() {
+    let text = ROD.replace(
+        "position = \"x^2 + y^2 - l^2\"",
+        "position = \"x^2 + y^2 - l^2\"\nvelocity = \"x*xd + y*yd\"",
+    );
+    assert_error(&text, "constraints[0]", "exactly one of `position`");
+}
+
+#[test]
+fn a_velocity_constraint_must_be_linear_and_not_integrable() {
+    // Three coordinates, so that a non-integrable row exists at all.
+    let knife = |row: &str| {
+        ROD.replace("lagrangian = \"(dot(x)^2 + dot(y)^2)/2 - g*y\"", "lagrangian = \"(dot(x)^2 + dot(y)^2 + dot(phi)^2)/2 - g*y\"")
+            .replace(
+                "[[constraints]]\nname = \"rod\"\nposition = \"x^2 + y^2 - l^2\"",
+                &format!("[[coordinates]]\nname = \"phi\"\nvelocity = \"phid\"\nstart = 0\n\n[[constraints]]\nname = \"blade\"\nvelocity = \"{row}\""),
+            )
+    };
+    // The knife edge (Chaplygin's sleigh) is accepted.
+    Model::parse("models/toy.toml", &knife("-sin(phi)*xd + cos(phi)*yd")).unwrap();
+    assert_error(
+        &knife("xd^2 + yd"),
+        "constraints[0].velocity",
+        "not linear in the velocities",
+    );
+    // x' x + y' y = 0 holds x² + y² constant: a position constraint.
+    assert_error(
+        &knife("x*xd + y*dot(y)"),
+        "constraints[0].velocity",
+        "is integrable",
+    );
+    // dot() is for velocity constraints, not position ones.
+    let text = ROD.replace("x^2 + y^2 - l^2", "dot(x)");
+    assert_error(&text, "constraints[0].position", "dot() is only allowed");
+    // Constraints and contacts do not mix.
+    let contact = ROD.replace(
+        "[[parameters]]\nname = \"g\"",
+        "[[contacts]]\nslides = \"x\"\nheld = \"y\"\nat = \"0\"\nfriction = \"0.5\"\n\n[[parameters]]\nname = \"g\"",
+    );
+    assert_error(&contact, "constraints", "cannot be combined");
+}

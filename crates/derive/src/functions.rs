@@ -68,6 +68,10 @@ pub enum Inputs {
     CoordinatesVelocities,
     /// Coordinates at time t.
     TimeCoordinates,
+    /// Those as dual numbers (time stays f64), for Jacobians at run time.
+    DualTimeCoordinates,
+    /// Coordinates and velocities as dual numbers, at time t.
+    DualCoordinatesVelocities,
     /// The Hamiltonian state `y = [q, p]` at time t.
     State,
     /// The state of the autonomous averaged system.
@@ -163,6 +167,18 @@ impl Context<'_> {
                 prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
                 format!("{time}: f64, q: &[f64; {n}], params: &Params")
             }
+            Inputs::DualTimeCoordinates => {
+                prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
+                format!("{time}: f64, q: &[crate::ode::Dual; {n}], params: &Params")
+            }
+            Inputs::DualCoordinatesVelocities => {
+                prelude.push(format!(
+                    "let ([{}], [{}]) = (*q, *qd);",
+                    self.coordinates().join(", "),
+                    self.velocities().join(", ")
+                ));
+                format!("{time}: f64, q: &[crate::ode::Dual; {n}], qd: &[crate::ode::Dual; {n}], params: &Params")
+            }
             Inputs::ContactState => {
                 prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
                 format!("y: &[f64; {}], params: &Params", 2 * n)
@@ -198,6 +214,8 @@ impl Context<'_> {
                 | Inputs::DualState
                 | Inputs::CoordinatesVelocities
                 | Inputs::TimeCoordinates
+                | Inputs::DualTimeCoordinates
+                | Inputs::DualCoordinatesVelocities
         ) {
             prelude.extend(phase_line);
         }
@@ -232,24 +250,19 @@ impl Context<'_> {
         let mut emitter = Emitter::default();
         emitter.lift = match inputs {
             Inputs::HyperDualAveragedState => Some("crate::ode::HyperDual::from"),
-            Inputs::DualState | Inputs::DualAveragedState | Inputs::DualCoordinates => {
+            Inputs::DualState
+            | Inputs::DualAveragedState
+            | Inputs::DualCoordinates
+            | Inputs::DualTimeCoordinates
+            | Inputs::DualCoordinatesVelocities => {
                 emitter.factorisation = Some("crate::ode::dual::Cholesky");
                 Some("crate::ode::Dual::from")
             }
             _ => None,
         };
-        // A vector's entries are lifted one by one (an entry may be a
-        // constant f64).
-        let result = match result.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
-            Some(entries) => {
-                let lifted: Vec<String> = entries
-                    .split(", ")
-                    .map(|e| emitter.lifted(e.to_string()))
-                    .collect();
-                format!("[{}]", lifted.join(", "))
-            }
-            None => emitter.lifted(result),
-        };
+        // A vector's or a matrix's entries are lifted one by one (an entry
+        // may be a constant f64).
+        let result = lift_entries(&emitter, &result);
         for step in steps {
             emitter.apply(step).map_err(|e| e.in_function(name))?;
         }
@@ -263,6 +276,32 @@ impl Context<'_> {
             result,
         })
     }
+}
+
+/// `result` with each entry of its (nested) array literal lifted.
+fn lift_entries(emitter: &Emitter, result: &str) -> String {
+    let Some(inner) = result.strip_prefix('[').and_then(|r| r.strip_suffix(']')) else {
+        return emitter.lifted(result.to_string());
+    };
+    let mut entries = Vec::new();
+    let (mut depth, mut begin) = (0usize, 0usize);
+    for (i, c) in inner.char_indices() {
+        match c {
+            '[' | '(' => depth += 1,
+            ']' | ')' => depth -= 1,
+            ',' if depth == 0 => {
+                entries.push(inner[begin..i].trim());
+                begin = i + 1;
+            }
+            _ => {}
+        }
+    }
+    entries.push(inner[begin..].trim());
+    let lifted: Vec<String> = entries
+        .into_iter()
+        .map(|e| lift_entries(emitter, e))
+        .collect();
+    format!("[{}]", lifted.join(", "))
 }
 
 impl Context<'_> {

@@ -373,6 +373,58 @@ pub fn render_constrained(
         &[outs],
         result,
     )?);
+    // The forms the accelerations need, over dual numbers: the Jacobian of
+    // the equations of motion at run time, one column a pass.
+    let dual = |name: &str, inputs: Inputs, ret: String, outs, result| {
+        cx.function(
+            &format!("{name}_dual"),
+            &format!("`{name}` over dual numbers (derivatives at run time)."),
+            inputs,
+            ret,
+            &[outs],
+            result,
+        )
+    };
+    let (outs, result) = matrix("m", &derivation.mass_matrix);
+    functions.push(dual(
+        "mass_matrix",
+        Inputs::DualTimeCoordinates,
+        format!("[[crate::ode::Dual; {n}]; {n}]"),
+        outs,
+        result,
+    )?);
+    let (outs, result) = vector("f", &derivation.free_forces);
+    functions.push(dual(
+        "free_forces",
+        Inputs::DualCoordinatesVelocities,
+        format!("[crate::ode::Dual; {n}]"),
+        outs,
+        result,
+    )?);
+    let (outs, result) = matrix("jac", &derivation.jacobian);
+    functions.push(dual(
+        "constraint_jacobian",
+        Inputs::DualTimeCoordinates,
+        format!("[[crate::ode::Dual; {n}]; {k}]"),
+        outs,
+        result,
+    )?);
+    let (outs, result) = vector("ct", &derivation.rates);
+    functions.push(dual(
+        "constraint_rates",
+        Inputs::DualTimeCoordinates,
+        format!("[crate::ode::Dual; {k}]"),
+        outs,
+        result,
+    )?);
+    let (outs, result) = vector("h", &derivation.bias);
+    functions.push(dual(
+        "constraint_bias",
+        Inputs::DualCoordinatesVelocities,
+        format!("[crate::ode::Dual; {k}]"),
+        outs,
+        result,
+    )?);
     functions.push(cx.function(
         "energy",
         "Energy function E = Σ q'∂L/∂q' − L.",

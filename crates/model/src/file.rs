@@ -1216,7 +1216,7 @@ impl Model {
                     if !(residual.abs() <= 1e-9 * size * gradient.max(1.0)) {
                         return Err((
                             format!("constraints[{r}].position"),
-                            format!("the coordinates' starts violate '{}': its value there is {residual:e} (t = 0, default parameters); give starts that satisfy every position constraint", constraint.name),
+                            format!("the coordinates' starts violate '{}': its value there is {residual:.3e} (t = 0, default parameters); give starts that satisfy every position constraint", constraint.name),
                         ));
                     }
                 }

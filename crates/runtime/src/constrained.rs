@@ -20,9 +20,13 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::linalg::Cholesky;
 use crate::ode::any_size::fixed_state;
-use crate::ode::holonomic::{project, ConstraintError, Holonomic, Projection};
+use crate::ode::holonomic::{
+    project, restricted_monodromy, tangent_basis, ConstraintError, Holonomic, Projection,
+};
+use crate::tangent::monodromy::monodromy;
 use crate::ode::{
-    AnyOptions, AnySolution, AnySystem, Integrator, Method, OdeError, SizedSystem, System,
+    AnyOptions, AnySolution, AnySystem, Dual, Integrator, Method, OdeError, Scalar, SizedSystem,
+    System,
 };
 use crate::registry::{ModelInfo, ParameterError};
 
@@ -54,6 +58,41 @@ pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send +
     fn constraint_bias(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; K];
     /// The energy function Σ q'∂L/∂q' − L.
     fn energy(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> f64;
+    /// The forms the accelerations need, over dual numbers (for the
+    /// Jacobian of the equations of motion).
+    fn mass_matrix_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; N];
+    fn free_forces_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; N];
+    fn constraint_jacobian_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; K];
+    fn constraint_rates_dual(&self, t: f64, q: &[Dual; N]) -> [Dual; K];
+    fn constraint_bias_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; K];
+}
+
+/// q'' and λ of M q'' = F + Gᵀλ, G q'' + h = 0 by the Schur complement:
+/// λ = (G M⁻¹ Gᵀ)⁻¹ (−h − G M⁻¹ F), q'' = M⁻¹ (F + Gᵀλ). NaN where M or
+/// G M⁻¹ Gᵀ is not positive definite.
+#[inline]
+fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
+    mass: [[Num; N]; N],
+    g: [[Num; N]; K],
+    free: [Num; N],
+    h: [Num; K],
+) -> ([Num; N], [Num; K]) {
+    let mass = Cholesky::new(mass);
+    // M⁻¹Gᵀ, column by column.
+    let m_inv_gt: [[Num; N]; K] = std::array::from_fn(|r| mass.solve(g[r]));
+    let schur: [[Num; K]; K] =
+        std::array::from_fn(|r| std::array::from_fn(|c| dot(&g[r], &m_inv_gt[c])));
+    let m_inv_f = mass.solve(free);
+    let rhs: [Num; K] = std::array::from_fn(|r| -h[r] - dot(&g[r], &m_inv_f));
+    let lambda = Cholesky::new(schur).solve(rhs);
+    let accelerations = std::array::from_fn(|i| {
+        let mut a = m_inv_f[i];
+        for r in 0..K {
+            a += m_inv_gt[r][i] * lambda[r];
+        }
+        a
+    });
+    (accelerations, lambda)
 }
 
 /// The equations of motion of constrained forms `F` as an ODE on
@@ -84,21 +123,12 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
     pub fn accelerations(&self, t: f64, y: &[f64; S]) -> ([f64; N], [f64; K]) {
         let (q, v) = Self::split(y);
         let forms = &self.0;
-        let mass = Cholesky::new(forms.mass_matrix(t, &q));
-        let g = forms.constraint_jacobian(t, &q);
-        let free = forms.free_forces(t, &q, &v);
-        let h = forms.constraint_bias(t, &q, &v);
-        // M⁻¹Gᵀ, column by column.
-        let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|r| mass.solve(g[r]));
-        let schur: [[f64; K]; K] =
-            std::array::from_fn(|r| std::array::from_fn(|c| dot(&g[r], &m_inv_gt[c])));
-        let m_inv_f = mass.solve(free);
-        let rhs: [f64; K] = std::array::from_fn(|r| -h[r] - dot(&g[r], &m_inv_f));
-        let lambda = Cholesky::new(schur).solve(rhs);
-        let accelerations = std::array::from_fn(|i| {
-            m_inv_f[i] + (0..K).map(|r| m_inv_gt[r][i] * lambda[r]).sum::<f64>()
-        });
-        (accelerations, lambda)
+        solve_constrained(
+            forms.mass_matrix(t, &q),
+            forms.constraint_jacobian(t, &q),
+            forms.free_forces(t, &q, &v),
+            forms.constraint_bias(t, &q, &v),
+        )
     }
 
     /// max |g| over the position constraints and max |G q' + c_t| over all.
@@ -116,8 +146,13 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
     }
 }
 
-fn dot<const N: usize>(a: &[f64; N], b: &[f64; N]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+#[inline]
+fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Num {
+    let mut sum = Num::from(0.0);
+    for (x, y) in a.iter().zip(b) {
+        sum += *x * *y;
+    }
+    sum
 }
 
 impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> System<S>
@@ -127,6 +162,30 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
     fn rhs(&self, t: f64, y: &[f64; S]) -> [f64; S] {
         let (accelerations, _) = self.accelerations(t, y);
         std::array::from_fn(|i| if i < N { y[N + i] } else { accelerations[i - N] })
+    }
+
+    /// Exact to round-off: the accelerations over dual numbers, one
+    /// column of the Jacobian a pass.
+    fn jacobian(&self, t: f64, y: &[f64; S]) -> Option<[[f64; S]; S]> {
+        let forms = &self.0;
+        let mut jacobian = [[0.0; S]; S];
+        for column in 0..S {
+            let seeded =
+                |i: usize| Dual::seeded(y[i], if i == column { 1.0 } else { 0.0 });
+            let q: [Dual; N] = std::array::from_fn(seeded);
+            let v: [Dual; N] = std::array::from_fn(|i| seeded(N + i));
+            let (accelerations, _) = solve_constrained(
+                forms.mass_matrix_dual(t, &q),
+                forms.constraint_jacobian_dual(t, &q),
+                forms.free_forces_dual(t, &q, &v),
+                forms.constraint_bias_dual(t, &q, &v),
+            );
+            for i in 0..N {
+                jacobian[i][column] = if N + i == column { 1.0 } else { 0.0 };
+                jacobian[N + i][column] = accelerations[i].du;
+            }
+        }
+        Some(jacobian)
     }
 }
 
@@ -159,6 +218,42 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> H
 /// method stops at |g| ≤ 1e-14 times the state's size.
 pub const PROJECTION_TOLERANCE: f64 = 1e-14;
 
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
+    OnConstraints<F, N, K, S>
+{
+    /// The Jacobian (2k × 2n) of the state's constraints [g; G q' + c_t]
+    /// with respect to [q; q'] (a velocity constraint has no position
+    /// row: its row of g is zero), exact by dual numbers.
+    pub fn state_constraints_jacobian(&self, t: f64, y: &[f64; S]) -> DMatrix<f64> {
+        let (q, v) = Self::split(y);
+        let forms = &self.0;
+        let holonomic = F::holonomic();
+        let g = forms.constraint_jacobian(t, &q);
+        let rows: Vec<usize> = (0..K).filter(|&r| holonomic[r]).collect();
+        let mut c = DMatrix::zeros(rows.len() + K, S);
+        for (row, &r) in rows.iter().enumerate() {
+            for j in 0..N {
+                c[(row, j)] = g[r][j];
+            }
+        }
+        for j in 0..N {
+            let q_dual: [Dual; N] =
+                std::array::from_fn(|i| Dual::seeded(q[i], if i == j { 1.0 } else { 0.0 }));
+            let g_dual = forms.constraint_jacobian_dual(t, &q_dual);
+            let rates = forms.constraint_rates_dual(t, &q_dual);
+            for r in 0..K {
+                let mut velocity_form = rates[r];
+                for (entry, vk) in g_dual[r].iter().zip(&v) {
+                    velocity_form += *entry * *vk;
+                }
+                c[(rows.len() + r, j)] = velocity_form.du;
+                c[(rows.len() + r, N + j)] = g[r][j];
+            }
+        }
+        c
+    }
+}
+
 /// A constrained model's equations as an [`AnySystem`] whose stream
 /// projects the state onto the constraints at every segment's end (before
 /// the analysis sees it), so that a period map of 10⁵ periods stays on them.
@@ -175,9 +270,8 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> A
     fn rhs(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
         self.system.rhs(t, y)
     }
-    fn jacobian(&self, _t: f64, y: &[f64]) -> Result<Option<DMatrix<f64>>, OdeError> {
-        fixed_state::<S>(y)?;
-        Ok(None)
+    fn jacobian(&self, t: f64, y: &[f64]) -> Result<Option<DMatrix<f64>>, OdeError> {
+        self.system.jacobian(t, y)
     }
     fn solve(
         &self,
@@ -256,34 +350,57 @@ pub trait ConstrainedSystems: Sync {
     /// (max |g|, max |G q' + c_t|) at (t, y).
     fn residuals(&self, params: &[f64], t: f64, y: &[f64]) -> Result<(f64, f64), OdeError>;
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError>;
+    /// An orthonormal basis (columns) of the tangent space of the
+    /// constrained phase space at (t, y), or None where the constraints
+    /// are degenerate.
+    fn tangent_basis(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Option<DMatrix<f64>>, OdeError>;
+    /// The state after `period` from `y0` and the monodromy matrix
+    /// ∂y(T)/∂y(0) of the full state [q; q'] (2n × 2n).
+    fn monodromy(
+        &self,
+        params: &[f64],
+        integrator: &mut Integrator,
+        period: f64,
+        y0: &[f64],
+    ) -> Result<(Vec<f64>, DMatrix<f64>), OdeError>;
 }
 
 /// The generated forms `F` at their sizes as [`ConstrainedSystems`] (the
 /// model's module holds one in a static).
-pub struct Constrained<F, const N: usize, const K: usize, const S: usize>(PhantomData<fn() -> F>);
+/// V = S + S² is the state with its monodromy's columns.
+pub struct Constrained<F, const N: usize, const K: usize, const S: usize, const V: usize>(
+    PhantomData<fn() -> F>,
+);
 
-impl<F, const N: usize, const K: usize, const S: usize> Constrained<F, N, K, S> {
+impl<F, const N: usize, const K: usize, const S: usize, const V: usize> Constrained<F, N, K, S, V> {
     pub const fn new() -> Self {
         Constrained(PhantomData)
     }
 }
 
-impl<F, const N: usize, const K: usize, const S: usize> Default for Constrained<F, N, K, S> {
+impl<F, const N: usize, const K: usize, const S: usize, const V: usize> Default
+    for Constrained<F, N, K, S, V>
+{
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    Constrained<F, N, K, S>
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
+    Constrained<F, N, K, S, V>
 {
     fn equations(params: &[f64]) -> OnConstraints<F, N, K, S> {
         OnConstraints::new(F::from_values(params))
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> ConstrainedSystems
-    for Constrained<F, N, K, S>
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
+    ConstrainedSystems for Constrained<F, N, K, S, V>
 {
     fn info(&self) -> &'static ModelInfo {
         F::info()
@@ -339,6 +456,54 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> C
         let (q, v) = OnConstraints::<F, N, K, S>::split(&y);
         Ok(F::from_values(params).energy(t, &q, &v))
     }
+    fn tangent_basis(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Option<DMatrix<f64>>, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        let c = Self::equations(params).state_constraints_jacobian(t, &y);
+        Ok(tangent_basis(&c))
+    }
+    fn monodromy(
+        &self,
+        params: &[f64],
+        integrator: &mut Integrator,
+        period: f64,
+        y0: &[f64],
+    ) -> Result<(Vec<f64>, DMatrix<f64>), OdeError> {
+        let y0 = fixed_state::<S>(y0)?;
+        let system = Self::equations(params);
+        let (end, m) = monodromy::<_, S, V>(integrator, &system, period, &y0)?;
+        Ok((end.to_vec(), DMatrix::from_fn(S, S, |i, k| m[i][k])))
+    }
+}
+
+/// The monodromy matrix of the periodic orbit through the consistent state
+/// `y0` restricted to the constraints' tangent space (2(n − k) for k
+/// holonomic constraints): Zᵀ Φ Z with Z an orthonormal basis there, whose
+/// eigenvalues are the Floquet multipliers on the constraints, without the
+/// spurious ones of the directions the constraints forbid. Also the state
+/// after the period.
+pub fn monodromy_on_constraints(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    method: Method,
+    period: f64,
+    y0: &[f64],
+) -> Result<(Vec<f64>, DMatrix<f64>), ConstrainedError> {
+    let name = model.info().name;
+    let mut integrator = Integrator::new(method)?;
+    let (end, full) = model.monodromy(params, &mut integrator, period, y0)?;
+    let basis = model
+        .tangent_basis(params, 0.0, y0)?
+        .ok_or_else(|| ConstrainedError::Constraint {
+            model: name,
+            t: 0.0,
+            source: ConstraintError::Singular { q: y0.to_vec() },
+        })?;
+    Ok((end, restricted_monodromy(&full, &basis)))
 }
 
 /// Why a constrained run stopped.
