@@ -4,9 +4,10 @@
 //! vibrates equals the angle model, and its multiplier is the rod's force
 //! computed by hand in the pivot's accelerating frame.
 
-use mechlab::constrained::{run, ConstrainedSystems};
+use mechlab::analysis::on_constraints::{monodromy_on_constraints, run};
 use mechlab::models::kapitza;
 use mechlab::ode::{states_at, Method};
+use mechlab::registry::ConstrainedSystems;
 use mechlab_test_models::cartesian_kapitza;
 
 const TIGHT: Method = Method::Dop853 {
@@ -64,7 +65,10 @@ fn a_point_on_a_vibrating_rod_moves_as_kapitzas_pendulum() {
                 "A = {a}, t = {t}: λ = {lambda}, by hand {by_hand}"
             );
         }
-        assert!(worst < 1e-10, "A = {a}, μ = {mu}: angles differ by {worst:e}");
+        assert!(
+            worst < 1e-10,
+            "A = {a}, μ = {mu}: angles differ by {worst:e}"
+        );
         assert!(points.largest_residual.0 < 1e-13 && points.largest_residual.1 < 1e-13);
     }
 }
@@ -87,8 +91,7 @@ fn floquet_multipliers_on_the_constraints_are_the_angle_models() {
         let y0 = [0.0, a * eps + 1.0, 0.0, 0.0];
         let model = &cartesian_kapitza::SYSTEMS;
         let (end, restricted) =
-            mechlab::constrained::monodromy_on_constraints(model, &params, TIGHT, period, &y0)
-                .unwrap();
+            monodromy_on_constraints(model, &params, TIGHT, period, &y0).unwrap();
         assert_eq!(restricted.shape(), (2, 2));
         assert!((end[1] - y0[1]).abs() < 1e-12, "the orbit closes");
         let close = |x: f64, y: f64| (x - y).abs() < 1e-10 * (1.0 + y.abs());
@@ -112,4 +115,92 @@ fn floquet_multipliers_on_the_constraints_are_the_angle_models() {
             .count();
         assert!(ones >= 2, "A = {a}: {:?}", full.complex_eigenvalues());
     }
+}
+
+/// The four-bar linkage held upside down on its vibrating base
+/// (`models/four_bar.toml`, three angles and two loop-closure constraints)
+/// against its hand-reduced form in the crank angle φ alone: with Y(φ) the
+/// mass-weighted height of the rods' centres and m(φ) the reduced inertia,
+/// both from the closure solved by Newton's method here, the averaged
+/// potential g Y + a² Y'²/(4m) is stable at the symmetric top (Y' = 0)
+/// above a*² = 2 g m / |Y''|.
+#[test]
+fn a_linkages_vibrational_threshold_is_its_hand_reduced_ones() {
+    use mechlab::analysis::on_constraints::vibration::{
+        vibration_stability, Exact, VibrationSettings,
+    };
+    let (d, l, c, g) = (1.2, 1.0, 0.6, 1.0);
+    let top = (0.3f64).asin();
+    // φ2, φ3 closing the loop at crank angle φ1.
+    let closure = |p1: f64| {
+        let (mut p2, mut p3): (f64, f64) = (0.0, -top);
+        for _ in 0..60 {
+            let f = [
+                -d + l * p1.sin() + c * p2.cos() - l * p3.sin(),
+                l * p1.cos() + c * p2.sin() - l * p3.cos(),
+            ];
+            let j = [[-c * p2.sin(), -l * p3.cos()], [c * p2.cos(), l * p3.sin()]];
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            p2 -= (j[1][1] * f[0] - j[0][1] * f[1]) / det;
+            p3 -= (-j[1][0] * f[0] + j[0][0] * f[1]) / det;
+        }
+        [p1, p2, p3]
+    };
+    let centres = |p: [f64; 3]| {
+        let b = [-d / 2.0 + l * p[0].sin(), l * p[0].cos()];
+        [
+            [-d / 2.0 + l / 2.0 * p[0].sin(), l / 2.0 * p[0].cos()],
+            [b[0] + c / 2.0 * p[1].cos(), b[1] + c / 2.0 * p[1].sin()],
+            [d / 2.0 + l / 2.0 * p[2].sin(), l / 2.0 * p[2].cos()],
+        ]
+    };
+    let height = |p1: f64| centres(closure(p1)).iter().map(|x| x[1]).sum::<f64>();
+    let h = 1e-6;
+    let (before, after) = (closure(top - h), closure(top + h));
+    let (cb, ca) = (centres(before), centres(after));
+    let lengths = [l, c, l];
+    let inertia: f64 = (0..3)
+        .map(|i| {
+            let v = [
+                (ca[i][0] - cb[i][0]) / (2.0 * h),
+                (ca[i][1] - cb[i][1]) / (2.0 * h),
+            ];
+            let w = (after[i] - before[i]) / (2.0 * h);
+            v[0] * v[0] + v[1] * v[1] + lengths[i] * lengths[i] / 12.0 * w * w
+        })
+        .sum();
+    let k = 1e-4;
+    let curvature = (height(top + k) - 2.0 * height(top) + height(top - k)) / (k * k);
+    let by_hand = (2.0 * g * inertia / curvature.abs()).sqrt();
+
+    let model = mechlab::models::four_bar::MODEL.constrained.unwrap();
+    let params = mechlab::models::four_bar::Params::default().values();
+    let result = vibration_stability(model, &params, &VibrationSettings::default()).unwrap();
+    assert_eq!(result.averaged_thresholds.len(), 1, "{result:?}");
+    let threshold = result.averaged_thresholds[0];
+    assert!(
+        (threshold - by_hand).abs() < 1e-5 * by_hand,
+        "a* = {threshold}, by hand {by_hand}"
+    );
+    // At a = 2 > a*: stable on average, and the symmetric top is a periodic
+    // orbit of the exact system, stable from near a* on.
+    assert!(result.averaged_stable && result.squared_frequencies.len() == 1);
+    assert!((result.equilibrium[0] - top).abs() < 1e-9 && result.equilibrium[1].abs() < 1e-9);
+    let Exact::Periodic {
+        stable,
+        windows,
+        moduli,
+    } = &result.exact
+    else {
+        panic!(
+            "the symmetric top stays at rest on the base: {:?}",
+            result.exact
+        );
+    };
+    assert!(*stable && moduli.len() == 2, "{moduli:?}");
+    let lower = windows.first().unwrap()[0];
+    assert!(
+        (lower - by_hand).abs() < 0.05 * by_hand,
+        "exact window from {lower}, a* = {by_hand}"
+    );
 }

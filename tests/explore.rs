@@ -43,7 +43,11 @@ fn every_model_can_be_explored() {
             // The run is on the constraints from its (projected) start on.
             for (t, y) in result.times.iter().zip(&result.exact) {
                 let (g, c) = constrained.residuals(&model.defaults(), *t, y).unwrap();
-                assert!(g < 1e-12 && c < 1e-12, "{}: residuals {g:e}, {c:e} at t = {t}", info.name);
+                assert!(
+                    g < 1e-12 && c < 1e-12,
+                    "{}: residuals {g:e}, {c:e} at t = {t}",
+                    info.name
+                );
             }
             assert!(result.equilibria.is_empty() && result.equilibria_not_searched.is_some());
             continue;

@@ -40,6 +40,13 @@ pub struct ConstrainedDerivation {
     /// h = Σ ∂c/∂q_j q'_j + ∂c/∂t.
     pub bias: Vec<String>,
     pub energy: String,
+    /// V = −L at q' = 0 and b = ∂L/∂q' at q' = 0, for the averaging.
+    pub potential: String,
+    pub linear_term: Vec<String>,
+    /// Whether every constraint is holonomic and fixed (independent of
+    /// time and the fast phase) and M does not depend on them: the
+    /// averaging's conditions.
+    pub stationary: bool,
     /// The coordinates' starts, expressions in the parameters.
     pub starts: Vec<String>,
 }
@@ -73,19 +80,26 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
     let lagrangian = kinematic(model, &model.lagrangian)?;
     let rayleigh = kinematic(model, &model.rayleigh)?;
     let mut rec = Recorder::for_model(model, qd.iter().map(|v| v.to_string()).collect());
-    rec.record("lagrangian", "L(q, q', t) over all coordinates", &lagrangian)?;
+    rec.record(
+        "lagrangian",
+        "L(q, q', t) over all coordinates",
+        &lagrangian,
+    )?;
     let phase_rate = match &rate {
         Some(rate) => Some(rec.record("phase_rate", "dθ/dt of the fast phase", rate)?),
         None => None,
     };
 
     let n = q.len();
+    let moves = |e: &Atom| !crate::algebra::is_zero(&partial_t(e).expand());
+    let mut stationary = true;
     let mut mass_matrix = vec![Vec::new(); n];
     let mut free_forces = Vec::new();
     for i in 0..n {
         let momentum = lagrangian.derivative(symbol!(qd[i]));
         for j in 0..n {
             let entry = momentum.derivative(symbol!(qd[j])).expand();
+            stationary &= !moves(&entry);
             mass_matrix[i].push(rec.record(
                 format!("mass_matrix[{i}][{j}]"),
                 "M = ∂²L/∂q'²",
@@ -119,6 +133,7 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         let velocity_level = match &constraint.kind {
             ConstraintKind::Position(e) => {
                 let g = kinematic(model, e)?;
+                stationary &= !moves(&g);
                 rec.record(
                     format!("constraint[{r}]"),
                     format!("g = 0: the position constraint '{name}'"),
@@ -130,6 +145,7 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
                 total(&g)
             }
             ConstraintKind::Velocity(e) => {
+                stationary = false;
                 residuals.push("0".into());
                 let c = kinematic(model, e)?;
                 rec.record(
@@ -169,6 +185,17 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         energy += lagrangian.derivative(symbol!(*vk)) * var(vk);
     }
     let energy = rec.record("energy", "E = Σ q'∂L/∂q' − L", &energy.expand())?;
+    let at_rest = |e: &Atom| qd.iter().fold(e.clone(), |acc, v| subst(&acc, v, &num(0)));
+    let potential = rec.record(
+        "potential",
+        "V = −L at q' = 0",
+        &(-at_rest(&lagrangian)).expand(),
+    )?;
+    let mut linear_term = Vec::new();
+    for (i, v) in qd.iter().enumerate() {
+        let b = at_rest(&lagrangian.derivative(symbol!(*v))).expand();
+        linear_term.push(rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", &b)?);
+    }
     let starts = model
         .coordinates
         .iter()
@@ -189,6 +216,9 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         rates,
         bias,
         energy,
+        potential,
+        linear_term,
+        stationary,
         starts,
     })
 }

@@ -426,6 +426,23 @@ pub fn render_constrained(
         result,
     )?);
     functions.push(cx.function(
+        "potential",
+        "V = −L at q' = 0 (with the fast phase, for the averaging).",
+        Inputs::TimeCoordinates,
+        "f64".into(),
+        &[vec![("v__".into(), derivation.potential.clone())]],
+        "v__".into(),
+    )?);
+    let (outs, result) = vector("b", &derivation.linear_term);
+    functions.push(cx.function(
+        "linear_term",
+        "b = ∂L/∂q' at q' = 0 (the vibration's coupling, for the averaging).",
+        Inputs::TimeCoordinates,
+        format!("[f64; {n}]"),
+        &[outs],
+        result,
+    )?);
+    functions.push(cx.function(
         "energy",
         "Energy function E = Σ q'∂L/∂q' − L.",
         Inputs::CoordinatesVelocities,
@@ -478,6 +495,7 @@ pub fn render_constrained(
             .collect::<Vec<_>>(),
     );
     context.insert("has_phase", &derivation.phase_rate.is_some());
+    context.insert("stationary", &derivation.stationary);
     context.insert("functions", &functions);
     tera.render("constrained_model.rs.tera", &context)
         .map_err(|source| DeriveError::Template {

@@ -1180,7 +1180,10 @@ impl Model {
             if !value.is_finite() {
                 return Err((
                     format!("coordinates[{i}].start"),
-                    format!("the start of '{}' is {value} with the default parameters", c.name),
+                    format!(
+                        "the start of '{}' is {value} with the default parameters",
+                        c.name
+                    ),
                 ));
             }
             start.push(value);
@@ -1330,10 +1333,7 @@ impl Model {
 /// The numerical rank of a matrix given by rows (Gaussian elimination with
 /// partial pivoting, relative tolerance 1e-9).
 fn rank(mut rows: Vec<Vec<f64>>) -> usize {
-    let scale = rows
-        .iter()
-        .flatten()
-        .fold(0.0_f64, |m, x| m.max(x.abs()));
+    let scale = rows.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
     let columns = rows.first().map_or(0, Vec::len);
     let mut rank = 0;
     for column in 0..columns {

@@ -10,11 +10,13 @@
 
 use crate::analysis::equilibria::{effective_equilibria, Search};
 pub use crate::analysis::equilibria::{Equilibrium, NotSearched, Verdict};
+use crate::analysis::on_constraints::{self, ConstrainedError};
 use crate::contact::{ContactError, ContactModel, StickSlip};
 use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
-use crate::constrained::ConstrainedSystems;
-use crate::registry::{display_name, DynamicModel, Kind, Model, ModelInfo, Systems};
+use crate::registry::{
+    display_name, ConstrainedSystems, DynamicModel, Kind, Model, ModelInfo, Systems,
+};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -191,7 +193,7 @@ pub enum ExploreError {
     #[error(transparent)]
     Contact(#[from] ContactError),
     #[error(transparent)]
-    Constrained(#[from] crate::constrained::ConstrainedError),
+    Constrained(#[from] ConstrainedError),
     #[error("the state of '{model}' has {expected} components, got {got}")]
     StateLength {
         model: &'static str,
@@ -352,12 +354,12 @@ fn constrained_runs(
     settings: &Settings,
 ) -> Result<Exploration, ExploreError> {
     let times = grid(settings.t_end, settings.samples);
-    let run = crate::constrained::run(model, params, Some(y0), settings.method, &times)?;
+    let run = on_constraints::run(model, params, Some(y0), settings.method, &times)?;
     let e0 = run.energy.first().copied().unwrap_or(0.0);
     let period_map = match model.phase_period(params) {
         Some(period) if settings.periods > 0 => {
             let map_times: Vec<f64> = (0..=settings.periods).map(|k| k as f64 * period).collect();
-            let map = crate::constrained::run(model, params, Some(y0), settings.method, &map_times)?;
+            let map = on_constraints::run(model, params, Some(y0), settings.method, &map_times)?;
             Some(map.states)
         }
         _ => None,

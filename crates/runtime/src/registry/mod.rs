@@ -3,6 +3,9 @@
 
 use std::fmt;
 
+mod constrained;
+pub use constrained::{Constrained, ConstrainedSystems};
+
 use crate::ode::any_size::fixed_state;
 use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem, Stats};
 use crate::tangent::lyapunov::fli_of_starts;
@@ -580,7 +583,7 @@ pub struct Model {
     /// None for a contact or a constrained model.
     pub sized: Option<FixedSize>,
     /// A constrained model's equations and projections.
-    pub constrained: Option<&'static dyn crate::constrained::ConstrainedSystems>,
+    pub constrained: Option<&'static dyn ConstrainedSystems>,
 }
 
 impl Model {

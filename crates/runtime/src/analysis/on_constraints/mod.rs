@@ -1,0 +1,150 @@
+//! Running and analysing constrained models on their constraints: runs
+//! with projection at each output time and their reactions, and the
+//! Floquet multipliers on the constraints' tangent space
+//! ([`monodromy_on_constraints`]); stabilisation by vibration in
+//! [`vibration`].
+
+pub mod vibration;
+
+use nalgebra::DMatrix;
+
+use crate::ode::holonomic::{restricted_monodromy, ConstraintError};
+use crate::ode::{AnyOptions, Integrator, Method, OdeError};
+use crate::registry::{ConstrainedSystems, ParameterError};
+
+/// The monodromy matrix of the periodic orbit through the consistent state
+/// `y0` restricted to the constraints' tangent space (2(n − k) for k
+/// holonomic constraints): Zᵀ Φ Z with Z an orthonormal basis there, whose
+/// eigenvalues are the Floquet multipliers on the constraints, without the
+/// spurious ones of the directions the constraints forbid. Also the state
+/// after the period.
+pub fn monodromy_on_constraints(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    method: Method,
+    period: f64,
+    y0: &[f64],
+) -> Result<(Vec<f64>, DMatrix<f64>), ConstrainedError> {
+    let name = model.info().name;
+    let mut integrator = Integrator::new(method)?;
+    let (end, full) = model.monodromy(params, &mut integrator, period, y0)?;
+    let basis =
+        model
+            .tangent_basis(params, 0.0, y0)?
+            .ok_or_else(|| ConstrainedError::Constraint {
+                model: name,
+                t: 0.0,
+                source: ConstraintError::Singular { q: y0.to_vec() },
+            })?;
+    Ok((end, restricted_monodromy(&full, &basis)))
+}
+
+/// Why a constrained run stopped.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConstrainedError {
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+    /// No consistent state near the start, or degenerate constraints on
+    /// the way (with the time).
+    #[error("model '{model}' at t = {t}: {source}")]
+    Constraint {
+        model: &'static str,
+        t: f64,
+        source: ConstraintError,
+    },
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// Output times that do not increase from the start.
+    #[error("the output times must increase from t0 = {t0} and be finite")]
+    Times { t0: f64 },
+}
+
+/// A run on the constraints: at each output time the state (projected),
+/// the reactions, the energy function, and the residuals the integration
+/// had left before that projection (the drift one segment allows).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ConstrainedRun {
+    pub model: &'static str,
+    pub constraint_names: Vec<&'static str>,
+    /// The start after its projection onto the constraints.
+    pub start: Vec<f64>,
+    pub times: Vec<f64>,
+    pub states: Vec<Vec<f64>>,
+    pub reactions: Vec<Vec<f64>>,
+    pub energy: Vec<f64>,
+    /// Largest (|g|, |G q' + c_t|) found at a segment's end before its
+    /// projection.
+    pub largest_drift: (f64, f64),
+    /// Largest residuals after the projections.
+    pub largest_residual: (f64, f64),
+    pub steps: u64,
+}
+
+/// Runs `model` from `y0` (the model file's start at rest if None; made
+/// consistent by projection) at t0 = times[0] through the output `times`,
+/// projecting at each of them.
+pub fn run(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    y0: Option<&[f64]>,
+    method: Method,
+    times: &[f64],
+) -> Result<ConstrainedRun, ConstrainedError> {
+    let name = model.info().name;
+    let t0 = times.first().copied().unwrap_or(0.0);
+    if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| !(w[1] > w[0])) {
+        return Err(ConstrainedError::Times { t0 });
+    }
+    let constraint = |t: f64| {
+        move |source| ConstrainedError::Constraint {
+            model: name,
+            t,
+            source,
+        }
+    };
+    let mut y = match y0 {
+        Some(y0) => y0.to_vec(),
+        None => model.start(params),
+    };
+    if y.iter().any(|x| !x.is_finite()) {
+        return Err(OdeError::NonFiniteInitialState { t: t0, y }.into());
+    }
+    model.project(params, t0, &mut y).map_err(constraint(t0))?;
+    let system = model.exact(params);
+    let mut integrator = Integrator::new(method)?;
+    let mut result = ConstrainedRun {
+        model: name,
+        constraint_names: model.constraint_names().to_vec(),
+        start: y.clone(),
+        times: Vec::new(),
+        states: Vec::new(),
+        reactions: Vec::new(),
+        energy: Vec::new(),
+        largest_drift: (0.0, 0.0),
+        largest_residual: (0.0, 0.0),
+        steps: 0,
+    };
+    let mut t = t0;
+    for &t1 in times {
+        if t1 > t {
+            y = system
+                .solve(&mut integrator, t, &y, t1, AnyOptions::default())?
+                .y;
+            let drift = model.residuals(params, t1, &y)?;
+            result.largest_drift = larger(result.largest_drift, drift);
+            model.project(params, t1, &mut y).map_err(constraint(t1))?;
+            t = t1;
+        }
+        result.largest_residual = larger(result.largest_residual, model.residuals(params, t, &y)?);
+        result.times.push(t);
+        result.reactions.push(model.reactions(params, t, &y)?);
+        result.energy.push(model.energy(params, t, &y)?);
+        result.states.push(y.clone());
+    }
+    result.steps = integrator.stats.steps;
+    Ok(result)
+}
+
+fn larger(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0.max(b.0), a.1.max(b.1))
+}

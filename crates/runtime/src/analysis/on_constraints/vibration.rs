@@ -1,0 +1,500 @@
+//! Stabilisation by vibration on the constraints: Study 2's theory for
+//! points with ideal holonomic constraints, in the model's own (possibly
+//! redundant) coordinates.
+//!
+//! With fixed holonomic constraints g(q) = 0, L = ½ q'ᵀM q' + b(q, θ)·q' − V(q, θ)
+//! and a fast phase θ whose coupling b has zero mean, the first-order
+//! averaged motion is that of the effective potential
+//!
+//!   W(q) = mean_θ V + ½ mean_θ ⟨P b, b⟩,   P = M⁻¹ − M⁻¹Gᵀ(G M⁻¹ Gᵀ)⁻¹G M⁻¹,
+//!
+//! on the constraints: P is the inverse mass matrix projected on them, so
+//! only the part of the vibration's impulse the constraints let through
+//! counts. An equilibrium solves ∇W = Gᵀμ, g = 0; it is stable when the
+//! stiffness on the tangent space, Zᵀ(∇²W − Σ μᵢ∇²gᵢ)Z, is positive
+//! definite (the constraints' curvature enters through the multipliers μ).
+//! The means over θ are exact quadratures (32 nodes: V and b are
+//! trigonometric polynomials in θ of low degree); ∇W and ∇²W are central
+//! differences (errors about 1e-10 and 1e-8 of W's scale), ∇²g exact.
+//!
+//! The exact system answers too: where the equilibrium at rest relative to
+//! the base is a periodic orbit of the vibrating system, its Floquet
+//! multipliers on the constraints ([`super::monodromy_on_constraints`])
+//! say whether it is stable, amplitude by amplitude.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{DMatrix, DVector};
+
+use super::{monodromy_on_constraints, ConstrainedError};
+use crate::analysis::Refusal;
+use crate::ode::holonomic::{tangent_inverse_mass, tangent_stability, vibrational_potential};
+use crate::ode::{Integrator, Method, OdeError};
+use crate::registry::ConstrainedSystems;
+
+/// Phases of the quadrature over θ.
+const NODES: usize = 32;
+
+/// What to compute.
+#[derive(Clone, Debug)]
+pub struct VibrationSettings {
+    /// The amplitude parameter (default: the model file's
+    /// `[fast_phase] amplitude`).
+    pub amplitude: Option<String>,
+    /// The largest amplitude scanned (default: twice the value in the
+    /// parameters, or 4 if it is 0).
+    pub max_amplitude: Option<f64>,
+    /// Where Newton's method starts (coordinates; default the model
+    /// file's start).
+    pub start: Option<Vec<f64>>,
+    /// Amplitudes scanned between 0 and the largest.
+    pub scan: usize,
+    pub method: Method,
+}
+
+impl Default for VibrationSettings {
+    fn default() -> Self {
+        VibrationSettings {
+            amplitude: None,
+            max_amplitude: None,
+            start: None,
+            scan: 40,
+            method: Method::Dop853 {
+                rtol: 1e-12,
+                atol: 1e-12,
+            },
+        }
+    }
+}
+
+/// The exact system's verdict on the equilibrium.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub enum Exact {
+    /// At rest relative to the base it is a periodic orbit of the exact
+    /// system: its Floquet multipliers' moduli at the amplitude, whether
+    /// they are all within 1e-7 of the unit circle or inside it, and the
+    /// intervals of scanned amplitudes where they are (edges by bisection).
+    Periodic {
+        moduli: Vec<f64>,
+        stable: bool,
+        windows: Vec<[f64; 2]>,
+    },
+    /// The vibration moves the orbit off the averaged equilibrium (|P(y₀) − y₀|
+    /// is `gap` after one period): its multipliers need the period map's
+    /// fixed point on the constraints, which is not computed here.
+    MovedByVibration { gap: f64 },
+}
+
+/// The averaged equilibrium near the start, its stability, the amplitudes
+/// where that changes, and the exact system's verdict.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct VibrationStability {
+    pub model: &'static str,
+    pub params: BTreeMap<String, f64>,
+    pub amplitude: String,
+    pub amplitude_value: f64,
+    /// q* on the constraints.
+    pub equilibrium: Vec<f64>,
+    /// μ: the constraints' reactions holding q* against ∇W.
+    pub multipliers: Vec<f64>,
+    /// ω² of the small oscillations of the averaged motion on the
+    /// constraints (n − k of them, increasing): stable when all are > 0.
+    pub squared_frequencies: Vec<f64>,
+    pub averaged_stable: bool,
+    /// Amplitudes in the scanned range where the smallest ω² changes sign.
+    pub averaged_thresholds: Vec<f64>,
+    pub exact: Exact,
+}
+
+/// Why the analysis could not be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum VibrationError {
+    #[error(transparent)]
+    Refused(#[from] Refusal),
+    #[error("'{model}': the averaging on constraints needs fixed holonomic constraints and a mass matrix that the vibration does not move; write the coordinates relative to the vibrating base")]
+    MovingConstraints { model: &'static str },
+    #[error("'{model}': the vibration's coupling b has a mean of {mean:e} at q*: a gyroscopic averaged system, whose stability W alone does not decide")]
+    Gyroscopic { model: &'static str, mean: f64 },
+    #[error("'{model}': no equilibrium of the averaged system on the constraints near the start at {amplitude} = {value} (|∇W − Gᵀμ|, |g| still {residual:e} after Newton's method)")]
+    NoEquilibrium {
+        model: &'static str,
+        amplitude: String,
+        value: f64,
+        residual: f64,
+    },
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+    #[error(transparent)]
+    Constrained(#[from] ConstrainedError),
+}
+
+/// The averaged system of `model` at `params`.
+struct Averaged<'a> {
+    model: &'a dyn ConstrainedSystems,
+    params: Vec<f64>,
+    period: f64,
+}
+
+/// An equilibrium of the averaged system and its stiffness.
+struct Equilibrium {
+    q: Vec<f64>,
+    multipliers: Vec<f64>,
+    squared_frequencies: Vec<f64>,
+}
+
+impl Averaged<'_> {
+    /// W(q) and the mean of b.
+    fn effective(&self, q: &[f64]) -> Result<(f64, DVector<f64>), VibrationError> {
+        let rest = self.model.statics(&self.params, 0.0, q)?;
+        let p = tangent_inverse_mass(&rest.mass, &rest.jacobian, q).map_err(|source| {
+            ConstrainedError::Constraint {
+                model: self.model.info().name,
+                t: 0.0,
+                source,
+            }
+        })?;
+        let (mut potential, mut couplings) = (0.0, Vec::with_capacity(NODES));
+        for j in 0..NODES {
+            let t = self.period * j as f64 / NODES as f64;
+            let at = self.model.statics(&self.params, t, q)?;
+            potential += at.potential / NODES as f64;
+            couplings.push(at.linear_term);
+        }
+        let mean = couplings.iter().sum::<DVector<f64>>() / NODES as f64;
+        let oscillating: Vec<DVector<f64>> = couplings.iter().map(|b| b - &mean).collect();
+        Ok((potential + vibrational_potential(&p, &oscillating), mean))
+    }
+
+    fn w(&self, q: &[f64]) -> Result<f64, VibrationError> {
+        Ok(self.effective(q)?.0)
+    }
+
+    fn step(q: &[f64], i: usize, scale: f64) -> f64 {
+        scale * (1.0 + q[i].abs())
+    }
+
+    fn gradient(&self, q: &[f64]) -> Result<DVector<f64>, VibrationError> {
+        let mut gradient = DVector::zeros(q.len());
+        for i in 0..q.len() {
+            let h = Self::step(q, i, 1e-5);
+            let (mut plus, mut minus) = (q.to_vec(), q.to_vec());
+            plus[i] += h;
+            minus[i] -= h;
+            gradient[i] = (self.w(&plus)? - self.w(&minus)?) / (2.0 * h);
+        }
+        Ok(gradient)
+    }
+
+    fn hessian(&self, q: &[f64]) -> Result<DMatrix<f64>, VibrationError> {
+        let n = q.len();
+        let mut hessian = DMatrix::zeros(n, n);
+        let at = |di: (usize, f64), dj: (usize, f64)| {
+            let mut x = q.to_vec();
+            x[di.0] += di.1;
+            x[dj.0] += dj.1;
+            self.w(&x)
+        };
+        for i in 0..n {
+            let hi = Self::step(q, i, 1e-4);
+            for j in i..n {
+                let hj = Self::step(q, j, 1e-4);
+                let value =
+                    (at((i, hi), (j, hj))? - at((i, hi), (j, -hj))? - at((i, -hi), (j, hj))?
+                        + at((i, -hi), (j, -hj))?)
+                        / (4.0 * hi * hj);
+                hessian[(i, j)] = value;
+                hessian[(j, i)] = value;
+            }
+        }
+        Ok(hessian)
+    }
+
+    /// Newton's method on ∇W = Gᵀμ, g = 0 from `start`, then the stiffness
+    /// on the tangent space there.
+    fn equilibrium(
+        &self,
+        start: &[f64],
+        amplitude: (&str, f64),
+    ) -> Result<Equilibrium, VibrationError> {
+        let name = self.model.info().name;
+        let n = start.len();
+        let mut q = start.to_vec();
+        let mut residual = f64::INFINITY;
+        let mut multipliers = DVector::zeros(0);
+        for _ in 0..30 {
+            let rest = self.model.statics(&self.params, 0.0, &q)?;
+            let (g, value) = (&rest.jacobian, &rest.residual);
+            let k = g.nrows();
+            let gradient = self.gradient(&q)?;
+            if multipliers.len() != k {
+                multipliers = (g * g.transpose())
+                    .lu()
+                    .solve(&(g * &gradient))
+                    .unwrap_or_else(|| DVector::zeros(k));
+            }
+            let force = &gradient - g.transpose() * &multipliers;
+            residual = force.amax().max(value.amax());
+            if residual <= 1e-9 {
+                break;
+            }
+            let mut curvature = self.hessian(&q)?;
+            for (mu, h) in
+                multipliers
+                    .iter()
+                    .zip(self.model.constraint_hessians(&self.params, 0.0, &q)?)
+            {
+                curvature -= h * *mu;
+            }
+            let mut kkt = DMatrix::zeros(n + k, n + k);
+            kkt.view_mut((0, 0), (n, n)).copy_from(&curvature);
+            kkt.view_mut((0, n), (n, k)).copy_from(&(-g.transpose()));
+            kkt.view_mut((n, 0), (k, n)).copy_from(g);
+            let mut rhs = DVector::zeros(n + k);
+            rhs.rows_mut(0, n).copy_from(&(-force));
+            rhs.rows_mut(n, k).copy_from(&(-value));
+            let Some(step) = kkt.lu().solve(&rhs) else {
+                break;
+            };
+            for i in 0..n {
+                q[i] += step[i];
+            }
+            multipliers += step.rows(n, k);
+        }
+        if !(residual <= 1e-7) {
+            return Err(VibrationError::NoEquilibrium {
+                model: name,
+                amplitude: amplitude.0.into(),
+                value: amplitude.1,
+                residual,
+            });
+        }
+        let rest = self.model.statics(&self.params, 0.0, &q)?;
+        let stiffness = tangent_stability(
+            &rest.mass,
+            &rest.jacobian,
+            &self.gradient(&q)?,
+            &self.hessian(&q)?,
+            &self.model.constraint_hessians(&self.params, 0.0, &q)?,
+        );
+        let squared_frequencies = stiffness
+            .and_then(|s| {
+                let l = s.mass.clone().cholesky()?.l();
+                let l_inv = l.try_inverse()?;
+                let reduced = &l_inv * s.stiffness * l_inv.transpose();
+                let mut values: Vec<f64> = reduced
+                    .symmetric_eigen()
+                    .eigenvalues
+                    .iter()
+                    .copied()
+                    .collect();
+                values.sort_by(f64::total_cmp);
+                Some(values)
+            })
+            .unwrap_or_default();
+        Ok(Equilibrium {
+            q,
+            multipliers: multipliers.iter().copied().collect(),
+            squared_frequencies,
+        })
+    }
+}
+
+/// The stability of `model`'s equilibrium near the start under the
+/// vibration, averaged and exact (see the module's comment).
+pub fn vibration_stability(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    settings: &VibrationSettings,
+) -> Result<VibrationStability, VibrationError> {
+    let info = model.info();
+    let name = info.name;
+    let named = Refusal::named_values(info, params)?;
+    if model.phase_period(params).is_none() {
+        return Err(Refusal::no_fast_phase(name).into());
+    }
+    if !model.stationary() {
+        return Err(VibrationError::MovingConstraints { model: name });
+    }
+    let amplitude = match settings.amplitude.as_deref().or(info.amplitude) {
+        Some(a) => a.to_string(),
+        None => {
+            return Err(Refusal::Setting {
+                model: name.into(),
+                requirement: "name the amplitude parameter (the model file names none in [fast_phase] amplitude)",
+            }
+            .into())
+        }
+    };
+    let index = Refusal::parameter_index(info, &amplitude)?;
+    let value = params[index];
+    let at = |a: f64| -> Result<Averaged<'_>, VibrationError> {
+        let mut p = params.to_vec();
+        p[index] = a;
+        let period = model
+            .phase_period(&p)
+            .ok_or_else(|| Refusal::no_fast_phase(name))?;
+        Ok(Averaged {
+            model,
+            params: p,
+            period,
+        })
+    };
+    let n = info.coordinates.len();
+    let start = match &settings.start {
+        Some(q) if q.len() != n => {
+            return Err(Refusal::state_length(name, "start", q.len(), n).into())
+        }
+        Some(q) => q.clone(),
+        None => model.start(params)[..n].to_vec(),
+    };
+    let here = at(value)?;
+    let found = here.equilibrium(&start, (&amplitude, value))?;
+    let (_, mean) = here.effective(&found.q)?;
+    if mean.amax() > 1e-9 {
+        return Err(VibrationError::Gyroscopic {
+            model: name,
+            mean: mean.amax(),
+        });
+    }
+    let most = settings
+        .max_amplitude
+        .unwrap_or(if value > 0.0 { 2.0 * value } else { 4.0 });
+    let amplitudes: Vec<f64> = (0..=settings.scan.max(1))
+        .map(|k| most * k as f64 / settings.scan.max(1) as f64)
+        .collect();
+    // The smallest ω² along the scan, the equilibrium followed from each
+    // amplitude to the next.
+    let lowest = |a: f64, from: &[f64]| -> Result<(f64, Vec<f64>), VibrationError> {
+        let e = at(a)?.equilibrium(from, (&amplitude, a))?;
+        Ok((
+            e.squared_frequencies.first().copied().unwrap_or(f64::NAN),
+            e.q,
+        ))
+    };
+    let mut thresholds = Vec::new();
+    let mut previous: Option<(f64, f64, Vec<f64>)> = None;
+    for &a in &amplitudes {
+        let from = previous.as_ref().map_or(found.q.clone(), |p| p.2.clone());
+        let (omega2, q) = lowest(a, &from)?;
+        if let Some((a0, w0, q0)) = &previous {
+            if (w0 > &0.0) != (omega2 > 0.0) {
+                let (mut lo, mut hi, mut q_lo) = (*a0, a, q0.clone());
+                let positive_at_lo = *w0 > 0.0;
+                for _ in 0..40 {
+                    let mid = 0.5 * (lo + hi);
+                    let (w, q_mid) = lowest(mid, &q_lo)?;
+                    if (w > 0.0) == positive_at_lo {
+                        lo = mid;
+                        q_lo = q_mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                thresholds.push(0.5 * (lo + hi));
+            }
+        }
+        previous = Some((a, omega2, q));
+    }
+    let exact = exact_verdict(model, params, index, &found.q, &amplitudes, settings.method)?;
+    Ok(VibrationStability {
+        model: name,
+        params: named,
+        amplitude,
+        amplitude_value: value,
+        averaged_stable: found.squared_frequencies.first().is_some_and(|w| *w > 0.0),
+        equilibrium: found.q,
+        multipliers: found.multipliers,
+        squared_frequencies: found.squared_frequencies,
+        averaged_thresholds: thresholds,
+        exact,
+    })
+}
+
+/// Whether [q; 0] is a periodic orbit of the exact system at the
+/// amplitude in `params`, and if so its multipliers and the stable
+/// intervals of `amplitudes` (edges by bisection).
+fn exact_verdict(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    index: usize,
+    q: &[f64],
+    amplitudes: &[f64],
+    method: Method,
+) -> Result<Exact, VibrationError> {
+    let mut y0 = q.to_vec();
+    y0.resize(2 * q.len(), 0.0);
+    // The moduli of the multipliers at amplitude a, or the orbit's gap.
+    let moduli_at = |a: f64| -> Result<Result<Vec<f64>, f64>, VibrationError> {
+        let mut p = params.to_vec();
+        p[index] = a;
+        let period = model
+            .phase_period(&p)
+            .ok_or_else(|| Refusal::no_fast_phase(model.info().name))?;
+        let mut integrator = Integrator::new(method)?;
+        let end = model
+            .exact(&p)
+            .solve(&mut integrator, 0.0, &y0, period, Default::default())?
+            .y;
+        let gap = end
+            .iter()
+            .zip(&y0)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        if !(gap <= 1e-8) {
+            return Ok(Err(gap));
+        }
+        let (_, restricted) = monodromy_on_constraints(model, &p, method, period, &y0)?;
+        let mut moduli: Vec<f64> = restricted
+            .complex_eigenvalues()
+            .iter()
+            .map(|z| z.norm())
+            .collect();
+        moduli.sort_by(f64::total_cmp);
+        Ok(Ok(moduli))
+    };
+    let stable = |moduli: &[f64]| moduli.iter().all(|m| *m <= 1.0 + 1e-7);
+    let moduli = match moduli_at(params[index])? {
+        Ok(moduli) => moduli,
+        Err(gap) => return Ok(Exact::MovedByVibration { gap }),
+    };
+    let verdict = |a: f64| -> Result<Option<bool>, VibrationError> {
+        Ok(moduli_at(a)?.ok().map(|m| stable(&m)))
+    };
+    let mut windows: Vec<[f64; 2]> = Vec::new();
+    let mut open: Option<f64> = None;
+    let mut last: Option<(f64, bool)> = None;
+    for &a in amplitudes {
+        let Some(now) = verdict(a)? else {
+            continue;
+        };
+        let edge = match last {
+            Some((a0, before)) if before != now => {
+                let (mut lo, mut hi) = (a0, a);
+                for _ in 0..40 {
+                    let mid = 0.5 * (lo + hi);
+                    if verdict(mid)? == Some(before) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                Some(0.5 * (lo + hi))
+            }
+            None if now => Some(a),
+            _ => None,
+        };
+        match (edge, now) {
+            (Some(e), true) => open = Some(e),
+            (Some(e), false) => windows.extend(open.take().map(|o| [o, e])),
+            _ => {}
+        }
+        last = Some((a, now));
+    }
+    if let (Some(o), Some((a, true))) = (open, last) {
+        windows.push([o, a]);
+    }
+    Ok(Exact::Periodic {
+        stable: stable(&moduli),
+        moduli,
+        windows,
+    })
+}

@@ -1,0 +1,348 @@
+//! Models with ideal constraints at run time: closed loops, rods between
+//! points, moving guides, rolling.
+//!
+//! A constrained model's state is y = [q; q'] over its n coordinates
+//! (possibly redundant), and its k constraints read, at the velocity level,
+//! G(q, t) q' + c_t(q, t) = 0 (see `crates/derive/src/constraints.rs`).
+//! [`OnConstraints`] is the ODE of Lagrange's equations with multipliers,
+//! M q'' = F + Gᵀλ, G q'' + h = 0, solved at each state by the Schur
+//! complement at the model's own sizes, so that every integrator runs it.
+//! That ODE keeps the constraints only up to the integration error, so a
+//! run projects its state back onto them (positions by Newton's method in
+//! the metric of M, velocities exactly: [`crate::ode::holonomic::project`])
+//! at the end of every segment: every output time of a run
+//! (`analysis::on_constraints::run`), every period of a stream
+//! ([`Projecting`]). The multipliers λ are the constraints' reactions.
+//! The registry lists such a model through
+//! [`crate::registry::ConstrainedSystems`].
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::linalg::Cholesky;
+use crate::ode::any_size::fixed_state;
+use crate::ode::holonomic::{project, ConstraintError, Holonomic};
+use crate::ode::{
+    AnyOptions, AnySolution, AnySystem, Dual, Integrator, OdeError, Scalar, SizedSystem, System,
+};
+
+/// What a generated constrained model gives at its own sizes (N
+/// coordinates, K constraints), with its parameters: the model's module
+/// implements it on its `Forms`.
+pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send + 'static {
+    fn from_values(params: &[f64]) -> Self;
+    /// The names of the constraints, whose multipliers are their reactions.
+    fn constraint_names() -> &'static [&'static str];
+    /// Which constraints are holonomic (position constraints).
+    fn holonomic() -> [bool; K];
+    /// Which coordinates are angles.
+    fn periodic() -> [bool; N];
+    /// The model file's starts of the coordinates.
+    fn start(&self) -> [f64; N];
+    /// The period of the fast phase, if there is one.
+    fn phase_period(&self) -> Option<f64>;
+    fn mass_matrix(&self, t: f64, q: &[f64; N]) -> [[f64; N]; N];
+    fn free_forces(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; N];
+    /// g of each position constraint (0 for a velocity constraint).
+    fn position_residuals(&self, t: f64, q: &[f64; N]) -> [f64; K];
+    /// G of the velocity forms c = G q' + c_t.
+    fn constraint_jacobian(&self, t: f64, q: &[f64; N]) -> [[f64; N]; K];
+    /// c_t of the velocity forms.
+    fn constraint_rates(&self, t: f64, q: &[f64; N]) -> [f64; K];
+    /// h in d/dt c = G q'' + h.
+    fn constraint_bias(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; K];
+    /// The energy function Σ q'∂L/∂q' − L.
+    fn energy(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> f64;
+    /// Whether the constraints are holonomic and fixed and M does not
+    /// move with the phase (the averaging's conditions).
+    fn stationary() -> bool;
+    /// V = −L and b = ∂L/∂q' at q' = 0, at time t (for the averaging).
+    fn potential(&self, t: f64, q: &[f64; N]) -> f64;
+    fn linear_term(&self, t: f64, q: &[f64; N]) -> [f64; N];
+    /// The forms the accelerations need, over dual numbers (for the
+    /// Jacobian of the equations of motion).
+    fn mass_matrix_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; N];
+    fn free_forces_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; N];
+    fn constraint_jacobian_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; K];
+    fn constraint_rates_dual(&self, t: f64, q: &[Dual; N]) -> [Dual; K];
+    fn constraint_bias_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; K];
+}
+
+/// q'' and λ of M q'' = F + Gᵀλ, G q'' + h = 0 by the Schur complement:
+/// λ = (G M⁻¹ Gᵀ)⁻¹ (−h − G M⁻¹ F), q'' = M⁻¹ (F + Gᵀλ). NaN where M or
+/// G M⁻¹ Gᵀ is not positive definite.
+#[inline]
+fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
+    mass: [[Num; N]; N],
+    g: [[Num; N]; K],
+    free: [Num; N],
+    h: [Num; K],
+) -> ([Num; N], [Num; K]) {
+    let mass = Cholesky::new(mass);
+    // M⁻¹Gᵀ, column by column.
+    let m_inv_gt: [[Num; N]; K] = std::array::from_fn(|r| mass.solve(g[r]));
+    let schur: [[Num; K]; K] =
+        std::array::from_fn(|r| std::array::from_fn(|c| dot(&g[r], &m_inv_gt[c])));
+    let m_inv_f = mass.solve(free);
+    let rhs: [Num; K] = std::array::from_fn(|r| -h[r] - dot(&g[r], &m_inv_f));
+    let lambda = Cholesky::new(schur).solve(rhs);
+    let accelerations = std::array::from_fn(|i| {
+        let mut a = m_inv_f[i];
+        for r in 0..K {
+            a += m_inv_gt[r][i] * lambda[r];
+        }
+        a
+    });
+    (accelerations, lambda)
+}
+
+/// The equations of motion of constrained forms `F` as an ODE on
+/// y = [q; q'] of length S = 2N.
+#[derive(Clone, Debug)]
+pub struct OnConstraints<F, const N: usize, const K: usize, const S: usize>(pub F);
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
+    OnConstraints<F, N, K, S>
+{
+    /// The forms at `params`; S must be 2N.
+    pub fn new(forms: F) -> Self {
+        const { assert!(S == 2 * N, "the state of a constrained model is [q; q']") };
+        OnConstraints(forms)
+    }
+
+    /// The coordinates and velocities of a state.
+    pub fn split(y: &[f64; S]) -> ([f64; N], [f64; N]) {
+        (
+            std::array::from_fn(|i| y[i]),
+            std::array::from_fn(|i| y[N + i]),
+        )
+    }
+
+    /// The accelerations q'' and the multipliers λ at (t, y), by the Schur
+    /// complement: λ = (G M⁻¹ Gᵀ)⁻¹ (−h − G M⁻¹ F), q'' = M⁻¹ (F + Gᵀλ).
+    /// NaN where M or G M⁻¹ Gᵀ is not positive definite (the integrators
+    /// then stop with the state: a degenerate configuration).
+    pub fn accelerations(&self, t: f64, y: &[f64; S]) -> ([f64; N], [f64; K]) {
+        let (q, v) = Self::split(y);
+        let forms = &self.0;
+        solve_constrained(
+            forms.mass_matrix(t, &q),
+            forms.constraint_jacobian(t, &q),
+            forms.free_forces(t, &q, &v),
+            forms.constraint_bias(t, &q, &v),
+        )
+    }
+
+    /// max |g| over the position constraints and max |G q' + c_t| over all.
+    pub fn residuals(&self, t: f64, y: &[f64; S]) -> (f64, f64) {
+        let (q, v) = Self::split(y);
+        let position = self
+            .0
+            .position_residuals(t, &q)
+            .iter()
+            .fold(0.0_f64, |m, x| m.max(x.abs()));
+        let g = self.0.constraint_jacobian(t, &q);
+        let rates = self.0.constraint_rates(t, &q);
+        let velocity = (0..K).fold(0.0_f64, |m, r| m.max((dot(&g[r], &v) + rates[r]).abs()));
+        (position, velocity)
+    }
+}
+
+#[inline]
+fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Num {
+    let mut sum = Num::from(0.0);
+    for (x, y) in a.iter().zip(b) {
+        sum += *x * *y;
+    }
+    sum
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> System<S>
+    for OnConstraints<F, N, K, S>
+{
+    #[inline]
+    fn rhs(&self, t: f64, y: &[f64; S]) -> [f64; S] {
+        let (accelerations, _) = self.accelerations(t, y);
+        std::array::from_fn(|i| {
+            if i < N {
+                y[N + i]
+            } else {
+                accelerations[i - N]
+            }
+        })
+    }
+
+    /// Exact to round-off: the accelerations over dual numbers, one
+    /// column of the Jacobian a pass.
+    fn jacobian(&self, t: f64, y: &[f64; S]) -> Option<[[f64; S]; S]> {
+        let forms = &self.0;
+        let mut jacobian = [[0.0; S]; S];
+        for column in 0..S {
+            let seeded = |i: usize| Dual::seeded(y[i], if i == column { 1.0 } else { 0.0 });
+            let q: [Dual; N] = std::array::from_fn(seeded);
+            let v: [Dual; N] = std::array::from_fn(|i| seeded(N + i));
+            let (accelerations, _) = solve_constrained(
+                forms.mass_matrix_dual(t, &q),
+                forms.constraint_jacobian_dual(t, &q),
+                forms.free_forces_dual(t, &q, &v),
+                forms.constraint_bias_dual(t, &q, &v),
+            );
+            for i in 0..N {
+                jacobian[i][column] = if N + i == column { 1.0 } else { 0.0 };
+                jacobian[N + i][column] = accelerations[i].du;
+            }
+        }
+        Some(jacobian)
+    }
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> Holonomic
+    for OnConstraints<F, N, K, S>
+{
+    fn coordinates(&self) -> usize {
+        N
+    }
+    fn residual(&self, t: f64, q: &[f64]) -> DVector<f64> {
+        let q = fixed_state::<N>(q).expect("the projection passes n coordinates");
+        DVector::from_column_slice(&self.0.position_residuals(t, &q))
+    }
+    fn jacobian(&self, t: f64, q: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+        let q = fixed_state::<N>(q).expect("the projection passes n coordinates");
+        let g = self.0.constraint_jacobian(t, &q);
+        (
+            DMatrix::from_fn(K, N, |r, c| g[r][c]),
+            DVector::from_column_slice(&self.0.constraint_rates(t, &q)),
+        )
+    }
+    fn mass(&self, t: f64, q: &[f64]) -> DMatrix<f64> {
+        let q = fixed_state::<N>(q).expect("the projection passes n coordinates");
+        let m = self.0.mass_matrix(t, &q);
+        DMatrix::from_fn(N, N, |r, c| m[r][c])
+    }
+}
+
+/// How closely a projection brings a state onto the constraints: Newton's
+/// method stops at |g| ≤ 1e-14 times the state's size.
+pub const PROJECTION_TOLERANCE: f64 = 1e-14;
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
+    OnConstraints<F, N, K, S>
+{
+    /// The Jacobian (2k × 2n) of the state's constraints [g; G q' + c_t]
+    /// with respect to [q; q'] (a velocity constraint has no position
+    /// row: its row of g is zero), exact by dual numbers.
+    pub fn state_constraints_jacobian(&self, t: f64, y: &[f64; S]) -> DMatrix<f64> {
+        let (q, v) = Self::split(y);
+        let forms = &self.0;
+        let holonomic = F::holonomic();
+        let g = forms.constraint_jacobian(t, &q);
+        let rows: Vec<usize> = (0..K).filter(|&r| holonomic[r]).collect();
+        let mut c = DMatrix::zeros(rows.len() + K, S);
+        for (row, &r) in rows.iter().enumerate() {
+            for j in 0..N {
+                c[(row, j)] = g[r][j];
+            }
+        }
+        for j in 0..N {
+            let q_dual: [Dual; N] =
+                std::array::from_fn(|i| Dual::seeded(q[i], if i == j { 1.0 } else { 0.0 }));
+            let g_dual = forms.constraint_jacobian_dual(t, &q_dual);
+            let rates = forms.constraint_rates_dual(t, &q_dual);
+            for r in 0..K {
+                let mut velocity_form = rates[r];
+                for (entry, vk) in g_dual[r].iter().zip(&v) {
+                    velocity_form += *entry * *vk;
+                }
+                c[(rows.len() + r, j)] = velocity_form.du;
+                c[(rows.len() + r, N + j)] = g[r][j];
+            }
+        }
+        c
+    }
+}
+
+/// A constrained model's equations as an [`AnySystem`] whose stream
+/// projects the state onto the constraints at every segment's end (before
+/// the analysis sees it), so that a period map of 10⁵ periods stays on them.
+pub struct Projecting<F, const N: usize, const K: usize, const S: usize> {
+    system: SizedSystem<OnConstraints<F, N, K, S>, S>,
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
+    Projecting<F, N, K, S>
+{
+    pub fn new(equations: OnConstraints<F, N, K, S>) -> Self {
+        Projecting {
+            system: SizedSystem(equations),
+        }
+    }
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> AnySystem
+    for Projecting<F, N, K, S>
+{
+    fn dim(&self) -> usize {
+        S
+    }
+    fn rhs(&self, t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
+        self.system.rhs(t, y)
+    }
+    fn jacobian(&self, t: f64, y: &[f64]) -> Result<Option<DMatrix<f64>>, OdeError> {
+        self.system.jacobian(t, y)
+    }
+    fn solve(
+        &self,
+        integrator: &mut Integrator,
+        t0: f64,
+        y0: &[f64],
+        t1: f64,
+        options: AnyOptions<'_>,
+    ) -> Result<AnySolution, OdeError> {
+        self.system.solve(integrator, t0, y0, t1, options)
+    }
+    fn stream(
+        &self,
+        integrator: &mut Integrator,
+        y0: &[f64],
+        segment: f64,
+        segments: usize,
+        after: &mut dyn FnMut(&mut [f64]) -> bool,
+    ) -> Result<(), OdeError> {
+        let mut t = 0.0;
+        let equations = &self.system.0;
+        let mut failure = None;
+        self.system
+            .stream(integrator, y0, segment, segments, &mut |y| {
+                t += segment;
+                if let Err(e) = project(equations, t, y, PROJECTION_TOLERANCE * size(y)) {
+                    failure = Some(e);
+                    return false;
+                }
+                after(y)
+            })?;
+        match failure {
+            Some(ConstraintError::NoConvergence { .. })
+            | Some(ConstraintError::Singular { .. }) => Err(OdeError::NonFinite {
+                t,
+                y: vec![f64::NAN; S],
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// 1 + the largest |component| of a state: the scale of its residuals.
+pub fn size(y: &[f64]) -> f64 {
+    1.0 + y.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+/// A constrained model at (t, q) with q' = 0: the mass matrix, the position
+/// constraints' values and Jacobian (their rows only), V = −L and the
+/// vibration's coupling b = ∂L/∂q'.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Statics {
+    pub mass: DMatrix<f64>,
+    pub residual: DVector<f64>,
+    pub jacobian: DMatrix<f64>,
+    pub potential: f64,
+    pub linear_term: DVector<f64>,
+}

@@ -1,0 +1,219 @@
+//! A constrained model behind a trait object, with states and parameters
+//! as slices: what the registry lists and the analyses on constraints
+//! (`analysis::on_constraints`) take; one generic adapter over the
+//! generated forms ([`crate::constrained::ConstraintForms`]).
+
+use std::marker::PhantomData;
+
+use nalgebra::{DMatrix, DVector};
+
+use super::ModelInfo;
+use crate::constrained::{
+    size, ConstraintForms, OnConstraints, Projecting, Statics, PROJECTION_TOLERANCE,
+};
+use crate::ode::any_size::fixed_state;
+use crate::ode::holonomic::{project, tangent_basis, ConstraintError, Projection};
+use crate::ode::{AnySystem, Dual, Integrator, OdeError};
+use crate::tangent::monodromy::monodromy;
+
+/// A constrained model with states and parameters as slices.
+pub trait ConstrainedSystems: Sync {
+    fn info(&self) -> &'static ModelInfo;
+    /// The constraints' names (their reactions' labels).
+    fn constraint_names(&self) -> &'static [&'static str];
+    /// Which constraints are holonomic.
+    fn holonomic(&self) -> Vec<bool>;
+    /// Which components of the state [q; q'] are angles.
+    fn periodic_state(&self) -> Vec<bool>;
+    /// The model file's start at rest, [q_start; 0] (not yet projected:
+    /// a moving constraint may need velocities).
+    fn start(&self, params: &[f64]) -> Vec<f64>;
+    /// The period of the fast phase, if there is one.
+    fn phase_period(&self, params: &[f64]) -> Option<f64>;
+    /// The equations of motion; their stream projects at segments' ends.
+    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
+    /// Moves `y` onto the constraints at time t (see [`project`]).
+    fn project(&self, params: &[f64], t: f64, y: &mut [f64])
+        -> Result<Projection, ConstraintError>;
+    /// The multipliers λ at (t, y): the constraints' reactions, in the
+    /// units of their rows (for a rod written as |x − x₀|² − l² = 0, λ
+    /// times the gradient 2(x − x₀) is the force on the point).
+    fn reactions(&self, params: &[f64], t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError>;
+    /// (max |g|, max |G q' + c_t|) at (t, y).
+    fn residuals(&self, params: &[f64], t: f64, y: &[f64]) -> Result<(f64, f64), OdeError>;
+    fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError>;
+    /// An orthonormal basis (columns) of the tangent space of the
+    /// constrained phase space at (t, y), or None where the constraints
+    /// are degenerate.
+    fn tangent_basis(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Option<DMatrix<f64>>, OdeError>;
+    /// Whether the constraints are holonomic and fixed and M does not
+    /// move with the phase (the averaging's conditions).
+    fn stationary(&self) -> bool;
+    /// At (t, q): what the averaging reads (see [`Statics`]).
+    fn statics(&self, params: &[f64], t: f64, q: &[f64]) -> Result<Statics, OdeError>;
+    /// ∇²g of each position constraint at (t, q), exact by dual numbers.
+    fn constraint_hessians(
+        &self,
+        params: &[f64],
+        t: f64,
+        q: &[f64],
+    ) -> Result<Vec<DMatrix<f64>>, OdeError>;
+    /// The state after `period` from `y0` and the monodromy matrix
+    /// ∂y(T)/∂y(0) of the full state [q; q'] (2n × 2n).
+    fn monodromy(
+        &self,
+        params: &[f64],
+        integrator: &mut Integrator,
+        period: f64,
+        y0: &[f64],
+    ) -> Result<(Vec<f64>, DMatrix<f64>), OdeError>;
+}
+
+/// The generated forms `F` at their sizes as [`ConstrainedSystems`] (the
+/// model's module holds one in a static).
+/// V = S + S² is the state with its monodromy's columns.
+pub struct Constrained<F, const N: usize, const K: usize, const S: usize, const V: usize> {
+    info: &'static ModelInfo,
+    forms: PhantomData<fn() -> F>,
+}
+
+impl<F, const N: usize, const K: usize, const S: usize, const V: usize> Constrained<F, N, K, S, V> {
+    pub const fn new(info: &'static ModelInfo) -> Self {
+        Constrained {
+            info,
+            forms: PhantomData,
+        }
+    }
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
+    Constrained<F, N, K, S, V>
+{
+    fn equations(params: &[f64]) -> OnConstraints<F, N, K, S> {
+        OnConstraints::new(F::from_values(params))
+    }
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
+    ConstrainedSystems for Constrained<F, N, K, S, V>
+{
+    fn info(&self) -> &'static ModelInfo {
+        self.info
+    }
+    fn constraint_names(&self) -> &'static [&'static str] {
+        F::constraint_names()
+    }
+    fn holonomic(&self) -> Vec<bool> {
+        F::holonomic().to_vec()
+    }
+    fn periodic_state(&self) -> Vec<bool> {
+        let periodic = F::periodic();
+        (0..S).map(|i| i < N && periodic[i]).collect()
+    }
+    fn start(&self, params: &[f64]) -> Vec<f64> {
+        let mut y = F::from_values(params).start().to_vec();
+        y.resize(S, 0.0);
+        y
+    }
+    fn phase_period(&self, params: &[f64]) -> Option<f64> {
+        F::from_values(params).phase_period()
+    }
+    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
+        Box::new(Projecting::new(Self::equations(params)))
+    }
+    fn project(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &mut [f64],
+    ) -> Result<Projection, ConstraintError> {
+        if y.len() != S {
+            return Err(ConstraintError::StateLength {
+                given: y.len(),
+                coordinates: N,
+            });
+        }
+        let tolerance = PROJECTION_TOLERANCE * size(y);
+        project(&Self::equations(params), t, y, tolerance)
+    }
+    fn reactions(&self, params: &[f64], t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        Ok(Self::equations(params).accelerations(t, &y).1.to_vec())
+    }
+    fn residuals(&self, params: &[f64], t: f64, y: &[f64]) -> Result<(f64, f64), OdeError> {
+        let y = fixed_state::<S>(y)?;
+        Ok(Self::equations(params).residuals(t, &y))
+    }
+    fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        let (q, v) = OnConstraints::<F, N, K, S>::split(&y);
+        Ok(F::from_values(params).energy(t, &q, &v))
+    }
+    fn stationary(&self) -> bool {
+        F::stationary()
+    }
+    fn statics(&self, params: &[f64], t: f64, q: &[f64]) -> Result<Statics, OdeError> {
+        let q = fixed_state::<N>(q)?;
+        let forms = F::from_values(params);
+        let rows: Vec<usize> = (0..K).filter(|&r| F::holonomic()[r]).collect();
+        let m = forms.mass_matrix(t, &q);
+        let g = forms.constraint_jacobian(t, &q);
+        let residual = forms.position_residuals(t, &q);
+        Ok(Statics {
+            mass: DMatrix::from_fn(N, N, |i, k| m[i][k]),
+            residual: DVector::from_iterator(rows.len(), rows.iter().map(|&r| residual[r])),
+            jacobian: DMatrix::from_fn(rows.len(), N, |i, k| g[rows[i]][k]),
+            potential: forms.potential(t, &q),
+            linear_term: DVector::from_column_slice(&forms.linear_term(t, &q)),
+        })
+    }
+    fn constraint_hessians(
+        &self,
+        params: &[f64],
+        t: f64,
+        q: &[f64],
+    ) -> Result<Vec<DMatrix<f64>>, OdeError> {
+        let q = fixed_state::<N>(q)?;
+        let forms = F::from_values(params);
+        let rows: Vec<usize> = (0..K).filter(|&r| F::holonomic()[r]).collect();
+        let mut hessians = vec![DMatrix::zeros(N, N); rows.len()];
+        for j in 0..N {
+            let seeded: [Dual; N] =
+                std::array::from_fn(|i| Dual::seeded(q[i], if i == j { 1.0 } else { 0.0 }));
+            let g = forms.constraint_jacobian_dual(t, &seeded);
+            for (h, &r) in hessians.iter_mut().zip(&rows) {
+                for i in 0..N {
+                    h[(i, j)] = g[r][i].du;
+                }
+            }
+        }
+        Ok(hessians)
+    }
+    fn tangent_basis(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Option<DMatrix<f64>>, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        let c = Self::equations(params).state_constraints_jacobian(t, &y);
+        Ok(tangent_basis(&c))
+    }
+    fn monodromy(
+        &self,
+        params: &[f64],
+        integrator: &mut Integrator,
+        period: f64,
+        y0: &[f64],
+    ) -> Result<(Vec<f64>, DMatrix<f64>), OdeError> {
+        let y0 = fixed_state::<S>(y0)?;
+        let system = Self::equations(params);
+        let (end, m) = monodromy::<_, S, V>(integrator, &system, period, &y0)?;
+        Ok((end.to_vec(), DMatrix::from_fn(S, S, |i, k| m[i][k])))
+    }
+}
