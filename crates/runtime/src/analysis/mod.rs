@@ -103,6 +103,16 @@ pub(crate) fn hamiltonian(
     })
 }
 
+/// The model's flows (Hamiltonian or constrained), or the refusal of a
+/// contact model (which has none).
+pub(crate) fn flows(
+    model: &crate::registry::Model,
+) -> Result<&'static dyn crate::registry::Flows, Refusal> {
+    model
+        .flows()
+        .ok_or_else(|| Refusal::contact_model(model.info.name))
+}
+
 impl Refusal {
     pub fn contact_model(model: impl Into<String>) -> Refusal {
         Refusal::ContactModel {

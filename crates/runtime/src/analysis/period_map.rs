@@ -124,7 +124,10 @@ pub struct PortraitSettings {
     pub axes: [usize; 2],
     /// Initial states (full [q; p]); None: `count` seeds on a line along the
     /// first axis (over [−π, π) for an angle, [−p_max, p_max] otherwise)
-    /// through the zero state.
+    /// through the zero state; for a constrained model, along the second
+    /// axis over ±p_max about the model file's start. A constrained model's
+    /// seeds are made consistent in the chart of the two axes (their
+    /// components held, the others moved onto the constraints).
     pub seeds: Option<Vec<Vec<f64>>>,
     pub count: usize,
     pub p_max: f64,
@@ -177,6 +180,16 @@ pub enum PeriodMapError {
         #[source]
         source: crate::registry::PlaneError,
     },
+    /// A seed that cannot be made consistent with the constraints while
+    /// its axes' components are held (a chart singular there, or no
+    /// consistent state near).
+    #[error("model '{model}': the seed {seed:?} cannot be put on the constraints in the chart of the axes: {source}")]
+    Inconsistent {
+        model: String,
+        seed: Vec<f64>,
+        #[source]
+        source: crate::ode::holonomic::ConstraintError,
+    },
     /// Only some tiles of a map were asked for: they are written, there is
     /// no map to return.
     #[error("the tiles asked for are written; run without `only` to merge them into the map")]
@@ -196,13 +209,25 @@ pub fn portrait(
     params: &[f64],
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
-    let systems = crate::analysis::hamiltonian(model)?;
+    let systems = crate::analysis::flows(model)?;
     let info = systems.info();
     let named = Refusal::named_values(info, params)?;
     let period = fast_phase_period(systems, params)?;
     let axes = plane_names(info, settings.axes)?;
     let wrap = systems.periodic_state();
-    let seeds = portrait_seeds(info.name, settings, &wrap)?;
+    let constrained = model.constrained.is_some();
+    let base = systems.base_state(params);
+    let mut seeds = portrait_seeds(info.name, settings, &wrap, constrained.then_some(&base[..]))?;
+    for seed in &mut seeds {
+        let given = seed.clone();
+        systems
+            .consistent(params, seed, &settings.axes)
+            .map_err(|source| PeriodMapError::Inconsistent {
+                model: info.name.into(),
+                seed: given,
+                source,
+            })?;
+    }
     orbit_budget(seeds.len(), settings.periods, wrap.len())?;
     let start = std::time::Instant::now();
     let system = systems.exact(params);
@@ -253,7 +278,7 @@ pub fn portrait(
 /// The period of the model's fast phase, or the refusal of a model
 /// without one (no period map).
 pub(crate) fn fast_phase_period(
-    systems: &dyn crate::registry::Systems,
+    systems: &dyn crate::registry::Flows,
     params: &[f64],
 ) -> Result<f64, Refusal> {
     match systems.phase_period(params) {
@@ -275,11 +300,13 @@ pub(crate) fn plane_names(
 }
 
 /// The seeds a portrait asks for (each of the state's length), or `count`
-/// of them on a line along the first axis.
+/// of them on a line along the first axis; with a `base` state (a
+/// constrained model's start), along the second axis about it.
 fn portrait_seeds(
     model: &'static str,
     settings: &PortraitSettings,
     wrap: &[bool],
+    base: Option<&[f64]>,
 ) -> Result<Vec<Vec<f64>>, Refusal> {
     let n = wrap.len();
     if let Some(seeds) = &settings.seeds {
@@ -287,6 +314,17 @@ fn portrait_seeds(
             Some(s) => Err(Refusal::state_length(model, "seed", s.len(), n)),
             None => Ok(seeds.clone()),
         };
+    }
+    if let Some(base) = base {
+        let axis = settings.axes[1];
+        return Ok((0..settings.count)
+            .map(|k| {
+                let mut y = base.to_vec();
+                let fraction = (k as f64 + 0.5) / settings.count.max(1) as f64;
+                y[axis] += settings.p_max * (2.0 * fraction - 1.0);
+                y
+            })
+            .collect());
     }
     let axis = settings.axes[0];
     let (lo, hi) = if wrap[axis] {

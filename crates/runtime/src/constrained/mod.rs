@@ -38,6 +38,8 @@ pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send +
     fn periodic() -> [bool; N];
     /// The model file's starts of the coordinates.
     fn start(&self) -> [f64; N];
+    /// Whether the model has a fast phase.
+    fn has_fast_phase() -> bool;
     /// The period of the fast phase, if there is one.
     fn phase_period(&self) -> Option<f64>;
     fn mass_matrix(&self, t: f64, q: &[f64; N]) -> [[f64; N]; N];

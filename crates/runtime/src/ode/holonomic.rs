@@ -104,6 +104,21 @@ pub fn project(
     y: &mut [f64],
     tolerance: f64,
 ) -> Result<Projection, ConstraintError> {
+    project_holding(system, t, y, tolerance, &[])
+}
+
+/// [`project`] moving only the components of `y` not in `held` (indices
+/// into [q; q̇]): the held ones are a chart's coordinates, the others
+/// follow from the constraints (in the metric of M restricted to them).
+/// [`ConstraintError::Singular`] where the free components cannot satisfy
+/// the constraints (a chart that is singular there).
+pub fn project_holding(
+    system: &dyn Holonomic,
+    t: f64,
+    y: &mut [f64],
+    tolerance: f64,
+    held: &[usize],
+) -> Result<Projection, ConstraintError> {
     let n = system.coordinates();
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(ConstraintError::Tolerance { value: tolerance });
@@ -114,6 +129,15 @@ pub fn project(
             coordinates: n,
         });
     }
+    // The metric restricted to the free components: held ones get an
+    // overwhelming mass, so that the correction leaves them where they are.
+    let restricted = |mut m: DMatrix<f64>, offset: usize| {
+        let scale = 1e12 * (1.0 + m.amax());
+        for &h in held.iter().filter(|&&h| h >= offset && h < offset + n) {
+            m[(h - offset, h - offset)] += scale;
+        }
+        m
+    };
     const MAX_STEPS: usize = 20;
     let (q, v) = y.split_at_mut(n);
     let mut newton_steps = 0;
@@ -130,23 +154,34 @@ pub fn project(
             });
         }
         let (g, _) = system.jacobian(t, q);
-        let step = Factors::at(&system.mass(t, q), &g, q)?.correction(&residual);
-        for (x, d) in q.iter_mut().zip(step.iter()) {
-            *x += d;
+        let m = restricted(system.mass(t, q), 0);
+        let step = Factors::at(&m, &g, q)?.correction(&residual);
+        for (i, (x, d)) in q.iter_mut().zip(step.iter()).enumerate() {
+            if !held.contains(&i) {
+                *x += d;
+            }
         }
         newton_steps += 1;
     };
     let (g, g_t) = system.jacobian(t, q);
-    let velocity = DVector::from_column_slice(v);
-    let step = Factors::at(&system.mass(t, q), &g, q)?.correction(&(&g * &velocity + &g_t));
-    for (x, d) in v.iter_mut().zip(step.iter()) {
-        *x += d;
+    let factors = Factors::at(&restricted(system.mass(t, q), n), &g, q)?;
+    // Exact in one pass without held components; a second pass removes
+    // what their (tiny, skipped) share of the correction left.
+    for _ in 0..if held.is_empty() { 1 } else { 2 } {
+        let velocity = DVector::from_column_slice(v);
+        let step = factors.correction(&(&g * &velocity + &g_t));
+        for (i, (x, d)) in v.iter_mut().zip(step.iter()).enumerate() {
+            if !held.contains(&(n + i)) {
+                *x += d;
+            }
+        }
     }
     let velocity = DVector::from_column_slice(v);
+    let velocity_residual = (&g * velocity + g_t).amax();
     Ok(Projection {
         newton_steps,
         position_residual,
-        velocity_residual: (&g * velocity + g_t).amax(),
+        velocity_residual,
     })
 }
 

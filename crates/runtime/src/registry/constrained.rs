@@ -7,31 +7,28 @@ use std::marker::PhantomData;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::ModelInfo;
+use super::{Flows, ModelInfo};
 use crate::constrained::{
     size, ConstraintForms, OnConstraints, Projecting, Statics, PROJECTION_TOLERANCE,
 };
 use crate::ode::any_size::fixed_state;
-use crate::ode::holonomic::{project, tangent_basis, ConstraintError, Projection};
+use crate::ode::holonomic::{
+    project, project_holding, tangent_basis, ConstraintError, Projection,
+};
 use crate::ode::{AnySystem, Dual, Integrator, OdeError};
 use crate::tangent::monodromy::monodromy;
 
 /// A constrained model with states and parameters as slices.
-pub trait ConstrainedSystems: Sync {
-    fn info(&self) -> &'static ModelInfo;
+/// Its [`Flows`] run the equations of motion, whose stream projects the
+/// state onto the constraints at every segment's end.
+pub trait ConstrainedSystems: Flows {
     /// The constraints' names (their reactions' labels).
     fn constraint_names(&self) -> &'static [&'static str];
     /// Which constraints are holonomic.
     fn holonomic(&self) -> Vec<bool>;
-    /// Which components of the state [q; q'] are angles.
-    fn periodic_state(&self) -> Vec<bool>;
     /// The model file's start at rest, [q_start; 0] (not yet projected:
     /// a moving constraint may need velocities).
     fn start(&self, params: &[f64]) -> Vec<f64>;
-    /// The period of the fast phase, if there is one.
-    fn phase_period(&self, params: &[f64]) -> Option<f64>;
-    /// The equations of motion; their stream projects at segments' ends.
-    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
     /// Moves `y` onto the constraints at time t (see [`project`]).
     fn project(&self, params: &[f64], t: f64, y: &mut [f64])
         -> Result<Projection, ConstraintError>;
@@ -100,31 +97,57 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
 }
 
 impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
-    ConstrainedSystems for Constrained<F, N, K, S, V>
+    Flows for Constrained<F, N, K, S, V>
 {
     fn info(&self) -> &'static ModelInfo {
         self.info
     }
-    fn constraint_names(&self) -> &'static [&'static str] {
-        F::constraint_names()
-    }
-    fn holonomic(&self) -> Vec<bool> {
-        F::holonomic().to_vec()
+    fn has_fast_phase(&self) -> bool {
+        F::has_fast_phase()
     }
     fn periodic_state(&self) -> Vec<bool> {
         let periodic = F::periodic();
         (0..S).map(|i| i < N && periodic[i]).collect()
-    }
-    fn start(&self, params: &[f64]) -> Vec<f64> {
-        let mut y = F::from_values(params).start().to_vec();
-        y.resize(S, 0.0);
-        y
     }
     fn phase_period(&self, params: &[f64]) -> Option<f64> {
         F::from_values(params).phase_period()
     }
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
         Box::new(Projecting::new(Self::equations(params)))
+    }
+    fn base_state(&self, params: &[f64]) -> Vec<f64> {
+        ConstrainedSystems::start(self, params)
+    }
+    fn consistent(
+        &self,
+        params: &[f64],
+        y: &mut [f64],
+        held: &[usize],
+    ) -> Result<(), ConstraintError> {
+        if y.len() != S {
+            return Err(ConstraintError::StateLength {
+                given: y.len(),
+                coordinates: N,
+            });
+        }
+        let tolerance = PROJECTION_TOLERANCE * size(y);
+        project_holding(&Self::equations(params), 0.0, y, tolerance, held).map(|_| ())
+    }
+}
+
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
+    ConstrainedSystems for Constrained<F, N, K, S, V>
+{
+    fn constraint_names(&self) -> &'static [&'static str] {
+        F::constraint_names()
+    }
+    fn holonomic(&self) -> Vec<bool> {
+        F::holonomic().to_vec()
+    }
+    fn start(&self, params: &[f64]) -> Vec<f64> {
+        let mut y = F::from_values(params).start().to_vec();
+        y.resize(S, 0.0);
+        y
     }
     fn project(
         &self,

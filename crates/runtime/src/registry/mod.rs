@@ -6,6 +6,7 @@ use std::fmt;
 mod constrained;
 pub use constrained::{Constrained, ConstrainedSystems};
 
+
 use crate::ode::any_size::fixed_state;
 use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem, Stats};
 use crate::tangent::lyapunov::fli_of_starts;
@@ -378,23 +379,46 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Fixed<D, S,
     }
 }
 
-/// A Hamiltonian model's systems and functions with states as slices: what
-/// the analyses compiled once for every size use (see
-/// [`crate::ode::any_size`]). Parameters are values in declaration order.
-pub trait Systems: Sync {
+/// What every model with smooth equations of motion gives, whatever its
+/// state (a Hamiltonian model's [q; p], a constrained model's [q; q'] on
+/// its constraints): the flow the state-generic analyses (portraits,
+/// period maps) run. Parameters are values in declaration order.
+pub trait Flows: Sync {
     fn info(&self) -> &'static ModelInfo;
     fn has_fast_phase(&self) -> bool;
     /// Which components of the state are angles; its length is the state's.
     fn periodic_state(&self) -> Vec<bool>;
+    /// The period of the fast phase.
+    fn phase_period(&self, params: &[f64]) -> Option<f64>;
+    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
+    /// The state seeds are varied from: zero for a free model, the model
+    /// file's start for a constrained one.
+    fn base_state(&self, _params: &[f64]) -> Vec<f64> {
+        vec![0.0; self.periodic_state().len()]
+    }
+    /// Makes `y` a state of the model at t = 0 holding its components
+    /// `held` (a chart's coordinates): a free model's states all are; a
+    /// constrained model's other components move onto the constraints.
+    fn consistent(
+        &self,
+        _params: &[f64],
+        _y: &mut [f64],
+        _held: &[usize],
+    ) -> Result<(), crate::ode::holonomic::ConstraintError> {
+        Ok(())
+    }
+}
+
+/// A Hamiltonian model's systems and functions with states as slices: what
+/// the analyses compiled once for every size use (see
+/// [`crate::ode::any_size`]). Parameters are values in declaration order.
+pub trait Systems: Flows {
     /// The state at rest at the coordinates `q` (for [q; p], p = 0).
     fn at_rest(&self, q: &[f64]) -> Vec<f64> {
         let mut y = q.to_vec();
         y.resize(self.periodic_state().len(), 0.0);
         y
     }
-    /// The period of the fast phase.
-    fn phase_period(&self, params: &[f64]) -> Option<f64>;
-    fn exact(&self, params: &[f64]) -> Box<dyn AnySystem>;
     /// None without a fast phase.
     fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>>;
     /// The system averaged to second order in ε = 1/rate, where derived.
@@ -459,7 +483,7 @@ fn matrix<const N: usize>(m: &[[f64; N]; N]) -> DMatrix<f64> {
     DMatrix::from_fn(N, N, |i, k| m[i][k])
 }
 
-impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
+impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows
     for Erased<D, S, T, V>
 {
     fn info(&self) -> &'static ModelInfo {
@@ -477,6 +501,11 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
         Box::new(SizedSystem(Fixed::exact(self, params)))
     }
+}
+
+impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
+    for Erased<D, S, T, V>
+{
     fn averaged(&self, params: &[f64]) -> Option<Box<dyn AnySystem>> {
         let averaged = Fixed::averaged(self, params)?;
         Some(Box::new(SizedSystem(averaged)))
@@ -587,6 +616,16 @@ pub struct Model {
 }
 
 impl Model {
+    /// The model's [`Flows`]: its [`Systems`] or its constrained form
+    /// (None for a contact model).
+    pub fn flows(&self) -> Option<&'static dyn Flows> {
+        match (self.systems(), self.constrained) {
+            (Some(systems), _) => Some(systems),
+            (None, Some(constrained)) => Some(constrained),
+            (None, None) => None,
+        }
+    }
+
     /// The model's [`Systems`] (None for a contact model).
     pub fn systems(&self) -> Option<&'static dyn Systems> {
         Some(match self.sized? {

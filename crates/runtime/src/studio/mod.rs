@@ -70,6 +70,8 @@ pub enum RequestProblem {
     Axes { components: usize },
     #[error("the range of axis {axis} must be an interval of finite numbers, low < high")]
     Range { axis: usize },
+    #[error("the seed cannot be put on the constraints with its axes' components held: {0}")]
+    Inconsistent(crate::ode::holonomic::ConstraintError),
     #[error("{what} must be between 1 and {max}, got {got}")]
     Count {
         what: &'static str,
@@ -92,7 +94,7 @@ pub struct ParameterSummary {
 pub struct ModelSummary {
     pub name: &'static str,
     pub source_file: &'static str,
-    /// `hamiltonian` or `contacts`.
+    /// `hamiltonian`, `contacts` or `constrained`.
     pub kind: &'static str,
     pub dof: usize,
     pub fast_phase: bool,
@@ -271,11 +273,11 @@ impl Setup {
             Kind::Contacts { .. } => {
                 return Err(StudioError::Refused(Refusal::contact_model(info.name)))
             }
-            Kind::Constrained { .. } => {
-                return Err(StudioError::Refused(Refusal::Constrained {
-                    model: info.name.into(),
-                }))
-            }
+            Kind::Constrained {
+                coordinates,
+                fast_phase,
+                ..
+            } => (coordinates, fast_phase),
         };
         let mut params = model.defaults();
         for (name, &value) in &self.params {
@@ -414,7 +416,15 @@ pub fn orbit(
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
 ) -> Result<OrbitEnd, StudioError> {
     let setup = request.check(catalog)?;
-    let systems = crate::analysis::hamiltonian(setup.handle)?;
+    let systems = crate::analysis::flows(setup.handle)?;
+    // A constrained model's seed, on its constraints in the chart of the axes.
+    let mut seed = request.seed.clone();
+    systems
+        .consistent(&setup.params, &mut seed, &setup.axes)
+        .map_err(|e| StudioError::BadRequest {
+            model: setup.info.name.into(),
+            problem: RequestProblem::Inconsistent(e),
+        })?;
     let started = Instant::now();
     let period = systems
         .phase_period(&setup.params)
@@ -435,7 +445,7 @@ pub fn orbit(
         &mut integrator,
         &*system,
         period,
-        &request.seed,
+        &seed,
         request.periods,
         &periodic,
         &mut |y| {
