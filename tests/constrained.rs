@@ -216,7 +216,9 @@ fn a_moving_constraints_reaction_does_the_energys_change() {
     let model = &cartesian_kapitza::SYSTEMS;
     let steps = 4000;
     let t_end = 2.0;
-    let times: Vec<f64> = (0..=steps).map(|k| t_end * k as f64 / steps as f64).collect();
+    let times: Vec<f64> = (0..=steps)
+        .map(|k| t_end * k as f64 / steps as f64)
+        .collect();
     let y0 = [0.6, a * eps + 0.8, 0.4, -0.3];
     let moving = run(model, &params, Some(&y0), TIGHT, &times).unwrap();
     let power: Vec<f64> = times
@@ -244,8 +246,18 @@ fn a_moving_constraints_reaction_does_the_energys_change() {
     // The model's own energy function is the same E.
     assert!((moving.energy[steps] - energy(&moving.states[steps])).abs() < 1e-12);
     // Without the vibration the rod does no work.
-    let still = run(model, &[0.0, eps, 0.0], Some(&[0.6, 0.8, 0.4, -0.3]), TIGHT, &times).unwrap();
-    let drift = still.energy.iter().fold(0.0_f64, |m, e| m.max((e - still.energy[0]).abs()));
+    let still = run(
+        model,
+        &[0.0, eps, 0.0],
+        Some(&[0.6, 0.8, 0.4, -0.3]),
+        TIGHT,
+        &times,
+    )
+    .unwrap();
+    let drift = still
+        .energy
+        .iter()
+        .fold(0.0_f64, |m, e| m.max((e - still.energy[0]).abs()));
     assert!(drift < 1e-12, "{drift:e}");
 }
 
@@ -256,7 +268,9 @@ fn a_moving_constraints_reaction_does_the_energys_change() {
 /// ω = ±√(2E/J) sech(k t + c), A = √(2E/m), k = b m A / J, tanh c = u₀/A.
 #[test]
 fn chaplygins_sleigh_glides_as_its_closed_form() {
-    let model = mechlab::models::chaplygin_sleigh::MODEL.constrained.unwrap();
+    let model = mechlab::models::chaplygin_sleigh::MODEL
+        .constrained
+        .unwrap();
     let (m, inertia, b) = (1.0, 0.5, 0.5);
     let params = [m, inertia, b];
     let (u0, w0, heading) = (0.2, 1.5, 0.3f64);
@@ -280,11 +294,21 @@ fn chaplygins_sleigh_glides_as_its_closed_form() {
         let sideways = -y[3] * y[2].sin() + y[4] * y[2].cos();
         let u_exact = amplitude * (k * t + c).tanh();
         let w_exact = (2.0 * energy / j).sqrt() / (k * t + c).cosh();
-        assert!((u - u_exact).abs() < 1e-10, "t = {t}: u = {u}, closed form {u_exact}");
-        assert!((y[5] - w_exact).abs() < 1e-10, "t = {t}: ω = {}, closed form {w_exact}", y[5]);
+        assert!(
+            (u - u_exact).abs() < 1e-10,
+            "t = {t}: u = {u}, closed form {u_exact}"
+        );
+        assert!(
+            (y[5] - w_exact).abs() < 1e-10,
+            "t = {t}: ω = {}, closed form {w_exact}",
+            y[5]
+        );
         assert!(sideways.abs() < 1e-13);
     }
-    let drift = glide.energy.iter().fold(0.0_f64, |d, e| d.max((e - energy).abs()));
+    let drift = glide
+        .energy
+        .iter()
+        .fold(0.0_f64, |d, e| d.max((e - energy).abs()));
     assert!(drift < 1e-12, "energy drift {drift:e}");
     // A velocity constraint has no position row: the tangent space has
     // 2n − 1 = 5 dimensions.
@@ -306,18 +330,36 @@ fn two_points_on_two_rods_move_as_the_double_pendulum() {
     let (a, nu, l1, l2) = (p.a, p.nu, p.l1, p.l2);
     let (q1, q2) = (0.1f64, -0.15f64);
     let times: Vec<f64> = (0..=40).map(|k| 0.25 * k as f64).collect();
-    let exact = states_at(TIGHT, &angles::Exact { params: p }, 0.0, &[q1, q2, 0.0, 0.0], &times).unwrap();
+    let exact = states_at(
+        TIGHT,
+        &angles::Exact { params: p },
+        0.0,
+        &[q1, q2, 0.0, 0.0],
+        &times,
+    )
+    .unwrap();
     let base = |t: f64| a / nu * (nu * t).cos();
     let x1 = l1 * q1.sin();
     let z1 = base(0.0) + l1 * q1.cos();
-    let y0 = [x1, z1, x1 + l2 * q2.sin(), z1 + l2 * q2.cos(), 0.0, 0.0, 0.0, 0.0];
+    let y0 = [
+        x1,
+        z1,
+        x1 + l2 * q2.sin(),
+        z1 + l2 * q2.cos(),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
     let params = [p.m1, p.m2, l1, l2, p.g, a, nu];
     let run = run(&points::SYSTEMS, &params, Some(&y0), TIGHT, &times).unwrap();
     let mut worst: f64 = 0.0;
     for ((t, angle), y) in times.iter().zip(&exact).zip(&run.states) {
         let phi1 = y[0].atan2(y[1] - base(*t));
         let phi2 = (y[2] - y[0]).atan2(y[3] - y[1]);
-        worst = worst.max((phi1 - angle[0]).abs()).max((phi2 - angle[1]).abs());
+        worst = worst
+            .max((phi1 - angle[0]).abs())
+            .max((phi2 - angle[1]).abs());
     }
     assert!(worst < 1e-10, "angles differ by {worst:e}");
     assert!(run.largest_residual.0 < 1e-13 && run.largest_residual.1 < 1e-12);
@@ -333,8 +375,18 @@ fn two_points_on_two_rods_move_as_the_double_pendulum() {
         .unwrap()
         .monodromy(&angle_params, &mut integrator, period, &[0.0; 4])
         .unwrap();
-    let upright = [0.0, base(0.0) + l1, 0.0, base(0.0) + l1 + l2, 0.0, 0.0, 0.0, 0.0];
-    let (_, r) = monodromy_on_constraints(&points::SYSTEMS, &params, TIGHT, period, &upright).unwrap();
+    let upright = [
+        0.0,
+        base(0.0) + l1,
+        0.0,
+        base(0.0) + l1 + l2,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
+    let (_, r) =
+        monodromy_on_constraints(&points::SYSTEMS, &params, TIGHT, period, &upright).unwrap();
     let minors = |m: &nalgebra::DMatrix<f64>| {
         let mut sum = 0.0;
         for i in 0..4 {
@@ -349,6 +401,9 @@ fn two_points_on_two_rods_move_as_the_double_pendulum() {
         (minors(&r), minors(&m)),
         (r.determinant(), m.determinant()),
     ] {
-        assert!((ours - theirs).abs() < 1e-9 * (1.0 + theirs.abs()), "{ours} against {theirs}");
+        assert!(
+            (ours - theirs).abs() < 1e-9 * (1.0 + theirs.abs()),
+            "{ours} against {theirs}"
+        );
     }
 }

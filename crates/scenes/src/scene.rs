@@ -146,6 +146,10 @@ pub enum SceneError {
     /// A request of the studio (the server answers it with this error).
     #[error(transparent)]
     Studio(#[from] mechlab_runtime::studio::StudioError),
+    #[error(transparent)]
+    Constrained(#[from] mechlab_runtime::analysis::on_constraints::ConstrainedError),
+    #[error(transparent)]
+    Vibration(#[from] mechlab_runtime::analysis::on_constraints::vibration::VibrationError),
     /// The studio's server could not listen, or stopped.
     #[error("the studio cannot serve on {address}: {source}")]
     Serve {

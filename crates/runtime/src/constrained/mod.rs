@@ -20,7 +20,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::linalg::Cholesky;
 use crate::ode::any_size::fixed_state;
-use crate::ode::holonomic::{project, ConstraintError, Holonomic};
+use crate::ode::holonomic::{ConstraintError, Holonomic, Projection};
 use crate::ode::{
     AnyOptions, AnySolution, AnySystem, Dual, Integrator, OdeError, Scalar, SizedSystem, System,
 };
@@ -262,6 +262,83 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
     }
 }
 
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
+    OnConstraints<F, N, K, S>
+{
+    /// [`crate::ode::holonomic::project`] at the model's sizes, without
+    /// allocating (a run projects every reported state): positions by
+    /// Newton's method in the metric of M until |g| ≤ `tolerance`, then
+    /// velocities exactly.
+    pub fn project(
+        &self,
+        t: f64,
+        y: &mut [f64; S],
+        tolerance: f64,
+    ) -> Result<Projection, ConstraintError> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(ConstraintError::Tolerance { value: tolerance });
+        }
+        let forms = &self.0;
+        // The correction −M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ r, or why it does not exist.
+        let correction = |q: &[f64; N], r: [f64; K]| -> Result<[f64; N], ConstraintError> {
+            let mass = Cholesky::new(forms.mass_matrix(t, q));
+            let g = forms.constraint_jacobian(t, q);
+            let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|row| mass.solve(g[row]));
+            let schur: [[f64; K]; K] =
+                std::array::from_fn(|a| std::array::from_fn(|b| dot(&g[a], &m_inv_gt[b])));
+            let lambda = Cholesky::new(schur).solve(r);
+            let step: [f64; N] = std::array::from_fn(|i| {
+                -(0..K)
+                    .map(|row| m_inv_gt[row][i] * lambda[row])
+                    .sum::<f64>()
+            });
+            match step.iter().all(|x| x.is_finite()) {
+                true => Ok(step),
+                false => Err(ConstraintError::Singular { q: q.to_vec() }),
+            }
+        };
+        const MAX_STEPS: usize = 20;
+        let (mut q, mut v) = Self::split(y);
+        let mut newton_steps = 0;
+        let position_residual = loop {
+            let residual = forms.position_residuals(t, &q);
+            let size = residual.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            if size <= tolerance {
+                break size;
+            }
+            if newton_steps == MAX_STEPS || !size.is_finite() {
+                return Err(ConstraintError::NoConvergence {
+                    residual: size,
+                    iterations: newton_steps,
+                });
+            }
+            let step = correction(&q, residual)?;
+            for (x, d) in q.iter_mut().zip(step) {
+                *x += d;
+            }
+            newton_steps += 1;
+        };
+        let g = forms.constraint_jacobian(t, &q);
+        let rates = forms.constraint_rates(t, &q);
+        let velocity_form: [f64; K] = std::array::from_fn(|r| dot(&g[r], &v) + rates[r]);
+        let step = correction(&q, velocity_form)?;
+        for (x, d) in v.iter_mut().zip(step) {
+            *x += d;
+        }
+        let velocity_residual =
+            (0..K).fold(0.0_f64, |m, r| m.max((dot(&g[r], &v) + rates[r]).abs()));
+        for i in 0..N {
+            y[i] = q[i];
+            y[N + i] = v[i];
+        }
+        Ok(Projection {
+            newton_steps,
+            position_residual,
+            velocity_residual,
+        })
+    }
+}
+
 /// A constrained model's equations as an [`AnySystem`] whose stream
 /// projects the state onto the constraints at every segment's end (before
 /// the analysis sees it), so that a period map of 10⁵ periods stays on them.
@@ -315,7 +392,9 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> A
         self.system
             .stream(integrator, y0, segment, segments, &mut |y| {
                 t += segment;
-                if let Err(e) = project(equations, t, y, PROJECTION_TOLERANCE * size(y)) {
+                let tolerance = PROJECTION_TOLERANCE * size(y);
+                let state: &mut [f64; S] = y.try_into().expect("a state of the system's length");
+                if let Err(e) = equations.project(t, state, tolerance) {
                     failure = Some(e);
                     return false;
                 }

@@ -12,9 +12,7 @@ use crate::constrained::{
     size, ConstraintForms, OnConstraints, Projecting, Statics, PROJECTION_TOLERANCE,
 };
 use crate::ode::any_size::fixed_state;
-use crate::ode::holonomic::{
-    project, project_holding, tangent_basis, ConstraintError, Projection,
-};
+use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
 use crate::ode::{AnySystem, Dual, Integrator, OdeError};
 use crate::tangent::monodromy::monodromy;
 
@@ -96,8 +94,8 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
-    Flows for Constrained<F, N, K, S, V>
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize> Flows
+    for Constrained<F, N, K, S, V>
 {
     fn info(&self) -> &'static ModelInfo {
         self.info
@@ -155,14 +153,13 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         t: f64,
         y: &mut [f64],
     ) -> Result<Projection, ConstraintError> {
-        if y.len() != S {
-            return Err(ConstraintError::StateLength {
-                given: y.len(),
-                coordinates: N,
-            });
-        }
-        let tolerance = PROJECTION_TOLERANCE * size(y);
-        project(&Self::equations(params), t, y, tolerance)
+        let given = y.len();
+        let state: &mut [f64; S] = y.try_into().map_err(|_| ConstraintError::StateLength {
+            given,
+            coordinates: N,
+        })?;
+        let tolerance = PROJECTION_TOLERANCE * size(state);
+        Self::equations(params).project(t, state, tolerance)
     }
     fn reactions(&self, params: &[f64], t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
         let y = fixed_state::<S>(y)?;

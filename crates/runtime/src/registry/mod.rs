@@ -6,7 +6,6 @@ use std::fmt;
 mod constrained;
 pub use constrained::{Constrained, ConstrainedSystems};
 
-
 use crate::ode::any_size::fixed_state;
 use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem, Stats};
 use crate::tangent::lyapunov::fli_of_starts;
@@ -483,9 +482,7 @@ fn matrix<const N: usize>(m: &[[f64; N]; N]) -> DMatrix<f64> {
     DMatrix::from_fn(N, N, |i, k| m[i][k])
 }
 
-impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows
-    for Erased<D, S, T, V>
-{
+impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for Erased<D, S, T, V> {
     fn info(&self) -> &'static ModelInfo {
         self.0.info()
     }
