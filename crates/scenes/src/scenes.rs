@@ -504,6 +504,64 @@ pub fn period_map_scene(
     Ok(())
 }
 
+/// The `linkage` scene: stabilisation by vibration of a constrained model
+/// (the four-bar linkage held upside down by default): the averaged
+/// equilibrium on the constraints, its thresholds, and the exact window.
+pub fn linkage_scene(
+    catalog: Catalog,
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
+    use mechlab_runtime::analysis::on_constraints::vibration::{
+        vibration_stability, VibrationSettings,
+    };
+    let (model, scene) = generic_scene(
+        catalog,
+        scene_name,
+        "stabilisation by vibration on the constraints of a constrained model",
+        overrides,
+        ("four_bar", "dop853", "1e-12"),
+        &[
+            ("max_amplitude", "auto", "the largest amplitude scanned (auto: twice the amplitude's value)"),
+            ("scan", "40", "amplitudes scanned from 0"),
+        ],
+    )?;
+    let info = model.info;
+    let constrained = model.constrained.ok_or(SceneError::BadValue {
+        name: "model".into(),
+        value: info.name.into(),
+        reason: ValueProblem::Requirement("a model with [[constraints]] in its file"),
+    })?;
+    let settings = VibrationSettings {
+        max_amplitude: match scene.text("max_amplitude") {
+            "auto" => None,
+            _ => Some(scene.positive("max_amplitude")?),
+        },
+        scan: scene.count("scan")?,
+        method: method_from(&scene)?,
+        ..VibrationSettings::default()
+    };
+    let result = vibration_stability(constrained, &scene.parameter_values(info)?, &settings)?;
+    println!(
+        "{}: equilibrium q* = {:?}, averaged ω² = {:?} ({}); thresholds in {}: {:?}",
+        info.name,
+        result.equilibrium,
+        result.squared_frequencies,
+        if result.averaged_stable { "stable" } else { "unstable" },
+        result.amplitude,
+        result.averaged_thresholds
+    );
+    println!("exact: {:?}", result.exact);
+    scene.save_figure(&result.figure(), "linkage.png")?;
+    let rows = result
+        .scan
+        .iter()
+        .map(|p| (p.amplitude, p.lowest_squared_frequency, p.largest_modulus.unwrap_or(f64::NAN)));
+    scene.write_csv("scan.csv", &[result.amplitude.as_str(), "lowest_omega2", "largest_modulus"], rows)?;
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
 /// The `separatrix_splitting` scene: the hyperbolic fixed point of the
 /// period map of a 1-degree-of-freedom model with a fast phase, its
 /// manifolds, two primary homoclinic points and the lobe between them.

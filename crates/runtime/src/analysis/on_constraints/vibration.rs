@@ -104,6 +104,18 @@ pub struct VibrationStability {
     /// Amplitudes in the scanned range where the smallest ω² changes sign.
     pub averaged_thresholds: Vec<f64>,
     pub exact: Exact,
+    /// The scan: at each amplitude the smallest ω² of the averaged
+    /// equilibrium and the largest Floquet modulus of the exact orbit
+    /// (None where the vibration moves it).
+    pub scan: Vec<ScanPoint>,
+}
+
+/// One amplitude of the scan.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ScanPoint {
+    pub amplitude: f64,
+    pub lowest_squared_frequency: f64,
+    pub largest_modulus: Option<f64>,
 }
 
 /// Why the analysis could not be made.
@@ -372,10 +384,12 @@ pub fn vibration_stability(
         ))
     };
     let mut thresholds = Vec::new();
+    let mut lowest_along = Vec::new();
     let mut previous: Option<(f64, f64, Vec<f64>)> = None;
     for &a in &amplitudes {
         let from = previous.as_ref().map_or(found.q.clone(), |p| p.2.clone());
         let (omega2, q) = lowest(a, &from)?;
+        lowest_along.push(omega2);
         if let Some((a0, w0, q0)) = &previous {
             if (w0 > &0.0) != (omega2 > 0.0) {
                 let (mut lo, mut hi, mut q_lo) = (*a0, a, q0.clone());
@@ -395,7 +409,17 @@ pub fn vibration_stability(
         }
         previous = Some((a, omega2, q));
     }
-    let exact = exact_verdict(model, params, index, &found.q, &amplitudes, settings.method)?;
+    let (exact, largest) = exact_verdict(model, params, index, &found.q, &amplitudes, settings.method)?;
+    let scan = amplitudes
+        .iter()
+        .zip(lowest_along)
+        .zip(largest)
+        .map(|((&amplitude, lowest_squared_frequency), largest_modulus)| ScanPoint {
+            amplitude,
+            lowest_squared_frequency,
+            largest_modulus,
+        })
+        .collect();
     Ok(VibrationStability {
         model: name,
         params: named,
@@ -407,12 +431,14 @@ pub fn vibration_stability(
         squared_frequencies: found.squared_frequencies,
         averaged_thresholds: thresholds,
         exact,
+        scan,
     })
 }
 
 /// Whether [q; 0] is a periodic orbit of the exact system at the
 /// amplitude in `params`, and if so its multipliers and the stable
-/// intervals of `amplitudes` (edges by bisection).
+/// intervals of `amplitudes` (edges by bisection); and the largest modulus
+/// at each of `amplitudes` where it is periodic.
 fn exact_verdict(
     model: &dyn ConstrainedSystems,
     params: &[f64],
@@ -420,7 +446,7 @@ fn exact_verdict(
     q: &[f64],
     amplitudes: &[f64],
     method: Method,
-) -> Result<Exact, VibrationError> {
+) -> Result<(Exact, Vec<Option<f64>>), VibrationError> {
     let mut y0 = q.to_vec();
     y0.resize(2 * q.len(), 0.0);
     // The moduli of the multipliers at amplitude a, or the orbit's gap.
@@ -454,16 +480,22 @@ fn exact_verdict(
     let stable = |moduli: &[f64]| moduli.iter().all(|m| *m <= 1.0 + 1e-7);
     let moduli = match moduli_at(params[index])? {
         Ok(moduli) => moduli,
-        Err(gap) => return Ok(Exact::MovedByVibration { gap }),
+        Err(gap) => {
+            let none = vec![None; amplitudes.len()];
+            return Ok((Exact::MovedByVibration { gap }, none));
+        }
     };
     let verdict = |a: f64| -> Result<Option<bool>, VibrationError> {
         Ok(moduli_at(a)?.ok().map(|m| stable(&m)))
     };
     let mut windows: Vec<[f64; 2]> = Vec::new();
+    let mut largest = Vec::with_capacity(amplitudes.len());
     let mut open: Option<f64> = None;
     let mut last: Option<(f64, bool)> = None;
     for &a in amplitudes {
-        let Some(now) = verdict(a)? else {
+        let here = moduli_at(a)?.ok();
+        largest.push(here.as_ref().and_then(|m| m.last().copied()));
+        let Some(now) = here.map(|m| stable(&m)) else {
             continue;
         };
         let edge = match last {
@@ -492,9 +524,70 @@ fn exact_verdict(
     if let (Some(o), Some((a, true))) = (open, last) {
         windows.push([o, a]);
     }
-    Ok(Exact::Periodic {
+    let exact = Exact::Periodic {
         stable: stable(&moduli),
         moduli,
         windows,
-    })
+    };
+    Ok((exact, largest))
+}
+
+impl VibrationStability {
+    /// Two panels over the scanned amplitudes: the averaged equilibrium's
+    /// smallest ω² (stable above zero, the thresholds in red), and the
+    /// exact orbit's largest Floquet modulus (stable at 1).
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{Figure, PanelSpec, BLACK, GREY, RED};
+        use crate::registry::display_name;
+        let amplitude = display_name(&self.amplitude);
+        let span = |values: &mut dyn Iterator<Item = f64>| {
+            let (lo, hi) = values
+                .filter(|v| v.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+            (lo - 0.05 * (hi - lo).max(1e-9), hi + 0.05 * (hi - lo).max(1e-9))
+        };
+        let x = (0.0, self.scan.last().map_or(1.0, |p| p.amplitude));
+        let omega = span(&mut self.scan.iter().map(|p| p.lowest_squared_frequency).chain([0.0]));
+        let moduli: Vec<(f64, f64)> = self
+            .scan
+            .iter()
+            .filter_map(|p| Some((p.amplitude, p.largest_modulus?)))
+            .collect();
+        let rho = span(&mut moduli.iter().map(|p| p.1).chain([1.0]));
+        let titles = [
+            format!("{}: averaged, smallest ω² on the constraints", self.model),
+            format!("{}: exact, largest Floquet modulus", self.model),
+        ];
+        let specs = [
+            PanelSpec::new(
+                &titles[0],
+                &amplitude,
+                "ω²",
+                x,
+                omega,
+            ),
+            PanelSpec::new(
+                &titles[1],
+                &amplitude,
+                "|ρ|",
+                x,
+                (rho.0.min(0.99), rho.1.max(1.01)),
+            ),
+        ];
+        let mut figure = Figure::grid(2, 1, 560, 420, &specs);
+        let lowest: Vec<(f64, f64)> = self
+            .scan
+            .iter()
+            .map(|p| (p.amplitude, p.lowest_squared_frequency))
+            .collect();
+        figure.line(0, &lowest, BLACK);
+        figure.dashed_line(0, &[(x.0, 0.0), (x.1, 0.0)], GREY);
+        for a in &self.averaged_thresholds {
+            figure.line(0, &[(*a, omega.0), (*a, omega.1)], RED);
+            figure.line(1, &[(*a, 0.99f64.min(rho.0)), (*a, 1.01f64.max(rho.1))], RED);
+        }
+        figure.line(1, &moduli, BLACK);
+        figure.dashed_line(1, &[(x.0, 1.0), (x.1, 1.0)], GREY);
+        figure
+    }
 }
