@@ -421,7 +421,11 @@ fn a_hundred_thousand_periods_stay_on_the_constraints() {
     y0[3] = 0.3;
     model.project(&params, 0.0, &mut y0).unwrap();
     let system = model.exact(&params);
-    let mut integrator = mechlab::ode::Integrator::new(Method::Dop853 { rtol: 1e-10, atol: 1e-10 }).unwrap();
+    let mut integrator = mechlab::ode::Integrator::new(Method::Dop853 {
+        rtol: 1e-10,
+        atol: 1e-10,
+    })
+    .unwrap();
     let (mut worst, mut k) = ((0.0_f64, 0.0_f64), 0usize);
     system
         .stream(&mut integrator, &y0, period, 100_000, &mut |y| {

@@ -290,7 +290,8 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
             Err(
                 AveragingError::Order(..)
                 | AveragingError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
-                | AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. }),
+                | AveragingError::Refused(mechlab::analysis::Refusal::ContactModel { .. })
+                | AveragingError::Refused(mechlab::analysis::Refusal::Constrained { .. }),
             ) => {}
             Err(e) => panic!("{}: {e}", info.name),
         }

@@ -20,9 +20,16 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
     for info in models::ALL {
         let model = mechlab::models::by_name(info.name).unwrap().dynamic;
         let params = model.defaults();
-        let Kind::Hamiltonian { dof: n, fast_phase } = model.kind() else {
-            contact_model_is_refused(info.name, &params);
-            continue;
+        let (n, fast_phase) = match model.kind() {
+            Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
+            Kind::Constrained { .. } => {
+                constrained_model_on_its_constraints(info.name, &params);
+                continue;
+            }
+            Kind::Contacts { .. } => {
+                contact_model_is_refused(info.name, &params);
+                continue;
+            }
         };
         // A model without a fast phase has no period map and nothing to
         // average: each analysis says so.
@@ -63,6 +70,84 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
         averaging_checked > 0,
         "no model's averaging exponent was checked"
     );
+}
+
+/// A constrained model: the analyses of Hamiltonian forms refuse it by
+/// name; its portrait (with a fast phase) runs on its constraints from
+/// seeds put on them; its stabilisation by vibration gives an equilibrium
+/// on the constraints, or says why it cannot.
+fn constrained_model_on_its_constraints(name: &str, params: &[f64]) {
+    use mechlab::analysis::on_constraints::vibration::{
+        vibration_stability, VibrationError, VibrationSettings,
+    };
+    let handle = model_of(name);
+    let constrained = handle.constrained.unwrap();
+    let refused = mechlab::analysis::Refusal::Constrained {
+        model: name.to_string(),
+    };
+    let (a, b) = (
+        convergence(handle, params, &averaging_settings()).unwrap_err(),
+        chaos_map(handle, params, &map_settings(5), &|| true).unwrap_err(),
+    );
+    assert!(
+        matches!(a, AveragingError::Refused(ref r) if *r == refused),
+        "{a}"
+    );
+    assert!(
+        matches!(b, ChaosMapError::Refused(ref r) if *r == refused),
+        "{b}"
+    );
+    let n = handle.info.coordinates.len();
+    let settings = PortraitSettings {
+        axes: [0, n],
+        seeds: None,
+        count: 3,
+        p_max: 0.1,
+        periods: 20,
+        method: Method::Dop853 {
+            rtol: 1e-10,
+            atol: 1e-10,
+        },
+    };
+    match portrait(handle, params, &settings) {
+        Ok(result) => {
+            for seed in &result.seeds {
+                let (g, c) = constrained.residuals(params, 0.0, seed).unwrap();
+                assert!(g < 1e-12 && c < 1e-12, "{name}: a seed off the constraints");
+            }
+            assert!(result.failed.is_empty(), "{name}: {:?}", result.failed);
+        }
+        Err(e) => assert!(e.to_string().contains("no fast phase"), "{name}: {e}"),
+    }
+    match vibration_stability(
+        constrained,
+        params,
+        &VibrationSettings {
+            scan: 4,
+            ..Default::default()
+        },
+    ) {
+        Ok(result) => {
+            let statics = constrained
+                .statics(params, 0.0, &result.equilibrium)
+                .unwrap();
+            assert!(
+                statics.residual.amax() < 1e-9,
+                "{name}: q* off the constraints"
+            );
+            assert_eq!(
+                result.averaged_stable,
+                result.squared_frequencies.first().is_some_and(|w| *w > 0.0)
+            );
+        }
+        Err(
+            VibrationError::Refused(_)
+            | VibrationError::MovingConstraints { .. }
+            | VibrationError::Gyroscopic { .. }
+            | VibrationError::NoEquilibrium { .. },
+        ) => {}
+        Err(e) => panic!("{name}: {e}"),
+    }
 }
 
 /// One refusal, the same value from every analysis, naming the contact model.

@@ -51,151 +51,218 @@ pub struct ConstrainedDerivation {
     pub starts: Vec<String>,
 }
 
-pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
-    let q: Vec<&str> = model.coordinates.iter().map(|c| c.name.as_str()).collect();
-    let qd: Vec<&str> = model
-        .coordinates
-        .iter()
-        .map(|c| c.velocity.as_str())
-        .collect();
-    let rate = match &model.fast_phase {
-        Some(f) => Some(atom(&f.rate.to_string())?),
-        None => None,
-    };
-    // ∂/∂t at fixed q and q': through the fast phase, or time itself.
-    let partial_t = |e: &Atom| -> Atom {
-        match (&model.fast_phase, &rate) {
+/// The model's coordinates and velocities, and the time derivatives the
+/// constrained forms need.
+struct Calculus<'m> {
+    model: &'m Model,
+    q: Vec<&'m str>,
+    qd: Vec<&'m str>,
+    rate: Option<Atom>,
+}
+
+impl<'m> Calculus<'m> {
+    fn new(model: &'m Model) -> Result<Self, DeriveError> {
+        Ok(Calculus {
+            model,
+            q: model.coordinates.iter().map(|c| c.name.as_str()).collect(),
+            qd: model
+                .coordinates
+                .iter()
+                .map(|c| c.velocity.as_str())
+                .collect(),
+            rate: match &model.fast_phase {
+                Some(f) => Some(atom(&f.rate.to_string())?),
+                None => None,
+            },
+        })
+    }
+
+    /// ∂/∂t at fixed q and q': through the fast phase, or time itself.
+    fn partial_t(&self, e: &Atom) -> Atom {
+        match (&self.model.fast_phase, &self.rate) {
             (Some(f), Some(rate)) => rate * e.derivative(symbol!(f.name.as_str())),
-            _ => e.derivative(symbol!(model.time.as_str())),
+            _ => e.derivative(symbol!(self.model.time.as_str())),
         }
-    };
-    // Σ ∂e/∂q_j q'_j + ∂e/∂t, for e free of q''.
-    let total = |e: &Atom| -> Atom {
-        let mut d = partial_t(e);
-        for (qj, vj) in q.iter().zip(&qd) {
+    }
+
+    /// Σ ∂e/∂q_j q'_j + ∂e/∂t, for e free of q''.
+    fn total(&self, e: &Atom) -> Atom {
+        let mut d = self.partial_t(e);
+        for (qj, vj) in self.q.iter().zip(&self.qd) {
             d += e.derivative(symbol!(*qj)) * var(vj);
         }
         d
-    };
+    }
+
+    /// Whether `e` depends on time (or the phase).
+    fn moves(&self, e: &Atom) -> bool {
+        !crate::algebra::is_zero(&self.partial_t(e).expand())
+    }
+
+    /// M and F, recorded, and whether M stays still.
+    fn dynamics(
+        &self,
+        lagrangian: &Atom,
+        rayleigh: &Atom,
+        rec: &mut Recorder,
+    ) -> Result<(Vec<Vec<String>>, Vec<String>, bool), DeriveError> {
+        let (q, qd) = (&self.q, &self.qd);
+        let n = q.len();
+        let mut still = true;
+        let mut mass_matrix = vec![Vec::new(); n];
+        let mut free_forces = Vec::new();
+        for i in 0..n {
+            let momentum = lagrangian.derivative(symbol!(qd[i]));
+            for j in 0..n {
+                let entry = momentum.derivative(symbol!(qd[j])).expand();
+                still &= !self.moves(&entry);
+                mass_matrix[i].push(rec.record(
+                    format!("mass_matrix[{i}][{j}]"),
+                    "M = ∂²L/∂q'²",
+                    &entry,
+                )?);
+            }
+            // d/dt ∂L/∂q' without its q'' terms.
+            let mut velocity_terms = self.partial_t(&momentum);
+            for (qk, vk) in q.iter().zip(qd) {
+                velocity_terms += momentum.derivative(symbol!(*qk)) * var(vk);
+            }
+            let force = kinematic(self.model, &self.model.forces[i])?;
+            let free = lagrangian.derivative(symbol!(q[i])) - velocity_terms + force
+                - rayleigh.derivative(symbol!(qd[i]));
+            free_forces.push(rec.record(
+                format!("free_force[{i}]"),
+                format!(
+                    "F = ∂L/∂{0} − d/dt ∂L/∂{1} (without q'') + Q − ∂D/∂{1}",
+                    q[i], qd[i]
+                ),
+                &free.expand(),
+            )?);
+        }
+        Ok((mass_matrix, free_forces, still))
+    }
+
+    /// Each constraint's g (0 for a velocity one), G, c_t and h, recorded,
+    /// and whether all are holonomic and still.
+    fn constraint_rows(&self, rec: &mut Recorder) -> Result<(Rows, bool), DeriveError> {
+        let mut rows = Rows::default();
+        let mut still = true;
+        for (r, constraint) in self.model.constraints.iter().enumerate() {
+            let name = &constraint.name;
+            let velocity_level = match &constraint.kind {
+                ConstraintKind::Position(e) => {
+                    let g = kinematic(self.model, e)?;
+                    still &= !self.moves(&g);
+                    rec.record(
+                        format!("constraint[{r}]"),
+                        format!("g = 0: the position constraint '{name}'"),
+                        &g,
+                    )?;
+                    // The code keeps the file's form: the readable one
+                    // expands squares of differences, which cancel near the
+                    // constraint.
+                    rows.residuals.push(g.to_string());
+                    self.total(&g)
+                }
+                ConstraintKind::Velocity(e) => {
+                    still = false;
+                    rows.residuals.push("0".into());
+                    let c = kinematic(self.model, e)?;
+                    rec.record(
+                        format!("constraint[{r}]"),
+                        format!("c = 0: the velocity constraint '{name}'"),
+                        &c,
+                    )?;
+                    c
+                }
+            };
+            let mut row = Vec::new();
+            let mut rate_part = velocity_level.clone();
+            for (j, vj) in self.qd.iter().enumerate() {
+                let entry = velocity_level.derivative(symbol!(*vj)).expand();
+                rate_part = subst(&rate_part, vj, &num(0));
+                row.push(rec.record(
+                    format!("constraint_jacobian[{r}][{j}]"),
+                    format!("G = ∂c/∂q' of '{name}'"),
+                    &entry,
+                )?);
+            }
+            rows.jacobian.push(row);
+            rows.rates.push(rec.record(
+                format!("constraint_rate[{r}]"),
+                format!("c_t: the part of '{name}''s velocity form free of q'"),
+                &rate_part.expand(),
+            )?);
+            rows.bias.push(rec.record(
+                format!("constraint_bias[{r}]"),
+                format!("h = d/dt c − G q'' of '{name}'"),
+                &self.total(&velocity_level).expand(),
+            )?);
+        }
+        Ok((rows, still))
+    }
+
+    /// E, V and b, recorded.
+    fn energies(
+        &self,
+        lagrangian: &Atom,
+        rec: &mut Recorder,
+    ) -> Result<(String, String, Vec<String>), DeriveError> {
+        let mut energy = -lagrangian.clone();
+        for vk in &self.qd {
+            energy += lagrangian.derivative(symbol!(*vk)) * var(vk);
+        }
+        let energy = rec.record("energy", "E = Σ q'∂L/∂q' − L", &energy.expand())?;
+        let at_rest = |e: &Atom| {
+            self.qd
+                .iter()
+                .fold(e.clone(), |acc, v| subst(&acc, v, &num(0)))
+        };
+        let potential = rec.record(
+            "potential",
+            "V = −L at q' = 0",
+            &(-at_rest(lagrangian)).expand(),
+        )?;
+        let mut linear_term = Vec::new();
+        for (i, v) in self.qd.iter().enumerate() {
+            let b = at_rest(&lagrangian.derivative(symbol!(*v))).expand();
+            linear_term.push(rec.record(
+                format!("linear_term[{i}]"),
+                "b = ∂L/∂q' at q' = 0",
+                &b,
+            )?);
+        }
+        Ok((energy, potential, linear_term))
+    }
+}
+
+/// The constraints' rows, as text.
+#[derive(Default)]
+struct Rows {
+    residuals: Vec<String>,
+    jacobian: Vec<Vec<String>>,
+    rates: Vec<String>,
+    bias: Vec<String>,
+}
+
+pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
+    let calculus = Calculus::new(model)?;
     let lagrangian = kinematic(model, &model.lagrangian)?;
     let rayleigh = kinematic(model, &model.rayleigh)?;
-    let mut rec = Recorder::for_model(model, qd.iter().map(|v| v.to_string()).collect());
+    let mut rec = Recorder::for_model(model, calculus.qd.iter().map(|v| v.to_string()).collect());
     rec.record(
         "lagrangian",
         "L(q, q', t) over all coordinates",
         &lagrangian,
     )?;
-    let phase_rate = match &rate {
+    let phase_rate = match &calculus.rate {
         Some(rate) => Some(rec.record("phase_rate", "dθ/dt of the fast phase", rate)?),
         None => None,
     };
-
-    let n = q.len();
-    let moves = |e: &Atom| !crate::algebra::is_zero(&partial_t(e).expand());
-    let mut stationary = true;
-    let mut mass_matrix = vec![Vec::new(); n];
-    let mut free_forces = Vec::new();
-    for i in 0..n {
-        let momentum = lagrangian.derivative(symbol!(qd[i]));
-        for j in 0..n {
-            let entry = momentum.derivative(symbol!(qd[j])).expand();
-            stationary &= !moves(&entry);
-            mass_matrix[i].push(rec.record(
-                format!("mass_matrix[{i}][{j}]"),
-                "M = ∂²L/∂q'²",
-                &entry,
-            )?);
-        }
-        // d/dt ∂L/∂q' without its q'' terms.
-        let mut velocity_terms = partial_t(&momentum);
-        for (qk, vk) in q.iter().zip(&qd) {
-            velocity_terms += momentum.derivative(symbol!(*qk)) * var(vk);
-        }
-        let force = kinematic(model, &model.forces[i])?;
-        let free = lagrangian.derivative(symbol!(q[i])) - velocity_terms + force
-            - rayleigh.derivative(symbol!(qd[i]));
-        free_forces.push(rec.record(
-            format!("free_force[{i}]"),
-            format!(
-                "F = ∂L/∂{0} − d/dt ∂L/∂{1} (without q'') + Q − ∂D/∂{1}",
-                q[i], qd[i]
-            ),
-            &free.expand(),
-        )?);
-    }
-
-    let mut residuals = Vec::new();
-    let mut jacobian = Vec::new();
-    let mut rates = Vec::new();
-    let mut bias = Vec::new();
-    for (r, constraint) in model.constraints.iter().enumerate() {
-        let name = &constraint.name;
-        let velocity_level = match &constraint.kind {
-            ConstraintKind::Position(e) => {
-                let g = kinematic(model, e)?;
-                stationary &= !moves(&g);
-                rec.record(
-                    format!("constraint[{r}]"),
-                    format!("g = 0: the position constraint '{name}'"),
-                    &g,
-                )?;
-                // The code keeps the file's form: the readable one expands
-                // squares of differences, which cancel near the constraint.
-                residuals.push(g.to_string());
-                total(&g)
-            }
-            ConstraintKind::Velocity(e) => {
-                stationary = false;
-                residuals.push("0".into());
-                let c = kinematic(model, e)?;
-                rec.record(
-                    format!("constraint[{r}]"),
-                    format!("c = 0: the velocity constraint '{name}'"),
-                    &c,
-                )?;
-                c
-            }
-        };
-        let mut row = Vec::new();
-        let mut rate_part = velocity_level.clone();
-        for (j, vj) in qd.iter().enumerate() {
-            let entry = velocity_level.derivative(symbol!(*vj)).expand();
-            rate_part = subst(&rate_part, vj, &num(0));
-            row.push(rec.record(
-                format!("constraint_jacobian[{r}][{j}]"),
-                format!("G = ∂c/∂q' of '{name}'"),
-                &entry,
-            )?);
-        }
-        jacobian.push(row);
-        rates.push(rec.record(
-            format!("constraint_rate[{r}]"),
-            format!("c_t: the part of '{name}''s velocity form free of q'"),
-            &rate_part.expand(),
-        )?);
-        bias.push(rec.record(
-            format!("constraint_bias[{r}]"),
-            format!("h = d/dt c − G q'' of '{name}'"),
-            &total(&velocity_level).expand(),
-        )?);
-    }
-
-    let mut energy = -lagrangian.clone();
-    for vk in &qd {
-        energy += lagrangian.derivative(symbol!(*vk)) * var(vk);
-    }
-    let energy = rec.record("energy", "E = Σ q'∂L/∂q' − L", &energy.expand())?;
-    let at_rest = |e: &Atom| qd.iter().fold(e.clone(), |acc, v| subst(&acc, v, &num(0)));
-    let potential = rec.record(
-        "potential",
-        "V = −L at q' = 0",
-        &(-at_rest(&lagrangian)).expand(),
-    )?;
-    let mut linear_term = Vec::new();
-    for (i, v) in qd.iter().enumerate() {
-        let b = at_rest(&lagrangian.derivative(symbol!(*v))).expand();
-        linear_term.push(rec.record(format!("linear_term[{i}]"), "b = ∂L/∂q' at q' = 0", &b)?);
-    }
+    let (mass_matrix, free_forces, mass_still) =
+        calculus.dynamics(&lagrangian, &rayleigh, &mut rec)?;
+    let (rows, constraints_still) = calculus.constraint_rows(&mut rec)?;
+    let (energy, potential, linear_term) = calculus.energies(&lagrangian, &mut rec)?;
     let starts = model
         .coordinates
         .iter()
@@ -211,14 +278,14 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         phase_rate,
         mass_matrix,
         free_forces,
-        residuals,
-        jacobian,
-        rates,
-        bias,
+        residuals: rows.residuals,
+        jacobian: rows.jacobian,
+        rates: rows.rates,
+        bias: rows.bias,
         energy,
         potential,
         linear_term,
-        stationary,
+        stationary: mass_still && constraints_still,
         starts,
     })
 }

@@ -284,6 +284,179 @@ pub fn render_contacts(
         })
 }
 
+/// The values of one generated function of a constrained model.
+enum Values<'a> {
+    Scalar(&'a str),
+    Vector(&'a [String]),
+    Matrix(&'a [Vec<String>]),
+}
+
+/// One generated function of a constrained model: its name, doc, inputs
+/// and values, and the inputs of its twin over dual numbers, if it has one.
+struct Form<'a> {
+    name: &'static str,
+    /// Its values' names in the code: `{prefix}__{i}`.
+    prefix: &'static str,
+    doc: &'static str,
+    inputs: Inputs,
+    values: Values<'a>,
+    dual: Option<Inputs>,
+}
+
+/// The functions of a constrained model's module, in order.
+fn constrained_forms(derivation: &ConstrainedDerivation) -> Vec<Form<'_>> {
+    use Inputs::*;
+    let rate = derivation.phase_rate.as_deref();
+    [
+        rate.map(|rate| Form {
+            name: "phase_rate",
+            prefix: "rate",
+            doc: "dθ/dt of the fast phase θ.",
+            inputs: Params,
+            values: Values::Scalar(rate),
+            dual: None,
+        }),
+        Some(Form {
+            name: "start",
+            prefix: "q",
+            doc: "The coordinates' starts of the model file (consistent at t = 0 with the default parameters).",
+            inputs: Params,
+            values: Values::Vector(&derivation.starts),
+            dual: None,
+        }),
+        Some(Form {
+            name: "mass_matrix",
+            prefix: "m",
+            doc: "Mass matrix M = ∂²L/∂q'².",
+            inputs: TimeCoordinates,
+            values: Values::Matrix(&derivation.mass_matrix),
+            dual: Some(DualTimeCoordinates),
+        }),
+        Some(Form {
+            name: "free_forces",
+            prefix: "f",
+            doc: "Free generalised force F: M q'' = F + Gᵀλ.",
+            inputs: CoordinatesVelocities,
+            values: Values::Vector(&derivation.free_forces),
+            dual: Some(DualCoordinatesVelocities),
+        }),
+        Some(Form {
+            name: "position_residuals",
+            prefix: "g",
+            doc: "g of each position constraint (0 for a velocity constraint).",
+            inputs: TimeCoordinates,
+            values: Values::Vector(&derivation.residuals),
+            dual: None,
+        }),
+        Some(Form {
+            name: "constraint_jacobian",
+            prefix: "jac",
+            doc: "G = ∂c/∂q' of each constraint's velocity form c = G q' + c_t.",
+            inputs: TimeCoordinates,
+            values: Values::Matrix(&derivation.jacobian),
+            dual: Some(DualTimeCoordinates),
+        }),
+        Some(Form {
+            name: "constraint_rates",
+            prefix: "ct",
+            doc: "c_t of each constraint's velocity form c = G q' + c_t.",
+            inputs: TimeCoordinates,
+            values: Values::Vector(&derivation.rates),
+            dual: Some(DualTimeCoordinates),
+        }),
+        Some(Form {
+            name: "constraint_bias",
+            prefix: "h",
+            doc: "h: d/dt c = G q'' + h.",
+            inputs: CoordinatesVelocities,
+            values: Values::Vector(&derivation.bias),
+            dual: Some(DualCoordinatesVelocities),
+        }),
+        Some(Form {
+            name: "potential",
+            prefix: "v",
+            doc: "V = −L at q' = 0 (with the fast phase, for the averaging).",
+            inputs: TimeCoordinates,
+            values: Values::Scalar(&derivation.potential),
+            dual: None,
+        }),
+        Some(Form {
+            name: "linear_term",
+            prefix: "b",
+            doc: "b = ∂L/∂q' at q' = 0 (the vibration's coupling, for the averaging).",
+            inputs: TimeCoordinates,
+            values: Values::Vector(&derivation.linear_term),
+            dual: None,
+        }),
+        Some(Form {
+            name: "energy",
+            prefix: "e",
+            doc: "Energy function E = Σ q'∂L/∂q' − L.",
+            inputs: CoordinatesVelocities,
+            values: Values::Scalar(&derivation.energy),
+            dual: None,
+        }),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// The functions of a constrained model's module ([`constrained_forms`]),
+/// each with its twin over dual numbers where the Jacobians need it.
+fn constrained_functions(
+    cx: &Context,
+    derivation: &ConstrainedDerivation,
+) -> Result<Vec<crate::functions::Function>, DeriveError> {
+    let mut functions = Vec::new();
+    for form in constrained_forms(derivation) {
+        let (outs, result, shape) = match form.values {
+            Values::Scalar(text) => (
+                vec![(format!("{}__", form.prefix), text.to_string())],
+                format!("{}__", form.prefix),
+                None,
+            ),
+            Values::Vector(values) => {
+                let (outs, result) = vector(form.prefix, values);
+                (outs, result, Some((values.len(), None)))
+            }
+            Values::Matrix(rows) => {
+                let (outs, result) = matrix(form.prefix, rows);
+                let columns = rows.first().map_or(0, Vec::len);
+                (outs, result, Some((rows.len(), Some(columns))))
+            }
+        };
+        let ret = |number: &str| match shape {
+            None => number.to_string(),
+            Some((len, None)) => format!("[{number}; {len}]"),
+            Some((rows, Some(columns))) => format!("[[{number}; {columns}]; {rows}]"),
+        };
+        let outs = [outs];
+        functions.push(cx.function(
+            form.name,
+            form.doc,
+            form.inputs,
+            ret("f64"),
+            &outs,
+            result.clone(),
+        )?);
+        if let Some(inputs) = form.dual {
+            functions.push(cx.function(
+                &format!("{}_dual", form.name),
+                &format!(
+                    "`{}` over dual numbers (derivatives at run time).",
+                    form.name
+                ),
+                inputs,
+                ret("crate::ode::Dual"),
+                &outs,
+                result,
+            )?);
+        }
+    }
+    Ok(functions)
+}
+
 /// Renders the generated module of a model with ideal constraints.
 pub fn render_constrained(
     tera: &tera::Tera,
@@ -299,157 +472,7 @@ pub fn render_constrained(
         contact_state: Vec::new(),
         model_phase_rate: String::new(),
     };
-    let mut functions = Vec::new();
-    if let Some(rate) = &derivation.phase_rate {
-        functions.push(cx.function(
-            "phase_rate",
-            "dθ/dt of the fast phase θ.",
-            Inputs::Params,
-            "f64".into(),
-            &[vec![("rate__".into(), rate.clone())]],
-            "rate__".into(),
-        )?);
-    }
-    let (outs, result) = vector("q", &derivation.starts);
-    functions.push(cx.function(
-        "start",
-        "The coordinates' starts of the model file (consistent at t = 0 with the default parameters).",
-        Inputs::Params,
-        format!("[f64; {n}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = matrix("m", &derivation.mass_matrix);
-    functions.push(cx.function(
-        "mass_matrix",
-        "Mass matrix M = ∂²L/∂q'².",
-        Inputs::TimeCoordinates,
-        format!("[[f64; {n}]; {n}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = vector("f", &derivation.free_forces);
-    functions.push(cx.function(
-        "free_forces",
-        "Free generalised force F: M q'' = F + Gᵀλ.",
-        Inputs::CoordinatesVelocities,
-        format!("[f64; {n}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = vector("g", &derivation.residuals);
-    functions.push(cx.function(
-        "position_residuals",
-        "g of each position constraint (0 for a velocity constraint).",
-        Inputs::TimeCoordinates,
-        format!("[f64; {k}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = matrix("jac", &derivation.jacobian);
-    functions.push(cx.function(
-        "constraint_jacobian",
-        "G = ∂c/∂q' of each constraint's velocity form c = G q' + c_t.",
-        Inputs::TimeCoordinates,
-        format!("[[f64; {n}]; {k}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = vector("ct", &derivation.rates);
-    functions.push(cx.function(
-        "constraint_rates",
-        "c_t of each constraint's velocity form c = G q' + c_t.",
-        Inputs::TimeCoordinates,
-        format!("[f64; {k}]"),
-        &[outs],
-        result,
-    )?);
-    let (outs, result) = vector("h", &derivation.bias);
-    functions.push(cx.function(
-        "constraint_bias",
-        "h: d/dt c = G q'' + h.",
-        Inputs::CoordinatesVelocities,
-        format!("[f64; {k}]"),
-        &[outs],
-        result,
-    )?);
-    // The forms the accelerations need, over dual numbers: the Jacobian of
-    // the equations of motion at run time, one column a pass.
-    let dual = |name: &str, inputs: Inputs, ret: String, outs, result| {
-        cx.function(
-            &format!("{name}_dual"),
-            &format!("`{name}` over dual numbers (derivatives at run time)."),
-            inputs,
-            ret,
-            &[outs],
-            result,
-        )
-    };
-    let (outs, result) = matrix("m", &derivation.mass_matrix);
-    functions.push(dual(
-        "mass_matrix",
-        Inputs::DualTimeCoordinates,
-        format!("[[crate::ode::Dual; {n}]; {n}]"),
-        outs,
-        result,
-    )?);
-    let (outs, result) = vector("f", &derivation.free_forces);
-    functions.push(dual(
-        "free_forces",
-        Inputs::DualCoordinatesVelocities,
-        format!("[crate::ode::Dual; {n}]"),
-        outs,
-        result,
-    )?);
-    let (outs, result) = matrix("jac", &derivation.jacobian);
-    functions.push(dual(
-        "constraint_jacobian",
-        Inputs::DualTimeCoordinates,
-        format!("[[crate::ode::Dual; {n}]; {k}]"),
-        outs,
-        result,
-    )?);
-    let (outs, result) = vector("ct", &derivation.rates);
-    functions.push(dual(
-        "constraint_rates",
-        Inputs::DualTimeCoordinates,
-        format!("[crate::ode::Dual; {k}]"),
-        outs,
-        result,
-    )?);
-    let (outs, result) = vector("h", &derivation.bias);
-    functions.push(dual(
-        "constraint_bias",
-        Inputs::DualCoordinatesVelocities,
-        format!("[crate::ode::Dual; {k}]"),
-        outs,
-        result,
-    )?);
-    functions.push(cx.function(
-        "potential",
-        "V = −L at q' = 0 (with the fast phase, for the averaging).",
-        Inputs::TimeCoordinates,
-        "f64".into(),
-        &[vec![("v__".into(), derivation.potential.clone())]],
-        "v__".into(),
-    )?);
-    let (outs, result) = vector("b", &derivation.linear_term);
-    functions.push(cx.function(
-        "linear_term",
-        "b = ∂L/∂q' at q' = 0 (the vibration's coupling, for the averaging).",
-        Inputs::TimeCoordinates,
-        format!("[f64; {n}]"),
-        &[outs],
-        result,
-    )?);
-    functions.push(cx.function(
-        "energy",
-        "Energy function E = Σ q'∂L/∂q' − L.",
-        Inputs::CoordinatesVelocities,
-        "f64".into(),
-        &[vec![("e__".into(), derivation.energy.clone())]],
-        "e__".into(),
-    )?);
+    let functions = constrained_functions(&cx, derivation)?;
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);
     context.insert("constraints", &k);

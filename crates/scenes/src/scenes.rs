@@ -522,7 +522,11 @@ pub fn linkage_scene(
         overrides,
         ("four_bar", "dop853", "1e-12"),
         &[
-            ("max_amplitude", "auto", "the largest amplitude scanned (auto: twice the amplitude's value)"),
+            (
+                "max_amplitude",
+                "auto",
+                "the largest amplitude scanned (auto: twice the amplitude's value)",
+            ),
             ("scan", "40", "amplitudes scanned from 0"),
         ],
     )?;
@@ -547,17 +551,32 @@ pub fn linkage_scene(
         info.name,
         result.equilibrium,
         result.squared_frequencies,
-        if result.averaged_stable { "stable" } else { "unstable" },
+        if result.averaged_stable {
+            "stable"
+        } else {
+            "unstable"
+        },
         result.amplitude,
         result.averaged_thresholds
     );
     println!("exact: {:?}", result.exact);
     scene.save_figure(&result.figure(), "linkage.png")?;
-    let rows = result
-        .scan
-        .iter()
-        .map(|p| (p.amplitude, p.lowest_squared_frequency, p.largest_modulus.unwrap_or(f64::NAN)));
-    scene.write_csv("scan.csv", &[result.amplitude.as_str(), "lowest_omega2", "largest_modulus"], rows)?;
+    let rows = result.scan.iter().map(|p| {
+        (
+            p.amplitude,
+            p.lowest_squared_frequency,
+            p.largest_modulus.unwrap_or(f64::NAN),
+        )
+    });
+    scene.write_csv(
+        "scan.csv",
+        &[
+            result.amplitude.as_str(),
+            "lowest_omega2",
+            "largest_modulus",
+        ],
+        rows,
+    )?;
     scene.write_summary(&result)?;
     Ok(())
 }

@@ -9,7 +9,7 @@
 //! runs' wall time; the constrained run's cost at the angle model's error
 //! is interpolated on its work–precision line (log–log).
 
-use mechlab::analysis::on_constraints::run;
+use mechlab::analysis::on_constraints::{run, ConstrainedError};
 use mechlab::models::{double_pendulum as dp, kapitza};
 use mechlab::ode::{states_at, Method};
 use mechlab::scene::{knob, run as scene_run, Scene};
@@ -121,6 +121,134 @@ struct Chain {
     energy_error: f64,
 }
 
+/// A pendulum swinging below its pivot: the angle, and the bob on its rod.
+fn pendulum(times: &[f64]) -> Comparison {
+    let (q0, qd0) = (2.0f64, 0.3f64);
+    let kp = kapitza::Params {
+        A: 0.0,
+        eps: 0.1,
+        mu: 0.0,
+    };
+    compare(
+        "pendulum",
+        |method| {
+            let states = states_at(
+                method,
+                &kapitza::Exact { params: kp },
+                0.0,
+                &[q0, qd0],
+                times,
+            );
+            states.unwrap().into_iter().map(|y| vec![y[0]]).collect()
+        },
+        |method| {
+            let y0 = [q0.sin(), q0.cos(), q0.cos() * qd0, -q0.sin() * qd0];
+            let run = run(
+                &cartesian_kapitza::SYSTEMS,
+                &[0.0, 0.1, 0.0],
+                Some(&y0),
+                method,
+                times,
+            );
+            run.unwrap()
+                .states
+                .iter()
+                .map(|y| vec![y[0].atan2(y[1])])
+                .collect()
+        },
+    )
+}
+
+/// The double pendulum on its vibrating base, near the held upright.
+fn double_pendulum(times: &[f64]) -> Comparison {
+    let p = dp::Params {
+        mu: 0.0,
+        ..dp::Params::default()
+    };
+    let (q1, q2) = (0.1f64, -0.15f64);
+    let base = |t: f64| p.a / p.nu * (p.nu * t).cos();
+    compare(
+        "double pendulum",
+        |method| {
+            let system = dp::Exact { params: p };
+            let states = states_at(method, &system, 0.0, &[q1, q2, 0.0, 0.0], times);
+            states
+                .unwrap()
+                .into_iter()
+                .map(|y| y[..2].to_vec())
+                .collect()
+        },
+        |method| {
+            let (x1, z1) = (p.l1 * q1.sin(), base(0.0) + p.l1 * q1.cos());
+            let y0 = [
+                x1,
+                z1,
+                x1 + p.l2 * q2.sin(),
+                z1 + p.l2 * q2.cos(),
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ];
+            let params = [p.m1, p.m2, p.l1, p.l2, p.g, p.a, p.nu];
+            let run = run(
+                &cartesian_double_pendulum::SYSTEMS,
+                &params,
+                Some(&y0),
+                method,
+                times,
+            );
+            run.unwrap()
+                .states
+                .iter()
+                .zip(times)
+                .map(|(y, t)| {
+                    vec![
+                        y[0].atan2(y[1] - base(*t)),
+                        (y[2] - y[0]).atan2(y[3] - y[1]),
+                    ]
+                })
+                .collect()
+        },
+    )
+}
+
+/// The closed chain from its file's start for `t_end`, reported once per
+/// time unit.
+fn closed_chain(t_end: f64) -> Result<Chain, ConstrainedError> {
+    let times: Vec<f64> = (0..=t_end as usize).map(|k| k as f64).collect();
+    let params = closed_chain10::Params::default().values();
+    let start = Instant::now();
+    let chain = run(
+        &closed_chain10::SYSTEMS,
+        &params,
+        None,
+        dop853(1e-12),
+        &times,
+    )?;
+    let e0 = chain.energy[0];
+    let result = Chain {
+        time_units: t_end,
+        seconds: start.elapsed().as_secs_f64(),
+        largest_residual: chain.largest_residual,
+        largest_drift: chain.largest_drift,
+        energy_error: chain
+            .energy
+            .iter()
+            .fold(0.0_f64, |m, e| m.max((e - e0).abs())),
+    };
+    println!(
+        "closed chain of 10 rods, {t_end} time units: {:.2} s, residuals {:.1e} / {:.1e} (before projection {:.1e} / {:.1e}), energy error {:.1e}",
+        result.seconds,
+        result.largest_residual.0,
+        result.largest_residual.1,
+        result.largest_drift.0,
+        result.largest_drift.1,
+        result.energy_error
+    );
+    Ok(result)
+}
+
 fn main() {
     scene_run(|| {
         let scene = Scene::from_args(
@@ -133,129 +261,12 @@ fn main() {
             )],
         )?;
         let times: Vec<f64> = (0..=100).map(|k| k as f64).collect();
-        // A pendulum swinging below its pivot: the angle, and the bob.
-        let (q0, qd0) = (2.0f64, 0.3f64);
-        let kp = kapitza::Params {
-            A: 0.0,
-            eps: 0.1,
-            mu: 0.0,
-        };
-        let pendulum = compare(
-            "pendulum",
-            |method| {
-                let states = states_at(
-                    method,
-                    &kapitza::Exact { params: kp },
-                    0.0,
-                    &[q0, qd0],
-                    &times,
-                );
-                states.unwrap().into_iter().map(|y| vec![y[0]]).collect()
-            },
-            |method| {
-                let y0 = [q0.sin(), q0.cos(), q0.cos() * qd0, -q0.sin() * qd0];
-                let run = run(
-                    &cartesian_kapitza::SYSTEMS,
-                    &[0.0, 0.1, 0.0],
-                    Some(&y0),
-                    method,
-                    &times,
-                );
-                run.unwrap()
-                    .states
-                    .iter()
-                    .map(|y| vec![y[0].atan2(y[1])])
-                    .collect()
-            },
-        );
-        // The double pendulum on its vibrating base, near the held upright.
-        let p = dp::Params {
-            mu: 0.0,
-            ..dp::Params::default()
-        };
-        let (q1, q2) = (0.1f64, -0.15f64);
-        let base = |t: f64| p.a / p.nu * (p.nu * t).cos();
-        let double = compare(
-            "double pendulum",
-            |method| {
-                let system = dp::Exact { params: p };
-                let states = states_at(method, &system, 0.0, &[q1, q2, 0.0, 0.0], &times);
-                states
-                    .unwrap()
-                    .into_iter()
-                    .map(|y| y[..2].to_vec())
-                    .collect()
-            },
-            |method| {
-                let (x1, z1) = (p.l1 * q1.sin(), base(0.0) + p.l1 * q1.cos());
-                let y0 = [
-                    x1,
-                    z1,
-                    x1 + p.l2 * q2.sin(),
-                    z1 + p.l2 * q2.cos(),
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                ];
-                let params = [p.m1, p.m2, p.l1, p.l2, p.g, p.a, p.nu];
-                let run = run(
-                    &cartesian_double_pendulum::SYSTEMS,
-                    &params,
-                    Some(&y0),
-                    method,
-                    &times,
-                );
-                run.unwrap()
-                    .states
-                    .iter()
-                    .zip(&times)
-                    .map(|(y, t)| {
-                        vec![
-                            y[0].atan2(y[1] - base(*t)),
-                            (y[2] - y[0]).atan2(y[3] - y[1]),
-                        ]
-                    })
-                    .collect()
-            },
-        );
-        // The closed chain, its state projected once per time unit.
-        let t_end = scene.positive("chain_time")?;
-        let chain_times: Vec<f64> = (0..=t_end as usize).map(|k| k as f64).collect();
-        let params = closed_chain10::Params::default().values();
-        let start = Instant::now();
-        let chain_run = run(
-            &closed_chain10::SYSTEMS,
-            &params,
-            None,
-            dop853(1e-12),
-            &chain_times,
-        )?;
-        let e0 = chain_run.energy[0];
-        let chain = Chain {
-            time_units: t_end,
-            seconds: start.elapsed().as_secs_f64(),
-            largest_residual: chain_run.largest_residual,
-            largest_drift: chain_run.largest_drift,
-            energy_error: chain_run
-                .energy
-                .iter()
-                .fold(0.0_f64, |m, e| m.max((e - e0).abs())),
-        };
-        println!(
-            "closed chain of 10 rods, {t_end} time units: {:.2} s, residuals {:.1e} / {:.1e} (before projection {:.1e} / {:.1e}), energy error {:.1e}",
-            chain.seconds,
-            chain.largest_residual.0,
-            chain.largest_residual.1,
-            chain.largest_drift.0,
-            chain.largest_drift.1,
-            chain.energy_error
-        );
-        scene.write_summary(&serde_json::json!({
-            "pendulum": pendulum,
-            "double_pendulum": double,
-            "closed_chain": chain,
-        }))?;
+        let summary = serde_json::json!({
+            "pendulum": pendulum(&times),
+            "double_pendulum": double_pendulum(&times),
+            "closed_chain": closed_chain(scene.positive("chain_time")?)?,
+        });
+        scene.write_summary(&summary)?;
         Ok(())
     })
 }

@@ -327,10 +327,8 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
         }
         let velocity_residual =
             (0..K).fold(0.0_f64, |m, r| m.max((dot(&g[r], &v) + rates[r]).abs()));
-        for i in 0..N {
-            y[i] = q[i];
-            y[N + i] = v[i];
-        }
+        y[..N].copy_from_slice(&q);
+        y[N..].copy_from_slice(&v);
         Ok(Projection {
             newton_steps,
             position_residual,

@@ -374,10 +374,47 @@ pub fn vibration_stability(
     let amplitudes: Vec<f64> = (0..=settings.scan.max(1))
         .map(|k| most * k as f64 / settings.scan.max(1) as f64)
         .collect();
-    // The smallest ω² along the scan, the equilibrium followed from each
-    // amplitude to the next.
+    let (thresholds, lowest_along) = thresholds_along(&at, &amplitudes, &found.q, &amplitude)?;
+    let (exact, largest) =
+        exact_verdict(model, params, index, &found.q, &amplitudes, settings.method)?;
+    let scan = amplitudes
+        .iter()
+        .zip(lowest_along)
+        .zip(largest)
+        .map(
+            |((&amplitude, lowest_squared_frequency), largest_modulus)| ScanPoint {
+                amplitude,
+                lowest_squared_frequency,
+                largest_modulus,
+            },
+        )
+        .collect();
+    Ok(VibrationStability {
+        model: name,
+        params: named,
+        amplitude,
+        amplitude_value: value,
+        averaged_stable: found.squared_frequencies.first().is_some_and(|w| *w > 0.0),
+        equilibrium: found.q,
+        multipliers: found.multipliers,
+        squared_frequencies: found.squared_frequencies,
+        averaged_thresholds: thresholds,
+        exact,
+        scan,
+    })
+}
+
+/// The smallest ω² at each of `amplitudes` (the equilibrium followed from
+/// `start`, each amplitude's from the last's) and the amplitudes where it
+/// changes sign, by bisection.
+fn thresholds_along<'a>(
+    at: &dyn Fn(f64) -> Result<Averaged<'a>, VibrationError>,
+    amplitudes: &[f64],
+    start: &[f64],
+    amplitude: &str,
+) -> Result<(Vec<f64>, Vec<f64>), VibrationError> {
     let lowest = |a: f64, from: &[f64]| -> Result<(f64, Vec<f64>), VibrationError> {
-        let e = at(a)?.equilibrium(from, (&amplitude, a))?;
+        let e = at(a)?.equilibrium(from, (amplitude, a))?;
         Ok((
             e.squared_frequencies.first().copied().unwrap_or(f64::NAN),
             e.q,
@@ -386,12 +423,12 @@ pub fn vibration_stability(
     let mut thresholds = Vec::new();
     let mut lowest_along = Vec::new();
     let mut previous: Option<(f64, f64, Vec<f64>)> = None;
-    for &a in &amplitudes {
-        let from = previous.as_ref().map_or(found.q.clone(), |p| p.2.clone());
+    for &a in amplitudes {
+        let from = previous.as_ref().map_or(start.to_vec(), |p| p.2.clone());
         let (omega2, q) = lowest(a, &from)?;
         lowest_along.push(omega2);
         if let Some((a0, w0, q0)) = &previous {
-            if (w0 > &0.0) != (omega2 > 0.0) {
+            if (*w0 > 0.0) != (omega2 > 0.0) {
                 let (mut lo, mut hi, mut q_lo) = (*a0, a, q0.clone());
                 let positive_at_lo = *w0 > 0.0;
                 for _ in 0..40 {
@@ -409,30 +446,7 @@ pub fn vibration_stability(
         }
         previous = Some((a, omega2, q));
     }
-    let (exact, largest) = exact_verdict(model, params, index, &found.q, &amplitudes, settings.method)?;
-    let scan = amplitudes
-        .iter()
-        .zip(lowest_along)
-        .zip(largest)
-        .map(|((&amplitude, lowest_squared_frequency), largest_modulus)| ScanPoint {
-            amplitude,
-            lowest_squared_frequency,
-            largest_modulus,
-        })
-        .collect();
-    Ok(VibrationStability {
-        model: name,
-        params: named,
-        amplitude,
-        amplitude_value: value,
-        averaged_stable: found.squared_frequencies.first().is_some_and(|w| *w > 0.0),
-        equilibrium: found.q,
-        multipliers: found.multipliers,
-        squared_frequencies: found.squared_frequencies,
-        averaged_thresholds: thresholds,
-        exact,
-        scan,
-    })
+    Ok((thresholds, lowest_along))
 }
 
 /// Whether [q; 0] is a periodic orbit of the exact system at the
@@ -543,11 +557,22 @@ impl VibrationStability {
         let span = |values: &mut dyn Iterator<Item = f64>| {
             let (lo, hi) = values
                 .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
-            (lo - 0.05 * (hi - lo).max(1e-9), hi + 0.05 * (hi - lo).max(1e-9))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    (l.min(v), h.max(v))
+                });
+            (
+                lo - 0.05 * (hi - lo).max(1e-9),
+                hi + 0.05 * (hi - lo).max(1e-9),
+            )
         };
         let x = (0.0, self.scan.last().map_or(1.0, |p| p.amplitude));
-        let omega = span(&mut self.scan.iter().map(|p| p.lowest_squared_frequency).chain([0.0]));
+        let omega = span(
+            &mut self
+                .scan
+                .iter()
+                .map(|p| p.lowest_squared_frequency)
+                .chain([0.0]),
+        );
         let moduli: Vec<(f64, f64)> = self
             .scan
             .iter()
@@ -559,13 +584,7 @@ impl VibrationStability {
             format!("{}: exact, largest Floquet modulus", self.model),
         ];
         let specs = [
-            PanelSpec::new(
-                &titles[0],
-                &amplitude,
-                "ω²",
-                x,
-                omega,
-            ),
+            PanelSpec::new(&titles[0], &amplitude, "ω²", x, omega),
             PanelSpec::new(
                 &titles[1],
                 &amplitude,
@@ -584,7 +603,11 @@ impl VibrationStability {
         figure.dashed_line(0, &[(x.0, 0.0), (x.1, 0.0)], GREY);
         for a in &self.averaged_thresholds {
             figure.line(0, &[(*a, omega.0), (*a, omega.1)], RED);
-            figure.line(1, &[(*a, 0.99f64.min(rho.0)), (*a, 1.01f64.max(rho.1))], RED);
+            figure.line(
+                1,
+                &[(*a, 0.99f64.min(rho.0)), (*a, 1.01f64.max(rho.1))],
+                RED,
+            );
         }
         figure.line(1, &moduli, BLACK);
         figure.dashed_line(1, &[(x.0, 1.0), (x.1, 1.0)], GREY);
