@@ -72,6 +72,11 @@ measure slider_pendulum "edit: a term added to its Lagrangian" 20
 add_model "$here/spring_pendulum.toml" spring_pendulum
 measure spring_pendulum "add: spring_pendulum (2, a singular point at r = 0)" 20
 
+add_model models/slider_crank.toml slider_crank_copy
+measure slider_crank_copy "add: slider_crank (constrained: 3 coordinates, 2 closures)" 20
+sed -i 's/^default = 2.0$/default = 2.5/' models/slider_crank_copy.toml
+measure slider_crank_copy "edit: a default of the constrained model" 20
+
 add_model "$here/chain4_horizontal.toml" chain4_horizontal
 measure chain4_horizontal "add: chain4_horizontal (4)" 40
 add_model models/extra/six_link_pendulum.toml six_link_pendulum

@@ -747,7 +747,8 @@ impl Emitter {
                     continue;
                 }
                 let value = self.text(*root);
-                self.lines.push(format!("let {name} = {value};"));
+                self.lines
+                    .push(format!("let {name}{} = {value};", literal_type(&value)));
                 self.bound.insert(*root, name.clone());
             }
         }
@@ -845,7 +846,8 @@ impl Emitter {
         }
         let name = self.name_for(i);
         let value = self.text(i);
-        self.lines.push(format!("let {name} = {value};"));
+        self.lines
+            .push(format!("let {name}{} = {value};", literal_type(&value)));
         self.bound.insert(i, name);
     }
 }
@@ -908,4 +910,13 @@ pub fn step_operation_count(steps: &[Step]) -> Result<usize, EmitError> {
             _ => 1,
         })
         .sum())
+}
+
+/// The type a binding of `value` states: a bare literal's, since a method
+/// called on the name later (`x.cos()`) would find `{float}` ambiguous.
+fn literal_type(value: &str) -> &'static str {
+    match value.parse::<f64>() {
+        Ok(_) => ": f64",
+        Err(_) => "",
+    }
 }

@@ -222,8 +222,8 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> H
     }
 }
 
-/// How closely a projection brings a state onto the constraints: Newton's
-/// method stops at |g| ≤ 1e-14 times the state's size.
+/// How closely a projection brings a state onto the constraints (relative
+/// to the coordinates' scale, see [`OnConstraints::position_tolerance`]).
 pub const PROJECTION_TOLERANCE: f64 = 1e-14;
 
 impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
@@ -390,7 +390,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> A
         self.system
             .stream(integrator, y0, segment, segments, &mut |y| {
                 t += segment;
-                let tolerance = PROJECTION_TOLERANCE * size(y);
+                let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
                 let state: &mut [f64; S] = y.try_into().expect("a state of the system's length");
                 if let Err(e) = equations.project(t, state, tolerance) {
                     failure = Some(e);
@@ -409,9 +409,19 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> A
     }
 }
 
-/// 1 + the largest |component| of a state: the scale of its residuals.
-pub fn size(y: &[f64]) -> f64 {
-    1.0 + y.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
+    OnConstraints<F, N, K, S>
+{
+    /// Where Newton's method stops on a state: |g| ≤ 1e-14 (1 + the largest
+    /// |coordinate| that is not an angle), the scale of the residuals (an
+    /// angle's turns do not change it).
+    pub fn position_tolerance(y: &[f64]) -> f64 {
+        let periodic = F::periodic();
+        let largest = (0..N)
+            .filter(|&i| !periodic[i])
+            .fold(0.0_f64, |m, i| m.max(y[i].abs()));
+        PROJECTION_TOLERANCE * (1.0 + largest)
+    }
 }
 
 /// A constrained model at (t, q) with q' = 0: the mass matrix, the position

@@ -8,9 +8,7 @@ use std::marker::PhantomData;
 use nalgebra::{DMatrix, DVector};
 
 use super::{Flows, ModelInfo};
-use crate::constrained::{
-    size, ConstraintForms, OnConstraints, Projecting, Statics, PROJECTION_TOLERANCE,
-};
+use crate::constrained::{ConstraintForms, OnConstraints, Projecting, Statics};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
 use crate::ode::{AnySystem, Dual, Integrator, OdeError};
@@ -128,7 +126,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
                 coordinates: N,
             });
         }
-        let tolerance = PROJECTION_TOLERANCE * size(y);
+        let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
         project_holding(&Self::equations(params), 0.0, y, tolerance, held).map(|_| ())
     }
 }
@@ -158,7 +156,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
             given,
             coordinates: N,
         })?;
-        let tolerance = PROJECTION_TOLERANCE * size(state);
+        let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(state);
         Self::equations(params).project(t, state, tolerance)
     }
     fn reactions(&self, params: &[f64], t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
