@@ -438,3 +438,38 @@ fn a_hundred_thousand_periods_stay_on_the_constraints() {
     assert_eq!(k, 100_000);
     assert!(worst.0 <= 1e-12 && worst.1 <= 1e-12, "residuals {worst:?}");
 }
+
+/// The upright rolling disk (`models/rolling_disk.toml`, two nonholonomic
+/// rolling constraints): θ' and φ' stay constant, and the contact point
+/// runs on the circle x = x₀ + ρ (sin(φ₀ + φ't) − sin φ₀),
+/// y = y₀ − ρ (cos(φ₀ + φ't) − cos φ₀), ρ = R θ'/φ'.
+#[test]
+fn the_rolling_disk_runs_on_its_circle() {
+    let model = mechlab::models::rolling_disk::MODEL.constrained.unwrap();
+    let (m, r) = (1.0, 0.5);
+    let (roll, turn, heading) = (2.0, 0.7, 0.4f64);
+    // A partial start: the contact point's velocity follows by projection.
+    let y0 = [0.1, -0.2, 0.0, heading, 0.0, 0.0, roll, turn];
+    let times: Vec<f64> = (0..=50).map(|k| 0.2 * k as f64).collect();
+    let rolled = run(model, &[m, r], Some(&y0), TIGHT, &times).unwrap();
+    let start = &rolled.start;
+    // The projection in the metric of M changes θ' and φ' too: the circle
+    // is that of the projected start.
+    let (roll, turn) = (start[6], start[7]);
+    let rho = r * roll / turn;
+    for (t, y) in times.iter().zip(&rolled.states) {
+        let phi = heading + turn * t;
+        let x = 0.1 + rho * (phi.sin() - heading.sin());
+        let yy = -0.2 - rho * (phi.cos() - heading.cos());
+        assert!(
+            (y[0] - x).abs() < 1e-10 && (y[1] - yy).abs() < 1e-10,
+            "t = {t}: {y:?}"
+        );
+        assert!((y[6] - roll).abs() < 1e-11 && (y[7] - turn).abs() < 1e-11);
+    }
+    let drift = rolled
+        .energy
+        .iter()
+        .fold(0.0_f64, |d, e| d.max((e - rolled.energy[0]).abs()));
+    assert!(drift < 1e-12, "{drift:e}");
+}
