@@ -473,3 +473,30 @@ fn the_rolling_disk_runs_on_its_circle() {
         .fold(0.0_f64, |d, e| d.max((e - rolled.energy[0]).abs()));
     assert!(drift < 1e-12, "{drift:e}");
 }
+
+/// Andrews' squeezing mechanism written as a model file from its published
+/// description (`test_models/andrews_squeezer.toml`: seven angles, three
+/// loop closures): its positions at t = 0.03 are the Test Set for IVP
+/// Solvers' reference to 1e-8.
+#[test]
+fn andrews_squeezer_reaches_the_test_sets_reference() {
+    use mechlab_test_models::andrews_squeezer as squeezer;
+    let reference = [
+        0.1581077119629904e2,
+        -0.1575637105984298e2,
+        0.4082224013073101e-1,
+        -0.5347301163226948,
+        0.5244099658805304,
+        0.5347301163226948,
+        0.1048080741042263e1,
+    ];
+    let params = squeezer::Params::default().values();
+    let method = Method::Dop853 {
+        rtol: 1e-11,
+        atol: 1e-11,
+    };
+    let run = run(&squeezer::SYSTEMS, &params, None, method, &[0.0, 0.03]).unwrap();
+    let end = &run.states[1];
+    let worst = (0..7).fold(0.0_f64, |m, i| m.max((end[i] - reference[i]).abs()));
+    assert!(worst < 1e-8, "positions off by {worst:e}: {:?}", &end[..7]);
+}
