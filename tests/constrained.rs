@@ -500,3 +500,39 @@ fn andrews_squeezer_reaches_the_test_sets_reference() {
     let worst = (0..7).fold(0.0_f64, |m, i| m.max((end[i] - reference[i]).abs()));
     assert!(worst < 1e-8, "positions off by {worst:e}: {:?}", &end[..7]);
 }
+
+/// The fast Lyapunov indicator on the constraints: at the unstable upright
+/// of the Cartesian Kapitza pendulum below its threshold, the tangent
+/// vector (put on the constraints' tangent space) grows like the largest
+/// Floquet multiplier on the constraints, FLI ≈ N ln μ.
+#[test]
+fn fli_on_the_constraints_grows_with_the_largest_multiplier() {
+    use mechlab::registry::Flows;
+    let (a, eps) = (1.2, 0.1);
+    let params = [a, eps, 0.0];
+    let period = std::f64::consts::TAU * eps;
+    let upright = [0.0, a * eps + 1.0, 0.0, 0.0];
+    let model = &cartesian_kapitza::SYSTEMS;
+    let (_, restricted) =
+        monodromy_on_constraints(model, &params, TIGHT, period, &upright).unwrap();
+    let largest = restricted
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0_f64, f64::max);
+    assert!(
+        largest > 1.3,
+        "below the threshold the upright is hyperbolic: {largest}"
+    );
+    let periods = 40;
+    let (values, _) = model
+        .fli(&params, TIGHT, period, &upright, &[0.5; 4], periods, &[])
+        .unwrap();
+    let fli = values[0].clone().unwrap();
+    let rate = fli / periods as f64;
+    assert!(
+        (rate - largest.ln()).abs() < 0.05,
+        "FLI/N = {rate}, ln μ = {}",
+        largest.ln()
+    );
+}

@@ -55,6 +55,10 @@ pub struct ChaosMap {
     /// step-size underflow at a singular point): their FLI is +∞, shaded as
     /// the most chaotic.
     pub diverged: usize,
+    /// Pixels where a constrained model has no state with those two
+    /// components (outside its reach, or a chart singular there): their
+    /// FLI is NaN, and the figure leaves them blank.
+    pub without_state: usize,
     /// ln(periods): the FLI of a regular orbit.
     pub fli_regular_level: f64,
     pub seconds: f64,
@@ -95,7 +99,7 @@ pub fn chaos_map(
     settings: &ChaosMapSettings,
     row_done: &(dyn Fn() -> bool + Sync),
 ) -> Result<ChaosMap, ChaosMapError> {
-    let systems = crate::analysis::hamiltonian(model)?;
+    let systems = crate::analysis::flows(model)?;
     let info = systems.info();
     let period = super::period_map::fast_phase_period(systems, params)?;
     let periodic = systems.periodic_state();
@@ -103,7 +107,7 @@ pub fn chaos_map(
         params: named,
         axes,
         through,
-    } = request(info, params, settings, periodic.len())?;
+    } = request(info, params, settings, systems.base_state(params))?;
     let ranges = plane_ranges(settings, &periodic);
     crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
     let n = through.len();
@@ -131,6 +135,7 @@ pub fn chaos_map(
             &starts,
             &w0,
             settings.periods,
+            &settings.axes,
         )?;
         let values = values
             .into_iter()
@@ -196,6 +201,7 @@ pub fn chaos_map(
         method: settings.method.name(),
         chaotic_fraction: shading.chaotic_fraction,
         diverged: fli.iter().filter(|f| f.is_infinite()).count(),
+        without_state: fli.iter().filter(|f| f.is_nan()).count(),
         fli_regular_level: shading.regular_level,
         seconds,
         f_evals,
@@ -205,13 +211,15 @@ pub fn chaos_map(
 }
 
 /// The request read against the model: its parameters by name, the
-/// plane's axes and the state (of `n` numbers) the plane passes through.
+/// plane's axes and the state the plane passes through (by default
+/// `base`: zero, or a constrained model's start).
 fn request(
     info: &'static crate::registry::ModelInfo,
     params: &[f64],
     settings: &ChaosMapSettings,
-    n: usize,
+    base: Vec<f64>,
 ) -> Result<Request, ChaosMapError> {
+    let n = base.len();
     let named = Refusal::named_values(info, params)?;
     let axes = super::period_map::plane_names(info, settings.axes)?;
     let through = match &settings.through {
@@ -220,7 +228,8 @@ fn request(
             return Err(Refusal::state_length(info.name, what, y.len(), n).into());
         }
         Some(y) => y.clone(),
-        None => vec![0.0; n],
+        // The zero state, or a constrained model's start.
+        None => base,
     };
     Ok(Request {
         params: named,

@@ -7,11 +7,12 @@ use std::marker::PhantomData;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{Flows, ModelInfo};
+use super::{FliValues, Flows, ModelInfo};
 use crate::constrained::{ConstraintForms, OnConstraints, Projecting, Statics};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
-use crate::ode::{AnySystem, Dual, Integrator, OdeError};
+use crate::ode::{AnySystem, Dual, Integrator, Method, OdeError};
+use crate::tangent::lyapunov::fli_of_starts;
 use crate::tangent::monodromy::monodromy;
 
 /// A constrained model with states and parameters as slices.
@@ -69,13 +70,23 @@ pub trait ConstrainedSystems: Flows {
 
 /// The generated forms `F` at their sizes as [`ConstrainedSystems`] (the
 /// model's module holds one in a static).
-/// V = S + S² is the state with its monodromy's columns.
-pub struct Constrained<F, const N: usize, const K: usize, const S: usize, const V: usize> {
+/// V = S + S² is the state with its monodromy's columns, T = 2S with one
+/// tangent vector (stable Rust cannot compute them from S).
+pub struct Constrained<
+    F,
+    const N: usize,
+    const K: usize,
+    const S: usize,
+    const V: usize,
+    const T: usize,
+> {
     info: &'static ModelInfo,
     forms: PhantomData<fn() -> F>,
 }
 
-impl<F, const N: usize, const K: usize, const S: usize, const V: usize> Constrained<F, N, K, S, V> {
+impl<F, const N: usize, const K: usize, const S: usize, const V: usize, const T: usize>
+    Constrained<F, N, K, S, V, T>
+{
     pub const fn new(info: &'static ModelInfo) -> Self {
         Constrained {
             info,
@@ -84,16 +95,28 @@ impl<F, const N: usize, const K: usize, const S: usize, const V: usize> Constrai
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
-    Constrained<F, N, K, S, V>
+impl<
+        F: ConstraintForms<N, K>,
+        const N: usize,
+        const K: usize,
+        const S: usize,
+        const V: usize,
+        const T: usize,
+    > Constrained<F, N, K, S, V, T>
 {
     fn equations(params: &[f64]) -> OnConstraints<F, N, K, S> {
         OnConstraints::new(F::from_values(params))
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize> Flows
-    for Constrained<F, N, K, S, V>
+impl<
+        F: ConstraintForms<N, K>,
+        const N: usize,
+        const K: usize,
+        const S: usize,
+        const V: usize,
+        const T: usize,
+    > Flows for Constrained<F, N, K, S, V, T>
 {
     fn info(&self) -> &'static ModelInfo {
         self.info
@@ -114,6 +137,42 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
     fn base_state(&self, params: &[f64]) -> Vec<f64> {
         ConstrainedSystems::start(self, params)
     }
+    fn fli(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        w0: &[f64],
+        periods: usize,
+        held: &[usize],
+    ) -> Result<FliValues, OdeError> {
+        let system = Self::equations(params);
+        let w0 = DVector::from_column_slice(&fixed_state::<S>(w0)?);
+        let (mut values, mut f_evals) = (Vec::new(), 0);
+        for start in starts.chunks(S) {
+            let mut y = fixed_state::<S>(start)?;
+            let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(&y);
+            let on = project_holding(&system, 0.0, &mut y, tolerance, held).ok();
+            let basis = on.and_then(|_| tangent_basis(&system.state_constraints_jacobian(0.0, &y)));
+            let Some(basis) = basis else {
+                values.push(Ok(f64::NAN));
+                continue;
+            };
+            // w0 on the tangent space (its first direction if w0 is normal to it).
+            let mut w = &basis * (basis.transpose() * &w0);
+            if w.norm() < 1e-8 * w0.norm() {
+                w = basis.column(0).into_owned();
+            }
+            let w = w.normalize();
+            let w: [f64; S] = std::array::from_fn(|i| w[i]);
+            let (value, spent) =
+                fli_of_starts::<_, S, T>(&system, method, period, &[y], &w, periods)?;
+            values.extend(value);
+            f_evals += spent;
+        }
+        Ok((values, f_evals))
+    }
     fn consistent(
         &self,
         params: &[f64],
@@ -131,8 +190,14 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const V: usize>
-    ConstrainedSystems for Constrained<F, N, K, S, V>
+impl<
+        F: ConstraintForms<N, K>,
+        const N: usize,
+        const K: usize,
+        const S: usize,
+        const V: usize,
+        const T: usize,
+    > ConstrainedSystems for Constrained<F, N, K, S, V, T>
 {
     fn constraint_names(&self) -> &'static [&'static str] {
         F::constraint_names()

@@ -395,6 +395,25 @@ pub trait Flows: Sync {
     fn base_state(&self, _params: &[f64]) -> Vec<f64> {
         vec![0.0; self.periodic_state().len()]
     }
+    /// The fast Lyapunov indicator of the exact system's period map from
+    /// each start (`starts` holds them one after the other) with the
+    /// tangent vector `w0`, and the f-evaluations spent (see
+    /// [`crate::tangent::lyapunov::fli_of_starts`]). A constrained model
+    /// first puts each start on its constraints holding the components
+    /// `held` (a plane's axes) and its tangent vector on their tangent
+    /// space; a start it cannot put there gets NaN (no state of the model
+    /// there).
+    #[allow(clippy::too_many_arguments)]
+    fn fli(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        w0: &[f64],
+        periods: usize,
+        held: &[usize],
+    ) -> Result<FliValues, OdeError>;
     /// Makes `y` a state of the model at t = 0 holding its components
     /// `held` (a chart's coordinates): a free model's states all are; a
     /// constrained model's other components move onto the constraints.
@@ -425,19 +444,6 @@ pub trait Systems: Flows {
     /// The first-order map's shift y − y′ at time t (where the second
     /// order is derived).
     fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64]) -> Option<Vec<f64>>;
-    /// The fast Lyapunov indicator of the exact system's period map from
-    /// each start (`starts` holds them one after the other) with the
-    /// tangent vector `w0`, and the f-evaluations spent (see
-    /// [`crate::tangent::lyapunov::fli_of_starts`]).
-    fn fli(
-        &self,
-        params: &[f64],
-        method: Method,
-        period: f64,
-        starts: &[f64],
-        w0: &[f64],
-        periods: usize,
-    ) -> Result<FliValues, OdeError>;
     /// The mass matrix A(q).
     fn mass_matrix(&self, params: &[f64], q: &[f64]) -> DMatrix<f64>;
     /// ∂V/∂q and C = ∂²V/∂q² of the potential averaged over the phase.
@@ -498,6 +504,24 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
         Box::new(SizedSystem(Fixed::exact(self, params)))
     }
+    fn fli(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        w0: &[f64],
+        periods: usize,
+        _held: &[usize],
+    ) -> Result<FliValues, OdeError> {
+        let starts: Vec<[f64; S]> = starts
+            .chunks(S)
+            .map(fixed_state::<S>)
+            .collect::<Result<_, _>>()?;
+        let w0 = fixed_state::<S>(w0)?;
+        let system = Fixed::exact(self, params);
+        fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
+    }
 }
 
 impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
@@ -514,23 +538,6 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Systems
     fn averaged2_shift(&self, params: &[f64], t: f64, y: &[f64]) -> Option<Vec<f64>> {
         let y = fixed_state::<S>(y).ok()?;
         Some(self.0.averaged2_shift(params, t, &y)?.to_vec())
-    }
-    fn fli(
-        &self,
-        params: &[f64],
-        method: Method,
-        period: f64,
-        starts: &[f64],
-        w0: &[f64],
-        periods: usize,
-    ) -> Result<FliValues, OdeError> {
-        let starts: Vec<[f64; S]> = starts
-            .chunks(S)
-            .map(fixed_state::<S>)
-            .collect::<Result<_, _>>()?;
-        let w0 = fixed_state::<S>(w0)?;
-        let system = Fixed::exact(self, params);
-        fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
     }
     fn mass_matrix(&self, params: &[f64], q: &[f64]) -> DMatrix<f64> {
         matrix(&self.0.mass_matrix(params, &coordinates::<D>(q)))
