@@ -50,6 +50,18 @@ pub struct Exploration {
     pub equilibria_search_sampled: Option<Search>,
     /// Switches of a contact model, as text.
     pub switches: Vec<String>,
+    /// A constrained model's reactions along the run.
+    pub reactions: Option<Reactions>,
+}
+
+/// The multipliers of a constrained model's constraints, by name: at each
+/// time of the run, one value per constraint (the reaction in the units of
+/// its row: for a rod written as |x − x₀|² − l² = 0, λ times 2(x − x₀) is
+/// the force on the point).
+#[derive(Clone, Debug, Default)]
+pub struct Reactions {
+    pub names: Vec<&'static str>,
+    pub values: Vec<Vec<f64>>,
 }
 
 /// The start a scene uses when none is given: q = 0.3, 0.5, …, p = 0; for
@@ -124,13 +136,16 @@ impl Exploration {
             .fold(0.0f64, |m, e| m.max(e.abs()))
     }
 
-    /// The columns of the time series: t, the exact state, the averaged one.
+    /// The columns of the time series: t, the exact state, the averaged
+    /// one, a constrained model's reactions.
     pub fn series_header(&self) -> Vec<String> {
         let size = self.exact.first().map_or(0, Vec::len);
         let averaged = if self.averaged.is_some() { size } else { 0 };
+        let reactions = self.reactions.iter().flat_map(|r| &r.names);
         std::iter::once("t".to_string())
             .chain((0..size).map(|k| format!("exact_{k}")))
             .chain((0..averaged).map(|k| format!("averaged_{k}")))
+            .chain(reactions.map(|name| format!("reaction_{name}")))
             .collect()
     }
 
@@ -140,6 +155,11 @@ impl Exploration {
             std::iter::once(*t)
                 .chain(self.exact[k].iter().copied())
                 .chain(self.averaged.iter().flat_map(|a| a[k].iter().copied()))
+                .chain(
+                    self.reactions
+                        .iter()
+                        .flat_map(|r| r.values[k].iter().copied()),
+                )
                 .collect()
         })
     }
@@ -380,6 +400,10 @@ fn constrained_runs(
             run.largest_drift.0,
             run.largest_drift.1
         )],
+        reactions: Some(Reactions {
+            names: run.constraint_names,
+            values: run.reactions,
+        }),
         exact: run.states,
         times: run.times,
         ..Default::default()
@@ -507,6 +531,21 @@ fn degree_panels<'a>(
     ]
 }
 
+/// Each constraint's reaction against time in panel `k`, with a legend.
+fn draw_reactions(figure: &mut Figure, k: usize, times: &[f64], reactions: &Reactions) {
+    let mut legend = Vec::new();
+    for (r, name) in reactions.names.iter().enumerate() {
+        let curve: Vec<(f64, f64)> = times
+            .iter()
+            .zip(&reactions.values)
+            .map(|(t, values)| (*t, values[r]))
+            .collect();
+        figure.line(k, &curve, palette(r));
+        legend.push((display_name(name), palette(r)));
+    }
+    figure.legend(k, &legend);
+}
+
 /// The figure: per degree of freedom the time series, the phase portrait
 /// and the period map (or the velocity), then the energy change and the
 /// exact−averaged deviation.
@@ -561,7 +600,20 @@ pub fn figure(result: &Exploration, model: &dyn DynamicModel, t_end: f64) -> Fig
             range(deviation.iter().flatten().map(|p| p.1).chain([0.0])),
         ));
     }
+    let reaction_panel = result.reactions.as_ref().map(|reactions| {
+        specs.push(PanelSpec::new(
+            "reactions λ(t) of the constraints",
+            "t",
+            "",
+            t_range,
+            range(reactions.values.iter().flatten().copied()),
+        ));
+        specs.len() - 1
+    });
     let mut figure = Figure::grid(3, specs.len().div_ceil(3), 460, 340, &specs);
+    if let (Some(k), Some(reactions)) = (reaction_panel, &result.reactions) {
+        draw_reactions(&mut figure, k, &result.times, reactions);
+    }
     let series = |k: usize, rows: &[Vec<f64>]| {
         result
             .times
