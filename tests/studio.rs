@@ -154,6 +154,50 @@ async fn orbit_equals_the_library_period_map() {
     assert_eq!(end["f_evals"], integrator.stats.f_evals);
 }
 
+/// A constrained model's orbit: the seed is put on the constraints with
+/// the axes' components held, and the points are the library's portrait
+/// of the same seed, point for point.
+#[tokio::test]
+async fn a_constrained_models_orbit_is_its_portrait_on_the_constraints() {
+    use mechlab::analysis::period_map::{portrait, PortraitSettings};
+    // Off the constraints: the coupler's angle and the rocker's rate are wrong.
+    let seed = vec![0.35, 0.05, -0.3, 0.4, 0.0, 0.7];
+    let request = json!({"model": "four_bar", "params": {}, "method": "dop853", "tol": 1e-10,
+        "axes": [0, 3], "seed": seed, "periods": 40});
+    let (status, _, body) = call("POST", "/api/orbit", Some(request)).await;
+    assert_eq!(status, StatusCode::OK);
+    let lines = lines(&body);
+    let points: Vec<[f64; 2]> = lines
+        .iter()
+        .filter_map(|l| l.get("points"))
+        .flat_map(|p| serde_json::from_value::<Vec<[f64; 2]>>(p.clone()).unwrap())
+        .collect();
+    assert_eq!(points.len(), 41);
+    assert_eq!(points[0], [0.35, 0.4], "the axes' components are held");
+    let model = mechlab::models::by_name("four_bar").unwrap();
+    let settings = PortraitSettings {
+        axes: [0, 3],
+        seeds: Some(vec![seed]),
+        count: 1,
+        p_max: 1.0,
+        periods: 40,
+        method: Method::Dop853 {
+            rtol: 1e-10,
+            atol: 1e-10,
+        },
+    };
+    let expected = portrait(
+        model,
+        &mechlab::models::four_bar::Params::default().values(),
+        &settings,
+    )
+    .unwrap();
+    for (k, (got, want)) in points.iter().zip(&expected.orbits[0]).enumerate() {
+        assert_eq!(got[0], want.0, "point {k}");
+        assert_eq!(got[1], want.1, "point {k}");
+    }
+}
+
 /// Each refinement of the streamed chaos map is the library's map of the
 /// same view, pixel for pixel.
 #[tokio::test]

@@ -107,6 +107,9 @@ pub struct ModelSummary {
     pub amplitude: Option<&'static str>,
     pub default_axes: [usize; 2],
     pub default_ranges: [[f64; 2]; 2],
+    /// The state the plane passes through by default: zero, or a
+    /// constrained model's start (its seeds are put on its constraints).
+    pub through: Vec<f64>,
 }
 
 /// Every model of `catalog`, in its order.
@@ -126,6 +129,9 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
     };
     let periodic = model.periodic_state();
     let state = info.state_names();
+    let through = model
+        .start(&model.defaults())
+        .unwrap_or_else(|| vec![0.0; periodic.len()]);
     let default_axes = [0, dof.min(state.len().saturating_sub(1))];
     let default_ranges = default_axes.map(|a| {
         if periodic.get(a).copied().unwrap_or(false) {
@@ -135,14 +141,25 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
         }
     });
     ModelSummary {
+        through,
         name: info.name,
         source_file: info.source_file,
         kind,
         dof,
         fast_phase,
+        // A constrained model's second half are velocities: φ₁′.
         state: state
             .iter()
-            .map(|n| crate::registry::display_name(n))
+            .enumerate()
+            .map(|(i, n)| match kind {
+                "constrained" if i >= dof => {
+                    format!(
+                        "{}′",
+                        crate::registry::display_name(info.coordinates[i - dof])
+                    )
+                }
+                _ => crate::registry::display_name(n),
+            })
             .collect(),
         periodic,
         parameters: info

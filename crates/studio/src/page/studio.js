@@ -662,7 +662,7 @@ async function chooseModel(name) {
   studio.model = model;
   studio.params = {};
   studio.axes = model.default_axes.slice();
-  studio.through = new Array(model.state.length).fill(0);
+  studio.through = (model.through ?? new Array(model.state.length).fill(0)).slice();
   studio.overlay = null;
   studio.chaos = null;
   studio.manifolds = null;
@@ -676,10 +676,16 @@ async function chooseModel(name) {
   buildContinuation(model);
   buildSection(model);
   $("order").disabled = !model.fast_phase;
+  // A constrained model has no Taylor recurrences (the solve for its
+  // multipliers is not generated as one yet): its orbits run with DOP853.
+  if (model.kind === "constrained" && $("method").value === "taylor") $("method").value = "dop853";
   $("order").value = "1";
   defaultView(model);
-  say(model.kind !== "hamiltonian" ? `model '${name}' is a contact model: no phase plane here, its derivations are below`
-    : model.fast_phase ? "" : `model '${name}' has no fast phase: no period map; the level sets of H and the equilibria are shown`);
+  const notes = {
+    contacts: `model '${name}' is a contact model: no phase plane here, its derivations are below`,
+    constrained: `model '${name}' is constrained: a click seeds an orbit on its constraints (the axes' components held, the others follow from the constraints); the other layers are not drawn for it`,
+  };
+  say(notes[model.kind] ?? (model.fast_phase ? "" : `model '${name}' has no fast phase: no period map; the level sets of H and the equilibria are shown`));
   history.replaceState(null, "", `#${name}`);
   redraw();
   refreshOverlays();
