@@ -3,7 +3,8 @@
 # green: the tests that iterate over models assert what holds for every
 # model, pick their settings from the model's own scales, or skip with a
 # printed reason. This adds model files written for the check (those of
-# benches/edit_loop/, one of them without an `amplitude` key, and the
+# benches/edit_loop/, one of them without an `amplitude` key and one with a
+# moving constraint, and the
 # 6- and 12-link chains of models/extra/) to models/, runs the test
 # command, checks the 12-link chain's threshold from `stability` against
 # its closed form, and restores models/ however it ends.
