@@ -536,3 +536,43 @@ fn fli_on_the_constraints_grows_with_the_largest_multiplier() {
         largest.ln()
     );
 }
+
+/// The averaged motion on the constraints (`averaged_states`, the mean
+/// free force less ∇V_vibr) is Theorem 2's limit of the exact one: on the
+/// four-bar held upside down, the largest deviation of the crank angle
+/// over 10 time units falls like 1/ν (halving ν's period halves it).
+#[test]
+fn the_averaged_motion_on_the_constraints_is_the_exact_ones_limit() {
+    let model = mechlab::models::four_bar::MODEL.constrained.unwrap();
+    let deviation = |nu: f64| {
+        let params = mechlab::models::four_bar::Params {
+            nu,
+            ..Default::default()
+        }
+        .values();
+        let period = model.phase_period(&params).unwrap();
+        let times: Vec<f64> = (0..=(10.0 / period) as usize)
+            .map(|k| k as f64 * period)
+            .collect();
+        let mut seed = model.start(&params);
+        seed[3] = 0.3;
+        model.consistent(&params, &mut seed, &[0, 3]).unwrap();
+        let exact = run(model, &params, Some(&seed), TIGHT, &times).unwrap();
+        let averaged = model
+            .averaged_states(&params, TIGHT, &seed, &times)
+            .unwrap()
+            .unwrap();
+        exact
+            .states
+            .iter()
+            .zip(&averaged)
+            .fold(0.0_f64, |m, (e, a)| m.max((e[0] - a[0]).abs()))
+    };
+    let (d100, d200, d400) = (deviation(100.0), deviation(200.0), deviation(400.0));
+    for ratio in [d100 / d200, d200 / d400] {
+        assert!(
+            (1.6..2.5).contains(&ratio),
+            "deviations {d100:e}, {d200:e}, {d400:e}"
+        );
+    }
+}

@@ -513,7 +513,7 @@ pub fn linkage_scene(
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
     use mechlab_runtime::analysis::on_constraints::vibration::{
-        vibration_stability, VibrationSettings,
+        orbits_about, vibration_stability, VibrationSettings,
     };
     let (model, scene) = generic_scene(
         catalog,
@@ -528,6 +528,13 @@ pub fn linkage_scene(
                 "the largest amplitude scanned (auto: twice the amplitude's value)",
             ),
             ("scan", "40", "amplitudes scanned from 0"),
+            ("orbits", "6", "orbits about the equilibrium (0: none)"),
+            (
+                "kick",
+                "0.6",
+                "the largest kick in the first coordinate's velocity",
+            ),
+            ("periods", "300", "periods of the fast phase per orbit"),
         ],
     )?;
     let info = model.info;
@@ -561,6 +568,19 @@ pub fn linkage_scene(
     );
     println!("exact: {:?}", result.exact);
     scene.save_figure(&result.figure(), "linkage.png")?;
+    let count = scene.count("orbits")?;
+    if count > 0 {
+        let params = scene.parameter_values(info)?;
+        let shape = (count, scene.positive("kick")?, scene.count("periods")?);
+        let orbits = orbits_about(
+            constrained,
+            &params,
+            &result.equilibrium,
+            shape,
+            settings.method,
+        )?;
+        scene.save_figure(&orbits.figure(), "orbits.png")?;
+    }
     let rows = result.scan.iter().map(|p| {
         (
             p.amplitude,

@@ -16,6 +16,8 @@
 //! The registry lists such a model through
 //! [`crate::registry::ConstrainedSystems`].
 
+pub mod averaged;
+
 use nalgebra::{DMatrix, DVector};
 
 use crate::linalg::Cholesky;
@@ -73,7 +75,7 @@ pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send +
 /// λ = (G M⁻¹ Gᵀ)⁻¹ (−h − G M⁻¹ F), q'' = M⁻¹ (F + Gᵀλ). NaN where M or
 /// G M⁻¹ Gᵀ is not positive definite.
 #[inline]
-fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
+pub(crate) fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
     mass: [[Num; N]; N],
     g: [[Num; N]; K],
     free: [Num; N],
@@ -150,7 +152,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
 }
 
 #[inline]
-fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Num {
+pub(crate) fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Num {
     let mut sum = Num::from(0.0);
     for (x, y) in a.iter().zip(b) {
         sum += *x * *y;

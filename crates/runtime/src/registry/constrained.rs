@@ -8,10 +8,11 @@ use std::marker::PhantomData;
 use nalgebra::{DMatrix, DVector};
 
 use super::{FliValues, Flows, ModelInfo};
+use crate::constrained::averaged::AveragedOnConstraints;
 use crate::constrained::{ConstraintForms, OnConstraints, Projecting, Statics};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
-use crate::ode::{AnySystem, Dual, Integrator, Method, OdeError};
+use crate::ode::{states_at, AnySystem, Dual, Integrator, Method, OdeError};
 use crate::tangent::lyapunov::fli_of_starts;
 use crate::tangent::monodromy::monodromy;
 
@@ -57,6 +58,17 @@ pub trait ConstrainedSystems: Flows {
         t: f64,
         q: &[f64],
     ) -> Result<Vec<DMatrix<f64>>, OdeError>;
+    /// The first-order averaged motion's states at `times` from `y0`
+    /// (each projected onto the constraints), or None where the model has
+    /// no fast phase or its constraints or mass matrix move with it
+    /// ([`crate::constrained::averaged`]).
+    fn averaged_states(
+        &self,
+        params: &[f64],
+        method: Method,
+        y0: &[f64],
+        times: &[f64],
+    ) -> Result<Option<Vec<Vec<f64>>>, OdeError>;
     /// The state after `period` from `y0` and the monodromy matrix
     /// ∂y(T)/∂y(0) of the full state [q; q'] (2n × 2n).
     fn monodromy(
@@ -286,6 +298,28 @@ impl<
         let y = fixed_state::<S>(y)?;
         let c = Self::equations(params).state_constraints_jacobian(t, &y);
         Ok(tangent_basis(&c))
+    }
+    fn averaged_states(
+        &self,
+        params: &[f64],
+        method: Method,
+        y0: &[f64],
+        times: &[f64],
+    ) -> Result<Option<Vec<Vec<f64>>>, OdeError> {
+        let y0 = fixed_state::<S>(y0)?;
+        let exact = Self::equations(params);
+        let (Some(period), true) = (exact.0.phase_period(), F::stationary()) else {
+            return Ok(None);
+        };
+        let averaged = AveragedOnConstraints { exact, period };
+        let t0 = times.first().copied().unwrap_or(0.0);
+        let mut states = states_at(method, &averaged, t0, &y0, times)?;
+        for y in &mut states {
+            let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
+            // A failed projection leaves the state as the integration left it.
+            let _ = averaged.exact.project(0.0, y, tolerance);
+        }
+        Ok(Some(states.iter().map(|y| y.to_vec()).collect()))
     }
     fn monodromy(
         &self,

@@ -614,3 +614,103 @@ impl VibrationStability {
         figure
     }
 }
+
+/// Orbits about an equilibrium on the plane of the first coordinate and
+/// its velocity: the exact period map's points and the averaged motion's
+/// curves from the same seeds (the equilibrium kicked by `spread` · k /
+/// `count` in that velocity, put on the constraints with the plane's
+/// components held).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Orbits {
+    pub model: &'static str,
+    pub axes: [String; 2],
+    pub seeds: Vec<Vec<f64>>,
+    #[serde(skip)]
+    pub exact: Vec<Vec<(f64, f64)>>,
+    #[serde(skip)]
+    pub averaged: Vec<Vec<(f64, f64)>>,
+}
+
+/// [`Orbits`] of `model` about `q` over `periods` of the fast phase.
+pub fn orbits_about(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    q: &[f64],
+    (count, spread, periods): (usize, f64, usize),
+    method: Method,
+) -> Result<Orbits, VibrationError> {
+    let info = model.info();
+    let n = q.len();
+    let axes = [0, n];
+    let period = model
+        .phase_period(params)
+        .ok_or_else(|| Refusal::no_fast_phase(info.name))?;
+    let constraint = |source| ConstrainedError::Constraint {
+        model: info.name,
+        t: 0.0,
+        source,
+    };
+    let map_times: Vec<f64> = (0..=periods).map(|k| k as f64 * period).collect();
+    let curve_times: Vec<f64> = (0..=8 * periods.min(500))
+        .map(|k| k as f64 * periods as f64 * period / (8 * periods.min(500)) as f64)
+        .collect();
+    let plane = |states: &[Vec<f64>]| states.iter().map(|y| (y[0], y[n])).collect::<Vec<_>>();
+    let mut orbits = Orbits {
+        model: info.name,
+        axes: [info.coordinates[0].to_string(), info.momenta[0].to_string()],
+        seeds: Vec::new(),
+        exact: Vec::new(),
+        averaged: Vec::new(),
+    };
+    for k in 1..=count {
+        let mut seed = q.to_vec();
+        seed.resize(2 * n, 0.0);
+        seed[n] = spread * k as f64 / count as f64;
+        model
+            .consistent(params, &mut seed, &axes)
+            .map_err(constraint)?;
+        let exact = super::run(model, params, Some(&seed), method, &map_times)?;
+        orbits.exact.push(plane(&exact.states));
+        let averaged = model
+            .averaged_states(params, method, &seed, &curve_times)?
+            .ok_or(VibrationError::MovingConstraints { model: info.name })?;
+        orbits.averaged.push(plane(&averaged));
+        orbits.seeds.push(seed);
+    }
+    Ok(orbits)
+}
+
+impl Orbits {
+    /// The exact period map's points (a colour per orbit) over the averaged
+    /// motion's curves (black).
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{palette, Figure, PanelSpec, BLACK};
+        use crate::registry::display_name;
+        let all = self.exact.iter().chain(&self.averaged).flatten();
+        let (mut x, mut y) = (
+            (f64::INFINITY, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::NEG_INFINITY),
+        );
+        for p in all.filter(|p| p.0.is_finite() && p.1.is_finite()) {
+            x = (x.0.min(p.0), x.1.max(p.0));
+            y = (y.0.min(p.1), y.1.max(p.1));
+        }
+        let pad = |r: (f64, f64)| {
+            let d = 0.05 * (r.1 - r.0).max(1e-9);
+            (r.0 - d, r.1 + d)
+        };
+        let title = format!(
+            "{}: exact period map (points) and averaged motion (lines)",
+            self.model
+        );
+        let x_name = display_name(&self.axes[0]);
+        let y_name = format!("{x_name}′");
+        let spec = PanelSpec::new(&title, &x_name, &y_name, pad(x), pad(y));
+        let mut figure = Figure::single(720, 620, spec);
+        for (k, (exact, averaged)) in self.exact.iter().zip(&self.averaged).enumerate() {
+            figure.line(0, averaged, BLACK);
+            figure.points(0, exact.iter().copied(), palette(k), 2);
+        }
+        figure
+    }
+}
