@@ -576,3 +576,27 @@ fn the_averaged_motion_on_the_constraints_is_the_exact_ones_limit() {
         );
     }
 }
+
+/// The Taylor method, the scenes' default, is refused by name for a
+/// constrained model (one refusal, not every orbit stopped).
+#[test]
+fn the_taylor_method_is_refused_for_a_constrained_model() {
+    use mechlab::analysis::period_map::{portrait, PeriodMapError, PortraitSettings};
+    let settings = PortraitSettings {
+        axes: [0, 3],
+        seeds: None,
+        count: 2,
+        p_max: 0.1,
+        periods: 3,
+        method: Method::Taylor { tol: 1e-10 },
+    };
+    let model = mechlab::models::by_name("four_bar").unwrap();
+    let error = portrait(model, &model.dynamic.defaults(), &settings).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            PeriodMapError::Refused(mechlab::analysis::Refusal::Setting { .. })
+        ) && error.to_string().contains("dop853"),
+        "{error}"
+    );
+}
