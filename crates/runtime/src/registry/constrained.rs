@@ -14,7 +14,7 @@ use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
 use crate::ode::{states_at, AnySystem, Dual, Integrator, Method, OdeError};
 use crate::tangent::lyapunov::fli_of_starts;
-use crate::tangent::monodromy::monodromy;
+use crate::tangent::variational::Variational;
 
 /// A constrained model with states and parameters as slices.
 /// Its [`Flows`] run the equations of motion, whose stream projects the
@@ -82,23 +82,14 @@ pub trait ConstrainedSystems: Flows {
 
 /// The generated forms `F` at their sizes as [`ConstrainedSystems`] (the
 /// model's module holds one in a static).
-/// V = S + S² is the state with its monodromy's columns, T = 2S with one
-/// tangent vector (stable Rust cannot compute them from S).
-pub struct Constrained<
-    F,
-    const N: usize,
-    const K: usize,
-    const S: usize,
-    const V: usize,
-    const T: usize,
-> {
+/// T = 2S is the state with one tangent vector (stable Rust cannot
+/// compute it from S).
+pub struct Constrained<F, const N: usize, const K: usize, const S: usize, const T: usize> {
     info: &'static ModelInfo,
     forms: PhantomData<fn() -> F>,
 }
 
-impl<F, const N: usize, const K: usize, const S: usize, const V: usize, const T: usize>
-    Constrained<F, N, K, S, V, T>
-{
+impl<F, const N: usize, const K: usize, const S: usize, const T: usize> Constrained<F, N, K, S, T> {
     pub const fn new(info: &'static ModelInfo) -> Self {
         Constrained {
             info,
@@ -107,28 +98,16 @@ impl<F, const N: usize, const K: usize, const S: usize, const V: usize, const T:
     }
 }
 
-impl<
-        F: ConstraintForms<N, K>,
-        const N: usize,
-        const K: usize,
-        const S: usize,
-        const V: usize,
-        const T: usize,
-    > Constrained<F, N, K, S, V, T>
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const T: usize>
+    Constrained<F, N, K, S, T>
 {
     fn equations(params: &[f64]) -> OnConstraints<F, N, K, S> {
         OnConstraints::new(F::from_values(params))
     }
 }
 
-impl<
-        F: ConstraintForms<N, K>,
-        const N: usize,
-        const K: usize,
-        const S: usize,
-        const V: usize,
-        const T: usize,
-    > Flows for Constrained<F, N, K, S, V, T>
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const T: usize> Flows
+    for Constrained<F, N, K, S, T>
 {
     fn info(&self) -> &'static ModelInfo {
         self.info
@@ -202,14 +181,8 @@ impl<
     }
 }
 
-impl<
-        F: ConstraintForms<N, K>,
-        const N: usize,
-        const K: usize,
-        const S: usize,
-        const V: usize,
-        const T: usize,
-    > ConstrainedSystems for Constrained<F, N, K, S, V, T>
+impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const T: usize>
+    ConstrainedSystems for Constrained<F, N, K, S, T>
 {
     fn constraint_names(&self) -> &'static [&'static str] {
         F::constraint_names()
@@ -328,9 +301,24 @@ impl<
         period: f64,
         y0: &[f64],
     ) -> Result<(Vec<f64>, DMatrix<f64>), OdeError> {
+        // Column by column, with one tangent vector at a time: the
+        // variational system of S + S² numbers would be compiled for every
+        // model at its size (420 numbers for a chain of ten rods).
         let y0 = fixed_state::<S>(y0)?;
         let system = Self::equations(params);
-        let (end, m) = monodromy::<_, S, V>(integrator, &system, period, &y0)?;
-        Ok((end.to_vec(), DMatrix::from_fn(S, S, |i, k| m[i][k])))
+        let variational = Variational::<_, S, T>::new(&system);
+        let mut matrix = DMatrix::zeros(S, S);
+        let mut end = y0;
+        for k in 0..S {
+            let unit: [f64; S] = std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
+            let z0 = Variational::<OnConstraints<F, N, K, S>, S, T>::pack(&y0, &[unit]);
+            let z = integrator.advance(&variational, 0.0, &z0, period)?;
+            end = Variational::<OnConstraints<F, N, K, S>, S, T>::state(&z);
+            let column = Variational::<OnConstraints<F, N, K, S>, S, T>::tangent(&z, 0);
+            for i in 0..S {
+                matrix[(i, k)] = column[i];
+            }
+        }
+        Ok((end.to_vec(), matrix))
     }
 }
