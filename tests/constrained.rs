@@ -481,15 +481,7 @@ fn the_rolling_disk_runs_on_its_circle() {
 #[test]
 fn andrews_squeezer_reaches_the_test_sets_reference() {
     use mechlab_test_models::andrews_squeezer as squeezer;
-    let reference = [
-        0.1581077119629904e2,
-        -0.1575637105984298e2,
-        0.4082224013073101e-1,
-        -0.5347301163226948,
-        0.5244099658805304,
-        0.5347301163226948,
-        0.1048080741042263e1,
-    ];
+    let reference = mechlab_test_models::ANDREWS_AT_0_03;
     let params = squeezer::Params::default().values();
     let method = Method::Dop853 {
         rtol: 1e-11,

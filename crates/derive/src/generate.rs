@@ -477,46 +477,21 @@ pub fn render_constrained(
     context.insert("dof", &n);
     context.insert("constraints", &k);
     context.insert("state_dim", &(2 * n));
-    context.insert(
-        "coordinates",
-        &model
-            .coordinates
-            .iter()
-            .map(|c| c.name.clone())
-            .collect::<Vec<_>>(),
-    );
-    context.insert(
-        "velocities",
-        &model
-            .coordinates
-            .iter()
-            .map(|c| c.velocity.clone())
-            .collect::<Vec<_>>(),
-    );
-    context.insert(
-        "periodic",
-        &model
-            .coordinates
-            .iter()
-            .map(|c| c.periodic)
-            .collect::<Vec<_>>(),
-    );
-    context.insert(
-        "constraint_names",
-        &model
-            .constraints
-            .iter()
-            .map(|c| c.name.clone())
-            .collect::<Vec<_>>(),
-    );
-    context.insert(
-        "holonomic",
-        &model
-            .constraints
-            .iter()
-            .map(|c| matches!(c.kind, crate::model::ConstraintKind::Position(_)))
-            .collect::<Vec<_>>(),
-    );
+    let coordinates = &model.coordinates;
+    let names: Vec<&str> = coordinates.iter().map(|c| c.name.as_str()).collect();
+    let velocities: Vec<&str> = coordinates.iter().map(|c| c.velocity.as_str()).collect();
+    let periodic: Vec<bool> = coordinates.iter().map(|c| c.periodic).collect();
+    context.insert("coordinates", &names);
+    context.insert("velocities", &velocities);
+    context.insert("periodic", &periodic);
+    let constraints = &model.constraints;
+    let names: Vec<&str> = constraints.iter().map(|c| c.name.as_str()).collect();
+    let holonomic: Vec<bool> = constraints
+        .iter()
+        .map(|c| matches!(c.kind, crate::model::ConstraintKind::Position(_)))
+        .collect();
+    context.insert("constraint_names", &names);
+    context.insert("holonomic", &holonomic);
     context.insert("has_phase", &derivation.phase_rate.is_some());
     context.insert("stationary", &derivation.stationary);
     context.insert("functions", &functions);

@@ -1020,13 +1020,7 @@ impl Model {
     fn check_numerically(&self) -> Result<(), (String, String)> {
         let n = self.dof();
         let lagrangian = self.expanded_lagrangian();
-        let mut seed = 0x9E37_79B9_7F4A_7C15_u64;
-        let mut random = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut random = uniform(0x9E37_79B9_7F4A_7C15);
         let params = |s: &str| {
             self.parameters
                 .iter()
@@ -1052,23 +1046,15 @@ impl Model {
             let v: Vec<f64> = (0..n).map(|_| random()).collect();
             let phase = 3.0 * random();
             let time = random();
-            let at = |velocity: &[f64]| -> Result<f64, crate::expr::EvalError> {
-                let env = |s: &str| -> Option<f64> {
-                    if let Some(i) = self.coordinates.iter().position(|c| c.name == s) {
-                        return Some(q[i]);
-                    }
-                    if let Some(i) = self.coordinates.iter().position(|c| c.velocity == s) {
-                        return Some(velocity[i]);
-                    }
-                    if self.fast_phase.as_ref().is_some_and(|p| p.name == s) {
-                        return Some(phase);
-                    }
-                    if s == self.time {
-                        return Some(time);
-                    }
-                    params(s)
-                };
-                lagrangian.eval(&env)
+            let at = |velocity: &[f64]| {
+                Sample {
+                    model: self,
+                    q: q.clone(),
+                    v: velocity.to_vec(),
+                    phase,
+                    time,
+                }
+                .try_eval(&lagrangian)
             };
             let scaled = |s: f64| v.iter().map(|x| s * x).collect::<Vec<_>>();
             let l: Vec<f64> = [-1.0, 0.0, 1.0, 2.0]
@@ -1146,8 +1132,12 @@ impl Sample<'_> {
             .map(|p| p.default)
     }
 
+    fn try_eval(&self, e: &Expr) -> Result<f64, crate::expr::EvalError> {
+        e.eval(&|s| self.value(s))
+    }
+
     fn eval(&self, e: &Expr) -> f64 {
-        e.eval(&|s| self.value(s)).unwrap_or(f64::NAN)
+        self.try_eval(e).unwrap_or(f64::NAN)
     }
 }
 
@@ -1252,13 +1242,7 @@ impl Model {
         let key = format!("constraints[{r}].velocity");
         let name = &self.constraints[r].name;
         let n = self.dof();
-        let mut seed = 0x2545_F491_4F6C_DD1D_u64;
-        let mut random = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut random = uniform(0x2545_F491_4F6C_DD1D);
         let mut integrable = true;
         for sample in 0..4 {
             let q: Vec<f64> = at_start
@@ -1355,6 +1339,17 @@ fn rank(mut rows: Vec<Vec<f64>>) -> usize {
         rank += 1;
     }
     rank
+}
+
+/// A reproducible stream of numbers uniform in [−1, 1) (xorshift), for the
+/// sample states of the numerical checks.
+fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
 }
 
 fn cholesky_ok(a: &[Vec<f64>]) -> bool {

@@ -257,15 +257,7 @@ fn closed_chain(t_end: f64) -> Result<Chain, ConstrainedError> {
 /// positions' largest error against the Test Set's reference and the
 /// seconds (best of five) at each tolerance.
 fn andrews() -> Vec<(f64, f64, f64)> {
-    let reference = [
-        0.1581077119629904e2,
-        -0.1575637105984298e2,
-        0.4082224013073101e-1,
-        -0.5347301163226948,
-        0.5244099658805304,
-        0.5347301163226948,
-        0.1048080741042263e1,
-    ];
+    let reference = mechlab_test_models::ANDREWS_AT_0_03;
     let params = andrews_squeezer::Params::default().values();
     let rows: Vec<(f64, f64, f64)> = [1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
         .iter()

@@ -33,6 +33,11 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
     /// V_vibr(q) = ½ mean⟨P b̃, b̃⟩, P the inverse mass matrix projected on
     /// the constraints (at t = 0: they do not move).
     pub fn vibrational_potential(&self, q: &[f64; N]) -> f64 {
+        self.phase_means(q).vibrational
+    }
+
+    /// At q: the means over the phase of V and b, and V_vibr.
+    pub fn phase_means(&self, q: &[f64; N]) -> PhaseMeans {
         let forms = &self.exact.0;
         let mass = Cholesky::new(forms.mass_matrix(0.0, q));
         let g = forms.constraint_jacobian(0.0, q);
@@ -40,8 +45,12 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
         let schur: [[f64; K]; K] =
             std::array::from_fn(|a| std::array::from_fn(|c| dot(&g[a], &m_inv_gt[c])));
         let schur = Cholesky::new(schur);
+        let mut potential = 0.0;
         let couplings: Vec<[f64; N]> = (0..NODES)
-            .map(|j| forms.linear_term(self.phase_time(j), q))
+            .map(|j| {
+                potential += forms.potential(self.phase_time(j), q) / NODES as f64;
+                forms.linear_term(self.phase_time(j), q)
+            })
             .collect();
         let mean: [f64; N] =
             std::array::from_fn(|i| couplings.iter().map(|b| b[i]).sum::<f64>() / NODES as f64);
@@ -56,8 +65,22 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
             });
             sum += dot(&p_b, &b);
         }
-        0.5 * sum / NODES as f64
+        PhaseMeans {
+            potential,
+            coupling: mean.to_vec(),
+            vibrational: 0.5 * sum / NODES as f64,
+        }
     }
+}
+
+/// The means over the fast phase at a configuration: of V, of the
+/// vibration's coupling b (zero where the averaging applies), and the
+/// vibrational potential ½ mean⟨P b̃, b̃⟩.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhaseMeans {
+    pub potential: f64,
+    pub coupling: Vec<f64>,
+    pub vibrational: f64,
 }
 
 impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> System<S>

@@ -426,14 +426,11 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
     }
 }
 
-/// A constrained model at (t, q) with q' = 0: the mass matrix, the position
-/// constraints' values and Jacobian (their rows only), V = −L and the
-/// vibration's coupling b = ∂L/∂q'.
+/// A constrained model at (t, q): the mass matrix, and the position
+/// constraints' values and Jacobian (their rows only).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Statics {
     pub mass: DMatrix<f64>,
     pub residual: DVector<f64>,
     pub jacobian: DMatrix<f64>,
-    pub potential: f64,
-    pub linear_term: DVector<f64>,
 }

@@ -8,7 +8,7 @@ use std::marker::PhantomData;
 use nalgebra::{DMatrix, DVector};
 
 use super::{FliValues, Flows, ModelInfo};
-use crate::constrained::averaged::AveragedOnConstraints;
+use crate::constrained::averaged::{AveragedOnConstraints, PhaseMeans};
 use crate::constrained::{ConstraintForms, OnConstraints, Projecting, Statics};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
@@ -58,6 +58,10 @@ pub trait ConstrainedSystems: Flows {
         t: f64,
         q: &[f64],
     ) -> Result<Vec<DMatrix<f64>>, OdeError>;
+    /// At q, the means over the fast phase of V and b and the vibrational
+    /// potential on the constraints (None without a fast phase, or where
+    /// the constraints or the mass matrix move with it).
+    fn phase_means(&self, params: &[f64], q: &[f64]) -> Result<Option<PhaseMeans>, OdeError>;
     /// The first-order averaged motion's states at `times` from `y0`
     /// (each projected onto the constraints), or None where the model has
     /// no fast phase or its constraints or mass matrix move with it
@@ -103,6 +107,13 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
 {
     fn equations(params: &[f64]) -> OnConstraints<F, N, K, S> {
         OnConstraints::new(F::from_values(params))
+    }
+
+    /// The averaged motion, where the averaging applies.
+    fn averaged(params: &[f64]) -> Option<AveragedOnConstraints<F, N, K, S>> {
+        let exact = Self::equations(params);
+        let period = exact.0.phase_period().filter(|_| F::stationary())?;
+        Some(AveragedOnConstraints { exact, period })
     }
 }
 
@@ -236,8 +247,6 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
             mass: DMatrix::from_fn(N, N, |i, k| m[i][k]),
             residual: DVector::from_iterator(rows.len(), rows.iter().map(|&r| residual[r])),
             jacobian: DMatrix::from_fn(rows.len(), N, |i, k| g[rows[i]][k]),
-            potential: forms.potential(t, &q),
-            linear_term: DVector::from_column_slice(&forms.linear_term(t, &q)),
         })
     }
     fn constraint_hessians(
@@ -272,6 +281,10 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         let c = Self::equations(params).state_constraints_jacobian(t, &y);
         Ok(tangent_basis(&c))
     }
+    fn phase_means(&self, params: &[f64], q: &[f64]) -> Result<Option<PhaseMeans>, OdeError> {
+        let q = fixed_state::<N>(q)?;
+        Ok(Self::averaged(params).map(|averaged| averaged.phase_means(&q)))
+    }
     fn averaged_states(
         &self,
         params: &[f64],
@@ -280,11 +293,9 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         times: &[f64],
     ) -> Result<Option<Vec<Vec<f64>>>, OdeError> {
         let y0 = fixed_state::<S>(y0)?;
-        let exact = Self::equations(params);
-        let (Some(period), true) = (exact.0.phase_period(), F::stationary()) else {
+        let Some(averaged) = Self::averaged(params) else {
             return Ok(None);
         };
-        let averaged = AveragedOnConstraints { exact, period };
         let t0 = times.first().copied().unwrap_or(0.0);
         let mut states = states_at(method, &averaged, t0, &y0, times)?;
         for y in &mut states {

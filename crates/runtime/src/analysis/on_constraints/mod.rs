@@ -150,13 +150,11 @@ pub fn run(
         for (&ts, mut sample) in group.iter().zip(samples) {
             let drift = model.residuals(params, ts, &sample)?;
             result.largest_drift = larger(result.largest_drift, drift);
-            model
+            let left = model
                 .project(params, ts, &mut sample)
                 .map_err(constraint(ts))?;
-            result.largest_residual = larger(
-                result.largest_residual,
-                model.residuals(params, ts, &sample)?,
-            );
+            let residual = (left.position_residual, left.velocity_residual);
+            result.largest_residual = larger(result.largest_residual, residual);
             result.times.push(ts);
             result.reactions.push(model.reactions(params, ts, &sample)?);
             result.energy.push(model.energy(params, ts, &sample)?);

@@ -14,8 +14,9 @@
 //! stiffness on the tangent space, Zᵀ(∇²W − Σ μᵢ∇²gᵢ)Z, is positive
 //! definite (the constraints' curvature enters through the multipliers μ).
 //! The means over θ are exact quadratures (32 nodes: V and b are
-//! trigonometric polynomials in θ of low degree); ∇W and ∇²W are central
-//! differences (errors about 1e-10 and 1e-8 of W's scale), ∇²g exact.
+//! trigonometric polynomials in θ of low degree), taken at the model's
+//! sizes by `constrained::averaged`; ∇W and ∇²W are central differences
+//! (errors about 1e-10 and 1e-8 of W's scale), ∇²g exact.
 //!
 //! The exact system answers too: where the equilibrium at rest relative to
 //! the base is a periodic orbit of the vibrating system, its Floquet
@@ -28,12 +29,9 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{monodromy_on_constraints, ConstrainedError};
 use crate::analysis::Refusal;
-use crate::ode::holonomic::{tangent_inverse_mass, tangent_stability, vibrational_potential};
+use crate::ode::holonomic::tangent_stability;
 use crate::ode::{Integrator, Method, OdeError};
 use crate::registry::ConstrainedSystems;
-
-/// Phases of the quadrature over θ.
-const NODES: usize = 32;
 
 /// What to compute.
 #[derive(Clone, Debug)]
@@ -144,7 +142,6 @@ pub enum VibrationError {
 struct Averaged<'a> {
     model: &'a dyn ConstrainedSystems,
     params: Vec<f64>,
-    period: f64,
 }
 
 /// An equilibrium of the averaged system and its stiffness.
@@ -157,24 +154,13 @@ struct Equilibrium {
 impl Averaged<'_> {
     /// W(q) and the mean of b.
     fn effective(&self, q: &[f64]) -> Result<(f64, DVector<f64>), VibrationError> {
-        let rest = self.model.statics(&self.params, 0.0, q)?;
-        let p = tangent_inverse_mass(&rest.mass, &rest.jacobian, q).map_err(|source| {
-            ConstrainedError::Constraint {
-                model: self.model.info().name,
-                t: 0.0,
-                source,
-            }
-        })?;
-        let (mut potential, mut couplings) = (0.0, Vec::with_capacity(NODES));
-        for j in 0..NODES {
-            let t = self.period * j as f64 / NODES as f64;
-            let at = self.model.statics(&self.params, t, q)?;
-            potential += at.potential / NODES as f64;
-            couplings.push(at.linear_term);
-        }
-        let mean = couplings.iter().sum::<DVector<f64>>() / NODES as f64;
-        let oscillating: Vec<DVector<f64>> = couplings.iter().map(|b| b - &mean).collect();
-        Ok((potential + vibrational_potential(&p, &oscillating), mean))
+        let name = self.model.info().name;
+        let means = self
+            .model
+            .phase_means(&self.params, q)?
+            .ok_or(VibrationError::MovingConstraints { model: name })?;
+        let mean = DVector::from_vec(means.coupling);
+        Ok((means.potential + means.vibrational, mean))
     }
 
     fn w(&self, q: &[f64]) -> Result<f64, VibrationError> {
@@ -342,14 +328,7 @@ pub fn vibration_stability(
     let at = |a: f64| -> Result<Averaged<'_>, VibrationError> {
         let mut p = params.to_vec();
         p[index] = a;
-        let period = model
-            .phase_period(&p)
-            .ok_or_else(|| Refusal::no_fast_phase(name))?;
-        Ok(Averaged {
-            model,
-            params: p,
-            period,
-        })
+        Ok(Averaged { model, params: p })
     };
     let n = info.coordinates.len();
     let start = match &settings.start {
