@@ -521,3 +521,64 @@ fn a_velocity_constraint_must_be_linear_and_not_integrable() {
     );
     assert_error(&contact, "constraints", "cannot be combined");
 }
+
+/// `GOOD` drawn: a pivot and a bob on a rod.
+fn drawn(points: &str) -> String {
+    format!("{GOOD}\n[definitions]\nbob_x = \"sin(q)\"\n{points}")
+}
+
+const PIVOT: &str = "[[points]]\nname = \"pivot\"\nat = [\"0\", \"0\"]\n";
+
+#[test]
+fn points_are_read_with_their_bars() {
+    let text = drawn(&format!(
+        "{PIVOT}\n[[points]]\nname = \"bob\"\nat = [\"bob_x\", \"cos(q)\"]\njoined_to = [\"pivot\"]\n"
+    ));
+    let model = Model::parse("models/toy.toml", &text).unwrap();
+    let names: Vec<&str> = model.points.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["pivot", "bob"]);
+    assert_eq!(model.points[1].joined_to, [0]);
+}
+
+#[test]
+fn malformed_points_name_the_problem() {
+    let bob = |at: &str, joined: &str| {
+        drawn(&format!(
+            "{PIVOT}\n[[points]]\nname = \"bob\"\nat = {at}\njoined_to = {joined}\n"
+        ))
+    };
+    assert_error(
+        &bob(r#"["bob_x", "cos(q)"]"#, r#"["hinge"]"#),
+        "points[1].joined_to",
+        "'hinge' is not a point declared before 'bob'",
+    );
+    assert_error(
+        &bob(r#"["bob_x", "cos(q)", "0"]"#, "[]"),
+        "points[1].at",
+        "as [x, y]: 3 expressions given",
+    );
+    assert_error(
+        &bob(r#"["dot(bob_x)", "cos(q)"]"#, "[]"),
+        "points[1].at",
+        "dot() is only allowed",
+    );
+    assert_error(
+        &bob(r#"["qd", "cos(q)"]"#, "[]"),
+        "points[1].at",
+        "unknown symbol 'qd'",
+    );
+    assert_error(
+        &drawn(&format!("{PIVOT}\n{PIVOT}")),
+        "points[1].name",
+        "'pivot' names two points",
+    );
+    let too_many: String = (0..=mechlab_model::MAX_POINTS)
+        .map(|i| PIVOT.replace("\"pivot\"", &format!("\"p{i}\"")) + "\n")
+        .collect();
+    assert_error(&drawn(&too_many), "points", "a drawing has at most 64");
+    assert_error(
+        &format!("{CONTACTS}\n{PIVOT}"),
+        "points",
+        "a model with contacts cannot be drawn yet",
+    );
+}

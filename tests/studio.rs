@@ -198,6 +198,55 @@ async fn a_constrained_models_orbit_is_its_portrait_on_the_constraints() {
     }
 }
 
+/// The mechanism drawn from a click on the four-bar: its bars keep their
+/// lengths in every frame (the seed is put on the constraints as the
+/// orbit's is), its base moves as the model file says; a model without
+/// points gets a 422 naming `[[points]]`.
+#[tokio::test]
+async fn the_mechanism_moves_with_its_bars_rigid() {
+    let seed = vec![0.35, 0.05, -0.3, 0.4, 0.0, 0.7];
+    let request = json!({"model": "four_bar", "method": "dop853", "tol": 1e-11,
+        "axes": [0, 3], "seed": seed, "duration": 2.0, "frames": 61});
+    let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let view: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(view["points"], json!(["O1", "O2", "B", "C"]));
+    assert_eq!(view["bars"], json!([[0, 1], [0, 2], [2, 3], [1, 3]]));
+    let frames: Vec<Vec<[f64; 2]>> = serde_json::from_value(view["frames"].clone()).unwrap();
+    let times: Vec<f64> = serde_json::from_value(view["times"].clone()).unwrap();
+    assert_eq!((frames.len(), times[60]), (61, 2.0));
+    let p = mechlab::models::four_bar::Params::default();
+    let length = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    for (f, points) in frames.iter().enumerate() {
+        let [o1, o2, b, c] = [points[0], points[1], points[2], points[3]];
+        assert!((length(o1, b) - p.l).abs() < 1e-12, "crank, frame {f}");
+        assert!((length(o2, c) - p.l).abs() < 1e-12, "rocker, frame {f}");
+        assert!(
+            (length(b, c) - p.c).abs() < 1e-8,
+            "coupler (the closure), frame {f}"
+        );
+        let w = p.a / p.nu * (p.nu * times[f]).cos();
+        let base = [o1[0] + p.d / 2.0, o1[1] - w, o2[0] - p.d / 2.0, o2[1] - w];
+        assert!(base.iter().all(|e| e.abs() < 1e-15), "the base, frame {f}");
+    }
+    assert_eq!(
+        frames[0][2][0],
+        -p.d / 2.0 + p.l * 0.35f64.sin(),
+        "the crank angle is held"
+    );
+    let request = json!({"model": "duffing", "seed": [0.1, 0.0], "duration": 1.0, "frames": 10});
+    let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(
+        body.contains("names no points") && body.contains("[[points]]"),
+        "{body}"
+    );
+    let request = json!({"model": "kapitza", "seed": [0.1, 0.0], "duration": 1.0, "frames": 1});
+    let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(body.contains("from 2 to 3600 frames"), "{body}");
+}
+
 /// Each refinement of the streamed chaos map is the library's map of the
 /// same view, pixel for pixel.
 #[tokio::test]
@@ -842,6 +891,7 @@ mod browser {
         manifolds_and_a_branch_point(&client, &folder).await;
         sections_without_a_fast_phase(&client, &folder).await;
         a_slice_of_the_period_map(&client, &folder).await;
+        the_mechanism_moves(&client, &folder).await;
         client.close().await.unwrap();
     }
 
@@ -1038,5 +1088,34 @@ mod browser {
         assert_eq!(about_pi, serde_json::json!(true));
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("section_slice.png"), png).unwrap();
+    }
+
+    /// The four-bar: a click seeds an orbit and the mechanism moves beside
+    /// it, its crank pin B painted where the frame on show puts it.
+    async fn the_mechanism_moves(client: &Client, folder: &std::path::Path) {
+        select_model(client, "four_bar").await;
+        client
+            .execute("studio.seed(0.35, 0.4); return true;", vec![])
+            .await
+            .unwrap();
+        // Painted: the canvas pixel under B (index 2) of the frame on show
+        // is the points' colour, read in the same turn as the frame.
+        let painted = "studio.mechanism && studio.mechanismFrame > 30 && (() => { \
+             const m = studio.mechanism, f = studio.mechanismFrame, [x, y] = m.frames[f][2]; \
+             const c = document.getElementById('mechanism'), g = c.getContext('2d'); \
+             const [x0, x1, y0, y1] = m.box, w = c.width, h = c.height; \
+             const s = 0.85 * Math.min(w / (x1 - x0), h / (y1 - y0)); \
+             const px = Math.round(w / 2 + (x - (x0 + x1) / 2) * s), py = Math.round(h / 2 - (y - (y0 + y1) / 2) * s); \
+             const d = g.getImageData(px, py, 1, 1).data; return d[0] > 150 && d[1] < 120; })()";
+        let frames = read_when(
+            client,
+            painted,
+            "return studio.mechanism.frames.length;",
+            60,
+        )
+        .await;
+        assert_eq!(frames, serde_json::json!(601));
+        let png = client.screenshot().await.unwrap();
+        std::fs::write(folder.join("mechanism.png"), png).unwrap();
     }
 }

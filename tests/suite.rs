@@ -18,6 +18,7 @@ mod events;
 mod explore;
 mod holonomic;
 mod integrators;
+mod mechanism;
 mod model_errors;
 mod report;
 mod runtime;

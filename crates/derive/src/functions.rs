@@ -918,3 +918,36 @@ pub fn second_order_functions(
     )?);
     Ok(functions)
 }
+
+/// The drawing's points at (t, q) as `[[x, y]; P]` (the model file's
+/// `[[points]]`, definitions substituted), or none when the file names no
+/// points. Both the Hamiltonian and the constrained templates have q first
+/// in their state, so one form serves both.
+pub fn drawing_function(cx: &Context) -> Result<Option<Function>, DeriveError> {
+    let points = &cx.model.points;
+    if points.is_empty() {
+        return Ok(None);
+    }
+    let rows = points
+        .iter()
+        .map(|p| {
+            p.at.iter()
+                .map(|e| Ok(crate::derive::kinematic(cx.model, e)?.to_string()))
+                .collect::<Result<Vec<String>, DeriveError>>()
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let (outputs, result) = matrix("point", &rows);
+    let names: Vec<&str> = points.iter().map(|p| p.name.as_str()).collect();
+    cx.function(
+        "mechanism_points",
+        &format!(
+            "The mechanism's points ({}) in the figure's plane.",
+            names.join(", ")
+        ),
+        Inputs::TimeCoordinates,
+        format!("[[f64; 2]; {}]", points.len()),
+        &[outputs],
+        result,
+    )
+    .map(Some)
+}

@@ -63,10 +63,11 @@ pub fn render(
     };
     let n = cx.n();
     let m = 2 * n;
-    let (functions, taylor_functions) = match &derivation.numeric {
+    let (mut functions, taylor_functions) = match &derivation.numeric {
         Some(form) => crate::numeric::functions(&cx, derivation, form)?,
         None => symbolic_functions(&cx, derivation)?,
     };
+    functions.extend(crate::functions::drawing_function(&cx)?);
 
     // Functions of q alone must not depend on anything else.
     let forbidden: Vec<String> = cx
@@ -200,6 +201,15 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
         _ => String::new(),
     };
     context.insert("rate_parameter", &rate_parameter);
+    let point_names: Vec<&str> = model.points.iter().map(|p| p.name.as_str()).collect();
+    let bars: Vec<[usize; 2]> = model
+        .points
+        .iter()
+        .enumerate()
+        .flat_map(|(i, p)| p.joined_to.iter().map(move |&j| [j, i]))
+        .collect();
+    context.insert("point_names", &point_names);
+    context.insert("bars", &bars);
     context
 }
 
@@ -472,7 +482,8 @@ pub fn render_constrained(
         contact_state: Vec::new(),
         model_phase_rate: String::new(),
     };
-    let functions = constrained_functions(&cx, derivation)?;
+    let mut functions = constrained_functions(&cx, derivation)?;
+    functions.extend(crate::functions::drawing_function(&cx)?);
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);
     context.insert("constraints", &k);

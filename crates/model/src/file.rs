@@ -42,6 +42,10 @@ pub struct ModelFile {
     /// moving guides, rolling.
     #[serde(default)]
     pub constraints: Vec<ConstraintSpec>,
+    /// Points of the mechanism, for drawing it: each at (x, y), an
+    /// expression of the positions, joined by bars to earlier points.
+    #[serde(default)]
+    pub points: Vec<PointSpec>,
     /// How q' = A⁻¹(p − b) is computed: "symbolic" (cofactors) or
     /// "numeric" (A(q) emitted, solved by Cholesky in the generated code).
     /// Default: symbolic up to [`SYMBOLIC_INVERSE_MAX_DOF`] degrees of freedom.
@@ -107,6 +111,24 @@ pub struct ConstraintSpec {
     #[serde(default)]
     pub description: String,
 }
+
+/// A point of the mechanism's drawing: `at = ["x", "y"]` in the plane of
+/// the figure (expressions of the coordinates, parameters, time and fast
+/// phase, definitions allowed), `joined_to` the earlier points a bar joins
+/// it to.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSpec {
+    pub name: String,
+    pub at: Vec<String>,
+    #[serde(default)]
+    pub joined_to: Vec<String>,
+    #[serde(default)]
+    pub description: String,
+}
+
+/// The most points a drawing may have.
+pub const MAX_POINTS: usize = 64;
 
 /// A number in a model file: a value, or an expression in the parameters.
 #[derive(Debug, Deserialize)]
@@ -233,7 +255,20 @@ pub struct Model {
     pub rayleigh: Expr,
     pub contacts: Vec<Contact>,
     pub constraints: Vec<Constraint>,
+    /// The mechanism's points, in the order of the file (empty: no drawing).
+    pub points: Vec<Point>,
     pub inverse: Inverse,
+}
+
+/// A validated point of the drawing.
+#[derive(Clone, Debug)]
+pub struct Point {
+    pub name: String,
+    /// (x, y) as written (definitions not yet substituted).
+    pub at: [Expr; 2],
+    /// Indices of the earlier points a bar joins it to.
+    pub joined_to: Vec<usize>,
+    pub description: String,
 }
 
 /// A validated ideal constraint.
@@ -552,13 +587,7 @@ impl ModelFile {
         // Definitions are positions: no velocities, and no cycles.
         let mut parsed_defs = BTreeMap::new();
         for (name, text) in &self.definitions {
-            let positions = [
-                &names.coordinates,
-                &names.parameters,
-                &names.phase,
-                &names.time,
-                &names.definitions,
-            ];
+            let positions = names.positions();
             let e = parse(&format!("definitions.{name}"), text, &positions, false)?;
             parsed_defs.insert(name.clone(), e);
         }
@@ -586,6 +615,7 @@ impl ModelFile {
         let contacts =
             self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
         let (constraints, starts) = self.validate_constraints(file, names, &parse)?;
+        let points = self.validate_points(file, names, &parse)?;
         let mut coordinates: Vec<Coordinate> =
             self.coordinates.into_iter().map(Coordinate::from).collect();
         for (c, start) in coordinates.iter_mut().zip(starts) {
@@ -604,6 +634,7 @@ impl ModelFile {
             rayleigh,
             contacts,
             constraints,
+            points,
             inverse,
         };
         model
@@ -657,6 +688,18 @@ struct Names {
 }
 
 impl Names {
+    /// What a position may use: coordinates, parameters, the fast phase,
+    /// time and definitions (no velocities).
+    fn positions(&self) -> [&Vec<String>; 5] {
+        [
+            &self.coordinates,
+            &self.parameters,
+            &self.phase,
+            &self.time,
+            &self.definitions,
+        ]
+    }
+
     /// Every kind: what the Lagrangian, forces and Rayleigh function may use.
     fn all(&self) -> [&Vec<String>; 6] {
         [
@@ -778,6 +821,15 @@ impl<'f> Reader<'f> {
 }
 
 /// Parses one expression of the file: (key, text, allowed symbol sets, dot() allowed).
+/// A validator's errors: in `file`, at a key, for a reason.
+fn error_at(file: &str) -> impl Fn(String, String) -> ModelError + '_ {
+    move |key, reason| ModelError {
+        file: file.to_string(),
+        key,
+        reason,
+    }
+}
+
 type ExprParser<'a> = dyn Fn(&str, &str, &[&Vec<String>], bool) -> Result<Expr, ModelError> + 'a;
 
 impl ModelFile {
@@ -791,11 +843,7 @@ impl ModelFile {
         parameters: &Vec<String>,
         parse: &ExprParser,
     ) -> Result<Vec<Contact>, ModelError> {
-        let err = |key: String, reason: String| ModelError {
-            file: file.to_string(),
-            key,
-            reason,
-        };
+        let err = error_at(file);
         if self.contacts.is_empty() {
             return Ok(Vec::new());
         }
@@ -845,6 +893,86 @@ impl ModelFile {
 }
 
 impl ModelFile {
+    /// Points: identifiers named once, each at two position expressions,
+    /// joined only to earlier points; not with contacts (whose state is not
+    /// the coordinates).
+    fn validate_points(
+        &self,
+        file: &str,
+        names: &Names,
+        parse: &ExprParser,
+    ) -> Result<Vec<Point>, ModelError> {
+        let err = error_at(file);
+        if self.points.is_empty() {
+            return Ok(Vec::new());
+        }
+        if !self.contacts.is_empty() {
+            return Err(err(
+                "points".into(),
+                "a model with contacts cannot be drawn yet (its state holds the sliding coordinates only)".into(),
+            ));
+        }
+        if self.points.len() > MAX_POINTS {
+            return Err(err(
+                "points".into(),
+                format!(
+                    "{} points: a drawing has at most {MAX_POINTS}",
+                    self.points.len()
+                ),
+            ));
+        }
+        let positions = names.positions();
+        let mut points: Vec<Point> = Vec::new();
+        for (i, p) in self.points.iter().enumerate() {
+            if !is_identifier(&p.name) {
+                return Err(err(
+                    format!("points[{i}].name"),
+                    format!("'{}' is not an identifier", p.name),
+                ));
+            }
+            if points.iter().any(|q| q.name == p.name) {
+                return Err(err(
+                    format!("points[{i}].name"),
+                    format!("'{}' names two points", p.name),
+                ));
+            }
+            let [x, y] = p.at.as_slice() else {
+                return Err(err(
+                    format!("points[{i}].at"),
+                    format!(
+                        "give the point '{}' as [x, y]: {} expressions given",
+                        p.name,
+                        p.at.len()
+                    ),
+                ));
+            };
+            let key = format!("points[{i}].at");
+            let at = [
+                parse(&key, x, &positions, false)?,
+                parse(&key, y, &positions, false)?,
+            ];
+            let joined_to = p
+                .joined_to
+                .iter()
+                .map(|other| {
+                    points.iter().position(|q| &q.name == other).ok_or_else(|| {
+                        err(
+                            format!("points[{i}].joined_to"),
+                            format!("'{other}' is not a point declared before '{}'", p.name),
+                        )
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            points.push(Point {
+                name: p.name.clone(),
+                at,
+                joined_to,
+                description: p.description.clone(),
+            });
+        }
+        Ok(points)
+    }
+
     /// Constraints: each a position or a velocity expression, named once;
     /// fewer than the coordinates; not with contacts; and a start for
     /// every coordinate. Returns them and the coordinates' starts.
@@ -854,11 +982,7 @@ impl ModelFile {
         names: &Names,
         parse: &ExprParser,
     ) -> Result<(Vec<Constraint>, Vec<Option<Expr>>), ModelError> {
-        let err = |key: String, reason: String| ModelError {
-            file: file.to_string(),
-            key,
-            reason,
-        };
+        let err = error_at(file);
         let starts = self
             .coordinates
             .iter()
@@ -895,13 +1019,7 @@ impl ModelFile {
                 format!("{k} constraints on {n} coordinates leave no motion: a model needs fewer constraints than coordinates"),
             ));
         }
-        let positions = [
-            &names.coordinates,
-            &names.parameters,
-            &names.phase,
-            &names.time,
-            &names.definitions,
-        ];
+        let positions = names.positions();
         let mut constraints = Vec::new();
         for (i, c) in self.constraints.iter().enumerate() {
             if !is_identifier(&c.name) {

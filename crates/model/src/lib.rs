@@ -6,6 +6,6 @@ pub mod file;
 
 pub use expr::Expr;
 pub use file::{
-    Constraint, ConstraintKind, Contact, Inverse, Model, ModelError, Range, RangeError, MAX_DOF,
-    SYMBOLIC_INVERSE_MAX_DOF,
+    Constraint, ConstraintKind, Contact, Inverse, Model, ModelError, Point, Range, RangeError,
+    MAX_DOF, MAX_POINTS, SYMBOLIC_INVERSE_MAX_DOF,
 };

@@ -27,6 +27,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
+use mechlab_runtime::analysis::mechanism::MechanismError;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::registry::Catalog;
 use mechlab_runtime::studio::{
@@ -67,7 +68,10 @@ impl ApiError {
                 StudioError::Refused(_)
                 | StudioError::Splitting(_)
                 | StudioError::Continuation(_)
-                | StudioError::Section(_),
+                | StudioError::Section(_)
+                | StudioError::Mechanism(
+                    MechanismError::NotDrawn { .. } | MechanismError::Refused(_),
+                ),
             ) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
             ApiError::Panicked { .. } | ApiError::Join(_) => StatusCode::INTERNAL_SERVER_ERROR,
@@ -116,6 +120,7 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/continuation", post(continuation))
         .route("/api/section", post(section))
         .route("/api/section_map", post(section_map))
+        .route("/api/mechanism", post(mechanism))
         .fallback(|uri: axum::http::Uri| async move {
             ApiError::NotFound {
                 path: uri.to_string(),
@@ -196,6 +201,13 @@ async fn section_map(State(catalog): State<Catalog>, body: Bytes) -> Result<Resp
     let request: studio::SectionMapRequest = serde_json::from_slice(&body)?;
     let answer =
         blocking(move || studio::section_map(catalog, &request).map_err(ApiError::from)).await?;
+    Ok(axum::Json(answer).into_response())
+}
+
+async fn mechanism(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
+    let request: studio::MechanismRequest = serde_json::from_slice(&body)?;
+    let answer =
+        blocking(move || studio::mechanism(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())
 }
 

@@ -50,8 +50,23 @@ pub struct ModelInfo {
     /// transcendental calls weighted 20, divisions 4): (function, as derived
     /// by Symbolica, in the readable form, emitted).
     pub operation_counts: &'static [(&'static str, usize, usize, usize)],
+    /// The mechanism's drawing, if the model file names its points.
+    pub drawing: Option<&'static Drawing>,
     /// The generated Rust module.
     pub generated_code: &'static str,
+}
+
+/// A model's mechanism as its file draws it (`[[points]]`): named points,
+/// functions of the time and the coordinates, and bars between them.
+#[derive(Debug)]
+pub struct Drawing {
+    pub points: &'static [&'static str],
+    /// Bars between points, by index.
+    pub bars: &'static [[usize; 2]],
+    /// The points at (t, q) with the parameters' values in declaration
+    /// order; empty if q is not of the coordinates' length (the caller
+    /// checks; see [`crate::analysis::mechanism`]).
+    pub at: fn(f64, &[f64], &[f64]) -> Vec<[f64; 2]>,
 }
 
 impl ModelInfo {

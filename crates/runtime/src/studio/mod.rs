@@ -51,6 +51,8 @@ pub enum StudioError {
     Continuation(#[from] crate::analysis::continuation::ContinuationError),
     #[error(transparent)]
     Section(#[from] crate::analysis::section::SectionError),
+    #[error(transparent)]
+    Mechanism(#[from] crate::analysis::mechanism::MechanismError),
 }
 
 /// What is wrong with a request's numbers.
@@ -110,6 +112,9 @@ pub struct ModelSummary {
     /// The state the plane passes through by default: zero, or a
     /// constrained model's start (its seeds are put on its constraints).
     pub through: Vec<f64>,
+    /// The mechanism's points, if its model file names them (the page
+    /// draws the mechanism moving from each orbit's seed).
+    pub points: Vec<&'static str>,
 }
 
 /// Every model of `catalog`, in its order.
@@ -177,6 +182,7 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
         amplitude: info.amplitude,
         default_axes,
         default_ranges,
+        points: info.drawing.map(|d| d.points.to_vec()).unwrap_or_default(),
     }
 }
 
@@ -1080,4 +1086,58 @@ fn setup_tol(setup: &Resolved) -> f64 {
         Method::Taylor { tol } => tol,
         Method::Rk4 { .. } | Method::Gauss { .. } => 1e-10,
     }
+}
+
+/// The mechanism moving from an orbit's seed (the model file's points):
+/// `duration` time units drawn in `frames` frames.
+#[derive(Clone, Debug, Deserialize)]
+pub struct MechanismRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub seed: Vec<f64>,
+    pub duration: f64,
+    pub frames: usize,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+/// The frames of the mechanism, for the page to play.
+#[derive(Clone, Debug, Serialize)]
+pub struct MechanismView {
+    pub points: Vec<&'static str>,
+    pub bars: Vec<[usize; 2]>,
+    pub times: Vec<f64>,
+    /// `frames[f][p]`: the point p at `times[f]`.
+    pub frames: Vec<Vec<[f64; 2]>>,
+}
+
+/// The mechanism of `request` moving, from the seed put on the constraints
+/// as the orbit's is (its axes' components held).
+pub fn mechanism(
+    catalog: Catalog,
+    request: &MechanismRequest,
+) -> Result<MechanismView, StudioError> {
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    if request.seed.iter().any(|x| !x.is_finite()) {
+        return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
+    }
+    let frames = crate::analysis::mechanism::Frames {
+        duration: request.duration,
+        count: request.frames,
+    };
+    let animation = crate::analysis::mechanism::animate(
+        setup.handle,
+        &setup.params,
+        setup.method,
+        &request.seed,
+        &setup.axes,
+        frames,
+    )?;
+    Ok(MechanismView {
+        points: animation.points.to_vec(),
+        bars: animation.bars.to_vec(),
+        times: animation.times,
+        frames: animation.frames,
+    })
 }

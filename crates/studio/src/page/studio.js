@@ -109,6 +109,7 @@ let dirty = true;
 function redraw() { dirty = true; }
 function frame() {
   if (dirty) { dirty = false; draw(ctx, canvas.width, canvas.height); }
+  drawMechanism(performance.now());
   requestAnimationFrame(frame);
 }
 
@@ -347,6 +348,7 @@ function startOrbit(orbit) {
   if (orbit.section) { startSectionOrbit(orbit); return; }
   restart(orbit);
   const request = orbitRequest(orbit);
+  startMechanism(orbit.seed);
   postStream("/api/orbit", request, orbit.controller.signal, (line) => {
     if (line.points) {
       for (const p of line.points) orbit.points.push(p);
@@ -366,6 +368,76 @@ function startOrbit(orbit) {
     orbit.done = true;
     say(`orbit ${orbit.id}: ${e.message}`);
   }).finally(() => { listOrbits(); redraw(); });
+}
+
+// ---------- the mechanism, moving ----------
+
+const mechanismCanvas = $("mechanism");
+const mctx = mechanismCanvas.getContext("2d");
+let mechanismController = null;
+
+// The mechanism from `seed` (the orbit's), over the time asked for, played
+// at one time unit per second.
+async function startMechanism(seed) {
+  if (mechanismController) mechanismController.abort();
+  studio.mechanism = null;
+  if (!studio.model.points.length) return;
+  mechanismController = new AbortController();
+  const duration = Number($("mechanism-time").value);
+  const frames = Math.max(2, Math.min(3600, Math.round(30 * duration) + 1));
+  try {
+    const m = await postJson("/api/mechanism", { ...setup(), seed, duration, frames }, mechanismController.signal);
+    const xs = m.frames.flat().map((p) => p[0]), ys = m.frames.flat().map((p) => p[1]);
+    m.box = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+    m.started = performance.now();
+    studio.mechanism = m;
+    $("mechanism-note").textContent = `the mechanism from orbit ${studio.orbits.length}'s seed (${m.points.join(", ")})`;
+  } catch (e) {
+    if (!aborted(e)) $("mechanism-note").textContent = `mechanism: ${e.message}`;
+  }
+}
+
+function drawMechanism(now) {
+  const g = mctx, w = mechanismCanvas.width, h = mechanismCanvas.height;
+  g.fillStyle = "#fff";
+  g.fillRect(0, 0, w, h);
+  const m = studio.mechanism;
+  if (!m) return;
+  const step = m.times[1] - m.times[0];
+  const f = Math.min(m.frames.length - 1, Math.floor((now - m.started) / 1000 / step));
+  studio.mechanismFrame = f;
+  const [x0, x1, y0, y1] = m.box;
+  const scale = 0.85 * Math.min(w / Math.max(x1 - x0, 1e-9), h / Math.max(y1 - y0, 1e-9));
+  const at = ([x, y]) => [w / 2 + (x - (x0 + x1) / 2) * scale, h / 2 - (y - (y0 + y1) / 2) * scale];
+  // The last second's path of each point, faint.
+  g.strokeStyle = "rgba(35, 57, 91, 0.25)";
+  g.lineWidth = 1;
+  for (let p = 0; p < m.points.length; p++) {
+    g.beginPath();
+    for (let k = Math.max(0, f - Math.round(1 / step)); k <= f; k++) {
+      const [px, py] = at(m.frames[k][p]);
+      if (k === Math.max(0, f - Math.round(1 / step))) g.moveTo(px, py); else g.lineTo(px, py);
+    }
+    g.stroke();
+  }
+  const points = m.frames[f].map(at);
+  g.strokeStyle = "#23395b";
+  g.lineWidth = 3;
+  for (const [a, b] of m.bars) {
+    g.beginPath();
+    g.moveTo(...points[a]);
+    g.lineTo(...points[b]);
+    g.stroke();
+  }
+  g.fillStyle = "#b5462f";
+  g.font = "12px system-ui";
+  points.forEach(([px, py], p) => {
+    g.beginPath();
+    g.arc(px, py, 4.5, 0, 2 * Math.PI);
+    g.fill();
+    g.fillText(m.points[p], px + 6, py - 6);
+  });
+  $("mechanism-clock").textContent = `t = ${m.times[f].toFixed(2)} of ${m.times[m.times.length - 1]}`;
 }
 
 function seedAt(x, y) {
@@ -680,6 +752,10 @@ async function chooseModel(name) {
   // multipliers is not generated as one yet): its orbits run with DOP853.
   if (model.kind === "constrained" && $("method").value === "taylor") $("method").value = "dop853";
   $("order").value = "1";
+  studio.mechanism = null;
+  $("mechanism-note").textContent = model.points.length
+    ? "click the plane: the mechanism moves from the orbit's seed"
+    : `model '${name}' names no points: give its model file [[points]] (name, at = [x, y], joined_to) to draw it here`;
   defaultView(model);
   const notes = {
     contacts: `model '${name}' is a contact model: no phase plane here, its derivations are below`,
@@ -831,6 +907,7 @@ function wire() {
     removeOrbits(0);
     refreshOverlays();
   });
+  $("mechanism-replay").addEventListener("click", () => { if (studio.mechanism) studio.mechanism.started = performance.now(); });
   $("export-png").addEventListener("click", () => canvas.toBlob((blob) => download(`studio_${studio.model.name}.png`, blob)));
   $("export-svg").addEventListener("click", exportSvg);
   $("export-csv").addEventListener("click", exportCsv);

@@ -1,0 +1,175 @@
+//! The mechanism drawn moving: the generated points against positions
+//! written here by hand along the same motion, every drawn model's
+//! animation from its start, and the errors of a drawing.
+
+use mechlab::analysis::mechanism::{animate, Frames, MechanismError};
+use mechlab::analysis::Refusal;
+use mechlab::models::kapitza;
+use mechlab::ode::Method;
+
+const METHOD: Method = Method::Dop853 {
+    rtol: 1e-12,
+    atol: 1e-12,
+};
+
+/// Kapitza's pivot at (0, Aε cos(t/ε)) and its bob one length away at the
+/// angle q from the upward vertical, frame by frame.
+#[test]
+fn kapitzas_bob_is_where_its_angle_puts_it() {
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let p = kapitza::Params::default();
+    let params = p.values();
+    let start = [2.9, 0.3];
+    let frames = Frames {
+        duration: 3.0,
+        count: 301,
+    };
+    let animation = animate(model, &params, METHOD, &start, &[0, 1], frames).unwrap();
+    let flows = model.flows().unwrap();
+    let states = flows
+        .exact(&params)
+        .states_at(METHOD, 0.0, &start, &frames.times())
+        .unwrap();
+    assert_eq!(
+        (animation.points, animation.bars),
+        (&["pivot", "bob"][..], &[[0, 1]][..])
+    );
+    for ((t, y), points) in animation.times.iter().zip(&states).zip(&animation.frames) {
+        let pivot = p.A * p.eps * (t / p.eps).cos();
+        let bob = [y[0].sin(), pivot + y[0].cos()];
+        assert!(
+            points[0][0] == 0.0 && (points[0][1] - pivot).abs() < 1e-15,
+            "the pivot at t = {t}"
+        );
+        assert!(
+            (points[1][0] - bob[0]).abs() < 1e-15 && (points[1][1] - bob[1]).abs() < 1e-15,
+            "the bob at t = {t}: {:?} against {bob:?}",
+            points[1]
+        );
+    }
+}
+
+/// Every model whose file names points is drawn from its start (a
+/// constrained model's start is on its constraints) over a few of its own
+/// periods: the first frame is the drawing of the start, every point of
+/// every frame finite (a singular one would be a named error). A motion
+/// that leaves the model's domain from there (a spring through zero
+/// length) is skipped with the integrator's named error.
+#[test]
+fn every_drawn_model_moves_from_its_start() {
+    let mut drawn = 0;
+    for handle in mechlab::models::MODELS.iter() {
+        let (info, model) = (handle.info, handle.dynamic);
+        let Some(drawing) = info.drawing else {
+            println!("{}: names no points (not drawn)", info.name);
+            continue;
+        };
+        let Some(flows) = handle.flows() else {
+            continue; // (a contact model cannot name points: the reader refuses them)
+        };
+        let params = model.defaults();
+        let mut start = flows.base_state(&params);
+        let n = info.coordinates.len();
+        start[n] += 0.1; // a little speed along the first coordinate
+        if handle.constrained.is_none() {
+            // Off the origin of the coordinates (a polar chart's singular point).
+            start[..n].iter_mut().for_each(|q| *q += 0.5);
+        }
+        let duration = 3.0 * flows.phase_period(&params).unwrap_or(1.0);
+        let frames = Frames {
+            duration,
+            count: 31,
+        };
+        let held: Vec<usize> = (0..1).chain(n..n + 1).collect();
+        let animation = match animate(handle, &params, METHOD, &start, &held, frames) {
+            Ok(animation) => animation,
+            Err(MechanismError::Ode(e)) => {
+                println!(
+                    "{}: skipped, its motion from {start:?} stops: {e}",
+                    info.name
+                );
+                continue;
+            }
+            Err(e) => panic!("{}: {e}", info.name),
+        };
+        drawn += 1;
+        assert_eq!(animation.frames.len(), 31, "{}", info.name);
+        assert_eq!(
+            animation.frames[0],
+            (drawing.at)(0.0, &animation.start[..n], &params),
+            "{}: the first frame draws the start",
+            info.name
+        );
+        for points in &animation.frames {
+            assert_eq!(points.len(), drawing.points.len(), "{}", info.name);
+            assert!(
+                points.iter().flatten().all(|x| x.is_finite()),
+                "{}",
+                info.name
+            );
+        }
+    }
+    assert!(drawn > 0, "no model was drawn");
+}
+
+#[test]
+fn a_drawing_that_cannot_be_made_says_why() {
+    let frames = Frames {
+        duration: 1.0,
+        count: 10,
+    };
+    let duffing = mechlab::models::by_name("duffing").unwrap();
+    let error = animate(
+        duffing,
+        &duffing.dynamic.defaults(),
+        METHOD,
+        &[0.1, 0.0],
+        &[0, 1],
+        frames,
+    )
+    .unwrap_err();
+    assert!(matches!(error, MechanismError::NotDrawn { .. }), "{error}");
+    let kapitza = mechlab::models::by_name("kapitza").unwrap();
+    let params = kapitza::Params::default().values();
+    for (frames, start, what) in [
+        (
+            Frames {
+                duration: f64::NAN,
+                count: 10,
+            },
+            vec![0.1, 0.0],
+            "duration",
+        ),
+        (
+            Frames {
+                duration: 1.0,
+                count: 1,
+            },
+            vec![0.1, 0.0],
+            "frames",
+        ),
+        (frames, vec![0.1, 0.0, 0.0], "start"),
+    ] {
+        let error = animate(kapitza, &params, METHOD, &start, &[0, 1], frames).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                MechanismError::Refused(Refusal::Setting { .. } | Refusal::StateLength { .. })
+            ),
+            "{what}: {error}"
+        );
+        assert!(error.to_string().contains("kapitza"), "{error}");
+    }
+    let four_bar = mechlab::models::by_name("four_bar").unwrap();
+    let taylor = Method::Taylor { tol: 1e-12 };
+    let error = animate(
+        four_bar,
+        &four_bar.dynamic.defaults(),
+        taylor,
+        &[0.3, 0.0, -0.3, 0.0, 0.0, 0.0],
+        &[0, 3],
+        frames,
+    )
+    .unwrap_err();
+    assert!(error.to_string().contains("dop853"), "{error}");
+}
