@@ -33,7 +33,7 @@ use mechlab_runtime::registry::Catalog;
 use mechlab_runtime::studio::{
     self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError,
 };
-use mechlab_scenes::scene::SceneError;
+use mechlab_scenes::scene::{knob, Scene, SceneError, ValueProblem};
 use serde::Serialize;
 use std::net::SocketAddr;
 
@@ -131,6 +131,35 @@ pub fn router(catalog: Catalog) -> Router {
 
 fn asset(content_type: &'static str, text: &'static str) -> Response {
     ([(header::CONTENT_TYPE, content_type)], text).into_response()
+}
+
+/// The scene `name` serving `catalog` (`about` says which models): reads
+/// its knob `port` (default `default_port`, 0: any free port), then
+/// [`run`]s the server.
+pub fn scene(
+    name: &'static str,
+    catalog: Catalog,
+    about: &'static str,
+    default_port: &'static str,
+) -> Result<(), SceneError> {
+    let scene = Scene::from_args(
+        name,
+        about,
+        &[knob(
+            "port",
+            default_port,
+            "the port to listen on (0: any free port)",
+        )],
+    )?;
+    let port = scene
+        .text("port")
+        .parse::<u16>()
+        .map_err(|_| SceneError::BadValue {
+            name: "port".into(),
+            value: scene.text("port").into(),
+            reason: ValueProblem::Requirement("a port is a whole number from 0 to 65535"),
+        })?;
+    run(catalog, port)
 }
 
 /// Serves the studio on 127.0.0.1:`port` (0: any free port) until Ctrl-C,

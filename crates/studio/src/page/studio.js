@@ -376,15 +376,16 @@ const mechanismCanvas = $("mechanism");
 const mctx = mechanismCanvas.getContext("2d");
 let mechanismController = null;
 
-// The mechanism from `seed` (the orbit's), over the time asked for, played
-// at one time unit per second.
+// The mechanism from `seed` (the orbit's), over the time asked for, in
+// 601 frames played over 20 seconds whatever the model's time scale.
+const MECHANISM_FRAMES = 601, MECHANISM_SECONDS = 20;
 async function startMechanism(seed) {
   if (mechanismController) mechanismController.abort();
   studio.mechanism = null;
   if (!studio.model.points.length) return;
   mechanismController = new AbortController();
   const duration = Number($("mechanism-time").value);
-  const frames = Math.max(2, Math.min(3600, Math.round(30 * duration) + 1));
+  const frames = MECHANISM_FRAMES;
   try {
     const m = await postJson("/api/mechanism", { ...setup(), seed, duration, frames }, mechanismController.signal);
     const xs = m.frames.flat().map((p) => p[0]), ys = m.frames.flat().map((p) => p[1]);
@@ -403,20 +404,21 @@ function drawMechanism(now) {
   g.fillRect(0, 0, w, h);
   const m = studio.mechanism;
   if (!m) return;
-  const step = m.times[1] - m.times[0];
-  const f = Math.min(m.frames.length - 1, Math.floor((now - m.started) / 1000 / step));
+  const perSecond = (m.frames.length - 1) / MECHANISM_SECONDS;
+  const f = Math.min(m.frames.length - 1, Math.floor(((now - m.started) / 1000) * perSecond));
   studio.mechanismFrame = f;
   const [x0, x1, y0, y1] = m.box;
   const scale = 0.85 * Math.min(w / Math.max(x1 - x0, 1e-9), h / Math.max(y1 - y0, 1e-9));
   const at = ([x, y]) => [w / 2 + (x - (x0 + x1) / 2) * scale, h / 2 - (y - (y0 + y1) / 2) * scale];
   // The last second's path of each point, faint.
+  const trail = Math.round(perSecond);
   g.strokeStyle = "rgba(35, 57, 91, 0.25)";
   g.lineWidth = 1;
   for (let p = 0; p < m.points.length; p++) {
     g.beginPath();
-    for (let k = Math.max(0, f - Math.round(1 / step)); k <= f; k++) {
+    for (let k = Math.max(0, f - trail); k <= f; k++) {
       const [px, py] = at(m.frames[k][p]);
-      if (k === Math.max(0, f - Math.round(1 / step))) g.moveTo(px, py); else g.lineTo(px, py);
+      if (k === Math.max(0, f - trail)) g.moveTo(px, py); else g.lineTo(px, py);
     }
     g.stroke();
   }
@@ -437,7 +439,8 @@ function drawMechanism(now) {
     g.fill();
     g.fillText(m.points[p], px + 6, py - 6);
   });
-  $("mechanism-clock").textContent = `t = ${m.times[f].toFixed(2)} of ${m.times[m.times.length - 1]}`;
+  const end = m.times[m.times.length - 1];
+  $("mechanism-clock").textContent = `t = ${m.times[f].toPrecision(4)} of ${end} (played over ${MECHANISM_SECONDS} s)`;
 }
 
 function seedAt(x, y) {
