@@ -259,7 +259,7 @@ fn closed_chain(t_end: f64) -> Result<Chain, ConstrainedError> {
 fn andrews() -> Vec<(f64, f64, f64)> {
     let reference = mechlab_test_models::ANDREWS_AT_0_03;
     let params = andrews_squeezer::Params::default().values();
-    let rows: Vec<(f64, f64, f64)> = [1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
+    let rows: Vec<(f64, f64, f64)> = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
         .iter()
         .map(|&tol| {
             let (seconds, run) = timed(|| {
