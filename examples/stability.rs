@@ -5,7 +5,9 @@
 //! is none), and the exact system's stability window from its Floquet
 //! multipliers, drawn as the spectral radius against the amplitude. With
 //! `--set chart=x,y`, the stability chart of one equilibrium in two
-//! parameters, its boundaries located by bisection.
+//! parameters, its boundaries located by bisection. A constrained model
+//! is stabilised on its constraints, as the scene `linkage` does (its
+//! knobs then).
 //!
 //! `cargo run --release --example stability -- --set model=triple_pendulum`
 //! `cargo run --release --example stability -- --set chart=eps,A --set chart_y_max=12`
@@ -19,6 +21,15 @@ use mechlab::scenes::{method_from, method_knobs, model_from_args, tiles_from};
 fn main() {
     run(|| {
         let model = model_from_args(mechlab::models::MODELS, "kapitza")?;
+        if model.constrained.is_some() {
+            // Stabilised on its constraints: the `linkage` analysis, its knobs.
+            let overrides = [("model", model.info.name)];
+            return mechlab::scenes::linkage_scene(
+                mechlab::models::MODELS,
+                "stability",
+                &overrides,
+            );
+        }
         let info = model.info;
         let [method, tol] = method_knobs("dop853", "1e-10");
         let mut knobs = vec![

@@ -568,7 +568,7 @@ pub fn linkage_scene(
     );
     println!("exact: {:?}", result.exact);
     scene.save_figure(&result.figure(), "linkage.png")?;
-    let count = scene.count("orbits")?;
+    let count = scene.whole("orbits")?;
     if count > 0 {
         let params = scene.parameter_values(info)?;
         let shape = (count, scene.positive("kick")?, scene.count("periods")?);
