@@ -4,6 +4,9 @@
 //! vibrates equals the angle model, and its multiplier is the rod's force
 //! computed by hand in the pivot's accelerating frame.
 
+use mechlab::analysis::continuation::{
+    continuation, BifurcationKind, Continuation, ContinuationSettings,
+};
 use mechlab::analysis::on_constraints::{monodromy_on_constraints, run};
 use mechlab::models::kapitza;
 use mechlab::ode::{states_at, Method};
@@ -590,5 +593,97 @@ fn the_taylor_method_is_refused_for_a_constrained_model() {
             PeriodMapError::Refused(mechlab::analysis::Refusal::Setting { .. })
         ) && error.to_string().contains("dop853"),
         "{error}"
+    );
+}
+
+fn continuation_settings(parameter: &str, to: f64, start: &[f64]) -> ContinuationSettings {
+    ContinuationSettings {
+        parameter: parameter.into(),
+        to,
+        start: start.to_vec(),
+        period: 1,
+        max_period: 1,
+        switch_branch_points: false,
+        max_branches: 1,
+        points: 2000,
+        step: 0.01,
+        min_step: 1e-8,
+        max_step: 0.05,
+        method: Method::Dop853 {
+            rtol: 1e-12,
+            atol: 1e-12,
+        },
+        diagram: None,
+        chart: None,
+    }
+}
+
+/// Continued on its constraints (in the chart (x, x') the rod's vertical
+/// start gives), the point on a vibrating rod has the angle model's
+/// bifurcations: Kapitza's upright is born stable at a branch point and
+/// loses it at a period doubling, at the same amplitudes to 1e-8; its
+/// branch stays at x = 0.
+#[test]
+fn continuation_on_the_constraints_finds_the_angle_models_bifurcations() {
+    let params = [0.5, 0.1, 0.0];
+    let follow = |model: &mechlab::registry::Model, start: &[f64]| {
+        let settings = continuation_settings("A", 5.0, start);
+        let result = continuation(model, &params, &settings).unwrap();
+        assert!(!result.dissipative);
+        result
+    };
+    let angle = follow(mechlab::models::by_name("kapitza").unwrap(), &[0.0, 0.0]);
+    let upright = [0.0, 0.5 * 0.1 + 1.0, 0.0, 0.0];
+    let on_rod = follow(&cartesian_kapitza::MODEL, &upright);
+    assert_eq!(on_rod.state_names, ["x", "xd"]);
+    for point in &on_rod.branches[0].points {
+        assert!(point.state.iter().all(|x| x.abs() < 1e-10), "{point:?}");
+    }
+    let kinds = |r: &Continuation| -> Vec<(BifurcationKind, f64)> {
+        r.bifurcations
+            .iter()
+            .filter(|b| b.branch == 0)
+            .map(|b| (b.kind, b.parameter))
+            .collect()
+    };
+    let (expected, got) = (kinds(&angle), kinds(&on_rod));
+    assert_eq!(expected.len(), 2, "{expected:?}");
+    assert_eq!(got.len(), 2, "{got:?}");
+    for ((kind, a), (on_rod_kind, b)) in expected.iter().zip(&got) {
+        assert_eq!(kind, on_rod_kind);
+        assert!((a - b).abs() < 1e-8, "{kind:?}: {a} against {b}");
+    }
+}
+
+/// The four-bar's upright, followed down in the amplitude on its
+/// constraints, meets a branch point (the linkage tips over sideways) at
+/// the edge of the exact window the Floquet sweep bisects, to 1e-8.
+#[test]
+fn the_four_bars_upright_tips_over_at_the_exact_windows_edge() {
+    use mechlab::analysis::on_constraints::vibration::{
+        vibration_stability, Exact, VibrationSettings,
+    };
+    let model = mechlab::models::by_name("four_bar").unwrap();
+    let params = mechlab::models::four_bar::Params::default().values();
+    let settings = VibrationSettings {
+        scan: 40,
+        ..VibrationSettings::default()
+    };
+    let result = vibration_stability(model.constrained.unwrap(), &params, &settings).unwrap();
+    let Exact::Periodic { windows, .. } = &result.exact else {
+        panic!("{:?}", result.exact)
+    };
+    let edge = windows[0][0];
+    let result = continuation(model, &params, &continuation_settings("a", 1.0, &[])).unwrap();
+    let tipping = result
+        .bifurcations
+        .iter()
+        .find(|b| b.branch == 0)
+        .unwrap_or_else(|| panic!("{:?}", result.bifurcations));
+    assert_eq!(tipping.kind, BifurcationKind::BranchPoint);
+    assert!(
+        (tipping.parameter - edge).abs() < 1e-8,
+        "{} against {edge}",
+        tipping.parameter
     );
 }

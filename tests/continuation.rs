@@ -28,6 +28,7 @@ fn settings(parameter: &str, to: f64, start: &[f64]) -> ContinuationSettings {
         max_step: 0.02,
         method: Method::Taylor { tol: 1e-13 },
         diagram: None,
+        chart: None,
     }
 }
 

@@ -453,6 +453,36 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
         bad(json!({"model": "duffing", "seed": [1.0], "parameter": "gamma", "to": 1.0})).await;
     assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
     assert!(body.contains("seed"), "{body}");
+
+    // A constrained model, in the chart of the plane's axes: the four-bar's
+    // upright tips over at a branch point where its exact window opens
+    // (a = 1.18609, as the `linkage` scene finds); a model whose
+    // constraints leave more than the plane's two dimensions says so.
+    let upright = [
+        0.304_692_654_015_397_5,
+        0.0,
+        -0.304_692_654_015_397_5,
+        0.0,
+        0.0,
+        0.0,
+    ];
+    let request = json!({"model": "four_bar", "method": "dop853", "tol": 1e-10, "axes": [0, 3],
+        "seed": upright, "parameter": "a", "to": 1.0});
+    let (status, _, body) = call("POST", "/api/continuation", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let first = &answer["branches"][0]["points"][0];
+    assert!(
+        (first[0].as_f64().unwrap() - upright[0]).abs() < 1e-10,
+        "{first}"
+    );
+    let tipping = answer["bifurcations"][0]["parameter"].as_f64().unwrap();
+    assert!((tipping - 1.18609).abs() < 1e-5, "{body}");
+    let request = json!({"model": "rolling_disk", "method": "dop853", "seed": vec![0.0; 8],
+        "parameter": "R", "to": 2.0});
+    let (status, body) = bad(request).await;
+    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert!(body.contains("dimension 6"), "{body}");
 }
 
 /// The Poincaré section of a model without a fast phase: an orbit of

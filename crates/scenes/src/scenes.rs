@@ -838,7 +838,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
                 "the parameter continued in, from its value below to `to` (default: the model file's [fast_phase] amplitude)",
             ),
             ("to", "auto", "the other end of the parameter's interval (auto: 1.8 times its value, 1 where it is 0)"),
-            ("start", "1,0", "a guess of the first periodic orbit's state at t = 0 (zeros appended)"),
+            ("start", "1,0", "a guess of the first periodic orbit's state at t = 0 (zeros appended; for a constrained model the model file's start where not given, its components replaced by these)"),
             ("period", "1", "the first branch is of fixed points of P^period"),
             ("max_period", "16", "switch at period doublings up to this period"),
             ("switch", "yes", "also switch at branch points (pitchforks): yes or no"),
@@ -850,13 +850,17 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
             ("diagram", "400", "parameter values of the orbit diagram (0: none)"),
             ("transient", "300", "periods of the orbit diagram dropped first"),
             ("iterates", "100", "periods of the orbit diagram drawn"),
-            ("coordinate", "0", "the state component drawn (0 = first coordinate)"),
+            ("coordinate", "0", "the state component drawn (0 = first coordinate; for a constrained model, of its chart)"),
+            ("chart", "auto", "a constrained model's chart: the components of [q; q'] that are the branches' coordinates, comma-separated (auto: those that parametrise its constraints best at the start)"),
         ],
     )?;
     let params = scene.parameter_values(model.info)?;
     let settings = continuation_settings(model, &scene, &params)?;
     let coordinate = scene.whole("coordinate")?;
-    let states = model.info.state_names().len();
+    eprintln!("continuing in {} …", settings.parameter);
+    let result = continuation(model, &params, &settings)?;
+    // (A constrained model's states are its chart's coordinates.)
+    let states = result.state_names.len();
     if coordinate >= states {
         return Err(SceneError::BadValue {
             name: "coordinate".into(),
@@ -864,8 +868,6 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
             reason: ValueProblem::StateComponents(states),
         });
     }
-    eprintln!("continuing in {} …", settings.parameter);
-    let result = continuation(model, &params, &settings)?;
     write_continuation(&scene, &result, coordinate)?;
     scene.write_summary(&result)?;
     Ok(())
@@ -919,7 +921,11 @@ fn continuation_settings(
     Ok(ContinuationSettings {
         parameter,
         to,
-        start: scene.numbers("start")?,
+        // A constrained model starts at its file's start unless told.
+        start: match (model.constrained, Scene::peek("start")) {
+            (Some(_), None) => Vec::new(),
+            _ => scene.numbers("start")?,
+        },
         period: scene.count("period")?,
         max_period: scene.count("max_period")?,
         switch_branch_points,
@@ -938,6 +944,25 @@ fn continuation_settings(
                 })
             })
             .transpose()?,
+        chart: match scene.text("chart") {
+            "auto" => None,
+            _ => Some(
+                scene
+                    .numbers("chart")?
+                    .iter()
+                    .map(|&x| match x >= 0.0 && x.fract() == 0.0 {
+                        true => Ok(x as usize),
+                        false => Err(SceneError::BadValue {
+                            name: "chart".into(),
+                            value: scene.text("chart").into(),
+                            reason: ValueProblem::Requirement(
+                                "state components: whole numbers from 0",
+                            ),
+                        }),
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+        },
     })
 }
 

@@ -43,6 +43,18 @@ pub enum ConstraintError {
     /// A projection's tolerance that is not finite and positive.
     #[error("the projection's tolerance must be finite and positive, got {value}")]
     Tolerance { value: f64 },
+    /// The components held as a chart's coordinates do not parametrise
+    /// the constraint manifold at this state.
+    #[error("a singular chart: the state components {held:?} do not parametrise the constraints at y = {y:?}")]
+    SingularChart { held: Vec<usize>, y: Vec<f64> },
+    /// A chart of another size than the constraint manifold's dimension,
+    /// or naming a component twice or past the state.
+    #[error("a chart of the components {held:?} for a constraint manifold of dimension {dimension} in a state of {state} components: give {dimension} different components")]
+    ChartSize {
+        held: Vec<usize>,
+        dimension: usize,
+        state: usize,
+    },
     /// A state of another length than 2n.
     #[error("a state of {given} numbers for a system of {coordinates} coordinates (2 per coordinate expected)")]
     StateLength { given: usize, coordinates: usize },

@@ -348,6 +348,10 @@ pub enum OdeError {
     /// More output than a run may keep in memory, refused before the run.
     #[error(transparent)]
     TooLarge(#[from] crate::budget::TooLarge),
+    /// A state that cannot be put on a constrained model's constraints, or
+    /// a chart of them that is singular.
+    #[error(transparent)]
+    Constraint(#[from] holonomic::ConstraintError),
 }
 
 /// Solver state: the method, the last step size, statistics.

@@ -859,16 +859,27 @@ pub fn continuation(
         max_step: 0.05,
         method: setup.method,
         diagram: None,
+        // A constrained model of one degree of freedom on its constraints
+        // is continued in the chart of the plane's axes.
+        chart: setup.handle.constrained.map(|_| setup.axes.to_vec()),
     };
     let result = continuation(setup.handle, &setup.params, &settings)?;
     let periodic = setup.model.periodic();
+    // The state components of the axes in the branches' states.
+    let axes = match &result.chart {
+        Some(chart) => setup
+            .axes
+            .map(|a| chart.iter().position(|&c| c == a).unwrap_or(a)),
+        None => setup.axes,
+    };
     let place = |y: &[f64]| -> [f64; 2] {
         let at = |k: usize| {
             let axis = setup.axes[k];
+            let component = axes[k];
             if periodic.get(axis).copied().unwrap_or(false) {
-                wrap_angle(y[axis])
+                wrap_angle(y[component])
             } else {
-                y[axis]
+                y[component]
             }
         };
         [at(0), at(1)]

@@ -762,7 +762,7 @@ async function chooseModel(name) {
   defaultView(model);
   const notes = {
     contacts: `model '${name}' is a contact model: no phase plane here, its derivations are below`,
-    constrained: `model '${name}' is constrained: a click seeds an orbit on its constraints (the axes' components held, the others follow from the constraints); the other layers are not drawn for it`,
+    constrained: `model '${name}' is constrained: a click seeds an orbit on its constraints (the axes' components held, the others follow from the constraints), a shift-click continues it in the chart of the axes (one degree of freedom on the constraints), the mechanism moves above the parameters; the level sets and equilibria are not drawn for it`,
   };
   say(notes[model.kind] ?? (model.fast_phase ? "" : `model '${name}' has no fast phase: no period map; the level sets of H and the equilibria are shown`));
   history.replaceState(null, "", `#${name}`);

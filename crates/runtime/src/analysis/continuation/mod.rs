@@ -14,6 +14,7 @@
 //! they are compiled once, not once per model size.
 
 mod branch;
+mod chart;
 mod diagram;
 
 pub use branch::BranchEnd;
@@ -55,6 +56,22 @@ pub struct ContinuationSettings {
     pub method: Method,
     /// The orbit diagram beside the branches, if any.
     pub diagram: Option<DiagramSettings>,
+    /// A constrained model's chart: the components of [q; q'] that are
+    /// the branches' coordinates, as many as the constraint manifold's
+    /// dimension (None: those that parametrise it best at the start).
+    /// Other models ignore it.
+    pub chart: Option<Vec<usize>>,
+}
+
+impl ContinuationSettings {
+    /// The arclength steps' first value and bounds.
+    fn steps(&self) -> Steps {
+        Steps {
+            initial: self.step,
+            min: self.min_step,
+            max: self.max_step,
+        }
+    }
 }
 
 /// The brute-force orbit diagram's sampling.
@@ -216,6 +233,9 @@ pub struct Continuation {
     pub map_evaluations: u64,
     pub seconds: f64,
     pub diagram: Option<OrbitDiagram>,
+    /// A constrained model's chart: the components of [q; q'] that the
+    /// branches' states are (None: the full state).
+    pub chart: Option<Vec<usize>>,
     /// The state's names, for the figure.
     #[serde(skip)]
     pub state_names: Vec<&'static str>,
@@ -261,6 +281,10 @@ pub fn continuation(
     params: &[f64],
     settings: &ContinuationSettings,
 ) -> Result<Continuation, ContinuationError> {
+    if let Some(constrained) = model.constrained {
+        crate::analysis::method_applies(model, settings.method)?;
+        return on_constraints(constrained, params, settings);
+    }
     let systems = crate::analysis::hamiltonian(model)?;
     let info = systems.info();
     let name = info.name.to_string();
@@ -270,6 +294,49 @@ pub fn continuation(
     let mut result = run(&map, params[index], settings, &name)?;
     result.params = named;
     result.state_names = info.state_names();
+    Ok(result)
+}
+
+/// [`continuation`] of a constrained model, in the chart of its
+/// constraints that parametrises them best at the start: `settings.start`
+/// is a full state [q; q'] (the model file's start where it is shorter),
+/// the branches' states are the chart's coordinates, named.
+fn on_constraints(
+    model: &'static dyn crate::registry::ConstrainedSystems,
+    params: &[f64],
+    settings: &ContinuationSettings,
+) -> Result<Continuation, ContinuationError> {
+    let info = model.info();
+    let name = info.name.to_string();
+    let index = Refusal::parameter_index(info, &settings.parameter)?;
+    let named = Refusal::named_values(info, params)?;
+    let mut start = model.base_state(params);
+    if settings.start.len() > start.len() || !settings.start.iter().all(|x| x.is_finite()) {
+        return Err(Refusal::setting(
+            info.name,
+            "`start` must be finite, with at most one value per state component",
+        )
+        .into());
+    }
+    start[..settings.start.len()].copy_from_slice(&settings.start);
+    let held = settings.chart.as_deref();
+    let map = chart::ChartMap::new(model, params, index, settings.method, &start, held).map_err(
+        |source| ContinuationError::Start {
+            model: name.clone(),
+            guess: start.clone(),
+            parameter: params[index],
+            source,
+        },
+    )?;
+    let in_chart = ContinuationSettings {
+        start: map.chart(map.start()),
+        ..settings.clone()
+    };
+    let mut result = run(&map, params[index], &in_chart, &name)?;
+    result.params = named;
+    let names = info.state_names();
+    result.state_names = map.held().iter().map(|&i| names[i]).collect();
+    result.chart = Some(map.held().to_vec());
     Ok(result)
 }
 
@@ -320,6 +387,7 @@ pub(crate) fn orbit_branch(
             max_step: 0.05 * (bounds.1 - bounds.0).max(1e-3),
             method,
             diagram: None,
+            chart: None,
         };
         let result = run(&map, p0, &settings, name)?;
         along.extend(
@@ -516,11 +584,7 @@ fn run(
     let forward = settings.to > p0;
     let bounds = (p0.min(settings.to), p0.max(settings.to));
     let (first, dissipative) = first_orbit(map, settings.period, &guess, p0, forward, model)?;
-    let steps = Steps {
-        initial: settings.step,
-        min: settings.min_step,
-        max: settings.max_step,
-    };
+    let steps = settings.steps();
     let mut branches: Vec<Branch> = Vec::new();
     let mut bifurcations: Vec<Bifurcation> = Vec::new();
     let mut jobs = std::collections::VecDeque::from([Job {
@@ -619,6 +683,7 @@ fn run(
         map_evaluations: map.evaluations(),
         seconds: clock.elapsed().as_secs_f64(),
         diagram,
+        chart: None,
         state_names: Vec::new(),
     })
 }
