@@ -5,20 +5,18 @@
 //! of the map on the manifold, none spurious from the constraint
 //! directions.
 
-use super::FamilyMap;
+use super::{Family, FamilyMap};
 use crate::ode::holonomic::ConstraintError;
-use crate::ode::{AnyOptions, Integrator, Method, OdeError};
+use crate::ode::{AnyOptions, Method, OdeError};
 use crate::registry::ConstrainedSystems;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Mutex;
 
 pub(super) struct ChartMap {
     model: &'static dyn ConstrainedSystems,
-    params: Vec<f64>,
-    index: usize,
-    method: Method,
+    family: Family,
     /// The state components that are the chart's coordinates.
     held: Vec<usize>,
     periodic: Vec<bool>,
@@ -28,7 +26,6 @@ pub(super) struct ChartMap {
     /// The last state put on the constraints: the next one's first guess
     /// (Newton's method then stays on the branch of the closures it is on).
     guess: Mutex<Vec<f64>>,
-    evaluations: AtomicU64,
 }
 
 impl ChartMap {
@@ -66,13 +63,10 @@ impl ChartMap {
         Ok(ChartMap {
             periodic: held.iter().map(|&i| periodic[i]).collect(),
             model,
-            params: params.to_vec(),
-            index,
-            method,
+            family: Family::new(model, params, index, method),
             held,
             guess: Mutex::new(y.clone()),
             start: y,
-            evaluations: AtomicU64::new(0),
         })
         .and_then(|map| {
             // The chart must parametrise the constraints at the start.
@@ -94,12 +88,6 @@ impl ChartMap {
     /// The chart's coordinates of a full state.
     pub(super) fn chart(&self, y: &[f64]) -> Vec<f64> {
         self.held.iter().map(|&i| y[i]).collect()
-    }
-
-    fn with(&self, p: f64) -> Vec<f64> {
-        let mut params = self.params.clone();
-        params[self.index] = p;
-        params
     }
 
     /// The state on the constraints with the chart's coordinates `z`,
@@ -140,16 +128,6 @@ impl ChartMap {
         });
         let inverse = selected.try_inverse().ok_or_else(singular)?;
         Ok(basis * inverse)
-    }
-
-    fn period(&self, params: &[f64]) -> Result<f64, OdeError> {
-        match self.model.phase_period(params) {
-            Some(t) if t.is_finite() && t > 0.0 => Ok(t),
-            t => Err(OdeError::InvalidSetting {
-                what: "period of the phase at this parameter value",
-                value: t.unwrap_or(f64::NAN),
-            }),
-        }
     }
 
     /// The rows of a matrix at the chart's components.
@@ -203,8 +181,8 @@ impl FamilyMap for ChartMap {
     }
 
     fn field(&self, z: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>) {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
-        let params = self.with(p);
+        self.family.count(1);
+        let params = self.family.with(p);
         let m = self.held.len();
         let nan = || (vec![f64::NAN; m], DMatrix::from_element(m, m, f64::NAN));
         let Ok(y) = self.lift(z, &params) else {
@@ -223,9 +201,7 @@ impl FamilyMap for ChartMap {
     }
 
     fn parameter_allowed(&self, p: f64) -> bool {
-        let info = self.model.info();
-        info.check_parameter(info.parameter_names[self.index], p)
-            .is_ok()
+        self.family.parameter_allowed(p)
     }
 
     fn once(
@@ -234,11 +210,8 @@ impl FamilyMap for ChartMap {
         p: f64,
         jacobian: bool,
     ) -> Result<(Vec<f64>, Option<DMatrix<f64>>), OdeError> {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
-        let params = self.with(p);
-        let period = self.period(&params)?;
+        let (params, period, mut integrator) = self.family.period_at(p)?;
         let y = self.lift(z, &params)?;
-        let mut integrator = Integrator::new(self.method)?;
         if jacobian {
             let (image, monodromy) = self.model.monodromy(&params, &mut integrator, period, &y)?;
             let lifting = self.lifting(&y, &params)?;
@@ -260,27 +233,30 @@ impl FamilyMap for ChartMap {
         transient: usize,
         iterates: usize,
     ) -> Vec<Result<Vec<Vec<f64>>, OdeError>> {
-        self.evaluations.fetch_add(
-            (values.len() * (transient + iterates)) as u64,
-            Ordering::Relaxed,
-        );
+        self.family.count(values.len() * (transient + iterates));
         let wrap = self.model.periodic_state();
         values
             .par_iter()
             .map(|&p| {
-                let params = self.with(p);
+                let params = self.family.with(p);
                 let y = self.lift_from(self.start.clone(), start, &params)?;
-                let problem = [(self.model.exact(&params), self.period(&params))];
-                let states =
-                    super::diagram::iterates(self.method, &problem, &y, &wrap, transient, iterates)
-                        .pop()
-                        .expect("one problem, one result")?;
+                let problem = [(self.model.exact(&params), self.family.period(&params))];
+                let states = super::diagram::iterates(
+                    self.family.method,
+                    &problem,
+                    &y,
+                    &wrap,
+                    transient,
+                    iterates,
+                )
+                .pop()
+                .expect("one problem, one result")?;
                 Ok(states.iter().map(|y| self.chart(y)).collect())
             })
             .collect()
     }
 
     fn evaluations(&self) -> u64 {
-        self.evaluations.load(Ordering::Relaxed)
+        self.family.evaluations.load(Ordering::Relaxed)
     }
 }

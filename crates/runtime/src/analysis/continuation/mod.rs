@@ -439,32 +439,33 @@ pub(crate) fn orbit_branch(
     })
 }
 
-/// A model at fixed values of all parameters but one.
-struct AtModel {
-    model: &'static dyn Systems,
+/// A model at fixed values of all parameters but one: what both family
+/// maps share (the parameters, the method, the periods integrated).
+struct Family {
+    model: &'static dyn crate::registry::Flows,
     params: Vec<f64>,
     index: usize,
     method: Method,
-    periodic: Vec<bool>,
     evaluations: AtomicU64,
-    flow: bool,
 }
 
-impl AtModel {
-    /// The model at `params`, its parameter `index` free: a map if it has
-    /// a fast phase, a flow if not.
-    fn new(model: &'static dyn Systems, params: &[f64], index: usize, method: Method) -> Self {
-        AtModel {
+impl Family {
+    fn new(
+        model: &'static dyn crate::registry::Flows,
+        params: &[f64],
+        index: usize,
+        method: Method,
+    ) -> Self {
+        Family {
             model,
             params: params.to_vec(),
             index,
             method,
-            periodic: model.periodic_state(),
             evaluations: AtomicU64::new(0),
-            flow: !model.has_fast_phase(),
         }
     }
 
+    /// The parameters at the free one's value p.
     fn with(&self, p: f64) -> Vec<f64> {
         let mut params = self.params.clone();
         params[self.index] = p;
@@ -480,6 +481,44 @@ impl AtModel {
             }),
         }
     }
+
+    /// One period at p counted: the parameters, the period, an integrator.
+    fn period_at(&self, p: f64) -> Result<(Vec<f64>, f64, Integrator), OdeError> {
+        self.count(1);
+        let params = self.with(p);
+        let period = self.period(&params)?;
+        Ok((params, period, Integrator::new(self.method)?))
+    }
+
+    fn count(&self, periods: usize) {
+        self.evaluations
+            .fetch_add(periods as u64, Ordering::Relaxed);
+    }
+
+    fn parameter_allowed(&self, p: f64) -> bool {
+        let info = self.model.info();
+        info.check_parameter(info.parameter_names[self.index], p)
+            .is_ok()
+    }
+}
+
+/// A Hamiltonian model's period map (or flow) in one parameter.
+struct AtModel {
+    model: &'static dyn Systems,
+    family: Family,
+    periodic: Vec<bool>,
+}
+
+impl AtModel {
+    /// The model at `params`, its parameter `index` free: a map if it has
+    /// a fast phase, a flow if not.
+    fn new(model: &'static dyn Systems, params: &[f64], index: usize, method: Method) -> Self {
+        AtModel {
+            model,
+            family: Family::new(model, params, index, method),
+            periodic: model.periodic_state(),
+        }
+    }
 }
 
 impl FamilyMap for AtModel {
@@ -488,12 +527,12 @@ impl FamilyMap for AtModel {
     }
 
     fn flow(&self) -> bool {
-        self.flow
+        !self.model.has_fast_phase()
     }
 
     fn field(&self, y: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>) {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
-        let system = self.model.exact(&self.with(p));
+        self.family.count(1);
+        let system = self.model.exact(&self.family.with(p));
         let n = system.dim();
         let f = system.rhs(0.0, y).expect("a state of the model's length");
         let jacobian = system
@@ -504,9 +543,7 @@ impl FamilyMap for AtModel {
     }
 
     fn parameter_allowed(&self, p: f64) -> bool {
-        let info = self.model.info();
-        info.check_parameter(info.parameter_names[self.index], p)
-            .is_ok()
+        self.family.parameter_allowed(p)
     }
 
     fn once(
@@ -515,10 +552,7 @@ impl FamilyMap for AtModel {
         p: f64,
         jacobian: bool,
     ) -> Result<(Vec<f64>, Option<DMatrix<f64>>), OdeError> {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
-        let params = self.with(p);
-        let period = self.period(&params)?;
-        let mut integrator = Integrator::new(self.method)?;
+        let (params, period, mut integrator) = self.family.period_at(p)?;
         if jacobian {
             let (image, m) = self.model.monodromy(&params, &mut integrator, period, y)?;
             Ok((image, Some(m)))
@@ -539,21 +573,18 @@ impl FamilyMap for AtModel {
         let problems: Vec<_> = values
             .iter()
             .map(|&p| {
-                let params = self.with(p);
-                let period = self.period(&params);
+                let params = self.family.with(p);
+                let period = self.family.period(&params);
                 (self.model.exact(&params), period)
             })
             .collect();
-        self.evaluations.fetch_add(
-            (values.len() * (transient + iterates)) as u64,
-            Ordering::Relaxed,
-        );
-        let wrap = &self.periodic;
-        diagram::iterates(self.method, &problems, start, wrap, transient, iterates)
+        self.family.count(values.len() * (transient + iterates));
+        let (method, wrap) = (self.family.method, &self.periodic);
+        diagram::iterates(method, &problems, start, wrap, transient, iterates)
     }
 
     fn evaluations(&self) -> u64 {
-        self.evaluations.load(Ordering::Relaxed)
+        self.family.evaluations.load(Ordering::Relaxed)
     }
 }
 
