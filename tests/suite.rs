@@ -16,6 +16,7 @@ mod docs_commands;
 mod double_double;
 mod events;
 mod explore;
+mod frequency;
 mod holonomic;
 mod integrators;
 mod mechanism;

@@ -13,6 +13,7 @@ pub mod dimension;
 pub mod equilibria;
 pub mod fit;
 pub mod floquet;
+pub mod frequency;
 pub mod mechanism;
 pub mod on_constraints;
 pub mod period_map;
