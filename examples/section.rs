@@ -7,5 +7,5 @@
 //! `cargo run --release --example section -- --set model=<name> --set energy=<E>`
 
 fn main() {
-    mechlab::scene::run(|| mechlab::scenes::section_scene(mechlab::models::MODELS));
+    mechlab::scene::run(|| mechlab::scenes::section_scene(mechlab::models::MODELS, "section", &[]));
 }

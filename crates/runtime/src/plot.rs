@@ -54,6 +54,12 @@ pub enum ColorMap {
 }
 
 impl ColorMap {
+    /// The colour at v ∈ [0, 1] (for points coloured by a value).
+    pub fn rgb(self, v: f64) -> Rgb {
+        let RGBColor(r, g, b) = self.color(v);
+        Rgb(r, g, b)
+    }
+
     fn color(self, v: f64) -> RGBColor {
         let v = v.clamp(0.0, 1.0);
         match self {

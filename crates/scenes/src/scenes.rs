@@ -1034,14 +1034,23 @@ fn write_continuation(
 
 /// Scene `section`: the Poincaré section of an autonomous model of two
 /// degrees of freedom at a fixed energy.
-pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
+pub fn section_scene(
+    catalog: Catalog,
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
     use mechlab_runtime::analysis::section::{
         parse_plane, section, seeds_across, SectionError, SectionSettings,
     };
-    let model = model_from_args(catalog, Defaults(&[]).get("model", "henon_heiles"))?;
-    let mut knobs = section_knobs(model);
-    knobs.extend(parameter_knobs(model.info, &[]));
-    let scene = Scene::from_args("section", "Poincaré section at a fixed energy", &knobs)?;
+    let defaults = Defaults(overrides);
+    let model = model_from_args(catalog, defaults.get("model", "henon_heiles"))?;
+    let mut knobs = section_knobs(model, &defaults);
+    knobs.extend(parameter_knobs(model.info, overrides));
+    let scene = Scene::from_args(
+        scene_name,
+        "Poincaré section at a fixed energy, its MEGNO and frequency maps",
+        &knobs,
+    )?;
     let rising = match scene.text("direction") {
         "rising" => true,
         "falling" => false,
@@ -1066,15 +1075,38 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
         slab: scene.positive("slab")?,
     };
     let params = scene.parameter_values(model.info)?;
-    let seeds = seeds_across(
-        model,
-        &params,
-        &settings,
-        scene.positive("extent")?,
-        scene.count("orbits")?,
-    );
-    eprintln!("{} orbits at H = {} …", seeds.len(), settings.energy);
-    let result = section(model, &params, &seeds, &settings)?;
+    let frequencies = section_frequency_map(&scene, model, &params, &settings)?;
+    let result = match scene.whole("orbits")? {
+        0 => None,
+        orbits => {
+            let seeds = seeds_across(model, &params, &settings, scene.positive("extent")?, orbits);
+            eprintln!("{} orbits at H = {} …", seeds.len(), settings.energy);
+            let result = section(model, &params, &seeds, &settings)?;
+            write_section(&scene, &result, &settings)?;
+            Some(result)
+        }
+    };
+    let map = section_megno_map(&scene, model, &params, &settings)?;
+    #[derive(serde::Serialize)]
+    struct Summary<'a> {
+        section: Option<&'a mechlab_runtime::analysis::section::Section>,
+        megno_map: Option<&'a mechlab_runtime::analysis::section_map::SectionMap>,
+        frequency_map: Option<&'a mechlab_runtime::analysis::frequency_map::FrequencyMap>,
+    }
+    scene.write_summary(&Summary {
+        section: result.as_ref(),
+        megno_map: map.as_ref(),
+        frequency_map: frequencies.as_ref(),
+    })?;
+    Ok(())
+}
+
+/// The section's figure, table and report.
+fn write_section(
+    scene: &Scene,
+    result: &mechlab_runtime::analysis::section::Section,
+    settings: &mechlab_runtime::analysis::section::SectionSettings,
+) -> Result<(), SceneError> {
     scene.save_figure(&result.figure(), "section.png")?;
     let rows = result
         .orbits
@@ -1097,21 +1129,12 @@ pub fn section_scene(catalog: Catalog) -> Result<(), SceneError> {
             o.points[0], o.crossings, settings.crossings
         );
     }
-    let map = section_megno_map(&scene, model, &params, &settings)?;
-    #[derive(serde::Serialize)]
-    struct Summary<'a> {
-        section: &'a mechlab_runtime::analysis::section::Section,
-        megno_map: Option<&'a mechlab_runtime::analysis::section_map::SectionMap>,
-    }
-    scene.write_summary(&Summary {
-        section: &result,
-        megno_map: map.as_ref(),
-    })?;
     Ok(())
 }
 
-/// The `section` scene's knobs for `model` (its parameters not included).
-fn section_knobs(model: &Model) -> Vec<Knob> {
+/// The `section` scene's knobs for `model` (its parameters not included),
+/// with the scene's own defaults.
+fn section_knobs(model: &Model, defaults: &Defaults) -> Vec<Knob> {
     vec![
         knob(
             "model",
@@ -1136,8 +1159,8 @@ fn section_knobs(model: &Model) -> Vec<Knob> {
         ),
         knob(
             "orbits",
-            "24",
-            "orbits, seeded evenly across the accessible part of the other coordinate",
+            defaults.get("orbits", "24"),
+            "orbits, seeded evenly across the accessible part of the other coordinate (0: none)",
         ),
         knob("extent", "2", "seeds are searched for in [-extent, extent]"),
         knob("crossings", "400", "points per orbit"),
@@ -1156,7 +1179,17 @@ fn section_knobs(model: &Model) -> Vec<Knob> {
             "0",
             "pixels per side of a MEGNO chaos map of the section (0: none)",
         ),
-        knob("map_time", "2000", "the time each orbit of the map runs"),
+        knob("map_time", "2000", "the time each orbit of the MEGNO and frequency maps runs"),
+        knob(
+            "frequencies",
+            defaults.get("frequencies", "0"),
+            "pixels per side of a frequency map (NAFF) of the section (0: none)",
+        ),
+        knob(
+            "samples",
+            "4096",
+            "samples of each orbit of the frequency map",
+        ),
         knob(
             "phase",
             "0",
@@ -1168,6 +1201,48 @@ fn section_knobs(model: &Model) -> Vec<Knob> {
             "with a fast phase: points of the period map within this of the plane are kept",
         ),
     ]
+}
+
+/// The `section` scene's frequency map of the section when `frequencies`
+/// asks for one, with its figure and table.
+fn section_frequency_map(
+    scene: &Scene,
+    model: &Model,
+    params: &[f64],
+    settings: &mechlab_runtime::analysis::section::SectionSettings,
+) -> Result<Option<mechlab_runtime::analysis::frequency_map::FrequencyMap>, SceneError> {
+    use mechlab_runtime::analysis::frequency_map::{frequency_map, FrequencyMapSettings};
+    let pixels = scene.whole("frequencies")?;
+    if pixels == 0 {
+        return Ok(None);
+    }
+    eprintln!("frequency map, {pixels}² orbits …");
+    let map_settings = FrequencyMapSettings {
+        section: settings.clone(),
+        pixels,
+        t_max: scene.positive("map_time")?,
+        samples: scene.count("samples")?,
+        extent: scene.positive("extent")?,
+    };
+    let map = frequency_map(model, params, &map_settings)?;
+    eprintln!(
+        "{} accessible orbits, {:.1} % regular, in {:.1} s",
+        map.accessible,
+        100.0 * map.regular_fraction,
+        map.seconds
+    );
+    scene.save_figure(&map.figure(), "frequency_map.png")?;
+    let rows = (0..pixels * pixels).filter_map(|k| {
+        let [nu1, nu2] = map.frequencies[k];
+        nu1.is_finite()
+            .then_some((k % pixels, k / pixels, nu1, nu2, map.diffusion[k]))
+    });
+    scene.write_csv(
+        "frequency_map.csv",
+        &["column", "row", "nu1", "nu2", "diffusion_index"],
+        rows,
+    )?;
+    Ok(Some(map))
 }
 
 /// The `section` scene's MEGNO map of the section when `map` asks for one,

@@ -112,6 +112,9 @@ pub fn naff(
         }
         frequencies.push(frequency);
         amplitudes = analysis.amplitudes(signal, &frequencies);
+        if frequencies.len() == settings.terms {
+            break; // (no residual needed after the last term)
+        }
         residual.copy_from_slice(signal);
         for (&f, &a) in frequencies.iter().zip(&amplitudes) {
             analysis.subtract(&mut residual, f, a);
@@ -159,29 +162,39 @@ impl Analysis {
         }
     }
 
-    /// ⟨f, e^{iωt}⟩ and its first two derivatives in ω.
-    fn transform(&self, f: &[Complex<f64>], omega: f64) -> [Complex<f64>; 3] {
+    /// The signal times the window.
+    fn windowed(&self, f: &[Complex<f64>]) -> Vec<Complex<f64>> {
+        f.iter().zip(&self.window).map(|(z, w)| z * w).collect()
+    }
+
+    /// ⟨f, e^{iωt}⟩ and its first two derivatives in ω, from the windowed
+    /// signal.
+    fn transform(&self, windowed: &[Complex<f64>], omega: f64) -> [Complex<f64>; 3] {
         let mut sums = [Complex::new(0.0, 0.0); 3];
         self.for_each_phase(omega, |j, phase| {
             let t = j as f64 * self.dt;
-            let term = f[j] * phase * self.window[j];
+            let term = windowed[j] * phase;
             sums[0] += term;
-            sums[1] += term * Complex::new(0.0, -t);
-            sums[2] += term * (-t * t);
+            sums[1] += term * t;
+            sums[2] += term * (t * t);
         });
-        let n = f.len() as f64;
-        sums.map(|s| s / n)
+        let n = windowed.len() as f64;
+        // d/dω e^{−iωt} = −it e^{−iωt}, d²/dω² = −t² e^{−iωt}.
+        [
+            sums[0] / n,
+            sums[1] * Complex::new(0.0, -1.0 / n),
+            -sums[2] / n,
+        ]
     }
 
     /// The frequency of the largest peak of |⟨f, e^{iωt}⟩|, or None if f
     /// vanishes.
     fn peak(&self, f: &[Complex<f64>]) -> Option<f64> {
         let n = f.len();
-        let size = (2 * n).next_power_of_two();
+        let size = n.next_power_of_two();
+        let windowed = self.windowed(f);
         let mut data = vec![Complex::new(0.0, 0.0); size];
-        for (j, (&z, &w)) in f.iter().zip(&self.window).enumerate() {
-            data[j] = z * w;
-        }
+        data[..n].copy_from_slice(&windowed);
         fft(&mut data);
         let (k, largest) = data
             .iter()
@@ -192,27 +205,39 @@ impl Analysis {
             return None;
         }
         let bin = 2.0 * PI / (size as f64 * self.dt);
-        // The DFT's bin k is the frequency k·bin, aliased into (−π/dt, π/dt].
-        let coarse = match k <= size / 2 {
-            true => k as f64 * bin,
-            false => (k as f64 - size as f64) * bin,
+        // The peak between the bins by a parabola through the logarithms
+        // of the three magnitudes about it (exact for a Gaussian peak,
+        // close for the window's), a fraction of a bin from the maximum.
+        let magnitude = |k: usize| data[k % size].norm().max(f64::MIN_POSITIVE).ln();
+        let (left, centre, right) = (magnitude(k + size - 1), largest.ln(), magnitude(k + 1));
+        let curvature = left - 2.0 * centre + right;
+        let offset = match curvature < 0.0 {
+            true => (0.5 * (left - right) / curvature).clamp(-0.5, 0.5),
+            false => 0.0,
         };
-        Some(self.refine(f, coarse, bin))
+        // The DFT's bin k is the frequency k·bin, aliased into (−π/dt, π/dt].
+        let k = k as f64 + offset;
+        let coarse = match k <= (size / 2) as f64 {
+            true => k * bin,
+            false => (k - size as f64) * bin,
+        };
+        Some(self.refine(&windowed, coarse, bin))
     }
 
     /// Newton's method on g(ω) = d|A|²/dω, A = ⟨f, e^{iωt}⟩, kept within
     /// one bin of the coarse peak (bisecting on the sign of g when a step
-    /// leaves the bracket).
-    fn refine(&self, f: &[Complex<f64>], coarse: f64, bin: f64) -> f64 {
+    /// leaves the bracket), until a step is below 1e-13 of the frequency
+    /// (or of a bin, near zero).
+    fn refine(&self, windowed: &[Complex<f64>], coarse: f64, bin: f64) -> f64 {
         let slope = |omega: f64| {
-            let [a, d1, d2] = self.transform(f, omega);
+            let [a, d1, d2] = self.transform(windowed, omega);
             let g = 2.0 * (a.conj() * d1).re;
             let dg = 2.0 * (d1.conj() * d1 + a.conj() * d2).re;
             (g, dg)
         };
         let (mut low, mut high) = (coarse - bin, coarse + bin);
         let mut omega = coarse;
-        for _ in 0..60 {
+        for _ in 0..40 {
             let (g, dg) = slope(omega);
             // |A|² rises where g > 0: the maximum lies above.
             if g > 0.0 {
@@ -225,7 +250,7 @@ impl Analysis {
                 true => newton,
                 false => 0.5 * (low + high),
             };
-            if (next - omega).abs() <= 4.0 * f64::EPSILON * omega.abs().max(bin) {
+            if (next - omega).abs() <= 1e-13 * omega.abs().max(bin) {
                 return next;
             }
             omega = next;
@@ -246,8 +271,11 @@ impl Analysis {
             });
             sum / self.window.len() as f64
         });
-        let products =
-            DVector::from_iterator(k, frequencies.iter().map(|&w| self.transform(f, w)[0]));
+        let windowed = self.windowed(f);
+        let products = DVector::from_iterator(
+            k,
+            frequencies.iter().map(|&w| self.transform(&windowed, w)[0]),
+        );
         match gram.lu().solve(&products) {
             Some(a) => a.iter().copied().collect(),
             None => products.iter().copied().collect(),

@@ -14,6 +14,7 @@ pub mod equilibria;
 pub mod fit;
 pub mod floquet;
 pub mod frequency;
+pub mod frequency_map;
 pub mod mechanism;
 pub mod on_constraints;
 pub mod period_map;

@@ -57,6 +57,89 @@ pub struct SectionMap {
     pub megno: Vec<f64>,
 }
 
+/// The accessible region of a section at energy E as a grid of pixels:
+/// what a map over a section (MEGNO's, the frequency map) runs its orbits
+/// from.
+pub(super) struct SectionGrid {
+    pub fixed: &'static crate::registry::Erased<2, 4, 8, 20>,
+    /// The other coordinate's range and its momentum's.
+    pub window: [[f64; 2]; 2],
+    pub pixels: usize,
+    /// Each pixel's state on the plane (None where the energy is not
+    /// accessible), row 0 at the bottom.
+    pub seeds: Vec<Option<[f64; 4]>>,
+    pub axes: [String; 2],
+    pub energy_of: &'static str,
+}
+
+impl SectionGrid {
+    /// The grid of `pixels`² over the accessible region of the section of
+    /// a 2-degree `model` (`analysis` names the map for its refusals).
+    pub(super) fn new(
+        model: &Model,
+        params: &[f64],
+        section: &SectionSettings,
+        (pixels, extent): (usize, f64),
+        analysis: &'static str,
+    ) -> Result<SectionGrid, SectionError> {
+        let name = model.info.name.to_string();
+        let fixed = match model.sized {
+            Some(FixedSize::Dof2(fixed)) => fixed,
+            Some(_) => {
+                return Err(Refusal::Dimension {
+                    model: name,
+                    dof: model.info.coordinates.len(),
+                    analysis,
+                    supported: "2",
+                }
+                .into())
+            }
+            None => return Err(SectionError::Refused(Refusal::contact_model(name))),
+        };
+        let bad =
+            |requirement: &'static str| SectionError::from(Refusal::setting(&name, requirement));
+        if pixels < 2 || !(extent > 0.0) {
+            return Err(bad("pixels ≥ 2, t_max and extent positive"));
+        }
+        crate::budget::check_map(pixels).map_err(OdeError::from)?;
+        let chart = Chart::new(section, 2, &fixed.periodic())
+            .ok_or_else(|| bad(super::section::PLANE_COEFFICIENTS))?;
+        let energy = super::section::seed_energy(model, params)
+            .ok_or_else(|| bad(super::section::NO_AVERAGED_HAMILTONIAN))?;
+        let energy = |y: &[f64; 4]| energy(y);
+        // The least H over the solved momentum at a point of the plane.
+        let least = |q: f64, p: f64| chart.least_energy(&[q, p], &energy);
+        let centre = chart.centred(|q| least(q, 0.0), section.energy).centre();
+        let region = Region::find(&least, section.energy, extent, centre).ok_or_else(|| {
+            SectionError::NoSeeds {
+                model: name.clone(),
+            }
+        })?;
+        let window = region.window();
+        let at = |i: usize, range: [f64; 2]| {
+            range[0] + (range[1] - range[0]) * (i as f64 + 0.5) / pixels as f64
+        };
+        let seeds = (0..pixels * pixels)
+            .into_par_iter()
+            .map(|k| {
+                let (q, p) = (at(k % pixels, window[0]), at(k / pixels, window[1]));
+                region
+                    .contains(q, p)
+                    .then(|| on_plane::<4>(&[q, p], &chart, section, &energy).ok())
+                    .flatten()
+            })
+            .collect();
+        Ok(SectionGrid {
+            fixed,
+            window,
+            pixels,
+            seeds,
+            axes: chart.axes(&model.info.state_names()),
+            energy_of: if fixed.has_fast_phase() { "H̄" } else { "H" },
+        })
+    }
+}
+
 /// The MEGNO map of the section of a 2-degree autonomous `model`.
 pub fn section_map(
     model: &Model,
@@ -64,47 +147,25 @@ pub fn section_map(
     settings: &SectionMapSettings,
 ) -> Result<SectionMap, SectionError> {
     let name = model.info.name.to_string();
-    let fixed = match model.sized {
-        Some(FixedSize::Dof2(fixed)) => fixed,
-        Some(_) => {
-            return Err(Refusal::Dimension {
-                model: name,
-                dof: model.info.coordinates.len(),
-                analysis: "a section's MEGNO map",
-                supported: "2",
-            }
-            .into())
-        }
-        None => return Err(SectionError::Refused(Refusal::contact_model(name))),
-    };
     let s = &settings.section;
     let bad = |requirement: &'static str| SectionError::from(Refusal::setting(&name, requirement));
-    if settings.pixels < 2 || !(settings.t_max > 0.0 && settings.extent > 0.0) {
+    if !(settings.t_max > 0.0) {
         return Err(bad("pixels ≥ 2, t_max and extent positive"));
     }
-    crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
-    let chart = Chart::new(s, 2, &fixed.periodic())
-        .ok_or_else(|| bad(super::section::PLANE_COEFFICIENTS))?;
     let method = Method::Taylor { tol: s.tol };
     method.validate()?;
+    let start = std::time::Instant::now();
+    let grid = SectionGrid::new(
+        model,
+        params,
+        s,
+        (settings.pixels, settings.extent),
+        "a section's MEGNO map",
+    )?;
+    let fixed = grid.fixed;
     let chunk = megno_interval(fixed.has_fast_phase(), fixed.phase_period(params), s.phase)
         .ok_or_else(|| bad("with a fast phase the map starts its orbits at phase 0"))?;
-    let start = std::time::Instant::now();
-    let energy = super::section::seed_energy(model, params)
-        .ok_or_else(|| bad(super::section::NO_AVERAGED_HAMILTONIAN))?;
-    let energy = |y: &[f64; 4]| energy(y);
-    // The least H over the solved momentum at a point of the plane.
-    let least = |q: f64, p: f64| chart.least_energy(&[q, p], &energy);
-    let centre = chart.centred(|q| least(q, 0.0), s.energy).centre();
-    let region = Region::find(&least, s.energy, settings.extent, centre).ok_or_else(|| {
-        SectionError::NoSeeds {
-            model: name.clone(),
-        }
-    })?;
-    let window = region.window();
-    let n = settings.pixels;
-    let centre =
-        |i: usize, range: [f64; 2]| range[0] + (range[1] - range[0]) * (i as f64 + 0.5) / n as f64;
+    let n = grid.pixels;
     let system = fixed.exact(params);
     let chunks = (settings.t_max / chunk).ceil() as usize;
     let w0 = [0.5; 4];
@@ -113,19 +174,9 @@ pub fn section_map(
         .into_par_iter()
         .map(|rows| -> Result<(Vec<f64>, usize), SectionError> {
             // The accessible pixels' states, by their place in the block.
-            let seeds: Vec<(usize, [f64; 4])> = rows
-                .clone()
-                .flat_map(|j| (0..n).map(move |i| (j, i)))
-                .enumerate()
-                .filter_map(|(k, (j, i))| {
-                    let (q, p) = (centre(i, window[0]), centre(j, window[1]));
-                    if !region.contains(q, p) {
-                        return None;
-                    }
-                    on_plane::<4>(&[q, p], &chart, s, &energy)
-                        .ok()
-                        .map(|y| (k, y))
-                })
+            let offset = rows.start * n;
+            let seeds: Vec<(usize, [f64; 4])> = (offset..rows.end * n)
+                .filter_map(|k| grid.seeds[k].map(|y| (k - offset, y)))
                 .collect();
             let mut block = vec![f64::NAN; rows.len() * n];
             let mut integrator = LaneIntegrator::new(method)?;
@@ -152,13 +203,12 @@ pub fn section_map(
         .iter()
         .filter(|v| v.is_finite() && **v > CHAOS_THRESHOLD)
         .count();
-    let names = model.info.state_names();
     Ok(SectionMap {
         model: name,
         energy: s.energy,
-        energy_of: if fixed.has_fast_phase() { "H̄" } else { "H" },
-        axes: chart.axes(&names),
-        window,
+        energy_of: grid.energy_of,
+        axes: grid.axes,
+        window: grid.window,
         pixels: n,
         t_max: chunks as f64 * chunk,
         accessible,

@@ -1,0 +1,260 @@
+//! Laskar's frequency map on a surface of section: over a grid of the
+//! section's accessible region at energy E (as the MEGNO map's), each
+//! orbit's fundamental frequencies (ν₁, ν₂) by NAFF of q_j + i p_j, and
+//! its frequency diffusion index, log₁₀ of the largest change of a
+//! fundamental frequency between the orbit's first and second halves:
+//! near the rounding on KAM tori, large in the chaotic layers. The
+//! orbits run in the batch Taylor lanes on all cores.
+
+use super::frequency::{naff, NaffSettings};
+use super::section::{SectionError, SectionSettings};
+use super::section_map::SectionGrid;
+use crate::analysis::Refusal;
+use crate::ode::{LaneIntegrator, Method, Orbit};
+use crate::plot::{ColorMap, Figure, PanelSpec};
+use crate::registry::{Fixed, Model};
+use nalgebra::Complex;
+use rayon::prelude::*;
+
+/// What a frequency map computes.
+#[derive(Clone, Debug)]
+pub struct FrequencyMapSettings {
+    /// The plane, its crossing direction, the energy and the Taylor
+    /// method's tolerance (`crossings` is not used).
+    pub section: SectionSettings,
+    /// Pixels per side.
+    pub pixels: usize,
+    /// The time each orbit runs, and the samples taken over it.
+    pub t_max: f64,
+    pub samples: usize,
+    /// The accessible region is searched for in [−extent, extent]².
+    pub extent: f64,
+}
+
+/// A diffusion index below this is a regular orbit (a torus): its
+/// frequencies drift by less than 1e-4 between the halves. (Hénon–Heiles
+/// at E = 1/8 over T = 2000: 41.7 % of the section regular by it, 42.5 %
+/// by MEGNO's ⟨Y⟩ < 4.)
+pub const REGULAR_INDEX: f64 = -4.0;
+
+/// A frequency map of a section.
+#[derive(Debug, serde::Serialize)]
+pub struct FrequencyMap {
+    pub model: String,
+    pub energy: f64,
+    pub energy_of: &'static str,
+    pub axes: [String; 2],
+    pub window: [[f64; 2]; 2],
+    pub pixels: usize,
+    pub t_max: f64,
+    pub samples: usize,
+    /// Pixels where the energy is accessible, and those whose diffusion
+    /// index is below [`REGULAR_INDEX`].
+    pub accessible: usize,
+    pub regular: usize,
+    pub regular_fraction: f64,
+    /// Orbits the integrator could not follow (NaN in both maps).
+    pub failed: usize,
+    pub seconds: f64,
+    /// (ν₁, ν₂) per pixel, row 0 at the bottom; NaN where the energy is
+    /// not accessible.
+    #[serde(skip)]
+    pub frequencies: Vec<[f64; 2]>,
+    /// The diffusion index per pixel.
+    #[serde(skip)]
+    pub diffusion: Vec<f64>,
+}
+
+/// The frequency map of the section of a 2-degree autonomous `model`.
+pub fn frequency_map(
+    model: &Model,
+    params: &[f64],
+    settings: &FrequencyMapSettings,
+) -> Result<FrequencyMap, SectionError> {
+    let name = model.info.name.to_string();
+    let bad = |requirement: &'static str| SectionError::from(Refusal::setting(&name, requirement));
+    if !(settings.t_max.is_finite() && settings.t_max > 0.0) || settings.samples < 64 {
+        return Err(bad("t_max positive and at least 64 samples per orbit"));
+    }
+    let method = Method::Taylor {
+        tol: settings.section.tol,
+    };
+    method.validate()?;
+    let start = std::time::Instant::now();
+    let grid = SectionGrid::new(
+        model,
+        params,
+        &settings.section,
+        (settings.pixels, settings.extent),
+        "a frequency map",
+    )?;
+    if grid.fixed.has_fast_phase() {
+        return Err(Refusal::FastPhase {
+            model: name,
+            instead: "its frequency map is not computed yet (the frequencies of a period map are sampled once a period)",
+        }
+        .into());
+    }
+    let n = grid.pixels;
+    let system = grid.fixed.exact(params);
+    let dt = settings.t_max / settings.samples as f64;
+    let blocks: Vec<Vec<Option<([f64; 2], f64)>>> = super::row_blocks(0..n, n)
+        .into_par_iter()
+        .map(|rows| -> Result<_, SectionError> {
+            let offset = rows.start * n;
+            let seeds: Vec<(usize, [f64; 4])> = (offset..rows.end * n)
+                .filter_map(|k| grid.seeds[k].map(|y| (k - offset, y)))
+                .collect();
+            let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
+            let mut states: Vec<Vec<[f64; 4]>> = starts
+                .iter()
+                .map(|y| {
+                    let mut v = Vec::with_capacity(settings.samples);
+                    v.push(*y);
+                    v
+                })
+                .collect();
+            let mut integrator = LaneIntegrator::new(method)?;
+            let orbits = Orbit::of_one_system(&system, dt, &starts);
+            let errors = integrator.stream(&orbits, |k, y| {
+                states[k].push(*y);
+                states[k].len() < settings.samples
+            });
+            let mut block = vec![None; rows.len() * n];
+            for (((k, _), orbit), error) in seeds.iter().zip(&states).zip(errors) {
+                block[*k] = match error {
+                    None => Some(analyse(orbit, dt)),
+                    Some(_) => Some(([f64::NAN; 2], f64::NAN)),
+                };
+            }
+            Ok(block)
+        })
+        .collect::<Result<_, _>>()?;
+    let pixels: Vec<Option<([f64; 2], f64)>> = blocks.into_iter().flatten().collect();
+    let accessible = pixels.iter().flatten().count();
+    let failed = pixels.iter().flatten().filter(|(_, d)| d.is_nan()).count();
+    let regular = pixels
+        .iter()
+        .flatten()
+        .filter(|(_, d)| *d < REGULAR_INDEX)
+        .count();
+    Ok(FrequencyMap {
+        model: name,
+        energy: settings.section.energy,
+        energy_of: grid.energy_of,
+        axes: grid.axes,
+        window: grid.window,
+        pixels: n,
+        t_max: settings.t_max,
+        samples: settings.samples,
+        accessible,
+        regular,
+        regular_fraction: regular as f64 / (accessible - failed).max(1) as f64,
+        failed,
+        seconds: start.elapsed().as_secs_f64(),
+        frequencies: pixels
+            .iter()
+            .map(|p| p.map_or([f64::NAN; 2], |(nu, _)| nu))
+            .collect(),
+        diffusion: pixels
+            .iter()
+            .map(|p| p.map_or(f64::NAN, |(_, d)| d))
+            .collect(),
+    })
+}
+
+/// An orbit's fundamental frequencies (q_j + i p_j, the largest term)
+/// over the whole orbit, and its diffusion index between its halves.
+fn analyse(orbit: &[[f64; 4]], dt: f64) -> ([f64; 2], f64) {
+    let settings = NaffSettings {
+        terms: 1,
+        window_order: 1,
+    };
+    let fundamental = |states: &[[f64; 4]], j: usize| {
+        let signal: Vec<Complex<f64>> = states
+            .iter()
+            .map(|y| Complex::new(y[j], y[j + 2]))
+            .collect();
+        naff(&signal, dt, &settings)
+            .ok()
+            .and_then(|terms| terms.first().map(|t| t.frequency))
+            .unwrap_or(f64::NAN)
+    };
+    let half = orbit.len() / 2;
+    let nu = [fundamental(orbit, 0), fundamental(orbit, 1)];
+    let drift = (0..2)
+        .map(|j| (fundamental(&orbit[..half], j) - fundamental(&orbit[half..], j)).abs())
+        .fold(0.0_f64, f64::max);
+    // (A drift of exactly 0 is below any rounding: the floor is 1e-16.)
+    (nu, drift.max(1e-16).log10())
+}
+
+impl FrequencyMap {
+    /// The diffusion index over the section (−12 to 0, white where the
+    /// energy is not accessible) beside the frequency map ν₂ against ν₁,
+    /// each orbit a dot coloured by its index: the tori's frequencies
+    /// fill curves, the resonances show as lines through them, chaotic
+    /// orbits scatter.
+    pub fn figure(&self) -> Figure {
+        let title = format!(
+            "{}: diffusion index at {} = {}, T = {}; regular (< {REGULAR_INDEX}): {:.1} %",
+            self.model,
+            self.energy_of,
+            self.energy,
+            self.t_max,
+            100.0 * self.regular_fraction
+        );
+        let finite: Vec<[f64; 2]> = self
+            .frequencies
+            .iter()
+            .copied()
+            .filter(|nu| nu.iter().all(|x| x.is_finite()))
+            .collect();
+        let range = |j: usize| {
+            finite
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), nu| {
+                    (a.min(nu[j]), b.max(nu[j]))
+                })
+        };
+        let specs = [
+            PanelSpec::new(
+                &title,
+                &self.axes[0],
+                &self.axes[1],
+                (self.window[0][0], self.window[0][1]),
+                (self.window[1][0], self.window[1][1]),
+            ),
+            PanelSpec::new(
+                "frequency map (colour: diffusion index)",
+                "ν₁",
+                "ν₂",
+                range(0),
+                range(1),
+            ),
+        ];
+        let mut figure = Figure::grid(2, 1, 660, 620, &specs);
+        let shade = |d: f64| ((d + 12.0) / 12.0).clamp(0.0, 1.0);
+        let shades: Vec<f64> = self.diffusion.iter().map(|&d| shade(d)).collect();
+        figure.shaded_map(
+            0,
+            self.pixels,
+            self.pixels,
+            &shades,
+            ColorMap::Viridis,
+            "(index + 12) / 12",
+        );
+        // Ten bands of the index, each its colour.
+        for band in 0..10 {
+            let points = self
+                .frequencies
+                .iter()
+                .zip(&self.diffusion)
+                .filter(|(_, &d)| ((shade(d) * 10.0) as usize).min(9) == band)
+                .map(|(nu, _)| (nu[0], nu[1]));
+            let colour = ColorMap::Viridis.rgb((band as f64 + 0.5) / 10.0);
+            figure.points(1, points, colour, 1);
+        }
+        figure
+    }
+}
