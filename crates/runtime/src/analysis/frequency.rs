@@ -16,7 +16,9 @@
 //! the coarse peak needs (the 30 lines of [`fft`], tested against the
 //! direct sum).
 
-use nalgebra::{Complex, DMatrix, DVector};
+/// The signal's numbers (nalgebra's, re-exported for callers without it).
+pub use nalgebra::Complex;
+use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
 /// The fewest samples a frequency analysis accepts.
@@ -246,11 +248,12 @@ impl Analysis {
                 high = omega;
             }
             let newton = omega - g / dg;
-            let next = match dg < 0.0 && newton > low && newton < high {
+            // (A converged step lands on the bracket's end: kept.)
+            let next = match dg < 0.0 && newton >= low && newton <= high {
                 true => newton,
                 false => 0.5 * (low + high),
             };
-            if (next - omega).abs() <= 1e-13 * omega.abs().max(bin) {
+            if (next - omega).abs() <= 1e-15 * omega.abs().max(bin) {
                 return next;
             }
             omega = next;
