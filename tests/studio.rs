@@ -198,6 +198,41 @@ async fn a_constrained_models_orbit_is_its_portrait_on_the_constraints() {
     }
 }
 
+/// A clicked orbit's tune: near Kapitza's stable upright (A = 1.5,
+/// ε = 0.1) a small orbit of the period map turns by the angle of the
+/// upright's Floquet multipliers e^{±2πiν} each period: NAFF of its
+/// iterates gives ν to 1e-5 (the orbit's amplitude detunes it by less).
+#[tokio::test]
+async fn a_clicked_orbits_tune_is_its_floquet_angle() {
+    let request = json!({"model": "kapitza", "params": {"A": 1.5, "eps": 0.1, "mu": 0.0},
+        "method": "taylor", "tol": 1e-13, "seed": [0.01, 0.0], "periods": 2000});
+    let (status, _, body) = call("POST", "/api/orbit", Some(request)).await;
+    assert_eq!(status, StatusCode::OK);
+    let end = lines(&body).last().unwrap()["end"].clone();
+    let tune = end["tunes"][0].as_f64().unwrap_or_else(|| panic!("{end}"));
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let params = [1.5, 0.1, 0.0];
+    let mut integrator = Integrator::new(Method::Taylor { tol: 1e-13 }).unwrap();
+    let period = 2.0 * std::f64::consts::PI * 0.1;
+    let (_, monodromy) = model
+        .systems()
+        .unwrap()
+        .monodromy(&params, &mut integrator, period, &[0.0, 0.0])
+        .unwrap();
+    let floquet = (0.5 * monodromy.trace()).acos() / (2.0 * std::f64::consts::PI);
+    assert!(
+        (tune.abs() - floquet).abs() < 1e-5,
+        "NAFF {tune}, Floquet {floquet}"
+    );
+    // Too short an orbit has no tunes.
+    let request = json!({"model": "kapitza", "seed": [0.01, 0.0], "periods": 10});
+    let (_, _, body) = call("POST", "/api/orbit", Some(request)).await;
+    assert!(
+        lines(&body).last().unwrap()["end"]["tunes"].is_null(),
+        "{body}"
+    );
+}
+
 /// The mechanism drawn from a click on the four-bar: its bars keep their
 /// lengths in every frame (the seed is put on the constraints as the
 /// orbit's is), its base moves as the model file says; a model without

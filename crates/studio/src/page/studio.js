@@ -596,7 +596,9 @@ function listOrbits() {
     const item = document.createElement("li");
     item.style.color = orbit.color;
     const seed = orbit.seed.map((v) => v.toFixed(3)).join(", ");
-    item.textContent = `(${seed}) ${orbit.points.length} pts${orbit.error ? " stopped" : orbit.done ? "" : " …"}`;
+    const tunes = orbit.end && orbit.end.tunes ? ` ν ${orbit.end.tunes.map((t) => t.toFixed(5)).join(", ")}` : "";
+    item.textContent = `(${seed}) ${orbit.points.length} pts${orbit.error ? " stopped" : orbit.done ? "" : " …"}${tunes}`;
+    if (tunes) item.title = "the orbit's tunes: turns per period of each degree of freedom (NAFF of q + i p over the iterates)";
     if (orbit.error) { item.className = "error"; item.title = orbit.error; }
     list.appendChild(item);
   }
