@@ -9,6 +9,7 @@ mod common;
 mod analyses_by_name;
 mod attractor;
 mod bad_input;
+mod basins;
 mod constrained;
 mod continuation;
 mod dimension;

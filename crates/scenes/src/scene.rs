@@ -120,6 +120,8 @@ pub enum SceneError {
     #[error(transparent)]
     Ode(#[from] mechlab_runtime::ode::OdeError),
     #[error(transparent)]
+    Refused(#[from] mechlab_runtime::analysis::Refusal),
+    #[error(transparent)]
     Contact(#[from] mechlab_runtime::contact::ContactError),
     #[error(transparent)]
     Parameter(#[from] mechlab_runtime::registry::ParameterError),

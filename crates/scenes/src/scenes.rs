@@ -504,6 +504,72 @@ pub fn period_map_scene(
     Ok(())
 }
 
+/// The `basins` scene: the basins of attraction of a period map on a
+/// plane of the state, the attractors found unaided.
+pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use mechlab_runtime::analysis::basins::{basins, BasinSettings};
+    let (model, scene) = generic_scene(
+        catalog,
+        "basins",
+        "basins of attraction of the period map, the attractors found from the orbits",
+        &[],
+        ("duffing", "taylor", "1e-10"),
+        &[
+            ("axes", "0,1", "the state components along the map's axes"),
+            ("x", "-2,2", "the range of the first axis"),
+            ("y", "-2,2", "the range of the second axis"),
+            ("pixels", "200", "pixels per side"),
+            ("transient", "300", "periods run before the record"),
+            ("record", "16", "periods recorded to identify the attractor"),
+            (
+                "cell",
+                "0.05",
+                "the side of the state-space cells that identify attractors",
+            ),
+        ],
+    )?;
+    let range = |name: &str| -> Result<(f64, f64), SceneError> {
+        match scene.numbers(name)?[..] {
+            [lo, hi] => Ok((lo, hi)),
+            _ => Err(SceneError::BadValue {
+                name: name.into(),
+                value: scene.text(name).into(),
+                reason: ValueProblem::Requirement("low,high"),
+            }),
+        }
+    };
+    let settings = BasinSettings {
+        axes: axes_from(&scene)?,
+        ranges: [range("x")?, range("y")?],
+        through: None,
+        pixels: scene.count("pixels")?,
+        transient: scene.whole("transient")?,
+        record: scene.count("record")?,
+        cell: scene.positive("cell")?,
+        method: method_from(&scene)?,
+    };
+    let params = scene.parameter_values(model.info)?;
+    eprintln!("{}² starts …", settings.pixels);
+    let result = basins(model, &params, &settings)?;
+    for a in &result.attractors {
+        eprintln!(
+            "{}: {:.4} ± {:.4} of the starts, at {:?}",
+            a.kind, a.fraction, a.fraction_error, a.representative
+        );
+    }
+    eprintln!("diverged: {}; {:.1} s", result.diverged, result.seconds);
+    scene.save_figure(&result.figure(), "basins.png")?;
+    let n = result.pixels;
+    let rows = result
+        .labels
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (k % n, k / n, *l));
+    scene.write_csv("basins.csv", &["column", "row", "attractor"], rows)?;
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
 /// The `linkage` scene: stabilisation by vibration of a constrained model
 /// (the four-bar linkage held upside down by default): the averaged
 /// equilibrium on the constraints, its thresholds, and the exact window.

@@ -7,6 +7,7 @@
 
 pub mod attractor;
 pub mod averaging;
+pub mod basins;
 pub mod chaos_map;
 pub mod continuation;
 pub mod dimension;
