@@ -120,7 +120,7 @@ pub enum SceneError {
     #[error(transparent)]
     Ode(#[from] mechlab_runtime::ode::OdeError),
     #[error(transparent)]
-    Refused(#[from] mechlab_runtime::analysis::Refusal),
+    Basins(#[from] mechlab_runtime::analysis::basins::BasinsError),
     #[error(transparent)]
     Contact(#[from] mechlab_runtime::contact::ContactError),
     #[error(transparent)]

@@ -8,7 +8,7 @@
 //! class of their own, never assigned to an attractor.
 
 use super::Refusal;
-use crate::ode::{Integrator, Method, OdeError};
+use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec};
 use crate::registry::Model;
 use rayon::prelude::*;
@@ -33,8 +33,18 @@ pub struct BasinSettings {
     pub method: Method,
 }
 
-/// How a start ended.
+/// The label of a start whose orbit diverged or left the model's domain.
 pub const DIVERGED: i32 = -1;
+
+/// Why a basin map cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum BasinsError {
+    #[error(transparent)]
+    Refused(#[from] Refusal),
+    /// The method cannot run (its setting), before any orbit.
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
 
 /// An attractor found.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -70,7 +80,11 @@ pub struct Basins {
 }
 
 /// The basins of `model`'s period map at `params`.
-pub fn basins(model: &Model, params: &[f64], settings: &BasinSettings) -> Result<Basins, Refusal> {
+pub fn basins(
+    model: &Model,
+    params: &[f64],
+    settings: &BasinSettings,
+) -> Result<Basins, BasinsError> {
     let name = model.info.name;
     let flows = super::flows(model)?;
     super::method_applies(model, settings.method)?;
@@ -90,49 +104,50 @@ pub fn basins(model: &Model, params: &[f64], settings: &BasinSettings) -> Result
         return Err(Refusal::setting(
             name,
             "pixels ≥ 2, record ≥ 2, a positive cell and finite ranges low < high",
-        ));
+        )
+        .into());
     }
     let base = match &settings.through {
         Some(y) if y.len() == flows.periodic_state().len() => y.clone(),
         Some(_) => {
-            return Err(Refusal::setting(
-                name,
-                "`through` must be a full state of the model",
-            ))
+            let what = "`through` must be a full state of the model";
+            return Err(Refusal::setting(name, what).into());
         }
         None => flows.base_state(params),
     };
     let start = std::time::Instant::now();
     let n = settings.pixels;
     let wrap = flows.periodic_state();
-    let system = flows.exact(params);
-    // Each start's recorded iterates, or None if its orbit stopped.
-    let records: Vec<Option<Vec<Vec<f64>>>> = (0..n * n)
+    // Each start on the plane (None where the model has no state there).
+    let starts: Vec<Option<Vec<f64>>> = (0..n * n)
         .into_par_iter()
         .map(|k| {
             let at = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / n as f64;
             let mut y = base.clone();
             y[settings.axes[0]] = at(settings.ranges[0], k % n);
             y[settings.axes[1]] = at(settings.ranges[1], k / n);
-            if flows.consistent(params, &mut y, &settings.axes).is_err() {
-                return None;
-            }
-            let mut integrator = Integrator::new(settings.method).ok()?;
-            let mut record = Vec::with_capacity(settings.record);
-            let mut seen = 0;
-            let periods = settings.transient + settings.record;
-            let run: Result<(), OdeError> =
-                system.stream(&mut integrator, &y, period, periods, &mut |y| {
-                    seen += 1;
-                    if seen > settings.transient {
-                        record.push(wrapped(y, &wrap));
-                    }
-                    true
-                });
-            match run {
-                Ok(()) if record.len() == settings.record => Some(record),
-                _ => None,
-            }
+            flows
+                .consistent(params, &mut y, &settings.axes)
+                .ok()
+                .map(|()| y)
+        })
+        .collect();
+    let flat: Vec<f64> = starts.iter().flatten().flatten().copied().collect();
+    let mut runs = flows
+        .iterates(
+            params,
+            settings.method,
+            period,
+            &flat,
+            (settings.transient, settings.record),
+        )?
+        .into_iter();
+    // Each start's recorded iterates, angles wrapped, or None.
+    let records: Vec<Option<Vec<Vec<f64>>>> = starts
+        .iter()
+        .map(|start| {
+            let run = start.as_ref().and_then(|_| runs.next().flatten())?;
+            Some(run.iter().map(|y| wrapped(y, &wrap)).collect())
         })
         .collect();
     let (labels, attractors, points) = identify(&records, settings);

@@ -429,6 +429,27 @@ pub trait Flows: Sync {
         periods: usize,
         held: &[usize],
     ) -> Result<FliValues, OdeError>;
+    /// The iterates `transient + 1 ..= transient + record` of the exact
+    /// system's period map from each start (`starts` one after the other),
+    /// None for a start whose orbit stopped. Each orbit alone here; the
+    /// Hamiltonian models' fixed sizes run the Taylor method's in the
+    /// batch lanes.
+    fn iterates(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        (transient, record): (usize, usize),
+    ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
+        iterates_one_by_one(
+            &*self.exact(params),
+            method,
+            period,
+            starts,
+            (transient, record),
+        )
+    }
     /// Makes `y` a state of the model at t = 0 holding its components
     /// `held` (a chart's coordinates): a free model's states all are; a
     /// constrained model's other components move onto the constraints.
@@ -440,6 +461,34 @@ pub trait Flows: Sync {
     ) -> Result<(), crate::ode::holonomic::ConstraintError> {
         Ok(())
     }
+}
+
+/// [`Flows::iterates`] of `system`, each orbit alone (in parallel).
+fn iterates_one_by_one(
+    system: &dyn AnySystem,
+    method: Method,
+    period: f64,
+    starts: &[f64],
+    (transient, record): (usize, usize),
+) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
+    use rayon::prelude::*;
+    crate::ode::Integrator::new(method)?;
+    Ok(starts
+        .par_chunks(system.dim())
+        .map(|y0| {
+            let mut integrator = crate::ode::Integrator::new(method).ok()?;
+            let (mut seen, mut kept) = (0, Vec::with_capacity(record));
+            let periods = transient + record;
+            let run = system.stream(&mut integrator, y0, period, periods, &mut |y| {
+                seen += 1;
+                if seen > transient {
+                    kept.push(y.to_vec());
+                }
+                true
+            });
+            (run.is_ok() && kept.len() == record).then_some(kept)
+        })
+        .collect())
 }
 
 /// A Hamiltonian model's systems and functions with states as slices: what
@@ -536,6 +585,51 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
         let w0 = fixed_state::<S>(w0)?;
         let system = Fixed::exact(self, params);
         fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
+    }
+    fn iterates(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        (transient, record): (usize, usize),
+    ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
+        use crate::ode::{LaneIntegrator, Orbit};
+        use rayon::prelude::*;
+        if !matches!(method, Method::Taylor { .. }) {
+            let system = Flows::exact(self, params);
+            return iterates_one_by_one(&*system, method, period, starts, (transient, record));
+        }
+        let starts: Vec<[f64; S]> = starts
+            .chunks(S)
+            .map(fixed_state::<S>)
+            .collect::<Result<_, _>>()?;
+        let system = Fixed::exact(self, params);
+        LaneIntegrator::new(method)?;
+        // Blocks of orbits, each through one batch integrator.
+        let blocks: Vec<Vec<Option<Vec<Vec<f64>>>>> = starts
+            .par_chunks(256)
+            .map(|block| {
+                let Ok(mut integrator) = LaneIntegrator::new(method) else {
+                    return vec![None; block.len()];
+                };
+                let orbits = Orbit::of_one_system(&system, period, block);
+                let mut seen = vec![0usize; block.len()];
+                let mut kept: Vec<Vec<Vec<f64>>> = vec![Vec::with_capacity(record); block.len()];
+                let errors = integrator.stream(&orbits, |k, y| {
+                    seen[k] += 1;
+                    if seen[k] > transient {
+                        kept[k].push(y.to_vec());
+                    }
+                    seen[k] < transient + record
+                });
+                kept.into_iter()
+                    .zip(errors)
+                    .map(|(kept, error)| (error.is_none() && kept.len() == record).then_some(kept))
+                    .collect()
+            })
+            .collect();
+        Ok(blocks.into_iter().flatten().collect())
     }
 }
 
