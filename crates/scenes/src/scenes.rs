@@ -552,8 +552,9 @@ pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
     eprintln!("{}² starts …", settings.pixels);
     let result = basins(model, &params, &settings)?;
     for a in &result.attractors {
+        let seen = if a.confirmed { "" } else { " (one start only)" };
         eprintln!(
-            "{}: {:.4} ± {:.4} of the starts, at {:?}",
+            "{}: {:.4} ± {:.4} of the starts, at {:?}{seen}",
             a.kind, a.fraction, a.fraction_error, a.representative
         );
     }

@@ -54,6 +54,9 @@ pub struct Attractor {
     /// Its last recorded iterate from the first start that reached it.
     pub representative: Vec<f64>,
     pub starts: usize,
+    /// Reached from a second start too (an attractor seen once may be a
+    /// transient not yet settled).
+    pub confirmed: bool,
     /// The share of the grid's starts, and its standard error.
     pub fraction: f64,
     pub fraction_error: f64,
@@ -242,6 +245,7 @@ fn identify(
                 kind: kind_of(record, settings.cell * 1e-6),
                 representative: record.last().cloned().unwrap_or_default(),
                 starts: 0,
+                confirmed: false,
                 fraction: 0.0,
                 fraction_error: 0.0,
             });
@@ -257,6 +261,7 @@ fn identify(
     }
     let total = records.len() as f64;
     for a in &mut attractors {
+        a.confirmed = a.starts >= 2;
         a.fraction = a.starts as f64 / total;
         a.fraction_error = (a.fraction * (1.0 - a.fraction) / total).sqrt();
     }
