@@ -597,24 +597,15 @@ fn the_taylor_method_is_refused_for_a_constrained_model() {
 }
 
 fn continuation_settings(parameter: &str, to: f64, start: &[f64]) -> ContinuationSettings {
+    let method = Method::Dop853 {
+        rtol: 1e-12,
+        atol: 1e-12,
+    };
     ContinuationSettings {
-        parameter: parameter.into(),
-        to,
-        start: start.to_vec(),
-        period: 1,
-        max_period: 1,
-        switch_branch_points: false,
         max_branches: 1,
-        points: 2000,
         step: 0.01,
-        min_step: 1e-8,
         max_step: 0.05,
-        method: Method::Dop853 {
-            rtol: 1e-12,
-            atol: 1e-12,
-        },
-        diagram: None,
-        chart: None,
+        ..crate::common::continuation_settings(parameter, to, start, method)
     }
 }
 

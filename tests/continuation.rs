@@ -14,22 +14,7 @@ use mechlab_test_models::forced_oscillator::MODEL as FORCED;
 use nalgebra::{DMatrix, DVector};
 
 fn settings(parameter: &str, to: f64, start: &[f64]) -> ContinuationSettings {
-    ContinuationSettings {
-        parameter: parameter.into(),
-        to,
-        start: start.to_vec(),
-        period: 1,
-        max_period: 1,
-        switch_branch_points: false,
-        max_branches: 4,
-        points: 2000,
-        step: 0.005,
-        min_step: 1e-8,
-        max_step: 0.02,
-        method: Method::Taylor { tol: 1e-13 },
-        diagram: None,
-        chart: None,
-    }
+    crate::common::continuation_settings(parameter, to, start, Method::Taylor { tol: 1e-13 })
 }
 
 /// Parameter values of the forced oscillator: c, b, F, ω.

@@ -51,6 +51,15 @@ fn lines(text: &str) -> Vec<Value> {
         .collect()
 }
 
+/// The points of a streamed orbit's chunks, in order.
+fn orbit_points(lines: &[Value]) -> Vec<[f64; 2]> {
+    lines
+        .iter()
+        .filter_map(|l| l.get("points"))
+        .flat_map(|p| serde_json::from_value::<Vec<[f64; 2]>>(p.clone()).unwrap())
+        .collect()
+}
+
 /// Kapitza's period map from the library: its exact system at `params`
 /// (A, ε, μ) and the forcing period.
 fn kapitza_map(params: [f64; 3]) -> (kapitza::Exact, f64) {
@@ -127,11 +136,7 @@ async fn orbit_equals_the_library_period_map() {
     assert_eq!(status, StatusCode::OK);
     assert_eq!(kind, "application/x-ndjson");
     let lines = lines(&body);
-    let points: Vec<[f64; 2]> = lines
-        .iter()
-        .filter_map(|l| l.get("points"))
-        .flat_map(|p| serde_json::from_value::<Vec<[f64; 2]>>(p.clone()).unwrap())
-        .collect();
+    let points = orbit_points(&lines);
     let end = &lines.last().unwrap()["end"];
     assert_eq!(end["periods"], 300);
     assert_eq!(end["cancelled"], false);
@@ -167,11 +172,7 @@ async fn a_constrained_models_orbit_is_its_portrait_on_the_constraints() {
     let (status, _, body) = call("POST", "/api/orbit", Some(request)).await;
     assert_eq!(status, StatusCode::OK);
     let lines = lines(&body);
-    let points: Vec<[f64; 2]> = lines
-        .iter()
-        .filter_map(|l| l.get("points"))
-        .flat_map(|p| serde_json::from_value::<Vec<[f64; 2]>>(p.clone()).unwrap())
-        .collect();
+    let points = orbit_points(&lines);
     assert_eq!(points.len(), 41);
     assert_eq!(points[0], [0.35, 0.4], "the axes' components are held");
     let model = mechlab::models::by_name("four_bar").unwrap();

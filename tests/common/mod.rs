@@ -196,3 +196,29 @@ pub fn assert_whole_power_slopes(model: &str, slopes: &[Result<f64, String>], mo
     }
     slopes.iter().all(|s| s.is_ok())
 }
+
+/// Continuation settings of one branch of period 1 in `parameter` to `to`
+/// from `start`, with `method` (the tests change what they need).
+pub fn continuation_settings(
+    parameter: &str,
+    to: f64,
+    start: &[f64],
+    method: Method,
+) -> mechlab::analysis::continuation::ContinuationSettings {
+    mechlab::analysis::continuation::ContinuationSettings {
+        parameter: parameter.into(),
+        to,
+        start: start.to_vec(),
+        period: 1,
+        max_period: 1,
+        switch_branch_points: false,
+        max_branches: 4,
+        points: 2000,
+        step: 0.005,
+        min_step: 1e-8,
+        max_step: 0.02,
+        method,
+        diagram: None,
+        chart: None,
+    }
+}

@@ -11,7 +11,6 @@ use crate::ode::{AnyOptions, Method, OdeError};
 use crate::registry::ConstrainedSystems;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
-use std::sync::atomic::Ordering;
 use std::sync::Mutex;
 
 pub(super) struct ChartMap {
@@ -172,12 +171,12 @@ fn chart_of(basis: &DMatrix<f64>, holonomic: bool) -> Vec<usize> {
 }
 
 impl FamilyMap for ChartMap {
-    fn periodic(&self) -> &[bool] {
-        &self.periodic
+    fn family(&self) -> &Family {
+        &self.family
     }
 
-    fn flow(&self) -> bool {
-        !self.model.has_fast_phase()
+    fn periodic(&self) -> &[bool] {
+        &self.periodic
     }
 
     fn field(&self, z: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>) {
@@ -198,10 +197,6 @@ impl FamilyMap for ChartMap {
         };
         let f = self.chart(&f);
         (f, self.select(&(jacobian * lifting)))
-    }
-
-    fn parameter_allowed(&self, p: f64) -> bool {
-        self.family.parameter_allowed(p)
     }
 
     fn once(
@@ -254,9 +249,5 @@ impl FamilyMap for ChartMap {
                 Ok(states.iter().map(|y| self.chart(y)).collect())
             })
             .collect()
-    }
-
-    fn evaluations(&self) -> u64 {
-        self.family.evaluations.load(Ordering::Relaxed)
     }
 }

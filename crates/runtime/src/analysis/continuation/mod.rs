@@ -244,15 +244,21 @@ pub struct Continuation {
 /// The period map of a model as a function of one parameter, its sizes
 /// erased: what the continuation needs of the model.
 trait FamilyMap: Sync {
+    /// The model with one parameter free.
+    fn family(&self) -> &Family;
     /// Which state components are angles.
     fn periodic(&self) -> &[bool];
     /// Whether the branches are of equilibria of a flow (a model without a
     /// fast phase) rather than of fixed points of a period map.
-    fn flow(&self) -> bool;
+    fn flow(&self) -> bool {
+        !self.family().model.has_fast_phase()
+    }
     /// The flow's field f(y; p) and its Jacobian ∂f/∂y.
     fn field(&self, y: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>);
     /// Whether the model accepts this value of the parameter.
-    fn parameter_allowed(&self, p: f64) -> bool;
+    fn parameter_allowed(&self, p: f64) -> bool {
+        self.family().parameter_allowed(p)
+    }
     /// One period of the map from `y` at the parameter value p and, if
     /// `jacobian`, its monodromy matrix.
     fn once(
@@ -271,7 +277,9 @@ trait FamilyMap: Sync {
         iterates: usize,
     ) -> Vec<Result<Vec<Vec<f64>>, OdeError>>;
     /// Periods integrated so far.
-    fn evaluations(&self) -> u64;
+    fn evaluations(&self) -> u64 {
+        self.family().evaluations.load(Ordering::Relaxed)
+    }
 }
 
 /// Continues the periodic orbits of `model` at `params` (declaration
@@ -522,12 +530,12 @@ impl AtModel {
 }
 
 impl FamilyMap for AtModel {
-    fn periodic(&self) -> &[bool] {
-        &self.periodic
+    fn family(&self) -> &Family {
+        &self.family
     }
 
-    fn flow(&self) -> bool {
-        !self.model.has_fast_phase()
+    fn periodic(&self) -> &[bool] {
+        &self.periodic
     }
 
     fn field(&self, y: &[f64], p: f64) -> (Vec<f64>, DMatrix<f64>) {
@@ -540,10 +548,6 @@ impl FamilyMap for AtModel {
             .expect("a state of the model's length");
         let jacobian = jacobian.unwrap_or_else(|| DMatrix::from_element(n, n, f64::NAN));
         (f, jacobian)
-    }
-
-    fn parameter_allowed(&self, p: f64) -> bool {
-        self.family.parameter_allowed(p)
     }
 
     fn once(
@@ -581,10 +585,6 @@ impl FamilyMap for AtModel {
         self.family.count(values.len() * (transient + iterates));
         let (method, wrap) = (self.family.method, &self.periodic);
         diagram::iterates(method, &problems, start, wrap, transient, iterates)
-    }
-
-    fn evaluations(&self) -> u64 {
-        self.family.evaluations.load(Ordering::Relaxed)
     }
 }
 
