@@ -9,5 +9,5 @@
 //! `cargo run --release --example basins -- --set gamma=0.0 --set pixels=100`
 
 fn main() {
-    mechlab::scene::run(|| mechlab::scenes::basins_scene(mechlab::models::MODELS));
+    mechlab::scene::run(|| mechlab::scenes::basins_scene(mechlab::models::MODELS, None));
 }

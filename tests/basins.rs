@@ -1,8 +1,10 @@
 //! Basins of attraction: the unforced damped double well against its
-//! symmetry and its equilibria, and the forced one's attractors checked as
-//! cycles of the period map by an independent integration.
+//! symmetry and its equilibria, the forced one's attractors checked as
+//! cycles of the period map by an independent integration, early stops
+//! against whole runs, and the boundary's dimension against synthetic
+//! boundaries of known dimension and Melnikov's threshold.
 
-use mechlab::analysis::basins::{basins, BasinSettings, DIVERGED};
+use mechlab::analysis::basins::{basins, BasinSettings, Boundary, APERIODIC, DIVERGED};
 use mechlab::models::duffing;
 use mechlab::ode::{Integrator, Method};
 
@@ -16,6 +18,8 @@ fn settings(pixels: usize) -> BasinSettings {
         record: 8,
         cell: 0.05,
         method: Method::Taylor { tol: 1e-12 },
+        stop_early: true,
+        tiles: None,
     }
 }
 
@@ -26,7 +30,7 @@ fn settings(pixels: usize) -> BasinSettings {
 #[test]
 fn the_unforced_double_well_has_two_symmetric_basins() {
     let model = mechlab::models::by_name("duffing").unwrap();
-    let result = basins(model, &[0.3, 0.0, 1.2], &settings(24)).unwrap();
+    let result = basins(model, &[0.3, 0.0, 1.2], &settings(24), &|_| ()).unwrap();
     assert_eq!(result.attractors.len(), 2, "{:?}", result.attractors);
     assert_eq!(result.diverged, 0);
     for a in &result.attractors {
@@ -54,7 +58,7 @@ fn the_unforced_double_well_has_two_symmetric_basins() {
 fn the_forced_double_wells_attractors_are_cycles_of_its_period_map() {
     let model = mechlab::models::by_name("duffing").unwrap();
     let params = [0.3, 0.2, 1.2];
-    let result = basins(model, &params, &settings(16)).unwrap();
+    let result = basins(model, &params, &settings(16), &|_| ()).unwrap();
     assert!(!result.attractors.is_empty());
     let starts: usize = result.attractors.iter().map(|a| a.starts).sum();
     assert_eq!(starts + result.diverged, 256);
@@ -94,9 +98,150 @@ fn a_basin_map_that_cannot_be_made_says_why() {
     let duffing = mechlab::models::by_name("duffing").unwrap();
     let mut bad = settings(8);
     bad.cell = 0.0;
-    let error = basins(duffing, &[0.3, 0.0, 1.2], &bad).unwrap_err();
+    let error = basins(duffing, &[0.3, 0.0, 1.2], &bad, &|_| ()).unwrap_err();
     assert!(error.to_string().contains("positive cell"), "{error}");
     let henon = mechlab::models::by_name("henon_heiles").unwrap();
-    let error = basins(henon, &[1.0], &settings(8)).unwrap_err();
+    let error = basins(henon, &[1.0], &settings(8), &|_| ()).unwrap_err();
     assert!(error.to_string().contains("no fast phase"), "{error}");
+}
+
+/// Orbits stopped once settled on a cycle, or once on an attractor the
+/// scouts found, get the labels the whole runs give: the driven well's
+/// two cycles, and Ueda's chaotic attractor, its record joined from
+/// pieces.
+#[test]
+fn stopping_early_gives_the_labels_of_the_whole_runs() {
+    let duffing = mechlab::models::by_name("duffing").unwrap();
+    let mut whole = settings(48);
+    whole.stop_early = false;
+    let params = [0.3, 0.2, 1.2];
+    let early = basins(duffing, &params, &settings(48), &|_| ()).unwrap();
+    let full = basins(duffing, &params, &whole, &|_| ()).unwrap();
+    assert_eq!(early.attractors.len(), 2, "{:?}", early.attractors);
+    assert_eq!(early.labels, full.labels);
+
+    let ueda = mechlab::models::by_name("ueda").unwrap();
+    let mut chaotic = settings(32);
+    chaotic.ranges = [(-4.0, 4.0), (-8.0, 8.0)];
+    chaotic.record = 16;
+    chaotic.method = Method::Taylor { tol: 1e-10 };
+    let early = basins(ueda, &[0.05, 7.5, 1.0], &chaotic, &|_| ()).unwrap();
+    chaotic.stop_early = false;
+    let full = basins(ueda, &[0.05, 7.5, 1.0], &chaotic, &|_| ()).unwrap();
+    for result in [&early, &full] {
+        assert_eq!(result.attractors.len(), 1, "{:?}", result.attractors);
+        assert_eq!(result.attractors[0].kind, APERIODIC);
+        assert_eq!(result.attractors[0].fraction, 1.0);
+    }
+}
+
+/// Records of 4 iterates in cells of 0.02 leave Ueda's chaotic attractor
+/// in pieces no two records share; the representatives' longer runs join
+/// them into the one attractor.
+#[test]
+fn the_pieces_of_a_chaotic_attractor_are_joined() {
+    let ueda = mechlab::models::by_name("ueda").unwrap();
+    let mut pieces = settings(24);
+    pieces.ranges = [(-4.0, 4.0), (-8.0, 8.0)];
+    pieces.record = 4;
+    pieces.cell = 0.02;
+    pieces.stop_early = false;
+    pieces.method = Method::Taylor { tol: 1e-10 };
+    let result = basins(ueda, &[0.05, 7.5, 1.0], &pieces, &|_| ()).unwrap();
+    assert_eq!(result.attractors.len(), 1, "{:?}", result.attractors);
+}
+
+/// Labels of a 1024² grid split by the curve y = f(x): a straight line
+/// has uncertainty exponent 1 (dimension 1); the graph of Weierstrass'
+/// function Σ 2^(−Hk) cos(2π 2^k x) has box dimension 2 − H, so the
+/// exponent is H.
+#[test]
+fn the_boundary_dimension_of_known_curves() {
+    let n = 1024;
+    let split = |f: &dyn Fn(f64) -> f64| -> Vec<i32> {
+        (0..n * n)
+            .map(|k| {
+                let (x, y) = (
+                    ((k % n) as f64 + 0.5) / n as f64,
+                    ((k / n) as f64 + 0.5) / n as f64,
+                );
+                i32::from(y > f(x))
+            })
+            .collect()
+    };
+    let line = Boundary::of_labels(&split(&|x| 0.3 + 0.4 * x), n);
+    let alpha = line.exponent.unwrap();
+    assert!((alpha - 1.0).abs() < 0.02, "{line:?}");
+    assert!((line.dimension.unwrap() - 1.0).abs() < 0.02);
+    let h = 0.5;
+    let weierstrass = |x: f64| {
+        0.5 + 0.12
+            * (0..20)
+                .map(|k| {
+                    2f64.powf(-h * k as f64) * (2.0 * std::f64::consts::PI * 2f64.powi(k) * x).cos()
+                })
+                .sum::<f64>()
+    };
+    let rough = Boundary::of_labels(&split(&weierstrass), n);
+    assert!((rough.exponent.unwrap() - h).abs() < 0.1, "{rough:?}");
+    let one = Boundary::of_labels(&vec![0; 256 * 256], 256);
+    assert!(one.exponent.is_none() && one.why_not.unwrap().contains("no boundary"));
+    let small = Boundary::of_labels(
+        &split(&|x| x)
+            .iter()
+            .take(64 * 64)
+            .copied()
+            .collect::<Vec<_>>(),
+        64,
+    );
+    assert!(small.why_not.unwrap().contains("128 pixels"));
+}
+
+/// The driven double well's basin boundary is a smooth curve below
+/// Melnikov's threshold γ_c = 4δ cosh(πω/2)/(3√2 πω), where the saddle's
+/// manifolds do not cross, and fractal above it (Moon and Li): box
+/// dimension within 0.1 of 1 at 0.8 γ_c, above 1.5 at 1.15 γ_c (two
+/// cycles of period 4 there).
+#[test]
+fn the_double_well_boundary_turns_fractal_at_melnikovs_threshold() {
+    let model = mechlab::models::by_name("duffing").unwrap();
+    let (delta, omega) = (0.3, 1.2);
+    let pi = std::f64::consts::PI;
+    let threshold = 4.0 * delta * (pi * omega / 2.0).cosh() / (3.0 * 2f64.sqrt() * pi * omega);
+    let mut grid = settings(256);
+    grid.transient = 100;
+    grid.record = 16;
+    grid.method = Method::Taylor { tol: 1e-10 };
+    let dimension = |gamma: f64| {
+        let result = basins(model, &[delta, gamma, omega], &grid, &|_| ()).unwrap();
+        assert!(result.attractors.len() >= 2, "{:?}", result.attractors);
+        result.boundary.dimension.unwrap()
+    };
+    let below = dimension(0.8 * threshold);
+    assert!((below - 1.0).abs() < 0.1, "{below}");
+    let above = dimension(1.15 * threshold);
+    assert!(above > 1.5, "{above}");
+}
+
+/// Basins in tiles of rows: a job given some tiles writes them and has no
+/// map; the run that merges them gives the single run's labels.
+#[test]
+fn tiled_basins_equal_the_single_run() {
+    use mechlab::analysis::basins::BasinsError;
+    use mechlab::analysis::tiles::Tiles;
+    let model = mechlab::models::by_name("duffing").unwrap();
+    let params = [0.3, 0.2, 1.2];
+    let single = basins(model, &params, &settings(32), &|_| ()).unwrap();
+    let folder = tempfile::tempdir().unwrap();
+    let mut tiled = settings(32);
+    tiled.tiles = Some(Tiles {
+        folder: folder.path().to_path_buf(),
+        rows: 5,
+        only: Some(vec![0, 3, 6]),
+    });
+    let partial = basins(model, &params, &tiled, &|_| ());
+    assert!(matches!(partial, Err(BasinsError::Partial)), "{partial:?}");
+    tiled.tiles.as_mut().unwrap().only = None;
+    let merged = basins(model, &params, &tiled, &|_| ()).unwrap();
+    assert_eq!(merged.labels, single.labels);
 }

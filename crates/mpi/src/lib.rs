@@ -1,10 +1,9 @@
-//! A chaos map across the ranks of `mpirun`: each rank computes the tiles
-//! k with k mod size = rank; after a barrier the first merges them (all on
-//! disk by then) and writes the scene's files while the others wait (they
-//! share its output folder). The maps are the single process's, bit for
-//! bit (tests/mpi.rs).
+//! Tiled sweeps (chaos maps, basins) across the ranks of `mpirun`: each
+//! rank computes the tiles k with k mod size = rank; after a barrier the
+//! first merges them (all on disk by then) and writes the scene's files
+//! while the others wait (they share its output folder). The results are
+//! the single process's, bit for bit (tests/mpi.rs).
 
-use mechlab::analysis::chaos_map::{ChaosMap, ChaosMapError, ChaosMapSettings};
 use mechlab::scene::SceneError;
 use mechlab::scenes::TileSharing;
 use mpi::traits::{Communicator, CommunicatorCollectives};
@@ -30,38 +29,18 @@ impl Ranks {
 impl TileSharing for Ranks {
     fn run(
         &self,
-        settings: &ChaosMapSettings,
-        map: &dyn Fn(&ChaosMapSettings) -> Result<ChaosMap, ChaosMapError>,
-        write: &dyn Fn(&ChaosMap) -> Result<(), SceneError>,
+        count: usize,
+        compute: &dyn Fn(Vec<usize>) -> Result<(), SceneError>,
+        merge: &dyn Fn() -> Result<(), SceneError>,
     ) -> Result<(), SceneError> {
-        let Some(tiles) = &settings.tiles else {
-            return Err(SceneError::Inconsistent {
-                knobs: "tile_rows",
-                reason: "under mpirun the ranks share the map by tiles: set tile_rows > 0",
-            });
-        };
         let (rank, size) = (self.world.rank() as usize, self.world.size() as usize);
-        let count = settings.pixels.div_ceil(tiles.rows.max(1));
         let share: Vec<usize> = (0..count).filter(|k| k % size == rank).collect();
         eprintln!("rank {rank} of {size}: tiles {share:?}");
-        let mut mine = settings.clone();
-        if let Some(tiles) = &mut mine.tiles {
-            tiles.only = Some(share);
-        }
-        let computed = match map(&mine) {
-            Err(ChaosMapError::Partial) | Ok(_) => Ok(()),
-            Err(e) => Err(e),
-        };
+        let computed = compute(share);
         self.world.barrier();
         let written = match (rank, computed) {
-            (0, Ok(())) => {
-                let mut all = settings.clone();
-                if let Some(tiles) = &mut all.tiles {
-                    tiles.only = None;
-                }
-                map(&all).map_err(SceneError::from).and_then(|m| write(&m))
-            }
-            (_, computed) => computed.map_err(SceneError::from),
+            (0, Ok(())) => merge(),
+            (_, computed) => computed,
         };
         self.world.barrier();
         written

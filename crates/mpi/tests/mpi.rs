@@ -1,7 +1,7 @@
-//! `mpirun -n 2` of the `chaos_map` scene (ranks taking tiles, the first
-//! merging them) gives the single process's map bit for bit. Needs OpenMPI;
-//! `cargo test --release -p mechlab-mpi` builds the example it runs
-//! (docs/sweeps.md, "On a cluster").
+//! `mpirun -n 2` of the `chaos_map` and `basins` scenes (ranks taking
+//! tiles, the first merging them) gives the single process's results bit
+//! for bit. Needs OpenMPI; `cargo test --release -p mechlab-mpi` builds
+//! the examples it runs (docs/sweeps.md, "On a cluster").
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -17,19 +17,16 @@ fn example(name: &str) -> PathBuf {
         .join(name)
 }
 
-#[test]
-fn two_ranks_give_the_single_process_map() {
+/// Runs the scene `example` with `knobs` alone (tile_rows=0) and under
+/// `mpirun -n 2`; returns both runs' `file` and the ranks' tile folder.
+fn alone_and_by_two_ranks(
+    example_name: &str,
+    knobs: &[&str],
+    file: &str,
+) -> (Vec<u8>, Vec<u8>, usize) {
     let root = tempfile::tempdir().unwrap();
     let (single, ranks) = (root.path().join("single"), root.path().join("ranks"));
-    let knobs = [
-        "--set",
-        "pixels=40",
-        "--set",
-        "periods=60",
-        "--set",
-        "tile_rows=3",
-    ];
-    let status = Command::new(example("chaos_map_mpi"))
+    let status = Command::new(example(example_name))
         .args(knobs)
         .args(["--set", "tile_rows=0", "--out"])
         .arg(&single)
@@ -45,24 +42,54 @@ fn two_ranks_give_the_single_process_map() {
             "-x",
             "RAYON_NUM_THREADS=1",
         ])
-        .arg(example("chaos_map_mpi"))
+        .arg(example(example_name))
         .args(knobs)
         .arg("--out")
         .arg(&ranks)
         .status()
         .expect("mpirun (OpenMPI) is installed");
     assert!(status.success());
-    let csv = |dir: &PathBuf| std::fs::read(dir.join("chaos_map.csv")).unwrap();
-    assert_eq!(csv(&single), csv(&ranks), "the maps differ");
     let tiles = std::fs::read_dir(ranks.with_extension("tiles"))
         .unwrap()
         .next()
         .unwrap()
         .unwrap()
         .path();
-    assert_eq!(
+    (
+        std::fs::read(single.join(file)).unwrap(),
+        std::fs::read(ranks.join(file)).unwrap(),
         std::fs::read_dir(tiles).unwrap().count(),
-        14,
-        "40 rows in tiles of 3"
-    );
+    )
+}
+
+#[test]
+fn two_ranks_give_the_single_process_map() {
+    let knobs = [
+        "--set",
+        "pixels=40",
+        "--set",
+        "periods=60",
+        "--set",
+        "tile_rows=3",
+    ];
+    let (single, ranks, tiles) = alone_and_by_two_ranks("chaos_map_mpi", &knobs, "chaos_map.csv");
+    assert!(single == ranks, "the maps differ");
+    assert_eq!(tiles, 14, "40 rows in tiles of 3");
+}
+
+/// The basins of Duffing's driven well by two ranks (scouts run by each,
+/// the rows' tiles shared) equal the single process's, label for label.
+#[test]
+fn two_ranks_give_the_single_process_basins() {
+    let knobs = [
+        "--set",
+        "pixels=48",
+        "--set",
+        "transient=60",
+        "--set",
+        "tile_rows=5",
+    ];
+    let (single, ranks, tiles) = alone_and_by_two_ranks("basins_mpi", &knobs, "basins.csv");
+    assert!(single == ranks, "the basins differ");
+    assert_eq!(tiles, 10, "48 rows in tiles of 5");
 }

@@ -587,7 +587,11 @@ impl Progress {
     }
     /// One more item finished (from any thread).
     pub fn inc(&self) {
-        self.bar.inc(1);
+        self.advance(1);
+    }
+    /// `count` more items finished (from any thread).
+    pub fn advance(&self, count: usize) {
+        self.bar.inc(count as u64);
         if self.bar.position() >= self.bar.length().unwrap_or(0) {
             self.bar.finish();
         }

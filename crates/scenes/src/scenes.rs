@@ -148,23 +148,22 @@ pub fn chaos_map_scene(
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
     let params = scene.parameter_values(info)?;
-    let run = |settings: &ChaosMapSettings| {
-        chaos_map(model, &params, settings, &|| {
+    let sweep = |only: Option<Vec<usize>>| {
+        let mut settings = settings.clone();
+        if let Some(tiles) = &mut settings.tiles {
+            tiles.only = only;
+        }
+        let row_done = || {
             progress.inc();
             true
-        })
-    };
-    if let Some(sharing) = sharing {
-        return sharing.run(&settings, &run, &|map| write_chaos_map(&scene, map));
-    }
-    match run(&settings) {
-        // A job of an array: its tiles are written, the last run merges.
-        Err(ChaosMapError::Partial) => {
-            eprintln!("tiles {} written", scene.text("only_tiles"));
-            Ok(())
+        };
+        match chaos_map(model, &params, &settings, &row_done) {
+            Err(ChaosMapError::Partial) => Ok(false),
+            map => write_chaos_map(&scene, &map?).map(|()| true),
         }
-        map => write_chaos_map(&scene, &map?),
-    }
+    };
+    let rows = settings.pixels;
+    share_tiles(&scene, sharing, settings.tiles.as_ref(), rows, &sweep)
 }
 
 /// The chaos map's figures, CSV and summary.
@@ -185,19 +184,49 @@ fn write_chaos_map(scene: &Scene, map: &ChaosMap) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// Processes that share a tiled chaos map, such as the ranks of `mpirun`
-/// (`mechlab-mpi`, a package of its own so that neither the runtime nor
-/// the models are compiled again for it).
+/// Processes that share a tiled sweep (a chaos map, basins), such as the
+/// ranks of `mpirun` (`mechlab-mpi`, a package of its own so that neither
+/// the runtime nor the models are compiled again for it).
 pub trait TileSharing {
-    /// Computes this process's share of the tiles of `settings` with `map`;
-    /// then one process merges them (all on disk by then) and writes the
-    /// scene's files with `write`.
+    /// Runs `compute(share)` with this process's share of the `count`
+    /// tiles; once every process has, one runs `merge()` (every tile on
+    /// disk by then) while the others wait.
     fn run(
         &self,
-        settings: &ChaosMapSettings,
-        map: &dyn Fn(&ChaosMapSettings) -> Result<ChaosMap, ChaosMapError>,
-        write: &dyn Fn(&ChaosMap) -> Result<(), SceneError>,
+        count: usize,
+        compute: &dyn Fn(Vec<usize>) -> Result<(), SceneError>,
+        merge: &dyn Fn() -> Result<(), SceneError>,
     ) -> Result<(), SceneError>;
+}
+
+/// A tiled sweep run by `sharing` or alone: `sweep` with the tiles `only`
+/// (None: every missing tile, then the merge) returns whether it merged,
+/// and writes the scene's files when it did.
+fn share_tiles(
+    scene: &Scene,
+    sharing: Option<&dyn TileSharing>,
+    tiles: Option<&mechlab_runtime::analysis::tiles::Tiles>,
+    rows: usize,
+    sweep: &dyn Fn(Option<Vec<usize>>) -> Result<bool, SceneError>,
+) -> Result<(), SceneError> {
+    let Some(sharing) = sharing else {
+        let only = tiles.and_then(|t| t.only.clone());
+        if !sweep(only)? {
+            // A job of an array: its tiles are written, the last run merges.
+            eprintln!("tiles {} written", scene.text("only_tiles"));
+        }
+        return Ok(());
+    };
+    let Some(tiles) = tiles else {
+        return Err(SceneError::Inconsistent {
+            knobs: "tile_rows",
+            reason: "under mpirun the ranks share the map by tiles: set tile_rows > 0",
+        });
+    };
+    let count = rows.div_ceil(tiles.rows.max(1));
+    sharing.run(count, &|share| sweep(Some(share)).map(|_| ()), &|| {
+        sweep(None).map(|_| ())
+    })
 }
 
 /// The tiles of the knobs `size` (rows or columns per tile, 0 for none)
@@ -506,8 +535,8 @@ pub fn period_map_scene(
 
 /// The `basins` scene: the basins of attraction of a period map on a
 /// plane of the state, the attractors found unaided.
-pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::basins::{basins, BasinSettings};
+pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Result<(), SceneError> {
+    use mechlab_runtime::analysis::basins::{basins, BasinSettings, BasinsError};
     let (model, scene) = generic_scene(
         catalog,
         "basins",
@@ -526,6 +555,8 @@ pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
                 "0.05",
                 "the side of the state-space cells that identify attractors",
             ),
+            ("tile_rows", "0", "rows of starts per tile, each written to out/basins.tiles/ when done so a rerun resumes (0: no tiles)"),
+            ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the basins"),
         ],
     )?;
     let range = |name: &str| -> Result<(f64, f64), SceneError> {
@@ -547,10 +578,30 @@ pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
         record: scene.count("record")?,
         cell: scene.positive("cell")?,
         method: method_from(&scene)?,
+        stop_early: true,
+        tiles: tiles_from(&scene, ["tile_rows", "only_tiles"])?,
     };
     let params = scene.parameter_values(model.info)?;
-    eprintln!("{}² starts …", settings.pixels);
-    let result = basins(model, &params, &settings)?;
+    let progress = Progress::new("basins starts", settings.pixels.pow(2));
+    let sweep = |only: Option<Vec<usize>>| {
+        let mut settings = settings.clone();
+        if let Some(tiles) = &mut settings.tiles {
+            tiles.only = only;
+        }
+        match basins(model, &params, &settings, &|k| progress.advance(k)) {
+            Err(BasinsError::Partial) => Ok(false),
+            result => write_basins(&scene, &result?).map(|()| true),
+        }
+    };
+    let rows = settings.pixels;
+    share_tiles(&scene, sharing, settings.tiles.as_ref(), rows, &sweep)
+}
+
+/// The basins' summary lines, figure, CSV and summary.
+fn write_basins(
+    scene: &Scene,
+    result: &mechlab_runtime::analysis::basins::Basins,
+) -> Result<(), SceneError> {
     for a in &result.attractors {
         let seen = if a.confirmed { "" } else { " (one start only)" };
         eprintln!(
@@ -559,6 +610,17 @@ pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
         );
     }
     eprintln!("diverged: {}; {:.1} s", result.diverged, result.seconds);
+    let boundary = &result.boundary;
+    match (
+        boundary.exponent,
+        boundary.exponent_error,
+        boundary.dimension,
+    ) {
+        (Some(alpha), Some(error), Some(dimension)) => eprintln!(
+            "boundary: uncertainty exponent {alpha:.3} ± {error:.3}, box dimension {dimension:.3}"
+        ),
+        _ => eprintln!("boundary: {}", boundary.why_not.unwrap_or("not measured")),
+    }
     scene.save_figure(&result.figure(), "basins.png")?;
     let n = result.pixels;
     let rows = result
@@ -567,7 +629,7 @@ pub fn basins_scene(catalog: Catalog) -> Result<(), SceneError> {
         .enumerate()
         .map(|(k, l)| (k % n, k / n, *l));
     scene.write_csv("basins.csv", &["column", "row", "attractor"], rows)?;
-    scene.write_summary(&result)?;
+    scene.write_summary(result)?;
     Ok(())
 }
 

@@ -7,10 +7,11 @@
 //! number of starts that reached it; starts whose orbit diverged form a
 //! class of their own, never assigned to an attractor.
 
+use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec};
-use crate::registry::Model;
+use crate::registry::{cell_of, KnownAttractors, Model, Recording};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -31,7 +32,26 @@ pub struct BasinSettings {
     /// The side of the cells of the state space that identify attractors.
     pub cell: f64,
     pub method: Method,
+    /// Stop an orbit early: once it has settled on a cycle of period
+    /// ≤ record/2 (its iterate back within 1e-8 of a cell of the one k
+    /// periods before; its record completed by the cycle), or once
+    /// `record` consecutive iterates lie in cells of an attractor that
+    /// scouts (every 4th start each way, run first) found from two
+    /// starts (its record then that attractor's). False runs every orbit
+    /// its whole length: the same labels but for starts that shadow an
+    /// attractor for `record` periods and then leave it, slower.
+    pub stop_early: bool,
+    /// Rows of starts in tiles written as they are done (resume, job
+    /// arrays, MPI ranks).
+    pub tiles: Option<Tiles>,
 }
+
+/// The kind of an attractor that is not a cycle of period ≤ record/2.
+pub const APERIODIC: &str = "aperiodic";
+
+/// How many periods the representative of an aperiodic attractor runs to
+/// find the other pieces of its set.
+const EXTENSION: usize = 4096;
 
 /// The label of a start whose orbit diverged or left the model's domain.
 pub const DIVERGED: i32 = -1;
@@ -44,6 +64,11 @@ pub enum BasinsError {
     /// The method cannot run (its setting), before any orbit.
     #[error(transparent)]
     Ode(#[from] OdeError),
+    #[error(transparent)]
+    Tile(#[from] TileError),
+    /// Only some tiles were asked for: they are written, there is no map.
+    #[error("the tiles asked for are written; run without `only` to merge them into the basins")]
+    Partial,
 }
 
 /// An attractor found.
@@ -72,6 +97,8 @@ pub struct Basins {
     pub attractors: Vec<Attractor>,
     /// Starts whose orbit left the model's domain or diverged.
     pub diverged: usize,
+    /// The basins' boundary: its uncertainty exponent and box dimension.
+    pub boundary: Boundary,
     pub seconds: f64,
     /// Each pixel's attractor (an index of `attractors`, or [`DIVERGED`]),
     /// row 0 at the bottom.
@@ -82,11 +109,13 @@ pub struct Basins {
     pub points: Vec<Vec<[f64; 2]>>,
 }
 
-/// The basins of `model`'s period map at `params`.
+/// The basins of `model`'s period map at `params`; `done(k)` is told as
+/// each block of k orbits ends (progress).
 pub fn basins(
     model: &Model,
     params: &[f64],
     settings: &BasinSettings,
+    done: &(dyn Fn(usize) + Sync),
 ) -> Result<Basins, BasinsError> {
     let name = model.info.name;
     let flows = super::flows(model)?;
@@ -120,40 +149,25 @@ pub fn basins(
     };
     let start = std::time::Instant::now();
     let n = settings.pixels;
-    let wrap = flows.periodic_state();
-    // Each start on the plane (None where the model has no state there).
-    let starts: Vec<Option<Vec<f64>>> = (0..n * n)
-        .into_par_iter()
-        .map(|k| {
-            let at = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / n as f64;
-            let mut y = base.clone();
-            y[settings.axes[0]] = at(settings.ranges[0], k % n);
-            y[settings.axes[1]] = at(settings.ranges[1], k / n);
-            flows
-                .consistent(params, &mut y, &settings.axes)
-                .ok()
-                .map(|()| y)
-        })
-        .collect();
-    let flat: Vec<f64> = starts.iter().flatten().flatten().copied().collect();
-    let mut runs = flows
-        .iterates(
-            params,
-            settings.method,
-            period,
-            &flat,
-            (settings.transient, settings.record),
-        )?
-        .into_iter();
-    // Each start's recorded iterates, angles wrapped, or None.
-    let records: Vec<Option<Vec<Vec<f64>>>> = starts
-        .iter()
-        .map(|start| {
-            let run = start.as_ref().and_then(|_| runs.next().flatten())?;
-            Some(run.iter().map(|y| wrapped(y, &wrap)).collect())
-        })
-        .collect();
-    let (labels, attractors, points) = identify(&records, settings);
+    crate::budget::check(
+        || format!("the records of {n} × {n} starts"),
+        (n as u128).pow(2),
+        8 * base.len() * settings.record,
+    )
+    .map_err(OdeError::from)?;
+    let grid = Grid {
+        flows,
+        params,
+        settings,
+        period,
+        wrap: flows.periodic_state(),
+        base,
+        done,
+    };
+    let Some(records) = grid.all_records(name)? else {
+        return Err(BasinsError::Partial);
+    };
+    let (labels, attractors, points) = grid.find(&records)?;
     let diverged = labels.iter().filter(|&&l| l == DIVERGED).count();
     Ok(Basins {
         model: name.into(),
@@ -162,11 +176,203 @@ pub fn basins(
         pixels: n,
         attractors,
         diverged,
+        boundary: Boundary::of_labels(&labels, n),
         seconds: start.elapsed().as_secs_f64(),
         labels,
         points,
     })
 }
+
+/// A start's recorded iterates (angles wrapped), or None for a start with
+/// no state of the model there or whose orbit stopped.
+type Record = Option<Vec<Vec<f64>>>;
+
+/// What the orbits of one basin map share.
+struct Grid<'a> {
+    flows: &'a dyn crate::registry::Flows,
+    params: &'a [f64],
+    settings: &'a BasinSettings,
+    period: f64,
+    /// The state the plane passes through, and which components are angles.
+    base: Vec<f64>,
+    wrap: Vec<bool>,
+    done: &'a (dyn Fn(usize) + Sync),
+}
+
+impl Grid<'_> {
+    /// The start of pixel k (row-major, row 0 at the bottom), put on a
+    /// constrained model's constraints; None where the model has no state.
+    fn start(&self, k: usize) -> Option<Vec<f64>> {
+        let (settings, n) = (self.settings, self.settings.pixels);
+        let at = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / n as f64;
+        let mut y = self.base.clone();
+        y[settings.axes[0]] = at(settings.ranges[0], k % n);
+        y[settings.axes[1]] = at(settings.ranges[1], k / n);
+        self.flows
+            .consistent(self.params, &mut y, &settings.axes)
+            .ok()
+            .map(|()| y)
+    }
+
+    /// The records of the starts `pixels`, stopped early on the `known`
+    /// attractors if any.
+    fn records(
+        &self,
+        pixels: &[usize],
+        known: Option<&KnownAttractors>,
+    ) -> Result<Vec<Record>, BasinsError> {
+        let settings = self.settings;
+        let starts: Vec<Option<Vec<f64>>> = pixels.par_iter().map(|&k| self.start(k)).collect();
+        let flat: Vec<f64> = starts.iter().flatten().flatten().copied().collect();
+        let recording = Recording {
+            transient: settings.transient,
+            record: settings.record,
+            settle: settings.stop_early.then_some(settings.cell * 1e-8),
+            known,
+            done: self.done,
+        };
+        let mut runs = self
+            .flows
+            .iterates(self.params, settings.method, self.period, &flat, &recording)?
+            .into_iter();
+        Ok(starts
+            .iter()
+            .map(|start| {
+                let run = start.as_ref().and_then(|_| runs.next().flatten())?;
+                Some(run.iter().map(|y| wrapped(y, &self.wrap)).collect())
+            })
+            .collect())
+    }
+
+    /// The attractors of records. Aperiodic ones found apart may be pieces
+    /// of one chaotic set: each one's representative runs [`EXTENSION`]
+    /// periods further, and the cells it visits join the pieces they touch.
+    fn find(&self, records: &[Record]) -> Result<Found, BasinsError> {
+        let found = identify(records, &[], self.settings);
+        let aperiodic: Vec<f64> = (found.1.iter())
+            .filter(|a| a.kind == APERIODIC)
+            .flat_map(|a| a.representative.clone())
+            .collect();
+        if aperiodic.is_empty() {
+            return Ok(found);
+        }
+        let recording = Recording {
+            transient: 0,
+            record: EXTENSION,
+            settle: None,
+            known: None,
+            done: &|_| (),
+        };
+        let extras: Vec<Vec<Vec<f64>>> = self
+            .flows
+            .iterates(
+                self.params,
+                self.settings.method,
+                self.period,
+                &aperiodic,
+                &recording,
+            )?
+            .into_iter()
+            .flatten()
+            .map(|run| run.iter().map(|y| wrapped(y, &self.wrap)).collect())
+            .collect();
+        Ok(identify(records, &extras, self.settings))
+    }
+
+    /// Whether pixel k is a scout: with early stops, every 4th start each
+    /// way runs first, and the attractors the scouts confirm are known to
+    /// the other orbits, which stop once on one of them.
+    fn is_scout(&self, k: usize) -> bool {
+        let n = self.settings.pixels;
+        self.settings.stop_early
+            && n >= 16
+            && (k % n).is_multiple_of(4)
+            && (k / n).is_multiple_of(4)
+    }
+
+    /// The scouts' records, and the attractors they confirm.
+    fn scout(&self) -> Result<(Vec<Record>, KnownAttractors), BasinsError> {
+        let n = self.settings.pixels;
+        let scouts: Vec<usize> = (0..n * n).filter(|&k| self.is_scout(k)).collect();
+        let records = self.records(&scouts, None)?;
+        let mut known = KnownAttractors::new(self.settings.cell);
+        let (labels, attractors, _) = self.find(&records)?;
+        for (index, _) in attractors.iter().enumerate().filter(|(_, a)| a.confirmed) {
+            let on_it: Vec<&Vec<Vec<f64>>> = labels
+                .iter()
+                .zip(&records)
+                .filter(|(&l, _)| l == index as i32)
+                .filter_map(|(_, record)| record.as_ref())
+                .collect();
+            known.add(&on_it);
+        }
+        Ok((records, known))
+    }
+
+    /// Every start's record, the rows in tiles if asked for; None when
+    /// only some tiles were asked for (they are written).
+    fn all_records(&self, name: &str) -> Result<Option<Vec<Record>>, BasinsError> {
+        let (settings, n, dim) = (self.settings, self.settings.pixels, self.base.len());
+        let (scout_records, known) = self.scout()?;
+        let known = (!known.is_empty()).then_some(&known);
+        // The records of a range of rows, each start's `record` iterates
+        // one after the other, NaN for None (a tile's values).
+        let rows_of = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), BasinsError> {
+            let pixels = rows.start * n..rows.end * n;
+            let others: Vec<usize> = pixels.clone().filter(|&k| !self.is_scout(k)).collect();
+            let mut runs = self.records(&others, known)?.into_iter();
+            let mut values = Vec::with_capacity(pixels.len() * settings.record * dim);
+            for k in pixels {
+                let record = if self.is_scout(k) {
+                    scout_records[(k / n / 4) * n.div_ceil(4) + (k % n) / 4].clone()
+                } else {
+                    runs.next().flatten()
+                };
+                match record {
+                    Some(run) => values.extend(run.iter().flatten()),
+                    None => values.resize(values.len() + settings.record * dim, f64::NAN),
+                }
+            }
+            Ok((values, 0))
+        };
+        let values = match &settings.tiles {
+            None => rows_of(0..n)?.0,
+            Some(tiles) => {
+                let key = format!(
+                    "basins {name} {:?} {:?} {:?} {:?} {n} {} {} {} {:?} {} {}",
+                    self.params,
+                    settings.axes,
+                    settings.ranges,
+                    self.base,
+                    settings.transient,
+                    settings.record,
+                    settings.cell,
+                    settings.method,
+                    settings.stop_early,
+                    tiles.rows
+                );
+                let row = (n, n * settings.record * dim, "rows");
+                match run_tiles(tiles, fingerprint(&key), row, &rows_of)? {
+                    Some((values, _)) => values,
+                    None => return Ok(None),
+                }
+            }
+        };
+        Ok(Some(
+            values
+                .chunks(settings.record * dim)
+                .map(|record| {
+                    record[0]
+                        .is_finite()
+                        .then(|| record.chunks(dim).map(<[f64]>::to_vec).collect())
+                })
+                .collect(),
+        ))
+    }
+}
+
+/// Each start's label, the attractors, their iterates on the axes.
+type Found = (Vec<i32>, Vec<Attractor>, Vec<Vec<[f64; 2]>>);
 
 /// A state with its angles in [−π, π).
 fn wrapped(y: &[f64], wrap: &[bool]) -> Vec<f64> {
@@ -183,12 +389,10 @@ fn wrapped(y: &[f64], wrap: &[bool]) -> Vec<f64> {
 }
 
 /// The attractors of the records: union–find over the cells their
-/// iterates visit; each start's label, the attractors, their iterates on
-/// the axes.
-fn identify(
-    records: &[Option<Vec<Vec<f64>>>],
-    settings: &BasinSettings,
-) -> (Vec<i32>, Vec<Attractor>, Vec<Vec<[f64; 2]>>) {
+/// iterates visit, cells that touch being one; each start's label, the
+/// attractors, their iterates on the axes.
+/// `extras` are records of no start (they join the sets they touch).
+fn identify(records: &[Record], extras: &[Vec<Vec<f64>>], settings: &BasinSettings) -> Found {
     let mut parent: Vec<usize> = Vec::new();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
@@ -197,9 +401,17 @@ fn identify(
         }
         i
     }
+    fn unite(parent: &mut [usize], a: usize, b: usize) {
+        let (a, b) = (root(parent, a), root(parent, b));
+        parent[a.max(b)] = a.min(b);
+    }
     let mut owner: HashMap<Vec<i64>, usize> = HashMap::new();
     let mut first_set: Vec<usize> = Vec::with_capacity(records.len());
-    for record in records {
+    for record in records
+        .iter()
+        .map(Option::as_ref)
+        .chain(extras.iter().map(Some))
+    {
         let Some(record) = record else {
             first_set.push(usize::MAX);
             continue;
@@ -207,19 +419,16 @@ fn identify(
         let cells: Vec<Vec<i64>> = record
             .iter()
             .map(|y| {
-                y.iter()
-                    .map(|x| (x / settings.cell).floor() as i64)
-                    .collect()
+                let mut key = Vec::new();
+                cell_of(y, settings.cell, &mut key);
+                key
             })
             .collect();
         let set = parent.len();
         parent.push(set);
         for cell in cells {
             match owner.get(&cell) {
-                Some(&other) => {
-                    let (a, b) = (root(&mut parent, other), root(&mut parent, set));
-                    parent[a.max(b)] = a.min(b);
-                }
+                Some(&other) => unite(&mut parent, other, set),
                 None => {
                     owner.insert(cell, set);
                 }
@@ -227,12 +436,29 @@ fn identify(
         }
         first_set.push(set);
     }
+    // Cells that touch (a face or a corner) hold one attractor: a cycle
+    // on a cell's boundary has its records on both sides of it.
+    let cells: Vec<(Vec<i64>, usize)> = owner.iter().map(|(c, &s)| (c.clone(), s)).collect();
+    let mut neighbour = Vec::new();
+    for (cell, set) in &cells {
+        for offset in 0..3usize.pow(cell.len() as u32) {
+            neighbour.clear();
+            neighbour.extend(
+                cell.iter()
+                    .enumerate()
+                    .map(|(i, c)| c + (offset / 3usize.pow(i as u32) % 3) as i64 - 1),
+            );
+            if let Some(&other) = owner.get(&neighbour) {
+                unite(&mut parent, other, *set);
+            }
+        }
+    }
     // Attractors in order of their first start.
     let mut index_of: HashMap<usize, usize> = HashMap::new();
     let mut attractors: Vec<Attractor> = Vec::new();
     let mut points: Vec<Vec<[f64; 2]>> = Vec::new();
     let mut labels = Vec::with_capacity(records.len());
-    for (record, &set) in records.iter().zip(&first_set) {
+    for (record, &set) in records.iter().zip(&first_set[..records.len()]) {
         let Some(record) = record else {
             labels.push(DIVERGED);
             continue;
@@ -274,7 +500,100 @@ fn kind_of(record: &[Vec<f64>], tolerance: f64) -> String {
     let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tolerance);
     (1..=record.len() / 2)
         .find(|&k| (k..record.len()).all(|i| close(&record[i], &record[i - k])))
-        .map_or_else(|| "aperiodic".to_string(), |k| format!("period {k}"))
+        .map_or_else(|| APERIODIC.to_string(), |k| format!("period {k}"))
+}
+
+/// The basins' boundary, measured on the grid by final-state
+/// sensitivity (Grebogi, McDonald, Ott and Yorke): the fraction f(ε) of
+/// starts whose neighbours ε away along either axis end elsewhere (another
+/// attractor, or diverged), at ε = 1, 2, 4, … pixels up to 1/32 of the
+/// side (where f is still far from 1). f(ε) ∝ ε^α, α the uncertainty
+/// exponent, and the boundary's box dimension is 2 − α: 1 for a smooth
+/// curve, more for a fractal one. The grid sees no structure finer than a
+/// pixel: α is that of the scales it has.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Boundary {
+    /// ε as a fraction of each axis' range, and the fraction of uncertain
+    /// starts there.
+    pub epsilon: Vec<f64>,
+    pub uncertain: Vec<f64>,
+    /// α from the least-squares slope of log f against log ε, with its
+    /// standard error, and 2 − α; None with the reason in `why_not`.
+    pub exponent: Option<f64>,
+    pub exponent_error: Option<f64>,
+    pub dimension: Option<f64>,
+    pub why_not: Option<&'static str>,
+}
+
+impl Boundary {
+    /// The boundary of the `labels` of a `pixels`² grid.
+    pub fn of_labels(labels: &[i32], pixels: usize) -> Boundary {
+        let n = pixels;
+        let label = |i: usize, j: usize| labels[j * n + i];
+        let mut scales = Vec::new();
+        let mut s = 1;
+        while 32 * s <= n {
+            scales.push(s);
+            s *= 2;
+        }
+        let uncertain: Vec<f64> = scales
+            .iter()
+            .map(|&s| {
+                let inner = s..n - s;
+                let (mut count, mut total) = (0usize, 0usize);
+                for j in inner.clone() {
+                    for i in inner.clone() {
+                        let l = label(i, j);
+                        let differs = label(i - s, j) != l
+                            || label(i + s, j) != l
+                            || label(i, j - s) != l
+                            || label(i, j + s) != l;
+                        count += usize::from(differs);
+                        total += 1;
+                    }
+                }
+                count as f64 / total as f64
+            })
+            .collect();
+        let epsilon: Vec<f64> = scales.iter().map(|&s| s as f64 / n as f64).collect();
+        let refused = |why| Boundary {
+            epsilon: epsilon.clone(),
+            uncertain: uncertain.clone(),
+            exponent: None,
+            exponent_error: None,
+            dimension: None,
+            why_not: Some(why),
+        };
+        if scales.len() < 3 {
+            return refused("fewer than 3 scales from one pixel to 1/32 of the side: 128 pixels or more are needed");
+        }
+        if uncertain.iter().all(|&f| f == 0.0) {
+            return refused("every start ends on one attractor: there is no boundary");
+        }
+        if uncertain.contains(&0.0) {
+            return refused(
+                "no uncertain start at the finest scales: the boundary is not resolved by the grid",
+            );
+        }
+        let points: Vec<(f64, f64)> = epsilon
+            .iter()
+            .copied()
+            .zip(uncertain.iter().copied())
+            .collect();
+        let fit = super::fit::log_log(&points);
+        let slope = fit.slope;
+        // The slope's standard error from the fit's r².
+        let m = points.len() as f64;
+        let error = slope.abs() * ((1.0 / fit.r_squared - 1.0).max(0.0) / (m - 2.0)).sqrt();
+        Boundary {
+            exponent: Some(slope),
+            exponent_error: Some(error),
+            dimension: Some(2.0 - slope),
+            why_not: None,
+            epsilon,
+            uncertain,
+        }
+    }
 }
 
 impl Basins {

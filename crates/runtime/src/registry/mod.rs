@@ -4,7 +4,10 @@
 use std::fmt;
 
 mod constrained;
+mod recording;
 pub use constrained::{Constrained, ConstrainedSystems};
+use recording::Recorder;
+pub use recording::{cell_of, KnownAttractors, Recording};
 
 use crate::ode::any_size::fixed_state;
 use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem, Stats};
@@ -431,23 +434,25 @@ pub trait Flows: Sync {
     ) -> Result<FliValues, OdeError>;
     /// The iterates `transient + 1 ..= transient + record` of the exact
     /// system's period map from each start (`starts` one after the other),
-    /// None for a start whose orbit stopped. Each orbit alone here; the
-    /// Hamiltonian models' fixed sizes run the Taylor method's in the
-    /// batch lanes.
+    /// as `recording` says, None for a start whose orbit stopped. Each
+    /// orbit alone here; the Hamiltonian models' fixed sizes run the
+    /// Taylor method's in the batch lanes.
     fn iterates(
         &self,
         params: &[f64],
         method: Method,
         period: f64,
         starts: &[f64],
-        (transient, record): (usize, usize),
+        recording: &Recording,
     ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
+        let wrap = self.periodic_state();
         iterates_one_by_one(
             &*self.exact(params),
             method,
             period,
             starts,
-            (transient, record),
+            recording,
+            &wrap,
         )
     }
     /// Makes `y` a state of the model at t = 0 holding its components
@@ -469,24 +474,28 @@ fn iterates_one_by_one(
     method: Method,
     period: f64,
     starts: &[f64],
-    (transient, record): (usize, usize),
+    recording: &Recording,
+    wrap: &[bool],
 ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
     use rayon::prelude::*;
     crate::ode::Integrator::new(method)?;
+    let periods = recording.transient + recording.record;
     Ok(starts
-        .par_chunks(system.dim())
-        .map(|y0| {
-            let mut integrator = crate::ode::Integrator::new(method).ok()?;
-            let (mut seen, mut kept) = (0, Vec::with_capacity(record));
-            let periods = transient + record;
-            let run = system.stream(&mut integrator, y0, period, periods, &mut |y| {
-                seen += 1;
-                if seen > transient {
-                    kept.push(y.to_vec());
-                }
-                true
-            });
-            (run.is_ok() && kept.len() == record).then_some(kept)
+        .par_chunks(system.dim() * 16)
+        .flat_map_iter(|block| {
+            let records: Vec<_> = block
+                .chunks(system.dim())
+                .map(|y0| {
+                    let mut integrator = crate::ode::Integrator::new(method).ok()?;
+                    let mut recorder = Recorder::new(recording, wrap);
+                    let run = system.stream(&mut integrator, y0, period, periods, &mut |y| {
+                        recorder.push(y)
+                    });
+                    recorder.finish(run.is_ok())
+                })
+                .collect();
+            (recording.done)(records.len());
+            records
         })
         .collect())
 }
@@ -592,13 +601,14 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
         method: Method,
         period: f64,
         starts: &[f64],
-        (transient, record): (usize, usize),
+        recording: &Recording,
     ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
         use crate::ode::{LaneIntegrator, Orbit};
         use rayon::prelude::*;
+        let wrap = Fixed::periodic_state(self);
         if !matches!(method, Method::Taylor { .. }) {
             let system = Flows::exact(self, params);
-            return iterates_one_by_one(&*system, method, period, starts, (transient, record));
+            return iterates_one_by_one(&*system, method, period, starts, recording, &wrap);
         }
         let starts: Vec<[f64; S]> = starts
             .chunks(S)
@@ -614,18 +624,16 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
                     return vec![None; block.len()];
                 };
                 let orbits = Orbit::of_one_system(&system, period, block);
-                let mut seen = vec![0usize; block.len()];
-                let mut kept: Vec<Vec<Vec<f64>>> = vec![Vec::with_capacity(record); block.len()];
-                let errors = integrator.stream(&orbits, |k, y| {
-                    seen[k] += 1;
-                    if seen[k] > transient {
-                        kept[k].push(y.to_vec());
-                    }
-                    seen[k] < transient + record
-                });
-                kept.into_iter()
+                let mut recorders: Vec<Recorder> = block
+                    .iter()
+                    .map(|_| Recorder::new(recording, &wrap))
+                    .collect();
+                let errors = integrator.stream(&orbits, |k, y| recorders[k].push(y));
+                (recording.done)(block.len());
+                recorders
+                    .into_iter()
                     .zip(errors)
-                    .map(|(kept, error)| (error.is_none() && kept.len() == record).then_some(kept))
+                    .map(|(recorder, error)| recorder.finish(error.is_none()))
                     .collect()
             })
             .collect();
