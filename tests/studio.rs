@@ -318,6 +318,63 @@ async fn chaos_levels_equal_the_library_map() {
     }
 }
 
+/// The basins streamed for a view equal the library's basins of that view
+/// at each resolution; the unforced double well's two attractors are the
+/// wells' bottoms; a bad cell is a named error.
+#[tokio::test]
+async fn basins_levels_equal_the_library_basins() {
+    use mechlab::analysis::basins::{basins, BasinSettings};
+    let ranges = [[-2.0, 2.0], [-2.0, 2.0]];
+    let request = json!({"model": "duffing", "params": {"gamma": 0.0}, "tol": 1e-10,
+        "ranges": ranges, "levels": [16, 32], "transient": 60});
+    let (status, _, body) = call("POST", "/api/basins", Some(request.clone())).await;
+    assert_eq!(status, StatusCode::OK);
+    let levels = lines(&body);
+    assert_eq!(levels.len(), 2);
+    for level in &levels {
+        let pixels = level["pixels"].as_u64().unwrap() as usize;
+        let settings = BasinSettings {
+            axes: [0, 1],
+            ranges: ranges.map(|r| (r[0], r[1])),
+            through: Some(vec![0.0, 0.0]),
+            pixels,
+            transient: 60,
+            record: 16,
+            cell: 0.05,
+            method: Method::Taylor { tol: 1e-10 },
+            stop_early: true,
+            tiles: None,
+        };
+        let library = basins(model_of("duffing"), &[0.3, 0.0, 1.2], &settings, &|_| ()).unwrap();
+        let labels: Vec<i32> = serde_json::from_value(level["labels"].clone()).unwrap();
+        assert_eq!(labels, library.labels, "{pixels}² pixels");
+        let attractors = level["attractors"].as_array().unwrap();
+        assert_eq!(attractors.len(), 2);
+        for a in attractors {
+            let at: Vec<f64> = serde_json::from_value(a["representative"].clone()).unwrap();
+            assert!(
+                (at[0].abs() - 1.0).abs() < 1e-8 && at[1].abs() < 1e-8,
+                "{at:?}"
+            );
+        }
+    }
+    let mut bad = request;
+    bad["cell"] = json!(0.0);
+    let (status, _, body) = call("POST", "/api/basins", Some(bad)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(
+        body.contains("cell that identifies attractors must be a positive number"),
+        "{body}"
+    );
+    let (status, _, body) = call(
+        "POST",
+        "/api/basins",
+        Some(json!({"model": "henon_heiles", "ranges": ranges, "levels": [8], "transient": 10})),
+    )
+    .await;
+    assert!(status.is_client_error(), "{status}: {body}");
+}
+
 /// Kapitza's averaged Hamiltonian H̄ = p²/2 + cos q + A² sin² q / 4 (q from
 /// the upward vertical): its unstable equilibria sit at cos q = 2/A², the
 /// separatrices are the level H̄(q*, 0), and every drawn segment end lies
@@ -958,6 +1015,7 @@ mod browser {
         sections_without_a_fast_phase(&client, &folder).await;
         a_slice_of_the_period_map(&client, &folder).await;
         the_mechanism_moves(&client, &folder).await;
+        the_basins_layer(&client, &folder).await;
         client.close().await.unwrap();
     }
 
@@ -1059,6 +1117,56 @@ mod browser {
         let png = client.screenshot().await.unwrap();
         std::fs::write(folder.join("browser.png"), png).unwrap();
         eprintln!("screenshot: {}", folder.join("browser.png").display());
+    }
+
+    /// Duffing's unforced double well: the basins layer paints each start
+    /// in its attractor's colour (85 % over white), and a clicked orbit's
+    /// entry names the attractor its start ends on.
+    async fn the_basins_layer(client: &Client, folder: &std::path::Path) {
+        select_model(client, "duffing").await;
+        client
+            .execute(
+                "const g = document.getElementById('value-gamma'); g.value = '0'; g.dispatchEvent(new Event('change'));\
+                 document.getElementById('show-basins').click(); return true;",
+                vec![],
+            )
+            .await
+            .unwrap();
+        // At four starts away from the attractors, most of the 3 × 3
+        // canvas pixels around each (a grid line covers at most 3) are
+        // the colour of the start's label.
+        let painted = "studio.basins && studio.basins.pixels === 256 && studio.params.gamma === 0 && \
+             [[0.3, 0.6], [0.7, 0.3], [0.45, 0.8], [0.2, 0.2]].every(([u, v]) => { \
+               const x = studio.view.x[0] + u * (studio.view.x[1] - studio.view.x[0]); \
+               const y = studio.view.y[0] + v * (studio.view.y[1] - studio.view.y[0]); \
+               const want = studio.attractorColor(studio.attractorAt(x, y)).map(c => Math.round(0.85 * c + 0.15 * 255)); \
+               const [px, py] = studio.pixelOf(x, y); let good = 0; \
+               for (const dx of [-1, 0, 1]) for (const dy of [-1, 0, 1]) { \
+                 const got = studio.colorAt(px + dx, py + dy); \
+                 if (want.every((c, i) => Math.abs(c - got[i]) <= 2)) good += 1; } \
+               return good >= 5; })";
+        wait_for(client, painted, 60).await;
+        let labels = client
+            .execute("return [...new Set(studio.basins.labels)].sort();", vec![])
+            .await
+            .unwrap();
+        assert_eq!(
+            labels,
+            serde_json::json!([0, 1]),
+            "two wells, no diverged start"
+        );
+        client
+            .execute("studio.seed(0.5, 0.4); return true;", vec![])
+            .await
+            .unwrap();
+        wait_for(
+            client,
+            "document.getElementById('orbit-list').textContent.includes('attractor')",
+            30,
+        )
+        .await;
+        let png = client.screenshot().await.unwrap();
+        std::fs::write(folder.join("basins.png"), png).unwrap();
     }
 
     /// Hénon–Heiles: its section with the MEGNO map behind, then a tilted plane.

@@ -14,6 +14,8 @@
 //! | `POST /api/continuation` | the periodic orbit nearest a seed continued in a parameter, JSON |
 //! | `POST /api/section` | a Poincaré section orbit at a fixed energy from a seed, JSON |
 //! | `POST /api/section_map` | the MEGNO map of that section, JSON |
+//! | `POST /api/basins` | the basins of attraction of a view at growing resolutions, NDJSON |
+//! | `POST /api/mechanism` | the mechanism's frames from a seed, JSON |
 //!
 //! The numerics run on blocking threads; a streamed answer stops computing
 //! when the page drops it (a superseded request). Every error is a JSON
@@ -27,6 +29,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
+use mechlab_runtime::analysis::basins::BasinsError;
 use mechlab_runtime::analysis::mechanism::MechanismError;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::registry::Catalog;
@@ -69,6 +72,7 @@ impl ApiError {
                 | StudioError::Splitting(_)
                 | StudioError::Continuation(_)
                 | StudioError::Section(_)
+                | StudioError::Basins(BasinsError::Refused(_))
                 | StudioError::Mechanism(
                     MechanismError::NotDrawn { .. } | MechanismError::Refused(_),
                 ),
@@ -121,6 +125,7 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/section", post(section))
         .route("/api/section_map", post(section_map))
         .route("/api/mechanism", post(mechanism))
+        .route("/api/basins", post(basins))
         .fallback(|uri: axum::http::Uri| async move {
             ApiError::NotFound {
                 path: uri.to_string(),
@@ -255,6 +260,14 @@ async fn chaos(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, 
     request.check(catalog)?;
     Ok(stream(move |send, listening| {
         studio::chaos(catalog, &request, &mut |level| send(&level), listening)
+    }))
+}
+
+async fn basins(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
+    let request: studio::BasinsRequest = serde_json::from_slice(&body)?;
+    request.check(catalog)?;
+    Ok(stream(move |send, _| {
+        studio::basins(catalog, &request, &mut |level| send(&level))
     }))
 }
 

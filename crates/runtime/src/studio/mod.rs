@@ -53,6 +53,8 @@ pub enum StudioError {
     Section(#[from] crate::analysis::section::SectionError),
     #[error(transparent)]
     Mechanism(#[from] crate::analysis::mechanism::MechanismError),
+    #[error(transparent)]
+    Basins(#[from] crate::analysis::basins::BasinsError),
 }
 
 /// What is wrong with a request's numbers.
@@ -68,6 +70,8 @@ pub enum RequestProblem {
     UnknownField(String),
     #[error("{what} must be finite")]
     NotFinite { what: &'static str },
+    #[error("{what} must be a positive number, got {got}")]
+    NotPositive { what: &'static str, got: f64 },
     #[error("the axes must be two different state components among 0..{components}")]
     Axes { components: usize },
     #[error("the range of axis {axis} must be an interval of finite numbers, low < high")]
@@ -614,6 +618,108 @@ pub fn chaos(
                 .collect(),
             regular_level: map.fli_regular_level,
             chaotic_fraction: map.chaotic_fraction,
+            seconds: map.seconds,
+        };
+        if !sink(level) {
+            break;
+        }
+    }
+    Ok(())
+}
+
+/// The basins of attraction of a view's period map, at growing
+/// resolutions (`POST /api/basins`).
+#[derive(Clone, Debug, Deserialize)]
+pub struct BasinsRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub ranges: [[f64; 2]; 2],
+    /// Pixels per side of each refinement, in order.
+    pub levels: Vec<usize>,
+    /// Periods before the record, and periods recorded.
+    pub transient: usize,
+    #[serde(default = "default_record")]
+    pub record: usize,
+    /// The side of the cells that identify attractors.
+    #[serde(default = "default_cell")]
+    pub cell: f64,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+fn default_record() -> usize {
+    16
+}
+fn default_cell() -> f64 {
+    0.05
+}
+
+impl BasinsRequest {
+    /// The request checked, with the view's ranges.
+    pub fn check(&self, catalog: Catalog) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
+        let setup = self.setup.resolve(catalog, &self.unknown)?;
+        setup.needs_period_map()?;
+        let ranges = setup.ranges(&self.ranges)?;
+        setup.count("the transient", self.transient, MAX_CHAOS_PERIODS)?;
+        setup.count("the record", self.record, 256)?;
+        if !(self.cell > 0.0 && self.cell.is_finite()) {
+            let what = "the cell that identifies attractors";
+            return Err(setup.bad(RequestProblem::NotPositive {
+                what,
+                got: self.cell,
+            }));
+        }
+        setup.count("the number of levels", self.levels.len(), 8)?;
+        for &pixels in &self.levels {
+            setup.count("pixels per side", pixels, MAX_CHAOS_PIXELS)?;
+        }
+        Ok((setup, ranges))
+    }
+}
+
+/// One refinement of the basins.
+#[derive(Clone, Debug, Serialize)]
+pub struct BasinsLevel {
+    pub pixels: usize,
+    /// Each pixel's attractor (an index of `attractors`, −1: diverged),
+    /// row-major from the lower left.
+    pub labels: Vec<i32>,
+    pub attractors: Vec<crate::analysis::basins::Attractor>,
+    /// Each attractor's recorded iterates on the view's axes.
+    pub points: Vec<Vec<[f64; 2]>>,
+    pub boundary: crate::analysis::basins::Boundary,
+    pub seconds: f64,
+}
+
+/// Streams the basins of the view at each resolution of the request to
+/// `sink`, until it returns false.
+pub fn basins(
+    catalog: Catalog,
+    request: &BasinsRequest,
+    sink: &mut dyn FnMut(BasinsLevel) -> bool,
+) -> Result<(), StudioError> {
+    let (setup, ranges) = request.check(catalog)?;
+    for &pixels in &request.levels {
+        let settings = crate::analysis::basins::BasinSettings {
+            axes: setup.axes,
+            ranges,
+            through: Some(setup.through.clone()),
+            pixels,
+            transient: request.transient,
+            record: request.record,
+            cell: request.cell,
+            method: setup.method,
+            stop_early: true,
+            tiles: None,
+        };
+        let map = crate::analysis::basins::basins(setup.handle, &setup.params, &settings, &|_| ())?;
+        let level = BasinsLevel {
+            pixels,
+            labels: map.labels,
+            attractors: map.attractors,
+            points: map.points,
+            boundary: map.boundary,
             seconds: map.seconds,
         };
         if !sink(level) {

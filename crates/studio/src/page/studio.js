@@ -14,6 +14,7 @@ const studio = {
   orbits: [],
   overlay: null,
   chaos: null,
+  basins: null,
   manifolds: null,
   branches: null,
   section: false,
@@ -102,6 +103,8 @@ const axisName = (i) => (studio.section && studio.sectionAxes ? studio.sectionAx
 // For the browser test: where a point is drawn, and the colour there.
 studio.pixelOf = (x, y) => toPixel(x, y);
 studio.colorAt = (px, py) => Array.from(ctx.getImageData(Math.round(px), Math.round(py), 1, 1).data);
+studio.attractorAt = (x, y) => attractorAt(x, y);
+studio.attractorColor = (label) => attractorColor(label);
 
 // ---------- drawing ----------
 
@@ -121,6 +124,7 @@ function draw(g, width, height) {
   if (!studio.model) return;
   if (studio.section && studio.megno && $("show-megno").checked) drawImage(g, studio.megno);
   if (!studio.section && $("show-chaos").checked && studio.chaos) drawChaos(g);
+  if (!studio.section && $("show-basins").checked && studio.basins) drawBasins(g);
   drawGrid(g, width, height);
   if (!studio.section && studio.overlay && $("show-levels").checked) drawLevels(g);
   for (const orbit of studio.orbits) {
@@ -318,6 +322,44 @@ function pixelImage(n, colorOf) {
 }
 
 function drawChaos(g) { drawImage(g, studio.chaos); }
+
+// The plots' palette (attractor k's colour), white for diverged starts.
+const PALETTE = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189],
+  [140, 86, 75], [227, 119, 194], [80, 80, 80], [188, 189, 34], [23, 190, 207]];
+function attractorColor(label) { return label < 0 ? [255, 255, 255] : PALETTE[label % PALETTE.length]; }
+
+function basinsImage(level) {
+  return pixelImage(level.pixels, (k) => attractorColor(level.labels[k]));
+}
+
+// The basins, then each attractor's recorded iterates in black.
+function drawBasins(g) {
+  drawImage(g, studio.basins);
+  g.fillStyle = "#000";
+  for (const points of studio.basins.points) {
+    for (const [x, y] of points) {
+      const [px, py] = toPixel(x, y);
+      g.fillRect(px - 1.5, py - 1.5, 3, 3);
+    }
+  }
+}
+
+// The attractor the start (x, y) of the view ends on, from the basins
+// shown: its index, or null outside them.
+function attractorAt(x, y) {
+  const b = studio.basins;
+  if (!b) return null;
+  const [[x0, x1], [y0, y1]] = b.ranges;
+  const i = Math.floor((x - x0) / (x1 - x0) * b.pixels), j = Math.floor((y - y0) / (y1 - y0) * b.pixels);
+  if (i < 0 || j < 0 || i >= b.pixels || j >= b.pixels) return null;
+  return b.labels[j * b.pixels + i];
+}
+
+function attractorName(label) {
+  if (label < 0) return "diverged";
+  const a = studio.basins.attractors[label];
+  return `attractor ${label + 1}: ${a.kind}, ${(100 * a.fraction).toFixed(1)} % of the starts`;
+}
 
 function drawImage(g, { image, ranges }) {
   const [x0, y1] = toPixel(ranges[0][0], ranges[1][1]);
@@ -599,6 +641,14 @@ function listOrbits() {
     const tunes = orbit.end && orbit.end.tunes ? ` ν ${orbit.end.tunes.map((t) => t.toFixed(5)).join(", ")}` : "";
     item.textContent = `(${seed}) ${orbit.points.length} pts${orbit.error ? " stopped" : orbit.done ? "" : " …"}${tunes}`;
     if (tunes) item.title = "the orbit's tunes: turns per period of each degree of freedom (NAFF of q + i p over the iterates)";
+    const label = studio.basins && $("show-basins").checked ? attractorAt(orbit.seed[studio.axes[0]], orbit.seed[studio.axes[1]]) : null;
+    if (label !== null) {
+      const mark = document.createElement("span");
+      mark.className = "attractor";
+      mark.style.background = `rgb(${attractorColor(label).join(",")})`;
+      mark.title = "the attractor its start ends on, from the basins shown";
+      item.append(" → ", mark, ` ${attractorName(label)}`);
+    }
     if (orbit.error) { item.className = "error"; item.title = orbit.error; }
     list.appendChild(item);
   }
@@ -652,6 +702,33 @@ async function refreshChaos() {
   }
 }
 
+let basinsController = null;
+
+async function refreshBasins() {
+  if (basinsController) basinsController.abort();
+  basinsController = null;
+  if (!$("show-basins").checked || !studio.model.fast_phase) {
+    studio.basins = null; $("basins-note").textContent = ""; listOrbits(); redraw(); return;
+  }
+  basinsController = new AbortController();
+  const ranges = viewRanges();
+  const request = { ...setup(), ranges, levels: [32, 64, 128, 256],
+    transient: Math.max(0, Math.round(Number($("basins-transient").value))) };
+  try {
+    await postStream("/api/basins", request, basinsController.signal, (line) => {
+      if (line.error) { say(`basins: ${line.error}`); return; }
+      studio.basins = { ...line, ranges, image: basinsImage(line) };
+      const d = line.boundary.dimension;
+      $("basins-note").textContent = `(${line.attractors.length} attractor${line.attractors.length === 1 ? "" : "s"}${d == null ? "" : `, boundary dimension ${d.toFixed(2)}`})`;
+      $("status").textContent = `basins ${line.pixels}² in ${line.seconds.toFixed(2)} s`;
+      listOrbits();
+      redraw();
+    });
+  } catch (e) {
+    if (!aborted(e)) say(`basins: ${e.message}`);
+  }
+}
+
 // Waits until the changes stop for `ms` before calling `work`.
 function debounce(work, ms) {
   let timer = null;
@@ -682,7 +759,7 @@ async function refreshManifolds() {
     if (!aborted(e)) { manifoldsKey = null; studio.manifolds = null; $("manifolds-note").textContent = ""; say(`manifolds: ${e.message}`); }
   }
 }
-const refreshOverlays = debounce(() => { refreshOverlay(); refreshChaos(); refreshManifolds(); }, 150);
+const refreshOverlays = debounce(() => { refreshOverlay(); refreshChaos(); refreshBasins(); refreshManifolds(); }, 150);
 const rerunOrbits = debounce(() => { for (const orbit of studio.orbits) startOrbit(orbit); listOrbits(); }, 40);
 
 // ---------- the model and its controls ----------
@@ -742,6 +819,7 @@ async function chooseModel(name) {
   studio.through = (model.through ?? new Array(model.state.length).fill(0)).slice();
   studio.overlay = null;
   studio.chaos = null;
+  studio.basins = null;
   studio.manifolds = null;
   manifoldsKey = null;
   $("model").value = name;
@@ -841,6 +919,14 @@ function exportSvg() {
     const [x1, y0] = toPixel(ranges[0][1], ranges[1][0]);
     parts.push(`<image href="${image.toDataURL()}" x="${x0}" y="${y1}" width="${x1 - x0}" height="${y0 - y1}" opacity="0.85" style="image-rendering:pixelated"/>`);
   }
+  if ($("show-basins").checked && studio.basins) {
+    const { image, ranges } = studio.basins;
+    const [x0, y1] = toPixel(ranges[0][0], ranges[1][1]);
+    const [x1, y0] = toPixel(ranges[0][1], ranges[1][0]);
+    parts.push(`<image href="${image.toDataURL()}" x="${x0}" y="${y1}" width="${x1 - x0}" height="${y0 - y1}" opacity="0.85" style="image-rendering:pixelated"/>`);
+    const d = studio.basins.points.flat().map(([x, y]) => { const [p, q] = toPixel(x, y); return `M${(p - 1.5).toFixed(1)} ${(q - 1.5).toFixed(1)}h3v3h-3z`; }).join("");
+    parts.push(`<path d="${d}" fill="#000"/>`);
+  }
   if (studio.overlay && $("show-levels").checked) {
     for (const level of studio.overlay.levels) {
       const d = level.segments.map(([a, b, c, e]) => {
@@ -887,6 +973,7 @@ function wire() {
   $("section-plane").addEventListener("change", () => { if (studio.section) setSectionMode(true); });
   $("cont-clear").addEventListener("click", () => { studio.branches = null; $("cont-list").innerHTML = ""; redraw(); });
   for (const id of ["show-chaos", "chaos-periods"]) $(id).addEventListener("change", refreshChaos);
+  for (const id of ["show-basins", "basins-transient"]) $(id).addEventListener("change", refreshBasins);
   for (const [k, id] of [[0, "axis-x"], [1, "axis-y"]]) {
     $(id).addEventListener("change", () => {
       const axes = studio.axes.slice();
