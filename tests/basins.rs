@@ -4,7 +4,8 @@
 //! against whole runs, and the boundary's dimension against synthetic
 //! boundaries of known dimension and Melnikov's threshold.
 
-use mechlab::analysis::basins::{basins, BasinSettings, Boundary, APERIODIC, DIVERGED};
+use mechlab::analysis::attractor::{attractor, AttractorSettings};
+use mechlab::analysis::basins::{basins, BasinSettings, Boundary, CHAOTIC, DIVERGED};
 use mechlab::models::duffing;
 use mechlab::ode::{Integrator, Method};
 
@@ -130,7 +131,7 @@ fn stopping_early_gives_the_labels_of_the_whole_runs() {
     let full = basins(ueda, &[0.05, 7.5, 1.0], &chaotic, &|_| ()).unwrap();
     for result in [&early, &full] {
         assert_eq!(result.attractors.len(), 1, "{:?}", result.attractors);
-        assert_eq!(result.attractors[0].kind, APERIODIC);
+        assert_eq!(result.attractors[0].kind, CHAOTIC);
         assert_eq!(result.attractors[0].fraction, 1.0);
     }
 }
@@ -244,4 +245,55 @@ fn tiled_basins_equal_the_single_run() {
     tiled.tiles.as_mut().unwrap().only = None;
     let merged = basins(model, &params, &tiled, &|_| ()).unwrap();
     assert_eq!(merged.labels, single.labels);
+}
+
+/// What an attractor is, told by its longer run: at γ = 0.29 the driven
+/// well's two attractors are cycles of period 4, which a record of 4
+/// iterates cannot show (its cycles are looked for up to period 2); at
+/// γ = 0.27 the attractors called chaotic have a positive largest
+/// Lyapunov exponent by the attractor analysis (their iterates hop between
+/// bands in a fixed order, so a single frequency would look regular).
+#[test]
+fn attractors_are_told_apart_by_their_longer_runs() {
+    let model = mechlab::models::by_name("duffing").unwrap();
+    let mut short = settings(32);
+    short.record = 4;
+    short.method = Method::Taylor { tol: 1e-10 };
+    let result = basins(model, &[0.3, 0.29, 1.2], &short, &|_| ()).unwrap();
+    let kinds: Vec<&str> = result.attractors.iter().map(|a| a.kind.as_str()).collect();
+    assert_eq!(kinds, ["period 4", "period 4"], "{:?}", result.attractors);
+
+    let mut grid = settings(64);
+    grid.transient = 100;
+    grid.record = 16;
+    grid.method = Method::Taylor { tol: 1e-10 };
+    let params = [0.3, 0.27, 1.2];
+    let result = basins(model, &params, &grid, &|_| ()).unwrap();
+    let chaotic: Vec<_> = result
+        .attractors
+        .iter()
+        .filter(|a| a.kind == CHAOTIC)
+        .collect();
+    assert!(!chaotic.is_empty(), "{:?}", result.attractors);
+    for a in chaotic {
+        let measured = attractor(
+            model,
+            &params,
+            &AttractorSettings {
+                method: Method::Taylor { tol: 1e-10 },
+                start: [a.representative[0], a.representative[1]],
+                transient: 100,
+                points: 1000,
+                lyapunov_periods: 4000,
+                pixels: 50,
+            },
+        )
+        .unwrap();
+        assert!(
+            measured.lyapunov[0] > 10.0 * measured.lyapunov_error[0],
+            "{a:?}: {:?} ± {:?}",
+            measured.lyapunov,
+            measured.lyapunov_error
+        );
+    }
 }

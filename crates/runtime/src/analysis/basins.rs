@@ -46,8 +46,13 @@ pub struct BasinSettings {
     pub tiles: Option<Tiles>,
 }
 
-/// The kind of an attractor that is not a cycle of period ≤ record/2.
+/// The kind of an attractor whose record is not a cycle of period
+/// ≤ record/2 and whose longer run could not be told (it stopped, or
+/// its frequencies could not be found).
 pub const APERIODIC: &str = "aperiodic";
+/// The kinds a longer run tells an aperiodic record's attractor apart by.
+pub const QUASI_PERIODIC: &str = "quasi-periodic";
+pub const CHAOTIC: &str = "chaotic";
 
 /// How many periods the representative of an aperiodic attractor runs to
 /// find the other pieces of its set.
@@ -74,7 +79,9 @@ pub enum BasinsError {
 /// An attractor found.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Attractor {
-    /// "period k" for a cycle of P (to 1e-6 of the cell), else "aperiodic".
+    /// "period k" for a cycle of P (to 1e-6 of the cell), else what a
+    /// longer run shows: [`QUASI_PERIODIC`], [`CHAOTIC`], a cycle of a
+    /// longer period, or [`APERIODIC`] when it cannot tell.
     pub kind: String,
     /// Its last recorded iterate from the first start that reached it.
     pub representative: Vec<f64>,
@@ -246,16 +253,19 @@ impl Grid<'_> {
 
     /// The attractors of records. Aperiodic ones found apart may be pieces
     /// of one chaotic set: each one's representative runs [`EXTENSION`]
-    /// periods further, and the cells it visits join the pieces they touch.
+    /// periods further, the cells it visits join the pieces they touch,
+    /// and that run tells what the attractor is ([`Grid::kinds_of_runs`]).
     fn find(&self, records: &[Record]) -> Result<Found, BasinsError> {
-        let found = identify(records, &[], self.settings);
-        let aperiodic: Vec<f64> = (found.1.iter())
-            .filter(|a| a.kind == APERIODIC)
-            .flat_map(|a| a.representative.clone())
+        let (labels, attractors, points) = identify(records, &[], self.settings);
+        let pieces: Vec<usize> = (0..attractors.len())
+            .filter(|&i| attractors[i].kind == APERIODIC)
             .collect();
-        if aperiodic.is_empty() {
-            return Ok(found);
+        if pieces.is_empty() {
+            return Ok((labels, attractors, points));
         }
+        let starts: Vec<f64> = (pieces.iter())
+            .flat_map(|&i| attractors[i].representative.clone())
+            .collect();
         let recording = Recording {
             transient: 0,
             record: EXTENSION,
@@ -263,20 +273,72 @@ impl Grid<'_> {
             known: None,
             done: &|_| (),
         };
-        let extras: Vec<Vec<Vec<f64>>> = self
-            .flows
-            .iterates(
-                self.params,
-                self.settings.method,
-                self.period,
-                &aperiodic,
-                &recording,
-            )?
-            .into_iter()
-            .flatten()
+        let runs = (self.flows).iterates(
+            self.params,
+            self.settings.method,
+            self.period,
+            &starts,
+            &recording,
+        )?;
+        let kinds = self.kinds_of_runs(&starts, &runs)?;
+        let extras: Vec<Vec<Vec<f64>>> = (runs.into_iter().flatten())
             .map(|run| run.iter().map(|y| wrapped(y, &self.wrap)).collect())
             .collect();
-        Ok(identify(records, &extras, self.settings))
+        let (merged_labels, mut merged, points) = identify(records, &extras, self.settings);
+        // Each piece's kind goes to the attractor it is now part of
+        // (chaotic if any piece is).
+        for (piece, kind) in pieces.iter().zip(kinds) {
+            let first = labels.iter().position(|&l| l == *piece as i32);
+            let (Some(first), Some(kind)) = (first, kind) else {
+                continue;
+            };
+            let attractor = &mut merged[merged_labels[first] as usize];
+            if attractor.kind == APERIODIC || kind == CHAOTIC {
+                attractor.kind = kind;
+            }
+        }
+        Ok((merged_labels, merged, points))
+    }
+
+    /// What long runs on attractors (from `starts`, one after the other)
+    /// show them to be: a cycle of period k ≤ the run's length / 4 (its
+    /// second half repeats with period k, to 1e-6 of a cell); else chaotic
+    /// when the fast Lyapunov indicator over as many periods from its
+    /// start says so by the chaos maps' criterion (FLI > 2 ln N: a positive
+    /// Lyapunov exponent), quasi-periodic when not (an attracting torus's
+    /// tangent vectors grow no faster than N). None: the run stopped.
+    fn kinds_of_runs(
+        &self,
+        starts: &[f64],
+        runs: &[Option<Vec<Vec<f64>>>],
+    ) -> Result<Vec<Option<String>>, BasinsError> {
+        let dim = self.wrap.len();
+        let w0 = vec![(1.0 / dim as f64).sqrt(); dim];
+        let (fli, _) = self.flows.fli(
+            self.params,
+            self.settings.method,
+            self.period,
+            starts,
+            &w0,
+            EXTENSION,
+            &self.settings.axes,
+        )?;
+        Ok(runs
+            .iter()
+            .zip(fli)
+            .map(|(run, fli)| {
+                let run = run.as_ref()?;
+                let tail: Vec<Vec<f64>> = (run[run.len() / 2..].iter())
+                    .map(|y| wrapped(y, &self.wrap))
+                    .collect();
+                let cycle = kind_of(&tail, self.settings.cell * 1e-6);
+                if cycle != APERIODIC {
+                    return Some(cycle);
+                }
+                let chaotic = crate::tangent::lyapunov::fli_is_chaotic(fli.ok()?, EXTENSION);
+                Some(if chaotic { CHAOTIC } else { QUASI_PERIODIC }.to_string())
+            })
+            .collect())
     }
 
     /// Whether pixel k is a scout: with early stops, every 4th start each

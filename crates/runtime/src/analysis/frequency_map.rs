@@ -166,26 +166,36 @@ pub fn frequency_map(
 /// An orbit's fundamental frequencies (q_j + i p_j, the largest term)
 /// over the whole orbit, and its diffusion index between its halves.
 fn analyse(orbit: &[[f64; 4]], dt: f64) -> ([f64; 2], f64) {
+    let signals: Vec<Vec<Complex<f64>>> = (0..2)
+        .map(|j| orbit.iter().map(|y| Complex::new(y[j], y[j + 2])).collect())
+        .collect();
+    let (nu, index) = fundamentals(&signals, dt);
+    ([nu[0], nu[1]], index)
+}
+
+/// Each signal's fundamental frequency (its largest NAFF term) over its
+/// whole length (NaN where it has none), and the diffusion index: log₁₀
+/// of the largest change of one between the signals' first and second
+/// halves (a change of exactly 0 counts as 1e-16).
+fn fundamentals(signals: &[Vec<Complex<f64>>], dt: f64) -> (Vec<f64>, f64) {
     let settings = NaffSettings {
         terms: 1,
         window_order: 1,
     };
-    let fundamental = |states: &[[f64; 4]], j: usize| {
-        let signal: Vec<Complex<f64>> = states
-            .iter()
-            .map(|y| Complex::new(y[j], y[j + 2]))
-            .collect();
-        naff(&signal, dt, &settings)
+    let fundamental = |signal: &[Complex<f64>]| {
+        naff(signal, dt, &settings)
             .ok()
             .and_then(|terms| terms.first().map(|t| t.frequency))
             .unwrap_or(f64::NAN)
     };
-    let half = orbit.len() / 2;
-    let nu = [fundamental(orbit, 0), fundamental(orbit, 1)];
-    let drift = (0..2)
-        .map(|j| (fundamental(&orbit[..half], j) - fundamental(&orbit[half..], j)).abs())
+    let nu = signals.iter().map(|s| fundamental(s)).collect();
+    let drift = signals
+        .iter()
+        .map(|s| {
+            let half = s.len() / 2;
+            (fundamental(&s[..half]) - fundamental(&s[half..])).abs()
+        })
         .fold(0.0_f64, f64::max);
-    // (A drift of exactly 0 is below any rounding: the floor is 1e-16.)
     (nu, drift.max(1e-16).log10())
 }
 

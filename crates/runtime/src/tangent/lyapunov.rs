@@ -374,6 +374,13 @@ pub struct FliShading {
     pub chaotic_fraction: f64,
 }
 
+/// Whether an FLI after `iterations` periods marks a chaotic orbit: above
+/// 2 ln N, twice the level of a regular orbit (whose tangent vectors grow
+/// at most linearly).
+pub fn fli_is_chaotic(fli: f64, iterations: usize) -> bool {
+    fli > 2.0 * (iterations as f64).ln()
+}
+
 /// Shades FLI values from the regular level (white) to the 99th percentile
 /// (black), so that a few extreme orbits do not wash out the map.
 pub fn fli_shading(fli: &[f64], iterations: usize) -> FliShading {
@@ -391,7 +398,10 @@ pub fn fli_shading(fli: &[f64], iterations: usize) -> FliShading {
             .map(|x| ((x - low) / (high - low)).clamp(0.0, 1.0))
             .collect(),
         regular_level: low,
-        chaotic_fraction: fli.iter().filter(|x| **x > 2.0 * low).count() as f64
+        chaotic_fraction: fli
+            .iter()
+            .filter(|x| fli_is_chaotic(**x, iterations))
+            .count() as f64
             / fli.len().max(1) as f64,
     }
 }
