@@ -169,3 +169,82 @@ fn bad_signals_are_named() {
         Err(FrequencyError::Terms { given: 17, max: 16 })
     );
 }
+
+/// A period map's tunes: a libration about an offset centre, (3, 1) +
+/// r e^{−2πiνn}, and a circulating angle q = 0.3 + 2πνn (wrapped to
+/// [−π, π) as a plane shows it) give ν to 1e-10, and a constant tune a
+/// diffusion index at the rounding.
+#[test]
+fn tunes_of_a_libration_and_a_circulation() {
+    use mechlab::analysis::frequency_map::tunes;
+    let nu = 0.1234567;
+    let libration: Vec<Vec<f64>> = (0..1024)
+        .map(|n| {
+            let phase = 2.0 * PI * nu * n as f64;
+            vec![3.0 + 0.2 * phase.cos(), 1.0 - 0.2 * phase.sin()]
+        })
+        .collect();
+    let (got, index) = tunes(&libration, &[false, false]);
+    assert!((got[0] + nu).abs() < 1e-10, "{got:?}");
+    assert!(index < -9.0, "{index}");
+    let circulation: Vec<Vec<f64>> = (0..1024)
+        .map(|n| {
+            let q = 0.3 + 2.0 * PI * nu * n as f64;
+            vec![(q + PI).rem_euclid(2.0 * PI) - PI, 1.0]
+        })
+        .collect();
+    let (got, _) = tunes(&circulation, &[true, false]);
+    assert!((got[0] - nu).abs() < 1e-10, "{got:?}");
+}
+
+/// Kapitza's pendulum without vibration (A = 0) is the pendulum
+/// H = p²/2 + cos q: its period map (period 2πε) turns each libration of
+/// amplitude φ₀ about the hanging state by −ε ω(φ₀) turns, with
+/// ω = AGM(1, cos(φ₀/2)), the closed form derived in the test above. The
+/// frequency map's tunes equal it to 1e-8 at every pixel well inside the
+/// separatrix (E < 0.9), where the diffusion index is below −7.
+#[test]
+fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
+    use mechlab::analysis::chaos_map::ChaosMapSettings;
+    use mechlab::analysis::frequency_map::period_map_frequencies;
+    // (Quadratic convergence: 8 steps reach the rounding from any a, b.)
+    let agm = |mut a: f64, mut b: f64| {
+        for _ in 0..8 {
+            (a, b) = (0.5 * (a + b), (a * b).sqrt());
+        }
+        a
+    };
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let eps = 0.1;
+    let ranges = [(1.2, 5.0), (-1.5, 1.5)];
+    let settings = ChaosMapSettings {
+        axes: [0, 1],
+        ranges: ranges.map(Some),
+        p_max: 1.0,
+        through: None,
+        pixels: 12,
+        periods: 1024,
+        method: Method::Taylor { tol: 1e-12 },
+        tiles: None,
+    };
+    let map = period_map_frequencies(model, &[0.0, eps, 0.0], &settings, &|_| ()).unwrap();
+    let mut checked = 0;
+    for k in 0..144 {
+        let centre = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / 12.0;
+        let (q, p) = (centre(ranges[0], k % 12), centre(ranges[1], k / 12));
+        let energy = p * p / 2.0 + q.cos();
+        if energy >= 0.9 {
+            continue;
+        }
+        let amplitude = (-energy).acos();
+        let expected = -eps * agm(1.0, (amplitude / 2.0).cos());
+        let got = map.frequencies[k][0];
+        assert!(
+            (got - expected).abs() < 1e-8,
+            "({q}, {p}): {got} against {expected}"
+        );
+        assert!(map.diffusion[k] < -7.0, "({q}, {p}): {}", map.diffusion[k]);
+        checked += 1;
+    }
+    assert!(checked > 60, "{checked} pixels inside the separatrix");
+}

@@ -1332,6 +1332,104 @@ fn section_knobs(model: &Model, defaults: &Defaults) -> Vec<Knob> {
     ]
 }
 
+/// The `frequency_map` scene: Laskar's frequency map of a section at a
+/// fixed energy for an autonomous model (Hénon–Heiles by default; the
+/// `section` scene's knobs), or of the period map on a plane for a model
+/// with a fast phase (the chaos map's plane and knobs).
+pub fn frequency_map_scene(catalog: Catalog) -> Result<(), SceneError> {
+    let model = model_from_args(catalog, "henon_heiles")?;
+    use mechlab_runtime::registry::Kind;
+    let fast_phase = matches!(
+        model.dynamic.kind(),
+        Kind::Hamiltonian {
+            fast_phase: true,
+            ..
+        } | Kind::Constrained {
+            fast_phase: true,
+            ..
+        }
+    );
+    if !fast_phase {
+        let overrides = [("frequencies", "100"), ("orbits", "0")];
+        return section_scene(catalog, "frequency_map", &overrides);
+    }
+    let (model, scene) = generic_scene(
+        catalog,
+        "frequency_map",
+        "Laskar's frequency map of the period map: each orbit's tunes and diffusion index",
+        &[],
+        ("henon_heiles", "taylor", "1e-10"),
+        &[
+            (
+                "axes",
+                "0,1",
+                "the state components [q; p] along the two axes (0 = first coordinate)",
+            ),
+            (
+                "through",
+                "0",
+                "the state the plane passes through, comma-separated (0: all zero)",
+            ),
+            ("pixels", "100", "resolution (pixels per side)"),
+            ("periods", "1000", "iterates of each orbit (at least 64)"),
+            (
+                "p_max",
+                "3",
+                "an axis that is not an angle covers [−p_max, p_max]",
+            ),
+        ],
+    )?;
+    let settings = ChaosMapSettings {
+        axes: axes_from(&scene)?,
+        ranges: [None, None],
+        p_max: scene.positive("p_max")?,
+        through: (scene.text("through") != "0")
+            .then(|| scene.numbers("through"))
+            .transpose()?,
+        pixels: scene.count("pixels")?,
+        periods: scene.count("periods")?,
+        method: method_from(&scene)?,
+        tiles: None,
+    };
+    let params = scene.parameter_values(model.info)?;
+    let progress = Progress::new("frequency map orbits", settings.pixels.pow(2));
+    let map = mechlab_runtime::analysis::frequency_map::period_map_frequencies(
+        model,
+        &params,
+        &settings,
+        &|k| progress.advance(k),
+    )?;
+    write_frequency_map(&scene, &map)?;
+    scene.write_summary(&map)?;
+    Ok(())
+}
+
+/// A frequency map's summary line, figure and table.
+fn write_frequency_map(
+    scene: &Scene,
+    map: &mechlab_runtime::analysis::frequency_map::FrequencyMap,
+) -> Result<(), SceneError> {
+    eprintln!(
+        "{} orbits, {:.1} % regular, in {:.1} s",
+        map.accessible,
+        100.0 * map.regular_fraction,
+        map.seconds
+    );
+    scene.save_figure(&map.figure(), "frequency_map.png")?;
+    let pixels = map.pixels;
+    let rows = (0..pixels * pixels).filter_map(|k| {
+        let [nu1, nu2] = map.frequencies[k];
+        nu1.is_finite()
+            .then_some((k % pixels, k / pixels, nu1, nu2, map.diffusion[k]))
+    });
+    scene.write_csv(
+        "frequency_map.csv",
+        &["column", "row", "nu1", "nu2", "diffusion_index"],
+        rows,
+    )?;
+    Ok(())
+}
+
 /// The `section` scene's frequency map of the section when `frequencies`
 /// asks for one, with its figure and table.
 fn section_frequency_map(
@@ -1354,23 +1452,7 @@ fn section_frequency_map(
         extent: scene.positive("extent")?,
     };
     let map = frequency_map(model, params, &map_settings)?;
-    eprintln!(
-        "{} accessible orbits, {:.1} % regular, in {:.1} s",
-        map.accessible,
-        100.0 * map.regular_fraction,
-        map.seconds
-    );
-    scene.save_figure(&map.figure(), "frequency_map.png")?;
-    let rows = (0..pixels * pixels).filter_map(|k| {
-        let [nu1, nu2] = map.frequencies[k];
-        nu1.is_finite()
-            .then_some((k % pixels, k / pixels, nu1, nu2, map.diffusion[k]))
-    });
-    scene.write_csv(
-        "frequency_map.csv",
-        &["column", "row", "nu1", "nu2", "diffusion_index"],
-        rows,
-    )?;
+    write_frequency_map(scene, &map)?;
     Ok(Some(map))
 }
 

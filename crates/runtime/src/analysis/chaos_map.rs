@@ -78,7 +78,7 @@ impl ChaosMap {
     }
 }
 
-fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64) {
+pub(super) fn pixel_centre(ranges: &[(f64, f64); 2], pixels: usize, k: usize) -> (f64, f64) {
     let (i, j) = (k % pixels, k / pixels);
     let at = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / pixels as f64;
     (at(ranges[0], i), at(ranges[1], j))
@@ -214,7 +214,7 @@ pub fn chaos_map(
 /// The request read against the model: its parameters by name, the
 /// plane's axes and the state the plane passes through (by default
 /// `base`: zero, or a constrained model's start).
-fn request(
+pub(super) fn request(
     info: &'static crate::registry::ModelInfo,
     params: &[f64],
     settings: &ChaosMapSettings,
@@ -240,15 +240,15 @@ fn request(
 }
 
 /// A chaos map's request as the model reads it.
-struct Request {
-    params: BTreeMap<String, f64>,
-    axes: [String; 2],
-    through: Vec<f64>,
+pub(super) struct Request {
+    pub params: BTreeMap<String, f64>,
+    pub axes: [String; 2],
+    pub through: Vec<f64>,
 }
 
 /// The ranges of the map's axes: the settings', or [−π, π] for an angle
 /// and [−p_max, p_max] for any other component.
-fn plane_ranges(settings: &ChaosMapSettings, periodic: &[bool]) -> [(f64, f64); 2] {
+pub(super) fn plane_ranges(settings: &ChaosMapSettings, periodic: &[bool]) -> [(f64, f64); 2] {
     std::array::from_fn(|k| {
         let axis = settings.axes[k];
         settings.ranges[k].unwrap_or(if periodic.get(axis) == Some(&true) {

@@ -1,5 +1,6 @@
-//! Laskar's frequency map on a surface of section: over a grid of the
-//! section's accessible region at energy E (as the MEGNO map's), each
+//! Laskar's frequency map on a surface of section, or of a period map:
+//! over a grid of the section's accessible region at energy E (as the
+//! MEGNO map's), or of a plane of the period map (the chaos map's), each
 //! orbit's fundamental frequencies (ν₁, ν₂) by NAFF of q_j + i p_j, and
 //! its frequency diffusion index, log₁₀ of the largest change of a
 //! fundamental frequency between the orbit's first and second halves:
@@ -37,15 +38,17 @@ pub struct FrequencyMapSettings {
 /// by MEGNO's ⟨Y⟩ < 4.)
 pub const REGULAR_INDEX: f64 = -4.0;
 
-/// A frequency map of a section.
+/// A frequency map of a section or of a period map.
 #[derive(Debug, serde::Serialize)]
 pub struct FrequencyMap {
     pub model: String,
-    pub energy: f64,
-    pub energy_of: &'static str,
+    /// What was sampled: "the section at H = 0.125", "the period map".
+    pub surface: String,
     pub axes: [String; 2],
     pub window: [[f64; 2]; 2],
     pub pixels: usize,
+    /// The time each orbit ran, and the samples NAFF was given (a period
+    /// map's: its iterates, one a period).
     pub t_max: f64,
     pub samples: usize,
     /// Pixels where the energy is accessible, and those whose diffusion
@@ -57,7 +60,7 @@ pub struct FrequencyMap {
     pub failed: usize,
     pub seconds: f64,
     /// (ν₁, ν₂) per pixel, row 0 at the bottom; NaN where the energy is
-    /// not accessible.
+    /// not accessible (ν₂ NaN for a period map of one degree of freedom).
     #[serde(skip)]
     pub frequencies: Vec<[f64; 2]>,
     /// The diffusion index per pixel.
@@ -91,7 +94,7 @@ pub fn frequency_map(
     if grid.fixed.has_fast_phase() {
         return Err(Refusal::FastPhase {
             model: name,
-            instead: "its frequency map is not computed yet (the frequencies of a period map are sampled once a period)",
+            instead: "its frequency map is that of its period map (`period_map_frequencies`: the frequency_map scene's `periods`)",
         }
         .into());
     }
@@ -140,8 +143,10 @@ pub fn frequency_map(
         .count();
     Ok(FrequencyMap {
         model: name,
-        energy: settings.section.energy,
-        energy_of: grid.energy_of,
+        surface: format!(
+            "the section at {} = {}",
+            grid.energy_of, settings.section.energy
+        ),
         axes: grid.axes,
         window: grid.window,
         pixels: n,
@@ -161,6 +166,142 @@ pub fn frequency_map(
             .map(|p| p.map_or(f64::NAN, |(_, d)| d))
             .collect(),
     })
+}
+
+/// The frequency map of `model`'s period map on the chaos map's plane
+/// (`settings` as [`super::chaos_map::chaos_map`]'s; `periods` iterates
+/// per orbit, at least 64): each orbit's [`tunes`] and diffusion index.
+/// `done(k)` is told as blocks of k orbits end.
+pub fn period_map_frequencies(
+    model: &Model,
+    params: &[f64],
+    settings: &super::chaos_map::ChaosMapSettings,
+    done: &(dyn Fn(usize) + Sync),
+) -> Result<FrequencyMap, super::period_map::PeriodMapError> {
+    let flows = super::flows(model)?;
+    super::method_applies(model, settings.method)?;
+    let info = model.info;
+    let period = super::period_map::fast_phase_period(flows, params)?;
+    if settings.periods < 64 {
+        return Err(Refusal::setting(info.name, "a frequency map needs periods ≥ 64").into());
+    }
+    let periodic = flows.periodic_state();
+    let request = super::chaos_map::request(info, params, settings, flows.base_state(params))?;
+    let ranges = super::chaos_map::plane_ranges(settings, &periodic);
+    let n = settings.pixels;
+    crate::budget::check_map(n).map_err(crate::ode::OdeError::from)?;
+    let start = std::time::Instant::now();
+    let recording = crate::registry::Recording {
+        transient: 0,
+        record: settings.periods,
+        settle: None,
+        known: None,
+        done,
+    };
+    // Rows in blocks: each block's orbits run together and are analysed
+    // as they end, so only a block's iterates are held.
+    let blocks: Vec<Vec<([f64; 2], f64)>> = super::row_blocks(0..n, n)
+        .into_par_iter()
+        .map(|rows| -> Result<_, super::period_map::PeriodMapError> {
+            let starts: Vec<Option<Vec<f64>>> = (rows.start * n..rows.end * n)
+                .map(|k| {
+                    let (x, y) = super::chaos_map::pixel_centre(&ranges, n, k);
+                    let mut state = request.through.clone();
+                    (state[settings.axes[0]], state[settings.axes[1]]) = (x, y);
+                    flows
+                        .consistent(params, &mut state, &settings.axes)
+                        .ok()
+                        .map(|()| state)
+                })
+                .collect();
+            let flat: Vec<f64> = starts.iter().flatten().flatten().copied().collect();
+            let mut runs = flows
+                .iterates(params, settings.method, period, &flat, &recording)?
+                .into_iter();
+            Ok(starts
+                .iter()
+                .map(
+                    |start| match start.as_ref().and_then(|_| runs.next().flatten()) {
+                        Some(run) => {
+                            let (nu, index) = tunes(&run, &periodic);
+                            ([nu[0], nu.get(1).copied().unwrap_or(f64::NAN)], index)
+                        }
+                        None => ([f64::NAN; 2], f64::NAN),
+                    },
+                )
+                .collect())
+        })
+        .collect::<Result<_, _>>()?;
+    let pixels: Vec<([f64; 2], f64)> = blocks.into_iter().flatten().collect();
+    let failed = pixels.iter().filter(|(_, d)| d.is_nan()).count();
+    let regular = pixels.iter().filter(|(_, d)| *d < REGULAR_INDEX).count();
+    Ok(FrequencyMap {
+        model: info.name.into(),
+        surface: "the period map".into(),
+        axes: request.axes,
+        window: ranges.map(|(lo, hi)| [lo, hi]),
+        pixels: n,
+        t_max: period * settings.periods as f64,
+        samples: settings.periods,
+        accessible: n * n,
+        regular,
+        regular_fraction: regular as f64 / (n * n - failed).max(1) as f64,
+        failed,
+        seconds: start.elapsed().as_secs_f64(),
+        frequencies: pixels.iter().map(|(nu, _)| *nu).collect(),
+        diffusion: pixels.iter().map(|(_, d)| *d).collect(),
+    })
+}
+
+/// The tunes of an orbit of a period map (its states one a period, angles
+/// wrapped or not), one per degree of freedom in turns per period, and its
+/// diffusion index: NAFF of q_j + i p_j less its mean, where an angle is
+/// first unwrapped along the orbit; of e^{i q_j} for an angle that
+/// circulates (its unwrapped range passes 2π).
+pub fn tunes(run: &[Vec<f64>], periodic: &[bool]) -> (Vec<f64>, f64) {
+    let dof = periodic.len() / 2;
+    let signals: Vec<Vec<Complex<f64>>> = (0..dof)
+        .map(|j| {
+            let mut q: Vec<f64> = run.iter().map(|y| y[j]).collect();
+            if periodic[j] {
+                unwrap(&mut q);
+            }
+            let (low, high) = q
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    (a.min(x), b.max(x))
+                });
+            let signal: Vec<Complex<f64>> = if periodic[j] && high - low > std::f64::consts::TAU {
+                q.iter().map(|&x| Complex::from_polar(1.0, x)).collect()
+            } else {
+                q.iter()
+                    .zip(run)
+                    .map(|(&x, y)| Complex::new(x, y[j + dof]))
+                    .collect()
+            };
+            // Less its mean: a constant term would be the largest.
+            let mean = signal.iter().sum::<Complex<f64>>() / signal.len() as f64;
+            signal.iter().map(|z| z - mean).collect()
+        })
+        .collect();
+    // Angular frequencies per period of 1, in turns.
+    let (nu, index) = fundamentals(&signals, 1.0);
+    (
+        nu.iter().map(|w| w / std::f64::consts::TAU).collect(),
+        index,
+    )
+}
+
+/// Adds multiples of 2π to make each step of the angles `q` less than π.
+fn unwrap(q: &mut [f64]) {
+    use std::f64::consts::{PI, TAU};
+    let mut shift = 0.0;
+    for k in 1..q.len() {
+        let raw = q[k] + shift;
+        let step = raw - q[k - 1];
+        shift -= TAU * ((step + PI) / TAU).floor();
+        q[k] += shift;
+    }
 }
 
 /// An orbit's fundamental frequencies (q_j + i p_j, the largest term)
@@ -206,18 +347,28 @@ impl FrequencyMap {
     /// fill curves, the resonances show as lines through them, chaotic
     /// orbits scatter.
     pub fn figure(&self) -> Figure {
+        let t_max = format!("{:.4}", self.t_max);
         let title = format!(
-            "{}: diffusion index at {} = {}, T = {}; regular (< {REGULAR_INDEX}): {:.1} %",
+            "{}: diffusion index on {}, T = {}; regular (< {REGULAR_INDEX}): {:.1} %",
             self.model,
-            self.energy_of,
-            self.energy,
-            self.t_max,
+            self.surface,
+            t_max.trim_end_matches('0').trim_end_matches('.'),
             100.0 * self.regular_fraction
         );
-        let finite: Vec<[f64; 2]> = self
-            .frequencies
-            .iter()
-            .copied()
+        // One degree of freedom: its frequency against the first axis.
+        let one = self.frequencies.iter().all(|nu| nu[1].is_nan());
+        let (w, n) = (self.window[0], self.pixels);
+        let pair = |k: usize, nu: [f64; 2]| match one {
+            true => [
+                w[0] + (w[1] - w[0]) * ((k % n) as f64 + 0.5) / n as f64,
+                nu[0],
+            ],
+            false => nu,
+        };
+        let shown: Vec<[f64; 2]> = (self.frequencies.iter().enumerate())
+            .map(|(k, &nu)| pair(k, nu))
+            .collect();
+        let finite: Vec<[f64; 2]> = (shown.iter().copied())
             .filter(|nu| nu.iter().all(|x| x.is_finite()))
             .collect();
         let range = |j: usize| {
@@ -235,13 +386,22 @@ impl FrequencyMap {
                 (self.window[0][0], self.window[0][1]),
                 (self.window[1][0], self.window[1][1]),
             ),
-            PanelSpec::new(
-                "frequency map (colour: diffusion index)",
-                "ν₁",
-                "ν₂",
-                range(0),
-                range(1),
-            ),
+            match one {
+                true => PanelSpec::new(
+                    "frequency against the first axis (colour: diffusion index)",
+                    &self.axes[0],
+                    "ν₁",
+                    range(0),
+                    range(1),
+                ),
+                false => PanelSpec::new(
+                    "frequency map (colour: diffusion index)",
+                    "ν₁",
+                    "ν₂",
+                    range(0),
+                    range(1),
+                ),
+            },
         ];
         let mut figure = Figure::grid(2, 1, 660, 620, &specs);
         let shade = |d: f64| ((d + 12.0) / 12.0).clamp(0.0, 1.0);
@@ -256,9 +416,7 @@ impl FrequencyMap {
         );
         // Ten bands of the index, each its colour.
         for band in 0..10 {
-            let points = self
-                .frequencies
-                .iter()
+            let points = (shown.iter())
                 .zip(&self.diffusion)
                 .filter(|(_, &d)| ((shade(d) * 10.0) as usize).min(9) == band)
                 .map(|(nu, _)| (nu[0], nu[1]));

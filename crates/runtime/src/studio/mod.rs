@@ -428,38 +428,15 @@ pub struct OrbitEnd {
     pub f_evals: u64,
     pub seconds: f64,
     /// The orbit's tunes, one per degree of freedom: the fundamental
-    /// frequency of q_j + i p_j (of q_j + i q_j′ on constraints) over the
-    /// iterates, in turns per period (NAFF, Hanning window); None for an
-    /// orbit of fewer than 64 iterates or cancelled. Meaningful for
-    /// librations and tori: a rotating angle is sampled on its circle.
+    /// frequency of its iterates (q_j + i p_j less the mean, q_j + i q_j′
+    /// on constraints, e^{i q_j} for a circulating angle) in turns per
+    /// period ([`crate::analysis::frequency_map::tunes`]); None for an
+    /// orbit of fewer than 64 iterates or cancelled.
     pub tunes: Option<Vec<f64>>,
 }
 
 /// Iterates below which an orbit gets no tunes.
 const MIN_TUNE_ITERATES: usize = 64;
-
-/// The tunes of an orbit's states (one per period): for each degree of
-/// freedom the NAFF frequency of q_j + i p_j over 2π.
-fn tunes(states: &[Vec<f64>], dof: usize) -> Option<Vec<f64>> {
-    use crate::analysis::frequency::{naff, Complex, NaffSettings};
-    if states.len() < MIN_TUNE_ITERATES {
-        return None;
-    }
-    let settings = NaffSettings {
-        terms: 1,
-        window_order: 1,
-    };
-    (0..dof)
-        .map(|j| {
-            let signal: Vec<Complex<f64>> = states
-                .iter()
-                .map(|y| Complex::new(y[j], y[j + dof]))
-                .collect();
-            let terms = naff(&signal, 1.0, &settings).ok()?;
-            terms.first().map(|t| t.frequency / (2.0 * PI))
-        })
-        .collect()
-}
 
 /// How often a growing orbit is handed over.
 const CHUNK_INTERVAL: Duration = Duration::from_millis(40);
@@ -521,13 +498,13 @@ pub fn orbit(
             !cancelled
         },
     );
-    let dof = setup.dof;
     let end = |periods, cancelled, integrator: &Integrator| OrbitEnd {
         periods,
         cancelled,
         f_evals: integrator.stats.f_evals,
         seconds: started.elapsed().as_secs_f64(),
-        tunes: (!cancelled).then(|| tunes(&states, dof)).flatten(),
+        tunes: (!cancelled && states.len() >= MIN_TUNE_ITERATES)
+            .then(|| crate::analysis::frequency_map::tunes(&states, &periodic).0),
     };
     if let Err(error) = run {
         // The points before the failure are the page's to keep.
