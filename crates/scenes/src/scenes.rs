@@ -111,40 +111,18 @@ pub fn chaos_map_scene(
         overrides,
         ("kapitza", "taylor", "1e-6"),
         &[
-            (
-                "axes",
-                "0,1",
-                "the state components [q; p] along the two axes (0 = first coordinate)",
-            ),
-            (
-                "through",
-                "0",
-                "the state the plane passes through, comma-separated (0: all zero)",
-            ),
-            ("pixels", "300", "resolution (pixels per side)"),
-            ("periods", "180", "periods of the phase per pixel"),
-            (
-                "p_max",
-                "3",
-                "an axis that is not an angle covers [−p_max, p_max]",
-            ),
-            ("tile_rows", "10", "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
-            ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the map"),
-        ],
+            plane_knobs(("300", "180")),
+            vec![
+                ("tile_rows", "10", "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
+                ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the map"),
+            ],
+        ]
+        .concat(),
     )?;
     let info = model.info;
-    let axes = axes_from(&scene)?;
     let settings = ChaosMapSettings {
-        axes,
-        ranges: [None, None],
-        p_max: scene.positive("p_max")?,
-        through: (scene.text("through") != "0")
-            .then(|| scene.numbers("through"))
-            .transpose()?,
-        pixels: scene.count("pixels")?,
-        periods: scene.count("periods")?,
-        method: method_from(&scene)?,
         tiles: tiles_from(&scene, ["tile_rows", "only_tiles"])?,
+        ..plane_settings(&scene)?
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
     let params = scene.parameter_values(info)?;
@@ -164,6 +142,49 @@ pub fn chaos_map_scene(
     };
     let rows = settings.pixels;
     share_tiles(&scene, sharing, settings.tiles.as_ref(), rows, &sweep)
+}
+
+/// The knobs of a plane of the period map: its axes, the state it passes
+/// through, its pixels (default `pixels`), the periods per orbit (default
+/// `periods`) and the range of an axis that is not an angle.
+fn plane_knobs(
+    (pixels, periods): (&'static str, &'static str),
+) -> Vec<(&'static str, &'static str, &'static str)> {
+    vec![
+        (
+            "axes",
+            "0,1",
+            "the state components [q; p] along the two axes (0 = first coordinate)",
+        ),
+        (
+            "through",
+            "0",
+            "the state the plane passes through, comma-separated (0: all zero)",
+        ),
+        ("pixels", pixels, "resolution (pixels per side)"),
+        ("periods", periods, "periods of the phase per pixel"),
+        (
+            "p_max",
+            "3",
+            "an axis that is not an angle covers [−p_max, p_max]",
+        ),
+    ]
+}
+
+/// The plane of [`plane_knobs`] and the method, without tiles.
+fn plane_settings(scene: &Scene) -> Result<ChaosMapSettings, SceneError> {
+    Ok(ChaosMapSettings {
+        axes: axes_from(scene)?,
+        ranges: [None, None],
+        p_max: scene.positive("p_max")?,
+        through: (scene.text("through") != "0")
+            .then(|| scene.numbers("through"))
+            .transpose()?,
+        pixels: scene.count("pixels")?,
+        periods: scene.count("periods")?,
+        method: method_from(scene)?,
+        tiles: None,
+    })
 }
 
 /// The chaos map's figures, CSV and summary.
@@ -1359,38 +1380,9 @@ pub fn frequency_map_scene(catalog: Catalog) -> Result<(), SceneError> {
         "Laskar's frequency map of the period map: each orbit's tunes and diffusion index",
         &[],
         ("henon_heiles", "taylor", "1e-10"),
-        &[
-            (
-                "axes",
-                "0,1",
-                "the state components [q; p] along the two axes (0 = first coordinate)",
-            ),
-            (
-                "through",
-                "0",
-                "the state the plane passes through, comma-separated (0: all zero)",
-            ),
-            ("pixels", "100", "resolution (pixels per side)"),
-            ("periods", "1000", "iterates of each orbit (at least 64)"),
-            (
-                "p_max",
-                "3",
-                "an axis that is not an angle covers [−p_max, p_max]",
-            ),
-        ],
+        &plane_knobs(("100", "1000")),
     )?;
-    let settings = ChaosMapSettings {
-        axes: axes_from(&scene)?,
-        ranges: [None, None],
-        p_max: scene.positive("p_max")?,
-        through: (scene.text("through") != "0")
-            .then(|| scene.numbers("through"))
-            .transpose()?,
-        pixels: scene.count("pixels")?,
-        periods: scene.count("periods")?,
-        method: method_from(&scene)?,
-        tiles: None,
-    };
+    let settings = plane_settings(&scene)?;
     let params = scene.parameter_values(model.info)?;
     let progress = Progress::new("frequency map orbits", settings.pixels.pow(2));
     let map = mechlab_runtime::analysis::frequency_map::period_map_frequencies(
