@@ -281,21 +281,25 @@ impl Grid<'_> {
             &recording,
         )?;
         let kinds = self.kinds_of_runs(&starts, &runs)?;
-        let extras: Vec<Vec<Vec<f64>>> = (runs.into_iter().flatten())
-            .map(|run| run.iter().map(|y| wrapped(y, &self.wrap)).collect())
+        let runs: Vec<Option<Vec<Vec<f64>>>> = (runs.into_iter())
+            .map(|run| Some(run?.iter().map(|y| wrapped(y, &self.wrap)).collect()))
             .collect();
-        let (merged_labels, mut merged, points) = identify(records, &extras, self.settings);
+        let extras: Vec<Vec<Vec<f64>>> = runs.iter().flatten().cloned().collect();
+        let (merged_labels, mut merged, mut points) = identify(records, &extras, self.settings);
         // Each piece's kind goes to the attractor it is now part of
-        // (chaotic if any piece is).
-        for (piece, kind) in pieces.iter().zip(kinds) {
+        // (chaotic if any piece is), and its run to the attractor's points.
+        let axes = self.settings.axes;
+        for ((piece, kind), run) in pieces.iter().zip(kinds).zip(&runs) {
             let first = labels.iter().position(|&l| l == *piece as i32);
-            let (Some(first), Some(kind)) = (first, kind) else {
+            let (Some(first), Some(kind), Some(run)) = (first, kind, run) else {
                 continue;
             };
-            let attractor = &mut merged[merged_labels[first] as usize];
+            let index = merged_labels[first] as usize;
+            let attractor = &mut merged[index];
             if attractor.kind == APERIODIC || kind == CHAOTIC {
                 attractor.kind = kind;
             }
+            points[index].extend(run.iter().map(|y| [y[axes[0]], y[axes[1]]]));
         }
         Ok((merged_labels, merged, points))
     }
@@ -667,7 +671,11 @@ impl Basins {
             .iter()
             .map(|a| format!("{} {:.3}±{:.3}", a.kind, a.fraction, a.fraction_error))
             .collect();
-        let title = format!("{}: basins ({})", self.model, summary.join(", "));
+        let boundary = match self.boundary.dimension {
+            Some(d) => format!("; boundary dimension {d:.2}"),
+            None => String::new(),
+        };
+        let title = format!("{}: basins ({}){boundary}", self.model, summary.join(", "));
         let spec = PanelSpec::new(
             &title,
             &self.axes[0],
@@ -701,7 +709,7 @@ impl Basins {
                 0,
                 attractor.iter().map(|p| (p[0], p[1])),
                 crate::plot::BLACK,
-                3,
+                2,
             );
         }
         figure
