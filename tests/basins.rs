@@ -297,3 +297,41 @@ fn attractors_are_told_apart_by_their_longer_runs() {
         );
     }
 }
+
+/// Kapitza's pendulum with friction (μ = 0.1) shaken above the averaged
+/// threshold A² > 2: two attractors, each a fixed point of the period map,
+/// the hanging state (q = ±π: one attractor across the cut of the angle,
+/// its cells neighbours around the circle) and the upright one (q = 0) it
+/// stabilises, whose basin is the smaller.
+#[test]
+fn the_shaken_pendulum_with_friction_hangs_or_stands_upright() {
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let mut grid = settings(48);
+    grid.ranges = [(-std::f64::consts::PI, std::f64::consts::PI), (-3.0, 3.0)];
+    grid.transient = 300;
+    grid.method = Method::Taylor { tol: 1e-10 };
+    let result = basins(model, &[1.5, 0.1, 0.1], &grid, &|_| ()).unwrap();
+    assert_eq!(result.attractors.len(), 2, "{:?}", result.attractors);
+    let angle_to = |a: &[f64], q: f64| mechlab::analysis::period_map::wrap_angle(a[0] - q).abs();
+    let hanging = result
+        .attractors
+        .iter()
+        .find(|a| angle_to(&a.representative, std::f64::consts::PI) < 1e-2);
+    let upright = result
+        .attractors
+        .iter()
+        .find(|a| angle_to(&a.representative, 0.0) < 1e-2);
+    let (Some(hanging), Some(upright)) = (hanging, upright) else {
+        panic!("{:?}", result.attractors);
+    };
+    assert_eq!(
+        (hanging.kind.as_str(), upright.kind.as_str()),
+        ("period 1", "period 1")
+    );
+    assert!(
+        upright.fraction < hanging.fraction && upright.starts >= 2,
+        "{:?}",
+        result.attractors
+    );
+    assert_eq!(result.diverged, 0);
+}

@@ -11,7 +11,7 @@ use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec};
-use crate::registry::{cell_of, KnownAttractors, Model, Recording};
+use crate::registry::{within, Cells, KnownAttractors, Model, Recording};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -168,6 +168,7 @@ pub fn basins(
         settings,
         period,
         wrap: flows.periodic_state(),
+        cells: Cells::new(settings.cell, &flows.periodic_state()),
         base,
         done,
     };
@@ -203,6 +204,8 @@ struct Grid<'a> {
     /// The state the plane passes through, and which components are angles.
     base: Vec<f64>,
     wrap: Vec<bool>,
+    /// The cells that identify attractors.
+    cells: Cells,
     done: &'a (dyn Fn(usize) + Sync),
 }
 
@@ -256,7 +259,8 @@ impl Grid<'_> {
     /// periods further, the cells it visits join the pieces they touch,
     /// and that run tells what the attractor is ([`Grid::kinds_of_runs`]).
     fn find(&self, records: &[Record]) -> Result<Found, BasinsError> {
-        let (labels, attractors, points) = identify(records, &[], self.settings);
+        let (labels, attractors, points) =
+            identify(records, &[], self.settings, (&self.cells, &self.wrap));
         let pieces: Vec<usize> = (0..attractors.len())
             .filter(|&i| attractors[i].kind == APERIODIC)
             .collect();
@@ -285,7 +289,8 @@ impl Grid<'_> {
             .map(|run| Some(run?.iter().map(|y| wrapped(y, &self.wrap)).collect()))
             .collect();
         let extras: Vec<Vec<Vec<f64>>> = runs.iter().flatten().cloned().collect();
-        let (merged_labels, mut merged, mut points) = identify(records, &extras, self.settings);
+        let (merged_labels, mut merged, mut points) =
+            identify(records, &extras, self.settings, (&self.cells, &self.wrap));
         // Each piece's kind goes to the attractor it is now part of
         // (chaotic if any piece is), and its run to the attractor's points.
         let axes = self.settings.axes;
@@ -335,7 +340,7 @@ impl Grid<'_> {
                 let tail: Vec<Vec<f64>> = (run[run.len() / 2..].iter())
                     .map(|y| wrapped(y, &self.wrap))
                     .collect();
-                let cycle = kind_of(&tail, self.settings.cell * 1e-6);
+                let cycle = kind_of(&tail, &self.wrap, self.settings.cell * 1e-6);
                 if cycle != APERIODIC {
                     return Some(cycle);
                 }
@@ -361,7 +366,7 @@ impl Grid<'_> {
         let n = self.settings.pixels;
         let scouts: Vec<usize> = (0..n * n).filter(|&k| self.is_scout(k)).collect();
         let records = self.records(&scouts, None)?;
-        let mut known = KnownAttractors::new(self.settings.cell);
+        let mut known = KnownAttractors::new(self.cells.clone());
         let (labels, attractors, _) = self.find(&records)?;
         for (index, _) in attractors.iter().enumerate().filter(|(_, a)| a.confirmed) {
             let on_it: Vec<&Vec<Vec<f64>>> = labels
@@ -458,7 +463,12 @@ fn wrapped(y: &[f64], wrap: &[bool]) -> Vec<f64> {
 /// iterates visit, cells that touch being one; each start's label, the
 /// attractors, their iterates on the axes.
 /// `extras` are records of no start (they join the sets they touch).
-fn identify(records: &[Record], extras: &[Vec<Vec<f64>>], settings: &BasinSettings) -> Found {
+fn identify(
+    records: &[Record],
+    extras: &[Vec<Vec<f64>>],
+    settings: &BasinSettings,
+    (cells, wrap): (&Cells, &[bool]),
+) -> Found {
     let mut parent: Vec<usize> = Vec::new();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
@@ -486,7 +496,7 @@ fn identify(records: &[Record], extras: &[Vec<Vec<f64>>], settings: &BasinSettin
             .iter()
             .map(|y| {
                 let mut key = Vec::new();
-                cell_of(y, settings.cell, &mut key);
+                cells.of(y, &mut key);
                 key
             })
             .collect();
@@ -504,20 +514,13 @@ fn identify(records: &[Record], extras: &[Vec<Vec<f64>>], settings: &BasinSettin
     }
     // Cells that touch (a face or a corner) hold one attractor: a cycle
     // on a cell's boundary has its records on both sides of it.
-    let cells: Vec<(Vec<i64>, usize)> = owner.iter().map(|(c, &s)| (c.clone(), s)).collect();
-    let mut neighbour = Vec::new();
-    for (cell, set) in &cells {
-        for offset in 0..3usize.pow(cell.len() as u32) {
-            neighbour.clear();
-            neighbour.extend(
-                cell.iter()
-                    .enumerate()
-                    .map(|(i, c)| c + (offset / 3usize.pow(i as u32) % 3) as i64 - 1),
-            );
-            if let Some(&other) = owner.get(&neighbour) {
+    let claimed: Vec<(Vec<i64>, usize)> = owner.iter().map(|(c, &s)| (c.clone(), s)).collect();
+    for (cell, set) in &claimed {
+        cells.touching(cell, |neighbour| {
+            if let Some(&other) = owner.get(neighbour) {
                 unite(&mut parent, other, *set);
             }
-        }
+        });
     }
     // Attractors in order of their first start.
     let mut index_of: HashMap<usize, usize> = HashMap::new();
@@ -534,7 +537,7 @@ fn identify(records: &[Record], extras: &[Vec<Vec<f64>>], settings: &BasinSettin
         let index = *index_of.entry(r).or_insert(next);
         if index == next {
             attractors.push(Attractor {
-                kind: kind_of(record, settings.cell * 1e-6),
+                kind: kind_of(record, wrap, settings.cell * 1e-6),
                 representative: record.last().cloned().unwrap_or_default(),
                 starts: 0,
                 confirmed: false,
@@ -561,9 +564,10 @@ fn identify(records: &[Record], extras: &[Vec<Vec<f64>>], settings: &BasinSettin
 }
 
 /// "period k" if the record repeats with the least such k (within
-/// `tolerance` in every component), else "aperiodic".
-fn kind_of(record: &[Vec<f64>], tolerance: f64) -> String {
-    let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tolerance);
+/// `tolerance` in every component, the angles `wrap` modulo 2π), else
+/// "aperiodic".
+fn kind_of(record: &[Vec<f64>], wrap: &[bool], tolerance: f64) -> String {
+    let close = |a: &[f64], b: &[f64]| within(a, b, wrap, tolerance);
     (1..=record.len() / 2)
         .find(|&k| (k..record.len()).all(|i| close(&record[i], &record[i - k])))
         .map_or_else(|| APERIODIC.to_string(), |k| format!("period {k}"))

@@ -8,6 +8,7 @@
 //! to settle, not the whole transient.
 
 use std::collections::HashMap;
+use std::f64::consts::{PI, TAU};
 
 /// How each orbit is recorded.
 pub struct Recording<'a> {
@@ -27,26 +28,77 @@ pub struct Recording<'a> {
     pub done: &'a (dyn Fn(usize) + Sync),
 }
 
-/// Attractors found before, by the cells of the state space (side
-/// `cell`, angles in [−π, π)) their records visit.
+/// The cells of the state space that identify attractors: cubes of side
+/// `side`; along an angle, the circle is cut into whole cells (the last a
+/// little wider), so that cells across ±π are neighbours.
+#[derive(Clone, Debug, Default)]
+pub struct Cells {
+    side: f64,
+    /// Per component: how many cells go around it, for an angle.
+    around: Vec<Option<i64>>,
+}
+
+impl Cells {
+    /// Cells of side `side` for a state whose components `wrap` are angles.
+    pub fn new(side: f64, wrap: &[bool]) -> Cells {
+        let around = wrap
+            .iter()
+            .map(|&angle| angle.then(|| ((TAU / side).floor() as i64).max(1)))
+            .collect();
+        Cells { side, around }
+    }
+
+    /// The cell of the state `y` into `key`.
+    pub fn of(&self, y: &[f64], key: &mut Vec<i64>) {
+        key.clear();
+        key.extend(y.iter().zip(&self.around).map(|(&x, around)| match around {
+            Some(n) => {
+                let from_minus_pi = crate::analysis::period_map::wrap_angle(x) + PI;
+                ((from_minus_pi / self.side).floor() as i64).clamp(0, n - 1)
+            }
+            None => (x / self.side).floor() as i64,
+        }));
+    }
+
+    /// Calls `visit` with each cell that touches `cell` (a face or a
+    /// corner, around the circle for an angle), `cell` itself included.
+    pub fn touching(&self, cell: &[i64], mut visit: impl FnMut(&[i64])) {
+        let mut neighbour = Vec::with_capacity(cell.len());
+        for offset in 0..3usize.pow(cell.len() as u32) {
+            neighbour.clear();
+            neighbour.extend(
+                cell.iter()
+                    .zip(&self.around)
+                    .enumerate()
+                    .map(|(i, (c, around))| {
+                        let moved = c + (offset / 3usize.pow(i as u32) % 3) as i64 - 1;
+                        around.map_or(moved, |n| moved.rem_euclid(n))
+                    }),
+            );
+            visit(&neighbour);
+        }
+    }
+}
+
+/// Attractors found before, by the cells their records visit.
 #[derive(Debug, Default)]
 pub struct KnownAttractors {
-    cell: f64,
-    cells: HashMap<Vec<i64>, usize>,
+    cells: Cells,
+    owner: HashMap<Vec<i64>, usize>,
     records: Vec<Vec<Vec<f64>>>,
 }
 
 impl KnownAttractors {
-    /// No attractor yet; cells of side `cell`.
-    pub fn new(cell: f64) -> KnownAttractors {
+    /// No attractor yet.
+    pub fn new(cells: Cells) -> KnownAttractors {
         KnownAttractors {
-            cell,
+            cells,
             ..Default::default()
         }
     }
-    /// Adds an attractor by the records of the orbits on it (angles
-    /// wrapped; the first stands for it): its cells are those they visit
-    /// (a cell already claimed stays with its first attractor).
+    /// Adds an attractor by the records of the orbits on it (the first
+    /// stands for it): its cells are those they visit (a cell already
+    /// claimed stays with its first attractor).
     pub fn add(&mut self, records: &[&Vec<Vec<f64>>]) {
         let Some(&first) = records.first() else {
             return;
@@ -54,8 +106,8 @@ impl KnownAttractors {
         let index = self.records.len();
         let mut key = Vec::new();
         for y in records.iter().copied().flatten() {
-            cell_of(y, self.cell, &mut key);
-            self.cells.entry(key.clone()).or_insert(index);
+            self.cells.of(y, &mut key);
+            self.owner.entry(key.clone()).or_insert(index);
         }
         self.records.push(first.clone());
     }
@@ -64,10 +116,18 @@ impl KnownAttractors {
     }
 }
 
-/// The cell of the state `y` (angles wrapped) into `key`.
-pub fn cell_of(y: &[f64], cell: f64, key: &mut Vec<i64>) {
-    key.clear();
-    key.extend(y.iter().map(|x| (x / cell).floor() as i64));
+/// Whether the states `a` and `b` differ by at most `tolerance` in every
+/// component (the angles `wrap` modulo 2π).
+pub fn within(a: &[f64], b: &[f64], wrap: &[bool], tolerance: f64) -> bool {
+    a.iter().zip(b).zip(wrap).all(|((x, y), &angle)| {
+        let d = x - y;
+        let d = if angle {
+            crate::analysis::period_map::wrap_angle(d)
+        } else {
+            d
+        };
+        d.abs() <= tolerance
+    })
 }
 
 /// One orbit's record as it runs.
@@ -88,7 +148,6 @@ pub(crate) struct Recorder<'a> {
     /// consecutive iterates, and the cell of the last (a buffer).
     streak: (usize, usize),
     key: Vec<i64>,
-    wrapped: Vec<f64>,
     /// The known attractor it reached.
     recognised: Option<usize>,
 }
@@ -106,7 +165,6 @@ impl<'a> Recorder<'a> {
             settled: None,
             streak: (usize::MAX, 0),
             key: Vec::new(),
-            wrapped: Vec::new(),
             recognised: None,
         }
     }
@@ -121,17 +179,8 @@ impl<'a> Recorder<'a> {
             return false;
         }
         if let Some(known) = self.plan.known {
-            self.wrapped.clear();
-            self.wrapped
-                .extend(y.iter().zip(self.wrap).map(|(&x, &angle)| {
-                    if angle {
-                        crate::analysis::period_map::wrap_angle(x)
-                    } else {
-                        x
-                    }
-                }));
-            cell_of(&self.wrapped, known.cell, &mut self.key);
-            self.streak = match known.cells.get(&self.key) {
+            known.cells.of(y, &mut self.key);
+            self.streak = match known.owner.get(&self.key) {
                 Some(&a) if a == self.streak.0 => (a, self.streak.1 + 1),
                 Some(&a) => (a, 1),
                 None => (usize::MAX, 0),
@@ -164,15 +213,7 @@ impl<'a> Recorder<'a> {
     }
 
     fn close(&self, a: &[f64], b: &[f64], tolerance: f64) -> bool {
-        a.iter().zip(b).zip(self.wrap).all(|((x, y), &angle)| {
-            let d = x - y;
-            let d = if angle {
-                crate::analysis::period_map::wrap_angle(d)
-            } else {
-                d
-            };
-            d.abs() <= tolerance
-        })
+        within(a, b, self.wrap, tolerance)
     }
 
     /// The record, if the orbit ran to its end (`ran`: it stopped without
