@@ -53,6 +53,9 @@ pub const APERIODIC: &str = "aperiodic";
 /// The kinds a longer run tells an aperiodic record's attractor apart by.
 pub const QUASI_PERIODIC: &str = "quasi-periodic";
 pub const CHAOTIC: &str = "chaotic";
+/// Neither a cycle, nor chaotic, nor shown quasi-periodic by its longer
+/// run (a cycle approached too slowly, say): a longer transient tells.
+pub const NOT_SETTLED: &str = "not settled";
 
 /// How many periods the representative of an aperiodic attractor runs to
 /// find the other pieces of its set.
@@ -80,8 +83,9 @@ pub enum BasinsError {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Attractor {
     /// "period k" for a cycle of P (to 1e-6 of the cell), else what a
-    /// longer run shows: [`QUASI_PERIODIC`], [`CHAOTIC`], a cycle of a
-    /// longer period, or [`APERIODIC`] when it cannot tell.
+    /// longer run shows: a cycle of a longer period, [`CHAOTIC`],
+    /// [`QUASI_PERIODIC`], [`NOT_SETTLED`], or [`APERIODIC`] when that run
+    /// stopped.
     pub kind: String,
     /// Its last recorded iterate from the first start that reached it.
     pub representative: Vec<f64>,
@@ -314,8 +318,10 @@ impl Grid<'_> {
     /// second half repeats with period k, to 1e-6 of a cell); else chaotic
     /// when the fast Lyapunov indicator over as many periods from its
     /// start says so by the chaos maps' criterion (FLI > 2 ln N: a positive
-    /// Lyapunov exponent), quasi-periodic when not (an attracting torus's
-    /// tangent vectors grow no faster than N). None: the run stopped.
+    /// Lyapunov exponent); else quasi-periodic when its frequencies keep
+    /// between its halves (a diffusion index below the frequency maps'
+    /// regular one) and its last quarter spans at least half of what the
+    /// quarter before it does; else [`NOT_SETTLED`]. None: the run stopped.
     fn kinds_of_runs(
         &self,
         starts: &[f64],
@@ -344,8 +350,37 @@ impl Grid<'_> {
                 if cycle != APERIODIC {
                     return Some(cycle);
                 }
-                let chaotic = crate::tangent::lyapunov::fli_is_chaotic(fli.ok()?, EXTENSION);
-                Some(if chaotic { CHAOTIC } else { QUASI_PERIODIC }.to_string())
+                if crate::tangent::lyapunov::fli_is_chaotic(fli.ok()?, EXTENSION) {
+                    return Some(CHAOTIC.into());
+                }
+                // Quasi-periodic only on evidence: its frequencies keep
+                // (NAFF) and it keeps its extent (a cycle still being
+                // approached shrinks towards it).
+                let (_, index) = super::frequency_map::tunes(run, &self.wrap);
+                let quarter = run.len() / 4;
+                let extent = |part: &[Vec<f64>]| {
+                    (0..self.wrap.len())
+                        .map(|j| {
+                            let (lo, hi) = part
+                                .iter()
+                                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+                                    (a.min(y[j]), b.max(y[j]))
+                                });
+                            hi - lo
+                        })
+                        .fold(0.0, f64::max)
+                };
+                let keeps =
+                    extent(&run[3 * quarter..]) > 0.5 * extent(&run[2 * quarter..3 * quarter]);
+                let regular = index < super::frequency_map::REGULAR_INDEX;
+                Some(
+                    if regular && keeps {
+                        QUASI_PERIODIC
+                    } else {
+                        NOT_SETTLED
+                    }
+                    .to_string(),
+                )
             })
             .collect())
     }
