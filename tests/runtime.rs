@@ -8,7 +8,7 @@ use mechlab::ode::dual::{jacobian, lane_by_lane};
 use mechlab::ode::hyperdual::{gradient, hessian};
 use mechlab::ode::Scalar;
 use mechlab::ode::{Dual, Lanes, LANES};
-use mechlab::studio::contour::Field;
+use mechlab_studio::calls::contour::Field;
 
 /// f(x, y) = sin(x)·y³/(1 + x²) + √(exp(x y)) against its hand-derived
 /// gradient and Hessian.

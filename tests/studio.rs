@@ -777,11 +777,11 @@ async fn bad_requests_are_named_errors() {
 /// it handed over are the library's.
 #[test]
 fn a_dropped_orbit_stops() {
-    let request: mechlab::studio::OrbitRequest =
+    let request: mechlab_studio::calls::OrbitRequest =
         serde_json::from_value(json!({"model": "kapitza", "seed": [1.0, 0.5], "periods": 100_000}))
             .unwrap();
     let mut received = Vec::new();
-    let end = mechlab::studio::orbit(mechlab::models::MODELS, &request, &mut |chunk| {
+    let end = mechlab_studio::calls::orbit(mechlab::models::MODELS, &request, &mut |chunk| {
         received.extend(chunk.points);
         false
     })

@@ -20,7 +20,6 @@ pub mod ode;
 pub mod plot;
 pub mod registry;
 pub mod report;
-pub mod studio;
 pub mod study;
 pub mod tangent;
 

@@ -145,9 +145,6 @@ pub enum SceneError {
     Section(#[from] mechlab_runtime::analysis::section::SectionError),
     #[error(transparent)]
     Continuation(#[from] mechlab_runtime::analysis::continuation::ContinuationError),
-    /// A request of the studio (the server answers it with this error).
-    #[error(transparent)]
-    Studio(#[from] mechlab_runtime::studio::StudioError),
     #[error(transparent)]
     Constrained(#[from] mechlab_runtime::analysis::on_constraints::ConstrainedError),
     #[error(transparent)]

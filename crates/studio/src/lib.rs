@@ -1,11 +1,11 @@
-//! The studio's HTTP server (axum) over the library calls of
-//! `mechlab_runtime::studio`, in a crate of its own so that no other scene
+//! The studio's HTTP server (axum) over its library calls ([`calls`]),
+//! in a crate of its own so that no other scene
 //! compiles a web server: one static page with its script and
 //! style (served from the binary: no network, no CDN) and a JSON API.
 //!
 //! | route | answer |
 //! |---|---|
-//! | `GET /api/models` | every model with its parameters ([`mechlab_runtime::studio::models`]) |
+//! | `GET /api/models` | every model with its parameters ([`calls::models`]) |
 //! | `GET /api/models/{name}/derivations` | its derivations as MathML |
 //! | `POST /api/orbit` | an orbit of the period map, streamed as NDJSON lines |
 //! | `POST /api/chaos` | the FLI map of a view at growing resolutions, NDJSON |
@@ -29,16 +29,16 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
+use calls::{self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
 use mechlab_runtime::analysis::basins::BasinsError;
 use mechlab_runtime::analysis::mechanism::MechanismError;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::registry::Catalog;
-use mechlab_runtime::studio::{
-    self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError,
-};
 use mechlab_scenes::scene::{knob, Scene, SceneError, ValueProblem};
 use serde::Serialize;
 use std::net::SocketAddr;
+
+pub mod calls;
 
 const PAGE: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/studio.js");

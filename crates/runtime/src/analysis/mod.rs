@@ -109,7 +109,7 @@ pub(crate) fn hamiltonian(
 
 /// The model's flows (Hamiltonian or constrained), or the refusal of a
 /// contact model (which has none).
-pub(crate) fn flows(
+pub fn flows(
     model: &crate::registry::Model,
 ) -> Result<&'static dyn crate::registry::Flows, Refusal> {
     model

@@ -1,7 +1,6 @@
-//! The studio: an interactive page over the period map of any model of
-//! `models/`, served by a local web server (the `mechlab-studio` crate).
-//! This module holds
-//! what the page asks for, as library calls the tests reach without HTTP:
+//! The studio's library calls: what its page asks for, reached by the
+//! tests without HTTP, in the studio's crate so that the main scene's
+//! build compiles none of them:
 //! the models and their derivations as MathML, an orbit of the period map
 //! handed over in chunks as it grows, the level sets of the averaged
 //! Hamiltonian with the equilibria, and the FLI chaos map of a view at
@@ -9,11 +8,11 @@
 
 pub mod contour;
 
-use crate::analysis::chaos_map::{chaos_map, ChaosMapSettings};
-use crate::analysis::period_map::{stream_orbit, wrap_angle, PeriodMapError};
-use crate::analysis::Refusal;
-use crate::ode::{Integrator, Method, OdeError};
-use crate::registry::{Catalog, DynamicModel, Kind, Model, ModelInfo, ParameterError};
+use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMapSettings};
+use mechlab_runtime::analysis::period_map::{stream_orbit, wrap_angle, PeriodMapError};
+use mechlab_runtime::analysis::Refusal;
+use mechlab_runtime::ode::{Integrator, Method, OdeError};
+use mechlab_runtime::registry::{Catalog, DynamicModel, Kind, Model, ModelInfo, ParameterError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -30,10 +29,10 @@ pub const MAX_GRID: usize = 400;
 #[derive(Debug, thiserror::Error)]
 pub enum StudioError {
     #[error(transparent)]
-    UnknownModel(#[from] crate::registry::UnknownModel),
+    UnknownModel(#[from] mechlab_runtime::registry::UnknownModel),
     /// The analysis does not apply to this kind of model.
     #[error(transparent)]
-    Refused(#[from] crate::analysis::Refusal),
+    Refused(#[from] mechlab_runtime::analysis::Refusal),
     #[error("model '{model}': {problem}")]
     BadRequest {
         model: String,
@@ -46,15 +45,15 @@ pub enum StudioError {
     #[error(transparent)]
     PeriodMap(#[from] PeriodMapError),
     #[error(transparent)]
-    Splitting(#[from] crate::analysis::separatrix::SplittingError),
+    Splitting(#[from] mechlab_runtime::analysis::separatrix::SplittingError),
     #[error(transparent)]
-    Continuation(#[from] crate::analysis::continuation::ContinuationError),
+    Continuation(#[from] mechlab_runtime::analysis::continuation::ContinuationError),
     #[error(transparent)]
-    Section(#[from] crate::analysis::section::SectionError),
+    Section(#[from] mechlab_runtime::analysis::section::SectionError),
     #[error(transparent)]
-    Mechanism(#[from] crate::analysis::mechanism::MechanismError),
+    Mechanism(#[from] mechlab_runtime::analysis::mechanism::MechanismError),
     #[error(transparent)]
-    Basins(#[from] crate::analysis::basins::BasinsError),
+    Basins(#[from] mechlab_runtime::analysis::basins::BasinsError),
 }
 
 /// What is wrong with a request's numbers.
@@ -77,7 +76,7 @@ pub enum RequestProblem {
     #[error("the range of axis {axis} must be an interval of finite numbers, low < high")]
     Range { axis: usize },
     #[error("the seed cannot be put on the constraints with its axes' components held: {0}")]
-    Inconsistent(crate::ode::holonomic::ConstraintError),
+    Inconsistent(mechlab_runtime::ode::holonomic::ConstraintError),
     #[error("{what} must be between 1 and {max}, got {got}")]
     Count {
         what: &'static str,
@@ -164,10 +163,10 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
                 "constrained" if i >= dof => {
                     format!(
                         "{}′",
-                        crate::registry::display_name(info.coordinates[i - dof])
+                        mechlab_runtime::registry::display_name(info.coordinates[i - dof])
                     )
                 }
-                _ => crate::registry::display_name(n),
+                _ => mechlab_runtime::registry::display_name(n),
             })
             .collect(),
         periodic,
@@ -178,7 +177,7 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
             .zip(info.parameter_descriptions)
             .map(|((&name, default), &description)| ParameterSummary {
                 name,
-                symbol: crate::registry::display_name(name),
+                symbol: mechlab_runtime::registry::display_name(name),
                 default,
                 description,
             })
@@ -201,7 +200,7 @@ pub struct Derivation {
 /// The derivations a student reads first: L, H, the averaged H to each
 /// order, V_vibr and the effective potential, the equations of motion.
 pub fn derivations(catalog: Catalog, name: &str) -> Result<Vec<Derivation>, StudioError> {
-    let info = crate::registry::lookup(catalog, name)?.info;
+    let info = mechlab_runtime::registry::lookup(catalog, name)?.info;
     const SHOWN: [&str; 8] = [
         "lagrangian",
         "hamiltonian",
@@ -226,7 +225,7 @@ pub fn derivations(catalog: Catalog, name: &str) -> Result<Vec<Derivation>, Stud
         .map(|d| Derivation {
             key: d.key,
             description: d.description,
-            mathml: crate::mathml::mathml(d.latex, true),
+            mathml: mechlab_runtime::mathml::mathml(d.latex, true),
         })
         .collect())
 }
@@ -283,7 +282,7 @@ impl Setup {
         catalog: Catalog,
         unknown: &BTreeMap<String, serde_json::Value>,
     ) -> Result<Resolved, StudioError> {
-        let handle = crate::registry::lookup(catalog, &self.model)?;
+        let handle = mechlab_runtime::registry::lookup(catalog, &self.model)?;
         let (info, model) = (handle.info, handle.dynamic);
         if let Some(field) = unknown.keys().next() {
             return Err(StudioError::BadRequest {
@@ -430,7 +429,7 @@ pub struct OrbitEnd {
     /// The orbit's tunes, one per degree of freedom: the fundamental
     /// frequency of its iterates (q_j + i p_j less the mean, q_j + i q_j′
     /// on constraints, e^{i q_j} for a circulating angle) in turns per
-    /// period ([`crate::analysis::frequency_map::tunes`]); None for an
+    /// period ([`mechlab_runtime::analysis::frequency_map::tunes`]); None for an
     /// orbit of fewer than 64 iterates or cancelled.
     pub tunes: Option<Vec<f64>>,
 }
@@ -452,7 +451,7 @@ pub fn orbit(
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
 ) -> Result<OrbitEnd, StudioError> {
     let setup = request.check(catalog)?;
-    let systems = crate::analysis::flows(setup.handle)?;
+    let systems = mechlab_runtime::analysis::flows(setup.handle)?;
     // A constrained model's seed, on its constraints in the chart of the axes.
     let mut seed = request.seed.clone();
     systems
@@ -504,7 +503,7 @@ pub fn orbit(
         f_evals: integrator.stats.f_evals,
         seconds: started.elapsed().as_secs_f64(),
         tunes: (!cancelled && states.len() >= MIN_TUNE_ITERATES)
-            .then(|| crate::analysis::frequency_map::tunes(&states, &periodic).0),
+            .then(|| mechlab_runtime::analysis::frequency_map::tunes(&states, &periodic).0),
     };
     if let Err(error) = run {
         // The points before the failure are the page's to keep.
@@ -662,10 +661,10 @@ pub struct BasinsLevel {
     /// Each pixel's attractor (an index of `attractors`, −1: diverged),
     /// row-major from the lower left.
     pub labels: Vec<i32>,
-    pub attractors: Vec<crate::analysis::basins::Attractor>,
+    pub attractors: Vec<mechlab_runtime::analysis::basins::Attractor>,
     /// Each attractor's recorded iterates on the view's axes.
     pub points: Vec<Vec<[f64; 2]>>,
-    pub boundary: crate::analysis::basins::Boundary,
+    pub boundary: mechlab_runtime::analysis::basins::Boundary,
     pub seconds: f64,
 }
 
@@ -678,7 +677,7 @@ pub fn basins(
 ) -> Result<(), StudioError> {
     let (setup, ranges) = request.check(catalog)?;
     for &pixels in &request.levels {
-        let settings = crate::analysis::basins::BasinSettings {
+        let settings = mechlab_runtime::analysis::basins::BasinSettings {
             axes: setup.axes,
             ranges,
             through: Some(setup.through.clone()),
@@ -690,7 +689,12 @@ pub fn basins(
             stop_early: true,
             tiles: None,
         };
-        let map = crate::analysis::basins::basins(setup.handle, &setup.params, &settings, &|_| ())?;
+        let map = mechlab_runtime::analysis::basins::basins(
+            setup.handle,
+            &setup.params,
+            &settings,
+            &|_| (),
+        )?;
         let level = BasinsLevel {
             pixels,
             labels: map.labels,
@@ -783,7 +787,7 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
     };
     let field = contour::Field::sample(ranges, grid, value);
     let equilibria: Vec<EquilibriumMark> =
-        crate::analysis::equilibria::effective_equilibria(model, params)
+        mechlab_runtime::analysis::equilibria::effective_equilibria(model, params)
             .map(|(found, _)| found)
             .unwrap_or_default()
             .into_iter()
@@ -812,7 +816,7 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
                         .filter(|k| !setup.axes.contains(k))
                         .all(same),
                     point,
-                    stable: e.verdict == crate::analysis::equilibria::Verdict::Stable,
+                    stable: e.verdict == mechlab_runtime::analysis::equilibria::Verdict::Stable,
                     hessian_eigenvalues: e.hessian_eigenvalues,
                     q: e.q,
                 }
@@ -875,7 +879,7 @@ pub struct Manifolds {
 /// The manifolds of the hyperbolic fixed point of the model's period map
 /// (`analysis::separatrix`), for the studio's overlay.
 pub fn manifolds(catalog: Catalog, request: &ManifoldsRequest) -> Result<Manifolds, StudioError> {
-    use crate::analysis::separatrix::{separatrix_splitting, SplittingSettings};
+    use mechlab_runtime::analysis::separatrix::{separatrix_splitting, SplittingSettings};
     let setup = request.setup.resolve(catalog, &request.unknown)?;
     let settings = SplittingSettings {
         spacing: 0.03,
@@ -938,7 +942,7 @@ pub struct BranchLine {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct BifurcationMark {
-    pub kind: crate::analysis::continuation::BifurcationKind,
+    pub kind: mechlab_runtime::analysis::continuation::BifurcationKind,
     pub parameter: f64,
     pub at: [f64; 2],
     pub located: bool,
@@ -952,7 +956,7 @@ pub fn continuation(
     catalog: Catalog,
     request: &ContinuationRequest,
 ) -> Result<BranchesView, StudioError> {
-    use crate::analysis::continuation::{continuation, ContinuationSettings};
+    use mechlab_runtime::analysis::continuation::{continuation, ContinuationSettings};
     let setup = request.setup.resolve(catalog, &request.unknown)?;
     let components = setup.through.len();
     if request.seed.len() != components {
@@ -1067,16 +1071,18 @@ impl SectionPlane {
         coordinates: &[&str],
         crossings: usize,
         tol: f64,
-    ) -> Result<crate::analysis::section::SectionSettings, crate::analysis::section::SectionError>
-    {
+    ) -> Result<
+        mechlab_runtime::analysis::section::SectionSettings,
+        mechlab_runtime::analysis::section::SectionError,
+    > {
         let plane = match (&self.plane, self.coordinate) {
             (Some(text), _) if !text.trim().is_empty() => {
-                crate::analysis::section::parse_plane(text, coordinates)?
+                mechlab_runtime::analysis::section::parse_plane(text, coordinates)?
             }
             (_, 0) => [1.0, 0.0],
             _ => [0.0, 1.0],
         };
-        Ok(crate::analysis::section::SectionSettings {
+        Ok(mechlab_runtime::analysis::section::SectionSettings {
             plane,
             value: self.value,
             rising: self.rising,
@@ -1118,7 +1124,7 @@ pub struct SectionPoints {
     pub start: Vec<f64>,
     pub energy_drift: f64,
     /// Why the orbit ended (before its crossings: escaped, stopped, t_max).
-    pub end: crate::analysis::section::OrbitEnd,
+    pub end: mechlab_runtime::analysis::section::OrbitEnd,
     /// The same, in words, for the page.
     pub end_text: String,
 }
@@ -1131,8 +1137,12 @@ pub fn section(catalog: Catalog, request: &SectionRequest) -> Result<SectionPoin
     let settings = request
         .plane
         .settings(coordinates, crossings, setup_tol(&setup))?;
-    let mut found =
-        crate::analysis::section::section(setup.handle, &setup.params, &[request.seed], &settings)?;
+    let mut found = mechlab_runtime::analysis::section::section(
+        setup.handle,
+        &setup.params,
+        &[request.seed],
+        &settings,
+    )?;
     let orbit = found.orbits.remove(0);
     Ok(SectionPoints {
         axes: found.axes,
@@ -1177,7 +1187,7 @@ pub fn section_map(
     catalog: Catalog,
     request: &SectionMapRequest,
 ) -> Result<SectionMapView, StudioError> {
-    use crate::analysis::section_map::{section_map, SectionMapSettings};
+    use mechlab_runtime::analysis::section_map::{section_map, SectionMapSettings};
     let setup = request.setup.resolve(catalog, &request.unknown)?;
     let pixels = setup.count("pixels", request.pixels, MAX_CHAOS_PIXELS)?;
     if !(request.t_max > 0.0 && request.t_max <= 10_000.0) {
@@ -1252,11 +1262,11 @@ pub fn mechanism(
     if request.seed.iter().any(|x| !x.is_finite()) {
         return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
     }
-    let frames = crate::analysis::mechanism::Frames {
+    let frames = mechlab_runtime::analysis::mechanism::Frames {
         duration: request.duration,
         count: request.frames,
     };
-    let animation = crate::analysis::mechanism::animate(
+    let animation = mechlab_runtime::analysis::mechanism::animate(
         setup.handle,
         &setup.params,
         setup.method,
