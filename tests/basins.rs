@@ -335,3 +335,52 @@ fn the_shaken_pendulum_with_friction_hangs_or_stands_upright() {
     );
     assert_eq!(result.diverged, 0);
 }
+
+/// Kapitza's pendulum with weak friction (μ = 0.01) after a short
+/// transient: its orbits are still closing in on cycles (rotations among
+/// them). None is called quasi-periodic, and each called "not settled" is
+/// a cycle still being approached: its largest Lyapunov exponent, by the
+/// attractor analysis, is negative.
+#[test]
+fn a_cycle_still_being_approached_is_not_called_quasi_periodic() {
+    use mechlab::analysis::basins::{NOT_SETTLED, QUASI_PERIODIC};
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let mut grid = settings(32);
+    grid.ranges = [(-std::f64::consts::PI, std::f64::consts::PI), (-3.0, 3.0)];
+    grid.transient = 100;
+    grid.method = Method::Taylor { tol: 1e-8 };
+    let params = [1.5, 0.1, 0.01];
+    let result = basins(model, &params, &grid, &|_| ()).unwrap();
+    assert!(
+        result.attractors.iter().all(|a| a.kind != QUASI_PERIODIC),
+        "{:?}",
+        result.attractors
+    );
+    let unsettled: Vec<_> = result
+        .attractors
+        .iter()
+        .filter(|a| a.kind == NOT_SETTLED)
+        .collect();
+    assert!(!unsettled.is_empty(), "{:?}", result.attractors);
+    for a in unsettled {
+        let measured = attractor(
+            model,
+            &params,
+            &AttractorSettings {
+                method: Method::Taylor { tol: 1e-8 },
+                start: [a.representative[0], a.representative[1]],
+                transient: 0,
+                points: 100,
+                lyapunov_periods: 20_000,
+                pixels: 20,
+            },
+        )
+        .unwrap();
+        assert!(
+            measured.lyapunov[0] < -5.0 * measured.lyapunov_error[0],
+            "{a:?}: {:?} ± {:?}",
+            measured.lyapunov,
+            measured.lyapunov_error
+        );
+    }
+}

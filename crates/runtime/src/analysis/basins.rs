@@ -11,7 +11,7 @@ use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec};
-use crate::registry::{within, Cells, KnownAttractors, Model, Recording};
+use crate::registry::{distance, within, Cells, KnownAttractors, Model, Recording};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -60,6 +60,12 @@ pub const NOT_SETTLED: &str = "not settled";
 /// How many periods the representative of an aperiodic attractor runs to
 /// find the other pieces of its set.
 const EXTENSION: usize = 4096;
+
+/// How far a run's start is moved to see whether nearby orbits close in
+/// on it, and the e-folds of closing in over [`EXTENSION`] periods that
+/// mark a cycle still being approached (not a torus).
+const NUDGE: f64 = 1e-6;
+const CLOSING: f64 = 5.0;
 
 /// The label of a start whose orbit diverged or left the model's domain.
 pub const DIVERGED: i32 = -1;
@@ -320,8 +326,11 @@ impl Grid<'_> {
     /// start says so by the chaos maps' criterion (FLI > 2 ln N: a positive
     /// Lyapunov exponent); else quasi-periodic when its frequencies keep
     /// between its halves (a diffusion index below the frequency maps'
-    /// regular one) and its last quarter spans at least half of what the
-    /// quarter before it does; else [`NOT_SETTLED`]. None: the run stopped.
+    /// regular one) and the run from its start moved by [`NUDGE`] ends
+    /// less than [`CLOSING`] e-folds closer to it (an attracting torus
+    /// keeps the nudge along it; a cycle still being approached, of any
+    /// period, draws nearby orbits in); else [`NOT_SETTLED`]. None: the
+    /// run stopped.
     fn kinds_of_runs(
         &self,
         starts: &[f64],
@@ -338,10 +347,28 @@ impl Grid<'_> {
             EXTENSION,
             &self.settings.axes,
         )?;
+        // Each run again from its start moved by NUDGE: where it ends
+        // against the run tells whether nearby orbits close in.
+        let nudged: Vec<f64> = starts.iter().map(|x| x + NUDGE).collect();
+        let last = Recording {
+            transient: EXTENSION - 1,
+            record: 1,
+            settle: None,
+            known: None,
+            done: &|_| (),
+        };
+        let ends = self.flows.iterates(
+            self.params,
+            self.settings.method,
+            self.period,
+            &nudged,
+            &last,
+        )?;
         Ok(runs
             .iter()
             .zip(fli)
-            .map(|(run, fli)| {
+            .zip(ends)
+            .map(|((run, fli), end)| {
                 let run = run.as_ref()?;
                 let tail: Vec<Vec<f64>> = (run[run.len() / 2..].iter())
                     .map(|y| wrapped(y, &self.wrap))
@@ -354,24 +381,12 @@ impl Grid<'_> {
                     return Some(CHAOTIC.into());
                 }
                 // Quasi-periodic only on evidence: its frequencies keep
-                // (NAFF) and it keeps its extent (a cycle still being
-                // approached shrinks towards it).
+                // (NAFF), and a nudged orbit does not close in on it (on
+                // an attracting torus the nudge along it stays; towards a
+                // cycle still being approached, of any period, it dies).
                 let (_, index) = super::frequency_map::tunes(run, &self.wrap);
-                let quarter = run.len() / 4;
-                let extent = |part: &[Vec<f64>]| {
-                    (0..self.wrap.len())
-                        .map(|j| {
-                            let (lo, hi) = part
-                                .iter()
-                                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
-                                    (a.min(y[j]), b.max(y[j]))
-                                });
-                            hi - lo
-                        })
-                        .fold(0.0, f64::max)
-                };
-                let keeps =
-                    extent(&run[3 * quarter..]) > 0.5 * extent(&run[2 * quarter..3 * quarter]);
+                let apart = distance(end?.last()?, &run[run.len() - 1], &self.wrap);
+                let keeps = apart > NUDGE * (-CLOSING).exp();
                 let regular = index < super::frequency_map::REGULAR_INDEX;
                 Some(
                     if regular && keeps {

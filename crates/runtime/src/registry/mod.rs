@@ -7,7 +7,7 @@ mod constrained;
 mod recording;
 pub use constrained::{Constrained, ConstrainedSystems};
 use recording::Recorder;
-pub use recording::{within, Cells, KnownAttractors, Recording};
+pub use recording::{distance, within, Cells, KnownAttractors, Recording};
 
 use crate::ode::any_size::fixed_state;
 use crate::ode::{AnySystem, DynSystem, ErasedSystem, Method, OdeError, SizedSystem, Stats};

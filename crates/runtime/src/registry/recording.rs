@@ -116,18 +116,23 @@ impl KnownAttractors {
     }
 }
 
+/// The largest difference of the states' components (the angles `wrap`
+/// modulo 2π).
+pub fn distance(a: &[f64], b: &[f64], wrap: &[bool]) -> f64 {
+    a.iter()
+        .zip(b)
+        .zip(wrap)
+        .map(|((x, y), &angle)| match angle {
+            true => crate::analysis::period_map::wrap_angle(x - y).abs(),
+            false => (x - y).abs(),
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Whether the states `a` and `b` differ by at most `tolerance` in every
 /// component (the angles `wrap` modulo 2π).
 pub fn within(a: &[f64], b: &[f64], wrap: &[bool], tolerance: f64) -> bool {
-    a.iter().zip(b).zip(wrap).all(|((x, y), &angle)| {
-        let d = x - y;
-        let d = if angle {
-            crate::analysis::period_map::wrap_angle(d)
-        } else {
-            d
-        };
-        d.abs() <= tolerance
-    })
+    distance(a, b, wrap) <= tolerance
 }
 
 /// One orbit's record as it runs.
