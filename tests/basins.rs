@@ -9,6 +9,31 @@ use mechlab::analysis::basins::{basins, BasinSettings, Boundary, CHAOTIC, DIVERG
 use mechlab::models::duffing;
 use mechlab::ode::{Integrator, Method};
 
+/// The largest Lyapunov exponent of the period map from an attractor's
+/// representative and its error, by the attractor analysis (tolerance,
+/// transient, periods of each Lyapunov run).
+fn largest_exponent(
+    model: &mechlab::registry::Model,
+    params: &[f64],
+    a: &mechlab::analysis::basins::Attractor,
+    (tol, transient, periods): (f64, usize, usize),
+) -> (f64, f64) {
+    let measured = attractor(
+        model,
+        params,
+        &AttractorSettings {
+            method: Method::Taylor { tol },
+            start: [a.representative[0], a.representative[1]],
+            transient,
+            points: 100,
+            lyapunov_periods: periods,
+            pixels: 20,
+        },
+    )
+    .unwrap();
+    (measured.lyapunov[0], measured.lyapunov_error[0])
+}
+
 fn settings(pixels: usize) -> BasinSettings {
     BasinSettings {
         axes: [0, 1],
@@ -276,25 +301,8 @@ fn attractors_are_told_apart_by_their_longer_runs() {
         .collect();
     assert!(!chaotic.is_empty(), "{:?}", result.attractors);
     for a in chaotic {
-        let measured = attractor(
-            model,
-            &params,
-            &AttractorSettings {
-                method: Method::Taylor { tol: 1e-10 },
-                start: [a.representative[0], a.representative[1]],
-                transient: 100,
-                points: 1000,
-                lyapunov_periods: 4000,
-                pixels: 50,
-            },
-        )
-        .unwrap();
-        assert!(
-            measured.lyapunov[0] > 10.0 * measured.lyapunov_error[0],
-            "{a:?}: {:?} ± {:?}",
-            measured.lyapunov,
-            measured.lyapunov_error
-        );
+        let (lambda, error) = largest_exponent(model, &params, a, (1e-10, 100, 4000));
+        assert!(lambda > 10.0 * error, "{a:?}: {lambda} ± {error}");
     }
 }
 
@@ -363,24 +371,7 @@ fn a_cycle_still_being_approached_is_not_called_quasi_periodic() {
         .collect();
     assert!(!unsettled.is_empty(), "{:?}", result.attractors);
     for a in unsettled {
-        let measured = attractor(
-            model,
-            &params,
-            &AttractorSettings {
-                method: Method::Taylor { tol: 1e-8 },
-                start: [a.representative[0], a.representative[1]],
-                transient: 0,
-                points: 100,
-                lyapunov_periods: 20_000,
-                pixels: 20,
-            },
-        )
-        .unwrap();
-        assert!(
-            measured.lyapunov[0] < -5.0 * measured.lyapunov_error[0],
-            "{a:?}: {:?} ± {:?}",
-            measured.lyapunov,
-            measured.lyapunov_error
-        );
+        let (lambda, error) = largest_exponent(model, &params, a, (1e-8, 0, 20_000));
+        assert!(lambda < -5.0 * error, "{a:?}: {lambda} ± {error}");
     }
 }
