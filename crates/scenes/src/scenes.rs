@@ -110,14 +110,7 @@ pub fn chaos_map_scene(
         "FLI chaos map of the period map of any model",
         overrides,
         ("kapitza", "taylor", "1e-6"),
-        &[
-            plane_knobs(("300", "180")),
-            vec![
-                ("tile_rows", "10", "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
-                ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the map"),
-            ],
-        ]
-        .concat(),
+        &[plane_knobs(("300", "180")), tile_knobs("10").to_vec()].concat(),
     )?;
     let info = model.info;
     let settings = ChaosMapSettings {
@@ -248,6 +241,15 @@ fn share_tiles(
     sharing.run(count, &|share| sweep(Some(share)).map(|_| ()), &|| {
         sweep(None).map(|_| ())
     })
+}
+
+/// The knobs `tile_rows` (default `rows`; 0: no tiles) and `only_tiles`
+/// of a tiled sweep, read by [`tiles_from`].
+fn tile_knobs(rows: &'static str) -> [(&'static str, &'static str, &'static str); 2] {
+    [
+        ("tile_rows", rows, "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
+        ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the result"),
+    ]
 }
 
 /// The tiles of the knobs `size` (rows or columns per tile, 0 for none)
@@ -576,9 +578,10 @@ pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Resu
                 "0.05",
                 "the side of the state-space cells that identify attractors",
             ),
-            ("tile_rows", "0", "rows of starts per tile, each written to out/basins.tiles/ when done so a rerun resumes (0: no tiles)"),
-            ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the basins"),
-        ],
+        ]
+        .into_iter()
+        .chain(tile_knobs("0"))
+        .collect::<Vec<_>>(),
     )?;
     let range = |name: &str| -> Result<(f64, f64), SceneError> {
         match scene.numbers(name)?[..] {

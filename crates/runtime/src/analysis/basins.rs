@@ -223,11 +223,10 @@ impl Grid<'_> {
     /// The start of pixel k (row-major, row 0 at the bottom), put on a
     /// constrained model's constraints; None where the model has no state.
     fn start(&self, k: usize) -> Option<Vec<f64>> {
-        let (settings, n) = (self.settings, self.settings.pixels);
-        let at = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / n as f64;
+        let settings = self.settings;
         let mut y = self.base.clone();
-        y[settings.axes[0]] = at(settings.ranges[0], k % n);
-        y[settings.axes[1]] = at(settings.ranges[1], k / n);
+        (y[settings.axes[0]], y[settings.axes[1]]) =
+            super::chaos_map::pixel_centre(&settings.ranges, settings.pixels, k);
         self.flows
             .consistent(self.params, &mut y, &settings.axes)
             .ok()
@@ -370,10 +369,9 @@ impl Grid<'_> {
             .zip(ends)
             .map(|((run, fli), end)| {
                 let run = run.as_ref()?;
-                let tail: Vec<Vec<f64>> = (run[run.len() / 2..].iter())
-                    .map(|y| wrapped(y, &self.wrap))
-                    .collect();
-                let cycle = kind_of(&tail, &self.wrap, self.settings.cell * 1e-6);
+                // (kind_of compares angles modulo 2π: no wrapping needed.)
+                let tail = &run[run.len() / 2..];
+                let cycle = kind_of(tail, &self.wrap, self.settings.cell * 1e-6);
                 if cycle != APERIODIC {
                     return Some(cycle);
                 }
