@@ -49,30 +49,33 @@ fn a_point_on_a_vibrating_rod_moves_as_kapitzas_pendulum() {
         ];
         let model = &cartesian_kapitza::SYSTEMS;
         let params = [a, eps, mu];
-        let points = run(model, &params, Some(&y0), TIGHT, &times).unwrap();
-        let mut worst: f64 = 0.0;
-        for ((t, angle), point) in times.iter().zip(&angles).zip(&points.states) {
-            let (yp, vp, ap) = pivot(a, eps, *t);
-            let q = point[0].atan2(point[1] - yp);
-            let dq = (q - angle[0] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                - std::f64::consts::PI;
-            worst = worst.max(dq.abs());
-            // The rod's force on the bob, N = 2λ (x, y − y_p) for the
-            // constraint x² + (y − y_p)² − 1: along the rod, Newton in the
-            // pivot's frame gives N·e = (1 + ÿ_p) cos q − q'².
-            let qd = angle[1] + vp * angle[0].sin();
-            let lambda = model.reactions(&params, *t, point).unwrap()[0];
-            let by_hand = 0.5 * ((1.0 + ap) * angle[0].cos() - qd * qd);
+        for method in [TIGHT, Method::Taylor { tol: 1e-15 }] {
+            let points = run(model, &params, Some(&y0), method, &times).unwrap();
+            let mut worst: f64 = 0.0;
+            for ((t, angle), point) in times.iter().zip(&angles).zip(&points.states) {
+                let (yp, vp, ap) = pivot(a, eps, *t);
+                let q = point[0].atan2(point[1] - yp);
+                let dq = (q - angle[0] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+                worst = worst.max(dq.abs());
+                // The rod's force on the bob, N = 2λ (x, y − y_p) for the
+                // constraint x² + (y − y_p)² − 1: along the rod, Newton in the
+                // pivot's frame gives N·e = (1 + ÿ_p) cos q − q'².
+                let qd = angle[1] + vp * angle[0].sin();
+                let lambda = model.reactions(&params, *t, point).unwrap()[0];
+                let by_hand = 0.5 * ((1.0 + ap) * angle[0].cos() - qd * qd);
+                assert!(
+                    (lambda - by_hand).abs() < 1e-8 * (1.0 + by_hand.abs()),
+                    "A = {a}, t = {t}: λ = {lambda}, by hand {by_hand}"
+                );
+            }
             assert!(
-                (lambda - by_hand).abs() < 1e-8 * (1.0 + by_hand.abs()),
-                "A = {a}, t = {t}: λ = {lambda}, by hand {by_hand}"
+                worst < 1e-10,
+                "{}, A = {a}, μ = {mu}: angles differ by {worst:e}",
+                method.name()
             );
+            assert!(points.largest_residual.0 < 1e-13 && points.largest_residual.1 < 1e-13);
         }
-        assert!(
-            worst < 1e-10,
-            "A = {a}, μ = {mu}: angles differ by {worst:e}"
-        );
-        assert!(points.largest_residual.0 < 1e-13 && points.largest_residual.1 < 1e-13);
     }
 }
 
@@ -520,16 +523,19 @@ fn fli_on_the_constraints_grows_with_the_largest_multiplier() {
         "below the threshold the upright is hyperbolic: {largest}"
     );
     let periods = 40;
-    let (values, _) = model
-        .fli(&params, TIGHT, period, &upright, &[0.5; 4], periods, &[])
-        .unwrap();
-    let fli = values[0].clone().unwrap();
-    let rate = fli / periods as f64;
-    assert!(
-        (rate - largest.ln()).abs() < 0.05,
-        "FLI/N = {rate}, ln μ = {}",
-        largest.ln()
-    );
+    for method in [TIGHT, Method::Taylor { tol: 1e-13 }] {
+        let (values, _) = model
+            .fli(&params, method, period, &upright, &[0.5; 4], periods, &[])
+            .unwrap();
+        let fli = values[0].clone().unwrap();
+        let rate = fli / periods as f64;
+        assert!(
+            (rate - largest.ln()).abs() < 0.05,
+            "{}: FLI/N = {rate}, ln μ = {}",
+            method.name(),
+            largest.ln()
+        );
+    }
 }
 
 /// The averaged motion on the constraints (`averaged_states`, the mean
@@ -572,28 +578,82 @@ fn the_averaged_motion_on_the_constraints_is_the_exact_ones_limit() {
     }
 }
 
-/// The Taylor method, the scenes' default, is refused by name for a
-/// constrained model (one refusal, not every orbit stopped).
+/// The Taylor method's recurrences through the Schur complement, in the
+/// batch lanes: the four-bar's period map from 20 seeds (more than a batch
+/// holds, so lanes are refilled), projected at every period, equals
+/// DOP853's at tight tolerance to 1e-9 and each orbit run alone by the
+/// scalar Taylor method to round-off, on the constraints to 1e-12.
 #[test]
-fn the_taylor_method_is_refused_for_a_constrained_model() {
-    use mechlab::analysis::period_map::{portrait, PeriodMapError, PortraitSettings};
-    let settings = PortraitSettings {
-        axes: [0, 3],
-        seeds: None,
-        count: 2,
-        p_max: 0.1,
-        periods: 3,
-        method: Method::Taylor { tol: 1e-10 },
+fn the_taylor_method_runs_the_period_map_on_the_constraints_in_lanes() {
+    use mechlab::registry::Recording;
+    let model = mechlab::models::four_bar::MODEL.constrained.unwrap();
+    let params = mechlab::models::four_bar::Params::default().values();
+    let period = model.phase_period(&params).unwrap();
+    let mut starts = Vec::new();
+    for k in 0..20 {
+        let mut y0 = model.start(&params);
+        y0[3] = 0.04 * k as f64;
+        model.project(&params, 0.0, &mut y0).unwrap();
+        starts.extend(y0);
+    }
+    let recording = Recording {
+        transient: 0,
+        record: 50,
+        settle: None,
+        known: None,
+        done: &|_| {},
     };
-    let model = mechlab::models::by_name("four_bar").unwrap();
-    let error = portrait(model, &model.dynamic.defaults(), &settings).unwrap_err();
-    assert!(
-        matches!(
-            error,
-            PeriodMapError::Refused(mechlab::analysis::Refusal::Setting { .. })
-        ) && error.to_string().contains("dop853"),
-        "{error}"
-    );
+    // Components apart, angles (the first three) modulo 2π.
+    let apart = |a: &[f64], b: &[f64], i: usize| {
+        let d = a[i] - b[i];
+        match i < 3 {
+            true => {
+                (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+            }
+            false => d,
+        }
+        .abs()
+    };
+    let taylor = Method::Taylor { tol: 1e-15 };
+    let in_lanes = model
+        .iterates(&params, taylor, period, &starts, &recording)
+        .unwrap();
+    let by_dop853 = model
+        .iterates(&params, TIGHT, period, &starts, &recording)
+        .unwrap();
+    let system = model.exact(&params);
+    for (k, y0) in starts.chunks(6).enumerate() {
+        let (lanes, dop853) = (
+            in_lanes[k].as_ref().unwrap(),
+            by_dop853[k].as_ref().unwrap(),
+        );
+        let mut integrator = mechlab::ode::Integrator::new(taylor).unwrap();
+        let mut alone = Vec::new();
+        system
+            .stream(&mut integrator, y0, period, 50, &mut |y| {
+                alone.push(y.to_vec());
+                true
+            })
+            .unwrap();
+        for (n, ((a, b), c)) in lanes.iter().zip(dop853).zip(&alone).enumerate() {
+            let t = (n + 1) as f64 * period;
+            let (g, v) = model.residuals(&params, t, a).unwrap();
+            assert!(
+                g <= 1e-12 && v <= 1e-12,
+                "seed {k}, period {n}: residuals {g:e}, {v:e}"
+            );
+            for i in 0..6 {
+                assert!(
+                    apart(a, b, i) < 1e-9,
+                    "seed {k}, period {n}: {a:?} against DOP853 {b:?}"
+                );
+                assert!(
+                    apart(a, c, i) < 1e-13,
+                    "seed {k}, period {n}: lanes {a:?}, alone {c:?}"
+                );
+            }
+        }
+    }
 }
 
 fn continuation_settings(parameter: &str, to: f64, start: &[f64]) -> ContinuationSettings {

@@ -69,7 +69,8 @@ fn batch_fli_equals_the_scalar_fli_for_every_orbit() {
     let starts: Vec<[f64; 4]> = (0..13).map(spread).collect();
     let w0 = [0.5; 4];
     let mut batch = LaneIntegrator::new(TAYLOR).unwrap();
-    let values = fast_lyapunov_indicators::<_, 4, 8>(&mut batch, &system, period, &starts, &w0, 20);
+    let values =
+        fast_lyapunov_indicators::<_, 4, 8>(&mut batch, &system, period, &starts, &[w0], 20);
     let mut scalar = Integrator::new(TAYLOR).unwrap();
     for (start, value) in starts.iter().zip(values) {
         let expected =

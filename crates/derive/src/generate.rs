@@ -5,6 +5,7 @@ use crate::algebra::Derived;
 use crate::constraints::ConstrainedDerivation;
 use crate::contacts::ContactDerivation;
 use crate::derive::Derivation;
+use crate::emit::Step;
 use crate::error::DeriveError;
 use crate::functions::{matrix, named, symbolic_functions, vector, Context, Inputs};
 use crate::model::Model;
@@ -467,6 +468,96 @@ fn constrained_functions(
     Ok(functions)
 }
 
+/// The Taylor recurrences of the equations on the constraints, y = [q; q']:
+/// the same Schur complement as the runtime's, as two solves of the DAG,
+/// M [x_F, x_G] = [F, Gᵀ] and (G x_G) λ = −h − G x_F, then
+/// q'' = x_F + x_G λ. Their recurrences solve with the factors of order 0
+/// at every order (`crates/derive/src/taylor.rs`), so a step costs what
+/// the model's size asks and no inverse is formed.
+fn constrained_taylor(
+    cx: &Context,
+    derivation: &ConstrainedDerivation,
+) -> Result<crate::functions::TaylorFunction, DeriveError> {
+    use crate::numeric::{dot, names, upper};
+    let n = cx.n();
+    let k = derivation.jacobian.len();
+    let free: Vec<String> = (0..n).map(|i| format!("free__{i}")).collect();
+    let rows: Vec<Vec<String>> = (0..k)
+        .map(|r| (0..n).map(|i| format!("jac__{r}_{i}")).collect())
+        .collect();
+    let solved_free: Vec<String> = (0..n).map(|i| format!("solved_free__{i}")).collect();
+    let solved_rows: Vec<Vec<String>> = (0..k)
+        .map(|r| (0..n).map(|i| format!("solved_row{r}__{i}")).collect())
+        .collect();
+    let mut forms = upper("mass", &derivation.mass_matrix);
+    forms.extend(named("free", &derivation.free_forces));
+    forms.extend(matrix("jac", &derivation.jacobian).0);
+    forms.extend(named("bias", &derivation.bias));
+    let mut columns = vec![free];
+    columns.extend(rows.iter().cloned());
+    let mut solutions = vec![solved_free.clone()];
+    solutions.extend(solved_rows.iter().cloned());
+    let schur: Vec<Vec<String>> = (0..k)
+        .map(|r| (0..k).map(|c| dot(&rows[r], &solved_rows[c])).collect())
+        .collect();
+    let mut reduced = upper("schur", &schur);
+    reduced.extend((0..k).map(|r| {
+        (
+            format!("reduced__{r}"),
+            format!("-bias__{r}-{}", dot(&rows[r], &solved_free)),
+        )
+    }));
+    let lambda: Vec<String> = (0..k).map(|r| format!("lambda__{r}")).collect();
+    let accelerations: Vec<(String, String)> = (0..n)
+        .map(|i| {
+            let column: Vec<String> = (0..k).map(|r| solved_rows[r][i].clone()).collect();
+            let reaction = if k == 0 {
+                "0".to_string()
+            } else {
+                dot(&column, &lambda)
+            };
+            (
+                format!("acceleration__{i}"),
+                format!("{}+{reaction}", solved_free[i]),
+            )
+        })
+        .collect();
+    // q' = the velocities, as outputs of their own (the recurrences read
+    // outputs, and a state variable is not one).
+    let mut rates: Vec<(String, String)> = cx
+        .velocities()
+        .into_iter()
+        .enumerate()
+        .map(|(i, v)| (format!("coordinate_rate__{i}"), v))
+        .collect();
+    rates.extend(accelerations);
+    let outputs: Vec<String> = rates.iter().map(|(name, _)| name.clone()).collect();
+    let steps = [
+        Step::Values(forms),
+        Step::Solve {
+            matrix: names("mass", n),
+            columns,
+            names: solutions,
+        },
+        Step::Values(reduced),
+        Step::Solve {
+            matrix: names("schur", k),
+            columns: vec![(0..k).map(|r| format!("reduced__{r}")).collect()],
+            names: vec![lambda],
+        },
+        Step::Values(rates),
+    ];
+    let mut state = cx.coordinates();
+    state.extend(cx.velocities());
+    cx.taylor_steps(
+        "exact_taylor",
+        "Normalised Taylor coefficients out[k] = y^(k)(t)/k!, k = 0..=order, of the motion on the constraints through (t, y), y = [q; q']: M q'' = F + Gᵀλ with G q'' + h = 0, by the Schur complement.",
+        &steps,
+        &outputs,
+        state,
+    )
+}
+
 /// Renders the generated module of a model with ideal constraints.
 pub fn render_constrained(
     tera: &tera::Tera,
@@ -480,10 +571,11 @@ pub fn render_constrained(
         model,
         n,
         contact_state: Vec::new(),
-        model_phase_rate: String::new(),
+        model_phase_rate: derivation.phase_rate.clone().unwrap_or_default(),
     };
     let mut functions = constrained_functions(&cx, derivation)?;
     functions.extend(crate::functions::drawing_function(&cx)?);
+    let taylor_functions = vec![constrained_taylor(&cx, derivation)?];
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);
     context.insert("constraints", &k);
@@ -506,6 +598,8 @@ pub fn render_constrained(
     context.insert("has_phase", &derivation.phase_rate.is_some());
     context.insert("stationary", &derivation.stationary);
     context.insert("functions", &functions);
+    context.insert("taylor_functions", &taylor_functions);
+    context.insert("tangents_by_dual_numbers", &true);
     tera.render("constrained_model.rs.tera", &context)
         .map_err(|source| DeriveError::Template {
             template: "constrained_model.rs.tera",

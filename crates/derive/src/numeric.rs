@@ -37,7 +37,7 @@ fn entry(prefix: &str, i: usize, j: usize) -> String {
 }
 
 /// The upper triangle of a symmetric matrix as named outputs.
-fn upper(prefix: &str, m: &[Vec<String>]) -> Vec<(String, String)> {
+pub(crate) fn upper(prefix: &str, m: &[Vec<String>]) -> Vec<(String, String)> {
     let n = m.len();
     (0..n)
         .flat_map(|i| (i..n).map(move |j| (i, j)))
@@ -46,14 +46,14 @@ fn upper(prefix: &str, m: &[Vec<String>]) -> Vec<(String, String)> {
 }
 
 /// The full matrix of names of a symmetric matrix.
-fn names(prefix: &str, n: usize) -> Vec<Vec<String>> {
+pub(crate) fn names(prefix: &str, n: usize) -> Vec<Vec<String>> {
     (0..n)
         .map(|i| (0..n).map(|j| entry(prefix, i, j)).collect())
         .collect()
 }
 
 /// Σ_i x_i·y_i as text.
-fn dot(x: &[String], y: &[String]) -> String {
+pub(crate) fn dot(x: &[String], y: &[String]) -> String {
     let terms: Vec<String> = x.iter().zip(y).map(|(a, b)| format!("{a}*{b}")).collect();
     format!("({})", terms.join("+"))
 }

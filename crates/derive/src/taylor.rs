@@ -929,7 +929,12 @@ impl Writer<'_> {
     /// array; parameters are `Num` already).
     fn value_num(&self, k: usize) -> String {
         if self.is_literal(k) {
-            format!("Num::from({})", self.value(k))
+            let value = self.value(k);
+            let bare = value
+                .strip_prefix('(')
+                .and_then(|v| v.strip_suffix(')'))
+                .unwrap_or(&value);
+            format!("Num::from({bare})")
         } else {
             self.value(k)
         }

@@ -117,21 +117,6 @@ pub fn flows(
         .ok_or_else(|| Refusal::contact_model(model.info.name))
 }
 
-/// Refuses the Taylor method for a constrained model, whose recurrences are
-/// not generated yet (one refusal instead of every orbit stopping).
-pub(crate) fn method_applies(
-    model: &crate::registry::Model,
-    method: crate::ode::Method,
-) -> Result<(), Refusal> {
-    match (model.constrained, method) {
-        (Some(_), crate::ode::Method::Taylor { .. }) => Err(Refusal::Setting {
-            model: model.info.name.into(),
-            requirement: "a constrained model runs with dop853, radau5, gauss4, gauss6 or rk4 (its Taylor recurrences are not generated yet): set method",
-        }),
-        _ => Ok(()),
-    }
-}
-
 impl Refusal {
     pub fn contact_model(model: impl Into<String>) -> Refusal {
         Refusal::ContactModel {

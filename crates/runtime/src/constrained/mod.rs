@@ -24,7 +24,8 @@ use crate::linalg::Cholesky;
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{ConstraintError, Holonomic, Projection};
 use crate::ode::{
-    AnyOptions, AnySolution, AnySystem, Dual, Integrator, OdeError, Scalar, SizedSystem, System,
+    AnyOptions, AnySolution, AnySystem, Dual, Integrator, Lanes, OdeError, Scalar, SizedSystem,
+    System, TaylorWork, LANES,
 };
 
 /// What a generated constrained model gives at its own sizes (N
@@ -69,6 +70,44 @@ pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send +
     fn constraint_jacobian_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; K];
     fn constraint_rates_dual(&self, t: f64, q: &[Dual; N]) -> [Dual; K];
     fn constraint_bias_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; K];
+    /// The generated Taylor recurrences of the motion on the constraints
+    /// through (t, y), y = [q; q'] of length S = 2N (false for another S).
+    fn taylor<Num: Scalar, const S: usize>(
+        &self,
+        t: Num,
+        y: &[Num; S],
+        order: usize,
+        work: &mut TaylorWork<Num>,
+        out: &mut [[Num; S]],
+    ) -> bool;
+    /// [`ConstraintForms::taylor`] for a batch, lane l with `lanes[l]`'s
+    /// parameters.
+    fn taylor_lanes<const S: usize>(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        y: &[Lanes; S],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [[Lanes; S]],
+    ) -> bool;
+    /// The recurrences with tangent vectors, z = [y; V] (see
+    /// [`System::taylor_variational`]).
+    fn taylor_variational<Num: Scalar>(
+        &self,
+        t: Num,
+        z: &[Num],
+        order: usize,
+        work: &mut TaylorWork<Num>,
+        out: &mut [Num],
+    ) -> bool;
+    /// The same for a batch, lane by lane.
+    fn taylor_variational_lanes(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        z: &[Lanes],
+        order: usize,
+        out: &mut [Lanes],
+    ) -> bool;
 }
 
 /// q'' and λ of M q'' = F + Gᵀλ, G q'' + h = 0 by the Schur complement:
@@ -196,6 +235,54 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
             }
         }
         Some(jacobian)
+    }
+
+    #[inline]
+    fn taylor<Num: Scalar>(
+        &self,
+        t: Num,
+        y: &[Num; S],
+        order: usize,
+        work: &mut TaylorWork<Num>,
+        out: &mut [[Num; S]],
+    ) -> bool {
+        self.0.taylor(t, y, order, work, out)
+    }
+
+    #[inline]
+    fn taylor_lanes(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        y: &[Lanes; S],
+        order: usize,
+        work: &mut TaylorWork<Lanes>,
+        out: &mut [[Lanes; S]],
+    ) -> bool {
+        F::taylor_lanes(lanes.map(|system| &system.0), t, y, order, work, out)
+    }
+
+    #[inline]
+    fn taylor_variational<Num: Scalar>(
+        &self,
+        t: Num,
+        z: &[Num],
+        order: usize,
+        work: &mut TaylorWork<Num>,
+        out: &mut [Num],
+    ) -> bool {
+        self.0.taylor_variational(t, z, order, work, out)
+    }
+
+    #[inline]
+    fn taylor_variational_lanes(
+        lanes: [&Self; LANES],
+        t: Lanes,
+        z: &[Lanes],
+        order: usize,
+        _work: &mut TaylorWork<Lanes>,
+        out: &mut [Lanes],
+    ) -> bool {
+        F::taylor_variational_lanes(lanes.map(|system| &system.0), t, z, order, out)
     }
 }
 

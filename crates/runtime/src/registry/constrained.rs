@@ -7,12 +7,13 @@ use std::marker::PhantomData;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{FliValues, Flows, ModelInfo};
+use super::recording::{Recorder, Recording};
+use super::{iterates_one_by_one, FliValues, Flows, ModelInfo};
 use crate::constrained::averaged::{AveragedOnConstraints, PhaseMeans};
 use crate::constrained::{ConstraintForms, OnConstraints, Projecting, Statics};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
-use crate::ode::{states_at, AnySystem, Dual, Integrator, Method, OdeError};
+use crate::ode::{states_at, AnySystem, Dual, Integrator, LaneIntegrator, Method, OdeError, Orbit};
 use crate::tangent::lyapunov::fli_of_starts;
 use crate::tangent::variational::Variational;
 
@@ -151,29 +152,96 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
     ) -> Result<FliValues, OdeError> {
         let system = Self::equations(params);
         let w0 = DVector::from_column_slice(&fixed_state::<S>(w0)?);
-        let (mut values, mut f_evals) = (Vec::new(), 0);
+        // Each start on the constraints with its tangent vector on their
+        // tangent space, or None where the plane's point has no state.
+        let mut on_manifold = Vec::new();
         for start in starts.chunks(S) {
             let mut y = fixed_state::<S>(start)?;
             let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(&y);
             let on = project_holding(&system, 0.0, &mut y, tolerance, held).ok();
             let basis = on.and_then(|_| tangent_basis(&system.state_constraints_jacobian(0.0, &y)));
-            let Some(basis) = basis else {
-                values.push(Ok(f64::NAN));
-                continue;
-            };
-            // w0 on the tangent space (its first direction if w0 is normal to it).
-            let mut w = &basis * (basis.transpose() * &w0);
-            if w.norm() < 1e-8 * w0.norm() {
-                w = basis.column(0).into_owned();
-            }
-            let w = w.normalize();
-            let w: [f64; S] = std::array::from_fn(|i| w[i]);
-            let (value, spent) =
-                fli_of_starts::<_, S, T>(&system, method, period, &[y], &w, periods)?;
-            values.extend(value);
-            f_evals += spent;
+            on_manifold.push(basis.map(|basis| {
+                // w0 on the tangent space (its first direction if w0 is normal to it).
+                let mut w = &basis * (basis.transpose() * &w0);
+                if w.norm() < 1e-8 * w0.norm() {
+                    w = basis.column(0).into_owned();
+                }
+                let w = w.normalize();
+                (y, std::array::from_fn(|i| w[i]))
+            }));
         }
+        let (states, tangents): (Vec<[f64; S]>, Vec<[f64; S]>) =
+            on_manifold.iter().flatten().copied().unzip();
+        let (mut computed, f_evals) =
+            fli_of_starts::<_, S, T>(&system, method, period, &states, &tangents, periods)?;
+        let mut computed = computed.drain(..);
+        let values = on_manifold
+            .iter()
+            .map(|on| match on {
+                Some(_) => computed
+                    .next()
+                    .expect("one value per state on the constraints"),
+                None => Ok(f64::NAN),
+            })
+            .collect();
         Ok((values, f_evals))
+    }
+    /// With the Taylor method, in the batch lanes, each state projected
+    /// onto the constraints at every period's end as [`Projecting`]'s
+    /// stream does (an orbit whose projection fails stops, None).
+    fn iterates(
+        &self,
+        params: &[f64],
+        method: Method,
+        period: f64,
+        starts: &[f64],
+        recording: &Recording,
+    ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
+        use rayon::prelude::*;
+        let wrap = Flows::periodic_state(self);
+        if !matches!(method, Method::Taylor { .. }) {
+            let system = Flows::exact(self, params);
+            return iterates_one_by_one(&*system, method, period, starts, recording, &wrap);
+        }
+        let starts: Vec<[f64; S]> = starts
+            .chunks(S)
+            .map(fixed_state::<S>)
+            .collect::<Result<_, _>>()?;
+        let system = Self::equations(params);
+        LaneIntegrator::new(method)?;
+        let blocks: Vec<Vec<Option<Vec<Vec<f64>>>>> = starts
+            .par_chunks(256)
+            .map(|block| {
+                let Ok(mut integrator) = LaneIntegrator::new(method) else {
+                    return vec![None; block.len()];
+                };
+                let orbits = Orbit::of_one_system(&system, period, block);
+                let mut recorders: Vec<Recorder> = block
+                    .iter()
+                    .map(|_| Recorder::new(recording, &wrap))
+                    .collect();
+                let mut periods_done = vec![0usize; block.len()];
+                let mut off_constraints = vec![false; block.len()];
+                let errors = integrator.stream(&orbits, |k, y| {
+                    periods_done[k] += 1;
+                    let t = periods_done[k] as f64 * period;
+                    let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
+                    if system.project(t, y, tolerance).is_err() {
+                        off_constraints[k] = true;
+                        return false;
+                    }
+                    recorders[k].push(y)
+                });
+                (recording.done)(block.len());
+                recorders
+                    .into_iter()
+                    .zip(errors)
+                    .zip(off_constraints)
+                    .map(|((recorder, error), off)| recorder.finish(error.is_none() && !off))
+                    .collect()
+            })
+            .collect();
+        Ok(blocks.into_iter().flatten().collect())
     }
     fn consistent(
         &self,

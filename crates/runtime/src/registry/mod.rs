@@ -593,7 +593,7 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
             .collect::<Result<_, _>>()?;
         let w0 = fixed_state::<S>(w0)?;
         let system = Fixed::exact(self, params);
-        fli_of_starts::<_, S, T>(&system, method, period, &starts, &w0, periods)
+        fli_of_starts::<_, S, T>(&system, method, period, &starts, &[w0], periods)
     }
     fn iterates(
         &self,

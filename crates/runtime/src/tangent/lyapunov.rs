@@ -122,7 +122,7 @@ pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
     system: &S,
     period: f64,
     starts: &[[f64; N]],
-    w0: &[f64; N],
+    tangents: &[[f64; N]],
     periods: usize,
 ) -> Vec<Result<f64, OdeError>> {
     if periods == 0 {
@@ -133,9 +133,9 @@ pub fn fast_lyapunov_indicators<S: System<N>, const N: usize, const M: usize>(
         system,
         period,
         starts,
-        w0,
+        tangents,
         periods,
-        Fli::<N, M>::new(w0),
+        Fli::<N, M>::new,
     )
 }
 
@@ -148,7 +148,7 @@ pub fn fli_of_starts<S: System<N>, const N: usize, const M: usize>(
     method: Method,
     period: f64,
     starts: &[[f64; N]],
-    w0: &[f64; N],
+    tangents: &[[f64; N]],
     periods: usize,
 ) -> Result<(Vec<Result<f64, OdeError>>, u64), OdeError> {
     Ok(match method {
@@ -159,7 +159,7 @@ pub fn fli_of_starts<S: System<N>, const N: usize, const M: usize>(
                 system,
                 period,
                 starts,
-                w0,
+                tangents,
                 periods,
             );
             (values, integrator.stats.f_evals)
@@ -167,13 +167,13 @@ pub fn fli_of_starts<S: System<N>, const N: usize, const M: usize>(
         _ => {
             let mut integrator = Integrator::new(method)?;
             let mut values = Vec::with_capacity(starts.len());
-            for y0 in starts {
+            for (k, y0) in starts.iter().enumerate() {
                 let fli = fast_lyapunov_indicator::<_, N, M>(
                     &mut integrator,
                     system,
                     period,
                     y0,
-                    w0,
+                    tangent_of(tangents, k),
                     periods,
                 );
                 if fli.is_err() {
@@ -210,10 +210,18 @@ pub fn megno_values<S: System<N>, const N: usize, const M: usize>(
         system,
         chunk,
         starts,
-        w0,
+        std::slice::from_ref(w0),
         chunks,
-        Megno::<N, M>::new(w0, chunk),
+        |w0| Megno::<N, M>::new(w0, chunk),
     )
+}
+
+/// Start k's tangent vector: its own, or the one all starts share.
+fn tangent_of<const N: usize>(tangents: &[[f64; N]], k: usize) -> &[f64; N] {
+    match tangents {
+        [shared] => shared,
+        own => &own[k],
+    }
 }
 
 /// An indicator of one orbit's tangent vector, taken in after every
@@ -224,25 +232,29 @@ trait TangentIndicator<const M: usize>: Copy {
     fn value(&self) -> f64;
 }
 
-/// Every orbit from `starts` with the tangent vector `w0`, `segments`
-/// segments of length `segment` in the batch lanes, each with its own copy
-/// of `indicator`; its value, or the orbit's error.
+/// Every orbit from `starts` with its tangent vector (`tangents`: one per
+/// start, or one for all), `segments` segments of length `segment` in the
+/// batch lanes, each with the indicator `indicator` makes of its tangent
+/// vector; its value, or the orbit's error.
 fn in_lanes<S: System<N>, I: TangentIndicator<M>, const N: usize, const M: usize>(
     integrator: &mut LaneIntegrator,
     system: &S,
     segment: f64,
     starts: &[[f64; N]],
-    w0: &[f64; N],
+    tangents: &[[f64; N]],
     segments: usize,
-    indicator: I,
+    indicator: impl Fn(&[f64; N]) -> I,
 ) -> Vec<Result<f64, OdeError>> {
     let variational = Variational::<S, N, M>::new(system);
     let packed: Vec<[f64; M]> = starts
         .iter()
-        .map(|y0| Variational::<S, N, M>::pack(y0, &[*w0]))
+        .enumerate()
+        .map(|(k, y0)| Variational::<S, N, M>::pack(y0, &[*tangent_of(tangents, k)]))
         .collect();
     let orbits = Orbit::of_one_system(&variational, segment, &packed);
-    let mut state = vec![(indicator, 0usize); starts.len()];
+    let mut state: Vec<(I, usize)> = (0..starts.len())
+        .map(|k| (indicator(tangent_of(tangents, k)), 0))
+        .collect();
     let errors = integrator.stream(&orbits, |k, z| {
         let (indicator, done) = &mut state[k];
         indicator.after_segment(z);
