@@ -341,7 +341,7 @@ fn constrained_forms(derivation: &ConstrainedDerivation) -> Vec<Form<'_>> {
             doc: "Mass matrix M = ∂²L/∂q'².",
             inputs: TimeCoordinates,
             values: Values::Matrix(&derivation.mass_matrix),
-            dual: Some(DualTimeCoordinates),
+            dual: None,
         }),
         Some(Form {
             name: "free_forces",
@@ -349,7 +349,7 @@ fn constrained_forms(derivation: &ConstrainedDerivation) -> Vec<Form<'_>> {
             doc: "Free generalised force F: M q'' = F + Gᵀλ.",
             inputs: CoordinatesVelocities,
             values: Values::Vector(&derivation.free_forces),
-            dual: Some(DualCoordinatesVelocities),
+            dual: None,
         }),
         Some(Form {
             name: "position_residuals",
@@ -381,7 +381,7 @@ fn constrained_forms(derivation: &ConstrainedDerivation) -> Vec<Form<'_>> {
             doc: "h: d/dt c = G q'' + h.",
             inputs: CoordinatesVelocities,
             values: Values::Vector(&derivation.bias),
-            dual: Some(DualCoordinatesVelocities),
+            dual: None,
         }),
         Some(Form {
             name: "potential",

@@ -63,13 +63,10 @@ pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send +
     /// V = −L and b = ∂L/∂q' at q' = 0, at time t (for the averaging).
     fn potential(&self, t: f64, q: &[f64; N]) -> f64;
     fn linear_term(&self, t: f64, q: &[f64; N]) -> [f64; N];
-    /// The forms the accelerations need, over dual numbers (for the
-    /// Jacobian of the equations of motion).
-    fn mass_matrix_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; N];
-    fn free_forces_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; N];
+    /// G and c_t over dual numbers (for the derivatives of the velocity
+    /// forms and the constraints' curvature).
     fn constraint_jacobian_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; K];
     fn constraint_rates_dual(&self, t: f64, q: &[Dual; N]) -> [Dual; K];
-    fn constraint_bias_dual(&self, t: f64, q: &[Dual; N], v: &[Dual; N]) -> [Dual; K];
     /// The generated Taylor recurrences of the motion on the constraints
     /// through (t, y), y = [q; q'] of length S = 2N (false for another S).
     fn taylor<Num: Scalar, const S: usize>(
@@ -214,24 +211,22 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
         })
     }
 
-    /// Exact to round-off: the accelerations over dual numbers, one
-    /// column of the Jacobian a pass.
+    /// Exact to round-off: the generated recurrences over dual numbers at
+    /// order 1 (whose coefficient of order 1 is the field), one column a
+    /// pass, so the Jacobian and the Taylor method share one instance.
     fn jacobian(&self, t: f64, y: &[f64; S]) -> Option<[[f64; S]; S]> {
-        let forms = &self.0;
+        let mut work = TaylorWork::<Dual>::default();
+        let mut out = [[Dual::default(); S]; 2];
         let mut jacobian = [[0.0; S]; S];
         for column in 0..S {
-            let seeded = |i: usize| Dual::seeded(y[i], if i == column { 1.0 } else { 0.0 });
-            let q: [Dual; N] = std::array::from_fn(seeded);
-            let v: [Dual; N] = std::array::from_fn(|i| seeded(N + i));
-            let (accelerations, _) = solve_constrained(
-                forms.mass_matrix_dual(t, &q),
-                forms.constraint_jacobian_dual(t, &q),
-                forms.free_forces_dual(t, &q, &v),
-                forms.constraint_bias_dual(t, &q, &v),
-            );
-            for i in 0..N {
-                jacobian[i][column] = if N + i == column { 1.0 } else { 0.0 };
-                jacobian[N + i][column] = accelerations[i].du;
+            let seeded: [Dual; S] = std::array::from_fn(|i| {
+                Dual::seeded(y[i], if i == column { 1.0 } else { 0.0 })
+            });
+            if !self.0.taylor(Dual::seeded(t, 0.0), &seeded, 1, &mut work, &mut out) {
+                return None;
+            }
+            for (row, rate) in jacobian.iter_mut().zip(&out[1]) {
+                row[column] = rate.du;
             }
         }
         Some(jacobian)
