@@ -160,16 +160,36 @@ fn a_drawing_that_cannot_be_made_says_why() {
         );
         assert!(error.to_string().contains("kapitza"), "{error}");
     }
+}
+
+/// The Taylor method draws a constrained mechanism as DOP853 does: the
+/// four-bar's points in every frame to 1e-8.
+#[test]
+fn the_taylor_method_draws_the_four_bar_as_dop853_does() {
     let four_bar = mechlab::models::by_name("four_bar").unwrap();
-    let taylor = Method::Taylor { tol: 1e-12 };
-    let error = animate(
-        four_bar,
-        &four_bar.dynamic.defaults(),
-        taylor,
-        &[0.3, 0.0, -0.3, 0.0, 0.0, 0.0],
-        &[0, 3],
-        frames,
-    )
-    .unwrap_err();
-    assert!(error.to_string().contains("dop853"), "{error}");
+    let frames = Frames {
+        duration: 2.0,
+        count: 40,
+    };
+    let draw = |method| {
+        animate(
+            four_bar,
+            &four_bar.dynamic.defaults(),
+            method,
+            &[0.3, 0.0, -0.3, 0.2, 0.0, 0.0],
+            &[0, 3],
+            frames,
+        )
+        .unwrap()
+    };
+    let (taylor, dop853) = (draw(Method::Taylor { tol: 1e-13 }), draw(METHOD));
+    assert_eq!(taylor.frames.len(), dop853.frames.len());
+    for (a, b) in taylor.frames.iter().zip(&dop853.frames) {
+        for (p, q) in a.iter().zip(b) {
+            assert!(
+                (p[0] - q[0]).abs() < 1e-8 && (p[1] - q[1]).abs() < 1e-8,
+                "{p:?} against {q:?}"
+            );
+        }
+    }
 }

@@ -9,23 +9,21 @@
 //! so has its time derivative) less ∇V_vibr, V_vibr = ½ mean⟨P b̃, b̃⟩:
 //! the means are quadratures over 32 phases, ∇V_vibr central differences.
 
-use super::{dot, solve_constrained, ConstraintForms, OnConstraints};
+use super::{dot, solve_constrained, OnConstraints};
 use crate::linalg::Cholesky;
 use crate::ode::System;
 
 /// Phases of the quadratures over θ.
 const NODES: usize = 32;
 
-/// The averaged motion of the forms `F` (with `period` the fast phase's).
+/// The averaged motion of a model's forms (with `period` the fast phase's).
 #[derive(Clone, Debug)]
-pub struct AveragedOnConstraints<F, const N: usize, const K: usize, const S: usize> {
-    pub exact: OnConstraints<F, N, K, S>,
+pub struct AveragedOnConstraints<const N: usize, const K: usize, const S: usize> {
+    pub exact: OnConstraints<N, K, S>,
     pub period: f64,
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    AveragedOnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> AveragedOnConstraints<N, K, S> {
     fn phase_time(&self, j: usize) -> f64 {
         self.period * j as f64 / NODES as f64
     }
@@ -83,12 +81,10 @@ pub struct PhaseMeans {
     pub vibrational: f64,
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> System<S>
-    for AveragedOnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> System<S> for AveragedOnConstraints<N, K, S> {
     fn rhs(&self, _t: f64, y: &[f64; S]) -> [f64; S] {
         let forms = &self.exact.0;
-        let (q, v) = OnConstraints::<F, N, K, S>::split(y);
+        let (q, v) = OnConstraints::<N, K, S>::split(y);
         let mut free = [0.0; N];
         for j in 0..NODES {
             let f = forms.free_forces(self.phase_time(j), &q, &v);

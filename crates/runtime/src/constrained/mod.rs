@@ -28,83 +28,172 @@ use crate::ode::{
     System, TaylorWork, LANES,
 };
 
-/// What a generated constrained model gives at its own sizes (N
-/// coordinates, K constraints), with its parameters: the model's module
-/// implements it on its `Forms`.
-pub trait ConstraintForms<const N: usize, const K: usize>: Clone + Sync + Send + 'static {
-    fn from_values(params: &[f64]) -> Self;
-    /// The names of the constraints, whose multipliers are their reactions.
-    fn constraint_names() -> &'static [&'static str];
+/// What a generated constrained model gives, as plain functions of its
+/// parameters' values at its sizes (N coordinates, K constraints, the
+/// state S = 2N); the model's module holds one in a static (`FORMS`).
+/// The runtime takes the forms through this table, not as a type of their
+/// own, so its integrators and analyses are compiled once per size, not
+/// once per model: adding a model compiles only its own forms.
+pub struct FormsTable<const N: usize, const K: usize, const S: usize> {
+    /// The constraints' names, whose multipliers are their reactions.
+    pub constraint_names: &'static [&'static str],
     /// Which constraints are holonomic (position constraints).
-    fn holonomic() -> [bool; K];
+    pub holonomic: [bool; K],
     /// Which coordinates are angles.
-    fn periodic() -> [bool; N];
-    /// The model file's starts of the coordinates.
-    fn start(&self) -> [f64; N];
-    /// Whether the model has a fast phase.
-    fn has_fast_phase() -> bool;
-    /// The period of the fast phase, if there is one.
-    fn phase_period(&self) -> Option<f64>;
-    fn mass_matrix(&self, t: f64, q: &[f64; N]) -> [[f64; N]; N];
-    fn free_forces(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; N];
-    /// g of each position constraint (0 for a velocity constraint).
-    fn position_residuals(&self, t: f64, q: &[f64; N]) -> [f64; K];
-    /// G of the velocity forms c = G q' + c_t.
-    fn constraint_jacobian(&self, t: f64, q: &[f64; N]) -> [[f64; N]; K];
-    /// c_t of the velocity forms.
-    fn constraint_rates(&self, t: f64, q: &[f64; N]) -> [f64; K];
-    /// h in d/dt c = G q'' + h.
-    fn constraint_bias(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; K];
-    /// The energy function Σ q'∂L/∂q' − L.
-    fn energy(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> f64;
+    pub periodic: [bool; N],
+    pub has_fast_phase: bool,
     /// Whether the constraints are holonomic and fixed and M does not
     /// move with the phase (the averaging's conditions).
-    fn stationary() -> bool;
+    pub stationary: bool,
+    /// The model file's starts of the coordinates.
+    pub start: fn(&[f64]) -> [f64; N],
+    /// The period of the fast phase, if there is one.
+    pub phase_period: fn(&[f64]) -> Option<f64>,
+    pub mass_matrix: fn(&[f64], f64, &[f64; N]) -> [[f64; N]; N],
+    pub free_forces: fn(&[f64], f64, &[f64; N], &[f64; N]) -> [f64; N],
+    /// g of each position constraint (0 for a velocity constraint).
+    pub position_residuals: fn(&[f64], f64, &[f64; N]) -> [f64; K],
+    /// G of the velocity forms c = G q' + c_t.
+    pub constraint_jacobian: fn(&[f64], f64, &[f64; N]) -> [[f64; N]; K],
+    /// c_t of the velocity forms.
+    pub constraint_rates: fn(&[f64], f64, &[f64; N]) -> [f64; K],
+    /// h in d/dt c = G q'' + h.
+    pub constraint_bias: fn(&[f64], f64, &[f64; N], &[f64; N]) -> [f64; K],
+    /// The energy function Σ q'∂L/∂q' − L.
+    pub energy: fn(&[f64], f64, &[f64; N], &[f64; N]) -> f64,
     /// V = −L and b = ∂L/∂q' at q' = 0, at time t (for the averaging).
-    fn potential(&self, t: f64, q: &[f64; N]) -> f64;
-    fn linear_term(&self, t: f64, q: &[f64; N]) -> [f64; N];
-    /// G and c_t over dual numbers (for the derivatives of the velocity
-    /// forms and the constraints' curvature).
-    fn constraint_jacobian_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; K];
-    fn constraint_rates_dual(&self, t: f64, q: &[Dual; N]) -> [Dual; K];
+    pub potential: fn(&[f64], f64, &[f64; N]) -> f64,
+    pub linear_term: fn(&[f64], f64, &[f64; N]) -> [f64; N],
+    /// G and c_t over dual numbers (the derivatives of the velocity forms
+    /// and the constraints' curvature).
+    pub constraint_jacobian_dual: fn(&[f64], f64, &[Dual; N]) -> [[Dual; N]; K],
+    pub constraint_rates_dual: fn(&[f64], f64, &[Dual; N]) -> [Dual; K],
     /// The generated Taylor recurrences of the motion on the constraints
-    /// through (t, y), y = [q; q'] of length S = 2N (false for another S).
-    fn taylor<Num: Scalar, const S: usize>(
+    /// through (t, y), y = [q; q'] (see `crate::ode::System::taylor`), in
+    /// f64, over dual numbers (the Jacobian, the tangent recurrences) and
+    /// in the batch lanes (lane l with the parameters `params[l]`).
+    pub taylor: TaylorOf<f64, S>,
+    pub taylor_dual: TaylorOf<Dual, S>,
+    pub taylor_lanes:
+        fn([&[f64]; LANES], Lanes, &[Lanes; S], usize, &mut TaylorWork<Lanes>, &mut [[Lanes; S]]),
+    /// The recurrences with tangent vectors, z = [y; V] (see
+    /// `crate::ode::System::taylor_variational`).
+    pub taylor_variational: fn(&[f64], f64, &[f64], usize, &mut TaylorWork<f64>, &mut [f64]),
+}
+
+/// A model's Taylor recurrences in the number type `Num`.
+pub type TaylorOf<Num, const S: usize> =
+    fn(&[f64], Num, &[Num; S], usize, &mut TaylorWork<Num>, &mut [[Num; S]]);
+
+/// A constrained model's forms at its parameters' values.
+#[derive(Clone)]
+pub struct Forms<const N: usize, const K: usize, const S: usize> {
+    pub table: &'static FormsTable<N, K, S>,
+    pub params: Vec<f64>,
+}
+
+impl<const N: usize, const K: usize, const S: usize> std::fmt::Debug for Forms<N, K, S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Forms")
+            .field("constraints", &self.table.constraint_names)
+            .field("params", &self.params)
+            .finish()
+    }
+}
+
+impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
+    pub fn new(table: &'static FormsTable<N, K, S>, params: &[f64]) -> Self {
+        Forms {
+            table,
+            params: params.to_vec(),
+        }
+    }
+    pub fn start(&self) -> [f64; N] {
+        (self.table.start)(&self.params)
+    }
+    pub fn phase_period(&self) -> Option<f64> {
+        (self.table.phase_period)(&self.params)
+    }
+    #[inline]
+    pub fn mass_matrix(&self, t: f64, q: &[f64; N]) -> [[f64; N]; N] {
+        (self.table.mass_matrix)(&self.params, t, q)
+    }
+    #[inline]
+    pub fn free_forces(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
+        (self.table.free_forces)(&self.params, t, q, v)
+    }
+    #[inline]
+    pub fn position_residuals(&self, t: f64, q: &[f64; N]) -> [f64; K] {
+        (self.table.position_residuals)(&self.params, t, q)
+    }
+    #[inline]
+    pub fn constraint_jacobian(&self, t: f64, q: &[f64; N]) -> [[f64; N]; K] {
+        (self.table.constraint_jacobian)(&self.params, t, q)
+    }
+    #[inline]
+    pub fn constraint_rates(&self, t: f64, q: &[f64; N]) -> [f64; K] {
+        (self.table.constraint_rates)(&self.params, t, q)
+    }
+    #[inline]
+    pub fn constraint_bias(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; K] {
+        (self.table.constraint_bias)(&self.params, t, q, v)
+    }
+    pub fn energy(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> f64 {
+        (self.table.energy)(&self.params, t, q, v)
+    }
+    pub fn potential(&self, t: f64, q: &[f64; N]) -> f64 {
+        (self.table.potential)(&self.params, t, q)
+    }
+    pub fn linear_term(&self, t: f64, q: &[f64; N]) -> [f64; N] {
+        (self.table.linear_term)(&self.params, t, q)
+    }
+    pub fn constraint_jacobian_dual(&self, t: f64, q: &[Dual; N]) -> [[Dual; N]; K] {
+        (self.table.constraint_jacobian_dual)(&self.params, t, q)
+    }
+    pub fn constraint_rates_dual(&self, t: f64, q: &[Dual; N]) -> [Dual; K] {
+        (self.table.constraint_rates_dual)(&self.params, t, q)
+    }
+
+    /// The recurrences in `Num`: f64 and dual numbers have them (a number
+    /// type of another kind, false). The coefficients go through a buffer
+    /// of the table's type, a copy small beside the recurrences.
+    fn taylor<Num: Scalar>(
         &self,
         t: Num,
         y: &[Num; S],
         order: usize,
         work: &mut TaylorWork<Num>,
         out: &mut [[Num; S]],
-    ) -> bool;
-    /// [`ConstraintForms::taylor`] for a batch, lane l with `lanes[l]`'s
-    /// parameters.
-    fn taylor_lanes<const S: usize>(
-        lanes: [&Self; LANES],
-        t: Lanes,
-        y: &[Lanes; S],
-        order: usize,
-        work: &mut TaylorWork<Lanes>,
-        out: &mut [[Lanes; S]],
-    ) -> bool;
-    /// The recurrences with tangent vectors, z = [y; V] (see
-    /// [`System::taylor_variational`]).
-    fn taylor_variational<Num: Scalar>(
-        &self,
-        t: Num,
-        z: &[Num],
-        order: usize,
-        work: &mut TaylorWork<Num>,
-        out: &mut [Num],
-    ) -> bool;
-    /// The same for a batch, lane by lane.
-    fn taylor_variational_lanes(
-        lanes: [&Self; LANES],
-        t: Lanes,
-        z: &[Lanes],
-        order: usize,
-        out: &mut [Lanes],
-    ) -> bool;
+    ) -> bool {
+        fn run<Num: Scalar, T: Scalar, const S: usize>(
+            recurrences: TaylorOf<T, S>,
+            params: &[f64],
+            t: Num,
+            y: &[Num; S],
+            order: usize,
+            work: &mut TaylorWork<Num>,
+            out: &mut [[Num; S]],
+        ) -> bool {
+            use std::any::Any;
+            let (Some(&t), Some(y), Some(work)) = (
+                (&t as &dyn Any).downcast_ref::<T>(),
+                (y as &dyn Any).downcast_ref::<[T; S]>(),
+                (work as &mut dyn Any).downcast_mut::<TaylorWork<T>>(),
+            ) else {
+                return false;
+            };
+            let mut coefficients = vec![[T::default(); S]; out.len()];
+            recurrences(params, t, y, order, work, &mut coefficients);
+            for (row, computed) in out.iter_mut().zip(coefficients) {
+                if let Some(row) = (row as &mut dyn Any).downcast_mut::<[T; S]>() {
+                    *row = computed;
+                }
+            }
+            true
+        }
+        run(self.table.taylor, &self.params, t, y, order, work, out)
+            || run(self.table.taylor_dual, &self.params, t, y, order, work, out)
+    }
 }
 
 /// q'' and λ of M q'' = F + Gᵀλ, G q'' + h = 0 by the Schur complement:
@@ -135,16 +224,14 @@ pub(crate) fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
     (accelerations, lambda)
 }
 
-/// The equations of motion of constrained forms `F` as an ODE on
+/// The equations of motion of a constrained model's forms as an ODE on
 /// y = [q; q'] of length S = 2N.
 #[derive(Clone, Debug)]
-pub struct OnConstraints<F, const N: usize, const K: usize, const S: usize>(pub F);
+pub struct OnConstraints<const N: usize, const K: usize, const S: usize>(pub Forms<N, K, S>);
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    OnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// The forms at `params`; S must be 2N.
-    pub fn new(forms: F) -> Self {
+    pub fn new(forms: Forms<N, K, S>) -> Self {
         const { assert!(S == 2 * N, "the state of a constrained model is [q; q']") };
         OnConstraints(forms)
     }
@@ -196,9 +283,7 @@ pub(crate) fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Nu
     sum
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> System<S>
-    for OnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints<N, K, S> {
     #[inline]
     fn rhs(&self, t: f64, y: &[f64; S]) -> [f64; S] {
         let (accelerations, _) = self.accelerations(t, y);
@@ -215,21 +300,13 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
     /// order 1 (whose coefficient of order 1 is the field), one column a
     /// pass, so the Jacobian and the Taylor method share one instance.
     fn jacobian(&self, t: f64, y: &[f64; S]) -> Option<[[f64; S]; S]> {
-        let mut work = TaylorWork::<Dual>::default();
-        let mut out = [[Dual::default(); S]; 2];
-        let mut jacobian = [[0.0; S]; S];
-        for column in 0..S {
-            let seeded: [Dual; S] = std::array::from_fn(|i| {
-                Dual::seeded(y[i], if i == column { 1.0 } else { 0.0 })
-            });
-            if !self.0.taylor(Dual::seeded(t, 0.0), &seeded, 1, &mut work, &mut out) {
-                return None;
-            }
-            for (row, rate) in jacobian.iter_mut().zip(&out[1]) {
-                row[column] = rate.du;
-            }
-        }
-        Some(jacobian)
+        let forms = &self.0;
+        Some(crate::ode::dual::jacobian_by_recurrences(
+            y,
+            |y, work, out| {
+                (forms.table.taylor_dual)(&forms.params, Dual::seeded(t, 0.0), y, 1, work, out)
+            },
+        ))
     }
 
     #[inline]
@@ -253,7 +330,9 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
         work: &mut TaylorWork<Lanes>,
         out: &mut [[Lanes; S]],
     ) -> bool {
-        F::taylor_lanes(lanes.map(|system| &system.0), t, y, order, work, out)
+        let params = lanes.map(|system| &system.0.params[..]);
+        (lanes[0].0.table.taylor_lanes)(params, t, y, order, work, out);
+        true
     }
 
     #[inline]
@@ -265,7 +344,34 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
         work: &mut TaylorWork<Num>,
         out: &mut [Num],
     ) -> bool {
-        self.0.taylor_variational(t, z, order, work, out)
+        use std::any::Any;
+        if z.len() < 2 * S || !z.len().is_multiple_of(S) {
+            return false;
+        }
+        // f64 only: the tangent recurrences are not asked in other types.
+        let (Some(&t), Some(work)) = (
+            (&t as &dyn Any).downcast_ref::<f64>(),
+            (work as &mut dyn Any).downcast_mut::<TaylorWork<f64>>(),
+        ) else {
+            return false;
+        };
+        let mut flat = vec![0.0; out.len()];
+        let z: Vec<f64> = z
+            .iter()
+            .map(|x| {
+                (x as &dyn Any)
+                    .downcast_ref::<f64>()
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            })
+            .collect();
+        (self.0.table.taylor_variational)(&self.0.params, t, &z, order, work, &mut flat);
+        for (slot, x) in out.iter_mut().zip(flat) {
+            if let Some(slot) = (slot as &mut dyn Any).downcast_mut::<f64>() {
+                *slot = x;
+            }
+        }
+        true
     }
 
     #[inline]
@@ -277,13 +383,25 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> S
         _work: &mut TaylorWork<Lanes>,
         out: &mut [Lanes],
     ) -> bool {
-        F::taylor_variational_lanes(lanes.map(|system| &system.0), t, z, order, out)
+        if z.len() < 2 * S || !z.len().is_multiple_of(S) {
+            return false;
+        }
+        crate::ode::dual::lane_by_lane(z, out, |l, z, out| {
+            let forms = &lanes[l].0;
+            (forms.table.taylor_variational)(
+                &forms.params,
+                t.0[l],
+                z,
+                order,
+                &mut TaylorWork::default(),
+                out,
+            )
+        });
+        true
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> Holonomic
-    for OnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> Holonomic for OnConstraints<N, K, S> {
     fn coordinates(&self) -> usize {
         N
     }
@@ -310,16 +428,14 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> H
 /// to the coordinates' scale, see [`OnConstraints::position_tolerance`]).
 pub const PROJECTION_TOLERANCE: f64 = 1e-14;
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    OnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// The Jacobian (2k × 2n) of the state's constraints [g; G q' + c_t]
     /// with respect to [q; q'] (a velocity constraint has no position
     /// row: its row of g is zero), exact by dual numbers.
     pub fn state_constraints_jacobian(&self, t: f64, y: &[f64; S]) -> DMatrix<f64> {
         let (q, v) = Self::split(y);
         let forms = &self.0;
-        let holonomic = F::holonomic();
+        let holonomic = forms.table.holonomic;
         let g = forms.constraint_jacobian(t, &q);
         let rows: Vec<usize> = (0..K).filter(|&r| holonomic[r]).collect();
         let mut c = DMatrix::zeros(rows.len() + K, S);
@@ -346,9 +462,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    OnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// [`crate::ode::holonomic::project`] at the model's sizes, without
     /// allocating (a run projects every reported state): positions by
     /// Newton's method in the metric of M until |g| ≤ `tolerance`, then
@@ -424,23 +538,19 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
 /// A constrained model's equations as an [`AnySystem`] whose stream
 /// projects the state onto the constraints at every segment's end (before
 /// the analysis sees it), so that a period map of 10⁵ periods stays on them.
-pub struct Projecting<F, const N: usize, const K: usize, const S: usize> {
-    system: SizedSystem<OnConstraints<F, N, K, S>, S>,
+pub struct Projecting<const N: usize, const K: usize, const S: usize> {
+    system: SizedSystem<OnConstraints<N, K, S>, S>,
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    Projecting<F, N, K, S>
-{
-    pub fn new(equations: OnConstraints<F, N, K, S>) -> Self {
+impl<const N: usize, const K: usize, const S: usize> Projecting<N, K, S> {
+    pub fn new(equations: OnConstraints<N, K, S>) -> Self {
         Projecting {
             system: SizedSystem(equations),
         }
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> AnySystem
-    for Projecting<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> AnySystem for Projecting<N, K, S> {
     fn dim(&self) -> usize {
         S
     }
@@ -474,7 +584,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> A
         self.system
             .stream(integrator, y0, segment, segments, &mut |y| {
                 t += segment;
-                let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
+                let tolerance = equations.position_tolerance(y);
                 let state: &mut [f64; S] = y.try_into().expect("a state of the system's length");
                 if let Err(e) = equations.project(t, state, tolerance) {
                     failure = Some(e);
@@ -493,19 +603,23 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize> A
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize>
-    OnConstraints<F, N, K, S>
-{
+impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// Where Newton's method stops on a state: |g| ≤ 1e-14 (1 + the largest
     /// |coordinate| that is not an angle), the scale of the residuals (an
     /// angle's turns do not change it).
-    pub fn position_tolerance(y: &[f64]) -> f64 {
-        let periodic = F::periodic();
-        let largest = (0..N)
-            .filter(|&i| !periodic[i])
-            .fold(0.0_f64, |m, i| m.max(y[i].abs()));
-        PROJECTION_TOLERANCE * (1.0 + largest)
+    pub fn position_tolerance(&self, y: &[f64]) -> f64 {
+        position_tolerance(&self.0.table.periodic, y)
     }
+}
+
+/// Where Newton's method stops on a state: |g| ≤ 1e-14 (1 + the largest
+/// |coordinate| that is not an angle), the scale of the residuals (an
+/// angle's turns do not change it).
+pub fn position_tolerance<const N: usize>(periodic: &[bool; N], y: &[f64]) -> f64 {
+    let largest = (0..N)
+        .filter(|&i| !periodic[i])
+        .fold(0.0_f64, |m, i| m.max(y[i].abs()));
+    PROJECTION_TOLERANCE * (1.0 + largest)
 }
 
 /// A constrained model at (t, q): the mass matrix, and the position

@@ -341,6 +341,29 @@ pub fn jacobian<const N: usize>(
     jacobian
 }
 
+/// The Jacobian ∂f/∂y at y from a field's Taylor recurrences over dual
+/// numbers at order 1 (whose coefficient of order 1 is the field), one
+/// column a pass, with this thread's workspace.
+#[inline]
+pub fn jacobian_by_recurrences<const N: usize>(
+    y: &[f64; N],
+    recurrences: impl Fn(&[Dual; N], &mut TaylorWork<Dual>, &mut [[Dual; N]]),
+) -> [[f64; N]; N] {
+    with_workspace(|work| {
+        let mut out = [[Dual::default(); N]; 2];
+        let mut jacobian = [[0.0; N]; N];
+        for j in 0..N {
+            let mut seeded = y.map(Dual::from);
+            seeded[j].du = 1.0;
+            recurrences(&seeded, work, &mut out);
+            for (row, f) in jacobian.iter_mut().zip(&out[1]) {
+                row[j] = f.du;
+            }
+        }
+        jacobian
+    })
+}
+
 /// The variational recurrences from the state's: `z = [y, v₁, …, v_K]`,
 /// `out[row · len + i]` as the written-out variational recurrences lay
 /// them out (len = z.len()). Tangent k is the derivative part of the

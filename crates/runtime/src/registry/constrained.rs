@@ -3,14 +3,14 @@
 //! (`analysis::on_constraints`) take; one generic adapter over the
 //! generated forms ([`crate::constrained::ConstraintForms`]).
 
-use std::marker::PhantomData;
-
 use nalgebra::{DMatrix, DVector};
 
 use super::recording::{Recorder, Recording};
 use super::{iterates_one_by_one, FliValues, Flows, ModelInfo};
 use crate::constrained::averaged::{AveragedOnConstraints, PhaseMeans};
-use crate::constrained::{ConstraintForms, OnConstraints, Projecting, Statics};
+use crate::constrained::{
+    position_tolerance, Forms, FormsTable, OnConstraints, Projecting, Statics,
+};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
 use crate::ode::{states_at, AnySystem, Dual, Integrator, LaneIntegrator, Method, OdeError, Orbit};
@@ -85,57 +85,50 @@ pub trait ConstrainedSystems: Flows {
     ) -> Result<(Vec<f64>, DMatrix<f64>), OdeError>;
 }
 
-/// The generated forms `F` at their sizes as [`ConstrainedSystems`] (the
-/// model's module holds one in a static).
+/// A generated model's forms ([`FormsTable`]) at their sizes as
+/// [`ConstrainedSystems`] (the model's module holds one in a static).
 /// T = 2S is the state with one tangent vector (stable Rust cannot
 /// compute it from S).
-pub struct Constrained<F, const N: usize, const K: usize, const S: usize, const T: usize> {
+pub struct Constrained<const N: usize, const K: usize, const S: usize, const T: usize> {
     info: &'static ModelInfo,
-    forms: PhantomData<fn() -> F>,
+    forms: &'static FormsTable<N, K, S>,
 }
 
-impl<F, const N: usize, const K: usize, const S: usize, const T: usize> Constrained<F, N, K, S, T> {
-    pub const fn new(info: &'static ModelInfo) -> Self {
-        Constrained {
-            info,
-            forms: PhantomData,
-        }
+impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained<N, K, S, T> {
+    pub const fn new(info: &'static ModelInfo, forms: &'static FormsTable<N, K, S>) -> Self {
+        Constrained { info, forms }
     }
-}
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const T: usize>
-    Constrained<F, N, K, S, T>
-{
-    fn equations(params: &[f64]) -> OnConstraints<F, N, K, S> {
-        OnConstraints::new(F::from_values(params))
+    fn equations(&self, params: &[f64]) -> OnConstraints<N, K, S> {
+        OnConstraints::new(Forms::new(self.forms, params))
     }
 
     /// The averaged motion, where the averaging applies.
-    fn averaged(params: &[f64]) -> Option<AveragedOnConstraints<F, N, K, S>> {
-        let exact = Self::equations(params);
-        let period = exact.0.phase_period().filter(|_| F::stationary())?;
+    fn averaged(&self, params: &[f64]) -> Option<AveragedOnConstraints<N, K, S>> {
+        let exact = self.equations(params);
+        let period = exact.0.phase_period().filter(|_| self.forms.stationary)?;
         Some(AveragedOnConstraints { exact, period })
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const T: usize> Flows
-    for Constrained<F, N, K, S, T>
+impl<const N: usize, const K: usize, const S: usize, const T: usize> Flows
+    for Constrained<N, K, S, T>
 {
     fn info(&self) -> &'static ModelInfo {
         self.info
     }
     fn has_fast_phase(&self) -> bool {
-        F::has_fast_phase()
+        self.forms.has_fast_phase
     }
     fn periodic_state(&self) -> Vec<bool> {
-        let periodic = F::periodic();
+        let periodic = self.forms.periodic;
         (0..S).map(|i| i < N && periodic[i]).collect()
     }
     fn phase_period(&self, params: &[f64]) -> Option<f64> {
-        F::from_values(params).phase_period()
+        (self.forms.phase_period)(params)
     }
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
-        Box::new(Projecting::new(Self::equations(params)))
+        Box::new(Projecting::new(self.equations(params)))
     }
     fn base_state(&self, params: &[f64]) -> Vec<f64> {
         ConstrainedSystems::start(self, params)
@@ -150,14 +143,14 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         periods: usize,
         held: &[usize],
     ) -> Result<FliValues, OdeError> {
-        let system = Self::equations(params);
+        let system = self.equations(params);
         let w0 = DVector::from_column_slice(&fixed_state::<S>(w0)?);
         // Each start on the constraints with its tangent vector on their
         // tangent space, or None where the plane's point has no state.
         let mut on_manifold = Vec::new();
         for start in starts.chunks(S) {
             let mut y = fixed_state::<S>(start)?;
-            let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(&y);
+            let tolerance = position_tolerance(&self.forms.periodic, &y);
             let on = project_holding(&system, 0.0, &mut y, tolerance, held).ok();
             let basis = on.and_then(|_| tangent_basis(&system.state_constraints_jacobian(0.0, &y)));
             on_manifold.push(basis.map(|basis| {
@@ -207,7 +200,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
             .chunks(S)
             .map(fixed_state::<S>)
             .collect::<Result<_, _>>()?;
-        let system = Self::equations(params);
+        let system = self.equations(params);
         LaneIntegrator::new(method)?;
         let blocks: Vec<Vec<Option<Vec<Vec<f64>>>>> = starts
             .par_chunks(256)
@@ -225,7 +218,7 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
                 let errors = integrator.stream(&orbits, |k, y| {
                     periods_done[k] += 1;
                     let t = periods_done[k] as f64 * period;
-                    let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
+                    let tolerance = position_tolerance(&self.forms.periodic, y);
                     if system.project(t, y, tolerance).is_err() {
                         off_constraints[k] = true;
                         return false;
@@ -255,22 +248,22 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
                 coordinates: N,
             });
         }
-        let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
-        project_holding(&Self::equations(params), 0.0, y, tolerance, held).map(|_| ())
+        let tolerance = position_tolerance(&self.forms.periodic, y);
+        project_holding(&self.equations(params), 0.0, y, tolerance, held).map(|_| ())
     }
 }
 
-impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, const T: usize>
-    ConstrainedSystems for Constrained<F, N, K, S, T>
+impl<const N: usize, const K: usize, const S: usize, const T: usize> ConstrainedSystems
+    for Constrained<N, K, S, T>
 {
     fn constraint_names(&self) -> &'static [&'static str] {
-        F::constraint_names()
+        self.forms.constraint_names
     }
     fn holonomic(&self) -> Vec<bool> {
-        F::holonomic().to_vec()
+        self.forms.holonomic.to_vec()
     }
     fn start(&self, params: &[f64]) -> Vec<f64> {
-        let mut y = F::from_values(params).start().to_vec();
+        let mut y = (self.forms.start)(params).to_vec();
         y.resize(S, 0.0);
         y
     }
@@ -285,29 +278,29 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
             given,
             coordinates: N,
         })?;
-        let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(state);
-        Self::equations(params).project(t, state, tolerance)
+        let tolerance = position_tolerance(&self.forms.periodic, state);
+        self.equations(params).project(t, state, tolerance)
     }
     fn reactions(&self, params: &[f64], t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError> {
         let y = fixed_state::<S>(y)?;
-        Ok(Self::equations(params).accelerations(t, &y).1.to_vec())
+        Ok(self.equations(params).accelerations(t, &y).1.to_vec())
     }
     fn residuals(&self, params: &[f64], t: f64, y: &[f64]) -> Result<(f64, f64), OdeError> {
         let y = fixed_state::<S>(y)?;
-        Ok(Self::equations(params).residuals(t, &y))
+        Ok(self.equations(params).residuals(t, &y))
     }
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError> {
         let y = fixed_state::<S>(y)?;
-        let (q, v) = OnConstraints::<F, N, K, S>::split(&y);
-        Ok(F::from_values(params).energy(t, &q, &v))
+        let (q, v) = OnConstraints::<N, K, S>::split(&y);
+        Ok((self.forms.energy)(params, t, &q, &v))
     }
     fn stationary(&self) -> bool {
-        F::stationary()
+        self.forms.stationary
     }
     fn statics(&self, params: &[f64], t: f64, q: &[f64]) -> Result<Statics, OdeError> {
         let q = fixed_state::<N>(q)?;
-        let forms = F::from_values(params);
-        let rows: Vec<usize> = (0..K).filter(|&r| F::holonomic()[r]).collect();
+        let forms = Forms::new(self.forms, params);
+        let rows: Vec<usize> = (0..K).filter(|&r| self.forms.holonomic[r]).collect();
         let m = forms.mass_matrix(t, &q);
         let g = forms.constraint_jacobian(t, &q);
         let residual = forms.position_residuals(t, &q);
@@ -324,8 +317,8 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         q: &[f64],
     ) -> Result<Vec<DMatrix<f64>>, OdeError> {
         let q = fixed_state::<N>(q)?;
-        let forms = F::from_values(params);
-        let rows: Vec<usize> = (0..K).filter(|&r| F::holonomic()[r]).collect();
+        let forms = Forms::new(self.forms, params);
+        let rows: Vec<usize> = (0..K).filter(|&r| self.forms.holonomic[r]).collect();
         let mut hessians = vec![DMatrix::zeros(N, N); rows.len()];
         for j in 0..N {
             let seeded: [Dual; N] =
@@ -346,12 +339,14 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         y: &[f64],
     ) -> Result<Option<DMatrix<f64>>, OdeError> {
         let y = fixed_state::<S>(y)?;
-        let c = Self::equations(params).state_constraints_jacobian(t, &y);
+        let c = self.equations(params).state_constraints_jacobian(t, &y);
         Ok(tangent_basis(&c))
     }
     fn phase_means(&self, params: &[f64], q: &[f64]) -> Result<Option<PhaseMeans>, OdeError> {
         let q = fixed_state::<N>(q)?;
-        Ok(Self::averaged(params).map(|averaged| averaged.phase_means(&q)))
+        Ok(self
+            .averaged(params)
+            .map(|averaged| averaged.phase_means(&q)))
     }
     fn averaged_states(
         &self,
@@ -361,13 +356,13 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         times: &[f64],
     ) -> Result<Option<Vec<Vec<f64>>>, OdeError> {
         let y0 = fixed_state::<S>(y0)?;
-        let Some(averaged) = Self::averaged(params) else {
+        let Some(averaged) = self.averaged(params) else {
             return Ok(None);
         };
         let t0 = times.first().copied().unwrap_or(0.0);
         let mut states = states_at(method, &averaged, t0, &y0, times)?;
         for y in &mut states {
-            let tolerance = OnConstraints::<F, N, K, S>::position_tolerance(y);
+            let tolerance = position_tolerance(&self.forms.periodic, y);
             // A failed projection leaves the state as the integration left it.
             let _ = averaged.exact.project(0.0, y, tolerance);
         }
@@ -384,16 +379,16 @@ impl<F: ConstraintForms<N, K>, const N: usize, const K: usize, const S: usize, c
         // variational system of S + S² numbers would be compiled for every
         // model at its size (420 numbers for a chain of ten rods).
         let y0 = fixed_state::<S>(y0)?;
-        let system = Self::equations(params);
+        let system = self.equations(params);
         let variational = Variational::<_, S, T>::new(&system);
         let mut matrix = DMatrix::zeros(S, S);
         let mut end = y0;
         for k in 0..S {
             let unit: [f64; S] = std::array::from_fn(|i| if i == k { 1.0 } else { 0.0 });
-            let z0 = Variational::<OnConstraints<F, N, K, S>, S, T>::pack(&y0, &[unit]);
+            let z0 = Variational::<OnConstraints<N, K, S>, S, T>::pack(&y0, &[unit]);
             let z = integrator.advance(&variational, 0.0, &z0, period)?;
-            end = Variational::<OnConstraints<F, N, K, S>, S, T>::state(&z);
-            let column = Variational::<OnConstraints<F, N, K, S>, S, T>::tangent(&z, 0);
+            end = Variational::<OnConstraints<N, K, S>, S, T>::state(&z);
+            let column = Variational::<OnConstraints<N, K, S>, S, T>::tangent(&z, 0);
             for i in 0..S {
                 matrix[(i, k)] = column[i];
             }
