@@ -474,10 +474,7 @@ fn constrained_functions(
 /// q'' = x_F + x_G λ. Their recurrences solve with the factors of order 0
 /// at every order (`crates/derive/src/taylor.rs`), so a step costs what
 /// the model's size asks and no inverse is formed.
-fn constrained_taylor(
-    cx: &Context,
-    derivation: &ConstrainedDerivation,
-) -> Result<crate::functions::TaylorFunction, DeriveError> {
+fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<Step>, Vec<String>) {
     use crate::numeric::{dot, names, upper};
     let n = cx.n();
     let k = derivation.jacobian.len();
@@ -547,6 +544,15 @@ fn constrained_taylor(
         },
         Step::Values(rates),
     ];
+    (steps.to_vec(), outputs)
+}
+
+/// The Taylor recurrences of the motion on the constraints ([`constrained_steps`]).
+fn constrained_taylor(
+    cx: &Context,
+    derivation: &ConstrainedDerivation,
+) -> Result<crate::functions::TaylorFunction, DeriveError> {
+    let (steps, outputs) = constrained_steps(cx, derivation);
     let mut state = cx.coordinates();
     state.extend(cx.velocities());
     cx.taylor_steps(
@@ -555,6 +561,23 @@ fn constrained_taylor(
         &steps,
         &outputs,
         state,
+    )
+}
+
+/// The field [q'; q''] of the motion on the constraints as one function
+/// ([`constrained_steps`]): the forms share their subexpressions.
+fn constrained_rhs(
+    cx: &Context,
+    derivation: &ConstrainedDerivation,
+) -> Result<crate::functions::Function, DeriveError> {
+    let (steps, outputs) = constrained_steps(cx, derivation);
+    cx.function_steps(
+        "exact_rhs",
+        "The field [q'; q''] of the motion on the constraints at (t, q, q'): M q'' = F + Gᵀλ with G q'' + h = 0, by the Schur complement. NaN where M or G M⁻¹Gᵀ is not positive definite.",
+        Inputs::CoordinatesVelocities,
+        format!("[f64; {}]", outputs.len()),
+        &steps,
+        format!("[{}]", outputs.join(", ")),
     )
 }
 
@@ -575,6 +598,7 @@ pub fn render_constrained(
     };
     let mut functions = constrained_functions(&cx, derivation)?;
     functions.extend(crate::functions::drawing_function(&cx)?);
+    functions.push(constrained_rhs(&cx, derivation)?);
     let taylor_functions = vec![constrained_taylor(&cx, derivation)?];
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);

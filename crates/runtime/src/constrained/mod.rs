@@ -49,6 +49,8 @@ pub struct FormsTable<const N: usize, const K: usize, const S: usize> {
     pub start: fn(&[f64]) -> [f64; N],
     /// The period of the fast phase, if there is one.
     pub phase_period: fn(&[f64]) -> Option<f64>,
+    /// The field [q'; q''] at (t, y), its forms evaluated together.
+    pub rhs: fn(&[f64], f64, &[f64; S]) -> [f64; S],
     pub mass_matrix: fn(&[f64], f64, &[f64; N]) -> [[f64; N]; N],
     pub free_forces: fn(&[f64], f64, &[f64; N], &[f64; N]) -> [f64; N],
     /// g of each position constraint (0 for a velocity constraint).
@@ -286,14 +288,7 @@ pub(crate) fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Nu
 impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints<N, K, S> {
     #[inline]
     fn rhs(&self, t: f64, y: &[f64; S]) -> [f64; S] {
-        let (accelerations, _) = self.accelerations(t, y);
-        std::array::from_fn(|i| {
-            if i < N {
-                y[N + i]
-            } else {
-                accelerations[i - N]
-            }
-        })
+        (self.0.table.rhs)(&self.0.params, t, y)
     }
 
     /// Exact to round-off: the generated recurrences over dual numbers at
