@@ -1,7 +1,7 @@
 //! A constrained model behind a trait object, with states and parameters
 //! as slices: what the registry lists and the analyses on constraints
 //! (`analysis::on_constraints`) take; one generic adapter over the
-//! generated forms ([`crate::constrained::ConstraintForms`]).
+//! generated forms ([`crate::constrained::FormsTable`]), compiled once per size.
 
 use nalgebra::{DMatrix, DVector};
 
