@@ -738,3 +738,66 @@ fn the_four_bars_upright_tips_over_at_the_exact_windows_edge() {
         tipping.parameter
     );
 }
+
+/// A constrained model past 6 coordinates has no Taylor recurrences: the
+/// Taylor method is refused by name, and its Jacobian (by the field's twin
+/// over dual numbers) equals central differences of the field, as the
+/// four-bar's (by the recurrences over dual numbers) does.
+#[test]
+fn a_large_constrained_model_refuses_the_taylor_method_and_keeps_its_jacobian() {
+    use mechlab::analysis::period_map::{portrait, PeriodMapError, PortraitSettings};
+    use mechlab::ode::System;
+    use mechlab_test_models::closed_chain10;
+    let model = &closed_chain10::MODEL;
+    let settings = PortraitSettings {
+        axes: [0, 10],
+        seeds: None,
+        count: 2,
+        p_max: 0.1,
+        periods: 3,
+        method: Method::Taylor { tol: 1e-10 },
+    };
+    let error = portrait(model, &model.dynamic.defaults(), &settings).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            PeriodMapError::Refused(mechlab::analysis::Refusal::Setting { .. })
+        ) && error.to_string().contains("6 coordinates"),
+        "{error}"
+    );
+    fn central_differences<const S: usize>(system: &impl System<S>, y: &[f64; S]) -> f64 {
+        let exact = system.jacobian(0.3, y).unwrap();
+        let mut worst: f64 = 0.0;
+        for j in 0..S {
+            let h = 1e-6;
+            let (mut plus, mut minus) = (*y, *y);
+            plus[j] += h;
+            minus[j] -= h;
+            let (fp, fm) = (system.rhs(0.3, &plus), system.rhs(0.3, &minus));
+            for i in 0..S {
+                worst = worst.max((exact[i][j] - (fp[i] - fm[i]) / (2.0 * h)).abs());
+            }
+        }
+        worst
+    }
+    let chain = model.constrained.unwrap();
+    let params = model.dynamic.defaults();
+    let mut y = chain.start(&params);
+    for (i, v) in y.iter_mut().skip(10).enumerate() {
+        *v = 0.1 * (i as f64 - 4.5);
+    }
+    chain.project(&params, 0.0, &mut y).unwrap();
+    let forms = mechlab::constrained::Forms::new(&closed_chain10::FORMS, &params);
+    let y: [f64; 20] = y.try_into().unwrap();
+    let chain_error = central_differences(&closed_chain10::Exact::new(forms), &y);
+    assert!(chain_error < 1e-6, "closed chain: {chain_error:e}");
+    let four_bar = mechlab::models::four_bar::MODEL.constrained.unwrap();
+    let params = mechlab::models::four_bar::Params::default().values();
+    let mut y = four_bar.start(&params);
+    y[3] = 0.4;
+    four_bar.project(&params, 0.0, &mut y).unwrap();
+    let forms = mechlab::constrained::Forms::new(&mechlab::models::four_bar::FORMS, &params);
+    let y: [f64; 6] = y.try_into().unwrap();
+    let four_bar_error = central_differences(&mechlab::models::four_bar::Exact::new(forms), &y);
+    assert!(four_bar_error < 1e-6, "four-bar: {four_bar_error:e}");
+}

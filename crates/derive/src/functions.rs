@@ -70,6 +70,8 @@ pub enum Inputs {
     TimeCoordinates,
     /// Those as dual numbers (time stays f64), for Jacobians at run time.
     DualTimeCoordinates,
+    /// Coordinates and velocities as dual numbers, at time t.
+    DualCoordinatesVelocities,
     /// The Hamiltonian state `y = [q, p]` at time t.
     State,
     /// The state of the autonomous averaged system.
@@ -169,6 +171,14 @@ impl Context<'_> {
                 prelude.push(format!("let [{}] = *q;", self.coordinates().join(", ")));
                 format!("{time}: f64, q: &[crate::ode::Dual; {n}], params: &Params")
             }
+            Inputs::DualCoordinatesVelocities => {
+                prelude.push(format!(
+                    "let ([{}], [{}]) = (*q, *qd);",
+                    self.coordinates().join(", "),
+                    self.velocities().join(", ")
+                ));
+                format!("{time}: f64, q: &[crate::ode::Dual; {n}], qd: &[crate::ode::Dual; {n}], params: &Params")
+            }
             Inputs::ContactState => {
                 prelude.push(format!("let [{}] = *y;", self.contact_state.join(", ")));
                 format!("y: &[f64; {}], params: &Params", 2 * n)
@@ -205,6 +215,7 @@ impl Context<'_> {
                 | Inputs::CoordinatesVelocities
                 | Inputs::TimeCoordinates
                 | Inputs::DualTimeCoordinates
+                | Inputs::DualCoordinatesVelocities
         ) {
             prelude.extend(phase_line);
         }
@@ -242,7 +253,8 @@ impl Context<'_> {
             Inputs::DualState
             | Inputs::DualAveragedState
             | Inputs::DualCoordinates
-            | Inputs::DualTimeCoordinates => {
+            | Inputs::DualTimeCoordinates
+            | Inputs::DualCoordinatesVelocities => {
                 emitter.factorisation = Some("crate::ode::dual::Cholesky");
                 Some("crate::ode::Dual::from")
             }

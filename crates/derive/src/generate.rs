@@ -566,20 +566,38 @@ fn constrained_taylor(
 
 /// The field [q'; q''] of the motion on the constraints as one function
 /// ([`constrained_steps`]): the forms share their subexpressions.
+/// With `dual`, its twin over dual numbers (the Jacobian of a model
+/// without Taylor recurrences).
 fn constrained_rhs(
     cx: &Context,
     derivation: &ConstrainedDerivation,
+    dual: bool,
 ) -> Result<crate::functions::Function, DeriveError> {
     let (steps, outputs) = constrained_steps(cx, derivation);
+    let (name, inputs, number) = match dual {
+        false => ("exact_rhs", Inputs::CoordinatesVelocities, "f64"),
+        true => (
+            "exact_rhs_dual",
+            Inputs::DualCoordinatesVelocities,
+            "crate::ode::Dual",
+        ),
+    };
     cx.function_steps(
-        "exact_rhs",
+        name,
         "The field [q'; q''] of the motion on the constraints at (t, q, q'): M q'' = F + Gᵀλ with G q'' + h = 0, by the Schur complement. NaN where M or G M⁻¹Gᵀ is not positive definite.",
-        Inputs::CoordinatesVelocities,
-        format!("[f64; {}]", outputs.len()),
+        inputs,
+        format!("[{number}; {}]", outputs.len()),
         &steps,
         format!("[{}]", outputs.join(", ")),
     )
 }
+
+/// The most coordinates a constrained model has Taylor recurrences for.
+/// The recurrences solve with M at every order, and they are compiled in
+/// three number types (f64, the batch lanes, dual numbers): for a closed
+/// chain of ten rods they were two thirds of its module and a tenth of
+/// the test command's build. A larger model runs the other methods.
+pub const TAYLOR_COORDINATES: usize = 6;
 
 /// Renders the generated module of a model with ideal constraints.
 pub fn render_constrained(
@@ -598,8 +616,15 @@ pub fn render_constrained(
     };
     let mut functions = constrained_functions(&cx, derivation)?;
     functions.extend(crate::functions::drawing_function(&cx)?);
-    functions.push(constrained_rhs(&cx, derivation)?);
-    let taylor_functions = vec![constrained_taylor(&cx, derivation)?];
+    functions.push(constrained_rhs(&cx, derivation, false)?);
+    let has_taylor = n <= TAYLOR_COORDINATES;
+    let taylor_functions = match has_taylor {
+        true => vec![constrained_taylor(&cx, derivation)?],
+        false => {
+            functions.push(constrained_rhs(&cx, derivation, true)?);
+            Vec::new()
+        }
+    };
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);
     context.insert("constraints", &k);
@@ -624,6 +649,8 @@ pub fn render_constrained(
     context.insert("functions", &functions);
     context.insert("taylor_functions", &taylor_functions);
     context.insert("tangents_by_dual_numbers", &true);
+    context.insert("has_taylor", &has_taylor);
+    context.insert("taylor_coordinates", &TAYLOR_COORDINATES);
     tera.render("constrained_model.rs.tera", &context)
         .map_err(|source| DeriveError::Template {
             template: "constrained_model.rs.tera",

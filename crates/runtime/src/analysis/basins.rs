@@ -136,6 +136,7 @@ pub fn basins(
 ) -> Result<Basins, BasinsError> {
     let name = model.info.name;
     let flows = super::flows(model)?;
+    super::method_applies(model, settings.method)?;
     Refusal::named_values(model.info, params)?;
     let period = flows
         .phase_period(params)

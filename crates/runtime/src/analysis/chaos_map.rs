@@ -100,6 +100,7 @@ pub fn chaos_map(
     row_done: &(dyn Fn() -> bool + Sync),
 ) -> Result<ChaosMap, ChaosMapError> {
     let systems = crate::analysis::flows(model)?;
+    crate::analysis::method_applies(model, settings.method)?;
     let info = systems.info();
     let period = super::period_map::fast_phase_period(systems, params)?;
     let periodic = systems.periodic_state();

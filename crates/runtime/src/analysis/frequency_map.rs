@@ -179,6 +179,8 @@ pub fn period_map_frequencies(
     done: &(dyn Fn(usize) + Sync),
 ) -> Result<FrequencyMap, super::period_map::PeriodMapError> {
     let flows = super::flows(model)?;
+
+    super::method_applies(model, settings.method)?;
     let info = model.info;
     let period = super::period_map::fast_phase_period(flows, params)?;
     if settings.periods < 64 {

@@ -83,6 +83,7 @@ pub fn animate(
         .ok_or_else(|| MechanismError::NotDrawn { model: name.into() })?;
     Refusal::named_values(info, params)?;
     let flows = super::flows(model)?;
+    super::method_applies(model, method)?;
     if !(frames.duration.is_finite() && frames.duration > 0.0) {
         return Err(
             Refusal::setting(name, "the animation's duration must be finite and positive").into(),

@@ -117,6 +117,25 @@ pub fn flows(
         .ok_or_else(|| Refusal::contact_model(model.info.name))
 }
 
+/// Refuses the Taylor method for a model without Taylor recurrences (a
+/// constrained model of more than 6 coordinates): one refusal instead of
+/// every orbit stopping.
+pub(crate) fn method_applies(
+    model: &crate::registry::Model,
+    method: crate::ode::Method,
+) -> Result<(), Refusal> {
+    let recurrences = model
+        .flows()
+        .is_none_or(|flows| flows.has_taylor_recurrences());
+    match (recurrences, method) {
+        (false, crate::ode::Method::Taylor { .. }) => Err(Refusal::Setting {
+            model: model.info.name.into(),
+            requirement: "a constrained model of more than 6 coordinates has no Taylor recurrences (compiled in three number types, they would cost its build more than the method saves): set method to dop853, radau5, gauss4, gauss6 or rk4",
+        }),
+        _ => Ok(()),
+    }
+}
+
 impl Refusal {
     pub fn contact_model(model: impl Into<String>) -> Refusal {
         Refusal::ContactModel {

@@ -210,6 +210,7 @@ pub fn portrait(
     settings: &PortraitSettings,
 ) -> Result<Portrait, PeriodMapError> {
     let systems = crate::analysis::flows(model)?;
+    crate::analysis::method_applies(model, settings.method)?;
     let info = systems.info();
     let named = Refusal::named_values(info, params)?;
     let period = fast_phase_period(systems, params)?;

@@ -70,16 +70,21 @@ pub struct FormsTable<const N: usize, const K: usize, const S: usize> {
     /// and the constraints' curvature).
     pub constraint_jacobian_dual: fn(&[f64], f64, &[Dual; N]) -> [[Dual; N]; K],
     pub constraint_rates_dual: fn(&[f64], f64, &[Dual; N]) -> [Dual; K],
-    /// The generated Taylor recurrences of the motion on the constraints
-    /// through (t, y), y = [q; q'] (see `crate::ode::System::taylor`), in
-    /// f64, over dual numbers (the Jacobian, the tangent recurrences) and
-    /// in the batch lanes (lane l with the parameters `params[l]`).
+    /// ∂f/∂y of the field, exact to round-off (by dual numbers).
+    pub jacobian: fn(&[f64], f64, &[f64; S]) -> [[f64; S]; S],
+    /// The generated Taylor recurrences, for a model of at most
+    /// `TAYLOR_COORDINATES` (6) coordinates.
+    pub recurrences: Option<Recurrences<S>>,
+}
+
+/// The generated Taylor recurrences of the motion on the constraints
+/// through (t, y), y = [q; q'] (see `crate::ode::System::taylor`): in f64,
+/// in the batch lanes (lane l with the parameters `params[l]`), and with
+/// tangent vectors z = [y; V] (see `crate::ode::System::taylor_variational`).
+pub struct Recurrences<const S: usize> {
     pub taylor: TaylorOf<f64, S>,
-    pub taylor_dual: TaylorOf<Dual, S>,
     pub taylor_lanes:
         fn([&[f64]; LANES], Lanes, &[Lanes; S], usize, &mut TaylorWork<Lanes>, &mut [[Lanes; S]]),
-    /// The recurrences with tangent vectors, z = [y; V] (see
-    /// `crate::ode::System::taylor_variational`).
     pub taylor_variational: fn(&[f64], f64, &[f64], usize, &mut TaylorWork<f64>, &mut [f64]),
 }
 
@@ -156,9 +161,9 @@ impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
         (self.table.constraint_rates_dual)(&self.params, t, q)
     }
 
-    /// The recurrences in `Num`: f64 and dual numbers have them (a number
-    /// type of another kind, false). The coefficients go through a buffer
-    /// of the table's type, a copy small beside the recurrences.
+    /// The recurrences in `Num` where the model has them and `Num` is f64
+    /// (false otherwise). The coefficients go through a buffer of f64, a
+    /// copy small beside the recurrences.
     fn taylor<Num: Scalar>(
         &self,
         t: Num,
@@ -167,34 +172,23 @@ impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
         work: &mut TaylorWork<Num>,
         out: &mut [[Num; S]],
     ) -> bool {
-        fn run<Num: Scalar, T: Scalar, const S: usize>(
-            recurrences: TaylorOf<T, S>,
-            params: &[f64],
-            t: Num,
-            y: &[Num; S],
-            order: usize,
-            work: &mut TaylorWork<Num>,
-            out: &mut [[Num; S]],
-        ) -> bool {
-            use std::any::Any;
-            let (Some(&t), Some(y), Some(work)) = (
-                (&t as &dyn Any).downcast_ref::<T>(),
-                (y as &dyn Any).downcast_ref::<[T; S]>(),
-                (work as &mut dyn Any).downcast_mut::<TaylorWork<T>>(),
-            ) else {
-                return false;
-            };
-            let mut coefficients = vec![[T::default(); S]; out.len()];
-            recurrences(params, t, y, order, work, &mut coefficients);
-            for (row, computed) in out.iter_mut().zip(coefficients) {
-                if let Some(row) = (row as &mut dyn Any).downcast_mut::<[T; S]>() {
-                    *row = computed;
-                }
+        use std::any::Any;
+        let (Some(recurrences), Some(&t), Some(y), Some(work)) = (
+            &self.table.recurrences,
+            (&t as &dyn Any).downcast_ref::<f64>(),
+            (y as &dyn Any).downcast_ref::<[f64; S]>(),
+            (work as &mut dyn Any).downcast_mut::<TaylorWork<f64>>(),
+        ) else {
+            return false;
+        };
+        let mut coefficients = vec![[0.0; S]; out.len()];
+        (recurrences.taylor)(&self.params, t, y, order, work, &mut coefficients);
+        for (row, computed) in out.iter_mut().zip(coefficients) {
+            if let Some(row) = (row as &mut dyn Any).downcast_mut::<[f64; S]>() {
+                *row = computed;
             }
-            true
         }
-        run(self.table.taylor, &self.params, t, y, order, work, out)
-            || run(self.table.taylor_dual, &self.params, t, y, order, work, out)
+        true
     }
 }
 
@@ -291,17 +285,9 @@ impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints
         (self.0.table.rhs)(&self.0.params, t, y)
     }
 
-    /// Exact to round-off: the generated recurrences over dual numbers at
-    /// order 1 (whose coefficient of order 1 is the field), one column a
-    /// pass, so the Jacobian and the Taylor method share one instance.
+    /// Exact to round-off, by dual numbers (the model's table says how).
     fn jacobian(&self, t: f64, y: &[f64; S]) -> Option<[[f64; S]; S]> {
-        let forms = &self.0;
-        Some(crate::ode::dual::jacobian_by_recurrences(
-            y,
-            |y, work, out| {
-                (forms.table.taylor_dual)(&forms.params, Dual::seeded(t, 0.0), y, 1, work, out)
-            },
-        ))
+        Some((self.0.table.jacobian)(&self.0.params, t, y))
     }
 
     #[inline]
@@ -325,8 +311,11 @@ impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints
         work: &mut TaylorWork<Lanes>,
         out: &mut [[Lanes; S]],
     ) -> bool {
+        let Some(recurrences) = &lanes[0].0.table.recurrences else {
+            return false;
+        };
         let params = lanes.map(|system| &system.0.params[..]);
-        (lanes[0].0.table.taylor_lanes)(params, t, y, order, work, out);
+        (recurrences.taylor_lanes)(params, t, y, order, work, out);
         true
     }
 
@@ -340,6 +329,9 @@ impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints
         out: &mut [Num],
     ) -> bool {
         use std::any::Any;
+        let Some(recurrences) = &self.0.table.recurrences else {
+            return false;
+        };
         if z.len() < 2 * S || !z.len().is_multiple_of(S) {
             return false;
         }
@@ -360,7 +352,7 @@ impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints
                     .unwrap_or(f64::NAN)
             })
             .collect();
-        (self.0.table.taylor_variational)(&self.0.params, t, &z, order, work, &mut flat);
+        (recurrences.taylor_variational)(&self.0.params, t, &z, order, work, &mut flat);
         for (slot, x) in out.iter_mut().zip(flat) {
             if let Some(slot) = (slot as &mut dyn Any).downcast_mut::<f64>() {
                 *slot = x;
@@ -378,12 +370,15 @@ impl<const N: usize, const K: usize, const S: usize> System<S> for OnConstraints
         _work: &mut TaylorWork<Lanes>,
         out: &mut [Lanes],
     ) -> bool {
+        let Some(recurrences) = &lanes[0].0.table.recurrences else {
+            return false;
+        };
         if z.len() < 2 * S || !z.len().is_multiple_of(S) {
             return false;
         }
         crate::ode::dual::lane_by_lane(z, out, |l, z, out| {
             let forms = &lanes[l].0;
-            (forms.table.taylor_variational)(
+            (recurrences.taylor_variational)(
                 &forms.params,
                 t.0[l],
                 z,

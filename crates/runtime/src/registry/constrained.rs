@@ -130,6 +130,9 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Flows
     fn exact(&self, params: &[f64]) -> Box<dyn AnySystem> {
         Box::new(Projecting::new(self.equations(params)))
     }
+    fn has_taylor_recurrences(&self) -> bool {
+        self.forms.recurrences.is_some()
+    }
     fn base_state(&self, params: &[f64]) -> Vec<f64> {
         ConstrainedSystems::start(self, params)
     }

@@ -455,6 +455,11 @@ pub trait Flows: Sync {
             &wrap,
         )
     }
+    /// Whether the model has Taylor recurrences (every Hamiltonian model;
+    /// a constrained one up to 6 coordinates).
+    fn has_taylor_recurrences(&self) -> bool {
+        true
+    }
     /// Makes `y` a state of the model at t = 0 holding its components
     /// `held` (a chart's coordinates): a free model's states all are; a
     /// constrained model's other components move onto the constraints.

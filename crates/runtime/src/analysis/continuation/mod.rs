@@ -290,6 +290,7 @@ pub fn continuation(
     settings: &ContinuationSettings,
 ) -> Result<Continuation, ContinuationError> {
     if let Some(constrained) = model.constrained {
+        crate::analysis::method_applies(model, settings.method)?;
         return on_constraints(constrained, params, settings);
     }
     let systems = crate::analysis::hamiltonian(model)?;
