@@ -801,3 +801,59 @@ fn a_large_constrained_model_refuses_the_taylor_method_and_keeps_its_jacobian() 
     let four_bar_error = central_differences(&mechlab::models::four_bar::Exact::new(forms), &y);
     assert!(four_bar_error < 1e-6, "four-bar: {four_bar_error:e}");
 }
+
+/// The attractor analysis by name on a constrained model: Kapitza's
+/// upright with friction, held by the vibration, attracts the point on the
+/// vibrating rod. Its Lyapunov exponents on the constraints are the logs
+/// of the angle model's Floquet multipliers there (|ρ|, a focus), they
+/// sum to ln det = −μT, and so does the divergence of the flow on the
+/// constraint manifold, measured apart along the orbit.
+#[test]
+fn the_attractor_on_the_constraints_has_the_angle_models_exponents() {
+    use mechlab::analysis::attractor::{attractor, AttractorSettings};
+    let (a, eps, mu) = (1.5, 0.1, 0.1);
+    let params = [a, eps, mu];
+    let period = std::f64::consts::TAU * eps;
+    let mut integrator = mechlab::ode::Integrator::new(TIGHT).unwrap();
+    let (_, m) = kapitza::MODEL
+        .systems()
+        .unwrap()
+        .monodromy(&params, &mut integrator, period, &[0.0, 0.0])
+        .unwrap();
+    let mut expected: Vec<f64> = m
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm().ln())
+        .collect();
+    expected.sort_by(|x, y| y.total_cmp(x));
+    let settings = AttractorSettings {
+        method: TIGHT,
+        start: [0.05, 0.0],
+        transient: 100,
+        points: 200,
+        lyapunov_periods: 2000,
+        pixels: 20,
+    };
+    let model = &cartesian_kapitza::MODEL;
+    let found = attractor(model, &params, &settings).unwrap();
+    assert_eq!(found.lyapunov.len(), 2);
+    for (lambda, ln_rho) in found.lyapunov.iter().zip(&expected) {
+        assert!(
+            (lambda - ln_rho).abs() < 1e-3,
+            "λ {:?} against ln|ρ| {expected:?}",
+            found.lyapunov
+        );
+    }
+    assert!(
+        (found.lyapunov_sum + mu * period).abs() < 1e-3,
+        "Σλ = {}",
+        found.lyapunov_sum
+    );
+    assert!(
+        (found.divergence_per_period + mu * period).abs() < 1e-4,
+        "divergence {} against {}",
+        found.divergence_per_period,
+        -mu * period
+    );
+    assert_eq!(found.axes, ["x", "xd"]);
+}

@@ -916,7 +916,8 @@ fn splitting_sweep_of(
 }
 
 /// Scene `attractor`: the attractor of the period map of a forced, damped
-/// 1-degree model by name, its Lyapunov spectrum and dimensions.
+/// model of one degree of freedom (a constrained one: on its constraints)
+/// by name, its Lyapunov spectrum and dimensions.
 pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
     use mechlab_runtime::analysis::attractor::{attractor, AttractorSettings};
     let (model, scene) = generic_scene(
@@ -934,7 +935,11 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
                 "periods of each of the two Lyapunov runs",
             ),
             ("start_q", "1", "the first coordinate of the start"),
-            ("start_p", "0", "the momentum of the start"),
+            (
+                "start_p",
+                "0",
+                "the momentum of the start (a constrained model: the first coordinate's velocity)",
+            ),
             ("pixels", "500", "pixels per side of the density image"),
         ],
     )?;

@@ -39,6 +39,10 @@ pub enum AttractorError {
     Refused(#[from] crate::analysis::Refusal),
     #[error(transparent)]
     Ode(#[from] OdeError),
+    /// A constrained model's start with no state on its constraints near,
+    /// or constraints that degenerate on the way.
+    #[error(transparent)]
+    Constrained(#[from] crate::analysis::on_constraints::ConstrainedError),
 }
 
 /// The attractor, as measured.
@@ -87,6 +91,9 @@ pub fn attractor(
     params: &[f64],
     settings: &AttractorSettings,
 ) -> Result<Attractor, AttractorError> {
+    if let Some(constrained) = model.constrained {
+        return super::on_constraints::attractor::attractor(model, constrained, params, settings);
+    }
     let name = model.info.name.to_string();
     let fixed = match model.sized {
         Some(FixedSize::Dof1(fixed)) => fixed,
@@ -186,7 +193,10 @@ pub fn attractor(
 }
 
 /// The settings' sanity and the memory they ask for, as named errors.
-fn check_settings(settings: &AttractorSettings, name: &str) -> Result<(), AttractorError> {
+pub(crate) fn check_settings(
+    settings: &AttractorSettings,
+    name: &str,
+) -> Result<(), AttractorError> {
     let settings_error = |requirement: &'static str| Refusal::setting(name, requirement);
     if settings.points < 100 || settings.lyapunov_periods < 10 || settings.pixels < 10 {
         return Err(settings_error("points ≥ 100, lyapunov_periods ≥ 10 and pixels ≥ 10").into());
