@@ -118,14 +118,23 @@ pub struct ModelSummary {
     /// The mechanism's points, if its model file names them (the page
     /// draws the mechanism moving from each orbit's seed).
     pub points: Vec<&'static str>,
+    /// Whether the Taylor method runs it (a constrained model of more than
+    /// 6 coordinates has no Taylor recurrences: the page picks DOP853).
+    pub taylor: bool,
 }
 
 /// Every model of `catalog`, in its order.
 pub fn models(catalog: Catalog) -> Vec<ModelSummary> {
-    catalog.iter().map(|m| summary(m.info, m.dynamic)).collect()
+    catalog
+        .iter()
+        .map(|m| {
+            let taylor = m.flows().is_none_or(|f| f.has_taylor_recurrences());
+            summary(m.info, m.dynamic, taylor)
+        })
+        .collect()
 }
 
-fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
+fn summary(info: &'static ModelInfo, model: &dyn DynamicModel, taylor: bool) -> ModelSummary {
     let (kind, dof, fast_phase) = match model.kind() {
         Kind::Hamiltonian { dof, fast_phase } => ("hamiltonian", dof, fast_phase),
         Kind::Contacts { count } => ("contacts", count, false),
@@ -149,6 +158,7 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel) -> ModelSummary {
         }
     });
     ModelSummary {
+        taylor,
         through,
         name: info.name,
         source_file: info.source_file,

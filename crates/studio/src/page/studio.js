@@ -831,9 +831,9 @@ async function chooseModel(name) {
   buildContinuation(model);
   buildSection(model);
   $("order").disabled = !model.fast_phase;
-  // A constrained model has no Taylor recurrences (the solve for its
-  // multipliers is not generated as one yet): its orbits run with DOP853.
-  if (model.kind === "constrained" && $("method").value === "taylor") $("method").value = "dop853";
+  // A constrained model of more than 6 coordinates has no Taylor
+  // recurrences: its orbits run with DOP853.
+  if (!model.taylor && $("method").value === "taylor") $("method").value = "dop853";
   $("order").value = "1";
   studio.mechanism = null;
   $("mechanism-note").textContent = model.points.length
