@@ -53,7 +53,7 @@ impl Cells {
         key.clear();
         key.extend(y.iter().zip(&self.around).map(|(&x, around)| match around {
             Some(n) => {
-                let from_minus_pi = crate::analysis::period_map::wrap_angle(x) + PI;
+                let from_minus_pi = crate::ode::wrap_angle(x) + PI;
                 ((from_minus_pi / self.side).floor() as i64).clamp(0, n - 1)
             }
             None => (x / self.side).floor() as i64,
@@ -123,7 +123,7 @@ pub fn distance(a: &[f64], b: &[f64], wrap: &[bool]) -> f64 {
         .zip(b)
         .zip(wrap)
         .map(|((x, y), &angle)| match angle {
-            true => crate::analysis::period_map::wrap_angle(x - y).abs(),
+            true => crate::ode::wrap_angle(x - y).abs(),
             false => (x - y).abs(),
         })
         .fold(0.0, f64::max)

@@ -2,9 +2,9 @@
 //! with projection at each output time and their reactions, and the
 //! Floquet multipliers on the constraints' tangent space
 //! ([`monodromy_on_constraints`]); stabilisation by vibration in
-//! [`vibration`]; the attractor of a period map in [`attractor`].
+//! [`vibration`] (the attractor of a period map on the constraints is
+//! `analysis::attractor::on_constraints`).
 
-pub mod attractor;
 pub mod vibration;
 
 use nalgebra::DMatrix;

@@ -14,9 +14,10 @@
 
 use nalgebra::DMatrix;
 
-use super::ConstrainedError;
-use crate::analysis::attractor::{Attractor, AttractorError, AttractorSettings};
+use super::types::check_settings;
+use super::{Attractor, AttractorError, AttractorSettings};
 use crate::analysis::dimension::{box_counting, kaplan_yorke_dimension};
+use crate::analysis::on_constraints::ConstrainedError;
 use crate::analysis::Refusal;
 use crate::ode::{wrap_angle, Integrator, Method, OdeError};
 use crate::registry::{ConstrainedSystems, Model};
@@ -24,7 +25,7 @@ use crate::registry::{ConstrainedSystems, Model};
 /// The attractor of `model`'s period map on its constraints at `params`;
 /// `settings.start` gives the first coordinate and its velocity, the other
 /// components go onto the constraints.
-pub fn attractor(
+pub(super) fn attractor(
     model: &Model,
     constrained: &dyn ConstrainedSystems,
     params: &[f64],
@@ -35,7 +36,7 @@ pub fn attractor(
         Some(t) if constrained.has_fast_phase() => t,
         _ => return Err(Refusal::no_fast_phase(name).into()),
     };
-    crate::analysis::attractor::check_settings(settings, name)?;
+    check_settings(settings, name)?;
     let named = Refusal::named_values(model.info, params)?;
     let n = model.info.coordinates.len();
     let chart = [0, n];

@@ -1,17 +1,9 @@
-//! The attractor of the period map of a forced, damped model of one degree
-//! of freedom, by model name: the orbit after its transient as a density
-//! image, the full Lyapunov spectrum with its convergence and an error
-//! from a second initial condition, the check Σλ = ∫₀ᵀ div f dt (the
-//! divergence of the flow averaged along the orbit, measured separately),
-//! and the box-counting and Kaplan–Yorke dimensions.
+//! What the attractor analysis takes and gives, for either kind of model.
 
-use super::dimension::{bounds, box_counting, kaplan_yorke_dimension};
-use super::lyapunov::lyapunov_history;
-use super::period_map::orbit;
+use crate::analysis::dimension::bounds;
 use crate::analysis::Refusal;
-use crate::ode::{ErasedSystem, Integrator, Method, OdeError, Options, System};
+use crate::ode::{Method, OdeError};
 use crate::plot::{ColorMap, Figure, PanelSpec, Rgb};
-use crate::registry::{Fixed, FixedSize, Model};
 use std::collections::BTreeMap;
 
 /// What to compute.
@@ -85,113 +77,6 @@ pub struct Attractor {
     pub axes: [&'static str; 2],
 }
 
-/// The attractor of `model`'s period map at `params`.
-pub fn attractor(
-    model: &Model,
-    params: &[f64],
-    settings: &AttractorSettings,
-) -> Result<Attractor, AttractorError> {
-    if let Some(constrained) = model.constrained {
-        return super::on_constraints::attractor::attractor(model, constrained, params, settings);
-    }
-    let name = model.info.name.to_string();
-    let fixed = match model.sized {
-        Some(FixedSize::Dof1(fixed)) => fixed,
-        Some(_) => {
-            return Err(Refusal::Dimension {
-                model: name,
-                dof: model.info.coordinates.len(),
-                analysis: "the attractor",
-                supported: "one degree of freedom (a period map of the plane)",
-            }
-            .into())
-        }
-        None => return Err(AttractorError::Refused(Refusal::contact_model(name))),
-    };
-    let period = match fixed.phase_period(params) {
-        Some(t) if fixed.has_fast_phase() => t,
-        _ => return Err(AttractorError::Refused(Refusal::no_fast_phase(name))),
-    };
-    check_settings(settings, &name)?;
-    let named = Refusal::named_values(model.info, params)?;
-    let system = fixed.exact(params);
-    let periodic = model.dynamic.periodic()[0];
-    let wrap = [periodic, false];
-    let start = std::time::Instant::now();
-    let mut integrator = Integrator::new(settings.method)?;
-    let settled = *orbit(
-        &mut integrator,
-        &system,
-        period,
-        &settings.start,
-        settings.transient,
-        &wrap,
-    )?
-    .last()
-    .expect("the start at least");
-    let second = [settled[0] + 1e-3, settled[1]];
-    let spectrum = |from: [f64; 2], every: usize| {
-        let mut integrator = Integrator::new(settings.method)?;
-        lyapunov_history::<_, 2, 6>(
-            &mut integrator,
-            &system,
-            period,
-            &from,
-            0,
-            settings.lyapunov_periods,
-            &wrap,
-            every,
-        )
-    };
-    let every = (settings.lyapunov_periods / 200).max(1);
-    let ((first, other), points) = rayon::join(
-        || rayon::join(|| spectrum(settled, every), || spectrum(second, 0)),
-        || {
-            orbit(
-                &mut integrator,
-                &system,
-                period,
-                &settled,
-                settings.points,
-                &wrap,
-            )
-        },
-    );
-    let (first, other) = (first?, other?);
-    let points = points?;
-    let divergence = mean_divergence(&system, period, &points[..points.len().min(200)])?;
-    let sides: Vec<f64> = (2..=9).map(|k| 0.5f64.powi(k)).collect();
-    let counted = box_counting(&points, &sides, 2..sides.len() - 1);
-    let error = first
-        .exponents
-        .iter()
-        .zip(&other.exponents)
-        .map(|(a, b)| (a - b).abs())
-        .collect();
-    Ok(Attractor {
-        model: name,
-        params: named,
-        period,
-        points: points.len(),
-        lyapunov_per_time: first.exponents.iter().map(|l| l / period).collect(),
-        lyapunov_sum: first.exponents.iter().sum(),
-        kaplan_yorke_dimension: kaplan_yorke_dimension(&first.exponents),
-        lyapunov_second_start: other.exponents,
-        lyapunov_error: error,
-        lyapunov: first.exponents,
-        divergence_per_period: divergence,
-        box_dimension: counted.dimension,
-        box_sides: counted.sides,
-        boxes: counted.boxes,
-        seconds: start.elapsed().as_secs_f64(),
-        convergence: first.history,
-        orbit: points,
-        periodic,
-        pixels: settings.pixels,
-        axes: [model.info.coordinates[0], model.info.momenta[0]],
-    })
-}
-
 /// The settings' sanity and the memory they ask for, as named errors.
 pub(crate) fn check_settings(
     settings: &AttractorSettings,
@@ -216,54 +101,6 @@ pub(crate) fn check_settings(
     )
     .map_err(OdeError::from)?;
     Ok(())
-}
-
-/// ∫₀ᵀ tr ∂f/∂y dt from each of `starts` along one period (Simpson's rule
-/// at 64 intervals), averaged over the starts.
-fn mean_divergence(
-    system: &ErasedSystem<2>,
-    period: f64,
-    starts: &[[f64; 2]],
-) -> Result<f64, OdeError> {
-    const INTERVALS: usize = 64;
-    let times: Vec<f64> = (1..=INTERVALS)
-        .map(|k| period * k as f64 / INTERVALS as f64)
-        .collect();
-    let trace = |t: f64, y: &[f64; 2]| {
-        system
-            .jacobian(t, y)
-            .map_or(f64::NAN, |j| j[0][0] + j[1][1])
-    };
-    let mut total = 0.0;
-    for y0 in starts {
-        let mut integrator = Integrator::new(Method::Dop853 {
-            rtol: 1e-10,
-            atol: 1e-10,
-        })?;
-        let states = integrator
-            .solve(
-                system,
-                0.0,
-                y0,
-                times.last().copied().unwrap_or(0.0),
-                Options::default().times(&times),
-            )?
-            .samples;
-        let h = period / INTERVALS as f64;
-        let mut sum = trace(0.0, y0);
-        for (k, (t, y)) in times.iter().zip(&states).enumerate() {
-            let weight = if k + 1 == INTERVALS {
-                1.0
-            } else if k % 2 == 0 {
-                4.0
-            } else {
-                2.0
-            };
-            sum += weight * trace(*t, y);
-        }
-        total += sum * h / 3.0;
-    }
-    Ok(total / starts.len() as f64)
 }
 
 impl Attractor {
