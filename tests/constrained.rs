@@ -857,3 +857,52 @@ fn the_attractor_on_the_constraints_has_the_angle_models_exponents() {
     );
     assert_eq!(found.axes, ["x", "xd"]);
 }
+
+/// On a chaotic attractor (Kapitza's pendulum shaken slowly, ε = 0.5,
+/// A = 1, μ = 0.1, where the angle model's largest exponent is about 0.86
+/// per period), the point on the vibrating rod has the angle model's
+/// exponents within their errors, and its exponents and its divergence
+/// on the manifold sum to −μT (the divergence to the telescoping of the
+/// volume's density over the 200 periods it is averaged on).
+#[test]
+fn a_chaotic_attractor_on_the_constraints_has_the_angle_models_spectrum() {
+    use mechlab::analysis::attractor::{attractor, AttractorSettings};
+    let (eps, a, mu) = (0.5, 1.0, 0.1);
+    let period = std::f64::consts::TAU * eps;
+    let settings = |start: [f64; 2]| AttractorSettings {
+        method: Method::Dop853 {
+            rtol: 1e-10,
+            atol: 1e-10,
+        },
+        start,
+        transient: 200,
+        points: 400,
+        lyapunov_periods: 2000,
+        pixels: 20,
+    };
+    let angle = attractor(&kapitza::MODEL, &[a, eps, mu], &settings([2.0, 0.0])).unwrap();
+    let point = attractor(
+        &cartesian_kapitza::MODEL,
+        &[a, eps, mu],
+        &settings([0.5, 0.0]),
+    )
+    .unwrap();
+    assert!(angle.lyapunov[0] > 0.5, "chaos: {:?}", angle.lyapunov);
+    for (k, (p, q)) in point.lyapunov.iter().zip(&angle.lyapunov).enumerate() {
+        let error = point.lyapunov_error[k] + angle.lyapunov_error[k];
+        assert!(
+            (p - q).abs() < 0.1_f64.max(4.0 * error),
+            "λ{k}: {p} on the rod, {q} by angle (errors {error})"
+        );
+    }
+    assert!(
+        (point.lyapunov_sum + mu * period).abs() < 0.02,
+        "Σλ = {}",
+        point.lyapunov_sum
+    );
+    assert!(
+        (point.divergence_per_period + mu * period).abs() < 0.05,
+        "divergence {}",
+        point.divergence_per_period
+    );
+}

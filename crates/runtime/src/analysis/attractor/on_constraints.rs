@@ -19,7 +19,7 @@ use super::{Attractor, AttractorError, AttractorSettings};
 use crate::analysis::dimension::{box_counting, kaplan_yorke_dimension};
 use crate::analysis::on_constraints::ConstrainedError;
 use crate::analysis::Refusal;
-use crate::ode::{wrap_angle, Integrator, Method, OdeError};
+use crate::ode::{wrap_angle, AnyOptions, Integrator, Method, OdeError};
 use crate::registry::{ConstrainedSystems, Model};
 
 /// The attractor of `model`'s period map on its constraints at `params`;
@@ -197,15 +197,25 @@ fn divergence_over_period(
             .ok_or(OdeError::NonFinite { t, y: y.to_vec() })?;
         Ok((z.transpose() * jacobian * z).trace())
     };
-    let mut states = vec![y0.to_vec()];
+    // One solve with dense output (a stream's segments each start at t = 0,
+    // as a period map's do).
+    let times: Vec<f64> = (1..=INTERVALS).map(|k| k as f64 * h).collect();
     let mut integrator = Integrator::new(Method::Dop853 {
         rtol: 1e-10,
         atol: 1e-10,
     })?;
-    system.stream(&mut integrator, y0, h, INTERVALS, &mut |y| {
-        states.push(y.to_vec());
-        true
-    })?;
+    let mut states = vec![y0.to_vec()];
+    states.extend(
+        system
+            .solve(
+                &mut integrator,
+                0.0,
+                y0,
+                period,
+                AnyOptions::default().times(&times),
+            )?
+            .samples,
+    );
     let mut sum = 0.0;
     for (k, y) in states.iter().enumerate() {
         let weight = match k {
