@@ -5,7 +5,7 @@
 use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError, ValueProblem};
 use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMap, ChaosMapError, ChaosMapSettings};
 use mechlab_runtime::ode::Method;
-use mechlab_runtime::registry::{Catalog, Model};
+use mechlab_runtime::registry::{Catalog, Model, ModelInfo};
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
 /// clear error listing the known ones.
@@ -26,8 +26,13 @@ impl Defaults<'_> {
     }
 }
 
-/// The two state components of the `axes` knob.
-fn axes_from(scene: &Scene) -> Result<[usize; 2], SceneError> {
+/// The two state components of the `axes` knob; `auto` is the first
+/// coordinate and its momentum (a constrained model's: its velocity), the
+/// plane of a period map's phase portrait, which every model has.
+fn axes_from(scene: &Scene, info: &ModelInfo) -> Result<[usize; 2], SceneError> {
+    if scene.text("axes") == "auto" {
+        return Ok([0, info.coordinates.len()]);
+    }
     match scene.numbers("axes")?[..] {
         [x, y] if x >= 0.0 && y >= 0.0 && x.fract() == 0.0 && y.fract() == 0.0 => {
             Ok([x as usize, y as usize])
@@ -115,7 +120,7 @@ pub fn chaos_map_scene(
     let info = model.info;
     let settings = ChaosMapSettings {
         tiles: tiles_from(&scene, ["tile_rows", "only_tiles"])?,
-        ..plane_settings(&scene)?
+        ..plane_settings(&scene, info)?
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
     let params = scene.parameter_values(info)?;
@@ -146,8 +151,8 @@ fn plane_knobs(
     vec![
         (
             "axes",
-            "0,1",
-            "the state components [q; p] along the two axes (0 = first coordinate)",
+            "auto",
+            "the state components [q; p] along the two axes (0 = first coordinate; auto: the first coordinate and its momentum, or velocity)",
         ),
         (
             "through",
@@ -165,9 +170,9 @@ fn plane_knobs(
 }
 
 /// The plane of [`plane_knobs`] and the method, without tiles.
-fn plane_settings(scene: &Scene) -> Result<ChaosMapSettings, SceneError> {
+fn plane_settings(scene: &Scene, info: &ModelInfo) -> Result<ChaosMapSettings, SceneError> {
     Ok(ChaosMapSettings {
-        axes: axes_from(scene)?,
+        axes: axes_from(scene, info)?,
         ranges: [None, None],
         p_max: scene.positive("p_max")?,
         through: (scene.text("through") != "0")
@@ -503,7 +508,7 @@ pub fn period_map_scene(
         overrides,
         ("kapitza", "taylor", "1e-10"),
         &[
-            ("axes", "0,1", "the state components [q; p] drawn (0 = first coordinate)"),
+            ("axes", "auto", "the state components [q; p] drawn (0 = first coordinate; auto: the first coordinate and its momentum, or velocity)"),
             ("seeds", "line", "initial states [q; p], comma-separated, several separated by ';' (line: `count` seeds along the first axis)"),
             ("count", "24", "seeds on the line"),
             ("p_max", "2.5", "the line covers [−p_max, p_max] when the first axis is not an angle"),
@@ -511,7 +516,7 @@ pub fn period_map_scene(
         ],
     )?;
     let info = model.info;
-    let axes = axes_from(&scene)?;
+    let axes = axes_from(&scene, model.info)?;
     let seeds = match scene.text("seeds") {
         "line" => None,
         text => Some(
@@ -567,7 +572,7 @@ pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Resu
         &[],
         ("duffing", "taylor", "1e-10"),
         &[
-            ("axes", "0,1", "the state components along the map's axes"),
+            ("axes", "auto", "the state components along the map's axes (auto: the first coordinate and its momentum, or velocity)"),
             ("x", "-2,2", "the range of the first axis"),
             ("y", "-2,2", "the range of the second axis"),
             ("pixels", "200", "pixels per side"),
@@ -594,7 +599,7 @@ pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Resu
         }
     };
     let settings = BasinSettings {
-        axes: axes_from(&scene)?,
+        axes: axes_from(&scene, model.info)?,
         ranges: [range("x")?, range("y")?],
         through: None,
         pixels: scene.count("pixels")?,
@@ -1390,7 +1395,7 @@ pub fn frequency_map_scene(catalog: Catalog) -> Result<(), SceneError> {
         ("henon_heiles", "taylor", "1e-10"),
         &plane_knobs(("100", "1000")),
     )?;
-    let settings = plane_settings(&scene)?;
+    let settings = plane_settings(&scene, model.info)?;
     let params = scene.parameter_values(model.info)?;
     let progress = Progress::new("frequency map orbits", settings.pixels.pow(2));
     let map = mechlab_runtime::analysis::frequency_map::period_map_frequencies(
