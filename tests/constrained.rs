@@ -906,3 +906,24 @@ fn a_chaotic_attractor_on_the_constraints_has_the_angle_models_spectrum() {
         point.divergence_per_period
     );
 }
+
+/// The figures name a constrained model's velocity as the coordinate's
+/// rate (φ₁′), a Hamiltonian model's momentum as p_φ₁.
+#[test]
+fn a_velocity_is_labelled_as_the_coordinates_rate() {
+    use mechlab::analysis::period_map::{portrait, PortraitSettings};
+    let model = mechlab::models::by_name("four_bar").unwrap();
+    let settings = PortraitSettings {
+        axes: [0, 3],
+        seeds: None,
+        count: 2,
+        p_max: 0.1,
+        periods: 2,
+        method: Method::Taylor { tol: 1e-10 },
+    };
+    let drawn = portrait(model, &model.dynamic.defaults(), &settings).unwrap();
+    assert_eq!(drawn.labels, ["φ₁".to_string(), "φ₁′".to_string()]);
+    assert_eq!(drawn.axes, ["phi1".to_string(), "phi1d".to_string()]);
+    let info = &mechlab::models::double_pendulum::INFO;
+    assert_eq!(info.label(2), format!("p_{}", info.label(0)));
+}

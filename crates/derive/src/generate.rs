@@ -650,6 +650,7 @@ pub fn render_constrained(
     context.insert("taylor_functions", &taylor_functions);
     context.insert("tangents_by_dual_numbers", &true);
     context.insert("has_taylor", &has_taylor);
+    context.insert("state_velocities", &true);
     context.insert("taylor_coordinates", &TAYLOR_COORDINATES);
     tera.render("constrained_model.rs.tera", &context)
         .map_err(|source| DeriveError::Template {

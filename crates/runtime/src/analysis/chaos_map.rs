@@ -44,6 +44,9 @@ pub struct ChaosMap {
     pub params: BTreeMap<String, f64>,
     /// The names of the two axes' state components.
     pub axes: [String; 2],
+    /// The axes in the figures' notation (φ₁, p_φ₁, φ₁′).
+    #[serde(skip)]
+    pub labels: [String; 2],
     pub ranges: [(f64, f64); 2],
     pub through: Vec<f64>,
     pub pixels: usize,
@@ -107,6 +110,7 @@ pub fn chaos_map(
     let Request {
         params: named,
         axes,
+        labels,
         through,
     } = request(info, params, settings, systems.base_state(params))?;
     let ranges = plane_ranges(settings, &periodic);
@@ -195,6 +199,7 @@ pub fn chaos_map(
         model: info.name.into(),
         params: named,
         axes,
+        labels,
         ranges,
         through,
         pixels,
@@ -235,6 +240,7 @@ pub(super) fn request(
     Ok(Request {
         params: named,
         axes,
+        labels: settings.axes.map(|a| info.label(a)),
         through,
     })
 }
@@ -243,6 +249,7 @@ pub(super) fn request(
 pub(super) struct Request {
     pub params: BTreeMap<String, f64>,
     pub axes: [String; 2],
+    pub labels: [String; 2],
     pub through: Vec<f64>,
 }
 
@@ -290,7 +297,7 @@ impl ChaosMap {
             ),
             _ => format!("{}: FLI map, {} periods", self.model, self.periods),
         };
-        let (x, y) = (display_name(&self.axes[0]), display_name(&self.axes[1]));
+        let [x, y] = self.labels.clone();
         let side = self.pixels.max(360);
         let spec = PanelSpec::new(&title, &x, &y, self.ranges[0], self.ranges[1]);
         let label = "FLI: regular level (0) to the 99th percentile (1)";

@@ -157,6 +157,9 @@ pub struct Portrait {
     pub model: String,
     pub params: std::collections::BTreeMap<String, f64>,
     pub axes: [String; 2],
+    /// The axes in the figures' notation (φ₁, p_φ₁, φ₁′).
+    #[serde(skip)]
+    pub labels: [String; 2],
     pub seeds: Vec<Vec<f64>>,
     pub periods: usize,
     /// Orbits that stopped, with the reason (the others are in `orbits`).
@@ -267,6 +270,7 @@ pub fn portrait(
     Ok(Portrait {
         model: info.name.into(),
         params: named,
+        labels: settings.axes.map(|a| info.label(a)),
         axes,
         seeds,
         periods: settings.periods,
@@ -346,7 +350,6 @@ impl Portrait {
     /// The orbits as dots, a colour per orbit, axes in the model's notation.
     pub fn figure(&self) -> crate::plot::Figure {
         use crate::plot::{palette, Figure, PanelSpec};
-        use crate::registry::display_name;
         let range = |k: usize| {
             let values = self
                 .orbits
@@ -369,7 +372,7 @@ impl Portrait {
             self.orbits.len(),
             self.periods
         );
-        let (x, y) = (display_name(&self.axes[0]), display_name(&self.axes[1]));
+        let [x, y] = self.labels.clone();
         let mut figure =
             Figure::single(720, 620, PanelSpec::new(&title, &x, &y, range(0), range(1)));
         for (k, orbit) in self.orbits.iter().enumerate() {

@@ -36,6 +36,9 @@ pub struct ModelInfo {
     pub source_file: &'static str,
     pub coordinates: &'static [&'static str],
     pub momenta: &'static [&'static str],
+    /// Whether the state's second half are the coordinates' velocities
+    /// (a constrained model: `momenta` then names the velocities).
+    pub velocities: bool,
     pub parameter_names: &'static [&'static str],
     /// Defaults of the model file, as text.
     pub parameter_defaults: &'static [&'static str],
@@ -80,6 +83,17 @@ impl ModelInfo {
             .chain(self.momenta)
             .copied()
             .collect()
+    }
+
+    /// State component `index` in the figures' notation: φ₁, p_φ₁, or a
+    /// velocity φ₁′.
+    pub fn label(&self, index: usize) -> String {
+        let n = self.coordinates.len();
+        match (index.checked_sub(n), self.velocities) {
+            (None, _) => display_name(self.coordinates[index]),
+            (Some(i), true) => format!("{}′", display_name(self.coordinates[i])),
+            (Some(i), false) => display_name(self.momenta[i]),
+        }
     }
 
     /// The names of two different state components chosen as a plane's
