@@ -5,15 +5,15 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::recording::{Recorder, Recording};
-use super::{iterates_one_by_one, FliValues, Flows, ModelInfo};
+use super::recording::Recording;
+use super::{iterates_in_lanes, iterates_one_by_one, FliValues, Flows, ModelInfo};
 use crate::constrained::averaged::{AveragedOnConstraints, PhaseMeans};
 use crate::constrained::{
     position_tolerance, Forms, FormsTable, OnConstraints, Projecting, Statics,
 };
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{project_holding, tangent_basis, ConstraintError, Projection};
-use crate::ode::{states_at, AnySystem, Dual, Integrator, LaneIntegrator, Method, OdeError, Orbit};
+use crate::ode::{states_at, AnySystem, Dual, Integrator, Method, OdeError};
 use crate::tangent::lyapunov::fli_of_starts;
 use crate::tangent::variational::Variational;
 
@@ -193,51 +193,25 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Flows
         starts: &[f64],
         recording: &Recording,
     ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
-        use rayon::prelude::*;
         let wrap = Flows::periodic_state(self);
         if !matches!(method, Method::Taylor { .. }) {
             let system = Flows::exact(self, params);
             return iterates_one_by_one(&*system, method, period, starts, recording, &wrap);
         }
-        let starts: Vec<[f64; S]> = starts
-            .chunks(S)
-            .map(fixed_state::<S>)
-            .collect::<Result<_, _>>()?;
         let system = self.equations(params);
-        LaneIntegrator::new(method)?;
-        let blocks: Vec<Vec<Option<Vec<Vec<f64>>>>> = starts
-            .par_chunks(256)
-            .map(|block| {
-                let Ok(mut integrator) = LaneIntegrator::new(method) else {
-                    return vec![None; block.len()];
-                };
-                let orbits = Orbit::of_one_system(&system, period, block);
-                let mut recorders: Vec<Recorder> = block
-                    .iter()
-                    .map(|_| Recorder::new(recording, &wrap))
-                    .collect();
-                let mut periods_done = vec![0usize; block.len()];
-                let mut off_constraints = vec![false; block.len()];
-                let errors = integrator.stream(&orbits, |k, y| {
-                    periods_done[k] += 1;
-                    let t = periods_done[k] as f64 * period;
-                    let tolerance = position_tolerance(&self.forms.periodic, y);
-                    if system.project(t, y, tolerance).is_err() {
-                        off_constraints[k] = true;
-                        return false;
-                    }
-                    recorders[k].push(y)
-                });
-                (recording.done)(block.len());
-                recorders
-                    .into_iter()
-                    .zip(errors)
-                    .zip(off_constraints)
-                    .map(|((recorder, error), off)| recorder.finish(error.is_none() && !off))
-                    .collect()
-            })
-            .collect();
-        Ok(blocks.into_iter().flatten().collect())
+        let on_constraints = |t: f64, y: &mut [f64; S]| {
+            let tolerance = position_tolerance(&self.forms.periodic, y);
+            system.project(t, y, tolerance).is_ok()
+        };
+        iterates_in_lanes(
+            &system,
+            method,
+            period,
+            starts,
+            recording,
+            &wrap,
+            &on_constraints,
+        )
     }
     fn consistent(
         &self,

@@ -519,6 +519,61 @@ fn iterates_one_by_one(
         .collect())
 }
 
+/// [`Flows::iterates`] of `system` by the Taylor method in the batch lanes,
+/// blocks of orbits each through one batch integrator. `settle(t, y)`
+/// takes each state at a period's end (a constrained model puts it on its
+/// constraints); false stops the orbit, with no record.
+fn iterates_in_lanes<S: crate::ode::System<N> + Sync, const N: usize>(
+    system: &S,
+    method: Method,
+    period: f64,
+    starts: &[f64],
+    recording: &Recording,
+    wrap: &[bool],
+    settle: &(dyn Fn(f64, &mut [f64; N]) -> bool + Sync),
+) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
+    use crate::ode::{LaneIntegrator, Orbit};
+    use rayon::prelude::*;
+    let starts: Vec<[f64; N]> = starts
+        .chunks(N)
+        .map(fixed_state::<N>)
+        .collect::<Result<_, _>>()?;
+    LaneIntegrator::new(method)?;
+    let blocks: Vec<Vec<Option<Vec<Vec<f64>>>>> = starts
+        .par_chunks(256)
+        .map(|block| {
+            let Ok(mut integrator) = LaneIntegrator::new(method) else {
+                return vec![None; block.len()];
+            };
+            let orbits = Orbit::of_one_system(system, period, block);
+            let mut recorders: Vec<Recorder> = block
+                .iter()
+                .map(|_| Recorder::new(recording, wrap))
+                .collect();
+            let mut periods_done = vec![0usize; block.len()];
+            let mut unsettled = vec![false; block.len()];
+            let errors = integrator.stream(&orbits, |k, y| {
+                periods_done[k] += 1;
+                if !settle(periods_done[k] as f64 * period, y) {
+                    unsettled[k] = true;
+                    return false;
+                }
+                recorders[k].push(y)
+            });
+            (recording.done)(block.len());
+            recorders
+                .into_iter()
+                .zip(errors)
+                .zip(unsettled)
+                .map(|((recorder, error), unsettled)| {
+                    recorder.finish(error.is_none() && !unsettled)
+                })
+                .collect()
+        })
+        .collect();
+    Ok(blocks.into_iter().flatten().collect())
+}
+
 /// A Hamiltonian model's systems and functions with states as slices: what
 /// the analyses compiled once for every size use (see
 /// [`crate::ode::any_size`]). Parameters are values in declaration order.
@@ -622,41 +677,21 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
         starts: &[f64],
         recording: &Recording,
     ) -> Result<Vec<Option<Vec<Vec<f64>>>>, OdeError> {
-        use crate::ode::{LaneIntegrator, Orbit};
-        use rayon::prelude::*;
         let wrap = Fixed::periodic_state(self);
         if !matches!(method, Method::Taylor { .. }) {
             let system = Flows::exact(self, params);
             return iterates_one_by_one(&*system, method, period, starts, recording, &wrap);
         }
-        let starts: Vec<[f64; S]> = starts
-            .chunks(S)
-            .map(fixed_state::<S>)
-            .collect::<Result<_, _>>()?;
         let system = Fixed::exact(self, params);
-        LaneIntegrator::new(method)?;
-        // Blocks of orbits, each through one batch integrator.
-        let blocks: Vec<Vec<Option<Vec<Vec<f64>>>>> = starts
-            .par_chunks(256)
-            .map(|block| {
-                let Ok(mut integrator) = LaneIntegrator::new(method) else {
-                    return vec![None; block.len()];
-                };
-                let orbits = Orbit::of_one_system(&system, period, block);
-                let mut recorders: Vec<Recorder> = block
-                    .iter()
-                    .map(|_| Recorder::new(recording, &wrap))
-                    .collect();
-                let errors = integrator.stream(&orbits, |k, y| recorders[k].push(y));
-                (recording.done)(block.len());
-                recorders
-                    .into_iter()
-                    .zip(errors)
-                    .map(|(recorder, error)| recorder.finish(error.is_none()))
-                    .collect()
-            })
-            .collect();
-        Ok(blocks.into_iter().flatten().collect())
+        iterates_in_lanes(
+            &system,
+            method,
+            period,
+            starts,
+            recording,
+            &wrap,
+            &|_, _| true,
+        )
     }
 }
 
