@@ -11,7 +11,7 @@ use mechlab::models;
 
 fn settings(energy: f64) -> SectionSettings {
     SectionSettings {
-        plane: [1.0, 0.0],
+        plane: vec![1.0, 0.0],
         value: 0.0,
         rising: true,
         energy,
@@ -222,7 +222,7 @@ fn planes_are_read_as_linear_functions_of_the_coordinates() {
 fn a_tilted_plane_has_a_canonical_chart() {
     let model = models::by_name("henon_heiles").unwrap();
     let tilted = |energy: f64, crossings: usize| SectionSettings {
-        plane: [1.0, 0.5],
+        plane: vec![1.0, 0.5],
         crossings,
         ..settings(energy)
     };
@@ -245,7 +245,7 @@ fn a_tilted_plane_has_a_canonical_chart() {
     }
     // The same plane written as −x − 0.5 y, crossed falling: the same map.
     let turned = SectionSettings {
-        plane: [-1.0, -0.5],
+        plane: vec![-1.0, -0.5],
         rising: false,
         ..tilted(0.125, 2)
     };
@@ -441,7 +441,7 @@ fn orbits_that_end_early_say_why_and_seeds_go_where_orbits_recur() {
     let model = &mechlab_test_models::swinging_atwood::MODEL;
     let params = model.dynamic.defaults(); // M = 3, m = 1, g = 1
     let s = SectionSettings {
-        plane: [0.0, 1.0],
+        plane: vec![0.0, 1.0],
         energy: 1.0,
         crossings: 20,
         t_max: 400.0,
@@ -592,4 +592,117 @@ fn the_diffusion_index_is_small_on_tori_and_large_in_the_chaotic_sea() {
         .flat_map(|nu| nu.iter().map(|f| (f.abs() - 1.0).abs()))
         .fold(0.0, f64::max);
     assert!(worst < 1e-9, "uncoupled: {worst}");
+}
+
+/// The free double pendulum written with two Cartesian points on two rods
+/// has the angle model's section: on x₁ = 0 (φ₁ = 0, rising), orbits from
+/// the same states cross at the same points, x₂ = l₂ sin φ₂. The angle
+/// model's seeds come from the Cartesian starts by a hand-written
+/// Legendre map.
+#[test]
+fn two_points_on_two_rods_cross_their_plane_where_the_angle_model_does() {
+    let points = &mechlab_test_models::cartesian_free_double_pendulum::MODEL;
+    let angles = models::by_name("free_double_pendulum").unwrap();
+    let params = [1.0, 1.0, 1.0, 1.0, 1.0]; // m1, m2, l1, l2, g
+    let energy = -2.5; // the hanging rest is at −3
+    let cartesian = SectionSettings {
+        plane: parse_plane("x1", points.info.coordinates).unwrap(),
+        crossings: 25,
+        t_max: 500.0,
+        ..settings(energy)
+    };
+    let seeds = seeds_across(points, &params, &cartesian, 2.0, 4);
+    assert_eq!(seeds.len(), 4);
+    // On x₁ = 0 at E = −2.5: −1 − cos φ₂ − … ≤ E needs |x₂| < sin(acos 0.5).
+    assert!(seeds.iter().all(|s| s[0].abs() < 0.87), "{seeds:?}");
+    let drawn = section(points, &params, &seeds, &cartesian).unwrap();
+    assert_eq!(drawn.axes, ["x₂", "x₂′"]);
+    assert!(
+        drawn.largest_energy_drift < 1e-9,
+        "{}",
+        drawn.largest_energy_drift
+    );
+    // The event located to 1e-12 in time, then the projection.
+    assert!(
+        drawn.largest_plane_distance < 1e-10,
+        "{}",
+        drawn.largest_plane_distance
+    );
+    // Each Cartesian start as the angle model's seed (φ₂, p₂), φ₁ = 0.
+    let (m1, m2, l1, l2) = (1.0, 1.0, 1.0, 1.0);
+    let mut angle_seeds = Vec::new();
+    let mut angle_p1 = Vec::new();
+    for orbit in &drawn.orbits {
+        let y = &orbit.start;
+        assert_eq!(orbit.end, OrbitEnd::Complete);
+        let (u, w) = (y[2] - y[0], y[1] - y[3]);
+        let phi2 = u.atan2(w);
+        let phi1_rate = (-y[1] * y[4] + y[0] * y[5]) / (l1 * l1);
+        let phi2_rate = (w * (y[6] - y[4]) - u * (y[5] - y[7])) / (l2 * l2);
+        let m12 = m2 * l1 * l2 * phi2.cos(); // cos(φ₁ − φ₂) at φ₁ = 0
+        angle_p1.push((m1 + m2) * l1 * l1 * phi1_rate + m12 * phi2_rate);
+        angle_seeds.push([phi2, m12 * phi1_rate + m2 * l2 * l2 * phi2_rate]);
+    }
+    let angle = SectionSettings {
+        plane: vec![1.0, 0.0],
+        crossings: 25,
+        t_max: 500.0,
+        ..settings(energy)
+    };
+    let reference = section(angles, &params, &angle_seeds, &angle).unwrap();
+    let mut worst: f64 = 0.0;
+    for ((a, b), p1) in reference.orbits.iter().zip(&drawn.orbits).zip(&angle_p1) {
+        // The angle model solved p₁ from H = E as the constraints did.
+        assert!(
+            (a.start[2] - p1).abs() < 1e-10,
+            "p1 {} against {p1}",
+            a.start[2]
+        );
+        assert_eq!(a.points.len(), b.points.len());
+        for (pa, pb) in a.points.iter().zip(&b.points) {
+            worst = worst.max((l2 * pa[0].sin() - pb[0]).abs());
+        }
+    }
+    assert!(worst < 1e-8, "x₂ differs by {worst:e}");
+}
+
+/// A section on constraints is refused, with the reason, where it does not
+/// apply: a fast phase, one degree of freedom, a nonholonomic constraint,
+/// a plane of two coordinates.
+#[test]
+fn sections_on_constraints_are_refused_where_they_do_not_apply() {
+    let refused = |name: &str, plane: Vec<f64>| {
+        let model = models::by_name(name).unwrap();
+        let params = model.dynamic.defaults();
+        let s = SectionSettings {
+            plane,
+            ..settings(0.0)
+        };
+        match section(model, &params, &[[0.0, 0.0]], &s) {
+            Err(SectionError::Refused(refusal)) => refusal,
+            other => panic!("{name}: {other:?}"),
+        }
+    };
+    assert!(matches!(
+        refused("four_bar", vec![1.0, 0.0, 0.0]),
+        Refusal::FastPhase { .. }
+    ));
+    assert!(matches!(
+        refused("slider_crank", vec![1.0, 0.0, 0.0]),
+        Refusal::Dimension { dof: 1, .. }
+    ));
+    let nonholonomic = refused("chaplygin_sleigh", vec![1.0, 0.0, 0.0]);
+    assert!(
+        nonholonomic.to_string().contains("holonomic"),
+        "{nonholonomic}"
+    );
+    let points = &mechlab_test_models::cartesian_free_double_pendulum::MODEL;
+    let s = SectionSettings {
+        plane: vec![1.0, 0.0, 1.0, 0.0],
+        ..settings(-2.5)
+    };
+    match section(points, &[1.0; 5], &[[0.0, 0.0]], &s) {
+        Err(SectionError::Refused(r)) => assert!(r.to_string().contains("one coordinate"), "{r}"),
+        other => panic!("{other:?}"),
+    }
 }

@@ -594,7 +594,7 @@ async fn section_orbits_and_their_megno_map() {
     assert!(answer["energy_drift"].as_f64().unwrap() < 1e-9, "{body}");
     let model = mechlab::models::by_name("henon_heiles").unwrap();
     let settings = SectionSettings {
-        plane: [1.0, 0.0],
+        plane: vec![1.0, 0.0],
         value: 0.0,
         rising: true,
         energy: 0.125,
@@ -626,7 +626,7 @@ async fn section_orbits_and_their_megno_map() {
     assert_eq!(answer["axes"], json!(["y", "p_y − 0.5·p_x"]));
     let points: Vec<[f64; 2]> = serde_json::from_value(answer["points"].clone()).unwrap();
     let on_tilted = SectionSettings {
-        plane: [1.0, 0.5],
+        plane: vec![1.0, 0.5],
         crossings: 30,
         t_max: 20.0 * 30.0 + 100.0,
         ..settings.clone()

@@ -99,12 +99,9 @@ pub enum Refusal {
 pub(crate) fn hamiltonian(
     model: &crate::registry::Model,
 ) -> Result<&'static dyn crate::registry::Systems, Refusal> {
-    model.systems().ok_or_else(|| match model.constrained {
-        Some(_) => Refusal::Constrained {
-            model: model.info.name.into(),
-        },
-        None => Refusal::contact_model(model.info.name),
-    })
+    model
+        .systems()
+        .ok_or_else(|| Refusal::without_hamiltonian_form(model))
 }
 
 /// The model's flows (Hamiltonian or constrained), or the refusal of a
@@ -137,6 +134,18 @@ pub(crate) fn method_applies(
 }
 
 impl Refusal {
+    /// The refusal of a model without a Hamiltonian form: a constrained
+    /// model's (the analysis does not run on constraints yet) or a contact
+    /// model's.
+    pub fn without_hamiltonian_form(model: &crate::registry::Model) -> Refusal {
+        match model.constrained {
+            Some(_) => Refusal::Constrained {
+                model: model.info.name.into(),
+            },
+            None => Refusal::contact_model(model.info.name),
+        }
+    }
+
     pub fn contact_model(model: impl Into<String>) -> Refusal {
         Refusal::ContactModel {
             model: model.into(),

@@ -94,7 +94,11 @@ impl SectionGrid {
                 }
                 .into())
             }
-            None => return Err(SectionError::Refused(Refusal::contact_model(name))),
+            None => {
+                return Err(SectionError::Refused(Refusal::without_hamiltonian_form(
+                    model,
+                )))
+            }
         };
         let bad =
             |requirement: &'static str| SectionError::from(Refusal::setting(&name, requirement));

@@ -1089,8 +1089,9 @@ impl SectionPlane {
             (Some(text), _) if !text.trim().is_empty() => {
                 mechlab_runtime::analysis::section::parse_plane(text, coordinates)?
             }
-            (_, 0) => [1.0, 0.0],
-            _ => [0.0, 1.0],
+            (_, chosen) => (0..coordinates.len())
+                .map(|i| if i == chosen { 1.0 } else { 0.0 })
+                .collect(),
         };
         Ok(mechlab_runtime::analysis::section::SectionSettings {
             plane,

@@ -15,6 +15,8 @@
 //! event location); each orbit reports how far its points drifted from
 //! H = E and from the plane.
 
+mod on_constraints;
+
 use crate::analysis::Refusal;
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options};
 use crate::registry::{Fixed, FixedSize, Model};
@@ -23,9 +25,11 @@ use rayon::prelude::*;
 /// Where the section lies and how far each orbit is followed.
 #[derive(Clone, Debug)]
 pub struct SectionSettings {
-    /// The plane a·q = value, a linear function of the coordinates ([1, 0]:
-    /// the first coordinate's plane; [1, −1]: equal coordinates).
-    pub plane: [f64; 2],
+    /// The plane a·q = value, a linear function of the coordinates, one
+    /// coefficient per coordinate ([1, 0]: the first coordinate's plane;
+    /// [1, −1]: equal coordinates). A constrained model's plane is one
+    /// coordinate's.
+    pub plane: Vec<f64>,
     pub value: f64,
     /// Crossings with a·q increasing (else decreasing).
     pub rising: bool,
@@ -190,6 +194,18 @@ pub enum SectionError {
     /// singularity of the mass matrix at the seed).
     #[error("seed ({}, {}): H is not quadratic and convex in the momentum there (a singular point of the chart?)", seed[0], seed[1])]
     Singular { seed: [f64; 2] },
+    /// A constrained model's seed with no consistent state on the plane.
+    #[error("seed ({}, {}): no state on the constraints there: {source}", seed[0], seed[1])]
+    Constraint {
+        seed: [f64; 2],
+        source: crate::ode::holonomic::ConstraintError,
+    },
+    /// A constrained model's start that cannot be put on its constraints.
+    #[error("model '{model}': its start is not near its constraints: {source}")]
+    Start {
+        model: String,
+        source: crate::ode::holonomic::ConstraintError,
+    },
     #[error(transparent)]
     Plane(#[from] PlaneTextError),
     #[error("method: {0}")]
@@ -203,6 +219,9 @@ pub fn section(
     seeds: &[[f64; 2]],
     settings: &SectionSettings,
 ) -> Result<Section, SectionError> {
+    if let Some(systems) = model.constrained {
+        return on_constraints::section(model, systems, params, seeds, settings);
+    }
     let work = Sections {
         model,
         params,
@@ -372,7 +391,7 @@ impl Sections<'_> {
             energy_of: if stroboscope.is_some() { "H̄" } else { "H" },
             plane: format!(
                 "{} = {} ({}{})",
-                plane_name(s.plane, &names),
+                plane_name(&s.plane, &names),
                 short(s.value),
                 if s.rising { "increasing" } else { "decreasing" },
                 match stroboscope {
@@ -603,8 +622,13 @@ pub(super) struct Chart {
 impl Chart {
     /// None for a plane whose coefficients are not finite or both 0.
     pub(super) fn new(s: &SectionSettings, dof: usize, periodic: &[bool]) -> Option<Chart> {
-        let a = s.plane;
-        if dof != 2 || periodic.len() != 2 || !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
+        let a = &s.plane;
+        if dof != 2
+            || periodic.len() != 2
+            || a.len() != 2
+            || !a.iter().all(|x| x.is_finite())
+            || a.iter().all(|&x| x == 0.0)
+        {
             return None;
         }
         let c = if a[0].abs() >= a[1].abs() { 0 } else { 1 };
@@ -718,7 +742,7 @@ impl Chart {
 }
 
 /// a·q as text, "x", "q1 − q2", "2·x + 0.5·y".
-fn plane_name(a: [f64; 2], names: &[&str]) -> String {
+fn plane_name(a: &[f64], names: &[&str]) -> String {
     let mut text = String::new();
     for (k, name) in a.iter().zip(names) {
         if *k == 0.0 {
@@ -737,12 +761,12 @@ fn plane_name(a: [f64; 2], names: &[&str]) -> String {
 
 /// A plane written as a linear function of the coordinates' names, as in
 /// "x", "q1 - q2", "x + 0.5*y" or "-2*y", as its coefficients.
-pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneTextError> {
+pub fn parse_plane(text: &str, names: &[&str]) -> Result<Vec<f64>, PlaneTextError> {
     let bad = |problem: PlaneTextProblem| PlaneTextError {
         text: text.to_string(),
         problem,
     };
-    let mut a = [0.0; 2];
+    let mut a = vec![0.0; names.len()];
     // Split into signed terms at + or − that do not follow an exponent's e.
     let mut terms: Vec<String> = vec![String::new()];
     let chars: Vec<char> = text.chars().filter(|c| !c.is_whitespace()).collect();
@@ -775,7 +799,7 @@ pub fn parse_plane(text: &str, names: &[&str]) -> Result<[f64; 2], PlaneTextErro
             .ok_or_else(|| bad(PlaneTextProblem::Term))?;
         a[index] += sign * factor;
     }
-    if !a.iter().all(|x| x.is_finite()) || a == [0.0, 0.0] {
+    if !a.iter().all(|x| x.is_finite()) || a.iter().all(|&x| x == 0.0) {
         return Err(bad(PlaneTextProblem::Zero));
     }
     Ok(a)
@@ -864,7 +888,11 @@ pub(super) fn on_plane<const S: usize>(
 /// [α, β, γ] of H = α p² + β p + γ along one momentum, from its values at
 /// p = −1, 0, 1 (exact: H is quadratic in the momenta).
 pub(super) fn quadratic(h: impl Fn(f64) -> f64) -> [f64; 3] {
-    let (minus, zero, plus) = (h(-1.0), h(0.0), h(1.0));
+    quadratic_through([h(-1.0), h(0.0), h(1.0)])
+}
+
+/// [α, β, γ] of the quadratic through its values at p = −1, 0, 1.
+fn quadratic_through([minus, zero, plus]: [f64; 3]) -> [f64; 3] {
     [0.5 * (plus + minus) - zero, 0.5 * (plus - minus), zero]
 }
 
@@ -879,6 +907,9 @@ pub fn seeds_across(
     extent: f64,
     count: usize,
 ) -> Vec<[f64; 2]> {
+    if let Some(systems) = model.constrained {
+        return on_constraints::seeds_across(model, systems, params, settings, extent, count);
+    }
     let dof = model.info.coordinates.len();
     let Some(chart) = Chart::new(settings, dof, &model.dynamic.periodic()) else {
         return Vec::new();
@@ -888,14 +919,27 @@ pub fn seeds_across(
     };
     let energy = |y: &[f64; 4]| energy(y);
     let least = |q: f64| chart.least_energy(&[q, 0.0], &energy);
-    let grid = 2001;
     let centre = chart.centred(least, settings.energy).centre();
+    seeds_on_line(least, centre, extent, settings.energy, count)
+}
+
+/// `count` seeds (q, 0) evenly over the stretch of [centre − extent,
+/// centre + extent] around the centre where `least`(q) < `energy`, else
+/// over its longest such stretch; none where there is none.
+fn seeds_on_line(
+    least: impl Fn(f64) -> f64,
+    centre: f64,
+    extent: f64,
+    energy: f64,
+    count: usize,
+) -> Vec<[f64; 2]> {
+    let grid = 2001;
     let q = |i: usize| centre - extent + 2.0 * extent * i as f64 / (grid - 1) as f64;
     // The accessible runs of the grid; the one around 0 (else the longest):
     // beyond a barrier the energy may be accessible again on an open branch.
     let mut runs: Vec<(usize, usize)> = Vec::new();
     for i in 0..grid {
-        if least(q(i)) < settings.energy {
+        if least(q(i)) < energy {
             match runs.last_mut() {
                 Some(run) if run.1 + 1 == i => run.1 = i,
                 _ => runs.push((i, i)),
@@ -923,7 +967,7 @@ pub fn seeds_across(
     let (lo, hi) = (q(first), q(last));
     (0..count)
         .map(|k| [lo + (hi - lo) * (k as f64 + 0.5) / count as f64, 0.0])
-        .filter(|&[q, _]| least(q) < settings.energy)
+        .filter(|&[q, _]| least(q) < energy)
         .collect()
 }
 
