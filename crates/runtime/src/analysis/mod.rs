@@ -24,6 +24,7 @@ pub mod section_map;
 pub mod separatrix;
 pub mod stability;
 pub mod standard_map;
+pub mod states;
 pub mod tiles;
 pub mod vibrational_stability;
 

@@ -1,0 +1,476 @@
+//! `mechlab._native`: the generated models of `models/` and their analyses
+//! for Python, NumPy arrays in and out. Each call resolves the model's
+//! parameters by name (checked against their ranges), runs one library
+//! function off the GIL (`detached`), and returns arrays or the analysis's
+//! summary as a dict (the same fields a scene writes to summary.json), its
+//! per-point data as arrays. The package `mechlab` (python/mechlab) wraps
+//! the dicts as attribute-access results.
+
+mod analyses;
+mod detached;
+mod errors;
+
+use std::collections::BTreeMap;
+
+use mechlab::analysis::states::{states_at, states_of_starts};
+use mechlab::ode::Method;
+use mechlab::registry::{Kind, Model};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike1, PyArrayLike2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use detached::detached;
+use errors::py_err;
+
+/// The names of the models (the files models/<name>.toml).
+#[pyfunction]
+fn models() -> Vec<&'static str> {
+    mechlab::models::MODELS
+        .iter()
+        .map(|m| m.info.name)
+        .collect()
+}
+
+/// The model `name`; a ValueError lists the known ones.
+#[pyfunction]
+fn model(name: &str) -> PyResult<PyModel> {
+    mechlab::models::by_name(name)
+        .map(|model| PyModel { model })
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// One derived expression: its key, what it is, its text and LaTeX.
+#[pyclass(frozen, name = "Derivation", module = "mechlab")]
+struct PyDerivation {
+    #[pyo3(get)]
+    key: &'static str,
+    #[pyo3(get)]
+    description: &'static str,
+    #[pyo3(get)]
+    text: &'static str,
+    #[pyo3(get)]
+    latex: &'static str,
+}
+
+#[pymethods]
+impl PyDerivation {
+    fn __repr__(&self) -> String {
+        format!("{} = {}", self.key, self.text)
+    }
+    fn _repr_latex_(&self) -> String {
+        format!("$${}$$", self.latex)
+    }
+}
+
+/// A model's derivations, shown in Jupyter as one aligned block.
+#[pyclass(frozen, name = "Derivations", module = "mechlab", sequence)]
+struct PyDerivations {
+    model: &'static Model,
+}
+
+#[pymethods]
+impl PyDerivations {
+    fn __len__(&self) -> usize {
+        self.model.info.derivations.len()
+    }
+    fn __getitem__(&self, index: isize) -> PyResult<PyDerivation> {
+        let all = self.model.info.derivations;
+        let i = if index < 0 {
+            all.len() as isize + index
+        } else {
+            index
+        };
+        let d = usize::try_from(i)
+            .ok()
+            .and_then(|i| all.get(i))
+            .ok_or_else(|| {
+                pyo3::exceptions::PyIndexError::new_err("derivation index out of range")
+            })?;
+        Ok(PyDerivation {
+            key: d.key,
+            description: d.description,
+            text: d.text,
+            latex: d.latex,
+        })
+    }
+    fn __repr__(&self) -> String {
+        let lines: Vec<String> = self
+            .model
+            .info
+            .derivations
+            .iter()
+            .map(|d| format!("{} = {}", d.key, d.text))
+            .collect();
+        lines.join("\n")
+    }
+    fn _repr_latex_(&self) -> String {
+        let rows: Vec<String> = self
+            .model
+            .info
+            .derivations
+            .iter()
+            .map(|d| {
+                format!(
+                    "&\\text{{{}}}: && {} \\\\",
+                    d.description.replace('_', "\\_"),
+                    d.latex
+                )
+            })
+            .collect();
+        format!(
+            "$$\\begin{{aligned}}\n{}\n\\end{{aligned}}$$",
+            rows.join("\n")
+        )
+    }
+}
+
+/// A generated model: what it is, its parameters, its derivations, and
+/// the analyses by name.
+#[pyclass(frozen, name = "Model", module = "mechlab")]
+struct PyModel {
+    model: &'static Model,
+}
+
+#[pymethods]
+impl PyModel {
+    #[getter]
+    fn name(&self) -> &'static str {
+        self.model.info.name
+    }
+    /// "hamiltonian", "constrained" or "contact".
+    #[getter]
+    fn kind(&self) -> &'static str {
+        match (self.model.constrained, self.model.dynamic.kind()) {
+            (Some(_), _) => "constrained",
+            (None, Kind::Hamiltonian { .. }) => "hamiltonian",
+            (None, _) => "contact",
+        }
+    }
+    #[getter]
+    fn fast_phase(&self) -> bool {
+        self.model.info.rate_parameter.is_some()
+            || self.model.flows().is_some_and(|f| f.has_fast_phase())
+    }
+    #[getter]
+    fn coordinates(&self) -> Vec<&'static str> {
+        self.model.info.coordinates.to_vec()
+    }
+    /// The state's components in the figures' notation (φ, p_φ, φ′).
+    #[getter]
+    fn state_names(&self) -> Vec<String> {
+        let info = self.model.info;
+        (0..2 * info.coordinates.len())
+            .map(|i| info.label(i))
+            .collect()
+    }
+    /// The constraints' names (empty for a model without constraints).
+    #[getter]
+    fn constraints(&self) -> Vec<&'static str> {
+        self.model
+            .constrained
+            .map_or_else(Vec::new, |c| c.constraint_names().to_vec())
+    }
+    /// Each parameter's default value, in declaration order.
+    #[getter]
+    fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let dict = PyDict::new(py);
+        let info = self.model.info;
+        for (name, value) in info
+            .parameter_names
+            .iter()
+            .zip(self.model.dynamic.defaults())
+        {
+            dict.set_item(name, value)?;
+        }
+        Ok(dict)
+    }
+    /// Each parameter's range, as the model file gives it ("(0, inf)").
+    #[getter]
+    fn ranges(&self) -> BTreeMap<&'static str, String> {
+        let info = self.model.info;
+        info.parameter_names
+            .iter()
+            .zip(info.parameter_ranges)
+            .map(|(n, r)| (*n, r.to_string()))
+            .collect()
+    }
+    #[getter]
+    fn descriptions(&self) -> BTreeMap<&'static str, &'static str> {
+        let info = self.model.info;
+        info.parameter_names
+            .iter()
+            .copied()
+            .zip(info.parameter_descriptions.iter().copied())
+            .collect()
+    }
+    /// The parameter that scales the vibration, if the file names one.
+    #[getter]
+    fn amplitude(&self) -> Option<&'static str> {
+        self.model.info.amplitude
+    }
+    /// The model file's text and path.
+    #[getter]
+    fn source(&self) -> &'static str {
+        self.model.info.source
+    }
+    #[getter]
+    fn source_file(&self) -> &'static str {
+        self.model.info.source_file
+    }
+    #[getter]
+    fn derivations(&self) -> PyDerivations {
+        PyDerivations { model: self.model }
+    }
+    fn __repr__(&self) -> String {
+        format!("mechlab.model({:?})", self.model.info.name)
+    }
+
+    /// The parameter values in declaration order, the defaults overridden
+    /// by `params` (name → value); an unknown name or a value outside its
+    /// range is a ValueError naming it.
+    #[pyo3(signature = (params=None))]
+    fn values(&self, params: Option<BTreeMap<String, f64>>) -> PyResult<Vec<f64>> {
+        parameter_values(self.model, params)
+    }
+
+    /// The start the scenes take when none is given (q = 0.3, 0.5, …,
+    /// p = 0; a constrained model's file start, on its constraints).
+    #[pyo3(signature = (params=None))]
+    fn start<'py>(
+        &self,
+        py: Python<'py>,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+        let values = parameter_values(self.model, params)?;
+        let y = mechlab::analysis::states::start(self.model, &values).map_err(py_err)?;
+        Ok(y.into_pyarray(py))
+    }
+
+    /// The states at the times `t` from `y0` at t[0] (dense output; a
+    /// constrained model's start and states put on its constraints), one
+    /// row per time.
+    #[pyo3(signature = (y0, t, *, method="dop853", tol=1e-10, params=None))]
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        y0: PyArrayLike1<'py, f64, AllowTypeChange>,
+        t: PyArrayLike1<'py, f64, AllowTypeChange>,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let values = parameter_values(self.model, params)?;
+        let method = Method::parse(method, tol).map_err(py_err)?;
+        let (y0, times) = (y0.as_slice()?.to_vec(), t.as_slice()?.to_vec());
+        let model = self.model;
+        let states =
+            detached(py, |_| states_at(model, &values, method, &y0, &times))?.map_err(py_err)?;
+        let dim = y0.len();
+        let flat: Vec<f64> = states.into_iter().flatten().collect();
+        let array = Array2::from_shape_vec((flat.len() / dim.max(1), dim), flat)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(array.into_pyarray(py))
+    }
+
+    /// The states at the times `t` from each row of `y0` (in parallel):
+    /// `states[k, i]` is orbit k at t[i]; an orbit that stopped is NaN
+    /// and listed in `failed` as (k, why).
+    #[pyo3(signature = (y0, t, *, method="dop853", tol=1e-10, params=None))]
+    fn integrate_many<'py>(
+        &self,
+        py: Python<'py>,
+        y0: PyArrayLike2<'py, f64, AllowTypeChange>,
+        t: PyArrayLike1<'py, f64, AllowTypeChange>,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let method = Method::parse(method, tol).map_err(py_err)?;
+        let starts: Vec<Vec<f64>> = y0
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| r.to_vec())
+            .collect();
+        let times = t.as_slice()?.to_vec();
+        let model = self.model;
+        let runs = detached(py, |_| {
+            states_of_starts(model, &values, method, &starts, &times)
+        })?
+        .map_err(py_err)?;
+        let dim = y0.as_array().ncols();
+        let mut states = Array3::from_elem((starts.len(), times.len(), dim), f64::NAN);
+        let mut failed = Vec::new();
+        for (k, run) in runs.into_iter().enumerate() {
+            match run {
+                Ok(orbit) => {
+                    for (i, y) in orbit.iter().enumerate() {
+                        for (j, x) in y.iter().enumerate() {
+                            states[(k, i, j)] = *x;
+                        }
+                    }
+                }
+                Err(e) => failed.push((k, e.to_string())),
+            }
+        }
+        let result = PyDict::new(py);
+        result.set_item("states", states.into_pyarray(py))?;
+        result.set_item("failed", failed)?;
+        Ok(result)
+    }
+
+    /// Orbits of the period map from `seeds` (full states) or from
+    /// `count` seeds on a line along the first axis, each drawn in the
+    /// plane of `axes` (indices or names of state components).
+    #[pyo3(signature = (*, axes=None, seeds=None, count=24, p_max=2.5, periods=500, method="taylor", tol=1e-10, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn period_map<'py>(
+        &self,
+        py: Python<'py>,
+        axes: Option<(analyses::Axis, analyses::Axis)>,
+        seeds: Option<Vec<Vec<f64>>>,
+        count: usize,
+        p_max: f64,
+        periods: usize,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let method = Method::parse(method, tol).map_err(py_err)?;
+        let axes = analyses::axes(self.model, axes)?;
+        analyses::portrait(
+            py, self.model, values, axes, seeds, count, p_max, periods, method,
+        )
+    }
+
+    /// The fast Lyapunov indicator of the period map on a plane of
+    /// `pixels`² starts (`fli[j, i]`, row 0 at the bottom), with a
+    /// progress bar; Ctrl-C stops it between blocks of rows.
+    #[pyo3(signature = (*, pixels=300, periods=180, axes=None, ranges=None, through=None, p_max=3.0, method="taylor", tol=1e-6, params=None, progress=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn chaos_map<'py>(
+        &self,
+        py: Python<'py>,
+        pixels: usize,
+        periods: usize,
+        axes: Option<(analyses::Axis, analyses::Axis)>,
+        ranges: Option<((f64, f64), (f64, f64))>,
+        through: Option<Vec<f64>>,
+        p_max: f64,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+        progress: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let method = Method::parse(method, tol).map_err(py_err)?;
+        let axes = analyses::axes(self.model, axes)?;
+        let ranges = ranges.map_or([None, None], |(x, y)| [Some(x), Some(y)]);
+        analyses::chaos_map(
+            py, self.model, values, axes, ranges, through, pixels, periods, p_max, method, progress,
+        )
+    }
+
+    /// Stabilisation by vibration: for each equilibrium the averaged
+    /// threshold a* and the exact window of Floquet stability (a
+    /// constrained model: its equilibrium near the start, on its
+    /// constraints).
+    #[pyo3(signature = (*, amplitude=None, samples=40, a_max=None, edge_tolerance=1e-9, method="dop853", tol=1e-10, max_windows=None, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn stability<'py>(
+        &self,
+        py: Python<'py>,
+        amplitude: Option<String>,
+        samples: usize,
+        a_max: Option<f64>,
+        edge_tolerance: f64,
+        method: &str,
+        tol: f64,
+        max_windows: Option<usize>,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let method = Method::parse(method, tol).map_err(py_err)?;
+        analyses::stability(
+            py,
+            self.model,
+            values,
+            amplitude,
+            samples,
+            a_max,
+            edge_tolerance,
+            method,
+            max_windows,
+        )
+    }
+
+    /// A Poincaré section at the energy H = `energy` through the plane
+    /// `plane` = `value` (a linear function of the coordinates, "x",
+    /// "q1 - q2"; default the first coordinate), from `seeds` (the other
+    /// coordinate and its momentum) or `orbits` seeds across the
+    /// accessible stretch of [−extent, extent].
+    #[pyo3(signature = (*, energy, plane=None, value=0.0, rising=true, seeds=None, orbits=24, extent=2.0, crossings=400, t_max=20000.0, tol=1e-12, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn section<'py>(
+        &self,
+        py: Python<'py>,
+        energy: f64,
+        plane: Option<String>,
+        value: f64,
+        rising: bool,
+        seeds: Option<Vec<[f64; 2]>>,
+        orbits: usize,
+        extent: f64,
+        crossings: usize,
+        t_max: f64,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let request = analyses::SectionRequest {
+            energy,
+            plane,
+            value,
+            rising,
+            seeds,
+            orbits,
+            extent,
+            crossings,
+            t_max,
+            tol,
+        };
+        analyses::section(py, self.model, values, request)
+    }
+}
+
+/// The defaults of `model` with `params` (name → value) set, each checked.
+fn parameter_values(model: &Model, params: Option<BTreeMap<String, f64>>) -> PyResult<Vec<f64>> {
+    let info = model.info;
+    let mut values = model.dynamic.defaults();
+    for (name, value) in params.unwrap_or_default() {
+        info.check_parameter(&name, value).map_err(py_err)?;
+        if let Some(i) = info.parameter_names.iter().position(|n| *n == name) {
+            values[i] = value;
+        }
+    }
+    Ok(values)
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(models, m)?)?;
+    m.add_function(wrap_pyfunction!(model, m)?)?;
+    m.add_class::<PyModel>()?;
+    m.add_class::<PyDerivation>()?;
+    m.add_class::<PyDerivations>()?;
+    m.add("Refused", m.py().get_type::<errors::Refused>())?;
+    m.add(
+        "IntegrationError",
+        m.py().get_type::<errors::IntegrationError>(),
+    )?;
+    Ok(())
+}

@@ -1,0 +1,150 @@
+"""The Python module against closed forms and the library's own checks:
+each assertion could fail if the bindings were wrong (a parameter not
+passed, a state's rows shuffled, an error's class or message lost)."""
+
+import math
+import os
+import signal
+import threading
+import unittest
+
+import numpy as np
+
+import mechlab
+
+
+class Models(unittest.TestCase):
+    def test_the_catalogue_and_an_unknown_name(self):
+        self.assertIn("kapitza", mechlab.models())
+        with self.assertRaises(ValueError) as e:
+            mechlab.model("no_such_model")
+        self.assertIn("kapitza", str(e.exception))
+
+    def test_parameters_by_name_with_their_ranges(self):
+        m = mechlab.model("kapitza")
+        self.assertEqual(m.parameters["A"], 1.5)
+        self.assertEqual(m.ranges["eps"], "(0, inf)")
+        self.assertEqual(m.values({"A": 2.0})[list(m.parameters).index("A")], 2.0)
+        with self.assertRaises(ValueError) as e:
+            m.values({"bogus": 1.0})
+        self.assertIn("bogus", str(e.exception))
+        with self.assertRaises(ValueError) as e:
+            m.values({"eps": -1.0})
+        self.assertIn("eps", str(e.exception))
+
+    def test_derivations_as_text_and_latex(self):
+        d = mechlab.model("kapitza").derivations
+        self.assertGreater(len(d), 3)
+        keys = [x.key for x in d]
+        self.assertIn("hamiltonian", keys)
+        self.assertTrue(d._repr_latex_().startswith("$$\\begin{aligned}"))
+        self.assertTrue(d[0]._repr_latex_().startswith("$$"))
+
+
+class Integration(unittest.TestCase):
+    def test_uncoupled_henon_heiles_is_two_harmonic_oscillators(self):
+        m = mechlab.model("henon_heiles")
+        t = np.linspace(0.0, 20.0, 81)
+        y0 = np.array([0.3, -0.2, 0.1, 0.4])  # x, y, p_x, p_y
+        y = m.integrate(y0, t, tol=1e-12, params={"lambda": 0.0})
+        self.assertEqual(y.shape, (81, 4))
+        exact_x = y0[0] * np.cos(t) + y0[2] * np.sin(t)
+        exact_py = -y0[1] * np.sin(t) + y0[3] * np.cos(t)
+        self.assertLess(np.max(np.abs(y[:, 0] - exact_x)), 1e-9)
+        self.assertLess(np.max(np.abs(y[:, 3] - exact_py)), 1e-9)
+
+    def test_many_orbits_equal_each_run_alone(self):
+        m = mechlab.model("kapitza")
+        t = np.linspace(0.0, 3.0, 7)
+        starts = np.array([[0.1, 0.0], [1.0, 0.5], [3.0, -0.2]])
+        many = m.integrate_many(starts, t, params={"A": 2.0})
+        self.assertEqual(many.states.shape, (3, 7, 2))
+        self.assertEqual(many.failed, [])
+        for k in range(3):
+            alone = m.integrate(starts[k], t, params={"A": 2.0})
+            np.testing.assert_array_equal(many.states[k], alone)
+
+    def test_a_constrained_start_is_put_on_its_constraints(self):
+        m = mechlab.model("four_bar")
+        self.assertEqual(m.kind, "constrained")
+        start = m.start()
+        y = m.integrate(start, [0.0, 0.5, 1.0])
+        np.testing.assert_allclose(y[0], start, atol=1e-12)
+        # A start off the constraints is projected onto them, once for all.
+        moved = m.integrate(start + 0.05, [0.0, 1.0])[0]
+        self.assertGreater(np.max(np.abs(moved - start - 0.05)), 1e-3)
+        np.testing.assert_allclose(m.integrate(moved, [0.0, 1.0])[0], moved, atol=1e-12)
+
+    def test_bad_input_is_a_value_error_naming_it(self):
+        m = mechlab.model("kapitza")
+        with self.assertRaises(ValueError) as e:
+            m.integrate([0.1, 0.0, 0.0], [0.0, 1.0])
+        self.assertIn("3 components", str(e.exception))
+        with self.assertRaises(ValueError):
+            m.integrate([0.1, 0.0], [0.0, 1.0], tol=0.0)
+        with self.assertRaises(ValueError):
+            m.integrate([math.nan, 0.0], [0.0, 1.0])
+        with self.assertRaises(mechlab.Refused):
+            mechlab.model("painleve_klein").integrate([0.0] * 4, [0.0, 1.0])
+
+
+class Analyses(unittest.TestCase):
+    def test_kapitza_threshold_is_root_two(self):
+        s = mechlab.model("kapitza").stability(samples=12)
+        thresholds = [e.a_star for e in s.equilibria if e.a_star is not None]
+        self.assertEqual(len(thresholds), 1)
+        self.assertAlmostEqual(thresholds[0], math.sqrt(2.0), places=9)
+        upright = next(e for e in s.equilibria if e.a_star is not None)
+        lower = upright.exact_window[0]
+        # The exact window opens O(ε²) from a* (ε = 0.1).
+        self.assertLess(abs(lower - math.sqrt(2.0)), 0.05)
+
+    def test_uncoupled_section_returns_to_its_seeds(self):
+        m = mechlab.model("henon_heiles")
+        seeds = [[0.2, 0.0], [-0.5, 0.3]]
+        s = m.section(energy=0.3, seeds=seeds, crossings=20, params={"lambda": 0.0})
+        self.assertEqual(len(s.points), 2)
+        for points, seed in zip(s.points, seeds):
+            self.assertEqual(points.shape, (20, 2))
+            self.assertLess(np.max(np.abs(points - np.array(seed))), 1e-8)
+        with self.assertRaises(mechlab.Refused):
+            mechlab.model("kapitza").section(energy=0.0)
+
+    def test_period_map_orbits_are_arrays_on_the_plane(self):
+        m = mechlab.model("kapitza")
+        p = m.period_map(seeds=[[0.2, 0.0]], periods=50, axes=("q", "p_q"))
+        self.assertEqual(list(p.axes), ["q", "p_q"])
+        self.assertEqual(p.orbits[0].shape, (51, 2))
+        # Below a*, near the hanging rest, small orbits stay small.
+        self.assertLess(np.max(np.abs(p.orbits[0][:, 0])), 0.3)
+        with self.assertRaises(ValueError) as e:
+            m.period_map(axes=("q", "nope"))
+        self.assertIn("nope", str(e.exception))
+
+    def test_chaos_map_pixels_are_where_their_rows_and_columns_say(self):
+        m = mechlab.model("kapitza")
+        full = m.chaos_map(pixels=6, periods=40, progress=False)
+        self.assertEqual(full.fli.shape, (6, 6))
+        self.assertAlmostEqual(full.fli_regular_level, math.log(40.0))
+        # Pixel (i = 1, j = 3), row 0 at the bottom, as a map of its own:
+        # not its transpose's value.
+        (x0, x1), (y0, y1) = full.ranges
+        dx, dy = (x1 - x0) / 6, (y1 - y0) / 6
+        one = m.chaos_map(pixels=1, periods=40, progress=False,
+                          ranges=((x0 + dx, x0 + 2 * dx), (y0 + 3 * dy, y0 + 4 * dy)))
+        self.assertAlmostEqual(one.fli[0, 0], full.fli[3, 1], delta=1e-6 * abs(full.fli[3, 1]))
+        self.assertGreater(abs(full.fli[3, 1] - full.fli[1, 3]), 1.0)
+
+    def test_ctrl_c_stops_a_chaos_map(self):
+        m = mechlab.model("kapitza")
+        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+        timer.start()
+        try:
+            with self.assertRaises(KeyboardInterrupt):
+                m.chaos_map(pixels=400, periods=4000, progress=False)
+        finally:
+            timer.cancel()
+
+
+if __name__ == "__main__":
+    unittest.main()

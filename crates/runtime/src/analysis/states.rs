@@ -1,0 +1,147 @@
+//! One orbit, or many, of any model by name, sampled at given times (the
+//! exact system's dense output): what a notebook integrates. A constrained
+//! model's start is put on its constraints and so is each state reported.
+
+use rayon::prelude::*;
+
+use crate::analysis::on_constraints::{run, ConstrainedError};
+use crate::analysis::Refusal;
+use crate::ode::{Method, OdeError};
+use crate::registry::Model;
+
+/// Why no orbit can be run.
+#[derive(Debug, thiserror::Error)]
+pub enum StatesError {
+    #[error(transparent)]
+    Refused(#[from] Refusal),
+    /// Output times that are not finite or go back.
+    #[error("the output times must be finite and increase (the first is the start's time)")]
+    Times,
+    /// A constrained model's start with no consistent state near it.
+    #[error("model '{model}': the start is not near its constraints: {source}")]
+    Start {
+        model: &'static str,
+        source: crate::ode::holonomic::ConstraintError,
+    },
+    #[error(transparent)]
+    Constrained(#[from] ConstrainedError),
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+}
+
+/// The states of `model` at `times` from `y0` at times[0].
+pub fn states_at(
+    model: &Model,
+    params: &[f64],
+    method: Method,
+    y0: &[f64],
+    times: &[f64],
+) -> Result<Vec<Vec<f64>>, StatesError> {
+    check(
+        model,
+        params,
+        method,
+        std::slice::from_ref(&y0.to_vec()),
+        times,
+    )?;
+    orbit(model, params, method, y0, times)
+}
+
+/// The start the scenes take when none is given
+/// ([`crate::explore::default_start`]), a constrained model's put on its
+/// constraints at t = 0.
+pub fn start(model: &Model, params: &[f64]) -> Result<Vec<f64>, StatesError> {
+    Refusal::named_values(model.info, params)?;
+    let Some(constrained) = model.constrained else {
+        return Ok(crate::explore::default_start(model.dynamic));
+    };
+    let mut y = constrained.start(params);
+    constrained
+        .project(params, 0.0, &mut y)
+        .map_err(|source| StatesError::Start {
+            model: model.info.name,
+            source,
+        })?;
+    Ok(y)
+}
+
+/// The states of `model` at `times` from each start, in parallel; an orbit
+/// that stops keeps its error, the others go on.
+pub fn states_of_starts(
+    model: &Model,
+    params: &[f64],
+    method: Method,
+    starts: &[Vec<f64>],
+    times: &[f64],
+) -> Result<Vec<Result<Vec<Vec<f64>>, StatesError>>, StatesError> {
+    check(model, params, method, starts, times)?;
+    crate::budget::check(
+        || format!("{} orbits of {} states", starts.len(), times.len()),
+        starts.len() as u128 * times.len() as u128,
+        starts.first().map_or(0, Vec::len) * std::mem::size_of::<f64>(),
+    )
+    .map_err(OdeError::from)?;
+    Ok(starts
+        .par_iter()
+        .map(|y0| orbit(model, params, method, y0, times))
+        .collect())
+}
+
+/// The model, its parameters, the starts and the times as an orbit needs them.
+fn check(
+    model: &Model,
+    params: &[f64],
+    method: Method,
+    starts: &[Vec<f64>],
+    times: &[f64],
+) -> Result<(), StatesError> {
+    let flows = crate::analysis::flows(model)?;
+    crate::analysis::method_applies(model, method)?;
+    Refusal::named_values(model.info, params)?;
+    let dim = flows.periodic_state().len();
+    for y0 in starts {
+        if y0.len() != dim {
+            return Err(Refusal::state_length(model.info.name, "start", y0.len(), dim).into());
+        }
+        if y0.iter().any(|x| !x.is_finite()) {
+            return Err(OdeError::NonFiniteInitialState {
+                t: times.first().copied().unwrap_or(0.0),
+                y: y0.clone(),
+            }
+            .into());
+        }
+    }
+    if times.is_empty()
+        || times.iter().any(|t| !t.is_finite())
+        || times.windows(2).any(|w| !(w[1] > w[0]))
+    {
+        return Err(StatesError::Times);
+    }
+    Ok(())
+}
+
+fn orbit(
+    model: &Model,
+    params: &[f64],
+    method: Method,
+    y0: &[f64],
+    times: &[f64],
+) -> Result<Vec<Vec<f64>>, StatesError> {
+    if let Some(constrained) = model.constrained {
+        let mut start = y0.to_vec();
+        constrained
+            .project(params, times[0], &mut start)
+            .map_err(|source| StatesError::Start {
+                model: model.info.name,
+                source,
+            })?;
+        return Ok(run(constrained, params, Some(&start), method, times)?.states);
+    }
+    let system = crate::analysis::flows(model)?.exact(params);
+    // The first time is the start's: its state is y0 itself.
+    let mut states = vec![y0.to_vec()];
+    if times.len() > 1 {
+        states.extend(system.states_at(method, times[0], y0, &times[1..])?);
+    }
+    Ok(states)
+}
