@@ -41,7 +41,10 @@ fn orbits_by_name_at_given_times() {
     for (t, y) in times.iter().zip(&states) {
         let x = y0[0] * t.cos() + y0[2] * t.sin();
         let p_y = -y0[1] * t.sin() + y0[3] * t.cos();
-        assert!((y[0] - x).abs() < 1e-9 && (y[3] - p_y).abs() < 1e-9, "t = {t}: {y:?}");
+        assert!(
+            (y[0] - x).abs() < 1e-9 && (y[3] - p_y).abs() < 1e-9,
+            "t = {t}: {y:?}"
+        );
     }
     let starts = vec![y0.to_vec(), vec![0.0, 0.5, -0.3, 0.0]];
     let many = states_of_starts(model, &[1.0], method, &starts, &times).unwrap();

@@ -266,3 +266,166 @@ pub fn section<'py>(
     dict.set_item("points", orbits)?;
     Ok(dict)
 }
+
+impl Classify for mechlab::analysis::attractor::AttractorError {
+    fn class(&self) -> Class {
+        use mechlab::analysis::attractor::AttractorError;
+        match self {
+            AttractorError::Refused(r) => r.class(),
+            AttractorError::Ode(e) => e.class(),
+            AttractorError::Constrained(_) => Class::Integration,
+        }
+    }
+}
+
+impl Classify for mechlab::analysis::continuation::ContinuationError {
+    fn class(&self) -> Class {
+        use mechlab::analysis::continuation::ContinuationError;
+        match self {
+            ContinuationError::Refused(r) => r.class(),
+            ContinuationError::Ode(e) => e.class(),
+            _ => Class::Integration,
+        }
+    }
+}
+
+impl Classify for mechlab::analysis::separatrix::SplittingError {
+    fn class(&self) -> Class {
+        use mechlab::analysis::separatrix::SplittingError;
+        match self {
+            SplittingError::Refused(r) => r.class(),
+            _ => Class::Integration,
+        }
+    }
+}
+
+impl Classify for mechlab::analysis::averaging::AveragingError {
+    fn class(&self) -> Class {
+        use mechlab::analysis::averaging::AveragingError;
+        match self {
+            AveragingError::Refused(r) => r.class(),
+            AveragingError::Sweep { .. } | AveragingError::Order(..) => Class::Value,
+            _ => Class::Integration,
+        }
+    }
+}
+
+/// The attractor of a forced, damped period map (the `attractor`
+/// scene): its points as an (n, 2) array, the Lyapunov spectrum and the
+/// dimensions.
+pub fn attractor<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::attractor::AttractorSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::attractor::attractor as attractor_of;
+    let result = detached(py, |_| attractor_of(model, &values, &settings))?.map_err(py_err)?;
+    let dict = summary(py, &result)?;
+    dict.set_item("orbit", points(py, result.orbit.iter().copied()))?;
+    let convergence: Vec<(usize, Vec<f64>)> = result.convergence.clone();
+    dict.set_item("convergence", convergence)?;
+    Ok(dict)
+}
+
+/// Periodic orbits continued in a parameter with their bifurcations (the
+/// `continuation` scene).
+pub fn continuation<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::continuation::ContinuationSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::continuation::continuation as continuation_of;
+    let result = detached(py, |_| continuation_of(model, &values, &settings))?.map_err(py_err)?;
+    let dict = summary(py, &result)?;
+    dict.set_item("state_names", result.state_names.clone())?;
+    Ok(dict)
+}
+
+/// The splitting of the separatrices of the period map's saddle (the
+/// `separatrix_splitting` scene): lobe areas by two routes.
+pub fn separatrix_splitting<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::separatrix::SplittingSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::separatrix::separatrix_splitting as splitting_of;
+    let result = detached(py, |_| splitting_of(model, &values, &settings))?.map_err(py_err)?;
+    summary(py, &result)
+}
+
+/// The exact system against the averaged one as the phase's rate grows
+/// (the `averaging` scene): the deviation's slope against the frequency.
+pub fn averaging<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::averaging::ConvergenceSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::averaging::convergence;
+    let result = detached(py, |_| convergence(model, &values, &settings))?.map_err(py_err)?;
+    summary(py, &result)
+}
+
+impl Classify for mechlab::explore::ExploreError {
+    fn class(&self) -> Class {
+        use mechlab::explore::ExploreError;
+        match self {
+            ExploreError::Ode(e) => e.class(),
+            ExploreError::StateLength { .. } => Class::Value,
+            _ => Class::Integration,
+        }
+    }
+}
+
+/// Rows of numbers as a 2-D array (NaN-padded if ragged).
+fn table<'py>(py: Python<'py>, rows: &[Vec<f64>]) -> Bound<'py, numpy::PyArray2<f64>> {
+    let width = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let mut array = Array2::from_elem((rows.len(), width), f64::NAN);
+    for (i, row) in rows.iter().enumerate() {
+        for (j, x) in row.iter().enumerate() {
+            array[(i, j)] = *x;
+        }
+    }
+    array.into_pyarray(py)
+}
+
+/// What the `explore` scene shows, for any model (a contact model with its
+/// stick–slip switching too): the run, the averaged run and the period
+/// map where there is a fast phase, the energy's change, the equilibria,
+/// a constrained model's reactions.
+pub fn explore<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    y0: Vec<f64>,
+    settings: mechlab::explore::Settings,
+) -> PyResult<Bound<'py, PyDict>> {
+    let result = detached(py, |_| {
+        mechlab::explore::explore(model, &values, &y0, &settings)
+    })?
+    .map_err(py_err)?;
+    let dict = PyDict::new(py);
+    dict.set_item("times", result.times.clone().into_pyarray(py))?;
+    dict.set_item("states", table(py, &result.exact))?;
+    if let Some(averaged) = &result.averaged {
+        dict.set_item("averaged", table(py, averaged))?;
+    }
+    if let Some(map) = &result.period_map {
+        dict.set_item("period_map", table(py, map))?;
+    }
+    dict.set_item(
+        "energy_change",
+        result.energy_change.clone().into_pyarray(py),
+    )?;
+    dict.set_item("energy_label", result.energy_label)?;
+    dict.set_item("equilibria", pythonize::pythonize(py, &result.equilibria)?)?;
+    dict.set_item("switches", result.switches.clone())?;
+    if let Some(reactions) = &result.reactions {
+        dict.set_item("reaction_names", reactions.names.clone())?;
+        dict.set_item("reactions", table(py, &reactions.values))?;
+    }
+    Ok(dict)
+}

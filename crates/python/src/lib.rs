@@ -248,6 +248,30 @@ impl PyModel {
         Ok(y.into_pyarray(py))
     }
 
+    /// The energy function at (t, y): H, a constrained model's E on its
+    /// constraints, a contact model's E (what `explore` follows).
+    #[pyo3(signature = (y, t=0.0, *, params=None))]
+    fn energy(
+        &self,
+        y: PyArrayLike1<'_, f64, AllowTypeChange>,
+        t: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<f64> {
+        let values = parameter_values(self.model, params)?;
+        let y = y.as_slice()?;
+        let expected = self.model.dynamic.periodic_state().len();
+        if y.len() != expected {
+            let refusal = mechlab::analysis::Refusal::state_length(
+                self.model.info.name,
+                "state",
+                y.len(),
+                expected,
+            );
+            return Err(py_err(refusal));
+        }
+        Ok(self.model.dynamic.energy(&values, t, y))
+    }
+
     /// The states at the times `t` from `y0` at t[0] (dense output; a
     /// constrained model's start and states put on its constraints), one
     /// row per time.
@@ -406,6 +430,206 @@ impl PyModel {
             method,
             max_windows,
         )
+    }
+
+    /// The attractor of a forced, damped period map from (start_q,
+    /// start_p): its points, Lyapunov spectrum (two runs, their
+    /// difference the error) and box-counting and Kaplan–Yorke dimensions.
+    #[pyo3(signature = (*, start=(1.0, 0.0), transient=500, points=200_000, lyapunov_periods=16_000, pixels=500, method="taylor", tol=1e-10, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn attractor<'py>(
+        &self,
+        py: Python<'py>,
+        start: (f64, f64),
+        transient: usize,
+        points: usize,
+        lyapunov_periods: usize,
+        pixels: usize,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let settings = mechlab::analysis::attractor::AttractorSettings {
+            method: Method::parse(method, tol).map_err(py_err)?,
+            start: [start.0, start.1],
+            transient,
+            points,
+            lyapunov_periods,
+            pixels,
+        };
+        analyses::attractor(py, self.model, values, settings)
+    }
+
+    /// Periodic orbits of the period map followed in `parameter` (default
+    /// the model file's amplitude) from its value to `to` (default 1.8
+    /// times it), their Floquet multipliers and bifurcations; branches
+    /// born at period doublings up to `max_period` and at branch points
+    /// are followed too. `diagram` parameter values of the orbit diagram
+    /// (0: none).
+    #[pyo3(signature = (*, parameter=None, to=None, start=None, period=1, max_period=16, switch_branch_points=true, branches=12, points=3000, step=0.005, min_step=1e-8, max_step=0.02, diagram=0, transient=300, iterates=100, chart=None, method="taylor", tol=1e-12, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn continuation<'py>(
+        &self,
+        py: Python<'py>,
+        parameter: Option<String>,
+        to: Option<f64>,
+        start: Option<Vec<f64>>,
+        period: usize,
+        max_period: usize,
+        switch_branch_points: bool,
+        branches: usize,
+        points: usize,
+        step: f64,
+        min_step: f64,
+        max_step: f64,
+        diagram: usize,
+        transient: usize,
+        iterates: usize,
+        chart: Option<Vec<usize>>,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use mechlab::analysis::continuation::{default_end, ContinuationSettings, DiagramSettings};
+        let values = parameter_values(self.model, params)?;
+        let info = self.model.info;
+        let parameter = parameter
+            .or(info.amplitude.map(String::from))
+            .ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "model '{}' names no amplitude: pass parameter='<name>' (parameters: {})",
+                    info.name,
+                    info.parameter_names.join(", ")
+                ))
+            })?;
+        let settings = ContinuationSettings {
+            to: to.unwrap_or_else(|| default_end(info, &values, &parameter)),
+            parameter,
+            // A constrained model starts at its file's start unless told.
+            start: start.unwrap_or_else(|| match self.model.constrained {
+                Some(_) => Vec::new(),
+                None => vec![1.0, 0.0],
+            }),
+            period,
+            max_period,
+            switch_branch_points,
+            max_branches: branches,
+            points,
+            step,
+            min_step,
+            max_step,
+            method: Method::parse(method, tol).map_err(py_err)?,
+            diagram: (diagram > 0).then_some(DiagramSettings {
+                values: diagram,
+                transient,
+                iterates,
+            }),
+            chart,
+        };
+        analyses::continuation(py, self.model, values, settings)
+    }
+
+    /// The splitting of the separatrices of the period map's hyperbolic
+    /// fixed point (a model of one degree of freedom with a fast phase):
+    /// the lobe area by the action and by the polygon, in double or
+    /// double-double precision (`precision`: "double", "double-double"
+    /// or "auto").
+    #[pyo3(signature = (*, guess=None, spacing=0.02, p_max=4.0, iterates=400, max_points=20_000, lobe_points=400, precision="auto", method="taylor", tol=1e-14, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn separatrix_splitting<'py>(
+        &self,
+        py: Python<'py>,
+        guess: Option<(f64, f64)>,
+        spacing: f64,
+        p_max: f64,
+        iterates: usize,
+        max_points: usize,
+        lobe_points: usize,
+        precision: &str,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use mechlab::analysis::separatrix::{Precision, SplittingSettings};
+        let values = parameter_values(self.model, params)?;
+        let precision = Precision::parse(precision).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "precision {precision:?}: one of {}",
+                Precision::NAMES.join(", ")
+            ))
+        })?;
+        let settings = SplittingSettings {
+            method: Method::parse(method, tol).map_err(py_err)?,
+            guess: guess.map(|(q, p)| [q, p]),
+            spacing,
+            iterates,
+            max_points,
+            p_max,
+            lobe_points,
+            precision,
+        };
+        analyses::separatrix_splitting(py, self.model, values, settings)
+    }
+
+    /// The exact system against the averaged one (of `order` 1 or 2) as
+    /// the fast phase's rate grows: the largest deviation over [0, t_obs]
+    /// at each of `values` of `parameter` (default: the one the rate
+    /// depends on, at 4…64 times the model's frequency), and its slope
+    /// against the frequency (−1 at first order).
+    #[pyo3(signature = (*, parameter=None, values=None, y0=None, t_obs=2.0, order=1, method="dop853", tol=1e-11, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn averaging<'py>(
+        &self,
+        py: Python<'py>,
+        parameter: Option<String>,
+        values: Option<Vec<f64>>,
+        y0: Option<Vec<f64>>,
+        t_obs: f64,
+        order: usize,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let model_values = parameter_values(self.model, params)?;
+        let settings = mechlab::analysis::averaging::ConvergenceSettings {
+            parameter,
+            values,
+            y0,
+            t_obs,
+            method: Method::parse(method, tol).map_err(py_err)?,
+            order,
+        };
+        analyses::averaging(py, self.model, model_values, settings)
+    }
+
+    /// What the `explore` scene shows, for any model (the contact models
+    /// of Study 3 too): the run from `y0` (default the scenes' start) to
+    /// `t_end` at `samples` times, with the averaged run and `periods`
+    /// of the period map where there is a fast phase, the energy's
+    /// change, the equilibria, a constrained model's reactions.
+    #[pyo3(signature = (y0=None, *, t_end=20.0, samples=2000, periods=300, method="dop853", tol=1e-10, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn explore<'py>(
+        &self,
+        py: Python<'py>,
+        y0: Option<Vec<f64>>,
+        t_end: f64,
+        samples: usize,
+        periods: usize,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let settings = mechlab::explore::Settings {
+            method: Method::parse(method, tol).map_err(py_err)?,
+            t_end,
+            samples,
+            periods,
+        };
+        let y0 = y0.unwrap_or_else(|| mechlab::explore::default_start(self.model.dynamic));
+        analyses::explore(py, self.model, values, y0, settings)
     }
 
     /// A Poincaré section at the energy H = `energy` through the plane

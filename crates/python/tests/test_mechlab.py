@@ -135,6 +135,60 @@ class Analyses(unittest.TestCase):
         self.assertAlmostEqual(one.fli[0, 0], full.fli[3, 1], delta=1e-6 * abs(full.fli[3, 1]))
         self.assertGreater(abs(full.fli[3, 1] - full.fli[1, 3]), 1.0)
 
+    def test_continuation_meets_the_floquet_window_of_stability(self):
+        m = mechlab.model("kapitza")
+        p = {"A": 0.5, "eps": 0.1, "mu": 0.0}
+        s = m.stability(a_max=6.0, samples=120, edge_tolerance=1e-12, method="taylor", tol=1e-13, params=p)
+        upright = next(e for e in s.equilibria if e.q[0] == 0.0)
+        low, high = upright.exact_window
+        c = m.continuation(parameter="A", to=5.0, start=[0.0, 0.0], max_period=1,
+                           switch_branch_points=False, params=p)
+        on_upright = [b for b in c.bifurcations if b.branch == 0]
+        self.assertEqual([b.kind for b in on_upright], ["branch_point", "period_doubling"])
+        self.assertAlmostEqual(on_upright[0].parameter, low, delta=1e-8)
+        self.assertAlmostEqual(on_upright[1].parameter, high, delta=1e-8)
+
+    def test_the_attractors_spectrum_sums_to_the_damping(self):
+        m = mechlab.model("ueda")
+        a = m.attractor(points=2000, transient=200, lyapunov_periods=1000, pixels=50)
+        self.assertEqual(a.orbit.shape[1], 2)
+        self.assertGreaterEqual(len(a.orbit), a.points)
+        # Σλ per period = −k T for x'' + k x' + x³ = B cos t (T = 2π).
+        self.assertAlmostEqual(a.lyapunov_sum, -0.05 * 2 * math.pi, delta=1e-6)
+        self.assertGreater(a.lyapunov[0], 0.0)
+
+    def test_the_averaging_error_falls_as_one_over_the_frequency(self):
+        a = mechlab.model("kapitza").averaging(values=[0.05, 0.025, 0.0125], t_obs=1.0)
+        for slope in a.slope:
+            self.assertAlmostEqual(slope, -1.0, delta=0.1)
+        with self.assertRaises(ValueError):
+            mechlab.model("kapitza").averaging(order=7)
+
+    def test_separatrix_lobe_areas_agree_by_two_routes(self):
+        s = mechlab.model("kapitza").separatrix_splitting(precision="double", params={"A": 1.0, "eps": 0.3})
+        self.assertTrue(s.resolved)
+        self.assertLess(s.routes_relative_difference, 1e-6)
+        self.assertGreater(s.lobe_area_action, 0.0)
+
+    def test_painleve_klein_dissipates_and_switches(self):
+        m = mechlab.model("painleve_klein")
+        self.assertEqual(m.kind, "contact")
+        r = m.explore()
+        # Dry friction only takes energy: E(t) − E(0) never rises.
+        self.assertTrue(np.all(np.diff(r.energy_change) <= 1e-12))
+        self.assertLess(r.energy_change[-1], -1.0)
+        self.assertTrue(any("stick" in s for s in r.switches))
+        self.assertEqual(r.states.shape[1], 4)
+
+    def test_energy_is_conserved_along_an_autonomous_orbit(self):
+        m = mechlab.model("henon_heiles")
+        y = m.integrate([0.1, 0.2, 0.3, 0.0], np.linspace(0, 50, 11), tol=1e-12)
+        e = [m.energy(row) for row in y]
+        # H = (p² + x² + y²)/2 + x²y − y³/3 by hand.
+        x, yy, px, py = y[0]
+        self.assertAlmostEqual(e[0], (px**2 + py**2 + x**2 + yy**2) / 2 + x * x * yy - yy**3 / 3, places=14)
+        self.assertLess(max(abs(v - e[0]) for v in e), 1e-10)
+
     def test_ctrl_c_stops_a_chaos_map(self):
         m = mechlab.model("kapitza")
         timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))

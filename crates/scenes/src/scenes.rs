@@ -1069,15 +1069,7 @@ fn continuation_settings(
     }
     let to = match scene.text("to") {
         "auto" => {
-            let at = model
-                .info
-                .parameter_names
-                .iter()
-                .position(|p| *p == parameter);
-            match at.map(|i| params[i]) {
-                Some(0.0) | None => 1.0,
-                Some(value) => 1.8 * value,
-            }
+            mechlab_runtime::analysis::continuation::default_end(model.info, params, &parameter)
         }
         _ => scene.number("to")?,
     };

@@ -63,6 +63,16 @@ pub struct ContinuationSettings {
     pub chart: Option<Vec<usize>>,
 }
 
+/// The other end of a continuation in `parameter` when none is given:
+/// 1.8 times its value, 1 where it is 0 (or not a parameter of the model).
+pub fn default_end(info: &crate::registry::ModelInfo, params: &[f64], parameter: &str) -> f64 {
+    let at = info.parameter_names.iter().position(|p| *p == parameter);
+    match at.and_then(|i| params.get(i)) {
+        Some(0.0) | None => 1.0,
+        Some(value) => 1.8 * value,
+    }
+}
+
 impl ContinuationSettings {
     /// The arclength steps' first value and bounds.
     fn steps(&self) -> Steps {
