@@ -11,6 +11,8 @@
 # script, so that a return to the minutes this loop took before (444 s to
 # add a 1-degree model, over 15 minutes for a 6-link chain) cannot pass
 # unnoticed on a slow or busy runner.
+# With the Python module's environment (crates/python/check.sh), it times
+# the module's rebuild after an edit too.
 # The model files it adds come from this folder (written for the check,
 # not for mechlab's studies) and from models/extra; every file it adds to
 # or changes in models/ is restored when it ends, however it ends.
@@ -34,12 +36,19 @@ printf '%-58s %8s %8s  %s\n' "case" "seconds" "target" "verdict"
 
 # Times `explore` on model $1 (build included) for case $2 with target $3 s.
 measure() {
-    local model=$1 case=$2 target=$3 start end seconds verdict
+    local model=$1 case=$2 target=$3
+    timed "$case" "$target" cargo run --release --quiet --example explore -- --set model="$model" \
+        --set t_end=5 --set samples=200 --set periods=20
+}
+
+# Times the command $3... for case $1 with target $2 s.
+timed() {
+    local case=$1 target=$2 start end seconds verdict
+    shift 2
     start=$(now)
-    if ! cargo run --release --quiet --example explore -- --set model="$model" \
-        --set t_end=5 --set samples=200 --set periods=20 >"$log" 2>&1; then
+    if ! "$@" >"$log" 2>&1; then
         cat "$log" >&2
-        echo "$case: explore failed (above)" >&2
+        echo "$case: failed (above)" >&2
         exit 1
     fi
     end=$(now)
@@ -63,6 +72,19 @@ edited=models/kapitza.toml
 cp "$edited" "$edited.edit-loop-backup"
 sed -i 's/^default = 0.1$/default = 0.11/' "$edited"
 measure kapitza "edit: a default of kapitza.toml" 20
+
+# The Python module, where crates/python/check.sh has made its environment:
+# another default edited, the module rebuilt with the README's command and
+# the new value read from Python.
+python=target/python-env/bin/python
+if [ -x "$python" ]; then
+    sed -i 's/^default = 0.11$/default = 0.12/' "$edited"
+    python_loop() {
+        "$python" -m pip install -q ./crates/python &&
+            "$python" -c "import mechlab; assert mechlab.model('kapitza').parameters['eps'] == 0.12"
+    }
+    timed "python: the same edit, pip install ./crates/python" 30 python_loop
+fi
 
 add_model "$here/slider_pendulum.toml" slider_pendulum
 measure slider_pendulum "add: slider_pendulum (1 degree of freedom)" 20

@@ -1,10 +1,11 @@
 //! Long calls run without the GIL, on a thread of their own, while the
-//! calling thread checks for Ctrl-C every 50 ms: a KeyboardInterrupt
+//! calling thread checks for Ctrl-C every 50 ms until they end: a KeyboardInterrupt
 //! raises the `stop` flag, which the analyses that take a callback read
 //! between blocks of orbits (the others finish first), and is raised in
 //! Python once the work has returned.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
 use pyo3::prelude::*;
@@ -19,14 +20,24 @@ impl Stop {
 }
 
 /// `work` run off the GIL; Ctrl-C stops it where it looks at its [`Stop`].
+/// The calling thread wakes when the work ends (a channel), or every 50 ms
+/// to check for signals: a call of a millisecond takes a millisecond.
 pub fn detached<T: Send>(py: Python<'_>, work: impl FnOnce(&Stop) -> T + Send) -> PyResult<T> {
     let stop = Stop(AtomicBool::new(false));
     let mut interrupt = None;
     let result = py.detach(|| {
         std::thread::scope(|scope| {
-            let handle = scope.spawn(|| work(&stop));
-            while !handle.is_finished() {
-                std::thread::sleep(Duration::from_millis(50));
+            let (done, finished) = mpsc::channel::<()>();
+            let stop = &stop;
+            let handle = scope.spawn(move || {
+                let value = work(stop);
+                // (A panic drops `done` instead: the wait ends too.)
+                let _ = done.send(());
+                value
+            });
+            while let Err(RecvTimeoutError::Timeout) =
+                finished.recv_timeout(Duration::from_millis(50))
+            {
                 if interrupt.is_none() {
                     if let Err(e) = Python::attach(|py| py.check_signals()) {
                         stop.0.store(true, Ordering::Relaxed);
