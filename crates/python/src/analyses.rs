@@ -429,3 +429,84 @@ pub fn explore<'py>(
     }
     Ok(dict)
 }
+
+impl Classify for mechlab::analysis::basins::BasinsError {
+    fn class(&self) -> Class {
+        use mechlab::analysis::basins::BasinsError;
+        match self {
+            BasinsError::Refused(r) => r.class(),
+            BasinsError::Ode(e) => e.class(),
+            _ => Class::Value,
+        }
+    }
+}
+
+/// The iterates of the period map from many starts (the Taylor method in
+/// the batch lanes): `iterates[k, i]` is start k's state after
+/// transient + 1 + i periods, NaN for an orbit that stopped.
+pub fn iterates<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    starts: Vec<Vec<f64>>,
+    transient: usize,
+    record: usize,
+    method: Method,
+) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
+    use mechlab::analysis::period_map::iterates_of_starts;
+    let bar = progress(starts.len() as u64, &format!("{} orbits", model.info.name));
+    let runs = detached(py, |_| {
+        iterates_of_starts(model, &values, method, &starts, transient, record, &|k| {
+            bar.inc(k as u64)
+        })
+    })?
+    .map_err(py_err)?;
+    bar.finish_and_clear();
+    let dim = starts.first().map_or(0, Vec::len);
+    let mut array = numpy::ndarray::Array3::from_elem((starts.len(), record, dim), f64::NAN);
+    for (k, run) in runs.iter().enumerate() {
+        for (i, y) in run.iter().flatten().enumerate().take(record) {
+            for (j, x) in y.iter().enumerate().take(dim) {
+                array[(k, i, j)] = *x;
+            }
+        }
+    }
+    Ok(array.into_pyarray(py))
+}
+
+/// The basins of attraction of a period map's attractors on a plane of
+/// starts (the `basins` scene): `labels[j, i]` the attractor of each
+/// pixel (row 0 at the bottom; −1 diverged), each attractor's points.
+pub fn basins<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::basins::BasinSettings,
+    show_progress: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::basins::basins as basins_of;
+    let pixels = settings.pixels;
+    let bar = progress(
+        (pixels * pixels) as u64,
+        &format!("{} basins starts", model.info.name),
+    );
+    if !show_progress {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let result = detached(py, |_| {
+        basins_of(model, &values, &settings, &|k| bar.inc(k as u64))
+    })?
+    .map_err(py_err)?;
+    bar.finish_and_clear();
+    let dict = summary(py, &result)?;
+    let labels = Array2::from_shape_vec((pixels, pixels), result.labels.clone())
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    dict.set_item("labels", labels.into_pyarray(py))?;
+    let attractor_points: Vec<_> = result
+        .points
+        .iter()
+        .map(|p| points(py, p.iter().copied()))
+        .collect();
+    dict.set_item("points", attractor_points)?;
+    Ok(dict)
+}

@@ -632,6 +632,71 @@ impl PyModel {
         analyses::explore(py, self.model, values, y0, settings)
     }
 
+    /// The period map's iterates from many starts (rows of `starts`,
+    /// full states; the Taylor method runs them in the batch lanes):
+    /// `iterates[k, i]` is start k after transient + 1 + i periods, NaN
+    /// where its orbit stopped. A constrained model's starts are put on
+    /// its constraints first.
+    #[pyo3(signature = (starts, periods, *, transient=0, method="taylor", tol=1e-10, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn iterates<'py>(
+        &self,
+        py: Python<'py>,
+        starts: PyArrayLike2<'py, f64, AllowTypeChange>,
+        periods: usize,
+        transient: usize,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
+        let values = parameter_values(self.model, params)?;
+        let method = Method::parse(method, tol).map_err(py_err)?;
+        let starts: Vec<Vec<f64>> = starts
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| r.to_vec())
+            .collect();
+        analyses::iterates(py, self.model, values, starts, transient, periods, method)
+    }
+
+    /// The basins of attraction of the period map's attractors on a plane
+    /// of `pixels`² starts over `ranges` (`labels[j, i]`, row 0 at the
+    /// bottom, −1 where the orbit diverged), with a progress bar.
+    #[pyo3(signature = (*, axes=None, ranges=((-2.0, 2.0), (-2.0, 2.0)), through=None, pixels=200, transient=300, record=16, cell=0.05, stop_early=true, method="taylor", tol=1e-10, params=None, progress=true))]
+    #[allow(clippy::too_many_arguments)]
+    fn basins<'py>(
+        &self,
+        py: Python<'py>,
+        axes: Option<(analyses::Axis, analyses::Axis)>,
+        ranges: ((f64, f64), (f64, f64)),
+        through: Option<Vec<f64>>,
+        pixels: usize,
+        transient: usize,
+        record: usize,
+        cell: f64,
+        stop_early: bool,
+        method: &str,
+        tol: f64,
+        params: Option<BTreeMap<String, f64>>,
+        progress: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let settings = mechlab::analysis::basins::BasinSettings {
+            axes: analyses::axes(self.model, axes)?,
+            ranges: [ranges.0, ranges.1],
+            through,
+            pixels,
+            transient,
+            record,
+            cell,
+            method: Method::parse(method, tol).map_err(py_err)?,
+            stop_early,
+            tiles: None,
+        };
+        analyses::basins(py, self.model, values, settings, progress)
+    }
+
     /// A Poincaré section at the energy H = `energy` through the plane
     /// `plane` = `value` (a linear function of the coordinates, "x",
     /// "q1 - q2"; default the first coordinate), from `seeds` (the other

@@ -189,6 +189,28 @@ class Analyses(unittest.TestCase):
         self.assertAlmostEqual(e[0], (px**2 + py**2 + x**2 + yy**2) / 2 + x * x * yy - yy**3 / 3, places=14)
         self.assertLess(max(abs(v - e[0]) for v in e), 1e-10)
 
+    def test_iterates_in_the_lanes_are_the_period_maps_points(self):
+        m = mechlab.model("kapitza")
+        starts = np.array([[0.2, 0.0], [2.5, 0.3], [-1.0, 1.0]])
+        it = m.iterates(starts, 30, tol=1e-13, params={"A": 2.0})
+        self.assertEqual(it.shape, (3, 30, 2))
+        p = m.period_map(seeds=starts.tolist(), periods=30, tol=1e-13, params={"A": 2.0})
+        for k in range(3):
+            # The portrait's points start at the seed; q is an angle. The
+            # lanes take steps of their own: the two agree to the error.
+            d = it[k] - p.orbits[k][1:]
+            d[:, 0] = (d[:, 0] + math.pi) % (2 * math.pi) - math.pi
+            self.assertLess(np.max(np.abs(d)), 1e-10)
+
+    def test_basins_labels_count_as_their_fractions(self):
+        m = mechlab.model("duffing")
+        b = m.basins(pixels=24, progress=False)
+        self.assertEqual(b.labels.shape, (24, 24))
+        self.assertGreaterEqual(len(b.attractors), 2)
+        for k, a in enumerate(b.attractors):
+            self.assertEqual(int(np.sum(b.labels == k)), a.starts)
+            self.assertAlmostEqual(a.fraction, a.starts / 24**2)
+
     def test_ctrl_c_stops_a_chaos_map(self):
         m = mechlab.model("kapitza")
         timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))

@@ -51,6 +51,15 @@ class Model:
                   tol: float = 1e-10, params: Params = None) -> NDArray[np.float64]: ...
     def integrate_many(self, y0: ArrayLike, t: ArrayLike, *, method: str = "dop853",
                        tol: float = 1e-10, params: Params = None) -> dict[str, Any]: ...
+    def iterates(self, starts: ArrayLike, periods: int, *, transient: int = 0,
+                 method: str = "taylor", tol: float = 1e-10,
+                 params: Params = None) -> NDArray[np.float64]: ...
+    def basins(self, *, axes: Optional[Tuple[Axis, Axis]] = None,
+               ranges: Tuple[Tuple[float, float], Tuple[float, float]] = ((-2.0, 2.0), (-2.0, 2.0)),
+               through: Optional[Sequence[float]] = None, pixels: int = 200,
+               transient: int = 300, record: int = 16, cell: float = 0.05,
+               stop_early: bool = True, method: str = "taylor", tol: float = 1e-10,
+               params: Params = None, progress: bool = True) -> dict[str, Any]: ...
     def period_map(self, *, axes: Optional[Tuple[Axis, Axis]] = None,
                    seeds: Optional[Sequence[Sequence[float]]] = None, count: int = 24,
                    p_max: float = 2.5, periods: int = 500, method: str = "taylor",

@@ -206,6 +206,52 @@ pub enum PeriodMapError {
     Ode(#[from] OdeError),
 }
 
+/// The iterates `transient + 1 ..= transient + record` of the period map
+/// of `model` from each start, the full states (None for an orbit that
+/// stopped): the Taylor method's run in the batch lanes, a constrained
+/// model's starts put on its constraints first. `done` is called with the
+/// number of orbits done as blocks of them end.
+pub fn iterates_of_starts(
+    model: &Model,
+    params: &[f64],
+    method: Method,
+    starts: &[Vec<f64>],
+    transient: usize,
+    record: usize,
+    done: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<Option<Vec<Vec<f64>>>>, PeriodMapError> {
+    let systems = crate::analysis::flows(model)?;
+    crate::analysis::method_applies(model, method)?;
+    let info = systems.info();
+    Refusal::named_values(info, params)?;
+    let period = fast_phase_period(systems, params)?;
+    let dim = systems.periodic_state().len();
+    let mut flat = Vec::with_capacity(starts.len() * dim);
+    for start in starts {
+        if start.len() != dim {
+            return Err(Refusal::state_length(info.name, "start", start.len(), dim).into());
+        }
+        let mut y = start.clone();
+        systems
+            .consistent(params, &mut y, &[])
+            .map_err(|source| PeriodMapError::Inconsistent {
+                model: info.name.into(),
+                seed: start.clone(),
+                source,
+            })?;
+        flat.extend(y);
+    }
+    orbit_budget(starts.len(), record, dim)?;
+    let recording = crate::registry::Recording {
+        transient,
+        record,
+        settle: None,
+        known: None,
+        done,
+    };
+    Ok(systems.iterates(params, method, period, &flat, &recording)?)
+}
+
 /// The orbits of `model` with parameter values `params`.
 pub fn portrait(
     model: &Model,
