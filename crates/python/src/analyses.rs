@@ -226,6 +226,31 @@ pub struct SectionRequest {
     pub tol: f64,
 }
 
+/// The section's plane (default: the first coordinate's) at `energy`,
+/// crossed rising or not; the orbits' settings at the scene's defaults.
+pub fn plane_settings(
+    model: &Model,
+    plane: Option<&str>,
+    value: f64,
+    rising: bool,
+    energy: f64,
+) -> PyResult<SectionSettings> {
+    let info = model.info;
+    let text = plane.unwrap_or(info.coordinates[0]);
+    Ok(SectionSettings {
+        plane: parse_plane(text, info.coordinates)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?,
+        value,
+        rising,
+        energy,
+        crossings: 400,
+        t_max: 20_000.0,
+        tol: 1e-12,
+        phase: 0.0,
+        slab: 0.05,
+    })
+}
+
 /// A Poincaré section at a fixed energy (the `section` scene): each
 /// orbit's points on the plane as an (n, 2) array.
 pub fn section<'py>(
@@ -234,21 +259,18 @@ pub fn section<'py>(
     values: Vec<f64>,
     request: SectionRequest,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let info = model.info;
-    let plane_text = request
-        .plane
-        .unwrap_or_else(|| info.coordinates[0].to_string());
+    let settings = plane_settings(
+        model,
+        request.plane.as_deref(),
+        request.value,
+        request.rising,
+        request.energy,
+    )?;
     let settings = SectionSettings {
-        plane: parse_plane(&plane_text, info.coordinates)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?,
-        value: request.value,
-        rising: request.rising,
-        energy: request.energy,
         crossings: request.crossings,
         t_max: request.t_max,
         tol: request.tol,
-        phase: 0.0,
-        slab: 0.05,
+        ..settings
     };
     let result = detached(py, |_| {
         let seeds = request.seeds.clone().unwrap_or_else(|| {
@@ -509,4 +531,78 @@ pub fn basins<'py>(
         .collect();
     dict.set_item("points", attractor_points)?;
     Ok(dict)
+}
+
+/// The MEGNO map of a section (the `section` scene's `map`): ⟨Y⟩ of each
+/// pixel's orbit, NaN where the energy is not accessible.
+pub fn megno_map<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::section_map::SectionMapSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::section_map::section_map;
+    let pixels = settings.pixels;
+    let result = detached(py, |_| section_map(model, &values, &settings))?.map_err(py_err)?;
+    let dict = summary(py, &result)?;
+    let image = Array2::from_shape_vec((pixels, pixels), result.megno.clone())
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    dict.set_item("megno", image.into_pyarray(py))?;
+    Ok(dict)
+}
+
+/// A frequency map's summary with its tunes (ν₁, ν₂ as two images) and
+/// diffusion index per pixel.
+fn frequencies<'py>(
+    py: Python<'py>,
+    map: &mechlab::analysis::frequency_map::FrequencyMap,
+) -> PyResult<Bound<'py, PyDict>> {
+    let pixels = map.pixels;
+    let dict = summary(py, map)?;
+    let image = |f: &dyn Fn(usize) -> f64| {
+        Array2::from_shape_fn((pixels, pixels), |(j, i)| f(j * pixels + i)).into_pyarray(py)
+    };
+    dict.set_item("nu1", image(&|k| map.frequencies[k][0]))?;
+    dict.set_item("nu2", image(&|k| map.frequencies[k][1]))?;
+    dict.set_item("diffusion", image(&|k| map.diffusion[k]))?;
+    Ok(dict)
+}
+
+/// The frequency map (NAFF) of a section of an autonomous model (the
+/// `frequency_map` scene).
+pub fn frequency_map<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: mechlab::analysis::frequency_map::FrequencyMapSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::frequency_map::frequency_map as frequency_map_of;
+    let result = detached(py, |_| frequency_map_of(model, &values, &settings))?.map_err(py_err)?;
+    frequencies(py, &result)
+}
+
+/// The frequency map of a period map on a plane of starts (the
+/// `frequency_map` scene on a model with a fast phase), with a progress bar.
+pub fn period_map_frequencies<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: ChaosMapSettings,
+    show_progress: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mechlab::analysis::frequency_map::period_map_frequencies as frequencies_of;
+    let pixels = settings.pixels;
+    let bar = progress(
+        (pixels * pixels) as u64,
+        &format!("{} frequency map orbits", model.info.name),
+    );
+    if !show_progress {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let result = detached(py, |_| {
+        frequencies_of(model, &values, &settings, &|k| bar.inc(k as u64))
+    })?
+    .map_err(py_err)?;
+    bar.finish_and_clear();
+    frequencies(py, &result)
 }

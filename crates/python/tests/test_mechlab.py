@@ -211,6 +211,22 @@ class Analyses(unittest.TestCase):
             self.assertEqual(int(np.sum(b.labels == k)), a.starts)
             self.assertAlmostEqual(a.fraction, a.starts / 24**2)
 
+    def test_uncoupled_oscillators_have_unit_tunes_everywhere(self):
+        m = mechlab.model("henon_heiles")
+        f = m.frequency_map(energy=0.1, pixels=8, t_max=500, samples=1024, params={"lambda": 0.0})
+        accessible = np.isfinite(f.nu1)
+        self.assertEqual(int(np.sum(accessible)), f.accessible)
+        self.assertLess(np.max(np.abs(np.abs(f.nu1[accessible]) - 1.0)), 1e-9)
+        self.assertLess(np.max(np.abs(np.abs(f.nu2[accessible]) - 1.0)), 1e-9)
+
+    def test_megno_map_counts_its_chaotic_pixels(self):
+        g = mechlab.model("henon_heiles").megno_map(energy=0.125, pixels=20, t_max=500)
+        self.assertEqual(int(np.sum(np.isfinite(g.megno))), g.accessible)
+        self.assertEqual(int(np.sum(g.megno > 4.0)), g.chaotic)
+        self.assertGreater(g.chaotic, 0)
+        with self.assertRaises(mechlab.Refused):
+            mechlab.model("henon_heiles").period_map_frequencies(pixels=4, progress=False)
+
     def test_ctrl_c_stops_a_chaos_map(self):
         m = mechlab.model("kapitza")
         timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))

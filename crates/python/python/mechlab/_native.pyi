@@ -96,6 +96,20 @@ class Model:
                   y0: Optional[Sequence[float]] = None, t_obs: float = 2.0, order: int = 1,
                   method: str = "dop853", tol: float = 1e-11,
                   params: Params = None) -> dict[str, Any]: ...
+    def megno_map(self, *, energy: float, plane: Optional[str] = None, value: float = 0.0,
+                  rising: bool = True, pixels: int = 100, t_max: float = 2000.0,
+                  extent: float = 2.0, tol: float = 1e-12,
+                  params: Params = None) -> dict[str, Any]: ...
+    def frequency_map(self, *, energy: float, plane: Optional[str] = None, value: float = 0.0,
+                      rising: bool = True, pixels: int = 100, t_max: float = 2000.0,
+                      samples: int = 4096, extent: float = 2.0, tol: float = 1e-12,
+                      params: Params = None) -> dict[str, Any]: ...
+    def period_map_frequencies(self, *, pixels: int = 100, periods: int = 1000,
+                               axes: Optional[Tuple[Axis, Axis]] = None,
+                               ranges: Optional[Tuple[Tuple[float, float], Tuple[float, float]]] = None,
+                               through: Optional[Sequence[float]] = None, p_max: float = 3.0,
+                               method: str = "taylor", tol: float = 1e-10, params: Params = None,
+                               progress: bool = True) -> dict[str, Any]: ...
     def section(self, *, energy: float, plane: Optional[str] = None, value: float = 0.0,
                 rising: bool = True, seeds: Optional[Sequence[Tuple[float, float]]] = None,
                 orbits: int = 24, extent: float = 2.0, crossings: int = 400,
