@@ -73,7 +73,9 @@ fn every_analysis_runs_on_every_model_or_says_why_not() {
 }
 
 /// A constrained model: the analyses of Hamiltonian forms refuse it by
-/// name; its portrait (with a fast phase) runs on its constraints from
+/// name; its averaging error falls as a whole power of the frequency, or
+/// the analysis says why it does not apply (no fast phase, constraints
+/// that move with it); its portrait (with a fast phase) runs on its constraints from
 /// seeds put on them; its stabilisation by vibration gives an equilibrium
 /// on the constraints, or says why it cannot.
 fn constrained_model_on_its_constraints(name: &str, params: &[f64]) {
@@ -85,11 +87,19 @@ fn constrained_model_on_its_constraints(name: &str, params: &[f64]) {
     let refused = mechlab::analysis::Refusal::Constrained {
         model: name.to_string(),
     };
-    let a = convergence(handle, params, &averaging_settings()).unwrap_err();
+    let e = stability(handle, params, &stability_settings("")).unwrap_err();
     assert!(
-        matches!(a, AveragingError::Refused(ref r) if *r == refused),
-        "{a}"
+        matches!(e, StabilityError::Refused(ref r) if *r == refused),
+        "{e}"
     );
+    match crate::common::asymptotic_slopes(handle, params, &averaging_settings()) {
+        Ok(slopes) => {
+            crate::common::assert_whole_power_slopes(name, &slopes, -1.0);
+        }
+        Err(AveragingError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. }))
+        | Err(AveragingError::MovingConstraints { .. }) => {}
+        Err(e) => panic!("{name}: {e}"),
+    }
     let n = handle.info.coordinates.len();
     // The chaos map on a plane of a coordinate and its velocity through the
     // file's start: a pixel with no state of the model there is NaN,

@@ -226,6 +226,13 @@ pub enum AveragingError {
     },
     #[error("model '{0}': the averaged system of order {1} is not derived (order 1 is for every model with a fast phase, order 2 too except for models with a numeric solve of more than 4 degrees of freedom, whose code would grow like n⁴)")]
     Order(String, usize),
+    /// A constrained model whose constraints or mass matrix move with the
+    /// fast phase: the averaging with constraints is derived for fixed ones.
+    #[error("model '{model}': its constraints or its mass matrix move with the fast phase; the averaging on constraints is derived for fixed ones (`explore` runs the exact motion)")]
+    MovingConstraints { model: String },
+    /// A constrained run that could not stay on its constraints.
+    #[error(transparent)]
+    Constrained(#[from] crate::analysis::on_constraints::ConstrainedError),
     #[error(transparent)]
     Ode(#[from] OdeError),
 }
@@ -279,6 +286,9 @@ pub fn convergence(
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<AveragingConvergence, AveragingError> {
+    if let Some(constrained) = model.constrained {
+        return on_constraints(constrained, params, settings);
+    }
     let model = crate::analysis::hamiltonian(model)?;
     let info = model.info();
     if !model.has_fast_phase() {
@@ -324,6 +334,20 @@ pub fn convergence(
         }
         order => return Err(AveragingError::Order(info.name.into(), order)),
     };
+    Ok(summarised(info, parameter, values, y0, settings, run))
+}
+
+/// The sweep's deviations as the analysis reports them: local and fitted
+/// slopes, levels, ν × deviation.
+fn summarised(
+    info: &crate::registry::ModelInfo,
+    parameter: String,
+    values: Vec<f64>,
+    y0: Vec<f64>,
+    settings: &ConvergenceSettings,
+    run: Convergence,
+) -> AveragingConvergence {
+    let frequencies = run.frequencies.clone();
     let local: Vec<Vec<f64>> = run
         .max_deviation
         .iter()
@@ -334,10 +358,10 @@ pub fn convergence(
         .iter()
         .map(|d| d.iter().zip(&frequencies).map(|(d, nu)| d * nu).collect())
         .collect();
-    Ok(AveragingConvergence {
+    AveragingConvergence {
         model: info.name.into(),
         parameter,
-        values: values.clone(),
+        values,
         frequencies,
         coordinates: info.coordinates.iter().map(|c| c.to_string()).collect(),
         y0,
@@ -349,7 +373,76 @@ pub fn convergence(
         level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
         settled_slope: local.iter().map(|l| settled(l)).collect(),
         local_slopes: local,
-    })
+    }
+}
+
+/// [`convergence`] on a constrained model with fixed holonomic constraints
+/// (first order): the exact run on the constraints against the averaged
+/// motion of W = mean V + ½ mean⟨P b, b⟩ from the same consistent state,
+/// both projected at every sample. The start defaults to the model file's
+/// with its first coordinate moved by 0.2, put on the constraints holding it.
+fn on_constraints(
+    model: &'static dyn crate::registry::ConstrainedSystems,
+    params: &[f64],
+    settings: &ConvergenceSettings,
+) -> Result<AveragingConvergence, AveragingError> {
+    let info = model.info();
+    if !model.has_fast_phase() {
+        return Err(AveragingError::Refused(Refusal::no_fast_phase(info.name)));
+    }
+    if settings.order != 1 {
+        return Err(AveragingError::Order(info.name.into(), settings.order));
+    }
+    Refusal::named_values(info, params)?;
+    let n = info.coordinates.len();
+    let mut y0 = match &settings.y0 {
+        Some(y) if y.len() != 2 * n => {
+            return Err(Refusal::state_length(info.name, "initial state", y.len(), 2 * n).into())
+        }
+        Some(y) => y.clone(),
+        None => {
+            let mut y = model.start(params);
+            y[0] += 0.2;
+            y
+        }
+    };
+    let held: &[usize] = if settings.y0.is_some() { &[] } else { &[0] };
+    model.consistent(params, &mut y0, held).map_err(|source| {
+        crate::analysis::on_constraints::ConstrainedError::Constraint {
+            model: info.name,
+            t: 0.0,
+            source,
+        }
+    })?;
+    let (parameter, index, values, frequencies) = swept(model, params, settings)?;
+    let per_frequency: Vec<Vec<f64>> = frequencies
+        .par_iter()
+        .zip(&values)
+        .map(|(&nu, &value)| -> Result<Vec<f64>, AveragingError> {
+            let mut p = params.to_vec();
+            p[index] = value;
+            let grid = time_grid(settings.t_obs, 2.0 * std::f64::consts::PI / nu, 32, 2000);
+            let averaged = model
+                .averaged_states(&p, settings.method, &y0, &grid)?
+                .ok_or_else(|| AveragingError::MovingConstraints {
+                    model: info.name.into(),
+                })?;
+            let exact =
+                crate::analysis::on_constraints::run(model, &p, Some(&y0), settings.method, &grid)?
+                    .states;
+            Ok((0..n)
+                .map(|i| {
+                    exact
+                        .iter()
+                        .zip(&averaged)
+                        .map(|(e, a)| (e[i] - a[i]).abs())
+                        .fold(0.0, f64::max)
+                })
+                .collect())
+        })
+        .collect::<Result<_, _>>()?;
+    let run = fit_deviations(&frequencies, per_frequency, n);
+    Ok(summarised(info, parameter, values, y0, settings, run))
 }
 
 /// The start of both runs: the settings', or 0.2, −0.1, 0.2, … in the
@@ -379,7 +472,7 @@ fn initial_state(model: &dyn Systems, settings: &ConvergenceSettings) -> Result<
 /// each (checked to change).
 #[allow(clippy::type_complexity)]
 fn swept(
-    model: &dyn Systems,
+    model: &dyn crate::registry::Flows,
     params: &[f64],
     settings: &ConvergenceSettings,
 ) -> Result<(String, usize, Vec<f64>, Vec<f64>), AveragingError> {

@@ -44,7 +44,7 @@ pub enum Refusal {
     ContactModel { model: String },
     /// A model with constraints: this analysis does not run on a
     /// constraint manifold yet.
-    #[error("'{model}' is a constrained model: this analysis does not run on its constraints yet (the scenes `explore`, `period_map`, `chaos_map`, `basins`, `attractor`, `continuation`, `stability` and `linkage` run such models on them)")]
+    #[error("'{model}' is a constrained model: this analysis does not run on its constraints yet (the scenes `explore`, `period_map`, `chaos_map`, `basins`, `attractor`, `continuation`, `averaging`, `section`, `stability` and `linkage` run such models on them)")]
     Constrained { model: String },
     /// No `[fast_phase]` in its model file: no period map, nothing to average.
     #[error("model '{model}' has no fast phase ([fast_phase] in its model file): it has no period map and nothing to average")]
