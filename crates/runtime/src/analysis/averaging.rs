@@ -86,18 +86,24 @@ pub fn deviation_against_frequency(
             let grid = time_grid(t_obs, 2.0 * std::f64::consts::PI / nu, 32, 2000);
             let exact = exact.states_at(method, 0.0, y0, &grid)?;
             let averaged = averaged.states_at(method, 0.0, y0, &grid)?;
-            Ok((0..coordinates)
-                .map(|i| {
-                    exact
-                        .iter()
-                        .zip(&averaged)
-                        .map(|(e, a)| (e[i] - a[i]).abs())
-                        .fold(0.0, f64::max)
-                })
-                .collect())
+            Ok(largest_deviations(&exact, &averaged, coordinates))
         })
         .collect::<Result<_, OdeError>>()?;
     Ok(fit_deviations(frequencies, per_frequency, coordinates))
+}
+
+/// The largest |exact − averaged| of each of the first `coordinates`
+/// components over two runs' samples.
+fn largest_deviations(exact: &[Vec<f64>], averaged: &[Vec<f64>], coordinates: usize) -> Vec<f64> {
+    (0..coordinates)
+        .map(|i| {
+            exact
+                .iter()
+                .zip(averaged)
+                .map(|(e, a)| (e[i] - a[i]).abs())
+                .fold(0.0, f64::max)
+        })
+        .collect()
 }
 
 /// Per coordinate, the deviations against the frequencies and their
@@ -430,15 +436,7 @@ fn on_constraints(
             let exact =
                 crate::analysis::on_constraints::run(model, &p, Some(&y0), settings.method, &grid)?
                     .states;
-            Ok((0..n)
-                .map(|i| {
-                    exact
-                        .iter()
-                        .zip(&averaged)
-                        .map(|(e, a)| (e[i] - a[i]).abs())
-                        .fold(0.0, f64::max)
-                })
-                .collect())
+            Ok(largest_deviations(&exact, &averaged, n))
         })
         .collect::<Result<_, _>>()?;
     let run = fit_deviations(&frequencies, per_frequency, n);
