@@ -37,6 +37,10 @@ pub trait ConstrainedSystems: Flows {
     fn reactions(&self, params: &[f64], t: f64, y: &[f64]) -> Result<Vec<f64>, OdeError>;
     /// (max |g|, max |G q' + c_t|) at (t, y).
     fn residuals(&self, params: &[f64], t: f64, y: &[f64]) -> Result<(f64, f64), OdeError>;
+    /// What a run reports at an output time, in one call: the residuals
+    /// the integration left at (t, y), then `y` put on the constraints, and
+    /// there its reactions and energy.
+    fn output(&self, params: &[f64], t: f64, y: &mut [f64]) -> Result<Output, ConstraintError>;
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError>;
     /// An orthonormal basis (columns) of the tangent space of the
     /// constrained phase space at (t, y), or None where the constraints
@@ -95,6 +99,16 @@ pub trait ConstrainedSystems: Flows {
         plane: &PlaneCrossing,
         keep: &mut dyn FnMut(&[f64]) -> bool,
     ) -> Result<(f64, Vec<f64>), OdeError>;
+}
+
+/// A run's report at one output time ([`ConstrainedSystems::output`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Output {
+    /// (max |g|, max |G q' + c_t|) before the projection.
+    pub drift: (f64, f64),
+    pub projection: Projection,
+    pub reactions: Vec<f64>,
+    pub energy: f64,
 }
 
 /// A coordinate's plane q_c = value crossed in one direction, as a
@@ -301,6 +315,25 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
     fn residuals(&self, params: &[f64], t: f64, y: &[f64]) -> Result<(f64, f64), OdeError> {
         let y = fixed_state::<S>(y)?;
         Ok(self.equations(params).residuals(t, &y))
+    }
+    fn output(&self, params: &[f64], t: f64, y: &mut [f64]) -> Result<Output, ConstraintError> {
+        let given = y.len();
+        let state: &mut [f64; S] = y.try_into().map_err(|_| ConstraintError::StateLength {
+            given,
+            coordinates: N,
+        })?;
+        let equations = self.equations(params);
+        let drift = equations.residuals(t, state);
+        let tolerance = position_tolerance(&self.forms.periodic, state);
+        let projection = equations.project(t, state, tolerance)?;
+        let reactions = equations.accelerations(t, state).1.to_vec();
+        let (q, v) = OnConstraints::<N, K, S>::split(state);
+        Ok(Output {
+            drift,
+            projection,
+            reactions,
+            energy: (self.forms.energy)(params, t, &q, &v),
+        })
     }
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError> {
         let y = fixed_state::<S>(y)?;

@@ -5,7 +5,7 @@ use std::fmt;
 
 mod constrained;
 mod recording;
-pub use constrained::{Constrained, ConstrainedSystems, PlaneCrossing};
+pub use constrained::{Constrained, ConstrainedSystems, Output, PlaneCrossing};
 use recording::Recorder;
 pub use recording::{distance, within, Cells, KnownAttractors, Recording};
 

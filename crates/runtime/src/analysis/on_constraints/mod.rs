@@ -149,16 +149,16 @@ pub fn run(
             false => vec![y.clone()],
         };
         for (&ts, mut sample) in group.iter().zip(samples) {
-            let drift = model.residuals(params, ts, &sample)?;
-            result.largest_drift = larger(result.largest_drift, drift);
-            let left = model
-                .project(params, ts, &mut sample)
+            let output = model
+                .output(params, ts, &mut sample)
                 .map_err(constraint(ts))?;
+            result.largest_drift = larger(result.largest_drift, output.drift);
+            let left = output.projection;
             let residual = (left.position_residual, left.velocity_residual);
             result.largest_residual = larger(result.largest_residual, residual);
             result.times.push(ts);
-            result.reactions.push(model.reactions(params, ts, &sample)?);
-            result.energy.push(model.energy(params, ts, &sample)?);
+            result.reactions.push(output.reactions);
+            result.energy.push(output.energy);
             result.states.push(sample);
         }
         if t1 > t {
