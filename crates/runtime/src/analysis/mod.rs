@@ -46,6 +46,10 @@ pub enum Refusal {
     /// constraint manifold yet.
     #[error("'{model}' is a constrained model: this analysis does not run on its constraints yet (the scenes `explore`, `period_map`, `chaos_map`, `basins`, `attractor`, `continuation`, `averaging`, `section`, `stability` and `linkage` run such models on them)")]
     Constrained { model: String },
+    /// A model with a nonholonomic constraint, where the analysis needs
+    /// holonomic ones; `reason` says why.
+    #[error("'{model}' has a nonholonomic constraint: {reason}")]
+    Nonholonomic { model: String, reason: &'static str },
     /// No `[fast_phase]` in its model file: no period map, nothing to average.
     #[error("model '{model}' has no fast phase ([fast_phase] in its model file): it has no period map and nothing to average")]
     NoFastPhase { model: String },

@@ -102,7 +102,7 @@ pub enum ContinuationError {
     Refused(#[from] crate::analysis::Refusal),
     /// M − I is singular at the start: the guess sits on a bifurcation (or a
     /// degenerate orbit), where the branch's direction is not defined.
-    #[error("the Jacobian P'(y) − I is singular at the start (parameter {parameter}): start off the bifurcation, at another parameter value")]
+    #[error("the Jacobian P'(y) − I is singular at the start (parameter {parameter}): the start is a bifurcation, or one of a continuous family of fixed points (a symmetry or a conserved quantity, as a nonholonomic model's rest anywhere); start at another parameter value, or continue orbits that are isolated")]
     SingularJacobian { parameter: f64 },
     #[error("Newton found no fixed point of the period map from {guess:?} at parameter {parameter}: give a better `start`")]
     NoFixedPoint { guess: Vec<f64>, parameter: f64 },

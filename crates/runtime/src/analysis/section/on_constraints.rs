@@ -130,7 +130,11 @@ impl<'a> Chart<'a> {
             .into());
         }
         if systems.holonomic().iter().any(|h| !h) {
-            return Err(refuse("a section on the constraints needs holonomic constraints: with a nonholonomic one, a coordinate and its rate do not chart the energy surface on the plane"));
+            return Err(Refusal::Nonholonomic {
+                model: name.into(),
+                reason: "a section needs holonomic constraints (with a nonholonomic one, a coordinate and its rate do not chart the energy surface on the plane)",
+            }
+            .into());
         }
         let n = model.info.coordinates.len();
         let k = systems.constraint_names().len();
