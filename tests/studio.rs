@@ -797,3 +797,55 @@ fn a_dropped_orbit_stops() {
     let second = period_map(&mut integrator, &system, period, &[1.0, 0.5]).unwrap();
     assert_eq!(received[1], [wrap_angle(second[0]), second[1]]);
 }
+
+/// The page offers a section where the library draws one: a Hamiltonian
+/// model of 2 degrees of freedom (with a fast phase, a slice of its period
+/// map), or an autonomous one of 2 on holonomic constraints; its orbit on
+/// a constrained model is the library's, in the chart the library picks.
+#[test]
+fn sections_are_offered_where_they_apply_on_constraints_too() {
+    use mechlab::analysis::section::{section as library_section, SectionSettings};
+    use mechlab_studio::calls::{models, section, SectionRequest};
+    let offered = |catalog: mechlab::registry::Catalog, name: &str| {
+        models(catalog)
+            .into_iter()
+            .find(|m| m.name == name)
+            .unwrap()
+            .section
+    };
+    let main = mechlab::models::MODELS;
+    assert!(offered(main, "henon_heiles") && offered(main, "double_pendulum"));
+    for name in [
+        "kapitza",
+        "four_bar",
+        "chaplygin_sleigh",
+        "slider_crank",
+        "painleve_klein",
+    ] {
+        assert!(!offered(main, name), "{name}");
+    }
+    let tests = mechlab_test_models::MODELS;
+    assert!(offered(tests, "cartesian_free_double_pendulum"));
+    let request: SectionRequest = serde_json::from_value(json!({
+        "model": "cartesian_free_double_pendulum", "energy": -2.5, "seed": [0.3, 0.0],
+        "crossings": 20, "method": "dop853", "tol": 1e-12
+    }))
+    .unwrap();
+    let answer = section(tests, &request).unwrap();
+    assert_eq!(answer.axes, ["x₂", "x₂′"]);
+    let model = mechlab::registry::lookup(tests, "cartesian_free_double_pendulum").unwrap();
+    let settings = SectionSettings {
+        plane: vec![1.0, 0.0, 0.0, 0.0],
+        value: 0.0,
+        rising: true,
+        energy: -2.5,
+        crossings: 20,
+        t_max: 20.0 * 20.0 + 100.0,
+        tol: 1e-12,
+        phase: 0.0,
+        slab: 0.05,
+    };
+    let library =
+        library_section(model, &model.dynamic.defaults(), &[[0.3, 0.0]], &settings).unwrap();
+    assert_eq!(answer.points, library.orbits[0].points);
+}

@@ -121,6 +121,10 @@ pub struct ModelSummary {
     /// Whether the Taylor method runs it (a constrained model of more than
     /// 6 coordinates has no Taylor recurrences: the page picks DOP853).
     pub taylor: bool,
+    /// Whether the page offers its Poincaré section: a Hamiltonian model
+    /// of 2 degrees of freedom, or an autonomous one of 2 on holonomic
+    /// constraints (`analysis::section`).
+    pub section: bool,
 }
 
 /// Every model of `catalog`, in its order.
@@ -129,12 +133,24 @@ pub fn models(catalog: Catalog) -> Vec<ModelSummary> {
         .iter()
         .map(|m| {
             let taylor = m.flows().is_none_or(|f| f.has_taylor_recurrences());
-            summary(m.info, m.dynamic, taylor)
+            let section = match m.constrained {
+                Some(c) => {
+                    let free = m.info.coordinates.len() - c.constraint_names().len();
+                    free == 2 && !c.has_fast_phase() && c.holonomic().iter().all(|h| *h)
+                }
+                None => m.systems().is_some() && m.info.coordinates.len() == 2,
+            };
+            summary(m.info, m.dynamic, taylor, section)
         })
         .collect()
 }
 
-fn summary(info: &'static ModelInfo, model: &dyn DynamicModel, taylor: bool) -> ModelSummary {
+fn summary(
+    info: &'static ModelInfo,
+    model: &dyn DynamicModel,
+    taylor: bool,
+    section: bool,
+) -> ModelSummary {
     let (kind, dof, fast_phase) = match model.kind() {
         Kind::Hamiltonian { dof, fast_phase } => ("hamiltonian", dof, fast_phase),
         Kind::Contacts { count } => ("contacts", count, false),
@@ -159,6 +175,7 @@ fn summary(info: &'static ModelInfo, model: &dyn DynamicModel, taylor: bool) -> 
     });
     ModelSummary {
         taylor,
+        section,
         through,
         name: info.name,
         source_file: info.source_file,

@@ -563,6 +563,7 @@ async function refreshMegno() {
   if (megnoController) megnoController.abort();
   megnoController = null;
   if (!studio.section || !$("show-megno").checked) { studio.megno = null; $("megno-note").textContent = ""; redraw(); return; }
+  if (studio.model.kind === "constrained") { studio.megno = null; $("megno-note").textContent = "(not computed on constraints)"; redraw(); return; }
   megnoController = new AbortController();
   const signal = megnoController.signal;
   const t_max = Number($("megno-time").value);
@@ -602,8 +603,12 @@ function setSectionMode(on) {
   studio.sectionAxes = null;
   removeOrbits(0);
   if (on) {
-    const other = 1 - Number($("section-coordinate").value);
-    studio.axes = [other, 2 + other];
+    // A constrained model's chart is the server's (the first coordinate
+    // that, held with the plane's, fixes the others): its names come back
+    // with the first orbit.
+    const n = model.state.length / 2;
+    const other = model.kind === "constrained" ? 0 : 1 - Number($("section-coordinate").value);
+    studio.axes = [other, n + other];
     studio.view = { x: [-1, 1], y: [-1, 1] };
     studio.megnoViewSet = false;
   } else {
@@ -616,14 +621,14 @@ function setSectionMode(on) {
 }
 
 function buildSection(model) {
-  const applies = model.state.length === 4 && model.kind === "hamiltonian";
+  const applies = model.section;
   $("section-energy-of").textContent = model.fast_phase ? "H̄" : "H";
   $("section-controls").style.display = applies ? "" : "none";
   $("show-section").checked = false;
   $("section-plane").value = "";
   studio.section = false;
   studio.megno = null;
-  $("section-coordinate").innerHTML = model.state.slice(0, 2).map((name, i) => `<option value="${i}">${name}</option>`).join("");
+  $("section-coordinate").innerHTML = model.state.slice(0, model.state.length / 2).map((name, i) => `<option value="${i}">${name}</option>`).join("");
 }
 
 studio.sectionSeed = (x, y) => seedSection(x, y);
