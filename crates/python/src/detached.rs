@@ -1,8 +1,10 @@
 //! Long calls run without the GIL, on a thread of their own, while the
-//! calling thread checks for Ctrl-C every 50 ms until they end: a KeyboardInterrupt
-//! raises the `stop` flag, which the analyses that take a callback read
-//! between blocks of orbits (the others finish first), and is raised in
-//! Python once the work has returned.
+//! calling thread checks for Ctrl-C every 50 ms until they end: a
+//! KeyboardInterrupt raises the `stop` flag, which the analyses that take
+//! a callback read between blocks of orbits, and asks every integration
+//! to stop (`mechlab::ode::stop`), so that every analysis ends at its
+//! integrators' next step. The KeyboardInterrupt is raised in Python once
+//! the work has returned.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
@@ -25,6 +27,7 @@ impl Stop {
 pub fn detached<T: Send>(py: Python<'_>, work: impl FnOnce(&Stop) -> T + Send) -> PyResult<T> {
     let stop = Stop(AtomicBool::new(false));
     let mut interrupt = None;
+    mechlab::ode::stop::clear_stop();
     let result = py.detach(|| {
         std::thread::scope(|scope| {
             let (done, finished) = mpsc::channel::<()>();
@@ -41,6 +44,7 @@ pub fn detached<T: Send>(py: Python<'_>, work: impl FnOnce(&Stop) -> T + Send) -
                 if interrupt.is_none() {
                     if let Err(e) = Python::attach(|py| py.check_signals()) {
                         stop.0.store(true, Ordering::Relaxed);
+                        mechlab::ode::stop::request_stop();
                         interrupt = Some(e);
                     }
                 }

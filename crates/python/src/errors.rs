@@ -71,6 +71,7 @@ impl Classify for OdeError {
             | OdeError::NonFiniteInitialState { .. }
             | OdeError::StateLength { .. }
             | OdeError::TooLarge(_) => Class::Value,
+            OdeError::Stopped { .. } => Class::Interrupted,
             _ => Class::Integration,
         }
     }

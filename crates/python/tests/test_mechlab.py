@@ -237,6 +237,20 @@ class Analyses(unittest.TestCase):
         finally:
             timer.cancel()
 
+    def test_ctrl_c_stops_any_analysis_and_the_next_call_runs(self):
+        # An attractor of ten million points: no hook of its own, its
+        # integrations stop at their next step.
+        m = mechlab.model("ueda")
+        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+        timer.start()
+        try:
+            with self.assertRaises(KeyboardInterrupt):
+                m.attractor(points=10_000_000, lyapunov_periods=100_000)
+        finally:
+            timer.cancel()
+        s = mechlab.model("kapitza").stability(samples=6)
+        self.assertAlmostEqual(s.equilibria[1].a_star, math.sqrt(2.0), places=9)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -204,6 +204,9 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
         if attempts >= max_steps {
             return Err(OdeError::TooManySteps { t, max_steps });
         }
+        if super::stop::stop_requested() {
+            return Err(OdeError::Stopped { t });
+        }
         attempts += 1;
         let (signed, last) = match clock {
             Clock::Fixed {

@@ -23,6 +23,7 @@ mod radau5;
 mod rk4;
 pub mod series;
 mod solve;
+pub mod stop;
 pub mod taylor;
 mod taylor_lanes;
 
@@ -334,6 +335,9 @@ pub enum OdeError {
     StepSizeUnderflow { t: f64, h: f64, y: Box<[f64]> },
     #[error("more than {max_steps} steps, stopped at t = {t}")]
     TooManySteps { t: f64, max_steps: u64 },
+    /// A stop was requested ([`stop::request_stop`]: Ctrl-C).
+    #[error("stopped at t = {t}: a stop was requested (Ctrl-C)")]
+    Stopped { t: f64 },
     /// The implicit stage equations did not converge.
     #[error("implicit stage equations did not converge at t = {t} with h = {h:e}, y = {y:?}")]
     NoConvergence { t: f64, h: f64, y: Vec<f64> },

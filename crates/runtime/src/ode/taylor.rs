@@ -325,6 +325,9 @@ impl DoubleDoubleTaylor {
             if remaining.hi <= 0.0 {
                 return Ok(y);
             }
+            if super::stop::stop_requested() {
+                return Err(OdeError::Stopped { t: t.to_f64() });
+            }
             let (c, _) = self.coefficients.as_chunks_mut::<N>();
             if !system.taylor(t, &y, order, &mut self.work, c) {
                 return Err(OdeError::TaylorUnavailable);

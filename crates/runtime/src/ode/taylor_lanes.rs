@@ -231,6 +231,13 @@ impl LaneIntegrator {
         systems: [&S; LANES],
         run: &mut Run<N>,
     ) -> Option<LaneSet> {
+        if super::stop::stop_requested() {
+            let running = lane_set(run.running);
+            for l in members(running) {
+                run.errors[l] = Some(OdeError::Stopped { t: run.t[l] });
+            }
+            return Some(running);
+        }
         let (order, safety) = (self.order, self.safety);
         self.stats.order = self.stats.order.max(order as u64);
         self.coefficients.resize((order + 1) * N, Lanes::default());
