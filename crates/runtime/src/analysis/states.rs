@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use crate::analysis::on_constraints::{run, ConstrainedError};
+use crate::analysis::on_constraints::{states, ConstrainedError};
 use crate::analysis::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::registry::Model;
@@ -135,7 +135,7 @@ fn orbit(
                 model: model.info.name,
                 source,
             })?;
-        return Ok(run(constrained, params, Some(&start), method, times)?.states);
+        return Ok(states(constrained, params, &start, method, times)?);
     }
     let system = crate::analysis::flows(model)?.exact(params);
     // The first time is the start's: its state is y0 itself.

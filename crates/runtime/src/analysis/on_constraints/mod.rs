@@ -83,8 +83,9 @@ pub struct ConstrainedRun {
 
 /// Runs `model` from `y0` (the model file's start at rest if None; made
 /// consistent by projection) at t0 = times[0] through the output `times`:
-/// every reported state is projected onto the constraints, and so is the
-/// integrated state every 16 output times.
+/// every reported state is projected onto the constraints, with its
+/// reactions and energy, and so is the integrated state every 16 output
+/// times.
 pub fn run(
     model: &dyn ConstrainedSystems,
     params: &[f64],
@@ -92,6 +93,86 @@ pub fn run(
     method: Method,
     times: &[f64],
 ) -> Result<ConstrainedRun, ConstrainedError> {
+    let name = model.info().name;
+    let mut result = ConstrainedRun {
+        model: name,
+        constraint_names: model.constraint_names().to_vec(),
+        start: Vec::new(),
+        times: Vec::new(),
+        states: Vec::new(),
+        reactions: Vec::new(),
+        energy: Vec::new(),
+        largest_drift: (0.0, 0.0),
+        largest_residual: (0.0, 0.0),
+        steps: 0,
+    };
+    let (start, steps) = follow(model, params, y0, method, times, &mut |ts, mut sample| {
+        let output = model.output(params, ts, &mut sample).map_err(|source| {
+            ConstrainedError::Constraint {
+                model: name,
+                t: ts,
+                source,
+            }
+        })?;
+        result.largest_drift = larger(result.largest_drift, output.drift);
+        let left = output.projection;
+        let residual = (left.position_residual, left.velocity_residual);
+        result.largest_residual = larger(result.largest_residual, residual);
+        result.times.push(ts);
+        result.reactions.push(output.reactions);
+        result.energy.push(output.energy);
+        result.states.push(sample);
+        Ok(())
+    })?;
+    (result.start, result.steps) = (start, steps);
+    Ok(result)
+}
+
+/// The states alone of [`run`] (each projected onto the constraints): what
+/// an orbit by name returns, without the reactions and energies a run
+/// reports at every output.
+pub fn states(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    y0: &[f64],
+    method: Method,
+    times: &[f64],
+) -> Result<Vec<Vec<f64>>, ConstrainedError> {
+    let name = model.info().name;
+    let mut states = Vec::with_capacity(times.len());
+    follow(
+        model,
+        params,
+        Some(y0),
+        method,
+        times,
+        &mut |ts, mut sample| {
+            model.project(params, ts, &mut sample).map_err(|source| {
+                ConstrainedError::Constraint {
+                    model: name,
+                    t: ts,
+                    source,
+                }
+            })?;
+            states.push(sample);
+            Ok(())
+        },
+    )?;
+    Ok(states)
+}
+
+/// The integration of [`run`]: through groups of output times with dense
+/// output, the integrated state projected at each group's end; each
+/// output (not yet projected) goes to `report`. Returns the start after
+/// its projection and the steps taken.
+fn follow(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    y0: Option<&[f64]>,
+    method: Method,
+    times: &[f64],
+    report: &mut dyn FnMut(f64, Vec<f64>) -> Result<(), ConstrainedError>,
+) -> Result<(Vec<f64>, u64), ConstrainedError> {
     let name = model.info().name;
     let t0 = times.first().copied().unwrap_or(0.0);
     if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| !(w[1] > w[0])) {
@@ -112,24 +193,11 @@ pub fn run(
         return Err(OdeError::NonFiniteInitialState { t: t0, y }.into());
     }
     model.project(params, t0, &mut y).map_err(constraint(t0))?;
+    let start = y.clone();
     let system = model.exact(params);
     let mut integrator = Integrator::new(method)?;
-    let mut result = ConstrainedRun {
-        model: name,
-        constraint_names: model.constraint_names().to_vec(),
-        start: y.clone(),
-        times: Vec::new(),
-        states: Vec::new(),
-        reactions: Vec::new(),
-        energy: Vec::new(),
-        largest_drift: (0.0, 0.0),
-        largest_residual: (0.0, 0.0),
-        steps: 0,
-    };
-    // The integration runs through groups of output times with dense
-    // output, and its state is projected at each group's end; each reported
-    // state is projected too (a step cut short at every output time cost
-    // the pendulum's run twice its steps).
+    // Each reported state is projected too (a step cut short at every
+    // output time cost the pendulum's run twice its steps).
     let mut t = t0;
     for group in times.chunks(OUTPUTS_PER_PROJECTION) {
         let t1 = group[group.len() - 1];
@@ -148,26 +216,15 @@ pub fn run(
             // The first output is the start itself.
             false => vec![y.clone()],
         };
-        for (&ts, mut sample) in group.iter().zip(samples) {
-            let output = model
-                .output(params, ts, &mut sample)
-                .map_err(constraint(ts))?;
-            result.largest_drift = larger(result.largest_drift, output.drift);
-            let left = output.projection;
-            let residual = (left.position_residual, left.velocity_residual);
-            result.largest_residual = larger(result.largest_residual, residual);
-            result.times.push(ts);
-            result.reactions.push(output.reactions);
-            result.energy.push(output.energy);
-            result.states.push(sample);
+        for (&ts, sample) in group.iter().zip(samples) {
+            report(ts, sample)?;
         }
         if t1 > t {
             model.project(params, t1, &mut y).map_err(constraint(t1))?;
             t = t1;
         }
     }
-    result.steps = integrator.stats.steps;
-    Ok(result)
+    Ok((start, integrator.stats.steps))
 }
 
 /// Output times per projection of the integrated state.
