@@ -17,4 +17,5 @@ $PY -m pip install -q nbclient nbformat ipykernel matplotlib
 cargo run --release --quiet --example stability
 cargo run --release --quiet --example averaging
 cargo run --release --quiet --example explore -- --set model=painleve_klein
+cargo run --release --quiet --example linkage
 $PY docs/notebooks/check.py

@@ -402,8 +402,10 @@ impl PyModel {
     /// Stabilisation by vibration: for each equilibrium the averaged
     /// threshold a* and the exact window of Floquet stability (a
     /// constrained model: its equilibrium near the start, on its
-    /// constraints).
-    #[pyo3(signature = (*, amplitude=None, samples=40, a_max=None, edge_tolerance=1e-9, method="dop853", tol=1e-10, max_windows=None, params=None))]
+    /// constraints, as the `linkage` scene; `samples` amplitudes scanned
+    /// up to `a_max`). `tol` defaults to the scene's: 1e-10, or 1e-12 on
+    /// constraints.
+    #[pyo3(signature = (*, amplitude=None, samples=40, a_max=None, edge_tolerance=1e-9, method="dop853", tol=None, max_windows=None, params=None))]
     #[allow(clippy::too_many_arguments)]
     fn stability<'py>(
         &self,
@@ -413,11 +415,17 @@ impl PyModel {
         a_max: Option<f64>,
         edge_tolerance: f64,
         method: &str,
-        tol: f64,
+        tol: Option<f64>,
         max_windows: Option<usize>,
         params: Option<BTreeMap<String, f64>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
+        // The scenes' tolerances: `stability`'s, and `linkage`'s for a
+        // constrained model.
+        let tol = tol.unwrap_or(match self.model.constrained {
+            Some(_) => 1e-12,
+            None => 1e-10,
+        });
         let method = Method::parse(method, tol).map_err(py_err)?;
         analyses::stability(
             py,

@@ -72,7 +72,7 @@ class Model:
                   progress: bool = True) -> dict[str, Any]: ...
     def stability(self, *, amplitude: Optional[str] = None, samples: int = 40,
                   a_max: Optional[float] = None, edge_tolerance: float = 1e-9,
-                  method: str = "dop853", tol: float = 1e-10,
+                  method: str = "dop853", tol: Optional[float] = None,
                   max_windows: Optional[int] = None, params: Params = None) -> dict[str, Any]: ...
     def attractor(self, *, start: Tuple[float, float] = (1.0, 0.0), transient: int = 500,
                   points: int = 200_000, lyapunov_periods: int = 16_000, pixels: int = 500,
