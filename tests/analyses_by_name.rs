@@ -52,6 +52,24 @@ fn orbits_by_name_at_given_times() {
         let alone = states_at(model, &[1.0], method, y0, &times).unwrap();
         assert_eq!(run.as_ref().unwrap(), &alone);
     }
+    // The Taylor method runs a batch in the lanes, eight orbits at a time:
+    // eleven starts (a second, partial block) on the harmonic closed form,
+    // each lane as its scalar run.
+    let taylor = mechlab::ode::Method::Taylor { tol: 1e-14 };
+    let starts: Vec<Vec<f64>> = (0..11)
+        .map(|k| vec![0.05 * k as f64, -0.2, 0.1, 0.02 * k as f64])
+        .collect();
+    let lanes = states_of_starts(model, &[0.0], taylor, &starts, &times).unwrap();
+    for (run, y0) in lanes.iter().zip(&starts) {
+        let run = run.as_ref().unwrap();
+        assert_eq!(run.len(), times.len());
+        let alone = states_at(model, &[0.0], taylor, y0, &times).unwrap();
+        for ((t, y), z) in times.iter().zip(run).zip(&alone) {
+            let x = y0[0] * t.cos() + y0[2] * t.sin();
+            assert!((y[0] - x).abs() < 1e-12, "t = {t}: {y:?}");
+            assert!(y.iter().zip(z).all(|(a, b)| (a - b).abs() < 1e-12));
+        }
+    }
     let backwards = states_at(model, &[1.0], method, &y0, &[1.0, 0.5]);
     assert!(matches!(backwards, Err(StatesError::Times)));
     let short = states_at(model, &[1.0], method, &y0[..3], &times);

@@ -65,8 +65,9 @@ pub fn start(model: &Model, params: &[f64]) -> Result<Vec<f64>, StatesError> {
     Ok(y)
 }
 
-/// The states of `model` at `times` from each start, in parallel; an orbit
-/// that stops keeps its error, the others go on.
+/// The states of `model` at `times` from each start, in parallel (the
+/// Taylor method's in the batch lanes); an orbit that stops keeps its
+/// error, the others go on.
 pub fn states_of_starts(
     model: &Model,
     params: &[f64],
@@ -81,9 +82,17 @@ pub fn states_of_starts(
         starts.first().map_or(0, Vec::len) * std::mem::size_of::<f64>(),
     )
     .map_err(OdeError::from)?;
-    Ok(starts
-        .par_iter()
-        .map(|y0| orbit(model, params, method, y0, times))
+    if model.constrained.is_some() {
+        return Ok(starts
+            .par_iter()
+            .map(|y0| orbit(model, params, method, y0, times))
+            .collect());
+    }
+    let flat: Vec<f64> = starts.iter().flatten().copied().collect();
+    let runs = crate::analysis::flows(model)?.states_of_starts(params, method, &flat, times)?;
+    Ok(runs
+        .into_iter()
+        .map(|run| run.map_err(StatesError::from))
         .collect())
 }
 

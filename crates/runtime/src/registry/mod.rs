@@ -469,6 +469,19 @@ pub trait Flows: Sync {
             &wrap,
         )
     }
+    /// The states at `times` of each start (`starts` one after the other)
+    /// from times[0], an orbit that stops keeping its error: each orbit
+    /// alone here (in parallel); the Hamiltonian models' fixed sizes run
+    /// the Taylor method's in the batch lanes.
+    fn states_of_starts(
+        &self,
+        params: &[f64],
+        method: Method,
+        starts: &[f64],
+        times: &[f64],
+    ) -> Result<Vec<Result<Vec<Vec<f64>>, OdeError>>, OdeError> {
+        states_one_by_one(&*self.exact(params), method, starts, times)
+    }
     /// Whether the model has Taylor recurrences (every Hamiltonian model;
     /// a constrained one up to 6 coordinates).
     fn has_taylor_recurrences(&self) -> bool {
@@ -569,6 +582,81 @@ fn iterates_in_lanes<S: crate::ode::System<N> + Sync, const N: usize>(
                     recorder.finish(error.is_none() && !unsettled)
                 })
                 .collect()
+        })
+        .collect();
+    Ok(blocks.into_iter().flatten().collect())
+}
+
+/// [`Flows::states_of_starts`] of `system`, each orbit alone (in parallel).
+fn states_one_by_one(
+    system: &dyn AnySystem,
+    method: Method,
+    starts: &[f64],
+    times: &[f64],
+) -> Result<Vec<Result<Vec<Vec<f64>>, OdeError>>, OdeError> {
+    use rayon::prelude::*;
+    crate::ode::Integrator::new(method)?;
+    Ok(starts
+        .par_chunks(system.dim())
+        .map(|y0| {
+            let mut states = vec![y0.to_vec()];
+            if times.len() > 1 {
+                states.extend(system.states_at(method, times[0], y0, &times[1..])?);
+            }
+            Ok(states)
+        })
+        .collect())
+}
+
+/// [`Flows::states_of_starts`] of `system` by the Taylor method in the
+/// batch lanes: [`crate::ode::LANES`] orbits at a time, advanced together
+/// from each output time to the next (each lane's run is that lane's
+/// alone: the steps adapt per lane).
+fn states_in_lanes<S: crate::ode::System<N> + Sync, const N: usize>(
+    system: &S,
+    method: Method,
+    starts: &[f64],
+    times: &[f64],
+) -> Result<Vec<Result<Vec<Vec<f64>>, OdeError>>, OdeError> {
+    use crate::ode::{LaneIntegrator, LANES};
+    use rayon::prelude::*;
+    let starts: Vec<[f64; N]> = starts
+        .chunks(N)
+        .map(fixed_state::<N>)
+        .collect::<Result<_, _>>()?;
+    LaneIntegrator::new(method)?;
+    let blocks: Vec<Vec<Result<Vec<Vec<f64>>, OdeError>>> = starts
+        .par_chunks(LANES)
+        .map(|block| {
+            let mut integrator = match LaneIntegrator::new(method) {
+                Ok(integrator) => integrator,
+                Err(e) => return vec![Err(e); block.len()],
+            };
+            let mut y: [[f64; N]; LANES] = std::array::from_fn(|l| block[l.min(block.len() - 1)]);
+            let mut active: [bool; LANES] = std::array::from_fn(|l| l < block.len());
+            let mut runs: Vec<Result<Vec<Vec<f64>>, OdeError>> =
+                block.iter().map(|start| Ok(vec![start.to_vec()])).collect();
+            for w in times.windows(2) {
+                let results = integrator.advance(system, w[0], &y, active, w[1]);
+                for (l, result) in results.into_iter().enumerate().take(block.len()) {
+                    if !active[l] {
+                        continue;
+                    }
+                    match result {
+                        Ok(state) => {
+                            y[l] = state;
+                            if let Ok(states) = &mut runs[l] {
+                                states.push(state.to_vec());
+                            }
+                        }
+                        Err(e) => {
+                            runs[l] = Err(e);
+                            active[l] = false;
+                        }
+                    }
+                }
+            }
+            runs
         })
         .collect();
     Ok(blocks.into_iter().flatten().collect())
@@ -692,6 +780,20 @@ impl<const D: usize, const S: usize, const T: usize, const V: usize> Flows for E
             &wrap,
             &|_, _| true,
         )
+    }
+    fn states_of_starts(
+        &self,
+        params: &[f64],
+        method: Method,
+        starts: &[f64],
+        times: &[f64],
+    ) -> Result<Vec<Result<Vec<Vec<f64>>, OdeError>>, OdeError> {
+        if !matches!(method, Method::Taylor { .. }) {
+            // (The provided method, each orbit alone.)
+            let system = Flows::exact(self, params);
+            return states_one_by_one(&*system, method, starts, times);
+        }
+        states_in_lanes(&Fixed::exact(self, params), method, starts, times)
     }
 }
 
