@@ -31,7 +31,7 @@ fn sweep_folder(root: &std::path::Path) -> std::path::PathBuf {
 /// its run alone, and bad times or starts are refused by name.
 #[test]
 fn orbits_by_name_at_given_times() {
-    use mechlab::analysis::states::{start, states_at, states_of_starts, StatesError};
+    use mechlab::analysis::states::{states_at, states_of_starts, StatesError};
     let model = mechlab::models::by_name("henon_heiles").unwrap();
     let method = mechlab::ode::Method::parse("dop853", 1e-12).unwrap();
     let times: Vec<f64> = (0..=40).map(|k| 0.5 * k as f64).collect();
@@ -78,7 +78,9 @@ fn orbits_by_name_at_given_times() {
     // again leaves it where it is.
     let four_bar = mechlab::models::by_name("four_bar").unwrap();
     let params = four_bar.dynamic.defaults();
-    let y = start(four_bar, &params).unwrap();
+    let constrained = four_bar.constrained.unwrap();
+    let mut y = constrained.start(&params);
+    constrained.project(&params, 0.0, &mut y).unwrap();
     let again = states_at(four_bar, &params, method, &y, &[0.0]).unwrap();
     for (a, b) in y.iter().zip(&again[0]) {
         assert!((a - b).abs() < 1e-12);

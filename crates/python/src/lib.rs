@@ -244,7 +244,18 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
     ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
         let values = parameter_values(self.model, params)?;
-        let y = mechlab::analysis::states::start(self.model, &values).map_err(py_err)?;
+        let Some(constrained) = self.model.constrained else {
+            return Ok(mechlab::explore::default_start(self.model.dynamic).into_pyarray(py));
+        };
+        let mut y = constrained.start(&values);
+        constrained
+            .project(&values, 0.0, &mut y)
+            .map_err(|source| {
+                py_err(mechlab::analysis::states::StatesError::Start {
+                    model: self.model.info.name,
+                    source,
+                })
+            })?;
         Ok(y.into_pyarray(py))
     }
 

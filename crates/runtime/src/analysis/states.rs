@@ -47,24 +47,6 @@ pub fn states_at(
     orbit(model, params, method, y0, times)
 }
 
-/// The start the scenes take when none is given
-/// ([`crate::explore::default_start`]), a constrained model's put on its
-/// constraints at t = 0.
-pub fn start(model: &Model, params: &[f64]) -> Result<Vec<f64>, StatesError> {
-    Refusal::named_values(model.info, params)?;
-    let Some(constrained) = model.constrained else {
-        return Ok(crate::explore::default_start(model.dynamic));
-    };
-    let mut y = constrained.start(params);
-    constrained
-        .project(params, 0.0, &mut y)
-        .map_err(|source| StatesError::Start {
-            model: model.info.name,
-            source,
-        })?;
-    Ok(y)
-}
-
 /// The states of `model` at `times` from each start, in parallel (the
 /// Taylor method's in the batch lanes); an orbit that stops keeps its
 /// error, the others go on.
