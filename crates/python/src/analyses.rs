@@ -96,7 +96,7 @@ pub fn portrait<'py>(
         periods,
         method,
     };
-    let result = detached(py, |_| portrait_of(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || portrait_of(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     let orbits: Vec<_> = result
         .orbits
@@ -138,10 +138,10 @@ pub fn chaos_map<'py>(
     if !show_progress {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
-    let result = detached(py, |stop| {
+    let result = detached(py, || {
         fli_map(model, &values, &settings, &|| {
             bar.inc(1);
-            !stop.requested()
+            !mechlab::ode::stop::stop_requested()
         })
     })?
     .map_err(py_err)?;
@@ -188,7 +188,7 @@ pub fn stability<'py>(
             scan: samples,
             method,
         };
-        let result = detached(py, |_| vibration_stability(constrained, &values, &settings))?
+        let result = detached(py, || vibration_stability(constrained, &values, &settings))?
             .map_err(py_err)?;
         return summary(py, &result);
     }
@@ -206,7 +206,7 @@ pub fn stability<'py>(
         method,
         max_windows: max_windows.unwrap_or(MAX_WINDOWS),
     };
-    let result = detached(py, |_| stability_of(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || stability_of(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     dict.set_item("report", result.report(usize::MAX))?;
     Ok(dict)
@@ -272,7 +272,7 @@ pub fn section<'py>(
         tol: request.tol,
         ..settings
     };
-    let result = detached(py, |_| {
+    let result = detached(py, || {
         let seeds = request.seeds.clone().unwrap_or_else(|| {
             seeds_across(model, &values, &settings, request.extent, request.orbits)
         });
@@ -342,7 +342,7 @@ pub fn attractor<'py>(
     settings: mechlab::analysis::attractor::AttractorSettings,
 ) -> PyResult<Bound<'py, PyDict>> {
     use mechlab::analysis::attractor::attractor as attractor_of;
-    let result = detached(py, |_| attractor_of(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || attractor_of(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     dict.set_item("orbit", points(py, result.orbit.iter().copied()))?;
     let convergence: Vec<(usize, Vec<f64>)> = result.convergence.clone();
@@ -359,7 +359,7 @@ pub fn continuation<'py>(
     settings: mechlab::analysis::continuation::ContinuationSettings,
 ) -> PyResult<Bound<'py, PyDict>> {
     use mechlab::analysis::continuation::continuation as continuation_of;
-    let result = detached(py, |_| continuation_of(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || continuation_of(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     dict.set_item("state_names", result.state_names.clone())?;
     Ok(dict)
@@ -374,7 +374,7 @@ pub fn separatrix_splitting<'py>(
     settings: mechlab::analysis::separatrix::SplittingSettings,
 ) -> PyResult<Bound<'py, PyDict>> {
     use mechlab::analysis::separatrix::separatrix_splitting as splitting_of;
-    let result = detached(py, |_| splitting_of(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || splitting_of(model, &values, &settings))?.map_err(py_err)?;
     summary(py, &result)
 }
 
@@ -387,7 +387,7 @@ pub fn averaging<'py>(
     settings: mechlab::analysis::averaging::ConvergenceSettings,
 ) -> PyResult<Bound<'py, PyDict>> {
     use mechlab::analysis::averaging::convergence;
-    let result = detached(py, |_| convergence(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || convergence(model, &values, &settings))?.map_err(py_err)?;
     summary(py, &result)
 }
 
@@ -425,7 +425,7 @@ pub fn explore<'py>(
     y0: Vec<f64>,
     settings: mechlab::explore::Settings,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let result = detached(py, |_| {
+    let result = detached(py, || {
         mechlab::explore::explore(model, &values, &y0, &settings)
     })?
     .map_err(py_err)?;
@@ -477,7 +477,7 @@ pub fn iterates<'py>(
 ) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
     use mechlab::analysis::period_map::iterates_of_starts;
     let bar = progress(starts.len() as u64, &format!("{} orbits", model.info.name));
-    let runs = detached(py, |_| {
+    let runs = detached(py, || {
         iterates_of_starts(model, &values, method, &starts, transient, record, &|k| {
             bar.inc(k as u64)
         })
@@ -515,7 +515,7 @@ pub fn basins<'py>(
     if !show_progress {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
-    let result = detached(py, |_| {
+    let result = detached(py, || {
         basins_of(model, &values, &settings, &|k| bar.inc(k as u64))
     })?
     .map_err(py_err)?;
@@ -543,7 +543,7 @@ pub fn megno_map<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     use mechlab::analysis::section_map::section_map;
     let pixels = settings.pixels;
-    let result = detached(py, |_| section_map(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || section_map(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     let image = Array2::from_shape_vec((pixels, pixels), result.megno.clone())
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -577,7 +577,7 @@ pub fn frequency_map<'py>(
     settings: mechlab::analysis::frequency_map::FrequencyMapSettings,
 ) -> PyResult<Bound<'py, PyDict>> {
     use mechlab::analysis::frequency_map::frequency_map as frequency_map_of;
-    let result = detached(py, |_| frequency_map_of(model, &values, &settings))?.map_err(py_err)?;
+    let result = detached(py, || frequency_map_of(model, &values, &settings))?.map_err(py_err)?;
     frequencies(py, &result)
 }
 
@@ -599,7 +599,7 @@ pub fn period_map_frequencies<'py>(
     if !show_progress {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
-    let result = detached(py, |_| {
+    let result = detached(py, || {
         frequencies_of(model, &values, &settings, &|k| bar.inc(k as u64))
     })?
     .map_err(py_err)?;

@@ -1,39 +1,26 @@
 //! Long calls run without the GIL, on a thread of their own, while the
 //! calling thread checks for Ctrl-C every 50 ms until they end: a
-//! KeyboardInterrupt raises the `stop` flag, which the analyses that take
-//! a callback read between blocks of orbits, and asks every integration
-//! to stop (`mechlab::ode::stop`), so that every analysis ends at its
-//! integrators' next step. The KeyboardInterrupt is raised in Python once
-//! the work has returned.
+//! KeyboardInterrupt asks every integration to stop (`mechlab::ode::stop`),
+//! so that every analysis ends at its integrators' next step (a chaos map
+//! also skips the blocks of rows not yet started). The KeyboardInterrupt
+//! is raised in Python once the work has returned.
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
 use pyo3::prelude::*;
 
-/// Set once Python has asked the work to stop.
-pub struct Stop(AtomicBool);
-
-impl Stop {
-    pub fn requested(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-}
-
-/// `work` run off the GIL; Ctrl-C stops it where it looks at its [`Stop`].
+/// `work` run off the GIL; Ctrl-C stops its integrations.
 /// The calling thread wakes when the work ends (a channel), or every 50 ms
 /// to check for signals: a call of a millisecond takes a millisecond.
-pub fn detached<T: Send>(py: Python<'_>, work: impl FnOnce(&Stop) -> T + Send) -> PyResult<T> {
-    let stop = Stop(AtomicBool::new(false));
+pub fn detached<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
     let mut interrupt = None;
     mechlab::ode::stop::clear_stop();
     let result = py.detach(|| {
         std::thread::scope(|scope| {
             let (done, finished) = mpsc::channel::<()>();
-            let stop = &stop;
             let handle = scope.spawn(move || {
-                let value = work(stop);
+                let value = work();
                 // (A panic drops `done` instead: the wait ends too.)
                 let _ = done.send(());
                 value
@@ -43,7 +30,6 @@ pub fn detached<T: Send>(py: Python<'_>, work: impl FnOnce(&Stop) -> T + Send) -
             {
                 if interrupt.is_none() {
                     if let Err(e) = Python::attach(|py| py.check_signals()) {
-                        stop.0.store(true, Ordering::Relaxed);
                         mechlab::ode::stop::request_stop();
                         interrupt = Some(e);
                     }

@@ -301,7 +301,7 @@ impl PyModel {
         let (y0, times) = (y0.as_slice()?.to_vec(), t.as_slice()?.to_vec());
         let model = self.model;
         let states =
-            detached(py, |_| states_at(model, &values, method, &y0, &times))?.map_err(py_err)?;
+            detached(py, || states_at(model, &values, method, &y0, &times))?.map_err(py_err)?;
         let dim = y0.len();
         let flat: Vec<f64> = states.into_iter().flatten().collect();
         let array = Array2::from_shape_vec((flat.len() / dim.max(1), dim), flat)
@@ -332,7 +332,7 @@ impl PyModel {
             .collect();
         let times = t.as_slice()?.to_vec();
         let model = self.model;
-        let runs = detached(py, |_| {
+        let runs = detached(py, || {
             states_of_starts(model, &values, method, &starts, &times)
         })?
         .map_err(py_err)?;

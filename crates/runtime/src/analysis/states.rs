@@ -129,10 +129,5 @@ fn orbit(
         return Ok(states(constrained, params, &start, method, times)?);
     }
     let system = crate::analysis::flows(model)?.exact(params);
-    // The first time is the start's: its state is y0 itself.
-    let mut states = vec![y0.to_vec()];
-    if times.len() > 1 {
-        states.extend(system.states_at(method, times[0], y0, &times[1..])?);
-    }
-    Ok(states)
+    Ok(system.states_from(method, y0, times)?)
 }

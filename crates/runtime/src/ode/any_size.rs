@@ -46,6 +46,20 @@ pub trait AnySystem: Sync {
         let mut integrator = Integrator::new(method)?;
         Ok(self.solve(&mut integrator, t0, y0, t1, options)?.samples)
     }
+    /// The states at `times` from `y0` at times[0]: y0 itself, then
+    /// [`AnySystem::states_at`] the later times.
+    fn states_from(
+        &self,
+        method: Method,
+        y0: &[f64],
+        times: &[f64],
+    ) -> Result<Vec<Vec<f64>>, OdeError> {
+        let mut states = vec![y0.to_vec()];
+        if let Some((&t0, later)) = times.split_first().filter(|(_, later)| !later.is_empty()) {
+            states.extend(self.states_at(method, t0, y0, later)?);
+        }
+        Ok(states)
+    }
     /// [`Integrator::stream`]: `segments` segments of time `segment` from
     /// (0, y0), `after` called with each end's state (which it may change)
     /// and saying whether to go on.

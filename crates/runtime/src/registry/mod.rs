@@ -598,13 +598,7 @@ fn states_one_by_one(
     crate::ode::Integrator::new(method)?;
     Ok(starts
         .par_chunks(system.dim())
-        .map(|y0| {
-            let mut states = vec![y0.to_vec()];
-            if times.len() > 1 {
-                states.extend(system.states_at(method, times[0], y0, &times[1..])?);
-            }
-            Ok(states)
-        })
+        .map(|y0| system.states_from(method, y0, times))
         .collect())
 }
 
