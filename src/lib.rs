@@ -28,7 +28,7 @@
 
 pub use mechlab_runtime::{
     analysis, budget, constrained, contact, explore, linalg, mathml, ode, plot, registry, report,
-    study,
+    settings, study,
 };
 pub use mechlab_scenes::{scene, scenes};
 

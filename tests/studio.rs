@@ -360,7 +360,7 @@ async fn basins_levels_equal_the_library_basins() {
     let (status, _, body) = call("POST", "/api/basins", Some(bad)).await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
     assert!(
-        body.contains("cell that identifies attractors must be a positive number"),
+        body.contains("basins: cell = 0 is outside its range (> 0)"),
         "{body}"
     );
     let (status, _, body) = call(
@@ -767,7 +767,19 @@ async fn bad_requests_are_named_errors() {
     let chaos = json!({"model": "kapitza", "ranges": [[1.0, -1.0], [0.0, 1.0]], "levels": [8], "periods": 10});
     let (status, _, body) = call("POST", "/api/chaos", Some(chaos)).await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
-    assert!(body.contains("range of axis 0"), "{body}");
+    assert!(
+        body.contains("chaos_map: ranges = [[1.0,-1.0],[0.0,1.0]] is not a pair of intervals"),
+        "{body}"
+    );
+    // A setting the chaos map does not declare is refused by name, with
+    // the ones it does.
+    let chaos = json!({"model": "kapitza", "levels": [8], "period": 10});
+    let (status, _, body) = call("POST", "/api/chaos", Some(chaos)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST);
+    assert!(
+        body.contains("chaos_map: no setting 'period' (settings: axes, through, ranges"),
+        "{body}"
+    );
     let (status, _, body) = call("GET", "/api/nothing", None).await;
     assert_eq!(status, StatusCode::NOT_FOUND);
     assert!(body.contains("/api/nothing"));

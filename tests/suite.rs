@@ -12,6 +12,7 @@ mod bad_input;
 mod basins;
 mod constrained;
 mod continuation;
+mod declarations;
 mod dimension;
 mod docs_commands;
 mod double_double;

@@ -220,7 +220,47 @@ async fn browser_seeds_orbits_and_sweeps_a_parameter() {
     a_slice_of_the_period_map(&client, &folder).await;
     the_mechanism_moves(&client, &folder).await;
     the_basins_layer(&client, &folder).await;
+    the_address_and_the_declared_defaults(&client, &studio).await;
     client.close().await.unwrap();
+}
+
+/// The model named in the address opens, and the inputs of the declared
+/// settings start from the library's declarations (the studio's
+/// interactive values), served at `/api/schema`.
+async fn the_address_and_the_declared_defaults(client: &Client, studio: &str) {
+    client
+        .goto(&format!("{studio}?model=four_bar"))
+        .await
+        .unwrap();
+    wait_for(
+        client,
+        "window.studio && studio.ready && studio.model.name === 'four_bar'",
+        30,
+    )
+    .await;
+    let schema = mechlab::settings::schemas();
+    for (id, analysis, name) in [
+        ("chaos-periods", "chaos_map", "periods"),
+        ("basins-transient", "basins", "transient"),
+    ] {
+        let s = schema.iter().find(|s| s.analysis == analysis).unwrap();
+        let declared = s.interactive.get(name).cloned().unwrap_or_else(|| {
+            s.settings
+                .iter()
+                .find(|d| d.name == name)
+                .unwrap()
+                .default
+                .clone()
+        });
+        let shown = client
+            .execute(
+                &format!("return Number(document.getElementById('{id}').value);"),
+                vec![],
+            )
+            .await
+            .unwrap();
+        assert_eq!(shown.as_f64(), declared.as_f64(), "{id}");
+    }
 }
 
 /// Three clicked orbits of the Kapitza map, redrawn when the A slider moves.

@@ -110,30 +110,14 @@ pub fn portrait<'py>(
 
 /// The FLI map of the period map (the `chaos_map` scene), with a
 /// progress bar by rows; Ctrl-C stops it between blocks of rows.
-#[allow(clippy::too_many_arguments)]
 pub fn chaos_map<'py>(
     py: Python<'py>,
     model: &'static Model,
     values: Vec<f64>,
-    axes: [usize; 2],
-    ranges: [Option<(f64, f64)>; 2],
-    through: Option<Vec<f64>>,
-    pixels: usize,
-    periods: usize,
-    p_max: f64,
-    method: Method,
+    settings: ChaosMapSettings,
     show_progress: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let settings = ChaosMapSettings {
-        axes,
-        ranges,
-        p_max,
-        through,
-        pixels,
-        periods,
-        method,
-        tiles: None,
-    };
+    let pixels = settings.pixels;
     let bar = progress(pixels as u64, &format!("{} FLI map rows", model.info.name));
     if !show_progress {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());

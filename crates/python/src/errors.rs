@@ -77,6 +77,13 @@ impl Classify for OdeError {
     }
 }
 
+/// A declared setting's value refused (its name, value and range).
+impl Classify for mechlab::settings::SettingError {
+    fn class(&self) -> Class {
+        Class::Value
+    }
+}
+
 impl Classify for mechlab::registry::ParameterError {
     fn class(&self) -> Class {
         Class::Value

@@ -12,9 +12,12 @@ mod errors;
 
 use std::collections::BTreeMap;
 
+use mechlab::analysis::basins::BasinsOptions;
+use mechlab::analysis::chaos_map::ChaosMapOptions;
 use mechlab::analysis::states::{states_at, states_of_starts};
 use mechlab::ode::Method;
 use mechlab::registry::{Kind, Model};
+use mechlab::settings::Declared;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike1, PyArrayLike2};
 use pyo3::exceptions::PyValueError;
@@ -384,30 +387,20 @@ impl PyModel {
 
     /// The fast Lyapunov indicator of the period map on a plane of
     /// `pixels`² starts (`fli[j, i]`, row 0 at the bottom), with a
-    /// progress bar; Ctrl-C stops it between blocks of rows.
-    #[pyo3(signature = (*, pixels=300, periods=180, axes=None, ranges=None, through=None, p_max=3.0, method="taylor", tol=1e-6, params=None, progress=true))]
-    #[allow(clippy::too_many_arguments)]
+    /// progress bar; Ctrl-C stops it between blocks of rows. Settings: the
+    /// chaos map's declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, progress=true, **settings))]
     fn chaos_map<'py>(
         &self,
         py: Python<'py>,
-        pixels: usize,
-        periods: usize,
-        axes: Option<(analyses::Axis, analyses::Axis)>,
-        ranges: Option<((f64, f64), (f64, f64))>,
-        through: Option<Vec<f64>>,
-        p_max: f64,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
         progress: bool,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let method = Method::parse(method, tol).map_err(py_err)?;
-        let axes = analyses::axes(self.model, axes)?;
-        let ranges = ranges.map_or([None, None], |(x, y)| [Some(x), Some(y)]);
-        analyses::chaos_map(
-            py, self.model, values, axes, ranges, through, pixels, periods, p_max, method, progress,
-        )
+        let options: ChaosMapOptions = declared(settings)?;
+        let settings = options.resolve(self.model).map_err(py_err)?;
+        analyses::chaos_map(py, self.model, values, settings, progress)
     }
 
     /// Stabilisation by vibration: for each equilibrium the averaged
@@ -682,37 +675,18 @@ impl PyModel {
     /// The basins of attraction of the period map's attractors on a plane
     /// of `pixels`² starts over `ranges` (`labels[j, i]`, row 0 at the
     /// bottom, −1 where the orbit diverged), with a progress bar.
-    #[pyo3(signature = (*, axes=None, ranges=((-2.0, 2.0), (-2.0, 2.0)), through=None, pixels=200, transient=300, record=16, cell=0.05, stop_early=true, method="taylor", tol=1e-10, params=None, progress=true))]
-    #[allow(clippy::too_many_arguments)]
+    /// Settings: the basins' declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, progress=true, **settings))]
     fn basins<'py>(
         &self,
         py: Python<'py>,
-        axes: Option<(analyses::Axis, analyses::Axis)>,
-        ranges: ((f64, f64), (f64, f64)),
-        through: Option<Vec<f64>>,
-        pixels: usize,
-        transient: usize,
-        record: usize,
-        cell: f64,
-        stop_early: bool,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
         progress: bool,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let settings = mechlab::analysis::basins::BasinSettings {
-            axes: analyses::axes(self.model, axes)?,
-            ranges: [ranges.0, ranges.1],
-            through,
-            pixels,
-            transient,
-            record,
-            cell,
-            method: Method::parse(method, tol).map_err(py_err)?,
-            stop_early,
-            tiles: None,
-        };
+        let options: BasinsOptions = declared(settings)?;
+        let settings = options.resolve(self.model).map_err(py_err)?;
         analyses::basins(py, self.model, values, settings, progress)
     }
 
@@ -854,21 +828,34 @@ impl PyModel {
 
 /// The defaults of `model` with `params` (name → value) set, each checked.
 fn parameter_values(model: &Model, params: Option<BTreeMap<String, f64>>) -> PyResult<Vec<f64>> {
-    let info = model.info;
-    let mut values = model.dynamic.defaults();
-    for (name, value) in params.unwrap_or_default() {
-        info.check_parameter(&name, value).map_err(py_err)?;
-        if let Some(i) = info.parameter_names.iter().position(|n| *n == name) {
-            values[i] = value;
-        }
-    }
-    Ok(values)
+    model
+        .values_with(&params.unwrap_or_default())
+        .map_err(py_err)
+}
+
+/// A declared analysis's settings from keyword arguments (by the names of
+/// its declaration, its defaults where not given), checked by the
+/// declaration.
+fn declared<T: Declared>(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<T> {
+    let given: serde_json::Map<String, serde_json::Value> = match kwargs {
+        Some(kwargs) => pythonize::depythonize(kwargs)?,
+        None => serde_json::Map::new(),
+    };
+    T::default().with_json(&given).map_err(py_err)
+}
+
+/// Every declared analysis's settings: name, type, default, range and
+/// help (the studio's `GET /api/schema`).
+#[pyfunction]
+fn schema(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    Ok(pythonize::pythonize(py, &mechlab::settings::schemas())?)
 }
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models, m)?)?;
     m.add_function(wrap_pyfunction!(model, m)?)?;
+    m.add_function(wrap_pyfunction!(schema, m)?)?;
     m.add_class::<PyModel>()?;
     m.add_class::<PyDerivation>()?;
     m.add_class::<PyDerivations>()?;

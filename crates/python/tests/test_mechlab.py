@@ -202,6 +202,19 @@ class Analyses(unittest.TestCase):
             d[:, 0] = (d[:, 0] + math.pi) % (2 * math.pi) - math.pi
             self.assertLess(np.max(np.abs(d)), 1e-10)
 
+    def test_settings_are_checked_by_their_declaration(self):
+        # The same names, defaults and words as the scenes' and the studio's.
+        schema = {s.analysis: s for s in mechlab.schema()}
+        cell = next(d for d in schema["basins"].settings if d.name == "cell")
+        self.assertEqual((cell.default, cell.range), (0.05, "> 0"))
+        m = mechlab.model("duffing")
+        with self.assertRaisesRegex(ValueError, "basins: no setting 'cells'"):
+            m.basins(cells=0.1)
+        with self.assertRaisesRegex(ValueError, r"basins: cell = 0 is outside its range \(> 0\)"):
+            m.basins(cell=0.0)
+        with self.assertRaisesRegex(ValueError, "chaos_map: axes = q,q"):
+            mechlab.model("kapitza").chaos_map(axes=("q", "q"))
+
     def test_basins_labels_count_as_their_fractions(self):
         m = mechlab.model("duffing")
         b = m.basins(pixels=24, progress=False)

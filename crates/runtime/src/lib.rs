@@ -20,6 +20,7 @@ pub mod ode;
 pub mod plot;
 pub mod registry;
 pub mod report;
+pub mod settings;
 pub mod study;
 pub mod tangent;
 

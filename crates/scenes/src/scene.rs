@@ -6,22 +6,40 @@
 //! scene's last step): a crash never leaves half-written files or a mix of
 //! old and new results.
 
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// A knob of a scene: name, default (as text) and help.
+/// A knob of a scene: name, default (as text) and help; a declared
+/// analysis's knobs are made from its declaration
+/// ([`Knob::from_declaration`]).
 #[derive(Clone, Debug)]
 pub struct Knob {
     pub name: &'static str,
-    pub default: &'static str,
-    pub help: &'static str,
+    pub default: Cow<'static, str>,
+    pub help: Cow<'static, str>,
 }
 
 pub const fn knob(name: &'static str, default: &'static str, help: &'static str) -> Knob {
     Knob {
         name,
-        default,
-        help,
+        default: Cow::Borrowed(default),
+        help: Cow::Borrowed(help),
+    }
+}
+
+impl Knob {
+    /// The knob of a declared setting, its range in the help.
+    pub fn from_declaration(d: mechlab_runtime::settings::Declaration) -> Knob {
+        let help = match d.range.as_str() {
+            "any" => format!("{} [{}]", d.help, d.kind),
+            range => format!("{} [{}, {range}]", d.help, d.kind),
+        };
+        Knob {
+            name: d.name,
+            default: Cow::Owned(d.default_text),
+            help: Cow::Owned(help),
+        }
     }
 }
 
@@ -117,6 +135,9 @@ pub enum SceneError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// A declared setting's value refused (its name, value and range).
+    #[error(transparent)]
+    Setting(#[from] mechlab_runtime::settings::SettingError),
     #[error(transparent)]
     Ode(#[from] mechlab_runtime::ode::OdeError),
     #[error(transparent)]

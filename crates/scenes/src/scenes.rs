@@ -3,9 +3,12 @@
 //! defaults, the same files): knobs → one library call → figures.
 
 use crate::scene::{knob, parameter_knobs, Knob, Progress, Scene, SceneError, ValueProblem};
-use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMap, ChaosMapError, ChaosMapSettings};
+use mechlab_runtime::analysis::chaos_map::{
+    chaos_map, ChaosMap, ChaosMapError, ChaosMapOptions, ChaosMapSettings,
+};
 use mechlab_runtime::ode::Method;
 use mechlab_runtime::registry::{Catalog, Model, ModelInfo};
+use mechlab_runtime::settings::Declared;
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
 /// clear error listing the known ones.
@@ -99,31 +102,70 @@ pub fn method_from(scene: &Scene) -> Result<Method, SceneError> {
     Ok(Method::parse(scene.text("method"), scene.positive("tol")?)?)
 }
 
+/// A scene of a declared analysis: the `model` knob, the declaration's
+/// settings as knobs (with the preset's defaults where `overrides` gives
+/// one), the scene's `extra` knobs (tiles), then every parameter of the
+/// chosen model; the parsed scene and the settings it asks for, validated
+/// by the declaration.
+fn declared_scene<T: Declared>(
+    catalog: Catalog,
+    scene_name: &'static str,
+    (default_model, about): (&'static str, Option<&str>),
+    overrides: &[(&'static str, &'static str)],
+    extra: &[Knob],
+) -> Result<(&'static Model, Scene, T), SceneError> {
+    let defaults = Defaults(overrides);
+    let model_name = defaults.get("model", default_model);
+    let handle = model_from_args(catalog, model_name)?;
+    let names = T::names();
+    let preset = T::default().with_texts(
+        overrides
+            .iter()
+            .filter(|(n, _)| names.contains(n))
+            .map(|&(n, v)| (n, v)),
+    )?;
+    let mut knobs = vec![knob(
+        "model",
+        model_name,
+        "the model (a file models/<name>.toml)",
+    )];
+    knobs.extend(
+        preset
+            .declarations()
+            .into_iter()
+            .map(Knob::from_declaration),
+    );
+    knobs.extend(extra.iter().cloned());
+    knobs.extend(parameter_knobs(handle.info, overrides));
+    let about = about.map_or_else(T::about, str::to_string);
+    let scene = Scene::from_args(scene_name, &about, &knobs)?;
+    let options = T::default().with_texts(names.iter().map(|&n| (n, scene.text(n))))?;
+    Ok((handle, scene, options))
+}
+
 /// The `chaos_map` scene: the FLI map of any model's period map on a plane
 /// of two state components. `overrides` are the preset's defaults (model
-/// and its parameters, knobs); `sharing`, processes that share its tiles
-/// (None: this process computes them all).
+/// and its parameters, settings); `sharing`, processes that share its
+/// tiles (None: this process computes them all).
 pub fn chaos_map_scene(
     catalog: Catalog,
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
     sharing: Option<&dyn TileSharing>,
 ) -> Result<(), SceneError> {
-    let (model, scene) = generic_scene(
+    let (model, scene, options) = declared_scene::<ChaosMapOptions>(
         catalog,
         scene_name,
-        "FLI chaos map of the period map of any model",
+        ("kapitza", None),
         overrides,
-        ("kapitza", "taylor", "1e-6"),
-        &[plane_knobs(("300", "180")), tile_knobs("10").to_vec()].concat(),
+        &tile_knobs("10"),
     )?;
-    let info = model.info;
     let settings = ChaosMapSettings {
         tiles: tiles_from(&scene, ["tile_rows", "only_tiles"])?,
-        ..plane_settings(&scene, info)?
+        ..options.resolve(model)?
     };
     let progress = Progress::new(&format!("{scene_name} rows"), settings.pixels);
-    let params = scene.parameter_values(info)?;
+    let params = scene.parameter_values(model.info)?;
     let sweep = |only: Option<Vec<usize>>| {
         let mut settings = settings.clone();
         if let Some(tiles) = &mut settings.tiles {
@@ -140,49 +182,6 @@ pub fn chaos_map_scene(
     };
     let rows = settings.pixels;
     share_tiles(&scene, sharing, settings.tiles.as_ref(), rows, &sweep)
-}
-
-/// The knobs of a plane of the period map: its axes, the state it passes
-/// through, its pixels (default `pixels`), the periods per orbit (default
-/// `periods`) and the range of an axis that is not an angle.
-fn plane_knobs(
-    (pixels, periods): (&'static str, &'static str),
-) -> Vec<(&'static str, &'static str, &'static str)> {
-    vec![
-        (
-            "axes",
-            "auto",
-            "the state components [q; p] along the two axes (0 = first coordinate; auto: the first coordinate and its momentum, or velocity)",
-        ),
-        (
-            "through",
-            "0",
-            "the state the plane passes through, comma-separated (0: all zero)",
-        ),
-        ("pixels", pixels, "resolution (pixels per side)"),
-        ("periods", periods, "periods of the phase per pixel"),
-        (
-            "p_max",
-            "3",
-            "an axis that is not an angle covers [−p_max, p_max]",
-        ),
-    ]
-}
-
-/// The plane of [`plane_knobs`] and the method, without tiles.
-fn plane_settings(scene: &Scene, info: &ModelInfo) -> Result<ChaosMapSettings, SceneError> {
-    Ok(ChaosMapSettings {
-        axes: axes_from(scene, info)?,
-        ranges: [None, None],
-        p_max: scene.positive("p_max")?,
-        through: (scene.text("through") != "0")
-            .then(|| scene.numbers("through"))
-            .transpose()?,
-        pixels: scene.count("pixels")?,
-        periods: scene.count("periods")?,
-        method: method_from(scene)?,
-        tiles: None,
-    })
 }
 
 /// The chaos map's figures, CSV and summary.
@@ -250,10 +249,10 @@ fn share_tiles(
 
 /// The knobs `tile_rows` (default `rows`; 0: no tiles) and `only_tiles`
 /// of a tiled sweep, read by [`tiles_from`].
-fn tile_knobs(rows: &'static str) -> [(&'static str, &'static str, &'static str); 2] {
+fn tile_knobs(rows: &'static str) -> [Knob; 2] {
     [
-        ("tile_rows", rows, "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
-        ("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the result"),
+        knob("tile_rows", rows, "rows per tile, each written to out/<scene>.tiles/ when done so a rerun resumes (0: no tiles)"),
+        knob("only_tiles", "all", "compute only these tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the result"),
     ]
 }
 
@@ -564,51 +563,17 @@ pub fn period_map_scene(
 /// The `basins` scene: the basins of attraction of a period map on a
 /// plane of the state, the attractors found unaided.
 pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::basins::{basins, BasinSettings, BasinsError};
-    let (model, scene) = generic_scene(
+    use mechlab_runtime::analysis::basins::{basins, BasinSettings, BasinsError, BasinsOptions};
+    let (model, scene, options) = declared_scene::<BasinsOptions>(
         catalog,
         "basins",
-        "basins of attraction of the period map, the attractors found from the orbits",
+        ("duffing", None),
         &[],
-        ("duffing", "taylor", "1e-10"),
-        &[
-            ("axes", "auto", "the state components along the map's axes (auto: the first coordinate and its momentum, or velocity)"),
-            ("x", "-2,2", "the range of the first axis"),
-            ("y", "-2,2", "the range of the second axis"),
-            ("pixels", "200", "pixels per side"),
-            ("transient", "300", "periods run before the record"),
-            ("record", "16", "periods recorded to identify the attractor"),
-            (
-                "cell",
-                "0.05",
-                "the side of the state-space cells that identify attractors",
-            ),
-        ]
-        .into_iter()
-        .chain(tile_knobs("0"))
-        .collect::<Vec<_>>(),
+        &tile_knobs("0"),
     )?;
-    let range = |name: &str| -> Result<(f64, f64), SceneError> {
-        match scene.numbers(name)?[..] {
-            [lo, hi] => Ok((lo, hi)),
-            _ => Err(SceneError::BadValue {
-                name: name.into(),
-                value: scene.text(name).into(),
-                reason: ValueProblem::Requirement("low,high"),
-            }),
-        }
-    };
     let settings = BasinSettings {
-        axes: axes_from(&scene, model.info)?,
-        ranges: [range("x")?, range("y")?],
-        through: None,
-        pixels: scene.count("pixels")?,
-        transient: scene.whole("transient")?,
-        record: scene.count("record")?,
-        cell: scene.positive("cell")?,
-        method: method_from(&scene)?,
-        stop_early: true,
         tiles: tiles_from(&scene, ["tile_rows", "only_tiles"])?,
+        ..options.resolve(model)?
     };
     let params = scene.parameter_values(model.info)?;
     let progress = Progress::new("basins starts", settings.pixels.pow(2));
@@ -1379,15 +1344,19 @@ pub fn frequency_map_scene(catalog: Catalog) -> Result<(), SceneError> {
         let overrides = [("frequencies", "100"), ("orbits", "0")];
         return section_scene(catalog, "frequency_map", &overrides);
     }
-    let (model, scene) = generic_scene(
+    let (model, scene, options) = declared_scene::<ChaosMapOptions>(
         catalog,
         "frequency_map",
-        "Laskar's frequency map of the period map: each orbit's tunes and diffusion index",
+        (
+            "henon_heiles",
+            Some(
+                "Laskar's frequency map of the period map: each orbit's tunes and diffusion index",
+            ),
+        ),
+        &[("pixels", "100"), ("periods", "1000"), ("tol", "1e-10")],
         &[],
-        ("henon_heiles", "taylor", "1e-10"),
-        &plane_knobs(("100", "1000")),
     )?;
-    let settings = plane_settings(&scene, model.info)?;
+    let settings = options.resolve(model)?;
     let params = scene.parameter_values(model.info)?;
     let progress = Progress::new("frequency map orbits", settings.pixels.pow(2));
     let map = mechlab_runtime::analysis::frequency_map::period_map_frequencies(

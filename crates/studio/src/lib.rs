@@ -6,6 +6,7 @@
 //! | route | answer |
 //! |---|---|
 //! | `GET /api/models` | every model with its parameters ([`calls::models`]) |
+//! | `GET /api/schema` | every declared analysis's settings: name, type, default, range, help, and the studio's interactive defaults |
 //! | `GET /api/models/{name}/derivations` | its derivations as MathML |
 //! | `POST /api/orbit` | an orbit of the period map, streamed as NDJSON lines |
 //! | `POST /api/chaos` | the FLI map of a view at growing resolutions, NDJSON |
@@ -29,7 +30,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
-use calls::{self as studio, ChaosRequest, OrbitRequest, OverlayRequest, StudioError};
+use calls::{self as studio, OrbitRequest, OverlayRequest, StudioError};
 use mechlab_runtime::analysis::basins::BasinsError;
 use mechlab_runtime::analysis::mechanism::MechanismError;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
@@ -73,6 +74,7 @@ impl ApiError {
                 | StudioError::Continuation(_)
                 | StudioError::Section(_)
                 | StudioError::Basins(BasinsError::Refused(_))
+                | StudioError::PeriodMap(PeriodMapError::Refused(_))
                 | StudioError::Mechanism(
                     MechanismError::NotDrawn { .. } | MechanismError::Refused(_),
                 ),
@@ -115,6 +117,10 @@ pub fn router(catalog: Catalog) -> Router {
         .route(
             "/api/models",
             get(move || async move { axum::Json(studio::models(catalog)) }),
+        )
+        .route(
+            "/api/schema",
+            get(|| async { axum::Json(mechlab_runtime::settings::schemas()) }),
         )
         .route("/api/models/{name}/derivations", get(derivations))
         .route("/api/orbit", post(orbit))
@@ -256,16 +262,16 @@ async fn orbit(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, 
 }
 
 async fn chaos(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: ChaosRequest = serde_json::from_slice(&body)?;
-    request.check(catalog)?;
+    let request: studio::LevelsRequest = serde_json::from_slice(&body)?;
+    studio::chaos_levels(catalog, &request)?;
     Ok(stream(move |send, listening| {
         studio::chaos(catalog, &request, &mut |level| send(&level), listening)
     }))
 }
 
 async fn basins(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::BasinsRequest = serde_json::from_slice(&body)?;
-    request.check(catalog)?;
+    let request: studio::LevelsRequest = serde_json::from_slice(&body)?;
+    studio::basins_levels(catalog, &request)?;
     Ok(stream(move |send, _| {
         studio::basins(catalog, &request, &mut |level| send(&level))
     }))

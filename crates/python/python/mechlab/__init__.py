@@ -26,7 +26,7 @@ from typing import Any
 from . import _native
 from ._native import Derivation, Derivations, IntegrationError, Refused
 
-__all__ = ["models", "model", "Model", "Result", "Derivation", "Derivations",
+__all__ = ["models", "model", "schema", "Model", "Result", "Derivation", "Derivations",
            "Refused", "IntegrationError"]
 
 
@@ -90,3 +90,10 @@ def models() -> list[str]:
 def model(name: str) -> Model:
     """The model ``name``; a ``ValueError`` lists the known ones."""
     return Model(_native.model(name))
+
+
+def schema() -> list[Result]:
+    """Every declared analysis's settings: for each, its name, what it
+    computes, and each setting's name, type, default, range and help (the
+    keyword arguments its method takes)."""
+    return _wrap(_native.schema())

@@ -12,10 +12,66 @@ use super::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::plot::{palette, Figure, PanelSpec};
 use crate::registry::{distance, within, Cells, KnownAttractors, Model, Recording};
+use crate::settings::{method, resolve_axes, Axis, Declared, Range, SettingError, METHODS};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
-/// What a basin map computes.
+crate::declare_settings! {
+    /// The basins of attraction of the period map: every start of a plane
+    /// coloured by the attractor its orbit ends on, the attractors found
+    /// from the orbits.
+    pub struct BasinsOptions for "basins" {
+        /// The state components along the map's axes, by index or name
+        /// (auto: the first coordinate and its momentum, or velocity).
+        axes: Option<[Axis; 2]> = None, Range::Any;
+        /// The axes' ranges x0,x1,y0,y1.
+        ranges: [[f64; 2]; 2] = [[-2.0, 2.0], [-2.0, 2.0]], Range::Any;
+        /// The state the plane passes through (auto: the model's base state).
+        through: Option<Vec<f64>> = None, Range::Any;
+        /// Pixels per side.
+        pixels: usize = 200, Range::Count { min: 2, max: 4000 };
+        /// Periods run before the record.
+        transient: usize = 300, Range::Count { min: 0, max: 1_000_000 };
+        /// Periods recorded to identify the attractor.
+        record: usize = 16, Range::Count { min: 2, max: 4096 };
+        /// The side of the state-space cells that identify attractors.
+        cell: f64 = 0.05, Range::Positive;
+        /// Stop an orbit once it has settled on a cycle or in a known
+        /// attractor (no: run every orbit its whole length, slower).
+        stop_early: bool = true, Range::Any;
+        /// The integration method.
+        method: String = "taylor".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, Range::Positive;
+    }
+    interactive { transient: 200 }
+}
+
+impl BasinsOptions {
+    /// The settings of [`basins`] for `model`, `auto` resolved; refused
+    /// here, before any work, where the analysis does not apply.
+    pub fn resolve(&self, model: &Model) -> Result<BasinSettings, BasinsError> {
+        super::period_map_flows(model)?;
+        let method = method(Self::ANALYSIS, &self.method, self.tol)?;
+        super::method_applies(model, method)?;
+        Ok(BasinSettings {
+            axes: resolve_axes(Self::ANALYSIS, model.info, &self.axes)?,
+            ranges: self.ranges.map(|[low, high]| (low, high)),
+            through: self.through.clone(),
+            pixels: self.pixels,
+            transient: self.transient,
+            record: self.record,
+            cell: self.cell,
+            method,
+            stop_early: self.stop_early,
+            tiles: None,
+        })
+    }
+}
+
+/// What a basin map computes, resolved for one model from
+/// [`BasinsOptions`].
 #[derive(Clone, Debug)]
 pub struct BasinSettings {
     /// The state components along the map's axes, and their ranges.
@@ -83,6 +139,9 @@ pub enum BasinsError {
     /// Only some tiles were asked for: they are written, there is no map.
     #[error("the tiles asked for are written; run without `only` to merge them into the basins")]
     Partial,
+    /// A declared setting's value refused.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
 }
 
 /// An attractor found.

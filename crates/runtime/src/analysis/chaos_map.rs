@@ -9,12 +9,66 @@ pub use super::tiles::{TileError, Tiles};
 use crate::analysis::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::registry::Model;
+use crate::settings::{method, resolve_axes, Axis, Declared, Range, METHODS};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
-/// What [`chaos_map`] draws.
+crate::declare_settings! {
+    /// The FLI chaos map of the period map: every pixel of a plane of two
+    /// state components shaded by the fast Lyapunov indicator of its orbit.
+    pub struct ChaosMapOptions for "chaos_map" {
+        /// The state components [q; p] along the two axes, by index (0 = the
+        /// first coordinate) or name (auto: the first coordinate and its
+        /// momentum, or velocity).
+        axes: Option<[Axis; 2]> = None, Range::Any;
+        /// The state the plane passes through, one value per component (auto:
+        /// zero, or a constrained model's start).
+        through: Option<Vec<f64>> = None, Range::Any;
+        /// The axes' ranges x0,x1,y0,y1 (auto: [−π, π] for an angle,
+        /// [−p_max, p_max] otherwise).
+        ranges: Option<[[f64; 2]; 2]> = None, Range::Any;
+        /// The half-width of an axis that is not an angle, where the ranges
+        /// are auto.
+        p_max: f64 = 3.0, Range::Positive;
+        /// Pixels per side.
+        pixels: usize = 300, Range::Count { min: 1, max: 4000 };
+        /// Periods of the phase per pixel.
+        periods: usize = 180, Range::Count { min: 1, max: 1_000_000 };
+        /// The integration method.
+        method: String = "taylor".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-6, Range::Positive;
+    }
+    interactive { periods: 100 }
+}
+
+impl ChaosMapOptions {
+    /// The settings of [`chaos_map`] for `model`, `auto` resolved; refused
+    /// here, before any work, where the analysis does not apply.
+    pub fn resolve(&self, model: &Model) -> Result<ChaosMapSettings, ChaosMapError> {
+        super::period_map_flows(model)?;
+        let method = method(Self::ANALYSIS, &self.method, self.tol)?;
+        super::method_applies(model, method)?;
+        Ok(ChaosMapSettings {
+            axes: resolve_axes(Self::ANALYSIS, model.info, &self.axes)?,
+            ranges: self
+                .ranges
+                .map_or([None, None], |r| r.map(|[low, high]| Some((low, high)))),
+            p_max: self.p_max,
+            through: self.through.clone(),
+            pixels: self.pixels,
+            periods: self.periods,
+            method,
+            tiles: None,
+        })
+    }
+}
+
+/// What [`chaos_map`] draws, resolved for one model from
+/// [`ChaosMapOptions`].
 #[derive(Clone, Debug)]
 pub struct ChaosMapSettings {
     /// The state components ([q; p] indices) along the map's two axes.

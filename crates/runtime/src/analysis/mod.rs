@@ -119,6 +119,18 @@ pub fn flows(
         .ok_or_else(|| Refusal::contact_model(model.info.name))
 }
 
+/// The model's flows with a fast phase (a period map), or the refusal:
+/// what an analysis of the period map checks before it starts.
+pub fn period_map_flows(
+    model: &crate::registry::Model,
+) -> Result<&'static dyn crate::registry::Flows, Refusal> {
+    let flows = flows(model)?;
+    if !flows.has_fast_phase() {
+        return Err(Refusal::no_fast_phase(model.info.name));
+    }
+    Ok(flows)
+}
+
 /// Refuses the Taylor method for a model without Taylor recurrences (a
 /// constrained model of more than 6 coordinates): one refusal instead of
 /// every orbit stopping.

@@ -204,6 +204,9 @@ pub enum PeriodMapError {
     Tile(#[from] super::tiles::TileError),
     #[error(transparent)]
     Ode(#[from] OdeError),
+    /// A declared setting's value refused.
+    #[error(transparent)]
+    Setting(#[from] crate::settings::SettingError),
 }
 
 /// The iterates `transient + 1 ..= transient + record` of the period map

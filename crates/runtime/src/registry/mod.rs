@@ -887,6 +887,22 @@ pub struct Model {
 }
 
 impl Model {
+    /// The model file's parameter values with `given` (name → value) set,
+    /// each checked, in declaration order: how every front end reads the
+    /// parameters a user names.
+    pub fn values_with<'a>(
+        &self,
+        given: impl IntoIterator<Item = (&'a String, &'a f64)>,
+    ) -> Result<Vec<f64>, ParameterError> {
+        let mut values = self.dynamic.defaults();
+        for (name, &value) in given {
+            self.info.check_parameter(name, value)?;
+            let k = self.info.parameter_names.iter().position(|n| n == name);
+            values[k.expect("check_parameter knows every name")] = value;
+        }
+        Ok(values)
+    }
+
     /// The model's [`Flows`]: its [`Systems`] or its constrained form
     /// (None for a contact model).
     pub fn flows(&self) -> Option<&'static dyn Flows> {

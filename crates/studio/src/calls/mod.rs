@@ -8,11 +8,13 @@
 
 pub mod contour;
 
-use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMapSettings};
+use mechlab_runtime::analysis::basins::{BasinSettings, BasinsOptions};
+use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMapOptions, ChaosMapSettings};
 use mechlab_runtime::analysis::period_map::{stream_orbit, wrap_angle, PeriodMapError};
 use mechlab_runtime::analysis::Refusal;
 use mechlab_runtime::ode::{Integrator, Method, OdeError};
 use mechlab_runtime::registry::{Catalog, DynamicModel, Kind, Model, ModelInfo, ParameterError};
+use mechlab_runtime::settings::Declared;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -22,7 +24,6 @@ use std::time::{Duration, Instant};
 /// of work.
 pub const MAX_PERIODS: usize = 100_000;
 pub const MAX_CHAOS_PIXELS: usize = 400;
-pub const MAX_CHAOS_PERIODS: usize = 2_000;
 pub const MAX_GRID: usize = 400;
 
 /// Why the studio cannot answer a request. Each names what was wrong.
@@ -40,6 +41,12 @@ pub enum StudioError {
     },
     #[error(transparent)]
     Parameter(#[from] ParameterError),
+    /// A declared setting's value refused (its name, value and range).
+    #[error(transparent)]
+    Setting(#[from] mechlab_runtime::settings::SettingError),
+    /// Not 1 to 8 refinements of a map.
+    #[error("a map is drawn in 1 to 8 refinements (levels), got {got}")]
+    Levels { got: usize },
     #[error(transparent)]
     Ode(#[from] OdeError),
     #[error(transparent)]
@@ -544,33 +551,82 @@ pub fn orbit(
     Ok(end(request.periods, !listening, &integrator))
 }
 
-/// The chaos map of the current view, coarse first.
+/// A request of a declared analysis: the model, its parameters (the model
+/// file's values where not given), and the analysis's settings by the
+/// names of its declaration (the analysis's `interactive` preset where not
+/// given), each checked by the declaration.
 #[derive(Clone, Debug, Deserialize)]
-pub struct ChaosRequest {
+pub struct AnalysisRequest {
+    pub model: String,
+    #[serde(default)]
+    pub params: BTreeMap<String, f64>,
+    /// The analysis's settings (an unknown name is refused by name).
     #[serde(flatten)]
-    pub setup: Setup,
-    pub ranges: [[f64; 2]; 2],
-    /// Pixels per side of each refinement, in order.
-    pub levels: Vec<usize>,
-    pub periods: usize,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
+    pub settings: serde_json::Map<String, serde_json::Value>,
 }
 
-impl ChaosRequest {
-    /// The request checked, with the view's ranges.
-    pub fn check(&self, catalog: Catalog) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
-        let setup = self.setup.resolve(catalog, &self.unknown)?;
-        setup.needs_period_map()?;
-        let ranges = setup.ranges(&self.ranges)?;
-        setup.count("periods", self.periods, MAX_CHAOS_PERIODS)?;
-        setup.count("the number of levels", self.levels.len(), 8)?;
-        for &pixels in &self.levels {
-            setup.count("pixels per side", pixels, MAX_CHAOS_PIXELS)?;
-        }
-        Ok((setup, ranges))
+impl AnalysisRequest {
+    /// The model, its parameter values and the settings, checked.
+    pub fn resolve<T: Declared>(
+        &self,
+        catalog: Catalog,
+    ) -> Result<(&'static Model, Vec<f64>, T), StudioError> {
+        let handle = mechlab_runtime::registry::lookup(catalog, &self.model)?;
+        let params = handle.values_with(&self.params)?;
+        let settings = T::interactive().with_json(&self.settings)?;
+        Ok((handle, params, settings))
     }
+}
+
+/// A map of the current view drawn coarse first (the chaos map, the
+/// basins): the analysis's settings, at each number of pixels per side
+/// of `levels`.
+#[derive(Clone, Debug, Deserialize)]
+pub struct LevelsRequest {
+    /// Pixels per side of each refinement, in order (1 to 8 of them).
+    pub levels: Vec<usize>,
+    #[serde(flatten)]
+    pub analysis: AnalysisRequest,
+}
+
+impl LevelsRequest {
+    /// The request checked: the model, its parameters, and the settings of
+    /// each level, checked by the declaration and resolved for the model
+    /// by `resolve`.
+    pub fn check<T: Declared, S, E>(
+        &self,
+        catalog: Catalog,
+        resolve: impl Fn(&T, &Model) -> Result<S, E>,
+    ) -> Result<(&'static Model, Vec<f64>, Vec<S>), StudioError>
+    where
+        StudioError: From<E>,
+    {
+        let (model, params, options) = self.analysis.resolve::<T>(catalog)?;
+        if self.levels.is_empty() || self.levels.len() > 8 {
+            return Err(StudioError::Levels {
+                got: self.levels.len(),
+            });
+        }
+        let levels = self
+            .levels
+            .iter()
+            .map(|&pixels| {
+                let mut level = options.clone();
+                level.set_json("pixels", &pixels.into())?;
+                level.validate()?;
+                Ok(resolve(&level, model)?)
+            })
+            .collect::<Result<_, StudioError>>()?;
+        Ok((model, params, levels))
+    }
+}
+
+/// The chaos map's request checked, each level's settings resolved.
+pub fn chaos_levels(
+    catalog: Catalog,
+    request: &LevelsRequest,
+) -> Result<(&'static Model, Vec<f64>, Vec<ChaosMapSettings>), StudioError> {
+    request.check(catalog, ChaosMapOptions::resolve)
 }
 
 /// One refinement of the chaos map.
@@ -594,25 +650,15 @@ pub struct ChaosLevel {
 /// `PeriodMapError::Cancelled`).
 pub fn chaos(
     catalog: Catalog,
-    request: &ChaosRequest,
+    request: &LevelsRequest,
     sink: &mut dyn FnMut(ChaosLevel) -> bool,
     listening: &(dyn Fn() -> bool + Sync),
 ) -> Result<(), StudioError> {
-    let (setup, ranges) = request.check(catalog)?;
-    for &pixels in &request.levels {
-        let settings = ChaosMapSettings {
-            axes: setup.axes,
-            ranges: ranges.map(Some),
-            p_max: 1.0,
-            through: Some(setup.through.clone()),
-            pixels,
-            periods: request.periods,
-            method: setup.method,
-            tiles: None,
-        };
-        let map = chaos_map(setup.handle, &setup.params, &settings, listening)?;
+    let (model, params, levels) = chaos_levels(catalog, request)?;
+    for settings in &levels {
+        let map = chaos_map(model, &params, settings, listening)?;
         let level = ChaosLevel {
-            pixels,
+            pixels: settings.pixels,
             shades: map.shades,
             fli: map
                 .fli
@@ -630,55 +676,13 @@ pub fn chaos(
     Ok(())
 }
 
-/// The basins of attraction of a view's period map, at growing
-/// resolutions (`POST /api/basins`).
-#[derive(Clone, Debug, Deserialize)]
-pub struct BasinsRequest {
-    #[serde(flatten)]
-    pub setup: Setup,
-    pub ranges: [[f64; 2]; 2],
-    /// Pixels per side of each refinement, in order.
-    pub levels: Vec<usize>,
-    /// Periods before the record, and periods recorded.
-    pub transient: usize,
-    #[serde(default = "default_record")]
-    pub record: usize,
-    /// The side of the cells that identify attractors.
-    #[serde(default = "default_cell")]
-    pub cell: f64,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
-}
-
-fn default_record() -> usize {
-    16
-}
-fn default_cell() -> f64 {
-    0.05
-}
-
-impl BasinsRequest {
-    /// The request checked, with the view's ranges.
-    pub fn check(&self, catalog: Catalog) -> Result<(Resolved, [(f64, f64); 2]), StudioError> {
-        let setup = self.setup.resolve(catalog, &self.unknown)?;
-        setup.needs_period_map()?;
-        let ranges = setup.ranges(&self.ranges)?;
-        setup.count("the transient", self.transient, MAX_CHAOS_PERIODS)?;
-        setup.count("the record", self.record, 256)?;
-        if !(self.cell > 0.0 && self.cell.is_finite()) {
-            let what = "the cell that identifies attractors";
-            return Err(setup.bad(RequestProblem::NotPositive {
-                what,
-                got: self.cell,
-            }));
-        }
-        setup.count("the number of levels", self.levels.len(), 8)?;
-        for &pixels in &self.levels {
-            setup.count("pixels per side", pixels, MAX_CHAOS_PIXELS)?;
-        }
-        Ok((setup, ranges))
-    }
+/// The basins' request (`POST /api/basins`) checked, each level's
+/// settings resolved.
+pub fn basins_levels(
+    catalog: Catalog,
+    request: &LevelsRequest,
+) -> Result<(&'static Model, Vec<f64>, Vec<BasinSettings>), StudioError> {
+    request.check(catalog, BasinsOptions::resolve)
 }
 
 /// One refinement of the basins.
@@ -699,31 +703,14 @@ pub struct BasinsLevel {
 /// `sink`, until it returns false.
 pub fn basins(
     catalog: Catalog,
-    request: &BasinsRequest,
+    request: &LevelsRequest,
     sink: &mut dyn FnMut(BasinsLevel) -> bool,
 ) -> Result<(), StudioError> {
-    let (setup, ranges) = request.check(catalog)?;
-    for &pixels in &request.levels {
-        let settings = mechlab_runtime::analysis::basins::BasinSettings {
-            axes: setup.axes,
-            ranges,
-            through: Some(setup.through.clone()),
-            pixels,
-            transient: request.transient,
-            record: request.record,
-            cell: request.cell,
-            method: setup.method,
-            stop_early: true,
-            tiles: None,
-        };
-        let map = mechlab_runtime::analysis::basins::basins(
-            setup.handle,
-            &setup.params,
-            &settings,
-            &|_| (),
-        )?;
+    let (model, params, levels) = basins_levels(catalog, request)?;
+    for settings in &levels {
+        let map = mechlab_runtime::analysis::basins::basins(model, &params, settings, &|_| ())?;
         let level = BasinsLevel {
-            pixels,
+            pixels: settings.pixels,
             labels: map.labels,
             attractors: map.attractors,
             points: map.points,

@@ -816,6 +816,7 @@ function defaultView(model) {
 async function chooseModel(name) {
   const model = studio.models.find((m) => m.name === name);
   if (!model) return;
+  history.replaceState(null, "", `?model=${encodeURIComponent(name)}`);
   removeOrbits(0);
   studio.ready = false;
   studio.model = model;
@@ -1018,17 +1019,35 @@ function wire() {
   }, 1000);
 }
 
+// The analyses' settings as the library declares them (GET /api/schema):
+// the page's inputs for them start from the declared defaults, or the
+// studio's interactive values where it has lighter ones; no default is
+// written in this script.
+const declaredInputs = [["chaos-periods", "chaos_map", "periods"], ["basins-transient", "basins", "transient"]];
+
+function applySchema(schema) {
+  studio.schema = Object.fromEntries(schema.map((s) => [s.analysis, s]));
+  for (const [id, analysis, name] of declaredInputs) {
+    const { settings, interactive } = studio.schema[analysis];
+    const declared = settings.find((d) => d.name === name);
+    $(id).value = name in interactive ? interactive[name] : declared.default;
+    $(id).title = `${declared.help} (${analysis} setting ${name}: ${declared.range}; the scene's default ${declared.default})`;
+  }
+}
+
 async function start() {
   wire();
   requestAnimationFrame(frame);
   try {
+    applySchema(await getJson("/api/schema"));
     studio.models = await getJson("/api/models");
   } catch (e) {
     say(`cannot list the models: ${e.message}`);
     return;
   }
   $("model").innerHTML = studio.models.map((m) => `<option value="${m.name}">${m.name}</option>`).join("");
-  const wanted = location.hash.slice(1);
+  // The model in the address (`/?model=four_bar`, or `#four_bar`).
+  const wanted = new URLSearchParams(location.search).get("model") || location.hash.slice(1);
   const first = studio.models.find((m) => m.name === wanted) || studio.models.find((m) => m.name === "kapitza") || studio.models[0];
   await chooseModel(first.name);
 }
