@@ -59,7 +59,11 @@ fn python_method(schema: &Schema) -> String {
     for d in &schema.settings {
         s += &format!("        {},\n", d.python_argument());
     }
-    s += "        params: Params = None,\n        progress: bool = True,\n    ) -> dict[str, Any]:\n";
+    s += "        params: Params = None,\n";
+    if schema.analysis != "continuation" {
+        s += "        progress: bool = True,\n";
+    }
+    s += "    ) -> dict[str, Any]:\n";
     s += &format!("        \"\"\"{}\"\"\"\n", schema.about);
     s
 }

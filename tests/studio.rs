@@ -502,10 +502,10 @@ async fn manifolds_overlay_gives_the_tangle_or_a_named_error() {
 /// right-well orbit doubles its period at γ = 0.2655817860 (as the
 /// `continuation` scene finds) and the branch of period 2 is followed from
 /// there. Errors are named: a parameter the model lacks (422, listing
-/// them), a contact model (422), a seed of the wrong length (400).
+/// them), a contact model (422), a start longer than the state.
 #[tokio::test]
 async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
-    let request = json!({"model": "duffing", "seed": [1.0, 0.0], "parameter": "gamma", "to": 0.28, "tol": 1e-12});
+    let request = json!({"model": "duffing", "start": [1.0, 0.0], "parameter": "gamma", "to": 0.28, "tol": 1e-12});
     let (status, _, body) = call("POST", "/api/continuation", Some(request)).await;
     assert_eq!(status, StatusCode::OK, "{body}");
     let answer: Value = serde_json::from_str(&body).unwrap();
@@ -531,18 +531,20 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
         (status, body)
     };
     let (status, body) =
-        bad(json!({"model": "duffing", "seed": [1.0, 0.0], "parameter": "kappa", "to": 1.0})).await;
+        bad(json!({"model": "duffing", "start": [1.0, 0.0], "parameter": "kappa", "to": 1.0}))
+            .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
     assert!(body.contains("kappa") && body.contains("gamma"), "{body}");
     let (status, body) =
-        bad(json!({"model": "painleve_klein", "seed": [0.0, 0.0], "parameter": "mu", "to": 1.0}))
+        bad(json!({"model": "painleve_klein", "start": [0.0, 0.0], "parameter": "mu", "to": 1.0}))
             .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
     assert!(body.contains("contact"), "{body}");
     let (status, body) =
-        bad(json!({"model": "duffing", "seed": [1.0], "parameter": "gamma", "to": 1.0})).await;
-    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
-    assert!(body.contains("seed"), "{body}");
+        bad(json!({"model": "duffing", "start": [1.0, 0.0, 0.5], "parameter": "gamma", "to": 1.0}))
+            .await;
+    assert!(status.is_client_error(), "{status}: {body}");
+    assert!(body.contains("start"), "{body}");
 
     // A constrained model, in the chart of the plane's axes: the four-bar's
     // upright tips over at a branch point where its exact window opens
@@ -557,7 +559,7 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
         0.0,
     ];
     let request = json!({"model": "four_bar", "method": "dop853", "tol": 1e-10, "axes": [0, 3],
-        "seed": upright, "parameter": "a", "to": 1.0});
+        "start": upright, "parameter": "a", "to": 1.0});
     let (status, _, body) = call("POST", "/api/continuation", Some(request)).await;
     assert_eq!(status, StatusCode::OK, "{body}");
     let answer: Value = serde_json::from_str(&body).unwrap();
@@ -568,7 +570,7 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
     );
     let tipping = answer["bifurcations"][0]["parameter"].as_f64().unwrap();
     assert!((tipping - 1.18609).abs() < 1e-5, "{body}");
-    let request = json!({"model": "rolling_disk", "method": "dop853", "seed": vec![0.0; 8],
+    let request = json!({"model": "rolling_disk", "method": "dop853", "start": vec![0.0; 8],
         "parameter": "R", "to": 2.0});
     let (status, body) = bad(request).await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");

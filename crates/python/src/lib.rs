@@ -14,6 +14,7 @@ use std::collections::BTreeMap;
 
 use mechlab::analysis::basins::BasinsOptions;
 use mechlab::analysis::chaos_map::ChaosMapOptions;
+use mechlab::analysis::continuation::ContinuationOptions;
 use mechlab::analysis::states::{states_at, states_of_starts};
 use mechlab::ode::Method;
 use mechlab::registry::{Kind, Model};
@@ -473,72 +474,19 @@ impl PyModel {
         analyses::attractor(py, self.model, values, settings)
     }
 
-    /// Periodic orbits of the period map followed in `parameter` (default
-    /// the model file's amplitude) from its value to `to` (default 1.8
-    /// times it), their Floquet multipliers and bifurcations; branches
-    /// born at period doublings up to `max_period` and at branch points
-    /// are followed too. `diagram` parameter values of the orbit diagram
-    /// (0: none).
-    #[pyo3(signature = (*, parameter=None, to=None, start=None, period=1, max_period=16, switch_branch_points=true, branches=12, points=3000, step=0.005, min_step=1e-8, max_step=0.02, diagram=0, transient=300, iterates=100, chart=None, method="taylor", tol=1e-12, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// Periodic orbits of the period map followed in a parameter, their
+    /// Floquet multipliers and bifurcations, with the orbit diagram.
+    /// Settings: the continuation's declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn continuation<'py>(
         &self,
         py: Python<'py>,
-        parameter: Option<String>,
-        to: Option<f64>,
-        start: Option<Vec<f64>>,
-        period: usize,
-        max_period: usize,
-        switch_branch_points: bool,
-        branches: usize,
-        points: usize,
-        step: f64,
-        min_step: f64,
-        max_step: f64,
-        diagram: usize,
-        transient: usize,
-        iterates: usize,
-        chart: Option<Vec<usize>>,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        use mechlab::analysis::continuation::{default_end, ContinuationSettings, DiagramSettings};
         let values = parameter_values(self.model, params)?;
-        let info = self.model.info;
-        let parameter = parameter
-            .or(info.amplitude.map(String::from))
-            .ok_or_else(|| {
-                PyValueError::new_err(format!(
-                    "model '{}' names no amplitude: pass parameter='<name>' (parameters: {})",
-                    info.name,
-                    info.parameter_names.join(", ")
-                ))
-            })?;
-        let settings = ContinuationSettings {
-            to: to.unwrap_or_else(|| default_end(info, &values, &parameter)),
-            parameter,
-            // A constrained model starts at its file's start unless told.
-            start: start.unwrap_or_else(|| match self.model.constrained {
-                Some(_) => Vec::new(),
-                None => vec![1.0, 0.0],
-            }),
-            period,
-            max_period,
-            switch_branch_points,
-            max_branches: branches,
-            points,
-            step,
-            min_step,
-            max_step,
-            method: Method::parse(method, tol).map_err(py_err)?,
-            diagram: (diagram > 0).then_some(DiagramSettings {
-                values: diagram,
-                transient,
-                iterates,
-            }),
-            chart,
-        };
+        let options: ContinuationOptions = declared(settings)?;
+        let settings = options.resolve(self.model, &values).map_err(py_err)?;
         analyses::continuation(py, self.model, values, settings)
     }
 

@@ -130,6 +130,14 @@ pub enum SettingError {
         given: String,
         known: Vec<String>,
     },
+    /// `parameter = auto` where the model names no amplitude to take.
+    #[error("{analysis}: {name} = auto: model '{model}' names no [fast_phase] amplitude: name the parameter ({})", known.join(", "))]
+    NoAmplitude {
+        analysis: &'static str,
+        name: &'static str,
+        model: &'static str,
+        known: &'static [&'static str],
+    },
     /// Values that are each valid but do not fit together.
     #[error("{analysis}: {names}: {reason}")]
     Inconsistent {
@@ -287,6 +295,29 @@ impl SettingValue for Vec<f64> {
     }
     fn within(&self, range: &Range) -> bool {
         self.iter().all(|x| range.admits(*x))
+    }
+}
+
+impl SettingValue for Vec<usize> {
+    const KIND: &'static str = "list of indices";
+    const PYTHON: &'static str = "Sequence[int]";
+    fn from_text(text: &str) -> Option<Self> {
+        text.split(',').map(usize::from_text).collect()
+    }
+    fn from_json(value: &Value) -> Option<Self> {
+        value.as_array()?.iter().map(usize::from_json).collect()
+    }
+    fn to_json(&self) -> Value {
+        serde_json::json!(self)
+    }
+    fn to_text(&self) -> String {
+        self.iter()
+            .map(usize::to_string)
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+    fn within(&self, range: &Range) -> bool {
+        self.iter().all(|x| x.within(range))
     }
 }
 
@@ -614,10 +645,11 @@ impl Schema {
 
 /// The schemas of every analysis declared so far, in the docs' order.
 pub fn schemas() -> Vec<Schema> {
-    use crate::analysis::{basins, chaos_map};
+    use crate::analysis::{basins, chaos_map, continuation};
     vec![
         Schema::of::<chaos_map::ChaosMapOptions>(),
         Schema::of::<basins::BasinsOptions>(),
+        Schema::of::<continuation::ContinuationOptions>(),
     ]
 }
 

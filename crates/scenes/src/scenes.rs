@@ -946,44 +946,21 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
 /// Scene `continuation`: the periodic orbits of a model's period map
 /// followed in one parameter, their bifurcations, and the orbit diagram.
 pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::continuation::continuation;
-    // The parameter defaults to the model file's [fast_phase] amplitude.
-    let named = Scene::peek("model").unwrap_or_else(|| "duffing".into());
-    let amplitude = mechlab_runtime::registry::lookup(catalog, &named)
-        .ok()
-        .and_then(|m| m.info.amplitude)
-        .unwrap_or("none");
-    let (model, scene) = generic_scene(
+    use mechlab_runtime::analysis::continuation::{continuation, ContinuationOptions};
+    let drawn = knob(
+        "coordinate",
+        "0",
+        "the state component drawn (0 = first coordinate; for a constrained model, of its chart)",
+    );
+    let (model, scene, options) = declared_scene::<ContinuationOptions>(
         catalog,
         "continuation",
-        "periodic orbits of the period map continued in a parameter, bifurcations located",
-        &[("parameter", amplitude)],
-        ("duffing", "taylor", "1e-12"),
-        &[
-            (
-                "parameter",
-                "none",
-                "the parameter continued in, from its value below to `to` (default: the model file's [fast_phase] amplitude)",
-            ),
-            ("to", "auto", "the other end of the parameter's interval (auto: 1.8 times its value, 1 where it is 0)"),
-            ("start", "1,0", "a guess of the first periodic orbit's state at t = 0 (zeros appended; for a constrained model the model file's start where not given, its components replaced by these)"),
-            ("period", "1", "the first branch is of fixed points of P^period"),
-            ("max_period", "16", "switch at period doublings up to this period"),
-            ("switch", "yes", "also switch at branch points (pitchforks): yes or no"),
-            ("branches", "12", "at most this many branches"),
-            ("points", "3000", "at most this many points per branch"),
-            ("step", "0.005", "the first step in arclength"),
-            ("min_step", "1e-8", "a branch ends where the step falls below this"),
-            ("max_step", "0.02", "the largest step"),
-            ("diagram", "400", "parameter values of the orbit diagram (0: none)"),
-            ("transient", "300", "periods of the orbit diagram dropped first"),
-            ("iterates", "100", "periods of the orbit diagram drawn"),
-            ("coordinate", "0", "the state component drawn (0 = first coordinate; for a constrained model, of its chart)"),
-            ("chart", "auto", "a constrained model's chart: the components of [q; q'] that are the branches' coordinates, comma-separated (auto: those that parametrise its constraints best at the start)"),
-        ],
+        ("duffing", None),
+        &[],
+        &[drawn],
     )?;
     let params = scene.parameter_values(model.info)?;
-    let settings = continuation_settings(model, &scene, &params)?;
+    let settings = options.resolve(model, &params)?;
     let coordinate = scene.whole("coordinate")?;
     eprintln!("continuing in {} …", settings.parameter);
     let result = continuation(model, &params, &settings)?;
@@ -999,91 +976,6 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
     write_continuation(&scene, &result, coordinate)?;
     scene.write_summary(&result)?;
     Ok(())
-}
-
-/// The `continuation` scene's knobs as the analysis's settings.
-fn continuation_settings(
-    model: &Model,
-    scene: &Scene,
-    params: &[f64],
-) -> Result<mechlab_runtime::analysis::continuation::ContinuationSettings, SceneError> {
-    use mechlab_runtime::analysis::continuation::{ContinuationSettings, DiagramSettings};
-    let switch_branch_points = match scene.text("switch") {
-        "yes" => true,
-        "no" => false,
-        other => {
-            return Err(SceneError::BadValue {
-                name: "switch".into(),
-                value: other.into(),
-                reason: ValueProblem::Requirement("yes or no"),
-            })
-        }
-    };
-    let values = scene.whole("diagram")?;
-    let parameter = scene.text("parameter").to_string();
-    // (A contact model is refused by the analysis, by name.)
-    if parameter == "none" && model.sized.is_some() {
-        return Err(SceneError::BadValue {
-            name: "parameter".into(),
-            value: parameter,
-            reason: ValueProblem::NoAmplitude {
-                model: model.info.name,
-                known: model.info.parameter_names,
-            },
-        });
-    }
-    let to = match scene.text("to") {
-        "auto" => {
-            mechlab_runtime::analysis::continuation::default_end(model.info, params, &parameter)
-        }
-        _ => scene.number("to")?,
-    };
-    Ok(ContinuationSettings {
-        parameter,
-        to,
-        // A constrained model starts at its file's start unless told.
-        start: match (model.constrained, Scene::peek("start")) {
-            (Some(_), None) => Vec::new(),
-            _ => scene.numbers("start")?,
-        },
-        period: scene.count("period")?,
-        max_period: scene.count("max_period")?,
-        switch_branch_points,
-        max_branches: scene.count("branches")?,
-        points: scene.count("points")?,
-        step: scene.positive("step")?,
-        min_step: scene.positive("min_step")?,
-        max_step: scene.positive("max_step")?,
-        method: method_from(scene)?,
-        diagram: (values > 0)
-            .then(|| -> Result<DiagramSettings, SceneError> {
-                Ok(DiagramSettings {
-                    values,
-                    transient: scene.whole("transient")?,
-                    iterates: scene.count("iterates")?,
-                })
-            })
-            .transpose()?,
-        chart: match scene.text("chart") {
-            "auto" => None,
-            _ => Some(
-                scene
-                    .numbers("chart")?
-                    .iter()
-                    .map(|&x| match x >= 0.0 && x.fract() == 0.0 {
-                        true => Ok(x as usize),
-                        false => Err(SceneError::BadValue {
-                            name: "chart".into(),
-                            value: scene.text("chart").into(),
-                            reason: ValueProblem::Requirement(
-                                "state components: whole numbers from 0",
-                            ),
-                        }),
-                    })
-                    .collect::<Result<_, _>>()?,
-            ),
-        },
-    })
 }
 
 /// The `continuation` scene's figure and tables (branches, bifurcations,

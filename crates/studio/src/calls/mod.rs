@@ -928,14 +928,14 @@ pub fn manifolds(catalog: Catalog, request: &ManifoldsRequest) -> Result<Manifol
 /// to `to`.
 #[derive(Clone, Debug, Deserialize)]
 pub struct ContinuationRequest {
+    /// The page's axes: the branches are drawn on them, and a constrained
+    /// model is continued in their chart unless `chart` is given (auto:
+    /// the first coordinate and its momentum, or velocity).
+    #[serde(default)]
+    pub axes: Option<[usize; 2]>,
+    /// The continuation's settings (`start` is the clicked state).
     #[serde(flatten)]
-    pub setup: Setup,
-    pub seed: Vec<f64>,
-    pub parameter: String,
-    pub to: f64,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
+    pub analysis: AnalysisRequest,
 }
 
 /// Branches on the page's plane: each point (x, y, parameter) with its
@@ -970,48 +970,27 @@ pub fn continuation(
     catalog: Catalog,
     request: &ContinuationRequest,
 ) -> Result<BranchesView, StudioError> {
-    use mechlab_runtime::analysis::continuation::{continuation, ContinuationSettings};
-    let setup = request.setup.resolve(catalog, &request.unknown)?;
-    let components = setup.through.len();
-    if request.seed.len() != components {
-        return Err(setup.bad(RequestProblem::SeedLength {
-            got: request.seed.len(),
-            expected: components,
-        }));
+    use mechlab_runtime::analysis::continuation::{continuation, ContinuationOptions};
+    use mechlab_runtime::settings::{resolve_axes, Axis};
+    let (model, params, options) = request.analysis.resolve::<ContinuationOptions>(catalog)?;
+    let given = request.axes.map(|a| a.map(Axis::Index));
+    let view = resolve_axes(ContinuationOptions::ANALYSIS, model.info, &given)?;
+    let mut settings = options.resolve(model, &params)?;
+    // A constrained model of one degree of freedom on its constraints is
+    // continued in the chart of the plane's axes.
+    if model.constrained.is_some() && settings.chart.is_none() {
+        settings.chart = Some(view.to_vec());
     }
-    if !request.seed.iter().all(|x| x.is_finite()) {
-        return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
-    }
-    let settings = ContinuationSettings {
-        parameter: request.parameter.clone(),
-        to: request.to,
-        start: request.seed.clone(),
-        period: 1,
-        max_period: 4,
-        switch_branch_points: false,
-        max_branches: 4,
-        points: 1500,
-        step: 0.01,
-        min_step: 1e-8,
-        max_step: 0.05,
-        method: setup.method,
-        diagram: None,
-        // A constrained model of one degree of freedom on its constraints
-        // is continued in the chart of the plane's axes.
-        chart: setup.handle.constrained.map(|_| setup.axes.to_vec()),
-    };
-    let result = continuation(setup.handle, &setup.params, &settings)?;
-    let periodic = setup.model.periodic();
+    let result = continuation(model, &params, &settings)?;
+    let periodic = model.dynamic.periodic();
     // The state components of the axes in the branches' states.
     let axes = match &result.chart {
-        Some(chart) => setup
-            .axes
-            .map(|a| chart.iter().position(|&c| c == a).unwrap_or(a)),
-        None => setup.axes,
+        Some(chart) => view.map(|a| chart.iter().position(|&c| c == a).unwrap_or(a)),
+        None => view,
     };
     let place = |y: &[f64]| -> [f64; 2] {
         let at = |k: usize| {
-            let axis = setup.axes[k];
+            let axis = view[k];
             let component = axes[k];
             if periodic.get(axis).copied().unwrap_or(false) {
                 wrap_angle(y[component])

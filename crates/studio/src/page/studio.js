@@ -179,13 +179,16 @@ async function continueAt(x, y) {
   seed[studio.axes[0]] = x;
   seed[studio.axes[1]] = y;
   const parameter = $("cont-parameter").value;
-  const to = Number($("cont-to").value);
-  if (!Number.isFinite(to)) { say("continuation: `to` is not a number"); return; }
+  // An empty `to` is the declaration's auto (resolved by the library).
+  const to = $("cont-to").value.trim() === "" ? "auto" : Number($("cont-to").value);
+  if (to !== "auto" && !Number.isFinite(to)) { say("continuation: `to` is not a number"); return; }
   if (continuationController) continuationController.abort();
   continuationController = new AbortController();
   say(`continuing in ${parameter} …`);
   try {
-    const answer = await postJson("/api/continuation", { ...setup(), seed, parameter, to }, continuationController.signal);
+    const { model, params, method, tol, axes } = setup();
+    const request = { model, params, method, tol, axes, start: seed, parameter, to };
+    const answer = await postJson("/api/continuation", request, continuationController.signal);
     studio.branches = answer;
     const items = answer.bifurcations.map((m) =>
       `<li>${BIFURCATION_NAMES[m.kind]} at ${parameter} = ${m.parameter.toPrecision(10)}${m.located ? "" : " (bracketed)"}</li>`);
@@ -205,12 +208,9 @@ function buildContinuation(model) {
   select.innerHTML = model.parameters.map((p) => `<option value="${p.name}">${p.symbol}</option>`).join("");
   const chosen = model.parameters.find((p) => p.name === model.amplitude) || model.parameters[0];
   if (chosen) select.value = chosen.name;
-  const setTo = () => {
-    const value = studio.params[select.value];
-    $("cont-to").value = value ? 1.8 * value : 1;
-  };
-  select.onchange = setTo;
-  setTo();
+  // Empty: the library's end (the declaration's `to = auto`).
+  $("cont-to").value = "";
+  $("cont-to").placeholder = "auto";
   studio.branches = null;
   $("cont-list").innerHTML = "";
 }

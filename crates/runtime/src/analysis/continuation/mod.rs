@@ -24,12 +24,125 @@ use crate::analysis::floquet::{multipliers_of, Verdict};
 use crate::analysis::Refusal;
 use crate::ode::{AnyOptions, Integrator, Method, OdeError};
 use crate::registry::{Model, Systems};
+use crate::settings::{method, Declared, Range, SettingError, METHODS};
 use branch::{Origin, Solution, Steps};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// What to continue, and how far.
+crate::declare_settings! {
+    /// Periodic orbits of the period map continued in a parameter (the
+    /// equilibria of a model without a fast phase), their Floquet
+    /// multipliers and bifurcations, with the orbit diagram beside them.
+    pub struct ContinuationOptions for "continuation" {
+        /// The parameter continued in, from its value to `to` (auto: the
+        /// model file's [fast_phase] amplitude).
+        parameter: Option<String> = None, Range::Any;
+        /// The other end of the parameter's interval (auto: 1.8 times its
+        /// value, 1 where it is 0).
+        to: Option<f64> = None, Range::Any;
+        /// A guess of the first periodic orbit's state at t = 0, zeros
+        /// appended (auto: 1,0; a constrained model's start, its components
+        /// replaced by those given).
+        start: Option<Vec<f64>> = None, Range::Any;
+        /// The first branch is of fixed points of P^period.
+        period: usize = 1, Range::Count { min: 1, max: 1024 };
+        /// Switch at period doublings up to this period.
+        max_period: usize = 16, Range::Count { min: 1, max: 1 << 20 };
+        /// Also switch at branch points (pitchforks).
+        switch_branch_points: bool = true, Range::Any;
+        /// At most this many branches.
+        branches: usize = 12, Range::Count { min: 1, max: 1000 };
+        /// At most this many points per branch.
+        points: usize = 3000, Range::Count { min: 2, max: 1_000_000 };
+        /// The first step in arclength.
+        step: f64 = 0.005, Range::Positive;
+        /// A branch ends where the step falls below this.
+        min_step: f64 = 1e-8, Range::Positive;
+        /// The largest step.
+        max_step: f64 = 0.02, Range::Positive;
+        /// Parameter values of the orbit diagram beside the branches (0:
+        /// none).
+        diagram: usize = 400, Range::Count { min: 0, max: 100_000 };
+        /// Periods of the orbit diagram dropped first.
+        transient: usize = 300, Range::Count { min: 0, max: 1_000_000 };
+        /// Periods of the orbit diagram drawn.
+        iterates: usize = 100, Range::Count { min: 1, max: 1_000_000 };
+        /// A constrained model's chart: the components of [q; q'] that are
+        /// the branches' coordinates (auto: those that parametrise its
+        /// constraints best at the start).
+        chart: Option<Vec<usize>> = None, Range::Any;
+        /// The integration method.
+        method: String = "taylor".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-12, Range::Positive;
+    }
+    interactive {
+        max_period: 4,
+        switch_branch_points: false,
+        branches: 4,
+        points: 1500,
+        step: 0.01,
+        max_step: 0.05,
+        diagram: 0,
+    }
+}
+
+impl ContinuationOptions {
+    /// The settings of [`continuation`] for `model` at the parameter
+    /// values `params`, `auto` resolved.
+    pub fn resolve(
+        &self,
+        model: &Model,
+        params: &[f64],
+    ) -> Result<ContinuationSettings, ContinuationError> {
+        let info = model.info;
+        let parameter = match (&self.parameter, info.amplitude) {
+            (Some(p), _) => p.clone(),
+            (None, Some(amplitude)) => amplitude.to_string(),
+            (None, None) => {
+                return Err(SettingError::NoAmplitude {
+                    analysis: Self::ANALYSIS,
+                    name: "parameter",
+                    model: info.name,
+                    known: info.parameter_names,
+                }
+                .into())
+            }
+        };
+        Ok(ContinuationSettings {
+            to: self
+                .to
+                .unwrap_or_else(|| default_end(info, params, &parameter)),
+            parameter,
+            // A constrained model starts at its file's start unless told.
+            start: match (&self.start, model.constrained) {
+                (Some(start), _) => start.clone(),
+                (None, Some(_)) => Vec::new(),
+                (None, None) => vec![1.0, 0.0],
+            },
+            period: self.period,
+            max_period: self.max_period,
+            switch_branch_points: self.switch_branch_points,
+            max_branches: self.branches,
+            points: self.points,
+            step: self.step,
+            min_step: self.min_step,
+            max_step: self.max_step,
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            diagram: (self.diagram > 0).then_some(DiagramSettings {
+                values: self.diagram,
+                transient: self.transient,
+                iterates: self.iterates,
+            }),
+            chart: self.chart.clone(),
+        })
+    }
+}
+
+/// What to continue, and how far, resolved for one model from
+/// [`ContinuationOptions`].
 #[derive(Clone, Debug)]
 pub struct ContinuationSettings {
     /// The parameter continued in; it starts at the model's value.
@@ -119,6 +232,9 @@ pub enum ContinuationError {
     StepCollapse { parameter: f64, step: f64 },
     #[error(transparent)]
     Ode(#[from] OdeError),
+    /// A declared setting's value refused.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
 }
 
 /// The kinds of points located on a branch.
