@@ -60,7 +60,7 @@ fn python_method(schema: &Schema) -> String {
         s += &format!("        {},\n", d.python_argument());
     }
     s += "        params: Params = None,\n";
-    if schema.analysis != "continuation" {
+    if ["chaos_map", "basins"].contains(&schema.analysis) {
         s += "        progress: bool = True,\n";
     }
     s += "    ) -> dict[str, Any]:\n";

@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 use mechlab::analysis::basins::BasinsOptions;
 use mechlab::analysis::chaos_map::ChaosMapOptions;
 use mechlab::analysis::continuation::ContinuationOptions;
+use mechlab::analysis::separatrix::SplittingOptions;
 use mechlab::analysis::states::{states_at, states_of_starts};
 use mechlab::ode::Method;
 use mechlab::registry::{Kind, Model};
@@ -492,43 +493,18 @@ impl PyModel {
 
     /// The splitting of the separatrices of the period map's hyperbolic
     /// fixed point (a model of one degree of freedom with a fast phase):
-    /// the lobe area by the action and by the polygon, in double or
-    /// double-double precision (`precision`: "double", "double-double"
-    /// or "auto").
-    #[pyo3(signature = (*, guess=None, spacing=0.02, p_max=4.0, iterates=400, max_points=20_000, lobe_points=400, precision="auto", method="taylor", tol=1e-14, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// the lobe area by the action and by the polygon. Settings: the
+    /// separatrix splitting's declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn separatrix_splitting<'py>(
         &self,
         py: Python<'py>,
-        guess: Option<(f64, f64)>,
-        spacing: f64,
-        p_max: f64,
-        iterates: usize,
-        max_points: usize,
-        lobe_points: usize,
-        precision: &str,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        use mechlab::analysis::separatrix::{Precision, SplittingSettings};
         let values = parameter_values(self.model, params)?;
-        let precision = Precision::parse(precision).ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "precision {precision:?}: one of {}",
-                Precision::NAMES.join(", ")
-            ))
-        })?;
-        let settings = SplittingSettings {
-            method: Method::parse(method, tol).map_err(py_err)?,
-            guess: guess.map(|(q, p)| [q, p]),
-            spacing,
-            iterates,
-            max_points,
-            p_max,
-            lobe_points,
-            precision,
-        };
+        let options: SplittingOptions = declared(settings)?;
+        let settings = options.resolve().map_err(py_err)?;
         analyses::separatrix_splitting(py, self.model, values, settings)
     }
 

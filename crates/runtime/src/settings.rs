@@ -298,6 +298,27 @@ impl SettingValue for Vec<f64> {
     }
 }
 
+/// A point of a plane: `q,p` on the command line, `[q, p]` in JSON.
+impl SettingValue for [f64; 2] {
+    const KIND: &'static str = "point (two numbers)";
+    const PYTHON: &'static str = "tuple[float, float]";
+    fn from_text(text: &str) -> Option<Self> {
+        Vec::<f64>::from_text(text)?.try_into().ok()
+    }
+    fn from_json(value: &Value) -> Option<Self> {
+        Vec::<f64>::from_json(value)?.try_into().ok()
+    }
+    fn to_json(&self) -> Value {
+        serde_json::json!(self)
+    }
+    fn to_text(&self) -> String {
+        self.to_vec().to_text()
+    }
+    fn within(&self, range: &Range) -> bool {
+        self.iter().all(|x| range.admits(*x))
+    }
+}
+
 impl SettingValue for Vec<usize> {
     const KIND: &'static str = "list of indices";
     const PYTHON: &'static str = "Sequence[int]";
@@ -645,11 +666,12 @@ impl Schema {
 
 /// The schemas of every analysis declared so far, in the docs' order.
 pub fn schemas() -> Vec<Schema> {
-    use crate::analysis::{basins, chaos_map, continuation};
+    use crate::analysis::{basins, chaos_map, continuation, separatrix};
     vec![
         Schema::of::<chaos_map::ChaosMapOptions>(),
         Schema::of::<basins::BasinsOptions>(),
         Schema::of::<continuation::ContinuationOptions>(),
+        Schema::of::<separatrix::SplittingOptions>(),
     ]
 }
 

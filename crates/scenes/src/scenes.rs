@@ -732,66 +732,23 @@ pub fn separatrix_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::separatrix::{
-        separatrix_splitting, Precision, SplittingSettings,
-    };
-    let (model, scene) = generic_scene(
+    use mechlab_runtime::analysis::separatrix::{separatrix_splitting, SplittingOptions};
+    let sweep = [
+        knob(
+            "sweep",
+            "none",
+            "also sweep `sweep_parameter` geometrically: first,last,count (none: no sweep)",
+        ),
+        knob("sweep_parameter", "eps", "the parameter the sweep sets"),
+    ];
+    let (model, scene, options) = declared_scene::<SplittingOptions>(
         catalog,
         scene_name,
-        "separatrix splitting in the period map of a 1-degree-of-freedom model",
+        ("kapitza", None),
         overrides,
-        ("kapitza", "taylor", "1e-14"),
-        &[
-            (
-                "spacing",
-                "0.02",
-                "the largest distance between neighbouring points of a drawn manifold",
-            ),
-            (
-                "p_max",
-                "4",
-                "the manifolds are followed within |p − p*| ≤ p_max",
-            ),
-            (
-                "iterates",
-                "400",
-                "iterates of the period map per manifold, at most",
-            ),
-            ("max_points", "20000", "points per manifold, at most"),
-            (
-                "lobe_points",
-                "400",
-                "points per manifold piece of the lobe polygon",
-            ),
-            (
-                "sweep",
-                "none",
-                "also sweep `sweep_parameter` geometrically: first,last,count (none: no sweep)",
-            ),
-            ("sweep_parameter", "eps", "the parameter the sweep sets"),
-            (
-                "precision",
-                "auto",
-                "double, double-double (lobe areas below 1e-16 of the actions, reversible models) or auto (double-double where double does not resolve the area)",
-            ),
-        ],
+        &sweep,
     )?;
-    let precision =
-        Precision::parse(scene.text("precision")).ok_or_else(|| SceneError::BadValue {
-            name: "precision".into(),
-            value: scene.text("precision").into(),
-            reason: ValueProblem::OneOf(&Precision::NAMES),
-        })?;
-    let settings = SplittingSettings {
-        method: method_from(&scene)?,
-        guess: None,
-        spacing: scene.positive("spacing")?,
-        iterates: scene.count("iterates")?,
-        max_points: scene.count("max_points")?,
-        p_max: scene.positive("p_max")?,
-        lobe_points: scene.count("lobe_points")?,
-        precision,
-    };
+    let settings = options.resolve()?;
     let params = scene.parameter_values(model.info)?;
     eprintln!("growing the manifolds of the hyperbolic fixed point …");
     let splitting = separatrix_splitting(model, &params, &settings)?;

@@ -870,11 +870,9 @@ pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, St
 /// fixed point (a model of one degree of freedom with a fast phase).
 #[derive(Clone, Debug, Deserialize)]
 pub struct ManifoldsRequest {
+    /// The separatrix splitting's settings.
     #[serde(flatten)]
-    pub setup: Setup,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
+    pub analysis: AnalysisRequest,
 }
 
 /// W^u and W^s on the page's cylinder (q in [−π, π)) as segments
@@ -893,15 +891,10 @@ pub struct Manifolds {
 /// The manifolds of the hyperbolic fixed point of the model's period map
 /// (`analysis::separatrix`), for the studio's overlay.
 pub fn manifolds(catalog: Catalog, request: &ManifoldsRequest) -> Result<Manifolds, StudioError> {
-    use mechlab_runtime::analysis::separatrix::{separatrix_splitting, SplittingSettings};
-    let setup = request.setup.resolve(catalog, &request.unknown)?;
-    let settings = SplittingSettings {
-        spacing: 0.03,
-        lobe_points: 100,
-        ..Default::default()
-    };
-    let s = separatrix_splitting(setup.handle, &setup.params, &settings)?;
-    let periodic = setup.model.periodic()[0];
+    use mechlab_runtime::analysis::separatrix::{separatrix_splitting, SplittingOptions};
+    let (model, params, options) = request.analysis.resolve::<SplittingOptions>(catalog)?;
+    let s = separatrix_splitting(model, &params, &options.resolve()?)?;
+    let periodic = model.dynamic.periodic().first() == Some(&true);
     let place = |y: &[f64; 2]| [if periodic { wrap_angle(y[0]) } else { y[0] }, y[1]];
     // Consecutive points as segments, except across the cut at ±π.
     let segments = |points: &[[f64; 2]]| -> Vec<[f64; 4]> {

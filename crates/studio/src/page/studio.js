@@ -746,7 +746,8 @@ let manifoldsKey = null;
 async function refreshManifolds() {
   const wanted = $("show-manifolds").checked && studio.model.fast_phase && studio.model.state.length === 2;
   if (!wanted) { studio.manifolds = null; manifoldsKey = null; $("manifolds-note").textContent = ""; redraw(); return; }
-  const request = { model: studio.model.name, params: setup().params };
+  const { model, params, method, tol } = setup();
+  const request = { model, params, method, tol };
   const key = JSON.stringify(request);
   if (key === manifoldsKey) return;
   if (manifoldsController) manifoldsController.abort();

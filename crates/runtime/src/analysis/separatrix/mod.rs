@@ -24,12 +24,63 @@ use crate::ode::{
     DoubleDouble, DoubleDoubleTaylor, ErasedSystem, Integrator, Method, OdeError, Options, System,
 };
 use crate::registry::{DynamicModel, Fixed, FixedSize, Model};
+use crate::settings::{method, Declared, Range, SettingError, METHODS};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// What to compute and how finely.
+crate::declare_settings! {
+    /// The splitting of the separatrices of the period map's hyperbolic
+    /// fixed point (a model of one degree of freedom with a fast phase):
+    /// the manifolds, their homoclinic points and the lobe area by the
+    /// action and by the polygon.
+    pub struct SplittingOptions for "separatrix_splitting" {
+        /// Where Newton starts for the fixed point, q,p (auto: the saddles
+        /// of the averaged system, at rest).
+        guess: Option<[f64; 2]> = None, Range::Any;
+        /// The largest distance between neighbouring points of a drawn
+        /// manifold.
+        spacing: f64 = 0.02, Range::Positive;
+        /// The manifolds are followed within |p − p*| ≤ p_max.
+        p_max: f64 = 4.0, Range::Positive;
+        /// Iterates of the period map per manifold, at most.
+        iterates: usize = 400, Range::Count { min: 1, max: 1_000_000 };
+        /// Points per manifold, at most.
+        max_points: usize = 20_000, Range::Count { min: 2, max: 10_000_000 };
+        /// Points per manifold piece of the lobe polygon.
+        lobe_points: usize = 400, Range::Count { min: 4, max: 1_000_000 };
+        /// double, double-double (lobe areas below 1e-16 of the actions,
+        /// reversible models) or auto (double-double where double does not
+        /// resolve the area).
+        precision: String = "auto".into(), Range::OneOf(&Precision::NAMES);
+        /// The integration method of the period map (the action uses DOP853
+        /// at 1e-13).
+        method: String = "taylor".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-14, Range::Positive;
+    }
+    interactive { spacing: 0.03, lobe_points: 100 }
+}
+
+impl SplittingOptions {
+    /// The settings of [`separatrix_splitting`].
+    pub fn resolve(&self) -> Result<SplittingSettings, SettingError> {
+        Ok(SplittingSettings {
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            guess: self.guess,
+            spacing: self.spacing,
+            iterates: self.iterates,
+            max_points: self.max_points,
+            p_max: self.p_max,
+            lobe_points: self.lobe_points,
+            precision: Precision::parse(&self.precision).expect("validated by its range"),
+        })
+    }
+}
+
+/// What to compute and how finely, from [`SplittingOptions`].
 #[derive(Clone, Debug)]
 pub struct SplittingSettings {
     /// The integrator of the period map (the action uses DOP853 at 1e-13).
@@ -89,18 +140,12 @@ impl Precision {
     }
 }
 
+/// The declared defaults.
 impl Default for SplittingSettings {
     fn default() -> Self {
-        SplittingSettings {
-            method: Method::Taylor { tol: 1e-14 },
-            guess: None,
-            spacing: 0.02,
-            iterates: 400,
-            max_points: 20_000,
-            p_max: 4.0,
-            lobe_points: 400,
-            precision: Precision::Auto,
-        }
+        SplittingOptions::default()
+            .resolve()
+            .expect("the declared defaults are valid")
     }
 }
 
