@@ -587,7 +587,7 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
 #[tokio::test]
 async fn section_orbits_and_their_megno_map() {
     use mechlab::analysis::section::{section, SectionSettings};
-    let request = json!({"model": "henon_heiles", "energy": 0.125, "seed": [0.1, 0.0], "crossings": 50, "method": "dop853", "tol": 1e-12});
+    let request = json!({"model": "henon_heiles", "energy": 0.125, "seeds": [[0.1, 0.0]], "crossings": 50, "tol": 1e-12});
     let (status, _, body) = call("POST", "/api/section", Some(request)).await;
     assert_eq!(status, StatusCode::OK, "{body}");
     let answer: Value = serde_json::from_str(&body).unwrap();
@@ -601,7 +601,7 @@ async fn section_orbits_and_their_megno_map() {
         rising: true,
         energy: 0.125,
         crossings: 50,
-        t_max: 20.0 * 50.0 + 100.0,
+        t_max: 50.0 * 50.0,
         tol: 1e-12,
         phase: 0.0,
         slab: 0.05,
@@ -609,7 +609,7 @@ async fn section_orbits_and_their_megno_map() {
     let library = section(model, &model.dynamic.defaults(), &[[0.1, 0.0]], &settings).unwrap();
     assert_eq!(points, library.orbits[0].points);
 
-    let map = json!({"model": "henon_heiles", "energy": 0.125, "pixels": 16, "t_max": 200.0});
+    let map = json!({"model": "henon_heiles", "energy": 0.125, "map": 16, "map_time": 200.0});
     let (status, _, body) = call("POST", "/api/section_map", Some(map)).await;
     assert_eq!(status, StatusCode::OK, "{body}");
     let answer: Value = serde_json::from_str(&body).unwrap();
@@ -621,7 +621,7 @@ async fn section_orbits_and_their_megno_map() {
 
     // A plane given as a linear function of the coordinates: the library's
     // section on it, in the plane's chart, named; a bad plane is refused.
-    let tilted = json!({"model": "henon_heiles", "energy": 0.125, "plane": "x + 0.5*y", "seed": [0.1, 0.05], "crossings": 30, "method": "dop853", "tol": 1e-12});
+    let tilted = json!({"model": "henon_heiles", "energy": 0.125, "plane": "x + 0.5*y", "seeds": [[0.1, 0.05]], "crossings": 30, "tol": 1e-12});
     let (status, _, body) = call("POST", "/api/section", Some(tilted)).await;
     assert_eq!(status, StatusCode::OK, "{body}");
     let answer: Value = serde_json::from_str(&body).unwrap();
@@ -630,7 +630,7 @@ async fn section_orbits_and_their_megno_map() {
     let on_tilted = SectionSettings {
         plane: vec![1.0, 0.5],
         crossings: 30,
-        t_max: 20.0 * 30.0 + 100.0,
+        t_max: 50.0 * 30.0,
         ..settings.clone()
     };
     let library = section(model, &model.dynamic.defaults(), &[[0.1, 0.05]], &on_tilted).unwrap();
@@ -638,7 +638,7 @@ async fn section_orbits_and_their_megno_map() {
     let (status, _, body) = call(
         "POST",
         "/api/section",
-        Some(json!({"model": "henon_heiles", "energy": 0.125, "plane": "z", "seed": [0.1, 0.0], "crossings": 5})),
+        Some(json!({"model": "henon_heiles", "energy": 0.125, "plane": "z", "seeds": [[0.1, 0.0]], "crossings": 5})),
     )
     .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
@@ -650,7 +650,7 @@ async fn section_orbits_and_their_megno_map() {
     // A model with a fast phase and 2 degrees of freedom: the slice of its
     // period map, as the library draws it.
     let pi = std::f64::consts::PI;
-    let slice = json!({"model": "double_pendulum", "energy": -1.5, "value": pi, "seed": [pi + 0.3, 0.0], "crossings": 20, "method": "dop853", "tol": 1e-12});
+    let slice = json!({"model": "double_pendulum", "energy": -1.5, "value": pi, "seeds": [[pi + 0.3, 0.0]], "crossings": 20, "tol": 1e-12});
     let (status, _, body) = call("POST", "/api/section", Some(slice)).await;
     assert_eq!(status, StatusCode::OK, "{body}");
     let answer: Value = serde_json::from_str(&body).unwrap();
@@ -660,7 +660,7 @@ async fn section_orbits_and_their_megno_map() {
         value: pi,
         energy: -1.5,
         crossings: 20,
-        t_max: 20.0 * 20.0 + 100.0,
+        t_max: 50.0 * 20.0,
         ..settings
     };
     let params = shaken.dynamic.defaults();
@@ -671,7 +671,7 @@ async fn section_orbits_and_their_megno_map() {
     let (status, _, body) = call(
         "POST",
         "/api/section",
-        Some(json!({"model": "kapitza", "energy": 0.1, "seed": [0.1, 0.0], "crossings": 5})),
+        Some(json!({"model": "kapitza", "energy": 0.1, "seeds": [[0.1, 0.0]], "crossings": 5})),
     )
     .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
@@ -679,7 +679,7 @@ async fn section_orbits_and_their_megno_map() {
     let (status, _, body) = call(
         "POST",
         "/api/section",
-        Some(json!({"model": "henon_heiles", "energy": 0.125, "seed": [0.9, 0.0], "crossings": 5})),
+        Some(json!({"model": "henon_heiles", "energy": 0.125, "seeds": [[0.9, 0.0]], "crossings": 5})),
     )
     .await;
     assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
@@ -841,8 +841,8 @@ fn sections_are_offered_where_they_apply_on_constraints_too() {
     let tests = mechlab_test_models::MODELS;
     assert!(offered(tests, "cartesian_free_double_pendulum"));
     let request: SectionRequest = serde_json::from_value(json!({
-        "model": "cartesian_free_double_pendulum", "energy": -2.5, "seed": [0.3, 0.0],
-        "crossings": 20, "method": "dop853", "tol": 1e-12
+        "model": "cartesian_free_double_pendulum", "energy": -2.5, "seeds": [[0.3, 0.0]],
+        "crossings": 20, "tol": 1e-12
     }))
     .unwrap();
     let answer = section(tests, &request).unwrap();
@@ -854,7 +854,7 @@ fn sections_are_offered_where_they_apply_on_constraints_too() {
         rising: true,
         energy: -2.5,
         crossings: 20,
-        t_max: 20.0 * 20.0 + 100.0,
+        t_max: 50.0 * 20.0,
         tol: 1e-12,
         phase: 0.0,
         slab: 0.05,

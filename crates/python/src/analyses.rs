@@ -6,9 +6,7 @@
 use mechlab::analysis::chaos_map::{chaos_map as fli_map, ChaosMapSettings};
 use mechlab::analysis::on_constraints::vibration::{vibration_stability, VibrationSettings};
 use mechlab::analysis::period_map::{portrait as portrait_of, PortraitSettings};
-use mechlab::analysis::section::{
-    parse_plane, section as section_of, seeds_across, SectionSettings,
-};
+use mechlab::analysis::section::{section_study, SectionOptions};
 use mechlab::analysis::stability::{stability as stability_of, Settings, MAX_WINDOWS};
 use mechlab::ode::Method;
 use mechlab::registry::Model;
@@ -196,80 +194,50 @@ pub fn stability<'py>(
     Ok(dict)
 }
 
-/// What a section is asked for: the plane and the orbits.
-pub struct SectionRequest {
-    pub energy: f64,
-    pub plane: Option<String>,
-    pub value: f64,
-    pub rising: bool,
-    pub seeds: Option<Vec<[f64; 2]>>,
-    pub orbits: usize,
-    pub extent: f64,
-    pub crossings: usize,
-    pub t_max: f64,
-    pub tol: f64,
-}
-
-/// The section's plane (default: the first coordinate's) at `energy`,
-/// crossed rising or not; the orbits' settings at the scene's defaults.
-pub fn plane_settings(
-    model: &Model,
-    plane: Option<&str>,
-    value: f64,
-    rising: bool,
-    energy: f64,
-) -> PyResult<SectionSettings> {
-    let info = model.info;
-    let text = plane.unwrap_or(info.coordinates[0]);
-    Ok(SectionSettings {
-        plane: parse_plane(text, info.coordinates)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?,
-        value,
-        rising,
-        energy,
-        crossings: 400,
-        t_max: 20_000.0,
-        tol: 1e-12,
-        phase: 0.0,
-        slab: 0.05,
-    })
-}
-
-/// A Poincaré section at a fixed energy (the `section` scene): each
-/// orbit's points on the plane as an (n, 2) array.
+/// A Poincaré section at a fixed energy (the `section` scene): the
+/// scene's summary, each orbit's points as an (n, 2) array, the MEGNO map
+/// as an image `megno`, the frequency map's tunes and diffusion index as
+/// images.
 pub fn section<'py>(
     py: Python<'py>,
     model: &'static Model,
     values: Vec<f64>,
-    request: SectionRequest,
+    options: SectionOptions,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let settings = plane_settings(
-        model,
-        request.plane.as_deref(),
-        request.value,
-        request.rising,
-        request.energy,
-    )?;
-    let settings = SectionSettings {
-        crossings: request.crossings,
-        t_max: request.t_max,
-        tol: request.tol,
-        ..settings
+    let study =
+        detached(py, || section_study(model, &values, &options, &|_| ()))?.map_err(py_err)?;
+    let dict = PyDict::new(py);
+    let section = match &study.section {
+        None => None,
+        Some(section) => {
+            let orbits = summary(py, section)?;
+            let points: Vec<_> = section
+                .orbits
+                .iter()
+                .map(|o| points(py, o.points.iter().copied()))
+                .collect();
+            orbits.set_item("points", points)?;
+            Some(orbits)
+        }
     };
-    let result = detached(py, || {
-        let seeds = request.seeds.clone().unwrap_or_else(|| {
-            seeds_across(model, &values, &settings, request.extent, request.orbits)
-        });
-        section_of(model, &values, &seeds, &settings)
-    })?
-    .map_err(py_err)?;
-    let dict = summary(py, &result)?;
-    let orbits: Vec<_> = result
-        .orbits
-        .iter()
-        .map(|o| points(py, o.points.iter().copied()))
-        .collect();
-    dict.set_item("points", orbits)?;
+    dict.set_item("section", section)?;
+    let megno = match &study.megno_map {
+        None => None,
+        Some(map) => {
+            let pixels = map.pixels;
+            let summary = summary(py, map)?;
+            let image = Array2::from_shape_vec((pixels, pixels), map.megno.clone())
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            summary.set_item("megno", image.into_pyarray(py))?;
+            Some(summary)
+        }
+    };
+    dict.set_item("megno_map", megno)?;
+    let frequency_map = match &study.frequency_map {
+        None => None,
+        Some(map) => Some(frequencies(py, map)?),
+    };
+    dict.set_item("frequency_map", frequency_map)?;
     Ok(dict)
 }
 
@@ -517,24 +485,6 @@ pub fn basins<'py>(
     Ok(dict)
 }
 
-/// The MEGNO map of a section (the `section` scene's `map`): ⟨Y⟩ of each
-/// pixel's orbit, NaN where the energy is not accessible.
-pub fn megno_map<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::section_map::SectionMapSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::section_map::section_map;
-    let pixels = settings.pixels;
-    let result = detached(py, || section_map(model, &values, &settings))?.map_err(py_err)?;
-    let dict = summary(py, &result)?;
-    let image = Array2::from_shape_vec((pixels, pixels), result.megno.clone())
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    dict.set_item("megno", image.into_pyarray(py))?;
-    Ok(dict)
-}
-
 /// A frequency map's summary with its tunes (ν₁, ν₂ as two images) and
 /// diffusion index per pixel.
 fn frequencies<'py>(
@@ -550,19 +500,6 @@ fn frequencies<'py>(
     dict.set_item("nu2", image(&|k| map.frequencies[k][1]))?;
     dict.set_item("diffusion", image(&|k| map.diffusion[k]))?;
     Ok(dict)
-}
-
-/// The frequency map (NAFF) of a section of an autonomous model (the
-/// `frequency_map` scene).
-pub fn frequency_map<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::frequency_map::FrequencyMapSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::frequency_map::frequency_map as frequency_map_of;
-    let result = detached(py, || frequency_map_of(model, &values, &settings))?.map_err(py_err)?;
-    frequencies(py, &result)
 }
 
 /// The frequency map of a period map on a plane of starts (the

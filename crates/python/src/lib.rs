@@ -614,139 +614,38 @@ impl PyModel {
         analyses::basins(py, self.model, values, settings, progress)
     }
 
-    /// The MEGNO map of the section at `energy` through `plane` = `value`:
-    /// ⟨Y⟩ of the orbit through each of `pixels`² points of
-    /// [−extent, extent]² (2 on a torus, growing in chaos), NaN where the
-    /// energy is not accessible.
-    #[pyo3(signature = (*, energy, plane=None, value=0.0, rising=true, pixels=100, t_max=2000.0, extent=2.0, tol=1e-12, params=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn megno_map<'py>(
-        &self,
-        py: Python<'py>,
-        energy: f64,
-        plane: Option<String>,
-        value: f64,
-        rising: bool,
-        pixels: usize,
-        t_max: f64,
-        extent: f64,
-        tol: f64,
-        params: Option<BTreeMap<String, f64>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let section =
-            analyses::plane_settings(self.model, plane.as_deref(), value, rising, energy)?;
-        let settings = mechlab::analysis::section_map::SectionMapSettings {
-            section: mechlab::analysis::section::SectionSettings { tol, ..section },
-            pixels,
-            t_max,
-            extent,
-        };
-        analyses::megno_map(py, self.model, values, settings)
-    }
-
-    /// Laskar's frequency map of the section at `energy` (an autonomous
-    /// model of 2 degrees of freedom): the tunes ν₁, ν₂ of each pixel's
-    /// orbit by NAFF over [0, t_max] and its diffusion index between the
-    /// halves (`period_map_frequencies` for a model with a fast phase).
-    #[pyo3(signature = (*, energy, plane=None, value=0.0, rising=true, pixels=100, t_max=2000.0, samples=4096, extent=2.0, tol=1e-12, params=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn frequency_map<'py>(
-        &self,
-        py: Python<'py>,
-        energy: f64,
-        plane: Option<String>,
-        value: f64,
-        rising: bool,
-        pixels: usize,
-        t_max: f64,
-        samples: usize,
-        extent: f64,
-        tol: f64,
-        params: Option<BTreeMap<String, f64>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let section =
-            analyses::plane_settings(self.model, plane.as_deref(), value, rising, energy)?;
-        let settings = mechlab::analysis::frequency_map::FrequencyMapSettings {
-            section: mechlab::analysis::section::SectionSettings { tol, ..section },
-            pixels,
-            t_max,
-            samples,
-            extent,
-        };
-        analyses::frequency_map(py, self.model, values, settings)
-    }
-
     /// The frequency map of the period map (a model with a fast phase) on
     /// a plane of `pixels`² starts: each orbit's tunes over `periods` and
-    /// its diffusion index, with a progress bar.
-    #[pyo3(signature = (*, pixels=100, periods=1000, axes=None, ranges=None, through=None, p_max=3.0, method="taylor", tol=1e-10, params=None, progress=true))]
-    #[allow(clippy::too_many_arguments)]
+    /// its diffusion index, with a progress bar. Settings: the chaos map's
+    /// declaration, from the `frequency_map` scene's values.
+    #[pyo3(signature = (*, params=None, progress=true, **settings))]
     fn period_map_frequencies<'py>(
         &self,
         py: Python<'py>,
-        pixels: usize,
-        periods: usize,
-        axes: Option<(analyses::Axis, analyses::Axis)>,
-        ranges: Option<((f64, f64), (f64, f64))>,
-        through: Option<Vec<f64>>,
-        p_max: f64,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
         progress: bool,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let settings = mechlab::analysis::chaos_map::ChaosMapSettings {
-            axes: analyses::axes(self.model, axes)?,
-            ranges: ranges.map_or([None, None], |(x, y)| [Some(x), Some(y)]),
-            p_max,
-            through,
-            pixels,
-            periods,
-            method: Method::parse(method, tol).map_err(py_err)?,
-            tiles: None,
-        };
+        let base = mechlab::analysis::frequency_map::period_map_options();
+        let options = declared_from(base, settings)?;
+        let settings = options.resolve(self.model).map_err(py_err)?;
         analyses::period_map_frequencies(py, self.model, values, settings, progress)
     }
 
-    /// A Poincaré section at the energy H = `energy` through the plane
-    /// `plane` = `value` (a linear function of the coordinates, "x",
-    /// "q1 - q2"; default the first coordinate), from `seeds` (the other
-    /// coordinate and its momentum) or `orbits` seeds across the
-    /// accessible stretch of [−extent, extent].
-    #[pyo3(signature = (*, energy, plane=None, value=0.0, rising=true, seeds=None, orbits=24, extent=2.0, crossings=400, t_max=20000.0, tol=1e-12, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// A Poincaré section at a fixed energy: the `section` scene's
+    /// summary — its orbits (each one's points an (n, 2) array), its MEGNO
+    /// map and its frequency map where their pixels are asked for.
+    /// Settings: the section's declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn section<'py>(
         &self,
         py: Python<'py>,
-        energy: f64,
-        plane: Option<String>,
-        value: f64,
-        rising: bool,
-        seeds: Option<Vec<[f64; 2]>>,
-        orbits: usize,
-        extent: f64,
-        crossings: usize,
-        t_max: f64,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let request = analyses::SectionRequest {
-            energy,
-            plane,
-            value,
-            rising,
-            seeds,
-            orbits,
-            extent,
-            crossings,
-            t_max,
-            tol,
-        };
-        analyses::section(py, self.model, values, request)
+        analyses::section(py, self.model, values, declared(settings)?)
     }
 }
 
@@ -761,11 +660,16 @@ fn parameter_values(model: &Model, params: Option<BTreeMap<String, f64>>) -> PyR
 /// its declaration, its defaults where not given), checked by the
 /// declaration.
 fn declared<T: Declared>(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<T> {
+    declared_from(T::default(), kwargs)
+}
+
+/// The same from other defaults than the declaration's (a preset).
+fn declared_from<T: Declared>(base: T, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<T> {
     let given: serde_json::Map<String, serde_json::Value> = match kwargs {
         Some(kwargs) => pythonize::depythonize(kwargs)?,
         None => serde_json::Map::new(),
     };
-    T::default().with_json(&given).map_err(py_err)
+    base.with_json(&given).map_err(py_err)
 }
 
 /// Every declared analysis's settings: name, type, default, range and

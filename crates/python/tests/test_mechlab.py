@@ -102,7 +102,7 @@ class Analyses(unittest.TestCase):
     def test_uncoupled_section_returns_to_its_seeds(self):
         m = mechlab.model("henon_heiles")
         seeds = [[0.2, 0.0], [-0.5, 0.3]]
-        s = m.section(energy=0.3, seeds=seeds, crossings=20, params={"lambda": 0.0})
+        s = m.section(energy=0.3, seeds=seeds, crossings=20, params={"lambda": 0.0}).section
         self.assertEqual(len(s.points), 2)
         for points, seed in zip(s.points, seeds):
             self.assertEqual(points.shape, (20, 2))
@@ -226,14 +226,16 @@ class Analyses(unittest.TestCase):
 
     def test_uncoupled_oscillators_have_unit_tunes_everywhere(self):
         m = mechlab.model("henon_heiles")
-        f = m.frequency_map(energy=0.1, pixels=8, t_max=500, samples=1024, params={"lambda": 0.0})
+        f = m.section(energy=0.1, orbits=0, frequencies=8, map_time=500, samples=1024,
+                      params={"lambda": 0.0}).frequency_map
         accessible = np.isfinite(f.nu1)
         self.assertEqual(int(np.sum(accessible)), f.accessible)
         self.assertLess(np.max(np.abs(np.abs(f.nu1[accessible]) - 1.0)), 1e-9)
         self.assertLess(np.max(np.abs(np.abs(f.nu2[accessible]) - 1.0)), 1e-9)
 
     def test_megno_map_counts_its_chaotic_pixels(self):
-        g = mechlab.model("henon_heiles").megno_map(energy=0.125, pixels=20, t_max=500)
+        g = mechlab.model("henon_heiles").section(energy=0.125, orbits=0, map=20,
+                                                  map_time=500).megno_map
         self.assertEqual(int(np.sum(np.isfinite(g.megno))), g.accessible)
         self.assertEqual(int(np.sum(g.megno > 4.0)), g.chaotic)
         self.assertGreater(g.chaotic, 0)

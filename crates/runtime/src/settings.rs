@@ -319,6 +319,35 @@ impl SettingValue for [f64; 2] {
     }
 }
 
+/// Points of a plane: `q,p;q,p` on the command line, `[[q, p], …]` in
+/// JSON.
+impl SettingValue for Vec<[f64; 2]> {
+    const KIND: &'static str = "points (q,p;q,p…)";
+    const PYTHON: &'static str = "Sequence[tuple[float, float]]";
+    fn from_text(text: &str) -> Option<Self> {
+        text.split(';').map(<[f64; 2]>::from_text).collect()
+    }
+    fn from_json(value: &Value) -> Option<Self> {
+        value
+            .as_array()?
+            .iter()
+            .map(<[f64; 2]>::from_json)
+            .collect()
+    }
+    fn to_json(&self) -> Value {
+        serde_json::json!(self)
+    }
+    fn to_text(&self) -> String {
+        self.iter()
+            .map(|p| p.to_text())
+            .collect::<Vec<_>>()
+            .join(";")
+    }
+    fn within(&self, range: &Range) -> bool {
+        self.iter().all(|p| p.within(range))
+    }
+}
+
 impl SettingValue for Vec<usize> {
     const KIND: &'static str = "list of indices";
     const PYTHON: &'static str = "Sequence[int]";
@@ -666,12 +695,13 @@ impl Schema {
 
 /// The schemas of every analysis declared so far, in the docs' order.
 pub fn schemas() -> Vec<Schema> {
-    use crate::analysis::{basins, chaos_map, continuation, separatrix};
+    use crate::analysis::{basins, chaos_map, continuation, section, separatrix};
     vec![
         Schema::of::<chaos_map::ChaosMapOptions>(),
         Schema::of::<basins::BasinsOptions>(),
         Schema::of::<continuation::ContinuationOptions>(),
         Schema::of::<separatrix::SplittingOptions>(),
+        Schema::of::<section::SectionOptions>(),
     ]
 }
 

@@ -104,21 +104,22 @@ pub fn method_from(scene: &Scene) -> Result<Method, SceneError> {
 
 /// A scene of a declared analysis: the `model` knob, the declaration's
 /// settings as knobs (with the preset's defaults where `overrides` gives
-/// one), the scene's `extra` knobs (tiles), then every parameter of the
+/// one, over `base`: the declaration's defaults or a preset of the
+/// library's), the scene's `extra` knobs (tiles), then every parameter of the
 /// chosen model; the parsed scene and the settings it asks for, validated
 /// by the declaration.
 fn declared_scene<T: Declared>(
     catalog: Catalog,
     scene_name: &'static str,
     (default_model, about): (&'static str, Option<&str>),
-    overrides: &[(&'static str, &'static str)],
+    (base, overrides): (T, &[(&'static str, &'static str)]),
     extra: &[Knob],
 ) -> Result<(&'static Model, Scene, T), SceneError> {
     let defaults = Defaults(overrides);
     let model_name = defaults.get("model", default_model);
     let handle = model_from_args(catalog, model_name)?;
     let names = T::names();
-    let preset = T::default().with_texts(
+    let preset = base.with_texts(
         overrides
             .iter()
             .filter(|(n, _)| names.contains(n))
@@ -157,7 +158,7 @@ pub fn chaos_map_scene(
         catalog,
         scene_name,
         ("kapitza", None),
-        overrides,
+        (ChaosMapOptions::default(), overrides),
         &tile_knobs("10"),
     )?;
     let settings = ChaosMapSettings {
@@ -568,7 +569,7 @@ pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Resu
         catalog,
         "basins",
         ("duffing", None),
-        &[],
+        (BasinsOptions::default(), &[]),
         &tile_knobs("0"),
     )?;
     let settings = BasinSettings {
@@ -745,7 +746,7 @@ pub fn separatrix_scene(
         catalog,
         scene_name,
         ("kapitza", None),
-        overrides,
+        (SplittingOptions::default(), overrides),
         &sweep,
     )?;
     let settings = options.resolve()?;
@@ -913,7 +914,7 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
         catalog,
         "continuation",
         ("duffing", None),
-        &[],
+        (ContinuationOptions::default(), &[]),
         &[drawn],
     )?;
     let params = scene.parameter_values(model.info)?;
@@ -1008,65 +1009,26 @@ pub fn section_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::section::{
-        parse_plane, section, seeds_across, SectionError, SectionSettings,
-    };
-    let defaults = Defaults(overrides);
-    let model = model_from_args(catalog, defaults.get("model", "henon_heiles"))?;
-    let mut knobs = section_knobs(model, &defaults);
-    knobs.extend(parameter_knobs(model.info, overrides));
-    let scene = Scene::from_args(
+    use mechlab_runtime::analysis::section::{section_study, SectionOptions};
+    let (model, scene, options) = declared_scene::<SectionOptions>(
+        catalog,
         scene_name,
-        "Poincaré section at a fixed energy, its MEGNO and frequency maps",
-        &knobs,
+        ("henon_heiles", None),
+        (SectionOptions::default(), overrides),
+        &[],
     )?;
-    let rising = match scene.text("direction") {
-        "rising" => true,
-        "falling" => false,
-        other => {
-            return Err(SceneError::BadValue {
-                name: "direction".into(),
-                value: other.into(),
-                reason: ValueProblem::Requirement("rising or falling"),
-            })
-        }
-    };
-    let settings = SectionSettings {
-        plane: parse_plane(scene.text("plane"), model.info.coordinates)
-            .map_err(SectionError::from)?,
-        value: scene.number("value")?,
-        rising,
-        energy: scene.number("energy")?,
-        crossings: scene.count("crossings")?,
-        t_max: scene.positive("t_max")?,
-        tol: scene.positive("tol")?,
-        phase: scene.number("phase")?,
-        slab: scene.positive("slab")?,
-    };
     let params = scene.parameter_values(model.info)?;
-    let frequencies = section_frequency_map(&scene, model, &params, &settings)?;
-    let result = match scene.whole("orbits")? {
-        0 => None,
-        orbits => {
-            let seeds = seeds_across(model, &params, &settings, scene.positive("extent")?, orbits);
-            eprintln!("{} orbits at H = {} …", seeds.len(), settings.energy);
-            let result = section(model, &params, &seeds, &settings)?;
-            write_section(&scene, &result, &settings)?;
-            Some(result)
-        }
-    };
-    let map = section_megno_map(&scene, model, &params, &settings)?;
-    #[derive(serde::Serialize)]
-    struct Summary<'a> {
-        section: Option<&'a mechlab_runtime::analysis::section::Section>,
-        megno_map: Option<&'a mechlab_runtime::analysis::section_map::SectionMap>,
-        frequency_map: Option<&'a mechlab_runtime::analysis::frequency_map::FrequencyMap>,
+    let study = section_study(model, &params, &options, &|line| eprintln!("{line}"))?;
+    if let Some(section) = &study.section {
+        write_section(&scene, section, options.crossings)?;
     }
-    scene.write_summary(&Summary {
-        section: result.as_ref(),
-        megno_map: map.as_ref(),
-        frequency_map: frequencies.as_ref(),
-    })?;
+    if let Some(map) = &study.frequency_map {
+        write_frequency_map(&scene, map)?;
+    }
+    if let Some(map) = &study.megno_map {
+        write_megno_map(&scene, map)?;
+    }
+    scene.write_summary(&study)?;
     Ok(())
 }
 
@@ -1074,7 +1036,7 @@ pub fn section_scene(
 fn write_section(
     scene: &Scene,
     result: &mechlab_runtime::analysis::section::Section,
-    settings: &mechlab_runtime::analysis::section::SectionSettings,
+    crossings: usize,
 ) -> Result<(), SceneError> {
     scene.save_figure(&result.figure(), "section.png")?;
     let rows = result
@@ -1095,81 +1057,10 @@ fn write_section(
         let o = &result.orbits[k];
         eprintln!(
             "orbit {k} (seed {:?}) ended after {} of {} points: {end}",
-            o.points[0], o.crossings, settings.crossings
+            o.points[0], o.crossings, crossings
         );
     }
     Ok(())
-}
-
-/// The `section` scene's knobs for `model` (its parameters not included),
-/// with the scene's own defaults.
-fn section_knobs(model: &Model, defaults: &Defaults) -> Vec<Knob> {
-    vec![
-        knob(
-            "model",
-            model.info.name,
-            "the model (a file models/<name>.toml) of 2 degrees of freedom (with a fast phase: a slice of its period map)",
-        ),
-        knob(
-            "energy",
-            "0.125",
-            "the energy H = E of every orbit's seed (H̄, averaged, with a fast phase)",
-        ),
-        knob(
-            "plane",
-            model.info.coordinates[0],
-            "the plane: a linear function of the coordinates (\"x\", \"q1 - q2\", \"x + 0.5*y\") equal to `value`",
-        ),
-        knob("value", "0", "the plane's value"),
-        knob(
-            "direction",
-            "rising",
-            "crossings with the plane's function increasing (rising) or decreasing (falling)",
-        ),
-        knob(
-            "orbits",
-            defaults.get("orbits", "24"),
-            "orbits, seeded evenly across the accessible part of the other coordinate (0: none)",
-        ),
-        knob("extent", "2", "seeds are searched for in [-extent, extent]"),
-        knob("crossings", "400", "points per orbit"),
-        knob(
-            "t_max",
-            "20000",
-            "an orbit stops at this time, however few its crossings",
-        ),
-        knob(
-            "tol",
-            "1e-12",
-            "DOP853's tolerance (the map's Taylor method uses it too)",
-        ),
-        knob(
-            "map",
-            "0",
-            "pixels per side of a MEGNO chaos map of the section (0: none)",
-        ),
-        knob("map_time", "2000", "the time each orbit of the MEGNO and frequency maps runs"),
-        knob(
-            "frequencies",
-            defaults.get("frequencies", "0"),
-            "pixels per side of a frequency map (NAFF) of the section (0: none)",
-        ),
-        knob(
-            "samples",
-            "4096",
-            "samples of each orbit of the frequency map",
-        ),
-        knob(
-            "phase",
-            "0",
-            "with a fast phase: the forcing's phase 2πt/T at which the period map samples",
-        ),
-        knob(
-            "slab",
-            "0.05",
-            "with a fast phase: points of the period map within this of the plane are kept",
-        ),
-    ]
 }
 
 /// The `frequency_map` scene: Laskar's frequency map of a section at a
@@ -1202,7 +1093,10 @@ pub fn frequency_map_scene(catalog: Catalog) -> Result<(), SceneError> {
                 "Laskar's frequency map of the period map: each orbit's tunes and diffusion index",
             ),
         ),
-        &[("pixels", "100"), ("periods", "1000"), ("tol", "1e-10")],
+        (
+            mechlab_runtime::analysis::frequency_map::period_map_options(),
+            &[],
+        ),
         &[],
     )?;
     let settings = options.resolve(model)?;
@@ -1245,68 +1139,25 @@ fn write_frequency_map(
     Ok(())
 }
 
-/// The `section` scene's frequency map of the section when `frequencies`
-/// asks for one, with its figure and table.
-fn section_frequency_map(
+/// The MEGNO map's figure and table.
+fn write_megno_map(
     scene: &Scene,
-    model: &Model,
-    params: &[f64],
-    settings: &mechlab_runtime::analysis::section::SectionSettings,
-) -> Result<Option<mechlab_runtime::analysis::frequency_map::FrequencyMap>, SceneError> {
-    use mechlab_runtime::analysis::frequency_map::{frequency_map, FrequencyMapSettings};
-    let pixels = scene.whole("frequencies")?;
-    if pixels == 0 {
-        return Ok(None);
-    }
-    eprintln!("frequency map, {pixels}² orbits …");
-    let map_settings = FrequencyMapSettings {
-        section: settings.clone(),
-        pixels,
-        t_max: scene.positive("map_time")?,
-        samples: scene.count("samples")?,
-        extent: scene.positive("extent")?,
+    map: &mechlab_runtime::analysis::section_map::SectionMap,
+) -> Result<(), SceneError> {
+    scene.save_figure(&map.figure(), "section_megno.png")?;
+    let (window, pixels) = (map.window, map.pixels);
+    let at = move |k: usize, range: [f64; 2]| {
+        range[0] + (range[1] - range[0]) * (k as f64 + 0.5) / pixels as f64
     };
-    let map = frequency_map(model, params, &map_settings)?;
-    write_frequency_map(scene, &map)?;
-    Ok(Some(map))
-}
-
-/// The `section` scene's MEGNO map of the section when `map` asks for one,
-/// with its figure and table.
-fn section_megno_map(
-    scene: &Scene,
-    model: &Model,
-    params: &[f64],
-    settings: &mechlab_runtime::analysis::section::SectionSettings,
-) -> Result<Option<mechlab_runtime::analysis::section_map::SectionMap>, SceneError> {
-    Ok(match scene.whole("map")? {
-        0 => None,
-        pixels => {
-            use mechlab_runtime::analysis::section_map::{section_map, SectionMapSettings};
-            eprintln!("MEGNO map, {pixels}² orbits …");
-            let map_settings = SectionMapSettings {
-                section: settings.clone(),
-                pixels,
-                t_max: scene.positive("map_time")?,
-                extent: scene.positive("extent")?,
-            };
-            let map = section_map(model, params, &map_settings)?;
-            scene.save_figure(&map.figure(), "section_megno.png")?;
-            let window = map.window;
-            let at = move |k: usize, range: [f64; 2]| {
-                range[0] + (range[1] - range[0]) * (k as f64 + 0.5) / pixels as f64
-            };
-            let rows = map
-                .megno
-                .iter()
-                .enumerate()
-                .map(move |(k, v)| (at(k % pixels, window[0]), at(k / pixels, window[1]), *v));
-            scene.write_csv(
-                "section_megno.csv",
-                &[map.axes[0].as_str(), map.axes[1].as_str(), "megno"],
-                rows,
-            )?;
-            Some(map)
-        }
-    })
+    let rows = map
+        .megno
+        .iter()
+        .enumerate()
+        .map(move |(k, v)| (at(k % pixels, window[0]), at(k / pixels, window[1]), *v));
+    scene.write_csv(
+        "section_megno.csv",
+        &[map.axes[0].as_str(), map.axes[1].as_str(), "megno"],
+        rows,
+    )?;
+    Ok(())
 }

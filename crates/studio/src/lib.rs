@@ -238,7 +238,7 @@ async fn section(State(catalog): State<Catalog>, body: Bytes) -> Result<Response
 }
 
 async fn section_map(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::SectionMapRequest = serde_json::from_slice(&body)?;
+    let request: studio::SectionRequest = serde_json::from_slice(&body)?;
     let answer =
         blocking(move || studio::section_map(catalog, &request).map_err(ApiError::from)).await?;
     Ok(axum::Json(answer).into_response())

@@ -32,6 +32,18 @@ pub struct FrequencyMapSettings {
     pub extent: f64,
 }
 
+/// The frequency map of a period map reads the chaos map's plane and
+/// settings, with its own values: fewer pixels, orbits of 1000 periods (NAFF
+/// needs them long), and a tighter tolerance (the tunes to 1e-10).
+pub fn period_map_options() -> crate::analysis::chaos_map::ChaosMapOptions {
+    crate::analysis::chaos_map::ChaosMapOptions {
+        pixels: 100,
+        periods: 1000,
+        tol: 1e-10,
+        ..Default::default()
+    }
+}
+
 /// A diffusion index below this is a regular orbit (a torus): its
 /// frequencies drift by less than 1e-4 between the halves. (Hénon–Heiles
 /// at E = 1/8 over T = 2000: 41.7 % of the section regular by it, 42.5 %

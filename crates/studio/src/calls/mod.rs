@@ -44,6 +44,12 @@ pub enum StudioError {
     /// A declared setting's value refused (its name, value and range).
     #[error(transparent)]
     Setting(#[from] mechlab_runtime::settings::SettingError),
+    /// A section orbit asked for without a seed.
+    #[error("the section's orbit needs a seed: seeds = [[q, p]] (the other coordinate and its momentum on the plane)")]
+    NoSeed,
+    /// A section map asked for with no pixels.
+    #[error("the section's MEGNO map needs its pixels per side: map > 0")]
+    NoMap,
     /// Not 1 to 8 refinements of a map.
     #[error("a map is drawn in 1 to 8 refinements (levels), got {got}")]
     Levels { got: usize },
@@ -110,6 +116,9 @@ pub struct ModelSummary {
     pub kind: &'static str,
     pub dof: usize,
     pub fast_phase: bool,
+    /// The coordinates' names as the model file writes them (a section's
+    /// plane is written in them).
+    pub coordinates: &'static [&'static str],
     /// The state's names [q; p] in the figures' notation.
     pub state: Vec<String>,
     /// Per state component: an angle (shown mod 2π).
@@ -189,6 +198,7 @@ fn summary(
         kind,
         dof,
         fast_phase,
+        coordinates: info.coordinates,
         // A constrained model's second half are velocities: φ₁′.
         state: state
             .iter()
@@ -1026,79 +1036,25 @@ pub fn continuation(
     })
 }
 
-/// The plane of a Poincaré section on the page: q_c = value crossed in one
-/// direction, at the energy H = E (models of 2 degrees of freedom; with a
-/// fast phase, H̄ = E and a slice of the period map).
-#[derive(Clone, Debug, Deserialize)]
-pub struct SectionPlane {
-    pub energy: f64,
-    #[serde(default)]
-    pub coordinate: usize,
-    /// A linear function of the coordinates ("phi1 - phi2"), in place of
-    /// `coordinate` where given.
-    #[serde(default)]
-    pub plane: Option<String>,
-    #[serde(default)]
-    pub value: f64,
-    #[serde(default = "rising")]
-    pub rising: bool,
-}
-
-fn rising() -> bool {
-    true
-}
-
-impl SectionPlane {
-    /// The library's settings: the plane `plane` (a linear function of the
-    /// coordinates, as the `section` scene reads it) where given, else the
-    /// coordinate's.
-    fn settings(
-        &self,
-        coordinates: &[&str],
-        crossings: usize,
-        tol: f64,
-    ) -> Result<
-        mechlab_runtime::analysis::section::SectionSettings,
-        mechlab_runtime::analysis::section::SectionError,
-    > {
-        let plane = match (&self.plane, self.coordinate) {
-            (Some(text), _) if !text.trim().is_empty() => {
-                mechlab_runtime::analysis::section::parse_plane(text, coordinates)?
-            }
-            (_, chosen) => (0..coordinates.len())
-                .map(|i| if i == chosen { 1.0 } else { 0.0 })
-                .collect(),
-        };
-        Ok(mechlab_runtime::analysis::section::SectionSettings {
-            plane,
-            value: self.value,
-            rising: self.rising,
-            energy: self.energy,
-            crossings,
-            t_max: 20.0 * crossings as f64 + 100.0,
-            tol,
-            // With a fast phase: the period map at phase 0, within 0.05 of
-            // the plane.
-            phase: 0.0,
-            slab: 0.05,
-        })
-    }
-}
-
-/// What `POST /api/section` asks: the section orbit from a seed on the
-/// plane (the other coordinate and its momentum; the missing momentum is
-/// solved from H = E).
+/// What `POST /api/section` and `POST /api/section_map` ask: the
+/// section's settings (its interactive values where not given): the orbit
+/// from the one seed of `seeds`, or the MEGNO map of `map` pixels.
 #[derive(Clone, Debug, Deserialize)]
 pub struct SectionRequest {
     #[serde(flatten)]
-    pub setup: Setup,
-    #[serde(flatten)]
-    pub plane: SectionPlane,
-    pub seed: [f64; 2],
-    pub crossings: usize,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
+    pub analysis: AnalysisRequest,
+}
+
+impl SectionRequest {
+    /// The section's parts the request asks for.
+    fn study(
+        &self,
+        catalog: Catalog,
+    ) -> Result<mechlab_runtime::analysis::section::SectionStudy, StudioError> {
+        use mechlab_runtime::analysis::section::{section_study, SectionOptions};
+        let (model, params, options) = self.analysis.resolve::<SectionOptions>(catalog)?;
+        Ok(section_study(model, &params, &options, &|_| ())?)
+    }
 }
 
 /// A section orbit: its points on the plane (the seed first), its full
@@ -1116,20 +1072,13 @@ pub struct SectionPoints {
     pub end_text: String,
 }
 
-/// One orbit of the section map (`analysis::section`) for the studio.
+/// One orbit of the section map (`analysis::section`) for the studio: the
+/// first of the request's seeds.
 pub fn section(catalog: Catalog, request: &SectionRequest) -> Result<SectionPoints, StudioError> {
-    let setup = request.setup.resolve(catalog, &request.unknown)?;
-    let crossings = setup.count("crossings", request.crossings, MAX_PERIODS)?;
-    let coordinates = setup.handle.info.coordinates;
-    let settings = request
-        .plane
-        .settings(coordinates, crossings, setup_tol(&setup))?;
-    let mut found = mechlab_runtime::analysis::section::section(
-        setup.handle,
-        &setup.params,
-        &[request.seed],
-        &settings,
-    )?;
+    let study = request.study(catalog)?;
+    let Some(mut found) = study.section.filter(|s| !s.orbits.is_empty()) else {
+        return Err(StudioError::NoSeed);
+    };
     let orbit = found.orbits.remove(0);
     Ok(SectionPoints {
         axes: found.axes,
@@ -1139,21 +1088,6 @@ pub fn section(catalog: Catalog, request: &SectionRequest) -> Result<SectionPoin
         end_text: orbit.end.to_string(),
         end: orbit.end,
     })
-}
-
-/// What `POST /api/section_map` asks: the MEGNO map of the section.
-#[derive(Clone, Debug, Deserialize)]
-pub struct SectionMapRequest {
-    #[serde(flatten)]
-    pub setup: Setup,
-    #[serde(flatten)]
-    pub plane: SectionPlane,
-    pub pixels: usize,
-    /// The time each orbit of the map runs.
-    pub t_max: f64,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
 }
 
 /// The MEGNO map of a section: ⟨Y⟩ per pixel (row 0 at the bottom, null
@@ -1172,25 +1106,11 @@ pub struct SectionMapView {
 /// The MEGNO map of the section (`analysis::section_map`) for the studio.
 pub fn section_map(
     catalog: Catalog,
-    request: &SectionMapRequest,
+    request: &SectionRequest,
 ) -> Result<SectionMapView, StudioError> {
-    use mechlab_runtime::analysis::section_map::{section_map, SectionMapSettings};
-    let setup = request.setup.resolve(catalog, &request.unknown)?;
-    let pixels = setup.count("pixels", request.pixels, MAX_CHAOS_PIXELS)?;
-    if !(request.t_max > 0.0 && request.t_max <= 10_000.0) {
-        return Err(setup.bad(RequestProblem::NotFinite {
-            what: "t_max (in (0, 10 000])",
-        }));
-    }
-    let settings = SectionMapSettings {
-        section: request
-            .plane
-            .settings(setup.handle.info.coordinates, 1, setup_tol(&setup))?,
-        pixels,
-        t_max: request.t_max,
-        extent: 3.0,
+    let Some(map) = request.study(catalog)?.megno_map else {
+        return Err(StudioError::NoMap);
     };
-    let map = section_map(setup.handle, &setup.params, &settings)?;
     Ok(SectionMapView {
         axes: map.axes.clone(),
         window: map.window,
@@ -1203,16 +1123,6 @@ pub fn section_map(
         chaotic_fraction: map.chaotic_fraction,
         seconds: map.seconds,
     })
-}
-
-/// The tolerance of the page's method, for the section's DOP853 and the
-/// map's Taylor method.
-fn setup_tol(setup: &Resolved) -> f64 {
-    match setup.method {
-        Method::Dop853 { rtol, .. } | Method::Radau5 { rtol, .. } => rtol,
-        Method::Taylor { tol } => tol,
-        Method::Rk4 { .. } | Method::Gauss { .. } => 1e-10,
-    }
 }
 
 /// The mechanism moving from an orbit's seed (the model file's points):

@@ -504,11 +504,16 @@ function seedAt(x, y) {
 
 // ---------- the Poincaré section (a slice of the period map with a fast phase) ----------
 
-function sectionPlane() {
+// The section's settings as the page sets them (the `section`
+// declaration's names): the plane is the typed function, else the chosen
+// coordinate.
+function sectionSettings() {
+  const { model, params, tol } = setup();
+  const coordinate = studio.model.coordinates[Number($("section-coordinate").value)];
   return {
+    model, params, tol,
     energy: Number($("energy").value),
-    coordinate: Number($("section-coordinate").value),
-    plane: $("section-plane").value.trim() || undefined,
+    plane: $("section-plane").value.trim() || coordinate,
     value: Number($("section-value").value),
     rising: $("section-direction").value === "rising",
   };
@@ -526,7 +531,7 @@ function seedSection(x, y) {
 
 async function startSectionOrbit(orbit) {
   restart(orbit);
-  const request = { ...setup(), ...sectionPlane(), seed: orbit.seed, crossings: orbit.periods };
+  const request = { ...sectionSettings(), seeds: [orbit.seed], crossings: orbit.periods };
   try {
     const answer = await postJson("/api/section", request, orbit.controller.signal);
     orbit.points = answer.points;
@@ -569,7 +574,7 @@ async function refreshMegno() {
   const t_max = Number($("megno-time").value);
   for (const pixels of [32, 64, 128]) {
     try {
-      const map = await postJson("/api/section_map", { ...setup(), ...sectionPlane(), pixels, t_max }, signal);
+      const map = await postJson("/api/section_map", { ...sectionSettings(), map: pixels, map_time: t_max }, signal);
       studio.megno = { ranges: map.window, image: megnoImage(map) };
       studio.sectionAxes = map.axes;
       $("megno-note").textContent = `(${pixels}², chaotic ${(100 * map.chaotic_fraction).toFixed(1)} %)`;

@@ -16,6 +16,9 @@
 //! H = E and from the plane.
 
 mod on_constraints;
+mod study;
+
+pub use study::{section_study, SectionOptions, SectionStudy};
 
 use crate::analysis::Refusal;
 use crate::ode::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options};

@@ -1,0 +1,149 @@
+//! The section's settings, declared once, and the one call that runs
+//! what they ask for: the section's orbits, its MEGNO map and its
+//! frequency map, as the `section` scene, the studio and Python return
+//! them.
+
+use super::{parse_plane, section, seeds_across, Section, SectionError, SectionSettings};
+use crate::analysis::frequency_map::{frequency_map, FrequencyMap, FrequencyMapSettings};
+use crate::analysis::section_map::{section_map, SectionMap, SectionMapSettings};
+use crate::registry::Model;
+use crate::settings::Range;
+
+crate::declare_settings! {
+    /// A Poincaré section at a fixed energy (models of 2 degrees of
+    /// freedom, constrained ones too; with a fast phase, a slice of the
+    /// period map): its orbits, and the MEGNO and frequency maps of the
+    /// section.
+    pub struct SectionOptions for "section" {
+        /// The energy H = E of every orbit's seed (H̄, averaged, with a fast
+        /// phase).
+        energy: f64 = 0.125, Range::Any;
+        /// The plane: a linear function of the coordinates ("x", "q1 - q2",
+        /// "x + 0.5*y") equal to `value` (auto: the first coordinate).
+        plane: Option<String> = None, Range::Any;
+        /// The plane's value.
+        value: f64 = 0.0, Range::Any;
+        /// Crossings with the plane's function increasing (no: decreasing).
+        rising: bool = true, Range::Any;
+        /// Seeds on the plane: the other coordinate and its momentum, q,p;q,p
+        /// (auto: `orbits` seeds across the accessible part of [−extent,
+        /// extent]).
+        seeds: Option<Vec<[f64; 2]>> = None, Range::Any;
+        /// Orbits seeded evenly where `seeds` is auto (0: none).
+        orbits: usize = 24, Range::Count { min: 0, max: 10_000 };
+        /// Seeds and the maps' pixels are searched for in [−extent, extent].
+        extent: f64 = 2.0, Range::Positive;
+        /// Points per orbit.
+        crossings: usize = 400, Range::Count { min: 1, max: 10_000_000 };
+        /// An orbit stops at this time, however few its crossings (auto: 50
+        /// time units per crossing).
+        t_max: Option<f64> = None, Range::Positive;
+        /// Pixels per side of a MEGNO chaos map of the section (0: none).
+        map: usize = 0, Range::Count { min: 0, max: 4000 };
+        /// Pixels per side of a frequency map (NAFF) of the section (0:
+        /// none).
+        frequencies: usize = 0, Range::Count { min: 0, max: 4000 };
+        /// The time each orbit of the MEGNO and frequency maps runs.
+        map_time: f64 = 2000.0, Range::Positive;
+        /// Samples of each orbit of the frequency map.
+        samples: usize = 4096, Range::Count { min: 64, max: 100_000_000 };
+        /// With a fast phase: the forcing's phase 2πt/T at which the period
+        /// map samples.
+        phase: f64 = 0.0, Range::Any;
+        /// With a fast phase: points of the period map within this of the
+        /// plane are kept.
+        slab: f64 = 0.05, Range::Positive;
+        /// DOP853's tolerance (the maps' Taylor method uses it too).
+        tol: f64 = 1e-12, Range::Positive;
+    }
+    interactive { orbits: 0, extent: 3.0 }
+}
+
+/// What [`section_study`] finds: each part the settings ask for.
+#[derive(Debug, serde::Serialize)]
+pub struct SectionStudy {
+    pub section: Option<Section>,
+    pub megno_map: Option<SectionMap>,
+    pub frequency_map: Option<FrequencyMap>,
+}
+
+impl SectionOptions {
+    /// The section's plane and orbits' settings for `model`, `auto`
+    /// resolved.
+    pub fn resolve(&self, model: &Model) -> Result<SectionSettings, SectionError> {
+        let coordinates = model.info.coordinates;
+        let plane = parse_plane(self.plane.as_deref().unwrap_or(coordinates[0]), coordinates)?;
+        Ok(SectionSettings {
+            plane,
+            value: self.value,
+            rising: self.rising,
+            energy: self.energy,
+            crossings: self.crossings,
+            t_max: self.t_max.unwrap_or(50.0 * self.crossings as f64),
+            tol: self.tol,
+            phase: self.phase,
+            slab: self.slab,
+        })
+    }
+}
+
+/// The section of `model` that `options` ask for: its orbits (from the
+/// seeds, or `orbits` seeds across; none when 0), its MEGNO map and its
+/// frequency map (where their pixels are not 0); `say` hears what starts.
+pub fn section_study(
+    model: &Model,
+    params: &[f64],
+    options: &SectionOptions,
+    say: &dyn Fn(String),
+) -> Result<SectionStudy, SectionError> {
+    let settings = options.resolve(model)?;
+    let seeds = match &options.seeds {
+        Some(seeds) => seeds.clone(),
+        None if options.orbits == 0 => Vec::new(),
+        None => seeds_across(model, params, &settings, options.extent, options.orbits),
+    };
+    // (Where no seed is accessible, or the model is refused, `section`
+    // says so.)
+    let section = if options.orbits == 0 && options.seeds.is_none() {
+        None
+    } else {
+        say(format!(
+            "{} orbits at H = {} …",
+            seeds.len(),
+            settings.energy
+        ));
+        Some(section(model, params, &seeds, &settings)?)
+    };
+    let frequency_map = match options.frequencies {
+        0 => None,
+        pixels => {
+            say(format!("frequency map, {pixels}² orbits …"));
+            let map = FrequencyMapSettings {
+                section: settings.clone(),
+                pixels,
+                t_max: options.map_time,
+                samples: options.samples,
+                extent: options.extent,
+            };
+            Some(frequency_map(model, params, &map)?)
+        }
+    };
+    let megno_map = match options.map {
+        0 => None,
+        pixels => {
+            say(format!("MEGNO map, {pixels}² orbits …"));
+            let map = SectionMapSettings {
+                section: settings.clone(),
+                pixels,
+                t_max: options.map_time,
+                extent: options.extent,
+            };
+            Some(section_map(model, params, &map)?)
+        }
+    };
+    Ok(SectionStudy {
+        section,
+        megno_map,
+        frequency_map,
+    })
+}
