@@ -18,6 +18,7 @@ fn thresholds(model: &str, params: &[f64], amplitude: &str, a_max: f64) -> (f64,
         edge_tolerance: 1e-12,
         method: Method::parse("dop853", 1e-13).unwrap(),
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+        first: Default::default(),
     };
     let result = stability(model_of(model), params, &settings).unwrap();
     let upright = result

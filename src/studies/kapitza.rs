@@ -235,6 +235,7 @@ pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<AStar, St
         edge_tolerance: 1e-10,
         method,
         max_windows: crate::analysis::stability::MAX_WINDOWS,
+        first: Default::default(),
     };
     let params = Params { A: SQRT_2, eps, mu };
     let result = stability(&kapitza::MODEL, &params.values(), &settings)?;

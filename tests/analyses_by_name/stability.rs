@@ -17,6 +17,7 @@ fn settings(amplitude: &str) -> Settings {
         edge_tolerance: 1e-11,
         method: Method::parse("dop853", 1e-12).unwrap(),
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+        first: Default::default(),
     }
 }
 
@@ -474,4 +475,52 @@ fn a_moved_equilibrium_is_replaced_by_its_periodic_orbit() {
         .find(|m| (m.q[0].abs() - PI).abs() < 1e-9)
         .expect("the hanging position, moved");
     assert_eq!(hanging.verdict, Some("stable"));
+}
+
+/// `first` names the equilibria that get an exact window before the
+/// others: the triple pendulum's inverted chain (φ = 0 is the upright
+/// link, the greatest V) as `highest`, or by its coordinates (angles
+/// modulo 2π); coordinates where no equilibrium is are refused by name.
+#[test]
+fn first_names_the_equilibria_that_get_a_window() {
+    use mechlab::analysis::stability::FirstWindows;
+    let name = "triple_pendulum";
+    let windowed = |first: FirstWindows| -> Vec<Vec<f64>> {
+        let one = Settings {
+            max_windows: 1,
+            samples: 20,
+            edge_tolerance: 1e-6,
+            first,
+            ..settings("a")
+        };
+        let result = stability(model_of(name), &defaults(name), &one).unwrap();
+        result
+            .equilibria
+            .iter()
+            .filter(|e| e.a_star.is_some() && e.exact_reason.is_none())
+            .map(|e| e.q.clone())
+            .collect()
+    };
+    let upright = |q: &[f64]| {
+        q.iter()
+            .all(|x| mechlab::analysis::period_map::wrap_angle(*x).abs() < 1e-8)
+    };
+    // By default the lowest threshold comes first, and it is not the
+    // inverted chain's.
+    let lowest = windowed(FirstWindows::Lowest);
+    assert!(lowest.len() == 1 && !upright(&lowest[0]), "{lowest:?}");
+    let highest = windowed(FirstWindows::Highest);
+    assert_eq!(highest.len(), 1, "{highest:?}");
+    assert!(upright(&highest[0]), "{highest:?}");
+    let named = windowed(FirstWindows::At(vec![vec![2.0 * PI, 0.0, -2.0 * PI]]));
+    assert_eq!(named.len(), 1, "{named:?}");
+    assert!(upright(&named[0]), "{named:?}");
+    let nowhere = Settings {
+        first: FirstWindows::At(vec![vec![0.3, 0.0, 0.0]]),
+        ..settings("a")
+    };
+    match stability(model_of(name), &defaults(name), &nowhere) {
+        Err(StabilityError::NoEquilibriumNear { q, .. }) => assert_eq!(q, vec![0.3, 0.0, 0.0]),
+        other => panic!("{other:?}"),
+    }
 }

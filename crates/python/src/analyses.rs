@@ -7,7 +7,7 @@ use mechlab::analysis::chaos_map::{chaos_map as fli_map, ChaosMapSettings};
 use mechlab::analysis::on_constraints::vibration::{vibration_stability, VibrationSettings};
 use mechlab::analysis::period_map::{portrait as portrait_of, PortraitSettings};
 use mechlab::analysis::section::{section_study, SectionOptions};
-use mechlab::analysis::stability::{stability as stability_of, Settings, MAX_WINDOWS};
+use mechlab::analysis::stability::{stability as stability_of, Settings};
 use mechlab::ode::Method;
 use mechlab::registry::Model;
 use numpy::ndarray::Array2;
@@ -147,47 +147,33 @@ impl Classify for mechlab::analysis::on_constraints::vibration::VibrationError {
     }
 }
 
+/// A constrained model's stabilisation on its constraints (the `linkage`
+/// scene).
+pub fn linkage<'py>(
+    py: Python<'py>,
+    model: &'static Model,
+    values: Vec<f64>,
+    settings: VibrationSettings,
+) -> PyResult<Bound<'py, PyDict>> {
+    let Some(constrained) = model.constrained else {
+        return Err(py_err(mechlab::analysis::Refusal::Setting {
+            model: model.info.name.into(),
+            requirement: "linkage runs on a model with [[constraints]] in its file (`stability` on the others)",
+        }));
+    };
+    let result =
+        detached(py, || vibration_stability(constrained, &values, &settings))?.map_err(py_err)?;
+    summary(py, &result)
+}
+
 /// Stabilisation by vibration (the `stability` scene): thresholds a*
-/// and exact windows of a model's equilibria, or for a constrained model
-/// the `linkage` analysis of its equilibrium near the start.
-#[allow(clippy::too_many_arguments)]
+/// and exact windows of a model's equilibria.
 pub fn stability<'py>(
     py: Python<'py>,
     model: &'static Model,
     values: Vec<f64>,
-    amplitude: Option<String>,
-    samples: usize,
-    a_max: Option<f64>,
-    edge_tolerance: f64,
-    method: Method,
-    max_windows: Option<usize>,
+    settings: Settings,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if let Some(constrained) = model.constrained {
-        let settings = VibrationSettings {
-            amplitude,
-            max_amplitude: a_max,
-            start: None,
-            scan: samples,
-            method,
-        };
-        let result = detached(py, || vibration_stability(constrained, &values, &settings))?
-            .map_err(py_err)?;
-        return summary(py, &result);
-    }
-    let Some(amplitude) = amplitude.or(model.info.amplitude.map(String::from)) else {
-        return Err(crate::errors::Refused::new_err(format!(
-            "model '{}' names no amplitude ([fast_phase] amplitude in its file): pass amplitude='<parameter>'",
-            model.info.name
-        )));
-    };
-    let settings = Settings {
-        amplitude,
-        a_max,
-        samples,
-        edge_tolerance,
-        method,
-        max_windows: max_windows.unwrap_or(MAX_WINDOWS),
-    };
     let result = detached(py, || stability_of(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     dict.set_item("report", result.report(usize::MAX))?;

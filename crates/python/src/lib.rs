@@ -15,7 +15,9 @@ use std::collections::BTreeMap;
 use mechlab::analysis::basins::BasinsOptions;
 use mechlab::analysis::chaos_map::ChaosMapOptions;
 use mechlab::analysis::continuation::ContinuationOptions;
+use mechlab::analysis::on_constraints::vibration::LinkageOptions;
 use mechlab::analysis::separatrix::SplittingOptions;
+use mechlab::analysis::stability::StabilityOptions;
 use mechlab::analysis::states::{states_at, states_of_starts};
 use mechlab::ode::Method;
 use mechlab::registry::{Kind, Model};
@@ -405,45 +407,41 @@ impl PyModel {
         analyses::chaos_map(py, self.model, values, settings, progress)
     }
 
+    /// Stabilisation by vibration on the constraints of a constrained
+    /// model (the `linkage` scene): its equilibrium near the start, the
+    /// averaged thresholds, the exact multipliers against the amplitude.
+    /// Settings: the `linkage` declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
+    fn linkage<'py>(
+        &self,
+        py: Python<'py>,
+        params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let values = parameter_values(self.model, params)?;
+        let options: LinkageOptions = declared(settings)?;
+        analyses::linkage(py, self.model, values, options.resolve().map_err(py_err)?)
+    }
+
     /// Stabilisation by vibration: for each equilibrium the averaged
-    /// threshold a* and the exact window of Floquet stability (a
-    /// constrained model: its equilibrium near the start, on its
-    /// constraints, as the `linkage` scene; `samples` amplitudes scanned
-    /// up to `a_max`). `tol` defaults to the scene's: 1e-10, or 1e-12 on
-    /// constraints.
-    #[pyo3(signature = (*, amplitude=None, samples=40, a_max=None, edge_tolerance=1e-9, method="dop853", tol=None, max_windows=None, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// threshold a* and the exact window of Floquet stability (settings:
+    /// the `stability` declaration); a constrained model's equilibrium near
+    /// its start on its constraints (settings: the `linkage` declaration),
+    /// as the `stability` scene does.
+    #[pyo3(signature = (*, params=None, **settings))]
     fn stability<'py>(
         &self,
         py: Python<'py>,
-        amplitude: Option<String>,
-        samples: usize,
-        a_max: Option<f64>,
-        edge_tolerance: f64,
-        method: &str,
-        tol: Option<f64>,
-        max_windows: Option<usize>,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if self.model.constrained.is_some() {
+            return self.linkage(py, params, settings);
+        }
         let values = parameter_values(self.model, params)?;
-        // The scenes' tolerances: `stability`'s, and `linkage`'s for a
-        // constrained model.
-        let tol = tol.unwrap_or(match self.model.constrained {
-            Some(_) => 1e-12,
-            None => 1e-10,
-        });
-        let method = Method::parse(method, tol).map_err(py_err)?;
-        analyses::stability(
-            py,
-            self.model,
-            values,
-            amplitude,
-            samples,
-            a_max,
-            edge_tolerance,
-            method,
-            max_windows,
-        )
+        let options: StabilityOptions = declared(settings)?;
+        let settings = options.resolve(self.model).map_err(py_err)?;
+        analyses::stability(py, self.model, values, settings)
     }
 
     /// The attractor of a forced, damped period map from (start_q,

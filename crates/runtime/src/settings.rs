@@ -695,13 +695,16 @@ impl Schema {
 
 /// The schemas of every analysis declared so far, in the docs' order.
 pub fn schemas() -> Vec<Schema> {
-    use crate::analysis::{basins, chaos_map, continuation, section, separatrix};
+    use crate::analysis::on_constraints::vibration::LinkageOptions;
+    use crate::analysis::{basins, chaos_map, continuation, section, separatrix, stability};
     vec![
         Schema::of::<chaos_map::ChaosMapOptions>(),
         Schema::of::<basins::BasinsOptions>(),
         Schema::of::<continuation::ContinuationOptions>(),
         Schema::of::<separatrix::SplittingOptions>(),
         Schema::of::<section::SectionOptions>(),
+        Schema::of::<stability::StabilityOptions>(),
+        Schema::of::<LinkageOptions>(),
     ]
 }
 

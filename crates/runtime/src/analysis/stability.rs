@@ -21,12 +21,133 @@ use crate::analysis::period_map::wrap_angle;
 use crate::analysis::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::registry::{DynamicModel, Model, Systems};
+use crate::settings::{method, Declared, Range, SettingError, SettingValue, METHODS};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 
-/// How the analysis runs.
+crate::declare_settings! {
+    /// Stabilisation by vibration: for every equilibrium of the system
+    /// without vibration, the averaged threshold a* of the amplitude and
+    /// the exact system's window of Floquet stability.
+    pub struct StabilityOptions for "stability" {
+        /// The parameter that scales the vibration (auto: the model file's
+        /// [fast_phase] amplitude).
+        amplitude: Option<String> = None, Range::Any;
+        /// Amplitudes sampled on (0, a_max] to bracket the exact window's
+        /// edges.
+        samples: usize = 40, Range::Count { min: 2, max: 100_000 };
+        /// The largest amplitude of the exact window (auto: 3 a*).
+        a_max: Option<f64> = None, Range::Positive;
+        /// At most this many equilibria get an exact window (a Floquet
+        /// sweep each), `first` first.
+        max_windows: usize = MAX_WINDOWS, Range::Count { min: 0, max: 1_000_000 };
+        /// The equilibria that get an exact window first: lowest (the lowest
+        /// thresholds a*), highest (the one of greatest potential energy:
+        /// a chain held upside down), or coordinates q1,q2;q1,q2 (each the
+        /// equilibrium found nearest).
+        first: FirstWindows = FirstWindows::Lowest, Range::Any;
+        /// The window's edges (and a chart's boundaries) are bisected to
+        /// this.
+        edge_tolerance: f64 = 1e-9, Range::Positive;
+        /// The integration method of the monodromy matrices.
+        method: String = "dop853".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, Range::Positive;
+    }
+}
+
+impl StabilityOptions {
+    /// The settings of [`stability`] for `model`, `auto` resolved.
+    pub fn resolve(&self, model: &Model) -> Result<Settings, SettingError> {
+        let info = model.info;
+        let amplitude = match (&self.amplitude, info.amplitude) {
+            (Some(a), _) => a.clone(),
+            (None, Some(a)) => a.to_string(),
+            (None, None) => {
+                return Err(SettingError::NoAmplitude {
+                    analysis: Self::ANALYSIS,
+                    name: "amplitude",
+                    model: info.name,
+                    known: info.parameter_names,
+                })
+            }
+        };
+        Ok(Settings {
+            amplitude,
+            a_max: self.a_max,
+            samples: self.samples,
+            edge_tolerance: self.edge_tolerance,
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            max_windows: self.max_windows,
+            first: self.first.clone(),
+        })
+    }
+}
+
+/// Which equilibria get an exact window first.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum FirstWindows {
+    /// Those with the lowest thresholds a*.
+    #[default]
+    Lowest,
+    /// The one of greatest potential energy V (a chain held upside down).
+    Highest,
+    /// The equilibria found nearest these coordinates.
+    At(Vec<Vec<f64>>),
+}
+
+impl SettingValue for FirstWindows {
+    const KIND: &'static str = "lowest, highest, or coordinates q1,q2;…";
+    const PYTHON: &'static str = "str | Sequence[Sequence[float]]";
+    fn from_text(text: &str) -> Option<Self> {
+        match text.trim() {
+            "lowest" => Some(FirstWindows::Lowest),
+            "highest" => Some(FirstWindows::Highest),
+            states => states
+                .split(';')
+                .map(Vec::<f64>::from_text)
+                .collect::<Option<_>>()
+                .map(FirstWindows::At),
+        }
+    }
+    fn from_json(value: &serde_json::Value) -> Option<Self> {
+        match value {
+            serde_json::Value::String(s) => Self::from_text(s),
+            serde_json::Value::Array(states) => states
+                .iter()
+                .map(Vec::<f64>::from_json)
+                .collect::<Option<_>>()
+                .map(FirstWindows::At),
+            _ => None,
+        }
+    }
+    fn to_json(&self) -> serde_json::Value {
+        match self {
+            FirstWindows::At(states) => serde_json::json!(states),
+            _ => serde_json::Value::String(self.to_text()),
+        }
+    }
+    fn to_text(&self) -> String {
+        match self {
+            FirstWindows::Lowest => "lowest".into(),
+            FirstWindows::Highest => "highest".into(),
+            FirstWindows::At(states) => states
+                .iter()
+                .map(|q| q.to_text())
+                .collect::<Vec<_>>()
+                .join(";"),
+        }
+    }
+    fn within(&self, _: &Range) -> bool {
+        true
+    }
+}
+
+/// How the analysis runs, resolved for one model from
+/// [`StabilityOptions`].
 #[derive(Clone, Debug)]
 pub struct Settings {
     /// The parameter that scales the vibration.
@@ -44,6 +165,8 @@ pub struct Settings {
     /// multipliers each): those with the lowest thresholds, then those the
     /// vibration moves; the others say why they have none.
     pub max_windows: usize,
+    /// Which equilibria come first for their window.
+    pub first: FirstWindows,
 }
 
 /// The default of [`Settings::max_windows`]: every equilibrium of a chain of
@@ -238,6 +361,12 @@ pub enum StabilityError {
     Tile(#[from] TileError),
     #[error(transparent)]
     Ode(#[from] OdeError),
+    /// `first` names coordinates where no equilibrium was found.
+    #[error("model '{model}': no equilibrium (of those `stability` analyses) within 1e-3 of q = {q:?} for `first`")]
+    NoEquilibriumNear { model: String, q: Vec<f64> },
+    /// A declared setting's value refused.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
 }
 
 /// Runs the analysis on `model` with parameter values `params`
@@ -314,20 +443,11 @@ fn analyse(
                 .equilibria
                 .push(averaged_verdict(model, params, amplitude, q));
         }
-        let mut with_threshold: Vec<usize> = (0..result.equilibria.len())
-            .filter(|&k| {
-                let e = &result.equilibria[k];
-                e.a_star.is_some() && e.exact_reason.is_none()
-            })
-            .collect();
-        with_threshold.sort_by(|&x, &y| {
-            let a = |k: usize| result.equilibria[k].a_star.unwrap_or(f64::INFINITY);
-            a(x).total_cmp(&a(y))
-        });
+        let with_threshold = window_order(model, params, amplitude, &result.equilibria, settings)?;
         let budget = settings.max_windows;
         let costly = with_threshold.len() + moved.len();
         let skipped = format!(
-            "not computed: {costly} equilibria need an exact sweep, and the {budget} with the lowest thresholds come first (--set max_windows=N for more)"
+            "not computed: {costly} equilibria need an exact sweep, and the {budget} with the lowest thresholds (or named by `first`) come first (--set max_windows=N for more)"
         );
         for (rank, &k) in with_threshold.iter().enumerate() {
             let e = &mut result.equilibria[k];
@@ -453,6 +573,78 @@ fn moved_equilibrium(
         verdict,
         exact_window,
         exact_reason,
+    }
+}
+
+/// The equilibria with a threshold a*, in the order their exact windows
+/// are computed: those `first` names, then by a* ascending.
+fn window_order(
+    model: &dyn Systems,
+    params: &[f64],
+    amplitude: usize,
+    equilibria: &[EquilibriumStability],
+    settings: &Settings,
+) -> Result<Vec<usize>, StabilityError> {
+    let mut order: Vec<usize> = (0..equilibria.len())
+        .filter(|&k| equilibria[k].a_star.is_some() && equilibria[k].exact_reason.is_none())
+        .collect();
+    let a = |k: usize| equilibria[k].a_star.unwrap_or(f64::INFINITY);
+    order.sort_by(|&x, &y| a(x).total_cmp(&a(y)));
+    let chosen = chosen_first(model, params, amplitude, equilibria, &settings.first)?;
+    order.sort_by_key(|k| !chosen.contains(k));
+    Ok(order)
+}
+
+/// The equilibria (indices into `equilibria`) that `first` names: the one
+/// of greatest V (the amplitude set to 0, V_vibr vanishing with it), or
+/// those nearest the given coordinates (angles compared modulo 2π).
+fn chosen_first(
+    model: &dyn Systems,
+    params: &[f64],
+    amplitude: usize,
+    equilibria: &[EquilibriumStability],
+    first: &FirstWindows,
+) -> Result<Vec<usize>, StabilityError> {
+    match first {
+        FirstWindows::Lowest => Ok(Vec::new()),
+        FirstWindows::Highest => {
+            let mut still = params.to_vec();
+            still[amplitude] = 0.0;
+            let v = |e: &EquilibriumStability| model.effective_potential(&still, &e.q);
+            Ok((0..equilibria.len())
+                .max_by(|&a, &b| v(&equilibria[a]).total_cmp(&v(&equilibria[b])))
+                .into_iter()
+                .collect())
+        }
+        FirstWindows::At(states) => {
+            let periodic = model.periodic_state();
+            let distance = |a: &[f64], b: &[f64]| -> f64 {
+                a.iter()
+                    .zip(b)
+                    .zip(&periodic)
+                    .map(|((x, y), &angle)| match angle {
+                        true => wrap_angle(x - y).abs(),
+                        false => (x - y).abs(),
+                    })
+                    .fold(0.0, f64::max)
+            };
+            states
+                .iter()
+                .map(|q| {
+                    let nearest = (0..equilibria.len()).min_by(|&a, &b| {
+                        distance(&equilibria[a].q, q).total_cmp(&distance(&equilibria[b].q, q))
+                    });
+                    nearest
+                        .filter(|&k| {
+                            q.len() == equilibria[k].q.len() && distance(&equilibria[k].q, q) < 1e-3
+                        })
+                        .ok_or_else(|| StabilityError::NoEquilibriumNear {
+                            model: model.info().name.into(),
+                            q: q.clone(),
+                        })
+                })
+                .collect()
+        }
     }
 }
 

@@ -32,8 +32,47 @@ use crate::analysis::Refusal;
 use crate::ode::holonomic::tangent_stability;
 use crate::ode::{Integrator, Method, OdeError};
 use crate::registry::ConstrainedSystems;
+use crate::settings::{method, Declared, Range, SettingError, METHODS};
 
-/// What to compute.
+crate::declare_settings! {
+    /// Stabilisation by vibration on the constraints of a constrained
+    /// model: its equilibrium near the start, the averaged thresholds, and
+    /// the exact Floquet multipliers on the constraints against the
+    /// amplitude.
+    pub struct LinkageOptions for "linkage" {
+        /// The parameter that scales the vibration (auto: the model file's
+        /// [fast_phase] amplitude).
+        amplitude: Option<String> = None, Range::Any;
+        /// The largest amplitude scanned (auto: twice the amplitude's value,
+        /// 4 where it is 0).
+        max_amplitude: Option<f64> = None, Range::Positive;
+        /// Amplitudes scanned from 0.
+        scan: usize = 40, Range::Count { min: 2, max: 100_000 };
+        /// Where Newton's method starts, the coordinates (auto: the model
+        /// file's start).
+        start: Option<Vec<f64>> = None, Range::Any;
+        /// The integration method.
+        method: String = "dop853".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-12, Range::Positive;
+    }
+}
+
+impl LinkageOptions {
+    /// The settings of [`vibration_stability`].
+    pub fn resolve(&self) -> Result<VibrationSettings, SettingError> {
+        Ok(VibrationSettings {
+            amplitude: self.amplitude.clone(),
+            max_amplitude: self.max_amplitude,
+            start: self.start.clone(),
+            scan: self.scan,
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+        })
+    }
+}
+
+/// What to compute, from [`LinkageOptions`].
 #[derive(Clone, Debug)]
 pub struct VibrationSettings {
     /// The amplitude parameter (default: the model file's
@@ -50,18 +89,12 @@ pub struct VibrationSettings {
     pub method: Method,
 }
 
+/// The declared defaults.
 impl Default for VibrationSettings {
     fn default() -> Self {
-        VibrationSettings {
-            amplitude: None,
-            max_amplitude: None,
-            start: None,
-            scan: 40,
-            method: Method::Dop853 {
-                rtol: 1e-12,
-                atol: 1e-12,
-            },
-        }
+        LinkageOptions::default()
+            .resolve()
+            .expect("the declared defaults are valid")
     }
 }
 
