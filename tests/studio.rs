@@ -276,7 +276,7 @@ async fn the_mechanism_moves_with_its_bars_rigid() {
     );
     let request = json!({"model": "kapitza", "seed": [0.1, 0.0], "duration": 1.0, "frames": 1});
     let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;
-    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(status, StatusCode::BAD_REQUEST);
     assert!(body.contains("from 2 to 3600 frames"), "{body}");
 }
 
@@ -501,8 +501,9 @@ async fn manifolds_overlay_gives_the_tangle_or_a_named_error() {
 /// parameter, projected on the plane, with its bifurcations: Duffing's
 /// right-well orbit doubles its period at γ = 0.2655817860 (as the
 /// `continuation` scene finds) and the branch of period 2 is followed from
-/// there. Errors are named: a parameter the model lacks (422, listing
-/// them), a contact model (422), a start longer than the state.
+/// there. Errors are named: a parameter the model lacks (listing
+/// them: a bad value, 400, as everywhere), a contact model (422), a start
+/// longer than the state.
 #[tokio::test]
 async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
     let request = json!({"model": "duffing", "start": [1.0, 0.0], "parameter": "gamma", "to": 0.28, "tol": 1e-12});
@@ -533,7 +534,7 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
     let (status, body) =
         bad(json!({"model": "duffing", "start": [1.0, 0.0], "parameter": "kappa", "to": 1.0}))
             .await;
-    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
     assert!(body.contains("kappa") && body.contains("gamma"), "{body}");
     let (status, body) =
         bad(json!({"model": "painleve_klein", "start": [0.0, 0.0], "parameter": "mu", "to": 1.0}))
@@ -583,7 +584,7 @@ async fn continuation_follows_a_clicked_orbit_or_names_the_error() {
 /// accessible and inaccessible pixels and a chaotic fraction; the shaken
 /// double pendulum gets the slice of its period map the library draws; a
 /// model of 1 degree of freedom with a fast phase and a seed where the
-/// energy is not accessible are named errors (422).
+/// energy is not accessible are named errors (422 and 400).
 #[tokio::test]
 async fn section_orbits_and_their_megno_map() {
     use mechlab::analysis::section::{section, SectionSettings};
@@ -641,7 +642,7 @@ async fn section_orbits_and_their_megno_map() {
         Some(json!({"model": "henon_heiles", "energy": 0.125, "plane": "z", "seeds": [[0.1, 0.0]], "crossings": 5})),
     )
     .await;
-    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
     assert!(
         body.contains("plane") && body.contains("not a coordinate"),
         "{body}"
@@ -682,7 +683,7 @@ async fn section_orbits_and_their_megno_map() {
         Some(json!({"model": "henon_heiles", "energy": 0.125, "seeds": [[0.9, 0.0]], "crossings": 5})),
     )
     .await;
-    assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
     assert!(body.contains("not accessible"), "{body}");
 }
 

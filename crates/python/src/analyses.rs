@@ -17,44 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::detached::{detached, progress};
-use crate::errors::{py_err, Class, Classify};
-
-/// A state component by index or by name (raw, "p_phi", or as the
-/// figures write it, "p_φ").
-#[derive(FromPyObject)]
-pub enum Axis {
-    Index(usize),
-    Name(String),
-}
-
-/// The two state components of a plane; None: the first coordinate and
-/// its momentum (or velocity), as the scenes' `axes=auto`.
-pub fn axes(model: &Model, given: Option<(Axis, Axis)>) -> PyResult<[usize; 2]> {
-    let info = model.info;
-    let n = info.coordinates.len();
-    let Some((a, b)) = given else {
-        return Ok([0, n]);
-    };
-    let names = info.state_names();
-    let index = |axis: Axis| match axis {
-        Axis::Index(i) if i < 2 * n => Ok(i),
-        Axis::Name(name) => (0..2 * n)
-            .find(|&i| names[i] == name || info.label(i) == name)
-            .ok_or_else(|| {
-                PyValueError::new_err(format!(
-                    "model '{}' has no state component '{name}' (known: {})",
-                    info.name,
-                    names.join(", ")
-                ))
-            }),
-        Axis::Index(i) => Err(PyValueError::new_err(format!(
-            "model '{}' has {} state components: index {i} is past them",
-            info.name,
-            2 * n
-        ))),
-    };
-    Ok([index(a)?, index(b)?])
-}
+use crate::errors::py_err;
 
 /// `summary` (serde) as a dict.
 fn summary<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyDict>> {
@@ -79,21 +42,8 @@ pub fn portrait<'py>(
     py: Python<'py>,
     model: &'static Model,
     values: Vec<f64>,
-    axes: [usize; 2],
-    seeds: Option<Vec<Vec<f64>>>,
-    count: usize,
-    p_max: f64,
-    periods: usize,
-    method: Method,
+    settings: PortraitSettings,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let settings = PortraitSettings {
-        axes,
-        seeds,
-        count,
-        p_max,
-        periods,
-        method,
-    };
     let result = detached(py, || portrait_of(model, &values, &settings))?.map_err(py_err)?;
     let dict = summary(py, &result)?;
     let orbits: Vec<_> = result
@@ -134,17 +84,6 @@ pub fn chaos_map<'py>(
     dict.set_item("fli", image.into_pyarray(py))?;
     dict.set_item("labels", result.labels.to_vec())?;
     Ok(dict)
-}
-
-/// Why a constrained model's stabilisation cannot be computed.
-impl Classify for mechlab::analysis::on_constraints::vibration::VibrationError {
-    fn class(&self) -> Class {
-        use mechlab::analysis::on_constraints::vibration::VibrationError;
-        match self {
-            VibrationError::Refused(r) => r.class(),
-            _ => Class::Integration,
-        }
-    }
 }
 
 /// A constrained model's stabilisation on its constraints (the `linkage`
@@ -227,49 +166,6 @@ pub fn section<'py>(
     Ok(dict)
 }
 
-impl Classify for mechlab::analysis::attractor::AttractorError {
-    fn class(&self) -> Class {
-        use mechlab::analysis::attractor::AttractorError;
-        match self {
-            AttractorError::Refused(r) => r.class(),
-            AttractorError::Ode(e) => e.class(),
-            AttractorError::Constrained(_) => Class::Integration,
-        }
-    }
-}
-
-impl Classify for mechlab::analysis::continuation::ContinuationError {
-    fn class(&self) -> Class {
-        use mechlab::analysis::continuation::ContinuationError;
-        match self {
-            ContinuationError::Refused(r) => r.class(),
-            ContinuationError::Ode(e) => e.class(),
-            _ => Class::Integration,
-        }
-    }
-}
-
-impl Classify for mechlab::analysis::separatrix::SplittingError {
-    fn class(&self) -> Class {
-        use mechlab::analysis::separatrix::SplittingError;
-        match self {
-            SplittingError::Refused(r) => r.class(),
-            _ => Class::Integration,
-        }
-    }
-}
-
-impl Classify for mechlab::analysis::averaging::AveragingError {
-    fn class(&self) -> Class {
-        use mechlab::analysis::averaging::AveragingError;
-        match self {
-            AveragingError::Refused(r) => r.class(),
-            AveragingError::Sweep { .. } | AveragingError::Order(..) => Class::Value,
-            _ => Class::Integration,
-        }
-    }
-}
-
 /// The attractor of a forced, damped period map (the `attractor`
 /// scene): its points as an (n, 2) array, the Lyapunov spectrum and the
 /// dimensions.
@@ -329,17 +225,6 @@ pub fn averaging<'py>(
     summary(py, &result)
 }
 
-impl Classify for mechlab::explore::ExploreError {
-    fn class(&self) -> Class {
-        use mechlab::explore::ExploreError;
-        match self {
-            ExploreError::Ode(e) => e.class(),
-            ExploreError::StateLength { .. } => Class::Value,
-            _ => Class::Integration,
-        }
-    }
-}
-
 /// Rows of numbers as a 2-D array (NaN-padded if ragged).
 fn table<'py>(py: Python<'py>, rows: &[Vec<f64>]) -> Bound<'py, numpy::PyArray2<f64>> {
     let width = rows.iter().map(Vec::len).max().unwrap_or(0);
@@ -388,17 +273,6 @@ pub fn explore<'py>(
         dict.set_item("reactions", table(py, &reactions.values))?;
     }
     Ok(dict)
-}
-
-impl Classify for mechlab::analysis::basins::BasinsError {
-    fn class(&self) -> Class {
-        use mechlab::analysis::basins::BasinsError;
-        match self {
-            BasinsError::Refused(r) => r.class(),
-            BasinsError::Ode(e) => e.class(),
-            _ => Class::Value,
-        }
-    }
 }
 
 /// The iterates of the period map from many starts (the Taylor method in

@@ -5,12 +5,7 @@
 //! integrator cannot follow is `mechlab.IntegrationError` (a
 //! `RuntimeError`); a run stopped by Ctrl-C is `KeyboardInterrupt`.
 
-use mechlab::analysis::period_map::PeriodMapError;
-use mechlab::analysis::section::SectionError;
-use mechlab::analysis::stability::StabilityError;
-use mechlab::analysis::states::StatesError;
-use mechlab::analysis::Refusal;
-use mechlab::ode::OdeError;
+use mechlab::classify::{Classify, ErrorClass};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::PyErr;
 
@@ -27,107 +22,14 @@ pyo3::create_exception!(
     "The integrator could not follow an orbit (the message says where)."
 );
 
-/// Which Python exception an error becomes.
-pub enum Class {
-    Value,
-    Refused,
-    Integration,
-    Interrupted,
-}
-
-/// An error of the library, classed for Python.
-pub trait Classify: std::fmt::Display {
-    fn class(&self) -> Class;
-}
-
-/// `error` as the Python exception of its class, with its message.
+/// `error` as the Python exception of its class (the library's one
+/// classification, `mechlab::classify`), with its message.
 pub fn py_err<E: Classify>(error: E) -> PyErr {
     let message = error.to_string();
     match error.class() {
-        Class::Value => PyValueError::new_err(message),
-        Class::Refused => Refused::new_err(message),
-        Class::Integration => IntegrationError::new_err(message),
-        Class::Interrupted => PyKeyboardInterrupt::new_err(message),
-    }
-}
-
-impl Classify for Refusal {
-    fn class(&self) -> Class {
-        match self {
-            Refusal::Parameter(_)
-            | Refusal::ParameterCount { .. }
-            | Refusal::StateLength { .. }
-            | Refusal::Setting { .. } => Class::Value,
-            _ => Class::Refused,
-        }
-    }
-}
-
-impl Classify for OdeError {
-    fn class(&self) -> Class {
-        match self {
-            OdeError::UnknownMethod(_)
-            | OdeError::InvalidSetting { .. }
-            | OdeError::NonFiniteInitialState { .. }
-            | OdeError::StateLength { .. }
-            | OdeError::TooLarge(_) => Class::Value,
-            OdeError::Stopped { .. } => Class::Interrupted,
-            _ => Class::Integration,
-        }
-    }
-}
-
-/// A declared setting's value refused (its name, value and range).
-impl Classify for mechlab::settings::SettingError {
-    fn class(&self) -> Class {
-        Class::Value
-    }
-}
-
-impl Classify for mechlab::registry::ParameterError {
-    fn class(&self) -> Class {
-        Class::Value
-    }
-}
-
-impl Classify for StatesError {
-    fn class(&self) -> Class {
-        match self {
-            StatesError::Refused(r) => r.class(),
-            StatesError::Times | StatesError::Start { .. } => Class::Value,
-            StatesError::Constrained(_) => Class::Integration,
-            StatesError::Ode(e) => e.class(),
-        }
-    }
-}
-
-impl Classify for PeriodMapError {
-    fn class(&self) -> Class {
-        match self {
-            PeriodMapError::Refused(r) => r.class(),
-            PeriodMapError::Cancelled => Class::Interrupted,
-            PeriodMapError::Ode(e) => e.class(),
-            _ => Class::Value,
-        }
-    }
-}
-
-impl Classify for StabilityError {
-    fn class(&self) -> Class {
-        match self {
-            StabilityError::Refused(r) => r.class(),
-            StabilityError::Ode(e) => e.class(),
-            _ => Class::Value,
-        }
-    }
-}
-
-impl Classify for SectionError {
-    fn class(&self) -> Class {
-        match self {
-            SectionError::Refused(r) => r.class(),
-            SectionError::Method(e) => e.class(),
-            _ => Class::Value,
-        }
+        ErrorClass::BadValue => PyValueError::new_err(message),
+        ErrorClass::Refused => Refused::new_err(message),
+        ErrorClass::Integration => IntegrationError::new_err(message),
+        ErrorClass::Stopped => PyKeyboardInterrupt::new_err(message),
     }
 }

@@ -12,10 +12,13 @@ mod errors;
 
 use std::collections::BTreeMap;
 
+use mechlab::analysis::attractor::AttractorOptions;
+use mechlab::analysis::averaging::AveragingOptions;
 use mechlab::analysis::basins::BasinsOptions;
 use mechlab::analysis::chaos_map::ChaosMapOptions;
 use mechlab::analysis::continuation::ContinuationOptions;
 use mechlab::analysis::on_constraints::vibration::LinkageOptions;
+use mechlab::analysis::period_map::PeriodMapOptions;
 use mechlab::analysis::separatrix::SplittingOptions;
 use mechlab::analysis::stability::StabilityOptions;
 use mechlab::analysis::states::{states_at, states_of_starts};
@@ -366,27 +369,19 @@ impl PyModel {
 
     /// Orbits of the period map from `seeds` (full states) or from
     /// `count` seeds on a line along the first axis, each drawn in the
-    /// plane of `axes` (indices or names of state components).
-    #[pyo3(signature = (*, axes=None, seeds=None, count=24, p_max=2.5, periods=500, method="taylor", tol=1e-10, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// plane of `axes`. Settings: the period map's declaration
+    /// (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn period_map<'py>(
         &self,
         py: Python<'py>,
-        axes: Option<(analyses::Axis, analyses::Axis)>,
-        seeds: Option<Vec<Vec<f64>>>,
-        count: usize,
-        p_max: f64,
-        periods: usize,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let method = Method::parse(method, tol).map_err(py_err)?;
-        let axes = analyses::axes(self.model, axes)?;
-        analyses::portrait(
-            py, self.model, values, axes, seeds, count, p_max, periods, method,
-        )
+        let options: PeriodMapOptions = declared(settings)?;
+        let settings = options.resolve(self.model).map_err(py_err)?;
+        analyses::portrait(py, self.model, values, settings)
     }
 
     /// The fast Lyapunov indicator of the period map on a plane of
@@ -444,33 +439,20 @@ impl PyModel {
         analyses::stability(py, self.model, values, settings)
     }
 
-    /// The attractor of a forced, damped period map from (start_q,
-    /// start_p): its points, Lyapunov spectrum (two runs, their
-    /// difference the error) and box-counting and Kaplan–Yorke dimensions.
-    #[pyo3(signature = (*, start=(1.0, 0.0), transient=500, points=200_000, lyapunov_periods=16_000, pixels=500, method="taylor", tol=1e-10, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// The attractor of a forced, damped period map: its points, Lyapunov
+    /// spectrum (two runs, their difference the error) and box-counting
+    /// and Kaplan–Yorke dimensions. Settings: the attractor's declaration
+    /// (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn attractor<'py>(
         &self,
         py: Python<'py>,
-        start: (f64, f64),
-        transient: usize,
-        points: usize,
-        lyapunov_periods: usize,
-        pixels: usize,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let settings = mechlab::analysis::attractor::AttractorSettings {
-            method: Method::parse(method, tol).map_err(py_err)?,
-            start: [start.0, start.1],
-            transient,
-            points,
-            lyapunov_periods,
-            pixels,
-        };
-        analyses::attractor(py, self.model, values, settings)
+        let options: AttractorOptions = declared(settings)?;
+        analyses::attractor(py, self.model, values, options.resolve().map_err(py_err)?)
     }
 
     /// Periodic orbits of the period map followed in a parameter, their
@@ -506,35 +488,20 @@ impl PyModel {
         analyses::separatrix_splitting(py, self.model, values, settings)
     }
 
-    /// The exact system against the averaged one (of `order` 1 or 2) as
-    /// the fast phase's rate grows: the largest deviation over [0, t_obs]
-    /// at each of `values` of `parameter` (default: the one the rate
-    /// depends on, at 4…64 times the model's frequency), and its slope
-    /// against the frequency (−1 at first order).
-    #[pyo3(signature = (*, parameter=None, values=None, y0=None, t_obs=2.0, order=1, method="dop853", tol=1e-11, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// The exact system against the averaged one (of order 1 or 2) as the
+    /// fast phase's rate grows: the largest deviation at each value of the
+    /// swept parameter, and its slope against the frequency (−1 at first
+    /// order). Settings: the averaging's declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn averaging<'py>(
         &self,
         py: Python<'py>,
-        parameter: Option<String>,
-        values: Option<Vec<f64>>,
-        y0: Option<Vec<f64>>,
-        t_obs: f64,
-        order: usize,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let model_values = parameter_values(self.model, params)?;
-        let settings = mechlab::analysis::averaging::ConvergenceSettings {
-            parameter,
-            values,
-            y0,
-            t_obs,
-            method: Method::parse(method, tol).map_err(py_err)?,
-            order,
-        };
-        analyses::averaging(py, self.model, model_values, settings)
+        let values = parameter_values(self.model, params)?;
+        let options: AveragingOptions = declared(settings)?;
+        analyses::averaging(py, self.model, values, options.resolve().map_err(py_err)?)
     }
 
     /// What the `explore` scene shows, for any model (the contact models

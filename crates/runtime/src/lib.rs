@@ -12,6 +12,7 @@
 
 pub mod analysis;
 pub mod budget;
+pub mod classify;
 pub mod constrained;
 pub mod contact;
 pub mod explore;

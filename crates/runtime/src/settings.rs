@@ -348,6 +348,101 @@ impl SettingValue for Vec<[f64; 2]> {
     }
 }
 
+/// States: `q,p;q,p` on the command line, `[[q, p], …]` in JSON.
+impl SettingValue for Vec<Vec<f64>> {
+    const KIND: &'static str = "states (q,p;q,p…)";
+    const PYTHON: &'static str = "Sequence[Sequence[float]]";
+    fn from_text(text: &str) -> Option<Self> {
+        text.split(';').map(Vec::<f64>::from_text).collect()
+    }
+    fn from_json(value: &Value) -> Option<Self> {
+        value
+            .as_array()?
+            .iter()
+            .map(Vec::<f64>::from_json)
+            .collect()
+    }
+    fn to_json(&self) -> Value {
+        serde_json::json!(self)
+    }
+    fn to_text(&self) -> String {
+        self.iter()
+            .map(|y| y.to_text())
+            .collect::<Vec<_>>()
+            .join(";")
+    }
+    fn within(&self, range: &Range) -> bool {
+        self.iter().all(|y| y.within(range))
+    }
+}
+
+/// Values of a parameter: a list `a,b,c`, or `geometric:first,last,count`
+/// (JSON: a list, or that text).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Values {
+    List(Vec<f64>),
+    Geometric { first: f64, last: f64, count: usize },
+}
+
+impl Values {
+    /// The values, in order.
+    pub fn values(&self) -> Vec<f64> {
+        match *self {
+            Values::List(ref v) => v.clone(),
+            Values::Geometric { first, last, count } => (0..count)
+                .map(|k| first * (last / first).powf(k as f64 / (count - 1) as f64))
+                .collect(),
+        }
+    }
+}
+
+impl SettingValue for Values {
+    const KIND: &'static str = "values: a,b,c or geometric:first,last,count";
+    const PYTHON: &'static str = "Sequence[float] | str";
+    fn from_text(text: &str) -> Option<Self> {
+        let Some(spec) = text.trim().strip_prefix("geometric:") else {
+            return Vec::<f64>::from_text(text).map(Values::List);
+        };
+        match Vec::<f64>::from_text(spec)?[..] {
+            [first, last, count]
+                if first > 0.0 && last > 0.0 && count >= 2.0 && count.fract() == 0.0 =>
+            {
+                Some(Values::Geometric {
+                    first,
+                    last,
+                    count: count as usize,
+                })
+            }
+            _ => None,
+        }
+    }
+    fn from_json(value: &Value) -> Option<Self> {
+        match value {
+            Value::String(text) => Self::from_text(text),
+            _ => Vec::<f64>::from_json(value).map(Values::List),
+        }
+    }
+    fn to_json(&self) -> Value {
+        match self {
+            Values::List(v) => v.to_json(),
+            Values::Geometric { .. } => Value::String(self.to_text()),
+        }
+    }
+    fn to_text(&self) -> String {
+        match self {
+            Values::List(v) => v.to_text(),
+            Values::Geometric { first, last, count } => format!(
+                "geometric:{},{},{count}",
+                number_text(*first),
+                number_text(*last)
+            ),
+        }
+    }
+    fn within(&self, range: &Range) -> bool {
+        self.values().iter().all(|x| range.admits(*x))
+    }
+}
+
 impl SettingValue for Vec<usize> {
     const KIND: &'static str = "list of indices";
     const PYTHON: &'static str = "Sequence[int]";
@@ -696,7 +791,10 @@ impl Schema {
 /// The schemas of every analysis declared so far, in the docs' order.
 pub fn schemas() -> Vec<Schema> {
     use crate::analysis::on_constraints::vibration::LinkageOptions;
-    use crate::analysis::{basins, chaos_map, continuation, section, separatrix, stability};
+    use crate::analysis::{
+        attractor, averaging, basins, chaos_map, continuation, period_map, section, separatrix,
+        stability,
+    };
     vec![
         Schema::of::<chaos_map::ChaosMapOptions>(),
         Schema::of::<basins::BasinsOptions>(),
@@ -705,6 +803,9 @@ pub fn schemas() -> Vec<Schema> {
         Schema::of::<section::SectionOptions>(),
         Schema::of::<stability::StabilityOptions>(),
         Schema::of::<LinkageOptions>(),
+        Schema::of::<attractor::AttractorOptions>(),
+        Schema::of::<averaging::AveragingOptions>(),
+        Schema::of::<period_map::PeriodMapOptions>(),
     ]
 }
 

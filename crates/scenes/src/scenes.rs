@@ -7,7 +7,7 @@ use mechlab_runtime::analysis::chaos_map::{
     chaos_map, ChaosMap, ChaosMapError, ChaosMapOptions, ChaosMapSettings,
 };
 use mechlab_runtime::ode::Method;
-use mechlab_runtime::registry::{Catalog, Model, ModelInfo};
+use mechlab_runtime::registry::{Catalog, Model};
 use mechlab_runtime::settings::Declared;
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
@@ -27,58 +27,6 @@ impl Defaults<'_> {
             .find(|(n, _)| *n == name)
             .map_or(generic, |(_, v)| v)
     }
-}
-
-/// The two state components of the `axes` knob; `auto` is the first
-/// coordinate and its momentum (a constrained model's: its velocity), the
-/// plane of a period map's phase portrait, which every model has.
-fn axes_from(scene: &Scene, info: &ModelInfo) -> Result<[usize; 2], SceneError> {
-    if scene.text("axes") == "auto" {
-        return Ok([0, info.coordinates.len()]);
-    }
-    match scene.numbers("axes")?[..] {
-        [x, y] if x >= 0.0 && y >= 0.0 && x.fract() == 0.0 && y.fract() == 0.0 => {
-            Ok([x as usize, y as usize])
-        }
-        _ => Err(SceneError::BadValue {
-            name: "axes".into(),
-            value: scene.text("axes").into(),
-            reason: ValueProblem::Requirement("two indices of state components"),
-        }),
-    }
-}
-
-/// The knobs of a generic scene — the model, the scene's own knobs, method
-/// and tolerance (each with the preset's default where `overrides` gives
-/// one), then every parameter of the chosen model — and the parsed scene.
-/// `defaults` are the generic scene's (model, method, tolerance).
-fn generic_scene(
-    catalog: Catalog,
-    scene_name: &'static str,
-    about: &str,
-    overrides: &[(&'static str, &'static str)],
-    (model, method, tol): (&'static str, &'static str, &'static str),
-    own: &[(&'static str, &'static str, &'static str)],
-) -> Result<(&'static Model, Scene), SceneError> {
-    let defaults = Defaults(overrides);
-    let model = defaults.get("model", model);
-    let handle = model_from_args(catalog, model)?;
-    let info = handle.info;
-    let mut knobs = vec![knob(
-        "model",
-        model,
-        "the model (a file models/<name>.toml) with a fast phase",
-    )];
-    knobs.extend(
-        own.iter()
-            .map(|&(name, value, help)| knob(name, defaults.get(name, value), help)),
-    );
-    knobs.extend(method_knobs(
-        defaults.get("method", method),
-        defaults.get("tol", tol),
-    ));
-    knobs.extend(parameter_knobs(info, overrides));
-    Ok((handle, Scene::from_args(scene_name, about, &knobs)?))
 }
 
 /// `method` and `tol` knobs with these defaults.
@@ -304,33 +252,16 @@ pub fn averaging_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::averaging::{convergence, ConvergenceSettings};
-    let (model, scene) = generic_scene(
+    use mechlab_runtime::analysis::averaging::{convergence, AveragingOptions};
+    let (model, scene, options) = declared_scene::<AveragingOptions>(
         catalog,
         scene_name,
-        "exact against averaged: the deviation against the frequency",
-        overrides,
-        ("double_pendulum", "dop853", "1e-11"),
-        &[
-            ("parameter", "auto", "the parameter swept to change ν (auto: the one the phase rate depends on)"),
-            ("values", "auto", "its values: a list, geometric:first,last,count, or auto (ν at 4…64 times the model's frequency)"),
-            ("y0", "auto", "the common initial state [q; p], comma-separated (auto: q = 0.2, −0.1, …, p = 0)"),
-            ("t_obs", "2", "the deviation is the maximum over [0, t_obs]"),
-            ("order", "1", "1: the averaged system from the same state; 2: the system averaged to second order, from the transformed state and mapped back"),
-        ],
+        ("double_pendulum", None),
+        (AveragingOptions::default(), overrides),
+        &[],
     )?;
-    let info = model.info;
-    let settings = ConvergenceSettings {
-        parameter: (scene.text("parameter") != "auto").then(|| scene.text("parameter").to_string()),
-        values: values_from(&scene)?,
-        y0: (scene.text("y0") != "auto")
-            .then(|| scene.numbers("y0"))
-            .transpose()?,
-        t_obs: scene.positive("t_obs")?,
-        method: method_from(&scene)?,
-        order: scene.count("order")?,
-    };
-    let result = convergence(model, &scene.parameter_values(info)?, &settings)?;
+    let settings = options.resolve()?;
+    let result = convergence(model, &scene.parameter_values(model.info)?, &settings)?;
     for (c, s) in result.coordinates.iter().zip(&result.slope) {
         eprintln!("{c}: max deviation ∝ ν^{s:.4}");
     }
@@ -362,28 +293,6 @@ pub fn averaging_scene(
     scene.save_figure(&averaging_figure(&result), "convergence.png")?;
     scene.write_summary(&result)?;
     Ok(())
-}
-
-/// A list of values, `auto` (None), or `geometric:first,last,count`.
-fn values_from(scene: &Scene) -> Result<Option<Vec<f64>>, SceneError> {
-    let text = scene.text("values");
-    if text == "auto" {
-        return Ok(None);
-    }
-    let Some(spec) = text.strip_prefix("geometric:") else {
-        return scene.numbers("values").map(Some);
-    };
-    let bad = |reason: &'static str| SceneError::BadValue {
-        name: "values".into(),
-        value: text.into(),
-        reason: ValueProblem::Requirement(reason),
-    };
-    let parts: Vec<f64> = spec
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| bad("geometric:first,last,count with numbers"))?;
-    geometric_progression(&parts).map(Some).map_err(bad)
 }
 
 /// `first,last,count`: `count` values from `first` to `last` in geometric
@@ -500,48 +409,16 @@ pub fn period_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::period_map::{portrait, PortraitSettings};
-    let (model, scene) = generic_scene(
+    use mechlab_runtime::analysis::period_map::{portrait, PeriodMapOptions};
+    let (model, scene, options) = declared_scene::<PeriodMapOptions>(
         catalog,
         scene_name,
-        "orbits of the period map of any model",
-        overrides,
-        ("kapitza", "taylor", "1e-10"),
-        &[
-            ("axes", "auto", "the state components [q; p] drawn (0 = first coordinate; auto: the first coordinate and its momentum, or velocity)"),
-            ("seeds", "line", "initial states [q; p], comma-separated, several separated by ';' (line: `count` seeds along the first axis)"),
-            ("count", "24", "seeds on the line"),
-            ("p_max", "2.5", "the line covers [−p_max, p_max] when the first axis is not an angle"),
-            ("periods", "500", "periods per orbit"),
-        ],
+        ("kapitza", None),
+        (PeriodMapOptions::default(), overrides),
+        &[],
     )?;
     let info = model.info;
-    let axes = axes_from(&scene, model.info)?;
-    let seeds = match scene.text("seeds") {
-        "line" => None,
-        text => Some(
-            text.split(';')
-                .map(|s| {
-                    s.split(',')
-                        .map(|v| v.trim().parse::<f64>())
-                        .collect::<Result<Vec<f64>, _>>()
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|_| SceneError::BadValue {
-                    name: "seeds".into(),
-                    value: text.into(),
-                    reason: ValueProblem::Requirement("numbers separated by ',' and states by ';'"),
-                })?,
-        ),
-    };
-    let settings = PortraitSettings {
-        axes,
-        seeds,
-        count: scene.count("count")?,
-        p_max: scene.positive("p_max")?,
-        periods: scene.count("periods")?,
-        method: method_from(&scene)?,
-    };
+    let settings = options.resolve(model)?;
     let result = portrait(model, &scene.parameter_values(info)?, &settings)?;
     for stopped in &result.failed {
         eprintln!("orbit {} stopped: {}", stopped.orbit, stopped.error);
@@ -948,38 +825,15 @@ fn splitting_sweep_of(
 /// model of one degree of freedom (a constrained one: on its constraints)
 /// by name, its Lyapunov spectrum and dimensions.
 pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::attractor::{attractor, AttractorSettings};
-    let (model, scene) = generic_scene(
+    use mechlab_runtime::analysis::attractor::{attractor, AttractorOptions};
+    let (model, scene, options) = declared_scene::<AttractorOptions>(
         catalog,
         "attractor",
-        "strange attractor of a forced, damped period map, its Lyapunov spectrum and dimensions",
+        ("ueda", None),
+        (AttractorOptions::default(), &[]),
         &[],
-        ("ueda", "taylor", "1e-10"),
-        &[
-            ("points", "200000", "points of the attractor"),
-            ("transient", "500", "periods dropped first"),
-            (
-                "lyapunov_periods",
-                "16000",
-                "periods of each of the two Lyapunov runs",
-            ),
-            ("start_q", "1", "the first coordinate of the start"),
-            (
-                "start_p",
-                "0",
-                "the momentum of the start (a constrained model: the first coordinate's velocity)",
-            ),
-            ("pixels", "500", "pixels per side of the density image"),
-        ],
     )?;
-    let settings = AttractorSettings {
-        method: method_from(&scene)?,
-        start: [scene.number("start_q")?, scene.number("start_p")?],
-        transient: scene.count("transient")?,
-        points: scene.count("points")?,
-        lyapunov_periods: scene.count("lyapunov_periods")?,
-        pixels: scene.count("pixels")?,
-    };
+    let settings = options.resolve()?;
     let params = scene.parameter_values(model.info)?;
     eprintln!(
         "{} periods of the map and two Lyapunov runs of {} …",

@@ -31,9 +31,8 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
 use calls::{self as studio, OrbitRequest, OverlayRequest, StudioError};
-use mechlab_runtime::analysis::basins::BasinsError;
-use mechlab_runtime::analysis::mechanism::MechanismError;
 use mechlab_runtime::analysis::period_map::PeriodMapError;
+use mechlab_runtime::classify::{Classify, ErrorClass};
 use mechlab_runtime::registry::Catalog;
 use mechlab_scenes::scene::{knob, Scene, SceneError, ValueProblem};
 use serde::Serialize;
@@ -63,23 +62,19 @@ pub enum ApiError {
 }
 
 impl ApiError {
+    /// The status of the library's class of the error (`classify`): a bad
+    /// value 400, a refusal or an integration failure 422; an unknown
+    /// model or route 404.
     fn status(&self) -> StatusCode {
         match self {
             ApiError::Studio(StudioError::UnknownModel(_)) | ApiError::NotFound { .. } => {
                 StatusCode::NOT_FOUND
             }
-            ApiError::Studio(
-                StudioError::Refused(_)
-                | StudioError::Splitting(_)
-                | StudioError::Continuation(_)
-                | StudioError::Section(_)
-                | StudioError::Basins(BasinsError::Refused(_))
-                | StudioError::PeriodMap(PeriodMapError::Refused(_))
-                | StudioError::Mechanism(
-                    MechanismError::NotDrawn { .. } | MechanismError::Refused(_),
-                ),
-            ) => StatusCode::UNPROCESSABLE_ENTITY,
-            ApiError::Studio(_) | ApiError::Json(_) => StatusCode::BAD_REQUEST,
+            ApiError::Studio(e) => match e.class() {
+                ErrorClass::BadValue | ErrorClass::Stopped => StatusCode::BAD_REQUEST,
+                ErrorClass::Refused | ErrorClass::Integration => StatusCode::UNPROCESSABLE_ENTITY,
+            },
+            ApiError::Json(_) => StatusCode::BAD_REQUEST,
             ApiError::Panicked { .. } | ApiError::Join(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
     }

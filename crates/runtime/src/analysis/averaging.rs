@@ -10,6 +10,7 @@ use super::fit::{log_log, LineFit};
 use crate::analysis::Refusal;
 use crate::ode::{states_at, AnySystem, Method, OdeError, System};
 use crate::registry::{Model, Systems};
+use crate::settings::{method, Declared, Range, SettingError, Values, METHODS};
 use rayon::prelude::*;
 
 /// Both systems on one time grid, from the same initial state.
@@ -134,7 +135,49 @@ fn fit_deviations(
     }
 }
 
-/// How [`convergence`] runs.
+crate::declare_settings! {
+    /// Exact against averaged (Theorem 2 on any model): the largest
+    /// deviation of each coordinate between the exact and averaged runs
+    /// from the same state, against the frequency of the fast phase, and
+    /// its fitted slope.
+    pub struct AveragingOptions for "averaging" {
+        /// The parameter swept to change ν (auto: the one the phase rate
+        /// depends on).
+        parameter: Option<String> = None, Range::Any;
+        /// Its values: a list, or geometric:first,last,count (auto: ν at
+        /// 4…64 times the model's frequency).
+        values: Option<Values> = None, Range::Any;
+        /// The common initial state [q; p] (auto: q = 0.2, −0.1, …, p = 0).
+        y0: Option<Vec<f64>> = None, Range::Any;
+        /// The deviation is the maximum over [0, t_obs].
+        t_obs: f64 = 2.0, Range::Positive;
+        /// 1: the averaged system from the same state; 2: the system
+        /// averaged to second order, from the transformed state and mapped
+        /// back.
+        order: usize = 1, Range::Count { min: 1, max: 2 };
+        /// The integration method.
+        method: String = "dop853".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-11, Range::Positive;
+    }
+}
+
+impl AveragingOptions {
+    /// The settings of [`convergence`].
+    pub fn resolve(&self) -> Result<ConvergenceSettings, SettingError> {
+        Ok(ConvergenceSettings {
+            parameter: self.parameter.clone(),
+            values: self.values.as_ref().map(Values::values),
+            y0: self.y0.clone(),
+            t_obs: self.t_obs,
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            order: self.order,
+        })
+    }
+}
+
+/// How [`convergence`] runs, from [`AveragingOptions`].
 #[derive(Clone, Debug)]
 pub struct ConvergenceSettings {
     /// The parameter swept to change the phase's frequency (None: the one

@@ -3,6 +3,7 @@
 use crate::analysis::Refusal;
 use crate::ode::{AnySystem, Integrator, Method, OdeError, Stats, System};
 use crate::registry::Model;
+use crate::settings::{method, resolve_axes, Axis, Declared, Range, SettingError, METHODS};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -117,7 +118,47 @@ fn orbit_budget(count: usize, periods: usize, n: usize) -> Result<(), OdeError> 
     Ok(())
 }
 
-/// What [`portrait`] computes.
+crate::declare_settings! {
+    /// Orbits of the period map of any model with a fast phase, projected
+    /// on two state components.
+    pub struct PeriodMapOptions for "period_map" {
+        /// The state components [q; p] drawn, by index or name (auto: the
+        /// first coordinate and its momentum, or velocity).
+        axes: Option<[Axis; 2]> = None, Range::Any;
+        /// Initial states [q; p], q,p;q,p (auto: `count` seeds on a line
+        /// along the first axis).
+        seeds: Option<Vec<Vec<f64>>> = None, Range::Any;
+        /// Seeds on the line.
+        count: usize = 24, Range::Count { min: 1, max: 100_000 };
+        /// The line covers [−p_max, p_max] when the first axis is not an
+        /// angle.
+        p_max: f64 = 2.5, Range::Positive;
+        /// Periods per orbit.
+        periods: usize = 500, Range::Count { min: 1, max: 100_000_000 };
+        /// The integration method.
+        method: String = "taylor".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, Range::Positive;
+    }
+}
+
+impl PeriodMapOptions {
+    /// The settings of [`portrait`] for `model`, `auto` resolved.
+    pub fn resolve(&self, model: &Model) -> Result<PortraitSettings, SettingError> {
+        Ok(PortraitSettings {
+            axes: resolve_axes(Self::ANALYSIS, model.info, &self.axes)?,
+            seeds: self.seeds.clone(),
+            count: self.count,
+            p_max: self.p_max,
+            periods: self.periods,
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+        })
+    }
+}
+
+/// What [`portrait`] computes, resolved for one model from
+/// [`PeriodMapOptions`].
 #[derive(Clone, Debug)]
 pub struct PortraitSettings {
     /// The state components ([q; p] indices) drawn.

@@ -69,6 +69,30 @@ pub enum StudioError {
     Basins(#[from] mechlab_runtime::analysis::basins::BasinsError),
 }
 
+/// The library's classes, and the studio's own errors as bad values.
+impl mechlab_runtime::classify::Classify for StudioError {
+    fn class(&self) -> mechlab_runtime::classify::ErrorClass {
+        use mechlab_runtime::classify::ErrorClass;
+        match self {
+            StudioError::UnknownModel(e) => e.class(),
+            StudioError::Refused(e) => e.class(),
+            StudioError::Parameter(e) => e.class(),
+            StudioError::Setting(e) => e.class(),
+            StudioError::Ode(e) => e.class(),
+            StudioError::PeriodMap(e) => e.class(),
+            StudioError::Splitting(e) => e.class(),
+            StudioError::Continuation(e) => e.class(),
+            StudioError::Section(e) => e.class(),
+            StudioError::Mechanism(e) => e.class(),
+            StudioError::Basins(e) => e.class(),
+            StudioError::BadRequest { .. }
+            | StudioError::NoSeed
+            | StudioError::NoMap
+            | StudioError::Levels { .. } => ErrorClass::BadValue,
+        }
+    }
+}
+
 /// What is wrong with a request's numbers.
 #[derive(Debug, thiserror::Error)]
 pub enum RequestProblem {

@@ -13,7 +13,7 @@ mod of_plane;
 pub mod on_constraints;
 mod types;
 
-pub use types::{Attractor, AttractorError, AttractorSettings};
+pub use types::{Attractor, AttractorError, AttractorOptions, AttractorSettings};
 
 use crate::registry::Model;
 

@@ -4,9 +4,48 @@ use crate::analysis::dimension::bounds;
 use crate::analysis::Refusal;
 use crate::ode::{Method, OdeError};
 use crate::plot::{ColorMap, Figure, PanelSpec, Rgb};
+use crate::settings::{method, Declared, Range, SettingError, METHODS};
 use std::collections::BTreeMap;
 
-/// What to compute.
+crate::declare_settings! {
+    /// The attractor of a forced, damped period map (a model of one degree
+    /// of freedom, a constrained one on its constraints): its points, its
+    /// Lyapunov spectrum with its error, and its dimensions.
+    pub struct AttractorOptions for "attractor" {
+        /// Where the orbit starts: the first coordinate and its momentum (a
+        /// constrained model: its velocity).
+        start: [f64; 2] = [1.0, 0.0], Range::Any;
+        /// Periods dropped first.
+        transient: usize = 500, Range::Count { min: 0, max: 100_000_000 };
+        /// Points of the attractor.
+        points: usize = 200_000, Range::Count { min: 1, max: 100_000_000 };
+        /// Periods of each of the two Lyapunov runs.
+        lyapunov_periods: usize = 16_000, Range::Count { min: 2, max: 100_000_000 };
+        /// Pixels per side of the density image.
+        pixels: usize = 500, Range::Count { min: 2, max: 4000 };
+        /// The integration method.
+        method: String = "taylor".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, Range::Positive;
+    }
+}
+
+impl AttractorOptions {
+    /// The settings of the attractor analysis.
+    pub fn resolve(&self) -> Result<AttractorSettings, SettingError> {
+        Ok(AttractorSettings {
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            start: self.start,
+            transient: self.transient,
+            points: self.points,
+            lyapunov_periods: self.lyapunov_periods,
+            pixels: self.pixels,
+        })
+    }
+}
+
+/// What to compute, from [`AttractorOptions`].
 #[derive(Clone, Debug)]
 pub struct AttractorSettings {
     pub method: Method,
@@ -35,6 +74,9 @@ pub enum AttractorError {
     /// or constraints that degenerate on the way.
     #[error(transparent)]
     Constrained(#[from] crate::analysis::on_constraints::ConstrainedError),
+    /// A declared setting's value refused.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
 }
 
 /// The attractor, as measured.
