@@ -572,3 +572,95 @@ fn swept(
     }
     Ok((parameter, index, values, frequencies))
 }
+
+impl AveragingConvergence {
+    /// Max deviation against ν (log–log, with the fits) and ν × max
+    /// deviation.
+    pub fn figure(&self) -> crate::plot::Figure {
+        use crate::plot::{palette, Figure, PanelSpec};
+        use crate::registry::display_name;
+        let result = self;
+        let range = |values: &mut dyn Iterator<Item = f64>| {
+            let (lo, hi) = values
+                .filter(|v| *v > 0.0)
+                .fold((f64::MAX, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+            (lo / 1.5, hi * 1.5)
+        };
+        let x = range(&mut result.frequencies.iter().copied());
+        let y = range(&mut result.max_deviation.iter().flatten().copied());
+        // ν^order × deviation levels off where the deviation is c/ν^order.
+        let order = result.order as i32;
+        let scaled_of = |k: usize| -> Vec<(f64, f64)> {
+            result
+                .frequencies
+                .iter()
+                .zip(&result.max_deviation[k])
+                .map(|(nu, d)| (*nu, d * nu.powi(order)))
+                .collect()
+        };
+        let scaled = range(
+            &mut (0..result.coordinates.len())
+                .flat_map(scaled_of)
+                .map(|p| p.1),
+        );
+        let title = format!(
+            "{}: exact against averaged (order {order}), t ≤ {}",
+            result.model, result.t_obs
+        );
+        let (power, scaled_title) = if order == 1 {
+            (
+                "ν × max deviation".to_string(),
+                "ν × max deviation: levels off where the deviation is c/ν".to_string(),
+            )
+        } else {
+            (
+                format!("ν^{order} × max deviation"),
+                format!("ν^{order} × max deviation: levels off where the deviation is c/ν^{order}"),
+            )
+        };
+        let specs = [
+            PanelSpec::new(
+                &title,
+                "frequency ν of the phase",
+                "max |exact − averaged|",
+                x,
+                y,
+            )
+            .log_log(),
+            PanelSpec::new(
+                &scaled_title,
+                "frequency ν of the phase",
+                &power,
+                x,
+                (0.0, scaled.1),
+            )
+            .log_x(),
+        ];
+        let mut figure = Figure::grid(2, 1, 620, 460, &specs);
+        let mut legend = Vec::new();
+        for (k, coordinate) in result.coordinates.iter().enumerate() {
+            let points: Vec<(f64, f64)> = result
+                .frequencies
+                .iter()
+                .copied()
+                .zip(result.max_deviation[k].iter().copied())
+                .collect();
+            figure.points(0, points.iter().copied(), palette(k), 4);
+            let fit: Vec<(f64, f64)> = [x.0 * 1.5, x.1 / 1.5]
+                .iter()
+                .map(|nu| (*nu, result.level[k] * nu.powf(result.slope[k])))
+                .collect();
+            figure.line(0, &fit, palette(k));
+            let scaled = scaled_of(k);
+            figure.line(1, &scaled, palette(k));
+            figure.points(1, scaled, palette(k), 4);
+            legend.push((
+                format!("{}: slope {:.3}", display_name(coordinate), result.slope[k]),
+                palette(k),
+            ));
+        }
+        figure.legend_at(0, &legend, true);
+        figure.legend_at(1, &legend, true);
+        figure
+    }
+}

@@ -1,0 +1,205 @@
+//! Stabilisation by vibration: the `stability` scene (and its chart)
+//! and the `linkage` scene on constraints.
+
+use super::declared_scene;
+use super::{model_from_args, tiles_from};
+use crate::scene::{knob, Knob, Scene, SceneError, ValueProblem};
+use mechlab_runtime::registry::{Catalog, Model};
+
+/// The `linkage` scene: stabilisation by vibration of a constrained model
+/// (the four-bar linkage held upside down by default): the averaged
+/// equilibrium on the constraints, its thresholds, and the exact window.
+pub fn linkage_scene(
+    catalog: Catalog,
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
+    use mechlab_runtime::analysis::on_constraints::vibration::{
+        orbits_about, vibration_stability, LinkageOptions,
+    };
+    let orbit_knobs = [
+        knob("orbits", "6", "orbits about the equilibrium (0: none)"),
+        knob(
+            "kick",
+            "0.6",
+            "the largest kick in the first coordinate's velocity",
+        ),
+        knob("periods", "300", "periods of the fast phase per orbit"),
+    ];
+    let (model, scene, options) = declared_scene::<LinkageOptions>(
+        catalog,
+        scene_name,
+        ("four_bar", None),
+        (LinkageOptions::default(), overrides),
+        &orbit_knobs,
+    )?;
+    let info = model.info;
+    let constrained = model.constrained.ok_or(SceneError::BadValue {
+        name: "model".into(),
+        value: info.name.into(),
+        reason: ValueProblem::Requirement("a model with [[constraints]] in its file"),
+    })?;
+    let settings = options.resolve()?;
+    let result = vibration_stability(constrained, &scene.parameter_values(info)?, &settings)?;
+    println!(
+        "{}: equilibrium q* = {:?}, averaged ω² = {:?} ({}); thresholds in {}: {:?}",
+        info.name,
+        result.equilibrium,
+        result.squared_frequencies,
+        if result.averaged_stable {
+            "stable"
+        } else {
+            "unstable"
+        },
+        result.amplitude,
+        result.averaged_thresholds
+    );
+    println!("exact: {:?}", result.exact);
+    scene.save_figure(&result.figure(), "linkage.png")?;
+    let count = scene.whole("orbits")?;
+    if count > 0 {
+        let params = scene.parameter_values(info)?;
+        let shape = (count, scene.positive("kick")?, scene.count("periods")?);
+        let orbits = orbits_about(
+            constrained,
+            &params,
+            &result.equilibrium,
+            shape,
+            settings.method,
+        )?;
+        scene.save_figure(&orbits.figure(), "orbits.png")?;
+    }
+    let rows = result.scan.iter().map(|p| {
+        (
+            p.amplitude,
+            p.lowest_squared_frequency,
+            p.largest_modulus.unwrap_or(f64::NAN),
+        )
+    });
+    scene.write_csv(
+        "scan.csv",
+        &[
+            result.amplitude.as_str(),
+            "lowest_omega2",
+            "largest_modulus",
+        ],
+        rows,
+    )?;
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
+/// The `stability` scene: stabilisation by vibration of any model's
+/// equilibria (a constrained model's on its constraints: the `linkage`
+/// scene), with `chart=x,y` the stability chart of one equilibrium in two
+/// parameters.
+pub fn stability_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use mechlab_runtime::analysis::stability::{stability, StabilityOptions};
+    let model = model_from_args(catalog, "kapitza")?;
+    if model.constrained.is_some() {
+        let overrides = [("model", model.info.name)];
+        return linkage_scene(catalog, "stability", &overrides);
+    }
+    let (model, scene, options) = declared_scene::<StabilityOptions>(
+        catalog,
+        "stability",
+        ("kapitza", None),
+        (StabilityOptions::default(), &[]),
+        &chart_knobs(),
+    )?;
+    let params = scene.parameter_values(model.info)?;
+    let settings = options.resolve(model)?;
+    let result = stability(model, &params, &settings)?;
+    for line in result.report(32) {
+        eprintln!("{line}");
+    }
+    scene.write_csv(
+        "spectral_radius.csv",
+        &["equilibrium", "amplitude", "spectral_radius"],
+        result.spectral_radius_rows(),
+    )?;
+    if let Some(figure) = result.figure() {
+        scene.save_figure(&figure, "spectral_radius.png")?;
+    }
+    if scene.text("chart") != "none" && !write_chart(&scene, model, &params, &settings)? {
+        return Ok(());
+    }
+    scene.write_summary(&result)?;
+    Ok(())
+}
+
+/// The stability chart's knobs.
+fn chart_knobs() -> Vec<Knob> {
+    vec![
+        knob("chart", "none", "two parameters x,y for a stability chart of the equilibrium chart_q (none: no chart)"),
+        knob("chart_q", "0", "the equilibrium of the chart, comma-separated (0: all coordinates zero)"),
+        knob("chart_x", "0.02,0.5,40", "first, last value and count of x"),
+        knob("chart_y_max", "12", "y is sampled on (0, chart_y_max]"),
+        knob("chart_y_samples", "120", "samples of y that bracket the boundaries"),
+        knob("chart_tile_columns", "4", "chart columns per tile, each written to out/stability.tiles/ when done so a rerun resumes (0: no tiles)"),
+        knob("chart_only_tiles", "all", "compute only these chart tiles (comma-separated indices, a job of an array) and stop; all: every missing tile, then the chart"),
+    ]
+}
+
+/// The stability chart of the chart knobs, its figure, table and
+/// `chart.json`; false for a job of an array whose tiles are written.
+fn write_chart(
+    scene: &Scene,
+    model: &Model,
+    params: &[f64],
+    settings: &mechlab_runtime::analysis::stability::Settings,
+) -> Result<bool, SceneError> {
+    use mechlab_runtime::analysis::stability::{stability_chart, ChartSettings, StabilityError};
+    let bad = |name: &str, reason: &'static str| SceneError::BadValue {
+        name: name.into(),
+        value: scene.text(name).into(),
+        reason: ValueProblem::Requirement(reason),
+    };
+    let Some((x, y)) = scene.text("chart").split_once(',') else {
+        return Err(bad("chart", "two parameter names x,y"));
+    };
+    let [first, last, count] = scene.numbers("chart_x")?[..] else {
+        return Err(bad("chart_x", "first,last,count"));
+    };
+    if !(count >= 2.0 && count.fract() == 0.0) {
+        return Err(bad("chart_x", "a whole count of at least 2"));
+    }
+    let n = count as usize;
+    let chart_settings = ChartSettings {
+        q: if scene.text("chart_q") == "0" {
+            vec![0.0; model.info.coordinates.len()]
+        } else {
+            scene.numbers("chart_q")?
+        },
+        x: x.trim().into(),
+        x_values: (0..n)
+            .map(|k| first + (last - first) * k as f64 / (n - 1) as f64)
+            .collect(),
+        y: y.trim().into(),
+        y_max: scene.positive("chart_y_max")?,
+        y_samples: scene.count("chart_y_samples")?,
+        edge_tolerance: settings.edge_tolerance,
+        method: settings.method,
+        tiles: tiles_from(scene, ["chart_tile_columns", "chart_only_tiles"])?,
+    };
+    let chart = match stability_chart(model, params, &chart_settings) {
+        // A job of an array: its tiles are written, the last run draws.
+        Err(StabilityError::Partial) => {
+            eprintln!("chart tiles {} written", scene.text("chart_only_tiles"));
+            return Ok(false);
+        }
+        chart => chart?,
+    };
+    scene.write_csv(
+        "chart_boundaries.csv",
+        &[chart.x.as_str(), chart.y.as_str()],
+        chart.boundary_rows(),
+    )?;
+    scene.save_figure(&chart.figure(), "chart.png")?;
+    let json = serde_json::to_string_pretty(&chart).map_err(|source| SceneError::Summary {
+        scene: "stability",
+        source,
+    })?;
+    scene.write_text("chart.json", &json)?;
+    Ok(true)
+}

@@ -1,0 +1,57 @@
+//! The mechanism moving from an orbit's seed.
+
+use super::*;
+
+/// The mechanism moving from an orbit's seed (the model file's points):
+/// `duration` time units drawn in `frames` frames.
+#[derive(Clone, Debug, Deserialize)]
+pub struct MechanismRequest {
+    #[serde(flatten)]
+    pub setup: Setup,
+    pub seed: Vec<f64>,
+    pub duration: f64,
+    pub frames: usize,
+    /// Fields no route knows (refused by name, not ignored).
+    #[serde(flatten)]
+    pub unknown: BTreeMap<String, serde_json::Value>,
+}
+
+/// The frames of the mechanism, for the page to play.
+#[derive(Clone, Debug, Serialize)]
+pub struct MechanismView {
+    pub points: Vec<&'static str>,
+    pub bars: Vec<[usize; 2]>,
+    pub times: Vec<f64>,
+    /// `frames[f][p]`: the point p at `times[f]`.
+    pub frames: Vec<Vec<[f64; 2]>>,
+}
+
+/// The mechanism of `request` moving, from the seed put on the constraints
+/// as the orbit's is (its axes' components held).
+pub fn mechanism(
+    catalog: Catalog,
+    request: &MechanismRequest,
+) -> Result<MechanismView, StudioError> {
+    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    if request.seed.iter().any(|x| !x.is_finite()) {
+        return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
+    }
+    let frames = mechlab_runtime::analysis::mechanism::Frames {
+        duration: request.duration,
+        count: request.frames,
+    };
+    let animation = mechlab_runtime::analysis::mechanism::animate(
+        setup.handle,
+        &setup.params,
+        setup.method,
+        &request.seed,
+        &setup.axes,
+        frames,
+    )?;
+    Ok(MechanismView {
+        points: animation.points.to_vec(),
+        bars: animation.bars.to_vec(),
+        times: animation.times,
+        frames: animation.frames,
+    })
+}
