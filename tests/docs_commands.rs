@@ -59,7 +59,9 @@ fn every_scene_command_in_the_docs_is_accepted() {
             // models/, as `benches/added_models/run.sh` puts it.
             let written_by_reader = args.iter().any(|a| {
                 a.strip_prefix("model=").is_some_and(|m| {
-                    workspace().join(format!("docs/first_model/{m}.toml")).exists()
+                    workspace()
+                        .join(format!("docs/first_model/{m}.toml"))
+                        .exists()
                         && !workspace().join(format!("models/{m}.toml")).exists()
                 })
             });

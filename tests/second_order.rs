@@ -288,6 +288,9 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
                     checked.push(info.name);
                 }
             }
+            // Friction at the defaults: the second order is not derived
+            // for it, and the analysis says so.
+            Err(e @ AveragingError::Dissipative { .. }) => eprintln!("{}: skipped: {e}", info.name),
             Err(
                 AveragingError::Order(..)
                 | AveragingError::Refused(mechlab::analysis::Refusal::NoFastPhase { .. })
@@ -308,4 +311,27 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
         assert!(checked.contains(&name), "{name} not checked: {checked:?}");
     }
     assert!(checked.len() >= 8, "{checked:?}");
+}
+
+/// Second-order averaging is derived for Hamiltonian systems: Kapitza's
+/// pendulum with friction (μ = 0.1, its averaged flow losing volume at the
+/// rate μ) is refused by name, not fitted to a wrong slope.
+#[test]
+fn second_order_averaging_refuses_friction() {
+    use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
+    let settings = ConvergenceSettings {
+        parameter: None,
+        values: None,
+        y0: None,
+        t_obs: 2.0,
+        method: Method::parse("dop853", 1e-12).unwrap(),
+        order: 2,
+    };
+    let damped = [1.5, 0.1, 0.1];
+    match convergence(model_of("kapitza"), &damped, &settings) {
+        Err(AveragingError::Dissipative { divergence, .. }) => {
+            assert!((divergence + 0.1).abs() < 1e-6, "{divergence}")
+        }
+        other => panic!("{other:?}"),
+    }
 }

@@ -68,6 +68,22 @@ fn kapitza_map(params: [f64; 3]) -> (kapitza::Exact, f64) {
 
 #[tokio::test]
 async fn models_and_page_are_served() {
+    // The settings the page fills its inputs from are the declarations,
+    // with the studio's interactive values named as such.
+    let (status, _, body) = call("GET", "/api/schema", None).await;
+    assert_eq!(status, StatusCode::OK);
+    let schema: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(
+        schema,
+        serde_json::to_value(mechlab::settings::schemas()).unwrap()
+    );
+    let chaos = schema
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["analysis"] == "chaos_map")
+        .unwrap();
+    assert_eq!(chaos["interactive"], json!({"periods": 100}));
     let (status, kind, body) = call("GET", "/api/models", None).await;
     assert_eq!(status, StatusCode::OK);
     assert!(kind.starts_with("application/json"));

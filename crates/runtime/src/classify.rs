@@ -180,6 +180,7 @@ impl Classify for AveragingError {
         match self {
             AveragingError::Refused(r) => r.class(),
             AveragingError::Sweep { .. } | AveragingError::Order(..) => BadValue,
+            AveragingError::Dissipative { .. } => ErrorClass::Refused,
             AveragingError::Ode(e) => e.class(),
             _ => Integration,
         }

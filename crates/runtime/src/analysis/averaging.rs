@@ -275,6 +275,9 @@ pub enum AveragingError {
     },
     #[error("model '{0}': the averaged system of order {1} is not derived (order 1 is for every model with a fast phase, order 2 too except for models with a numeric solve of more than 4 degrees of freedom, whose code would grow like n⁴)")]
     Order(String, usize),
+    /// Second-order averaging on a flow that is not Hamiltonian here.
+    #[error("model '{model}': the averaging to second order is derived for Hamiltonian systems, and this one loses volume at the start (the averaged flow's divergence {divergence:.3e}: friction, or other non-potential forces at these parameters); order 1 applies")]
+    Dissipative { model: String, divergence: f64 },
     /// A constrained model whose constraints or mass matrix move with the
     /// fast phase: the averaging with constraints is derived for fixed ones.
     #[error("model '{model}': its constraints or its mass matrix move with the fast phase; the averaging on constraints is derived for fixed ones (`explore` runs the exact motion)")]
@@ -369,6 +372,16 @@ pub fn convergence(
             if model.averaged2(params).is_none() {
                 return Err(AveragingError::Order(info.name.into(), 2));
             }
+            let averaged = model
+                .averaged(params)
+                .expect("a model with a fast phase has an averaged system");
+            let divergence = divergence_at(averaged.as_ref(), &y0)?;
+            if divergence.abs() > 1e-5 {
+                return Err(AveragingError::Dissipative {
+                    model: info.name.into(),
+                    divergence,
+                });
+            }
             let per_frequency: Vec<Vec<f64>> = frequencies
                 .par_iter()
                 .zip(&values)
@@ -384,6 +397,20 @@ pub fn convergence(
         order => return Err(AveragingError::Order(info.name.into(), order)),
     };
     Ok(summarised(info, parameter, values, y0, settings, run))
+}
+
+/// The divergence of `system`'s field at `y` (central differences): 0 for
+/// a Hamiltonian flow, the rate of volume loss of a damped one.
+fn divergence_at(system: &dyn AnySystem, y: &[f64]) -> Result<f64, OdeError> {
+    let h = 1e-6;
+    let mut sum = 0.0;
+    for i in 0..y.len() {
+        let (mut up, mut down) = (y.to_vec(), y.to_vec());
+        up[i] += h;
+        down[i] -= h;
+        sum += (system.rhs(0.0, &up)?[i] - system.rhs(0.0, &down)?[i]) / (2.0 * h);
+    }
+    Ok(sum)
 }
 
 /// The sweep's deviations as the analysis reports them: local and fitted
