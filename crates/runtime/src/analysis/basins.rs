@@ -168,6 +168,9 @@ pub struct Attractor {
 pub struct Basins {
     pub model: String,
     pub axes: [String; 2],
+    /// The axes in the figures' notation (φ₁, p_φ₁, φ₁′).
+    #[serde(skip)]
+    pub labels_of_axes: [String; 2],
     pub ranges: [(f64, f64); 2],
     pub pixels: usize,
     pub attractors: Vec<Attractor>,
@@ -249,6 +252,7 @@ pub fn basins(
     Ok(Basins {
         model: name.into(),
         axes,
+        labels_of_axes: settings.axes.map(|a| model.info.label(a)),
         ranges: settings.ranges,
         pixels: n,
         attractors,
@@ -789,8 +793,8 @@ impl Basins {
         let title = format!("{}: basins ({}){boundary}", self.model, summary.join(", "));
         let spec = PanelSpec::new(
             &title,
-            &self.axes[0],
-            &self.axes[1],
+            &self.labels_of_axes[0],
+            &self.labels_of_axes[1],
             self.ranges[0],
             self.ranges[1],
         );
