@@ -505,31 +505,20 @@ impl PyModel {
     }
 
     /// What the `explore` scene shows, for any model (the contact models
-    /// of Study 3 too): the run from `y0` (default the scenes' start) to
-    /// `t_end` at `samples` times, with the averaged run and `periods`
-    /// of the period map where there is a fast phase, the energy's
-    /// change, the equilibria, a constrained model's reactions.
-    #[pyo3(signature = (y0=None, *, t_end=20.0, samples=2000, periods=300, method="dop853", tol=1e-10, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    /// of Study 3 too): the run, with the averaged run and the period map
+    /// where there is a fast phase, the energy's change, the equilibria, a
+    /// constrained model's reactions. Settings: the explore declaration
+    /// (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
     fn explore<'py>(
         &self,
         py: Python<'py>,
-        y0: Option<Vec<f64>>,
-        t_end: f64,
-        samples: usize,
-        periods: usize,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let settings = mechlab::explore::Settings {
-            method: Method::parse(method, tol).map_err(py_err)?,
-            t_end,
-            samples,
-            periods,
-        };
-        let y0 = y0.unwrap_or_else(|| mechlab::explore::default_start(self.model.dynamic));
+        let options: mechlab::explore::ExploreOptions = declared(settings)?;
+        let (settings, y0) = options.resolve(self.model).map_err(py_err)?;
         analyses::explore(py, self.model, values, y0, settings)
     }
 

@@ -17,8 +17,49 @@ use crate::plot::{palette, Figure, PanelSpec, BLACK, GREY, RED};
 use crate::registry::{
     display_name, ConstrainedSystems, DynamicModel, Kind, Model, ModelInfo, Systems,
 };
+use crate::settings::{method, Declared, Range, SettingError, METHODS};
 
-/// What to run.
+crate::declare_settings! {
+    /// Any model by name: its run (and the averaged run and the period map
+    /// with a fast phase; stick–slip for a contact model), portraits, the
+    /// energy's change, the equilibria and a constrained model's reactions.
+    pub struct ExploreOptions for "explore" {
+        /// The initial state, [q; p] or [s; s'] (auto: q = 0.3, 0.5, …,
+        /// p = 0; contacts: s = 0, −0.3, …, s' = 1).
+        y0: Option<Vec<f64>> = None, Range::Any;
+        /// The length of the run.
+        t_end: f64 = 20.0, Range::Positive;
+        /// Samples of the time series.
+        samples: usize = 2000, Range::Count { min: 2, max: 100_000_000 };
+        /// Periods of the period map (models with a fast phase).
+        periods: usize = 300, Range::Count { min: 1, max: 100_000_000 };
+        /// The integration method.
+        method: String = "dop853".into(), Range::OneOf(METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, Range::Positive;
+    }
+}
+
+impl ExploreOptions {
+    /// The settings of [`explore`] and its start for `model`, `auto`
+    /// resolved.
+    pub fn resolve(&self, model: &Model) -> Result<(Settings, Vec<f64>), SettingError> {
+        let settings = Settings {
+            method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            t_end: self.t_end,
+            samples: self.samples,
+            periods: self.periods,
+        };
+        let y0 = self
+            .y0
+            .clone()
+            .unwrap_or_else(|| default_start(model.dynamic));
+        Ok((settings, y0))
+    }
+}
+
+/// What to run, resolved from [`ExploreOptions`].
 #[derive(Clone, Debug)]
 pub struct Settings {
     pub method: Method,

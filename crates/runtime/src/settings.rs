@@ -806,6 +806,7 @@ pub fn schemas() -> Vec<Schema> {
         Schema::of::<attractor::AttractorOptions>(),
         Schema::of::<averaging::AveragingOptions>(),
         Schema::of::<period_map::PeriodMapOptions>(),
+        Schema::of::<crate::explore::ExploreOptions>(),
     ]
 }
 

@@ -18,7 +18,7 @@ mod stability;
 pub use averaging::averaging_scene;
 pub use continuation::continuation_scene;
 pub use maps::{basins_scene, chaos_map_scene, frequency_map_scene};
-pub use orbits::{attractor_scene, period_map_scene};
+pub use orbits::{attractor_scene, explore_scene, period_map_scene};
 pub use section::section_scene;
 pub use separatrix::separatrix_scene;
 pub use stability::{linkage_scene, stability_scene};

@@ -76,3 +76,32 @@ pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
     scene.write_summary(&result)?;
     Ok(())
 }
+
+/// The `explore` scene: any model by name, its runs, portraits, period
+/// map, energy and equilibria.
+pub fn explore_scene(catalog: Catalog) -> Result<(), SceneError> {
+    use mechlab_runtime::explore::{explore, figure, ExploreOptions};
+    let (model, scene, options) = declared_scene::<ExploreOptions>(
+        catalog,
+        "explore",
+        ("kapitza", None),
+        (ExploreOptions::default(), &[]),
+        &[],
+    )?;
+    let info = model.info;
+    let params = scene.parameter_values(info)?;
+    let (settings, y0) = options.resolve(model)?;
+    let result = explore(model, &params, &y0, &settings)?;
+    scene.save_figure(
+        &figure(&result, model.dynamic, settings.t_end),
+        "explore.png",
+    )?;
+    let header = result.series_header();
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    scene.write_csv("series.csv", &header, result.series_rows())?;
+    for line in result.report(info.coordinates, 32) {
+        println!("{line}");
+    }
+    scene.write_summary(&result.summary(info, &params, &y0))?;
+    Ok(())
+}
