@@ -258,24 +258,29 @@ fn an_order_not_derived_is_an_error() {
     assert!(matches!(error, AveragingError::Order(_, 3)), "{error}");
 }
 
+/// The averaging analysis to second order at its automatic sweep.
+fn second_order_sweep() -> mechlab::analysis::averaging::ConvergenceSettings {
+    mechlab::analysis::averaging::ConvergenceSettings {
+        parameter: None,
+        values: None,
+        y0: None,
+        t_obs: 2.0,
+        method: Method::parse("dop853", 1e-12).unwrap(),
+        order: 2,
+    }
+}
+
 /// Every model file with a fast phase has a second-order system, and its
 /// trajectories deviate like 1/ν² from the exact ones (a wrong K̄₁, such as the circular
 /// pivot's A²p/2, or a wrong map would leave −1).
 #[test]
 fn every_second_order_model_converges_like_one_over_nu_squared() {
-    use mechlab::analysis::averaging::{AveragingError, ConvergenceSettings};
+    use mechlab::analysis::averaging::AveragingError;
     let mut checked = Vec::new();
     // The quadruple chain is a test model (test_models/), checked here too.
     let quadruple = &mechlab_test_models::quadruple_pendulum::INFO;
     for info in mechlab::models::ALL.iter().chain([quadruple]) {
-        let settings = ConvergenceSettings {
-            parameter: None,
-            values: None,
-            y0: None,
-            t_obs: 2.0,
-            method: Method::parse("dop853", 1e-12).unwrap(),
-            order: 2,
-        };
+        let settings = second_order_sweep();
         let defaults: Vec<f64> = info
             .parameter_defaults
             .iter()
@@ -318,15 +323,8 @@ fn every_second_order_model_converges_like_one_over_nu_squared() {
 /// rate μ) is refused by name, not fitted to a wrong slope.
 #[test]
 fn second_order_averaging_refuses_friction() {
-    use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
-    let settings = ConvergenceSettings {
-        parameter: None,
-        values: None,
-        y0: None,
-        t_obs: 2.0,
-        method: Method::parse("dop853", 1e-12).unwrap(),
-        order: 2,
-    };
+    use mechlab::analysis::averaging::{convergence, AveragingError};
+    let settings = second_order_sweep();
     let damped = [1.5, 0.1, 0.1];
     match convergence(model_of("kapitza"), &damped, &settings) {
         Err(AveragingError::Dissipative { divergence, .. }) => {

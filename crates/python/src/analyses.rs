@@ -37,7 +37,6 @@ fn points<'py>(
 }
 
 /// Orbits of the period map (the `period_map` scene).
-#[allow(clippy::too_many_arguments)]
 pub fn portrait<'py>(
     py: Python<'py>,
     model: &'static Model,
