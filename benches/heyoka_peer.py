@@ -7,7 +7,7 @@ max-norm distance of the final state from a reference computed by heyoka in
 80-bit extended precision (tolerance 1e-19). heyoka advances with
 `propagate_grid` over the period grid; mechlab samples each period's end from
 the step across it, as propagate_grid does, the time restarting at 0 there
-(`kapitza_period_map --set q0=… --set p0=…`).
+(`kapitza_period_map --set start=q,p`).
 
 One orbit takes milliseconds, and on the shared 2-core machines both
 solvers run about 35 % slower in spells of a fraction of a second (the
@@ -87,7 +87,7 @@ def mechlab_row(method, tol, ref):
     args = [
         "cargo", "run", "--release", "--quiet", "--example", "kapitza_period_map", "--",
         "--set", f"A={A}", "--set", f"eps={EPS}", "--set", f"mu={MU}",
-        "--set", f"q0={Q0!r}", "--set", f"p0={P0!r}", "--set", f"periods={PERIODS}",
+        "--set", f"start={Q0!r},{P0!r}", "--set", f"periods={PERIODS}",
         "--set", f"method={method}", "--set", f"tol={tol}", "--set", f"repeat={REPEAT}",
     ]
     subprocess.run(args, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)

@@ -6,6 +6,7 @@
 //! the same settings give the same numbers through each door.
 
 use mechlab::settings::{schemas, Declaration, Declared};
+use mechlab::studies::declared::schemas as study_schemas;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -96,7 +97,7 @@ fn the_python_stub_is_generated_from_the_declarations() {
 /// The reference of the declared analyses, as the book prints it.
 fn reference() -> String {
     let mut s = String::from("\n");
-    for schema in schemas() {
+    for schema in schemas().into_iter().chain(study_schemas()) {
         s += &format!("## `{}`\n\n{}\n\n", schema.analysis, schema.about);
         s += "| setting | type | default | range | what it sets |\n|---|---|---|---|---|\n";
         for d in &schema.settings {
@@ -137,7 +138,7 @@ fn the_books_reference_is_generated_from_the_declarations() {
 /// with the declared default, type and range.
 #[test]
 fn each_scene_help_lists_the_declared_settings() {
-    for schema in schemas() {
+    for schema in schemas().into_iter().chain(study_schemas()) {
         let binary = example(schema.analysis);
         let output = Command::new(&binary).arg("--help").output().unwrap();
         let help = String::from_utf8(output.stdout).unwrap();

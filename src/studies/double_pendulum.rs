@@ -23,7 +23,6 @@ use crate::models::double_pendulum::Averaged;
 use crate::models::double_pendulum::{self as model, Exact, Params};
 use crate::ode::{states_at, Integrator, Method, OdeError};
 use crate::plot::{Figure, PanelSpec, BLACK, BLUE, GREY, RED};
-use crate::scene::{Knob, Scene, SceneError};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -136,24 +135,22 @@ pub fn exact_stability_window(
     stability_window(&margin, 0.0, a_max, samples, 1e-11 * a_max)
 }
 
-/// Knobs for every parameter of the model (the model file's defaults
-/// except `overrides`).
-pub fn parameter_knobs(overrides: &[(&'static str, &'static str)]) -> Vec<Knob> {
-    crate::scene::parameter_knobs(&model::INFO, overrides)
-}
-
-/// The parameters set by the knobs of [`parameter_knobs`]: masses, lengths,
-/// g and ν positive, a and μ not negative.
-pub fn params_from_scene(scene: &Scene) -> Result<Params, SceneError> {
-    let mut params = Params::default();
-    for name in Params::NAMES {
-        let value = match name {
-            "a" | "mu" => scene.non_negative(name)?,
-            _ => scene.positive(name)?,
+/// The pendulum's parameters from the model's `values`: masses, lengths, g
+/// and ν positive, a and μ not negative.
+pub fn study_params(values: &[f64]) -> Result<Params, StudyError> {
+    for (name, value) in Params::NAMES.iter().zip(values) {
+        let fine = match *name {
+            "a" | "mu" => *value >= 0.0,
+            _ => *value > 0.0,
         };
-        params.set(name, value)?;
+        if !fine {
+            return Err(StudyError::Settings {
+                setting: "m1, m2, l1, l2, g, a, nu, mu",
+                requirement: "masses, lengths, g and ν positive; a and μ not negative",
+            });
+        }
     }
-    Ok(params)
+    Ok(Params::from_values(values))
 }
 
 /// Limits of a set of values, widened a little (and never empty).

@@ -9,3 +9,4 @@
 
 pub mod scene;
 pub mod scenes;
+pub mod study;

@@ -509,8 +509,12 @@ impl Scene {
     }
 
     pub fn write_text(&self, file: &str, text: &str) -> Result<PathBuf, SceneError> {
+        self.write_bytes(file, text.as_bytes())
+    }
+
+    pub fn write_bytes(&self, file: &str, bytes: &[u8]) -> Result<PathBuf, SceneError> {
         let path = self.path(file)?;
-        std::fs::write(&path, text).map_err(|source| SceneError::Io {
+        std::fs::write(&path, bytes).map_err(|source| SceneError::Io {
             path: path.clone(),
             source,
         })?;

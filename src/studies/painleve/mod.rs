@@ -11,6 +11,7 @@ pub mod impact;
 pub mod stiff_limit;
 
 use crate::models::painleve_klein::Params;
+use super::StudyError;
 
 /// δ, δ', R, cos φ, sin φ at the state [x1, x2, v1, v2].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -323,14 +324,10 @@ pub fn state_with_deformation(p: &Params, delta: f64, v: f64) -> [f64; 4] {
     [0.0, -dx, v, v]
 }
 
-/// Knobs for every parameter of the model file (its defaults).
-pub fn parameter_knobs() -> Vec<crate::scene::Knob> {
-    crate::scene::parameter_knobs(&crate::models::painleve_klein::INFO, &[])
-}
-
-/// The parameters set by those knobs: 0 < d < l, ε, k > 0, friction ≥ 0.
-pub fn params_from_scene(scene: &crate::scene::Scene) -> Result<Params, crate::scene::SceneError> {
-    let p = Params::from_values(&scene.parameter_values(&crate::models::painleve_klein::INFO)?);
+/// The rod's parameters from the model's `values`: 0 < d < l, ε, k > 0,
+/// friction ≥ 0.
+pub fn study_params(values: &[f64]) -> Result<Params, StudyError> {
+    let p = Params::from_values(values);
     if !(p.d > 0.0
         && p.d < p.l
         && p.eps > 0.0
@@ -339,9 +336,9 @@ pub fn params_from_scene(scene: &crate::scene::Scene) -> Result<Params, crate::s
         && p.mu2 >= 0.0
         && p.nu >= 0.0)
     {
-        return Err(crate::scene::SceneError::Inconsistent {
-            knobs: "d, l, eps, k, nu, mu1, mu2",
-            reason: "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0",
+        return Err(StudyError::Settings {
+            setting: "d, l, eps, k, nu, mu1, mu2",
+            requirement: "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0",
         });
     }
     Ok(p)

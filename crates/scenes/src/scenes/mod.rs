@@ -3,7 +3,6 @@
 //! defaults, the same files): knobs → one library call → figures.
 
 use crate::scene::{knob, parameter_knobs, Knob, Scene, SceneError, ValueProblem};
-use mechlab_runtime::ode::Method;
 use mechlab_runtime::registry::{Catalog, Model};
 use mechlab_runtime::settings::Declared;
 
@@ -14,6 +13,7 @@ mod orbits;
 mod section;
 mod separatrix;
 mod stability;
+mod standard_map;
 
 pub use averaging::averaging_scene;
 pub use continuation::continuation_scene;
@@ -22,6 +22,7 @@ pub use orbits::{attractor_scene, explore_scene, period_map_scene};
 pub use section::section_scene;
 pub use separatrix::separatrix_scene;
 pub use stability::{linkage_scene, stability_scene};
+pub use crate::study::{study_scene, write_outputs, Outputs, Study, Table};
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
 /// clear error listing the known ones.
@@ -40,27 +41,6 @@ impl Defaults<'_> {
             .find(|(n, _)| *n == name)
             .map_or(generic, |(_, v)| v)
     }
-}
-
-/// `method` and `tol` knobs with these defaults.
-pub fn method_knobs(method: &'static str, tol: &'static str) -> [Knob; 2] {
-    [
-        knob(
-            "method",
-            method,
-            "integration method (taylor, dop853, rk4, gauss4, gauss6, radau5)",
-        ),
-        knob(
-            "tol",
-            tol,
-            "its tolerance (taylor, dop853, radau5) or step size",
-        ),
-    ]
-}
-
-/// The method of the `method`/`tol` knobs.
-pub fn method_from(scene: &Scene) -> Result<Method, SceneError> {
-    Ok(Method::parse(scene.text("method"), scene.positive("tol")?)?)
 }
 
 /// A scene of a declared analysis: the `model` knob, the declaration's
