@@ -11,5 +11,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumAveraging>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumAveraging>,
+    );
 }

@@ -15,5 +15,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumStabilization>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumStabilization>,
+    );
 }

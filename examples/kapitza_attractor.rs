@@ -10,5 +10,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaAttractor>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaAttractor>,
+    );
 }

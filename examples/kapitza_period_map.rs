@@ -8,5 +8,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaPeriodMap>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaPeriodMap>,
+    );
 }

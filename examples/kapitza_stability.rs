@@ -13,5 +13,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaStability>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaStability>,
+    );
 }

@@ -14,5 +14,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveKleinImpact>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveKleinImpact>,
+    );
 }

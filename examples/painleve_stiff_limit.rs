@@ -12,5 +12,7 @@
 //! Its settings are declared in `mechlab::studies::declared`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveStiffLimit>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveStiffLimit>,
+    );
 }

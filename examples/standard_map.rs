@@ -6,5 +6,7 @@
 //! Its settings are declared in `mechlab::analysis::standard_map`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::analysis::standard_map::StandardMapOptions>);
+    mechlab::scene::run(
+        mechlab::scenes::study_scene::<mechlab::analysis::standard_map::StandardMapOptions>,
+    );
 }

@@ -27,8 +27,8 @@
 //! ```
 
 pub use mechlab_runtime::{
-    analysis, budget, classify, constrained, contact, explore, linalg, mathml, ode, plot, registry,
-    report, settings, study,
+    analysis, budget, classify, constrained, contact, explore, linalg, mathml, ode, outputs, plot,
+    registry, report, settings, study,
 };
 pub use mechlab_scenes::{scene, scenes};
 

@@ -96,7 +96,11 @@ impl Outputs for KapitzaOrbits {
     fn tables(&self) -> Vec<Table> {
         match self {
             KapitzaOrbits::One(orbit) => {
-                let rows = orbit.points.iter().enumerate().map(|(k, y)| (k, y[0], y[1]));
+                let rows = orbit
+                    .points
+                    .iter()
+                    .enumerate()
+                    .map(|(k, y)| (k, y[0], y[1]));
                 vec![Table::new("orbit.csv", &["period", "q", "p"], rows)]
             }
             KapitzaOrbits::Portraits { portraits, .. } => portraits
@@ -170,7 +174,11 @@ impl Outputs for UpperPosition {
         let header = ["A", "mu", "orbit", "period", "q", "p"];
         vec![
             Table::new("orbits_near_upper_position.csv", &header, self.orbit_rows()),
-            Table::new("stability_chart.csv", &["eps", "A_boundary"], self.chart_rows()),
+            Table::new(
+                "stability_chart.csv",
+                &["eps", "A_boundary"],
+                self.chart_rows(),
+            ),
         ]
     }
     fn lines(&self) -> Vec<String> {
@@ -180,7 +188,10 @@ impl Outputs for UpperPosition {
             self.determinant, self.determinant_expected, self.verdict
         )];
         lines.extend(self.a_star_by_eps.iter().map(|s| {
-            format!("ε = {}: A* = {:?}, second order {:?}", s.eps, s.a_star, s.a_star_second_order)
+            format!(
+                "ε = {}: A* = {:?}, second order {:?}",
+                s.eps, s.a_star, s.a_star_second_order
+            )
         }));
         lines
     }
@@ -295,8 +306,16 @@ impl Outputs for dp::AveragingCases {
     }
     fn tables(&self) -> Vec<Table> {
         let header = [
-            "case", "t", "phi1_exact", "phi2_exact", "phi1_limit", "phi2_limit", "v1_exact",
-            "v2_exact", "v1_limit", "v2_limit",
+            "case",
+            "t",
+            "phi1_exact",
+            "phi2_exact",
+            "phi1_limit",
+            "phi2_limit",
+            "v1_exact",
+            "v2_exact",
+            "v1_limit",
+            "v2_limit",
         ];
         vec![Table::new("series.csv", &header, self.rows())]
     }
@@ -343,7 +362,9 @@ impl Study for DoublePendulumStabilization {
             chart_points: self.chart_points,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
         };
-        Ok(dp::stabilization_study(&settings, &|done| progress.update(done))?)
+        Ok(dp::stabilization_study(&settings, &|done| {
+            progress.update(done)
+        })?)
     }
 }
 
@@ -353,7 +374,11 @@ impl Outputs for dp::EquilibriaStabilization {
     }
     fn tables(&self) -> Vec<Table> {
         let header = ["panel", "a", "spectral_radius"];
-        vec![Table::new("exact_spectral_radius.csv", &header, self.chart_rows())]
+        vec![Table::new(
+            "exact_spectral_radius.csv",
+            &header,
+            self.chart_rows(),
+        )]
     }
     fn lines(&self) -> Vec<String> {
         self.equilibria
@@ -411,15 +436,26 @@ impl Outputs for dp::Friction {
         vec![named("friction.png", self.figure())]
     }
     fn tables(&self) -> Vec<Table> {
-        let rows = self.exact.iter().map(|r| (r.nu, r.spectral_radius, r.predicted));
+        let rows = self
+            .exact
+            .iter()
+            .map(|r| (r.nu, r.spectral_radius, r.predicted));
         let decay = self
             .exact_decay
             .iter()
             .zip(&self.limit_decay)
             .map(|(e, l)| (e.0, e.1, l.1));
         vec![
-            Table::new("multipliers.csv", &["nu", "spectral_radius", "predicted"], rows),
-            Table::new("decay.csv", &["t", "distance_exact", "distance_limit"], decay),
+            Table::new(
+                "multipliers.csv",
+                &["nu", "spectral_radius", "predicted"],
+                rows,
+            ),
+            Table::new(
+                "decay.csv",
+                &["t", "distance_exact", "distance_limit"],
+                decay,
+            ),
         ]
     }
     fn lines(&self) -> Vec<String> {
@@ -458,7 +494,10 @@ impl Study for PainlevePhi {
         Some(&crate::models::painleve_klein::INFO)
     }
     fn run(&self, values: &[f64]) -> Result<graphs::PhiGraphs, SceneError> {
-        Ok(graphs::phi_graphs(&painleve::study_params(values)?, self.region_pixels))
+        Ok(graphs::phi_graphs(
+            &painleve::study_params(values)?,
+            self.region_pixels,
+        ))
     }
 }
 
@@ -471,12 +510,19 @@ impl Outputs for graphs::PhiGraphs {
         vec![Table::new("regions.csv", &header, &self.regions)]
     }
     fn lines(&self) -> Vec<String> {
-        let classes = self.examples.iter().zip(self.classes).map(|((_, roots), class)| {
-            format!(
-                "class {}: {}; {} (example: {} roots)",
-                class.signs, class.region, class.roots, roots.len()
-            )
-        });
+        let classes = self
+            .examples
+            .iter()
+            .zip(self.classes)
+            .map(|((_, roots), class)| {
+                format!(
+                    "class {}: {}; {} (example: {} roots)",
+                    class.signs,
+                    class.region,
+                    class.roots,
+                    roots.len()
+                )
+            });
         let given = self.given.iter().map(|g| {
             format!(
                 "given parameters, σ = {:+}: slopes {}, X* = {:.6}, roots {:?} (Φ' > 0: {:?}): {}",
@@ -510,7 +556,12 @@ impl Study for PainleveDelta {
     fn run(&self, values: &[f64]) -> Result<deformation::Deformation, SceneError> {
         let sigma = if self.sigma >= 0.0 { 1.0 } else { -1.0 };
         let params = painleve::study_params(values)?;
-        Ok(deformation::deformation(&params, sigma, self.starts, self.t_end)?)
+        Ok(deformation::deformation(
+            &params,
+            sigma,
+            self.starts,
+            self.t_end,
+        )?)
     }
 }
 
@@ -572,7 +623,17 @@ impl Outputs for impact::Impact {
     }
     fn tables(&self) -> Vec<Table> {
         let events = ["x2_0", "t", "point", "case", "from", "to", "v1", "v2", "R"];
-        let series = ["x2_0", "t", "x1", "x2", "v1", "v2", "delta", "delta_rate", "R"];
+        let series = [
+            "x2_0",
+            "t",
+            "x1",
+            "x2",
+            "v1",
+            "v2",
+            "delta",
+            "delta_rate",
+            "R",
+        ];
         vec![
             Table::new("events.csv", &events, self.event_rows()),
             Table::new("series.csv", &series, self.series_rows()),
@@ -621,13 +682,15 @@ impl Study for PainleveStiffLimit {
         None
     }
     fn run(&self, _: &[f64]) -> Result<stiff_limit::StiffLimit, SceneError> {
-        Ok(stiff_limit::stiff_limit(&stiff_limit::StiffLimitSettings {
-            eps_values: self.eps_values.clone(),
-            x2_regular: self.x2_regular,
-            x2_impact: self.x2_impact,
-            t_end: self.t_end,
-            method: method(Self::ANALYSIS, &self.method, self.tol)?,
-        })?)
+        Ok(stiff_limit::stiff_limit(
+            &stiff_limit::StiffLimitSettings {
+                eps_values: self.eps_values.clone(),
+                x2_regular: self.x2_regular,
+                x2_impact: self.x2_impact,
+                t_end: self.t_end,
+                method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            },
+        )?)
     }
 }
 
@@ -636,11 +699,16 @@ impl Outputs for stiff_limit::StiffLimit {
         vec![named("stiff_limit.png", self.figure())]
     }
     fn tables(&self) -> Vec<Table> {
-        let header = ["case", "eps", "outcome", "t_end", "final_R", "steps", "f_evals", "seconds"];
+        let header = [
+            "case", "eps", "outcome", "t_end", "final_R", "steps", "f_evals", "seconds",
+        ];
         vec![Table::new("runs.csv", &header, self.rows())]
     }
     fn lines(&self) -> Vec<String> {
-        let mut lines = vec![format!("rigid rod: stable root R* = {:?}", self.rigid_R_star)];
+        let mut lines = vec![format!(
+            "rigid rod: stable root R* = {:?}",
+            self.rigid_R_star
+        )];
         lines.extend(self.runs.iter().map(|r| {
             let events: Vec<(f64, usize, &str)> =
                 r.events.iter().map(|e| (e.t, e.point, e.case.as_str())).collect();

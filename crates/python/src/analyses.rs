@@ -3,13 +3,20 @@
 //! off the GIL, and returns its summary as a dict with its per-point data
 //! as NumPy arrays.
 
-use mechlab::analysis::chaos_map::{chaos_map as fli_map, ChaosMapSettings};
-use mechlab::analysis::on_constraints::vibration::{vibration_stability, VibrationSettings};
-use mechlab::analysis::period_map::{portrait as portrait_of, PortraitSettings};
-use mechlab::analysis::section::{section_study, SectionOptions};
-use mechlab::analysis::stability::{stability as stability_of, Settings};
+use std::collections::BTreeMap;
+
+use mechlab::analysis::attractor::Attractor;
+use mechlab::analysis::basins::Basins;
+use mechlab::analysis::chaos_map::{ChaosMap, ChaosMapSettings};
+use mechlab::analysis::continuation::Continuation;
+use mechlab::analysis::declared::Analysis;
+use mechlab::analysis::period_map::Portrait;
+use mechlab::analysis::section::SectionStudy;
+use mechlab::analysis::stability::Stability;
+use mechlab::explore::Exploration;
 use mechlab::ode::Method;
 use mechlab::registry::Model;
+use mechlab::settings::Declared;
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
@@ -20,7 +27,10 @@ use crate::detached::{detached, progress};
 use crate::errors::py_err;
 
 /// `summary` (serde) as a dict.
-fn summary<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyDict>> {
+pub fn summary<'py, T: serde::Serialize>(
+    py: Python<'py>,
+    value: &T,
+) -> PyResult<Bound<'py, PyDict>> {
     Ok(pythonize::pythonize(py, value)?.cast_into::<PyDict>()?)
 }
 
@@ -36,15 +46,50 @@ fn points<'py>(
         .into_pyarray(py)
 }
 
-/// Orbits of the period map (the `period_map` scene).
-pub fn portrait<'py>(
-    py: Python<'py>,
+/// A declared analysis's settings from keyword arguments (by the names of
+/// its declaration; `base`'s values where not given), checked by the
+/// declaration.
+pub fn declared_from<T: Declared>(base: T, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<T> {
+    let given: serde_json::Map<String, serde_json::Value> = match kwargs {
+        Some(kwargs) => pythonize::depythonize(kwargs)?,
+        None => serde_json::Map::new(),
+    };
+    base.with_json(&given).map_err(py_err)
+}
+
+/// Declared analysis `T` run with the keyword `settings`, off the GIL,
+/// with a progress bar where it counts its work and `show` asks for one;
+/// Ctrl-C stops it.
+pub fn run<T: Analysis>(
+    py: Python<'_>,
     model: &'static Model,
-    values: Vec<f64>,
-    settings: PortraitSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    let result = detached(py, || portrait_of(model, &values, &settings))?.map_err(py_err)?;
-    let dict = summary(py, &result)?;
+    params: Option<BTreeMap<String, f64>>,
+    settings: Option<&Bound<'_, PyDict>>,
+    show: bool,
+) -> PyResult<T::Output> {
+    let values = model
+        .values_with(&params.unwrap_or_default())
+        .map_err(py_err)?;
+    let options: T = declared_from(T::default(), settings)?;
+    let label = format!("{} {}", model.info.name, T::ANALYSIS);
+    let bar = progress(options.work() as u64, &label);
+    if !show || options.work() == 0 {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let result = detached(py, || {
+        options.run(model, &values, &|k| {
+            bar.inc(k as u64);
+            !mechlab::ode::stop::stop_requested()
+        })
+    })?
+    .map_err(py_err)?;
+    bar.finish_and_clear();
+    Ok(result)
+}
+
+/// A period map's portrait: each orbit as an (n, 2) array.
+pub fn portrait<'py>(py: Python<'py>, result: &Portrait) -> PyResult<Bound<'py, PyDict>> {
+    let dict = summary(py, result)?;
     let orbits: Vec<_> = result
         .orbits
         .iter()
@@ -55,29 +100,10 @@ pub fn portrait<'py>(
     Ok(dict)
 }
 
-/// The FLI map of the period map (the `chaos_map` scene), with a
-/// progress bar by rows; Ctrl-C stops it between blocks of rows.
-pub fn chaos_map<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: ChaosMapSettings,
-    show_progress: bool,
-) -> PyResult<Bound<'py, PyDict>> {
-    let pixels = settings.pixels;
-    let bar = progress(pixels as u64, &format!("{} FLI map rows", model.info.name));
-    if !show_progress {
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    let result = detached(py, || {
-        fli_map(model, &values, &settings, &|| {
-            bar.inc(1);
-            !mechlab::ode::stop::stop_requested()
-        })
-    })?
-    .map_err(py_err)?;
-    bar.finish_and_clear();
-    let dict = summary(py, &result)?;
+/// The FLI map as an image `fli`.
+pub fn chaos_map<'py>(py: Python<'py>, result: &ChaosMap) -> PyResult<Bound<'py, PyDict>> {
+    let pixels = result.pixels;
+    let dict = summary(py, result)?;
     let image = Array2::from_shape_vec((pixels, pixels), result.fli.clone())
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     dict.set_item("fli", image.into_pyarray(py))?;
@@ -85,51 +111,17 @@ pub fn chaos_map<'py>(
     Ok(dict)
 }
 
-/// A constrained model's stabilisation on its constraints (the `linkage`
-/// scene).
-pub fn linkage<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: VibrationSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    let Some(constrained) = model.constrained else {
-        return Err(py_err(mechlab::analysis::Refusal::Setting {
-            model: model.info.name.into(),
-            requirement: "linkage runs on a model with [[constraints]] in its file (`stability` on the others)",
-        }));
-    };
-    let result =
-        detached(py, || vibration_stability(constrained, &values, &settings))?.map_err(py_err)?;
-    summary(py, &result)
-}
-
-/// Stabilisation by vibration (the `stability` scene): thresholds a*
-/// and exact windows of a model's equilibria.
-pub fn stability<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: Settings,
-) -> PyResult<Bound<'py, PyDict>> {
-    let result = detached(py, || stability_of(model, &values, &settings))?.map_err(py_err)?;
-    let dict = summary(py, &result)?;
+/// Stabilisation by vibration with its text report.
+pub fn stability<'py>(py: Python<'py>, result: &Stability) -> PyResult<Bound<'py, PyDict>> {
+    let dict = summary(py, result)?;
     dict.set_item("report", result.report(usize::MAX))?;
     Ok(dict)
 }
 
-/// A Poincaré section at a fixed energy (the `section` scene): the
-/// scene's summary, each orbit's points as an (n, 2) array, the MEGNO map
-/// as an image `megno`, the frequency map's tunes and diffusion index as
-/// images.
-pub fn section<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    options: SectionOptions,
-) -> PyResult<Bound<'py, PyDict>> {
-    let study =
-        detached(py, || section_study(model, &values, &options, &|_| ()))?.map_err(py_err)?;
+/// A section study: each orbit's points as an (n, 2) array, the MEGNO
+/// map as an image `megno`, the frequency map's tunes and diffusion
+/// index as images.
+pub fn section<'py>(py: Python<'py>, study: &SectionStudy) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
     let section = match &study.section {
         None => None,
@@ -165,63 +157,20 @@ pub fn section<'py>(
     Ok(dict)
 }
 
-/// The attractor of a forced, damped period map (the `attractor`
-/// scene): its points as an (n, 2) array, the Lyapunov spectrum and the
-/// dimensions.
-pub fn attractor<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::attractor::AttractorSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::attractor::attractor as attractor_of;
-    let result = detached(py, || attractor_of(model, &values, &settings))?.map_err(py_err)?;
-    let dict = summary(py, &result)?;
+/// An attractor: its points as an (n, 2) array, the Lyapunov spectrum's
+/// convergence.
+pub fn attractor<'py>(py: Python<'py>, result: &Attractor) -> PyResult<Bound<'py, PyDict>> {
+    let dict = summary(py, result)?;
     dict.set_item("orbit", points(py, result.orbit.iter().copied()))?;
-    let convergence: Vec<(usize, Vec<f64>)> = result.convergence.clone();
-    dict.set_item("convergence", convergence)?;
+    dict.set_item("convergence", result.convergence.clone())?;
     Ok(dict)
 }
 
-/// Periodic orbits continued in a parameter with their bifurcations (the
-/// `continuation` scene).
-pub fn continuation<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::continuation::ContinuationSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::continuation::continuation as continuation_of;
-    let result = detached(py, || continuation_of(model, &values, &settings))?.map_err(py_err)?;
-    let dict = summary(py, &result)?;
+/// A continuation with the names of the state's components.
+pub fn continuation<'py>(py: Python<'py>, result: &Continuation) -> PyResult<Bound<'py, PyDict>> {
+    let dict = summary(py, result)?;
     dict.set_item("state_names", result.state_names.clone())?;
     Ok(dict)
-}
-
-/// The splitting of the separatrices of the period map's saddle (the
-/// `separatrix_splitting` scene): lobe areas by two routes.
-pub fn separatrix_splitting<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::separatrix::SplittingSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::separatrix::separatrix_splitting as splitting_of;
-    let result = detached(py, || splitting_of(model, &values, &settings))?.map_err(py_err)?;
-    summary(py, &result)
-}
-
-/// The exact system against the averaged one as the phase's rate grows
-/// (the `averaging` scene): the deviation's slope against the frequency.
-pub fn averaging<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::averaging::ConvergenceSettings,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::averaging::convergence;
-    let result = detached(py, || convergence(model, &values, &settings))?.map_err(py_err)?;
-    summary(py, &result)
 }
 
 /// Rows of numbers as a 2-D array (NaN-padded if ragged).
@@ -240,17 +189,7 @@ fn table<'py>(py: Python<'py>, rows: &[Vec<f64>]) -> Bound<'py, numpy::PyArray2<
 /// stick–slip switching too): the run, the averaged run and the period
 /// map where there is a fast phase, the energy's change, the equilibria,
 /// a constrained model's reactions.
-pub fn explore<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    y0: Vec<f64>,
-    settings: mechlab::explore::Settings,
-) -> PyResult<Bound<'py, PyDict>> {
-    let result = detached(py, || {
-        mechlab::explore::explore(model, &values, &y0, &settings)
-    })?
-    .map_err(py_err)?;
+pub fn explore<'py>(py: Python<'py>, result: &Exploration) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
     dict.set_item("times", result.times.clone().into_pyarray(py))?;
     dict.set_item("states", table(py, &result.exact))?;
@@ -307,31 +246,11 @@ pub fn iterates<'py>(
     Ok(array.into_pyarray(py))
 }
 
-/// The basins of attraction of a period map's attractors on a plane of
-/// starts (the `basins` scene): `labels[j, i]` the attractor of each
-/// pixel (row 0 at the bottom; −1 diverged), each attractor's points.
-pub fn basins<'py>(
-    py: Python<'py>,
-    model: &'static Model,
-    values: Vec<f64>,
-    settings: mechlab::analysis::basins::BasinSettings,
-    show_progress: bool,
-) -> PyResult<Bound<'py, PyDict>> {
-    use mechlab::analysis::basins::basins as basins_of;
-    let pixels = settings.pixels;
-    let bar = progress(
-        (pixels * pixels) as u64,
-        &format!("{} basins starts", model.info.name),
-    );
-    if !show_progress {
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    let result = detached(py, || {
-        basins_of(model, &values, &settings, &|k| bar.inc(k as u64))
-    })?
-    .map_err(py_err)?;
-    bar.finish_and_clear();
-    let dict = summary(py, &result)?;
+/// Basins: `labels[j, i]` the attractor of each pixel (row 0 at the
+/// bottom; −1 diverged), each attractor's points.
+pub fn basins<'py>(py: Python<'py>, result: &Basins) -> PyResult<Bound<'py, PyDict>> {
+    let pixels = result.pixels;
+    let dict = summary(py, result)?;
     let labels = Array2::from_shape_vec((pixels, pixels), result.labels.clone())
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     dict.set_item("labels", labels.into_pyarray(py))?;

@@ -17,14 +17,16 @@ use mechlab::analysis::averaging::AveragingOptions;
 use mechlab::analysis::basins::BasinsOptions;
 use mechlab::analysis::chaos_map::ChaosMapOptions;
 use mechlab::analysis::continuation::ContinuationOptions;
+use mechlab::analysis::declared::Analysis;
 use mechlab::analysis::on_constraints::vibration::LinkageOptions;
 use mechlab::analysis::period_map::PeriodMapOptions;
+use mechlab::analysis::section::SectionOptions;
 use mechlab::analysis::separatrix::SplittingOptions;
 use mechlab::analysis::stability::StabilityOptions;
 use mechlab::analysis::states::{states_at, states_of_starts};
+use mechlab::explore::ExploreOptions;
 use mechlab::ode::Method;
 use mechlab::registry::{Kind, Model};
-use mechlab::settings::Declared;
 use numpy::ndarray::{Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike1, PyArrayLike2};
 use pyo3::exceptions::PyValueError;
@@ -378,10 +380,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: PeriodMapOptions = declared(settings)?;
-        let settings = options.resolve(self.model).map_err(py_err)?;
-        analyses::portrait(py, self.model, values, settings)
+        let result = self.run::<PeriodMapOptions>(py, params, settings, false)?;
+        analyses::portrait(py, &result)
     }
 
     /// The fast Lyapunov indicator of the period map on a plane of
@@ -396,10 +396,8 @@ impl PyModel {
         progress: bool,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: ChaosMapOptions = declared(settings)?;
-        let settings = options.resolve(self.model).map_err(py_err)?;
-        analyses::chaos_map(py, self.model, values, settings, progress)
+        let result = self.run::<ChaosMapOptions>(py, params, settings, progress)?;
+        analyses::chaos_map(py, &result)
     }
 
     /// Stabilisation by vibration on the constraints of a constrained
@@ -413,9 +411,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: LinkageOptions = declared(settings)?;
-        analyses::linkage(py, self.model, values, options.resolve().map_err(py_err)?)
+        let result = self.run::<LinkageOptions>(py, params, settings, false)?;
+        analyses::summary(py, &result)
     }
 
     /// Stabilisation by vibration: for each equilibrium the averaged
@@ -433,10 +430,8 @@ impl PyModel {
         if self.model.constrained.is_some() {
             return self.linkage(py, params, settings);
         }
-        let values = parameter_values(self.model, params)?;
-        let options: StabilityOptions = declared(settings)?;
-        let settings = options.resolve(self.model).map_err(py_err)?;
-        analyses::stability(py, self.model, values, settings)
+        let result = self.run::<StabilityOptions>(py, params, settings, false)?;
+        analyses::stability(py, &result)
     }
 
     /// The attractor of a forced, damped period map: its points, Lyapunov
@@ -450,9 +445,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: AttractorOptions = declared(settings)?;
-        analyses::attractor(py, self.model, values, options.resolve().map_err(py_err)?)
+        let result = self.run::<AttractorOptions>(py, params, settings, false)?;
+        analyses::attractor(py, &result)
     }
 
     /// Periodic orbits of the period map followed in a parameter, their
@@ -465,10 +459,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: ContinuationOptions = declared(settings)?;
-        let settings = options.resolve(self.model, &values).map_err(py_err)?;
-        analyses::continuation(py, self.model, values, settings)
+        let result = self.run::<ContinuationOptions>(py, params, settings, false)?;
+        analyses::continuation(py, &result)
     }
 
     /// The splitting of the separatrices of the period map's hyperbolic
@@ -482,10 +474,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: SplittingOptions = declared(settings)?;
-        let settings = options.resolve().map_err(py_err)?;
-        analyses::separatrix_splitting(py, self.model, values, settings)
+        let result = self.run::<SplittingOptions>(py, params, settings, false)?;
+        analyses::summary(py, &result)
     }
 
     /// The exact system against the averaged one (of order 1 or 2) as the
@@ -499,9 +489,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: AveragingOptions = declared(settings)?;
-        analyses::averaging(py, self.model, values, options.resolve().map_err(py_err)?)
+        let result = self.run::<AveragingOptions>(py, params, settings, false)?;
+        analyses::summary(py, &result)
     }
 
     /// What the `explore` scene shows, for any model (the contact models
@@ -516,10 +505,8 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: mechlab::explore::ExploreOptions = declared(settings)?;
-        let (settings, y0) = options.resolve(self.model).map_err(py_err)?;
-        analyses::explore(py, self.model, values, y0, settings)
+        let result = self.run::<ExploreOptions>(py, params, settings, false)?;
+        analyses::explore(py, &result)
     }
 
     /// The period map's iterates from many starts (rows of `starts`,
@@ -562,10 +549,8 @@ impl PyModel {
         progress: bool,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        let options: BasinsOptions = declared(settings)?;
-        let settings = options.resolve(self.model).map_err(py_err)?;
-        analyses::basins(py, self.model, values, settings, progress)
+        let result = self.run::<BasinsOptions>(py, params, settings, progress)?;
+        analyses::basins(py, &result)
     }
 
     /// The frequency map of the period map (a model with a fast phase) on
@@ -582,7 +567,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
         let base = mechlab::analysis::frequency_map::period_map_options();
-        let options = declared_from(base, settings)?;
+        let options = analyses::declared_from(base, settings)?;
         let settings = options.resolve(self.model).map_err(py_err)?;
         analyses::period_map_frequencies(py, self.model, values, settings, progress)
     }
@@ -598,8 +583,21 @@ impl PyModel {
         params: Option<BTreeMap<String, f64>>,
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let values = parameter_values(self.model, params)?;
-        analyses::section(py, self.model, values, declared(settings)?)
+        let result = self.run::<SectionOptions>(py, params, settings, false)?;
+        analyses::section(py, &result)
+    }
+}
+
+impl PyModel {
+    /// Declared analysis `T` on this model (`analyses::run`).
+    fn run<T: Analysis>(
+        &self,
+        py: Python<'_>,
+        params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'_, PyDict>>,
+        show: bool,
+    ) -> PyResult<T::Output> {
+        analyses::run::<T>(py, self.model, params, settings, show)
     }
 }
 
@@ -608,22 +606,6 @@ fn parameter_values(model: &Model, params: Option<BTreeMap<String, f64>>) -> PyR
     model
         .values_with(&params.unwrap_or_default())
         .map_err(py_err)
-}
-
-/// A declared analysis's settings from keyword arguments (by the names of
-/// its declaration, its defaults where not given), checked by the
-/// declaration.
-fn declared<T: Declared>(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<T> {
-    declared_from(T::default(), kwargs)
-}
-
-/// The same from other defaults than the declaration's (a preset).
-fn declared_from<T: Declared>(base: T, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<T> {
-    let given: serde_json::Map<String, serde_json::Value> = match kwargs {
-        Some(kwargs) => pythonize::depythonize(kwargs)?,
-        None => serde_json::Map::new(),
-    };
-    base.with_json(&given).map_err(py_err)
 }
 
 /// Every declared analysis's settings: name, type, default, range and

@@ -18,6 +18,7 @@ pub mod contact;
 pub mod explore;
 pub mod mathml;
 pub mod ode;
+pub mod outputs;
 pub mod plot;
 pub mod registry;
 pub mod report;

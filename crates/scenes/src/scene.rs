@@ -139,6 +139,8 @@ pub enum SceneError {
     #[error(transparent)]
     Setting(#[from] mechlab_runtime::settings::SettingError),
     #[error(transparent)]
+    Analysis(#[from] mechlab_runtime::analysis::declared::AnalysisError),
+    #[error(transparent)]
     Ode(#[from] mechlab_runtime::ode::OdeError),
     #[error(transparent)]
     Basins(#[from] mechlab_runtime::analysis::basins::BasinsError),

@@ -6,52 +6,9 @@
 //! its scene is then one line.
 
 use crate::scene::{parameter_knobs, Knob, Scene, SceneError};
-use mechlab_runtime::plot::Figure;
+pub use mechlab_runtime::outputs::{Outputs, Table};
 use mechlab_runtime::registry::ModelInfo;
 use mechlab_runtime::settings::Declared;
-
-/// A table of a result, already in CSV (through the csv crate, floats in
-/// the shortest form that reads back exactly).
-pub struct Table {
-    pub file: String,
-    pub csv: Vec<u8>,
-}
-
-impl Table {
-    /// The CSV of `header` and one record per row (tuples or structs of
-    /// numbers and text).
-    pub fn new<R: serde::Serialize>(
-        file: impl Into<String>,
-        header: &[&str],
-        rows: impl IntoIterator<Item = R>,
-    ) -> Table {
-        let mut writer = csv::WriterBuilder::new()
-            .has_headers(false)
-            .from_writer(Vec::new());
-        writer.write_record(header).expect("CSV into memory");
-        for row in rows {
-            writer.serialize(row).expect("rows of numbers and text");
-        }
-        Table {
-            file: file.into(),
-            csv: writer.into_inner().expect("CSV into memory"),
-        }
-    }
-}
-
-/// What a result writes beside its `summary.json` (itself, serialised).
-pub trait Outputs: serde::Serialize {
-    /// Its figures, each with its file name (`.png`).
-    fn figures(&self) -> Vec<(String, Figure)>;
-    /// Its tables.
-    fn tables(&self) -> Vec<Table> {
-        Vec::new()
-    }
-    /// Its headline numbers, printed on the console.
-    fn lines(&self) -> Vec<String> {
-        Vec::new()
-    }
-}
 
 /// A study: its declared settings, the model whose parameters it takes (with
 /// the study's own defaults for some), and its run.
@@ -99,4 +56,17 @@ pub fn write_outputs<O: Outputs>(scene: &Scene, outcome: &O) -> Result<(), Scene
     }
     scene.write_summary(outcome)?;
     Ok(())
+}
+
+/// The standard map's study (declared and run in the library).
+impl Study for mechlab_runtime::analysis::standard_map::StandardMapOptions {
+    type Outcome = mechlab_runtime::analysis::standard_map::StandardMapStudy;
+    fn model() -> Option<&'static ModelInfo> {
+        None
+    }
+    fn run(&self, _: &[f64]) -> Result<Self::Outcome, SceneError> {
+        Ok(mechlab_runtime::analysis::standard_map::standard_map_study(
+            self,
+        ))
+    }
 }

@@ -10,8 +10,8 @@ pub mod graphs;
 pub mod impact;
 pub mod stiff_limit;
 
-use crate::models::painleve_klein::Params;
 use super::StudyError;
+use crate::models::painleve_klein::Params;
 
 /// δ, δ', R, cos φ, sin φ at the state [x1, x2, v1, v2].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -338,7 +338,8 @@ pub fn study_params(values: &[f64]) -> Result<Params, StudyError> {
     {
         return Err(StudyError::Settings {
             setting: "d, l, eps, k, nu, mu1, mu2",
-            requirement: "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0",
+            requirement:
+                "the rod needs 0 < d < l, ε > 0, k > 0, ν ≥ 0 and friction coefficients ≥ 0",
         });
     }
     Ok(p)

@@ -691,3 +691,39 @@ impl AveragingConvergence {
         figure
     }
 }
+
+impl crate::outputs::Outputs for AveragingConvergence {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        vec![("convergence.png".into(), self.figure())]
+    }
+    /// Per value and coordinate: the frequency, the largest deviation, and
+    /// ν × deviation.
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let rows = self.coordinates.iter().enumerate().flat_map(|(c, name)| {
+            (0..self.values.len()).map(move |k| {
+                (
+                    self.values[k],
+                    self.frequencies[k],
+                    name.clone(),
+                    self.max_deviation[c][k],
+                    self.frequency_times_deviation[c][k],
+                )
+            })
+        });
+        let header = [
+            self.parameter.as_str(),
+            "frequency",
+            "coordinate",
+            "max_deviation",
+            "frequency_times_max_deviation",
+        ];
+        vec![crate::outputs::Table::new("convergence.csv", &header, rows)]
+    }
+    fn lines(&self) -> Vec<String> {
+        self.coordinates
+            .iter()
+            .zip(&self.slope)
+            .map(|(c, s)| format!("{c}: max deviation ∝ ν^{s:.4}"))
+            .collect()
+    }
+}

@@ -10,6 +10,7 @@ pub mod averaging;
 pub mod basins;
 pub mod chaos_map;
 pub mod continuation;
+pub mod declared;
 pub mod dimension;
 pub mod equilibria;
 pub mod fit;

@@ -471,3 +471,24 @@ impl Portrait {
         figure
     }
 }
+
+impl crate::outputs::Outputs for Portrait {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        vec![("period_map.png".into(), self.figure())]
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let rows = self
+            .orbits
+            .iter()
+            .enumerate()
+            .flat_map(|(k, orbit)| orbit.iter().map(move |(a, b)| (k, *a, *b)));
+        let header = ["orbit", self.axes[0].as_str(), self.axes[1].as_str()];
+        vec![crate::outputs::Table::new("orbits.csv", &header, rows)]
+    }
+    fn lines(&self) -> Vec<String> {
+        self.failed
+            .iter()
+            .map(|stopped| format!("orbit {} stopped: {}", stopped.orbit, stopped.error))
+            .collect()
+    }
+}

@@ -2,6 +2,7 @@
 //! (q, p) ↦ (q + p + ε sin q, p + ε sin q), and its tangent map.
 
 use super::period_map::wrap_angle;
+use crate::outputs::{Outputs, Table};
 use crate::plot::{palette, ColorMap, Figure, PanelSpec};
 use crate::tangent::lyapunov::fli_shading;
 use rayon::prelude::*;
@@ -137,7 +138,10 @@ impl StandardMapStudy {
 
     /// The FLI map in `colors`.
     pub fn chaos_map_figure(&self, colors: ColorMap) -> Figure {
-        let title = format!("FLI chaos map, ε = {}, {} iterations", self.eps, self.iterations);
+        let title = format!(
+            "FLI chaos map, ε = {}, {} iterations",
+            self.eps, self.iterations
+        );
         let spec = PanelSpec::new(&title, "q", "p", (-PI, PI), (-PI, PI));
         let n = self.pixels;
         let mut figure = Figure::single(n + 90, n + 75, spec);
@@ -149,7 +153,10 @@ impl StandardMapStudy {
     /// (orbit, iterate, q, p) of every orbit.
     pub fn orbit_rows(&self) -> impl Iterator<Item = (usize, usize, f64, f64)> + '_ {
         self.orbits.iter().enumerate().flat_map(|(k, orbit)| {
-            orbit.iter().enumerate().map(move |(n, &(q, p))| (k, n, q, p))
+            orbit
+                .iter()
+                .enumerate()
+                .map(move |(n, &(q, p))| (k, n, q, p))
         })
     }
 
@@ -159,5 +166,31 @@ impl StandardMapStudy {
             let (q, p) = pixel_centre(k, self.pixels);
             (q, p, f)
         })
+    }
+}
+
+impl Outputs for StandardMapStudy {
+    fn figures(&self) -> Vec<(String, Figure)> {
+        vec![
+            ("orbits.png".into(), self.orbits_figure()),
+            (
+                "chaos_map.png".into(),
+                self.chaos_map_figure(ColorMap::Grey),
+            ),
+            (
+                "chaos_map_viridis.png".into(),
+                self.chaos_map_figure(ColorMap::Viridis),
+            ),
+        ]
+    }
+    fn tables(&self) -> Vec<Table> {
+        vec![
+            Table::new(
+                "orbits.csv",
+                &["orbit", "iterate", "q", "p"],
+                self.orbit_rows(),
+            ),
+            Table::new("chaos_map.csv", &["q", "p", "fli"], self.map_rows()),
+        ]
     }
 }

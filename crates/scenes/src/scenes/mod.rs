@@ -3,6 +3,7 @@
 //! defaults, the same files): knobs → one library call → figures.
 
 use crate::scene::{knob, parameter_knobs, Knob, Scene, SceneError, ValueProblem};
+use mechlab_runtime::analysis::declared::{no_progress, Analysis};
 use mechlab_runtime::registry::{Catalog, Model};
 use mechlab_runtime::settings::Declared;
 
@@ -13,8 +14,8 @@ mod orbits;
 mod section;
 mod separatrix;
 mod stability;
-mod standard_map;
 
+pub use crate::study::{study_scene, write_outputs, Outputs, Study, Table};
 pub use averaging::averaging_scene;
 pub use continuation::continuation_scene;
 pub use maps::{basins_scene, chaos_map_scene, frequency_map_scene};
@@ -22,7 +23,6 @@ pub use orbits::{attractor_scene, explore_scene, period_map_scene};
 pub use section::section_scene;
 pub use separatrix::separatrix_scene;
 pub use stability::{linkage_scene, stability_scene};
-pub use crate::study::{study_scene, write_outputs, Outputs, Study, Table};
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
 /// clear error listing the known ones.
@@ -83,6 +83,30 @@ fn declared_scene<T: Declared>(
     let scene = Scene::from_args(scene_name, &about, &knobs)?;
     let options = T::default().with_texts(names.iter().map(|&n| (n, scene.text(n))))?;
     Ok((handle, scene, options))
+}
+
+/// The scene of a declared analysis whose result says what it writes:
+/// [`declared_scene`], the one driver ([`Analysis::run`]), its files.
+fn analysis_scene<T: Analysis>(
+    catalog: Catalog,
+    scene_name: &'static str,
+    default_model: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError>
+where
+    T::Output: crate::study::Outputs,
+{
+    let (model, scene, options) = declared_scene::<T>(
+        catalog,
+        scene_name,
+        (default_model, None),
+        (T::default(), overrides),
+        &[],
+    )?;
+    eprintln!("{} on {} …", T::ANALYSIS, model.info.name);
+    let values = scene.parameter_values(model.info)?;
+    let result = options.run(model, &values, &no_progress)?;
+    crate::study::write_outputs(&scene, &result)
 }
 
 /// Processes that share a tiled sweep (a chaos map, basins), such as the

@@ -13,68 +13,16 @@ pub fn period_map_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::period_map::{portrait, PeriodMapOptions};
-    let (model, scene, options) = declared_scene::<PeriodMapOptions>(
-        catalog,
-        scene_name,
-        ("kapitza", None),
-        (PeriodMapOptions::default(), overrides),
-        &[],
-    )?;
-    let info = model.info;
-    let settings = options.resolve(model)?;
-    let result = portrait(model, &scene.parameter_values(info)?, &settings)?;
-    for stopped in &result.failed {
-        eprintln!("orbit {} stopped: {}", stopped.orbit, stopped.error);
-    }
-    scene.save_figure(&result.figure(), "period_map.png")?;
-    let rows = result
-        .orbits
-        .iter()
-        .enumerate()
-        .flat_map(|(k, orbit)| orbit.iter().map(move |(a, b)| (k, *a, *b)));
-    scene.write_csv(
-        "orbits.csv",
-        &["orbit", result.axes[0].as_str(), result.axes[1].as_str()],
-        rows,
-    )?;
-    scene.write_summary(&result)?;
-    Ok(())
+    use mechlab_runtime::analysis::period_map::PeriodMapOptions;
+    super::analysis_scene::<PeriodMapOptions>(catalog, scene_name, "kapitza", overrides)
 }
 
 /// Scene `attractor`: the attractor of the period map of a forced, damped
 /// model of one degree of freedom (a constrained one: on its constraints)
 /// by name, its Lyapunov spectrum and dimensions.
 pub fn attractor_scene(catalog: Catalog) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::attractor::{attractor, AttractorOptions};
-    let (model, scene, options) = declared_scene::<AttractorOptions>(
-        catalog,
-        "attractor",
-        ("ueda", None),
-        (AttractorOptions::default(), &[]),
-        &[],
-    )?;
-    let settings = options.resolve()?;
-    let params = scene.parameter_values(model.info)?;
-    eprintln!(
-        "{} periods of the map and two Lyapunov runs of {} …",
-        settings.transient + settings.points,
-        settings.lyapunov_periods
-    );
-    let result = attractor(model, &params, &settings)?;
-    scene.save_figure(&result.figure(), "attractor.png")?;
-    scene.write_csv(
-        "attractor.csv",
-        &["q", "p"],
-        result.orbit.iter().map(|y| (y[0], y[1])),
-    )?;
-    scene.write_csv(
-        "lyapunov_convergence.csv",
-        &["periods", "lambda_1", "lambda_2"],
-        result.convergence.iter().map(|(k, l)| (*k, l[0], l[1])),
-    )?;
-    scene.write_summary(&result)?;
-    Ok(())
+    use mechlab_runtime::analysis::attractor::AttractorOptions;
+    super::analysis_scene::<AttractorOptions>(catalog, "attractor", "ueda", &[])
 }
 
 /// The `explore` scene: any model by name, its runs, portraits, period

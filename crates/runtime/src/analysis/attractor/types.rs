@@ -232,3 +232,25 @@ impl Attractor {
         figure
     }
 }
+
+impl crate::outputs::Outputs for Attractor {
+    fn figures(&self) -> Vec<(String, Figure)> {
+        vec![("attractor.png".into(), self.figure())]
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        use crate::outputs::Table;
+        let convergence = self.convergence.iter().map(|(k, l)| (*k, l[0], l[1]));
+        vec![
+            Table::new(
+                "attractor.csv",
+                &["q", "p"],
+                self.orbit.iter().map(|y| (y[0], y[1])),
+            ),
+            Table::new(
+                "lyapunov_convergence.csv",
+                &["periods", "lambda_1", "lambda_2"],
+                convergence,
+            ),
+        ]
+    }
+}

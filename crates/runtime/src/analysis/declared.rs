@@ -1,0 +1,247 @@
+//! Every declared analysis behind one call: [`Analysis::run`] takes the
+//! declared settings, resolves what is `auto` from the model and runs the
+//! analysis. The scenes, the studio and Python call it alike, so the same
+//! settings give the same numbers whichever door they came through.
+
+use crate::analysis::attractor::{attractor, AttractorError, AttractorOptions};
+use crate::analysis::averaging::{convergence, AveragingError, AveragingOptions};
+use crate::analysis::basins::{basins, BasinsError, BasinsOptions};
+use crate::analysis::chaos_map::{chaos_map, ChaosMapOptions};
+use crate::analysis::continuation::{continuation, ContinuationError, ContinuationOptions};
+use crate::analysis::on_constraints::vibration::{
+    vibration_stability, LinkageOptions, VibrationError,
+};
+use crate::analysis::period_map::{portrait, PeriodMapError, PeriodMapOptions};
+use crate::analysis::section::{section_study, SectionError, SectionOptions};
+use crate::analysis::separatrix::{separatrix_splitting, SplittingError, SplittingOptions};
+use crate::analysis::stability::{stability, StabilityError, StabilityOptions};
+use crate::analysis::Refusal;
+use crate::classify::{Classify, ErrorClass};
+use crate::explore::{explore, ExploreError, ExploreOptions};
+use crate::registry::Model;
+use crate::settings::{Declared, SettingError};
+
+/// Progress of a run: `progress(k)` after `k` more units of its work (rows
+/// of a map, starts of the basins); `false` asks it to stop between blocks.
+pub type Progress<'a> = &'a (dyn Fn(usize) -> bool + Sync);
+
+/// A progress that counts nothing and never stops.
+pub fn no_progress(_: usize) -> bool {
+    true
+}
+
+/// A declared analysis: its settings ([`Declared`]), what it returns, and
+/// its run on a model.
+pub trait Analysis: Declared + Send + Sync {
+    type Output: Send;
+    /// The units `progress` counts in a run of these settings (0: it
+    /// reports none).
+    fn work(&self) -> usize {
+        0
+    }
+    /// Runs on `model` at the parameter `values`.
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        progress: Progress,
+    ) -> Result<Self::Output, AnalysisError>;
+}
+
+/// Why a declared analysis did not give its result.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    #[error(transparent)]
+    Setting(#[from] SettingError),
+    #[error(transparent)]
+    Refusal(#[from] Refusal),
+    #[error(transparent)]
+    Basins(#[from] BasinsError),
+    #[error(transparent)]
+    Continuation(#[from] ContinuationError),
+    #[error(transparent)]
+    Splitting(#[from] SplittingError),
+    #[error(transparent)]
+    Section(#[from] SectionError),
+    #[error(transparent)]
+    Stability(#[from] StabilityError),
+    #[error(transparent)]
+    Vibration(#[from] VibrationError),
+    #[error(transparent)]
+    Attractor(#[from] AttractorError),
+    #[error(transparent)]
+    Averaging(#[from] AveragingError),
+    #[error(transparent)]
+    PeriodMap(#[from] PeriodMapError),
+    #[error(transparent)]
+    Explore(#[from] ExploreError),
+}
+
+impl Classify for AnalysisError {
+    fn class(&self) -> ErrorClass {
+        match self {
+            AnalysisError::Setting(e) => e.class(),
+            AnalysisError::Refusal(e) => e.class(),
+            AnalysisError::Basins(e) => e.class(),
+            AnalysisError::Continuation(e) => e.class(),
+            AnalysisError::Splitting(e) => e.class(),
+            AnalysisError::Section(e) => e.class(),
+            AnalysisError::Stability(e) => e.class(),
+            AnalysisError::Vibration(e) => e.class(),
+            AnalysisError::Attractor(e) => e.class(),
+            AnalysisError::Averaging(e) => e.class(),
+            AnalysisError::PeriodMap(e) => e.class(),
+            AnalysisError::Explore(e) => e.class(),
+        }
+    }
+}
+
+impl Analysis for ChaosMapOptions {
+    type Output = crate::analysis::chaos_map::ChaosMap;
+    fn work(&self) -> usize {
+        self.pixels
+    }
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        progress: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(chaos_map(model, values, &self.resolve(model)?, &|| {
+            progress(1)
+        })?)
+    }
+}
+
+impl Analysis for BasinsOptions {
+    type Output = crate::analysis::basins::Basins;
+    fn work(&self) -> usize {
+        self.pixels * self.pixels
+    }
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        progress: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(basins(model, values, &self.resolve(model)?, &|k| {
+            progress(k);
+        })?)
+    }
+}
+
+impl Analysis for ContinuationOptions {
+    type Output = crate::analysis::continuation::Continuation;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(continuation(model, values, &self.resolve(model, values)?)?)
+    }
+}
+
+impl Analysis for SplittingOptions {
+    type Output = crate::analysis::separatrix::Splitting;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(separatrix_splitting(model, values, &self.resolve()?)?)
+    }
+}
+
+impl Analysis for SectionOptions {
+    type Output = crate::analysis::section::SectionStudy;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(section_study(model, values, self, &|_| ())?)
+    }
+}
+
+impl Analysis for StabilityOptions {
+    type Output = crate::analysis::stability::Stability;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(stability(model, values, &self.resolve(model)?)?)
+    }
+}
+
+impl Analysis for LinkageOptions {
+    type Output = crate::analysis::on_constraints::vibration::VibrationStability;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        let Some(constrained) = model.constrained else {
+            return Err(Refusal::Setting {
+                model: model.info.name.into(),
+                requirement: "linkage runs on a model with [[constraints]] in its file (`stability` on the others)",
+            }
+            .into());
+        };
+        Ok(vibration_stability(constrained, values, &self.resolve()?)?)
+    }
+}
+
+impl Analysis for AttractorOptions {
+    type Output = crate::analysis::attractor::Attractor;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(attractor(model, values, &self.resolve()?)?)
+    }
+}
+
+impl Analysis for AveragingOptions {
+    type Output = crate::analysis::averaging::AveragingConvergence;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(convergence(model, values, &self.resolve()?)?)
+    }
+}
+
+impl Analysis for PeriodMapOptions {
+    type Output = crate::analysis::period_map::Portrait;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        Ok(portrait(model, values, &self.resolve(model)?)?)
+    }
+}
+
+impl Analysis for ExploreOptions {
+    type Output = crate::explore::Exploration;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        let (settings, y0) = self.resolve(model)?;
+        Ok(explore(model, values, &y0, &settings)?)
+    }
+}
