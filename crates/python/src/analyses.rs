@@ -10,6 +10,7 @@ use mechlab::analysis::basins::Basins;
 use mechlab::analysis::chaos_map::{ChaosMap, ChaosMapSettings};
 use mechlab::analysis::continuation::Continuation;
 use mechlab::analysis::declared::Analysis;
+use mechlab::analysis::on_constraints::vibration::Linkage;
 use mechlab::analysis::period_map::Portrait;
 use mechlab::analysis::section::SectionStudy;
 use mechlab::analysis::stability::Stability;
@@ -108,6 +109,24 @@ pub fn chaos_map<'py>(py: Python<'py>, result: &ChaosMap) -> PyResult<Bound<'py,
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     dict.set_item("fli", image.into_pyarray(py))?;
     dict.set_item("labels", result.labels.to_vec())?;
+    Ok(dict)
+}
+
+/// Stabilisation on the constraints, with the orbits about the
+/// equilibrium (`orbits` and `averaged_orbits`, each an (n, 2) array).
+pub fn linkage<'py>(py: Python<'py>, result: &Linkage) -> PyResult<Bound<'py, PyDict>> {
+    let dict = summary(py, result)?;
+    if let Some(orbits) = &result.orbits {
+        let arrays = |runs: &[Vec<(f64, f64)>]| -> Vec<_> {
+            let pairs =
+                |run: &Vec<(f64, f64)>| run.iter().map(|&(x, y)| [x, y]).collect::<Vec<_>>();
+            runs.iter()
+                .map(|run| points(py, pairs(run).into_iter()))
+                .collect()
+        };
+        dict.set_item("orbits", arrays(&orbits.exact))?;
+        dict.set_item("averaged_orbits", arrays(&orbits.averaged))?;
+    }
     Ok(dict)
 }
 

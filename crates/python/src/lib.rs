@@ -412,7 +412,7 @@ impl PyModel {
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let result = self.run::<LinkageOptions>(py, params, settings, false)?;
-        analyses::summary(py, &result)
+        analyses::linkage(py, &result)
     }
 
     /// Stabilisation by vibration: for each equilibrium the averaged

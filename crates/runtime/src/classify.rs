@@ -137,6 +137,7 @@ impl Classify for BasinsError {
 impl Classify for VibrationError {
     fn class(&self) -> ErrorClass {
         match self {
+            VibrationError::Setting(e) => e.class(),
             VibrationError::Refused(r) => r.class(),
             VibrationError::Ode(e) => e.class(),
             _ => Integration,

@@ -41,6 +41,10 @@ pub trait Outputs: serde::Serialize {
     fn tables(&self) -> Vec<Table> {
         Vec::new()
     }
+    /// Its text files (a document, code).
+    fn texts(&self) -> Vec<(String, String)> {
+        Vec::new()
+    }
     /// Its headline numbers, printed on the console.
     fn lines(&self) -> Vec<String> {
         Vec::new()

@@ -231,3 +231,94 @@ pub fn scene_command(name: &str) -> Vec<&str> {
         ]
     }
 }
+
+/// A model's derivations as a document (the `model_report` scene): its
+/// file, each derived expression in LaTeX, the cost of its generated
+/// right-hand sides, and the generated code itself.
+#[derive(serde::Serialize)]
+pub struct ModelReport {
+    pub model: &'static str,
+    pub expressions: usize,
+    pub generated_lines: usize,
+    /// (function, derived, readable, emitted)
+    pub operation_counts: &'static [(&'static str, usize, usize, usize)],
+    #[serde(skip)]
+    info: &'static crate::registry::ModelInfo,
+}
+
+/// The report of `info`.
+pub fn model_report(info: &'static crate::registry::ModelInfo) -> ModelReport {
+    ModelReport {
+        model: info.name,
+        expressions: info.derivations.len(),
+        generated_lines: info.generated_code.lines().count(),
+        operation_counts: info.operation_counts,
+        info,
+    }
+}
+
+/// One-step averaging of the Kapitza pendulum, said beside its derivations.
+const KAPITZA_NOTE: &str = "One-step averaging (docs/studies.md, Study 1): the generating function \
+    W = P q + ε f(q, P, θ) with f = A P sin q cos θ + (A²/8) sin²q sin 2θ removes the phase at order zero, \
+    leaving Ĥ = H̄ + O(ε) with H̄ the averaged Hamiltonian above: P²/2 + cos Q + (A²/4) sin²Q. \
+    Its upper position Q = 0 is stable when V''(0) = −1 + A²/2 > 0, i.e. A > √2.";
+
+impl ModelReport {
+    /// The document in Markdown with its LaTeX.
+    pub fn markdown(&self) -> String {
+        let model = self.info;
+        let mut markdown = format!(
+            "# Model `{}`\n\nFrom `{}`:\n\n```toml\n{}```\n\n",
+            model.name, model.source_file, model.source
+        );
+        markdown += &format!(
+            "Coordinates {:?}, momenta {:?}; parameters {:?}.\n\n",
+            model.coordinates, model.momenta, model.parameter_names
+        );
+        for d in model.derivations {
+            markdown += &format!(
+                "## `{}`\n\n{}\n\n$$\n{}\n$$\n\n",
+                d.key, d.description, d.latex
+            );
+        }
+        if model.name == "kapitza" {
+            markdown += &format!("## One-step averaging\n\n{KAPITZA_NOTE}\n");
+        }
+        markdown += "## Cost of the generated right-hand sides\n\n\
+            Operations after common-subexpression elimination (transcendental calls count 20, \
+            divisions 4): as derived, in the readable form above, and emitted.\n\n\
+            | function | derived | readable | emitted |\n|---|---|---|---|\n";
+        for (function, derived, readable, emitted) in model.operation_counts {
+            markdown += &format!("| `{function}` | {derived} | {readable} | {emitted} |\n");
+        }
+        markdown
+    }
+}
+
+impl crate::outputs::Outputs for ModelReport {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        Vec::new()
+    }
+    fn texts(&self) -> Vec<(String, String)> {
+        vec![
+            ("derivations.md".into(), self.markdown()),
+            ("generated.rs".into(), self.info.generated_code.into()),
+        ]
+    }
+    fn lines(&self) -> Vec<String> {
+        let model = self.info;
+        let mut lines = vec![format!("model {} ({})\n", model.name, model.source_file)];
+        for d in model.derivations {
+            lines.push(format!("{}  [{}]\n    {}\n", d.key, d.description, d.text));
+        }
+        if model.name == "kapitza" {
+            lines.push(format!("{KAPITZA_NOTE}\n"));
+        }
+        for (function, derived, readable, emitted) in model.operation_counts {
+            lines.push(format!(
+                "cost of {function}: derived {derived}, readable {readable}, emitted {emitted}"
+            ));
+        }
+        lines
+    }
+}

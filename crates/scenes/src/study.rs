@@ -51,6 +51,9 @@ pub fn write_outputs<O: Outputs>(scene: &Scene, outcome: &O) -> Result<(), Scene
     for (file, figure) in outcome.figures() {
         scene.save_figure(&figure, &file)?;
     }
+    for (file, text) in outcome.texts() {
+        scene.write_text(&file, &text)?;
+    }
     for table in outcome.tables() {
         scene.write_bytes(&table.file, &table.csv)?;
     }

@@ -28,9 +28,9 @@ use axum::body::{Body, Bytes};
 use axum::extract::{Path, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
-use axum::routing::{get, post};
+use axum::routing::{get, post, MethodRouter};
 use axum::Router;
-use calls::{self as studio, OrbitRequest, OverlayRequest, StudioError};
+use calls::{self as studio, OrbitRequest, StudioError};
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::classify::{Classify, ErrorClass};
 use mechlab_runtime::registry::Catalog;
@@ -120,12 +120,12 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/models/{name}/derivations", get(derivations))
         .route("/api/orbit", post(orbit))
         .route("/api/chaos", post(chaos))
-        .route("/api/overlay", post(overlay))
-        .route("/api/manifolds", post(manifolds))
-        .route("/api/continuation", post(continuation))
-        .route("/api/section", post(section))
-        .route("/api/section_map", post(section_map))
-        .route("/api/mechanism", post(mechanism))
+        .route("/api/overlay", json_route(studio::overlay))
+        .route("/api/manifolds", json_route(studio::manifolds))
+        .route("/api/continuation", json_route(studio::continuation))
+        .route("/api/section", json_route(studio::section))
+        .route("/api/section_map", json_route(studio::section_map))
+        .route("/api/mechanism", json_route(studio::mechanism))
         .route("/api/basins", post(basins))
         .fallback(|uri: axum::http::Uri| async move {
             ApiError::NotFound {
@@ -204,48 +204,6 @@ async fn derivations(
     Ok(axum::Json(studio::derivations(catalog, &name)?).into_response())
 }
 
-async fn overlay(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: OverlayRequest = serde_json::from_slice(&body)?;
-    let answer =
-        blocking(move || studio::overlay(catalog, &request).map_err(ApiError::from)).await?;
-    Ok(axum::Json(answer).into_response())
-}
-
-async fn manifolds(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::ManifoldsRequest = serde_json::from_slice(&body)?;
-    let answer =
-        blocking(move || studio::manifolds(catalog, &request).map_err(ApiError::from)).await?;
-    Ok(axum::Json(answer).into_response())
-}
-
-async fn continuation(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::ContinuationRequest = serde_json::from_slice(&body)?;
-    let answer =
-        blocking(move || studio::continuation(catalog, &request).map_err(ApiError::from)).await?;
-    Ok(axum::Json(answer).into_response())
-}
-
-async fn section(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::SectionRequest = serde_json::from_slice(&body)?;
-    let answer =
-        blocking(move || studio::section(catalog, &request).map_err(ApiError::from)).await?;
-    Ok(axum::Json(answer).into_response())
-}
-
-async fn section_map(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::SectionRequest = serde_json::from_slice(&body)?;
-    let answer =
-        blocking(move || studio::section_map(catalog, &request).map_err(ApiError::from)).await?;
-    Ok(axum::Json(answer).into_response())
-}
-
-async fn mechanism(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: studio::MechanismRequest = serde_json::from_slice(&body)?;
-    let answer =
-        blocking(move || studio::mechanism(catalog, &request).map_err(ApiError::from)).await?;
-    Ok(axum::Json(answer).into_response())
-}
-
 async fn orbit(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
     let request: OrbitRequest = serde_json::from_slice(&body)?;
     request.check(catalog)?;
@@ -270,6 +228,23 @@ async fn basins(State(catalog): State<Catalog>, body: Bytes) -> Result<Response,
     Ok(stream(move |send, _| {
         studio::basins(catalog, &request, &mut |level| send(&level))
     }))
+}
+
+/// A route that answers one JSON request with one JSON answer, computed
+/// on a blocking thread.
+fn json_route<Q, A>(answer: fn(Catalog, &Q) -> Result<A, StudioError>) -> MethodRouter<Catalog>
+where
+    Q: serde::de::DeserializeOwned + Send + 'static,
+    A: Serialize + Send + 'static,
+{
+    post(
+        move |State(catalog): State<Catalog>, body: Bytes| async move {
+            let request: Q = serde_json::from_slice(&body)?;
+            let answer =
+                blocking(move || answer(catalog, &request).map_err(ApiError::from)).await?;
+            Ok::<_, ApiError>(axum::Json(answer).into_response())
+        },
+    )
 }
 
 #[derive(Serialize)]

@@ -8,9 +8,7 @@ use crate::analysis::averaging::{convergence, AveragingError, AveragingOptions};
 use crate::analysis::basins::{basins, BasinsError, BasinsOptions};
 use crate::analysis::chaos_map::{chaos_map, ChaosMapOptions};
 use crate::analysis::continuation::{continuation, ContinuationError, ContinuationOptions};
-use crate::analysis::on_constraints::vibration::{
-    vibration_stability, LinkageOptions, VibrationError,
-};
+use crate::analysis::on_constraints::vibration::{linkage, LinkageOptions, VibrationError};
 use crate::analysis::period_map::{portrait, PeriodMapError, PeriodMapOptions};
 use crate::analysis::section::{section_study, SectionError, SectionOptions};
 use crate::analysis::separatrix::{separatrix_splitting, SplittingError, SplittingOptions};
@@ -179,7 +177,7 @@ impl Analysis for StabilityOptions {
 }
 
 impl Analysis for LinkageOptions {
-    type Output = crate::analysis::on_constraints::vibration::VibrationStability;
+    type Output = crate::analysis::on_constraints::vibration::Linkage;
     fn run(
         &self,
         model: &'static Model,
@@ -193,7 +191,7 @@ impl Analysis for LinkageOptions {
             }
             .into());
         };
-        Ok(vibration_stability(constrained, values, &self.resolve()?)?)
+        Ok(linkage(constrained, values, self)?)
     }
 }
 

@@ -14,79 +14,8 @@ pub fn linkage_scene(
     scene_name: &'static str,
     overrides: &[(&'static str, &'static str)],
 ) -> Result<(), SceneError> {
-    use mechlab_runtime::analysis::on_constraints::vibration::{
-        orbits_about, vibration_stability, LinkageOptions,
-    };
-    let orbit_knobs = [
-        knob("orbits", "6", "orbits about the equilibrium (0: none)"),
-        knob(
-            "kick",
-            "0.6",
-            "the largest kick in the first coordinate's velocity",
-        ),
-        knob("periods", "300", "periods of the fast phase per orbit"),
-    ];
-    let (model, scene, options) = declared_scene::<LinkageOptions>(
-        catalog,
-        scene_name,
-        ("four_bar", None),
-        (LinkageOptions::default(), overrides),
-        &orbit_knobs,
-    )?;
-    let info = model.info;
-    let constrained = model.constrained.ok_or(SceneError::BadValue {
-        name: "model".into(),
-        value: info.name.into(),
-        reason: ValueProblem::Requirement("a model with [[constraints]] in its file"),
-    })?;
-    let settings = options.resolve()?;
-    let result = vibration_stability(constrained, &scene.parameter_values(info)?, &settings)?;
-    println!(
-        "{}: equilibrium q* = {:?}, averaged ω² = {:?} ({}); thresholds in {}: {:?}",
-        info.name,
-        result.equilibrium,
-        result.squared_frequencies,
-        if result.averaged_stable {
-            "stable"
-        } else {
-            "unstable"
-        },
-        result.amplitude,
-        result.averaged_thresholds
-    );
-    println!("exact: {:?}", result.exact);
-    scene.save_figure(&result.figure(), "linkage.png")?;
-    let count = scene.whole("orbits")?;
-    if count > 0 {
-        let params = scene.parameter_values(info)?;
-        let shape = (count, scene.positive("kick")?, scene.count("periods")?);
-        let orbits = orbits_about(
-            constrained,
-            &params,
-            &result.equilibrium,
-            shape,
-            settings.method,
-        )?;
-        scene.save_figure(&orbits.figure(), "orbits.png")?;
-    }
-    let rows = result.scan.iter().map(|p| {
-        (
-            p.amplitude,
-            p.lowest_squared_frequency,
-            p.largest_modulus.unwrap_or(f64::NAN),
-        )
-    });
-    scene.write_csv(
-        "scan.csv",
-        &[
-            result.amplitude.as_str(),
-            "lowest_omega2",
-            "largest_modulus",
-        ],
-        rows,
-    )?;
-    scene.write_summary(&result)?;
-    Ok(())
+    use mechlab_runtime::analysis::on_constraints::vibration::LinkageOptions;
+    super::analysis_scene::<LinkageOptions>(catalog, scene_name, "four_bar", overrides)
 }
 
 /// The `stability` scene: stabilisation by vibration of any model's

@@ -51,6 +51,12 @@ crate::declare_settings! {
         /// Where Newton's method starts, the coordinates (auto: the model
         /// file's start).
         start: Option<Vec<f64>> = None, Range::Any;
+        /// Orbits drawn about the equilibrium, exact and averaged (0: none).
+        orbits: usize = 6, Range::Count { min: 0, max: 1000 };
+        /// The largest kick in the first coordinate's velocity of those orbits.
+        kick: f64 = 0.6, Range::Positive;
+        /// Periods of the fast phase per orbit.
+        periods: usize = 300, Range::Count { min: 1, max: 10_000_000 };
         /// The integration method.
         method: String = "dop853".into(), Range::OneOf(METHODS);
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
@@ -152,6 +158,8 @@ pub struct ScanPoint {
 /// Why the analysis could not be made.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum VibrationError {
+    #[error(transparent)]
+    Setting(#[from] SettingError),
     #[error(transparent)]
     Refused(#[from] Refusal),
     #[error("'{model}': the averaging on constraints needs fixed holonomic constraints and a mass matrix that the vibration does not move; write the coordinates relative to the vibrating base")]
@@ -724,5 +732,77 @@ impl Orbits {
             figure.points(0, exact.iter().copied(), palette(k), 2);
         }
         figure
+    }
+}
+
+/// The `linkage` analysis's result: the stability on the constraints
+/// (its summary) and the orbits about the equilibrium.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Linkage {
+    #[serde(flatten)]
+    pub stability: VibrationStability,
+    #[serde(skip)]
+    pub orbits: Option<Orbits>,
+}
+
+/// The stability of `options` on the constraints of `model`, and its
+/// orbits where `options.orbits` asks for them.
+pub fn linkage(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    options: &LinkageOptions,
+) -> Result<Linkage, VibrationError> {
+    let settings = options.resolve()?;
+    let stability = vibration_stability(model, params, &settings)?;
+    let orbits = match options.orbits {
+        0 => None,
+        count => {
+            let shape = (count, options.kick, options.periods);
+            let q = &stability.equilibrium;
+            Some(orbits_about(model, params, q, shape, settings.method)?)
+        }
+    };
+    Ok(Linkage { stability, orbits })
+}
+
+impl crate::outputs::Outputs for Linkage {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        let mut figures = vec![("linkage.png".into(), self.stability.figure())];
+        if let Some(orbits) = &self.orbits {
+            figures.push(("orbits.png".into(), orbits.figure()));
+        }
+        figures
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let result = &self.stability;
+        let rows = result.scan.iter().map(|p| {
+            let modulus = p.largest_modulus.unwrap_or(f64::NAN);
+            (p.amplitude, p.lowest_squared_frequency, modulus)
+        });
+        let header = [
+            result.amplitude.as_str(),
+            "lowest_omega2",
+            "largest_modulus",
+        ];
+        vec![crate::outputs::Table::new("scan.csv", &header, rows)]
+    }
+    fn lines(&self) -> Vec<String> {
+        let result = &self.stability;
+        let verdict = if result.averaged_stable {
+            "stable"
+        } else {
+            "unstable"
+        };
+        vec![
+            format!(
+                "{}: equilibrium q* = {:?}, averaged ω² = {:?} ({verdict}); thresholds in {}: {:?}",
+                result.model,
+                result.equilibrium,
+                result.squared_frequencies,
+                result.amplitude,
+                result.averaged_thresholds
+            ),
+            format!("exact: {:?}", result.exact),
+        ]
     }
 }
