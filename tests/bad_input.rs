@@ -2,6 +2,7 @@
 //! command lines, end in a typed error or a success.
 
 use mechlab::scene::{knob, Scene};
+use mechlab::settings::Range;
 use mechlab_model::Model;
 use proptest::prelude::*;
 
@@ -87,19 +88,19 @@ proptest! {
         if let Ok(scene) = Scene::parse("random", &knobs, &args) {
             // Values that parse keep their contracts; the others are typed
             // errors naming the knob, never panics.
-            match scene.positive("tol") {
+            match scene.get::<f64>("tol", Range::Positive) {
                 Ok(tol) => prop_assert!(tol > 0.0 && tol.is_finite()),
                 Err(e) => prop_assert!(e.to_string().contains("--set tol="), "{}", e),
             }
-            match scene.number("a") {
+            match scene.get::<f64>("a", Range::Any) {
                 Ok(a) => prop_assert!(a.is_finite()),
                 Err(e) => prop_assert!(e.to_string().contains("--set a="), "{}", e),
             }
-            if let Ok(values) = scene.numbers("a") {
+            if let Ok(values) = scene.get::<Vec<f64>>("a", Range::Any) {
                 prop_assert!(!values.is_empty() && values.iter().all(|v| v.is_finite()));
             }
-            if let Ok(count) = scene.count("a") {
-                prop_assert!(count > 0);
+            if let Ok(count) = scene.get::<usize>("a", Range::Count { min: 1, max: 10 }) {
+                prop_assert!((1..=10).contains(&count));
             }
         }
     }

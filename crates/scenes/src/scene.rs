@@ -6,6 +6,7 @@
 //! scene's last step): a crash never leaves half-written files or a mix of
 //! old and new results.
 
+use mechlab_runtime::settings::{Range, SettingValue};
 use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -76,21 +77,9 @@ pub enum ValueProblem {
     /// A requirement the value failed, as the knob states it.
     #[error("{0}")]
     Requirement(&'static str),
-    /// Not one of the names the knob takes.
-    #[error("one of {}", .0.join(", "))]
-    OneOf(&'static [&'static str]),
-    /// A list of another length than the knob it goes with.
-    #[error("needs as many values as {knob} ({count})")]
-    AsManyAs { knob: &'static str, count: usize },
-    /// An index of a state component past the state's length.
-    #[error("the state has {0} components")]
-    StateComponents(usize),
-    /// `parameter=none` where the model names no amplitude to continue in.
-    #[error("model '{model}' names no [fast_phase] amplitude: choose the parameter to continue in ({})", known.join(", "))]
-    NoAmplitude {
-        model: &'static str,
-        known: &'static [&'static str],
-    },
+    /// Not of the knob's kind or outside its range.
+    #[error("takes {kind}, {range}")]
+    Kind { kind: &'static str, range: String },
 }
 
 /// Why a scene could not run.
@@ -322,7 +311,7 @@ impl Scene {
         info.parameter_names
             .iter()
             .map(|n| {
-                let value = self.number(n)?;
+                let value = self.get::<f64>(n, Range::Any)?;
                 info.check_parameter(n, value)?;
                 Ok(value)
             })
@@ -339,87 +328,21 @@ impl Scene {
             .1
     }
 
-    /// A finite number.
-    pub fn number(&self, name: &str) -> Result<f64, SceneError> {
+    /// The value of knob `name` as a `T` (a number, a count, a list: the
+    /// kinds of the declared settings), within `range`; else an error
+    /// naming the knob, its value, and what it takes.
+    pub fn get<T: SettingValue>(&self, name: &str, range: Range) -> Result<T, SceneError> {
         let text = self.text(name);
-        match text.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(SceneError::BadValue {
+        T::from_text(text)
+            .filter(|value| value.within(&range))
+            .ok_or_else(|| SceneError::BadValue {
                 name: name.into(),
                 value: text.into(),
-                reason: ValueProblem::Requirement("not a finite number"),
-            }),
-        }
-    }
-
-    /// A number that must be positive.
-    pub fn positive(&self, name: &str) -> Result<f64, SceneError> {
-        let v = self.number(name)?;
-        if v > 0.0 {
-            Ok(v)
-        } else {
-            Err(SceneError::BadValue {
-                name: name.into(),
-                value: self.text(name).into(),
-                reason: ValueProblem::Requirement("must be positive"),
+                reason: ValueProblem::Kind {
+                    kind: T::KIND,
+                    range: range.to_string(),
+                },
             })
-        }
-    }
-
-    /// A non-negative number.
-    pub fn non_negative(&self, name: &str) -> Result<f64, SceneError> {
-        let v = self.number(name)?;
-        if v >= 0.0 {
-            Ok(v)
-        } else {
-            Err(SceneError::BadValue {
-                name: name.into(),
-                value: self.text(name).into(),
-                reason: ValueProblem::Requirement("must not be negative"),
-            })
-        }
-    }
-
-    /// A positive whole number.
-    pub fn count(&self, name: &str) -> Result<usize, SceneError> {
-        let text = self.text(name);
-        match text.trim().parse::<usize>() {
-            Ok(v) if v > 0 => Ok(v),
-            _ => Err(SceneError::BadValue {
-                name: name.into(),
-                value: text.into(),
-                reason: ValueProblem::Requirement("not a positive whole number"),
-            }),
-        }
-    }
-
-    /// A whole number, 0 allowed (a count that 0 switches off).
-    pub fn whole(&self, name: &str) -> Result<usize, SceneError> {
-        let text = self.text(name);
-        text.trim()
-            .parse::<usize>()
-            .map_err(|_| SceneError::BadValue {
-                name: name.into(),
-                value: text.into(),
-                reason: ValueProblem::Requirement("not a whole number"),
-            })
-    }
-
-    /// A comma-separated list of finite numbers (at least one).
-    pub fn numbers(&self, name: &str) -> Result<Vec<f64>, SceneError> {
-        let text = self.text(name);
-        let values: Option<Vec<f64>> = text
-            .split(',')
-            .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
-            .collect();
-        match values {
-            Some(v) if !v.is_empty() => Ok(v),
-            _ => Err(SceneError::BadValue {
-                name: name.into(),
-                value: text.into(),
-                reason: ValueProblem::Requirement("not a comma-separated list of finite numbers"),
-            }),
-        }
     }
 
     /// The knobs and their values, for summaries: numbers as numbers,

@@ -303,7 +303,7 @@ fn main() {
         let summary = serde_json::json!({
             "pendulum": pendulum(&times),
             "double_pendulum": double_pendulum(&times),
-            "closed_chain": closed_chain(scene.positive("chain_time")?)?,
+            "closed_chain": closed_chain(scene.get("chain_time", mechlab::settings::Range::Positive)?)?,
             "andrews": andrews(),
         });
         scene.write_summary(&summary)?;

@@ -1,8 +1,9 @@
 //! The `continuation` scene.
 
 use super::declared_scene;
-use crate::scene::{knob, Scene, SceneError, ValueProblem};
+use crate::scene::{knob, Scene, SceneError};
 use mechlab_runtime::registry::Catalog;
+use mechlab_runtime::settings::Range;
 
 /// Scene `continuation`: the periodic orbits of a model's period map
 /// followed in one parameter, their bifurcations, and the orbit diagram.
@@ -22,18 +23,11 @@ pub fn continuation_scene(catalog: Catalog) -> Result<(), SceneError> {
     )?;
     let params = scene.parameter_values(model.info)?;
     let settings = options.resolve(model, &params)?;
-    let coordinate = scene.whole("coordinate")?;
     eprintln!("continuing in {} …", settings.parameter);
     let result = continuation(model, &params, &settings)?;
     // (A constrained model's states are its chart's coordinates.)
-    let states = result.state_names.len();
-    if coordinate >= states {
-        return Err(SceneError::BadValue {
-            name: "coordinate".into(),
-            value: coordinate.to_string(),
-            reason: ValueProblem::StateComponents(states),
-        });
-    }
+    let last = result.state_names.len() - 1;
+    let coordinate = scene.get("coordinate", Range::Count { min: 0, max: last })?;
     write_continuation(&scene, &result, coordinate)?;
     scene.write_summary(&result)?;
     Ok(())

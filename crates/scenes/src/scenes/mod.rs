@@ -2,10 +2,11 @@
 //! the study scenes that are its presets (the same knobs with other
 //! defaults, the same files): knobs → one library call → figures.
 
-use crate::scene::{knob, parameter_knobs, Knob, Scene, SceneError, ValueProblem};
+use crate::scene::{knob, parameter_knobs, Knob, Scene, SceneError};
 use mechlab_runtime::analysis::declared::{no_progress, Analysis};
 use mechlab_runtime::registry::{Catalog, Model};
 use mechlab_runtime::settings::Declared;
+use mechlab_runtime::settings::Range;
 
 mod averaging;
 mod continuation;
@@ -170,33 +171,23 @@ pub fn tiles_from(
     scene: &Scene,
     [size, only]: [&str; 2],
 ) -> Result<Option<mechlab_runtime::analysis::tiles::Tiles>, SceneError> {
-    if scene.number(size)? == 0.0 {
+    let rows: usize = scene.get(
+        size,
+        Range::Count {
+            min: 0,
+            max: usize::MAX,
+        },
+    )?;
+    if rows == 0 {
         return Ok(None);
     }
-    let only_name = only;
-    let only = match scene.text(only_name) {
+    let only = match scene.text(only) {
         "all" => None,
-        _ => Some(
-            scene
-                .numbers(only_name)?
-                .iter()
-                .map(|k| {
-                    (*k >= 0.0 && k.fract() == 0.0)
-                        .then_some(*k as usize)
-                        .ok_or_else(|| SceneError::BadValue {
-                            name: only_name.into(),
-                            value: scene.text(only_name).into(),
-                            reason: ValueProblem::Requirement(
-                                "tile indices are whole numbers from 0",
-                            ),
-                        })
-                })
-                .collect::<Result<_, _>>()?,
-        ),
+        _ => Some(scene.get::<Vec<usize>>(only, Range::Any)?),
     };
     Ok(Some(mechlab_runtime::analysis::tiles::Tiles {
         folder: scene.out.with_extension("tiles"),
-        rows: scene.count(size)?,
+        rows,
         only,
     }))
 }

@@ -4,6 +4,7 @@ use super::declared_scene;
 use super::geometric_progression;
 use crate::scene::{knob, Scene, SceneError, ValueProblem};
 use mechlab_runtime::registry::{Catalog, Model};
+use mechlab_runtime::settings::Range;
 
 /// The `separatrix_splitting` scene: the hyperbolic fixed point of the
 /// period map of a 1-degree-of-freedom model with a fast phase, its
@@ -74,13 +75,12 @@ fn splitting_sweep_of(
     Ok(match scene.text("sweep") {
         "none" => None,
         _ => {
-            let values = geometric_progression(&scene.numbers("sweep")?).map_err(|reason| {
-                SceneError::BadValue {
+            let values = geometric_progression(&scene.get::<Vec<f64>>("sweep", Range::Any)?)
+                .map_err(|reason| SceneError::BadValue {
                     name: "sweep".into(),
                     value: scene.text("sweep").into(),
                     reason: ValueProblem::Requirement(reason),
-                }
-            })?;
+                })?;
             eprintln!(
                 "sweeping {} over {} values …",
                 scene.text("sweep_parameter"),

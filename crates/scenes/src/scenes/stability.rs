@@ -5,6 +5,7 @@ use super::declared_scene;
 use super::{model_from_args, tiles_from};
 use crate::scene::{knob, Knob, Scene, SceneError, ValueProblem};
 use mechlab_runtime::registry::{Catalog, Model};
+use mechlab_runtime::settings::Range;
 
 /// The `linkage` scene: stabilisation by vibration of a constrained model
 /// (the four-bar linkage held upside down by default): the averaged
@@ -87,7 +88,7 @@ fn write_chart(
     let Some((x, y)) = scene.text("chart").split_once(',') else {
         return Err(bad("chart", "two parameter names x,y"));
     };
-    let [first, last, count] = scene.numbers("chart_x")?[..] else {
+    let [first, last, count] = scene.get::<Vec<f64>>("chart_x", Range::Any)?[..] else {
         return Err(bad("chart_x", "first,last,count"));
     };
     if !(count >= 2.0 && count.fract() == 0.0) {
@@ -98,15 +99,21 @@ fn write_chart(
         q: if scene.text("chart_q") == "0" {
             vec![0.0; model.info.coordinates.len()]
         } else {
-            scene.numbers("chart_q")?
+            scene.get("chart_q", Range::Any)?
         },
         x: x.trim().into(),
         x_values: (0..n)
             .map(|k| first + (last - first) * k as f64 / (n - 1) as f64)
             .collect(),
         y: y.trim().into(),
-        y_max: scene.positive("chart_y_max")?,
-        y_samples: scene.count("chart_y_samples")?,
+        y_max: scene.get("chart_y_max", Range::Positive)?,
+        y_samples: scene.get(
+            "chart_y_samples",
+            Range::Count {
+                min: 1,
+                max: 1_000_000,
+            },
+        )?,
         edge_tolerance: settings.edge_tolerance,
         method: settings.method,
         tiles: tiles_from(scene, ["chart_tile_columns", "chart_only_tiles"])?,
