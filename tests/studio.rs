@@ -75,7 +75,7 @@ async fn models_and_page_are_served() {
     let schema: Value = serde_json::from_str(&body).unwrap();
     assert_eq!(
         schema,
-        serde_json::to_value(mechlab::settings::schemas()).unwrap()
+        serde_json::to_value(mechlab_studio::calls::schemas()).unwrap()
     );
     let chaos = schema
         .as_array()
@@ -293,7 +293,10 @@ async fn the_mechanism_moves_with_its_bars_rigid() {
     let request = json!({"model": "kapitza", "seed": [0.1, 0.0], "duration": 1.0, "frames": 1});
     let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
-    assert!(body.contains("from 2 to 3600 frames"), "{body}");
+    assert!(
+        body.contains("frames = 1 is outside its range (2 to 3600)"),
+        "{body}"
+    );
 }
 
 /// Each refinement of the streamed chaos map is the library's map of the
@@ -461,7 +464,10 @@ async fn overlay_matches_the_averaged_hamiltonian_by_hand() {
     let third = json!({"model": "triple_pendulum", "ranges": [[-3.0, 3.0], [-3, 3]], "grid": 40, "levels": 5, "order": 3});
     let (status, _, body) = call("POST", "/api/overlay", Some(third)).await;
     assert_eq!(status, StatusCode::BAD_REQUEST);
-    assert!(body.contains("order 3 is not derived"), "{body}");
+    assert!(
+        body.contains("order = 3 is outside its range (1 to 2)"),
+        "{body}"
+    );
 }
 
 /// The manifolds overlay: Kapitza's W^u and W^s at A = 1 on the page's
@@ -728,7 +734,7 @@ async fn bad_requests_are_named_errors() {
         (
             orbit(json!({"tol": 0.0})),
             StatusCode::BAD_REQUEST,
-            "tolerance",
+            "tol = 0 is outside its range (> 0)",
         ),
         (
             orbit(json!({"method": "euler"})),
@@ -743,12 +749,12 @@ async fn bad_requests_are_named_errors() {
         (
             orbit(json!({"periods": 0})),
             StatusCode::BAD_REQUEST,
-            "periods must be between 1",
+            "periods = 0 is outside its range (1 to 100000)",
         ),
         (
             orbit(json!({"periods": 10_000_000})),
             StatusCode::BAD_REQUEST,
-            "periods must be between 1",
+            "periods = 10000000 is outside its range (1 to 100000)",
         ),
         (
             orbit(json!({"axes": [1, 1]})),
@@ -808,7 +814,7 @@ async fn bad_requests_are_named_errors() {
 /// it handed over are the library's.
 #[test]
 fn a_dropped_orbit_stops() {
-    let request: mechlab_studio::calls::OrbitRequest =
+    let request: mechlab_studio::calls::AnalysisRequest =
         serde_json::from_value(json!({"model": "kapitza", "seed": [1.0, 0.5], "periods": 100_000}))
             .unwrap();
     let mut received = Vec::new();

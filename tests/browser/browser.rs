@@ -225,8 +225,10 @@ async fn browser_seeds_orbits_and_sweeps_a_parameter() {
 }
 
 /// The model named in the address opens, and the inputs of the declared
-/// settings start from the library's declarations (the studio's
-/// interactive values), served at `/api/schema`.
+/// settings start from the library's and the studio's declarations (the
+/// studio's interactive values), served at `/api/schema`. A shared address
+/// restores the parameters, the axes, the view and the overlays, and the
+/// address follows the page.
 async fn the_address_and_the_declared_defaults(client: &Client, studio: &str) {
     client
         .goto(&format!("{studio}?model=four_bar"))
@@ -238,10 +240,13 @@ async fn the_address_and_the_declared_defaults(client: &Client, studio: &str) {
         30,
     )
     .await;
-    let schema = mechlab::settings::schemas();
+    let schema = mechlab_studio::calls::schemas();
     for (id, analysis, name) in [
         ("chaos-periods", "chaos_map", "periods"),
         ("basins-transient", "basins", "transient"),
+        ("tol", "orbit", "tol"),
+        ("periods", "orbit", "periods"),
+        ("mechanism-time", "mechanism", "duration"),
     ] {
         let s = schema.iter().find(|s| s.analysis == analysis).unwrap();
         let declared = s.interactive.get(name).cloned().unwrap_or_else(|| {
@@ -261,6 +266,47 @@ async fn the_address_and_the_declared_defaults(client: &Client, studio: &str) {
             .unwrap();
         assert_eq!(shown.as_f64(), declared.as_f64(), "{id}");
     }
+    let shared = "?model=kapitza&A=1.7&axes=0,1&x=-1,1&y=-0.5,0.5&show=levels,chaos";
+    client.goto(&format!("{studio}{shared}")).await.unwrap();
+    wait_for(
+        client,
+        "window.studio && studio.ready && studio.model.name === 'kapitza'",
+        30,
+    )
+    .await;
+    let restored = client
+        .execute(
+            "return [studio.params.A, studio.view.x, studio.view.y, \
+             document.getElementById('show-chaos').checked, \
+             document.getElementById('show-equilibria').checked];",
+            vec![],
+        )
+        .await
+        .unwrap();
+    assert_eq!(
+        restored,
+        serde_json::json!([1.7, [-1, 1], [-0.5, 0.5], true, false])
+    );
+    // The address follows a change of the page.
+    client
+        .execute(
+            "studio.params.A = 2.5; studio.view = {x: [-2, 2], y: [-1, 1]}; redraw(); return true;",
+            vec![],
+        )
+        .await
+        .unwrap();
+    let address = read_when(
+        client,
+        "location.search.includes('A=2.5')",
+        "return location.search;",
+        10,
+    )
+    .await;
+    let address = address.as_str().unwrap();
+    assert!(
+        address.contains("x=-2%2C2") && address.contains("show=levels%2Cchaos"),
+        "{address}"
+    );
 }
 
 /// Three clicked orbits of the Kapitza map, redrawn when the A slider moves.

@@ -30,7 +30,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post, MethodRouter};
 use axum::Router;
-use calls::{self as studio, OrbitRequest, StudioError};
+use calls::{self as studio, StudioError};
 use mechlab_runtime::analysis::period_map::PeriodMapError;
 use mechlab_runtime::classify::{Classify, ErrorClass};
 use mechlab_runtime::registry::Catalog;
@@ -115,7 +115,7 @@ pub fn router(catalog: Catalog) -> Router {
         )
         .route(
             "/api/schema",
-            get(|| async { axum::Json(mechlab_runtime::settings::schemas()) }),
+            get(|| async { axum::Json(studio::schemas()) }),
         )
         .route("/api/models/{name}/derivations", get(derivations))
         .route("/api/orbit", post(orbit))
@@ -205,8 +205,8 @@ async fn derivations(
 }
 
 async fn orbit(State(catalog): State<Catalog>, body: Bytes) -> Result<Response, ApiError> {
-    let request: OrbitRequest = serde_json::from_slice(&body)?;
-    request.check(catalog)?;
+    let request: studio::AnalysisRequest = serde_json::from_slice(&body)?;
+    studio::orbit_check(catalog, &request)?;
     Ok(stream(move |send, _| {
         let end = studio::orbit(catalog, &request, &mut |chunk| send(&chunk))?;
         send(&Ended { end });

@@ -2,20 +2,6 @@
 
 use super::*;
 
-/// The mechanism moving from an orbit's seed (the model file's points):
-/// `duration` time units drawn in `frames` frames.
-#[derive(Clone, Debug, Deserialize)]
-pub struct MechanismRequest {
-    #[serde(flatten)]
-    pub setup: Setup,
-    pub seed: Vec<f64>,
-    pub duration: f64,
-    pub frames: usize,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
-}
-
 /// The frames of the mechanism, for the page to play.
 #[derive(Clone, Debug, Serialize)]
 pub struct MechanismView {
@@ -30,9 +16,11 @@ pub struct MechanismView {
 /// as the orbit's is (its axes' components held).
 pub fn mechanism(
     catalog: Catalog,
-    request: &MechanismRequest,
+    request: &AnalysisRequest,
 ) -> Result<MechanismView, StudioError> {
-    let setup = request.setup.resolve(catalog, &request.unknown)?;
+    let (handle, params, request) = request.resolve::<MechanismOptions>(catalog)?;
+    let method = (request.method.as_str(), request.tol);
+    let setup = Plane::of(handle, params, request.axes, &request.through, method)?;
     if request.seed.iter().any(|x| !x.is_finite()) {
         return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
     }

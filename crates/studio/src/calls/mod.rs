@@ -13,6 +13,7 @@ mod mechanism;
 mod orbit;
 mod overlay;
 mod section;
+mod views;
 
 pub use continuation::*;
 pub use maps::*;
@@ -20,6 +21,7 @@ pub use mechanism::*;
 pub use orbit::*;
 pub use overlay::*;
 pub use section::*;
+pub use views::*;
 
 use mechlab_runtime::analysis::basins::{BasinSettings, BasinsOptions};
 use mechlab_runtime::analysis::chaos_map::{chaos_map, ChaosMapOptions, ChaosMapSettings};
@@ -117,24 +119,14 @@ pub enum RequestProblem {
     ThroughLength { got: usize, expected: usize },
     #[error("the averaged Hamiltonian to order {0} is not derived for this model (orders: 1, and 2 for models with a fast phase, except numeric-solve models of more than 4 degrees of freedom)")]
     Order(usize),
-    #[error("the request has a field '{0}' that this route does not know")]
-    UnknownField(String),
     #[error("{what} must be finite")]
     NotFinite { what: &'static str },
-    #[error("{what} must be a positive number, got {got}")]
-    NotPositive { what: &'static str, got: f64 },
     #[error("the axes must be two different state components among 0..{components}")]
     Axes { components: usize },
     #[error("the range of axis {axis} must be an interval of finite numbers, low < high")]
     Range { axis: usize },
     #[error("the seed cannot be put on the constraints with its axes' components held: {0}")]
     Inconsistent(mechlab_runtime::ode::holonomic::ConstraintError),
-    #[error("{what} must be between 1 and {max}, got {got}")]
-    Count {
-        what: &'static str,
-        got: usize,
-        max: usize,
-    },
 }
 
 /// A parameter as the page shows it: a slider around the model file's value.
@@ -311,152 +303,4 @@ pub fn derivations(catalog: Catalog, name: &str) -> Result<Vec<Derivation>, Stud
             mathml: mechlab_runtime::mathml::mathml(d.latex, true),
         })
         .collect())
-}
-
-fn first_order() -> usize {
-    1
-}
-
-fn default_method() -> String {
-    "taylor".into()
-}
-
-fn default_tol() -> f64 {
-    1e-10
-}
-
-/// What every request names: the model, its parameters (the model file's
-/// values where not given), the method and the plane drawn.
-#[derive(Clone, Debug, Deserialize)]
-pub struct Setup {
-    pub model: String,
-    #[serde(default)]
-    pub params: BTreeMap<String, f64>,
-    #[serde(default = "default_method")]
-    pub method: String,
-    #[serde(default = "default_tol")]
-    pub tol: f64,
-    /// The state components along the page's axes (default: q₁, p₁).
-    #[serde(default)]
-    pub axes: Option<[usize; 2]>,
-    /// The state the plane passes through (default 0).
-    #[serde(default)]
-    pub through: Option<Vec<f64>>,
-}
-
-/// A [`Setup`] checked against its model.
-#[derive(Clone)]
-pub struct Resolved {
-    pub handle: &'static Model,
-    pub info: &'static ModelInfo,
-    pub model: &'static dyn DynamicModel,
-    pub dof: usize,
-    pub fast_phase: bool,
-    pub params: Vec<f64>,
-    pub method: Method,
-    pub axes: [usize; 2],
-    pub through: Vec<f64>,
-}
-
-impl Setup {
-    /// The setup checked against its model; `unknown` are the request's
-    /// fields that no route knows.
-    pub fn resolve(
-        &self,
-        catalog: Catalog,
-        unknown: &BTreeMap<String, serde_json::Value>,
-    ) -> Result<Resolved, StudioError> {
-        let handle = mechlab_runtime::registry::lookup(catalog, &self.model)?;
-        let (info, model) = (handle.info, handle.dynamic);
-        if let Some(field) = unknown.keys().next() {
-            return Err(StudioError::BadRequest {
-                model: info.name.into(),
-                problem: RequestProblem::UnknownField(field.clone()),
-            });
-        }
-        let bad = |problem| StudioError::BadRequest {
-            model: info.name.into(),
-            problem,
-        };
-        let (dof, fast_phase) = match model.kind() {
-            Kind::Hamiltonian { dof, fast_phase } => (dof, fast_phase),
-            Kind::Contacts { .. } => {
-                return Err(StudioError::Refused(Refusal::contact_model(info.name)))
-            }
-            Kind::Constrained {
-                coordinates,
-                fast_phase,
-                ..
-            } => (coordinates, fast_phase),
-        };
-        let mut params = model.defaults();
-        for (name, &value) in &self.params {
-            info.check_parameter(name, value)?;
-            let k = info.parameter_names.iter().position(|n| n == name);
-            params[k.expect("check_parameter knows every name")] = value;
-        }
-        let method = Method::parse(&self.method, self.tol)?;
-        method.validate()?;
-        let states = model.periodic_state().len();
-        let axes = self.axes.unwrap_or([0, dof]);
-        if axes[0] == axes[1] || axes.iter().any(|&a| a >= states) {
-            return Err(bad(RequestProblem::Axes { components: states }));
-        }
-        let through = self.through.clone().unwrap_or_else(|| vec![0.0; states]);
-        if through.len() != states {
-            return Err(bad(RequestProblem::ThroughLength {
-                got: through.len(),
-                expected: states,
-            }));
-        }
-        if through.iter().any(|x| !x.is_finite()) {
-            return Err(bad(RequestProblem::NotFinite {
-                what: "the state to pass through",
-            }));
-        }
-        Ok(Resolved {
-            handle,
-            info,
-            model,
-            dof,
-            fast_phase,
-            params,
-            method,
-            axes,
-            through,
-        })
-    }
-}
-
-impl Resolved {
-    fn bad(&self, problem: RequestProblem) -> StudioError {
-        StudioError::BadRequest {
-            model: self.info.name.into(),
-            problem,
-        }
-    }
-
-    fn ranges(&self, ranges: &[[f64; 2]; 2]) -> Result<[(f64, f64); 2], StudioError> {
-        for (axis, r) in ranges.iter().enumerate() {
-            if !(r[0].is_finite() && r[1].is_finite() && r[0] < r[1]) {
-                return Err(self.bad(RequestProblem::Range { axis }));
-            }
-        }
-        Ok(ranges.map(|r| (r[0], r[1])))
-    }
-
-    fn count(&self, what: &'static str, got: usize, max: usize) -> Result<usize, StudioError> {
-        if got == 0 || got > max {
-            return Err(self.bad(RequestProblem::Count { what, got, max }));
-        }
-        Ok(got)
-    }
-
-    fn needs_period_map(&self) -> Result<(), StudioError> {
-        if self.fast_phase {
-            Ok(())
-        } else {
-            Err(StudioError::Refused(Refusal::no_fast_phase(self.info.name)))
-        }
-    }
 }

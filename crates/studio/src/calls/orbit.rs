@@ -2,37 +2,23 @@
 
 use super::*;
 
-/// A click on the page: an orbit of the period map from `seed` (the full
-/// state [q; p]), `periods` iterates.
-#[derive(Clone, Debug, Deserialize)]
-pub struct OrbitRequest {
-    #[serde(flatten)]
-    pub setup: Setup,
-    pub seed: Vec<f64>,
-    pub periods: usize,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
-}
-
-impl OrbitRequest {
-    /// The request checked: its model has a period map, the seed is a
-    /// finite state of the right size, the periods are within bounds.
-    pub fn check(&self, catalog: Catalog) -> Result<Resolved, StudioError> {
-        let setup = self.setup.resolve(catalog, &self.unknown)?;
-        setup.needs_period_map()?;
-        setup.count("periods", self.periods, MAX_PERIODS)?;
-        if self.seed.len() != 2 * setup.dof {
-            return Err(setup.bad(RequestProblem::SeedLength {
-                got: self.seed.len(),
-                expected: 2 * setup.dof,
-            }));
-        }
-        if self.seed.iter().any(|x| !x.is_finite()) {
-            return Err(setup.bad(RequestProblem::NotFinite { what: "the seed" }));
-        }
-        Ok(setup)
+/// A click on the page: the orbit of the period map of `request`'s
+/// declared settings ([`OrbitOptions`]), checked: its model has a period
+/// map, the seed is a finite state of the right size.
+pub fn orbit_check(
+    catalog: Catalog,
+    request: &AnalysisRequest,
+) -> Result<(Plane, OrbitOptions), StudioError> {
+    let (handle, params, options) = request.resolve::<OrbitOptions>(catalog)?;
+    let method = (options.method.as_str(), options.tol);
+    let plane = Plane::of(handle, params, options.axes, &options.through, method)?;
+    if !plane.fast_phase {
+        return Err(StudioError::Refused(Refusal::no_fast_phase(
+            plane.info.name,
+        )));
     }
+    plane.seed(&options.seed)?;
+    Ok((plane, options))
 }
 
 /// Points of an orbit projected on the page's axes (angles in [−π, π)), in
@@ -73,10 +59,10 @@ const CHUNK_POINTS: usize = 4096;
 /// model's domain ends with the integrator's error after the points before.
 pub fn orbit(
     catalog: Catalog,
-    request: &OrbitRequest,
+    request: &AnalysisRequest,
     sink: &mut dyn FnMut(OrbitChunk) -> bool,
 ) -> Result<OrbitEnd, StudioError> {
-    let setup = request.check(catalog)?;
+    let (setup, request) = orbit_check(catalog, request)?;
     let systems = mechlab_runtime::analysis::flows(setup.handle)?;
     // A constrained model's seed, on its constraints in the chart of the axes.
     let mut seed = request.seed.clone();

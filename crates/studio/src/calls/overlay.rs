@@ -3,26 +3,6 @@
 
 use super::*;
 
-/// The overlays of a view: level sets of the averaged Hamiltonian (of H
-/// without a fast phase) and the equilibria of V + V_vibr.
-#[derive(Clone, Debug, Deserialize)]
-pub struct OverlayRequest {
-    #[serde(flatten)]
-    pub setup: Setup,
-    pub ranges: [[f64; 2]; 2],
-    /// Grid points per side for the level sets.
-    pub grid: usize,
-    /// Number of level sets (besides those through unstable equilibria).
-    pub levels: usize,
-    /// The order of the averaged Hamiltonian drawn: 1 (H̄) or 2 (K̄ to ε²,
-    /// where derived).
-    #[serde(default = "first_order")]
-    pub order: usize,
-    /// Fields no route knows (refused by name, not ignored).
-    #[serde(flatten)]
-    pub unknown: BTreeMap<String, serde_json::Value>,
-}
-
 /// One level set, as segments (x₀, y₀, x₁, y₁) on the page's axes.
 #[derive(Clone, Debug, Serialize)]
 pub struct LevelSet {
@@ -53,11 +33,17 @@ pub struct Overlay {
 }
 
 /// The level sets and equilibria of a view.
-pub fn overlay(catalog: Catalog, request: &OverlayRequest) -> Result<Overlay, StudioError> {
-    let setup = request.setup.resolve(catalog, &request.unknown)?;
-    let ranges = setup.ranges(&request.ranges)?;
-    let grid = setup.count("grid points per side", request.grid, MAX_GRID)?;
-    let count = setup.count("level sets", request.levels, 100)?;
+pub fn overlay(catalog: Catalog, request: &AnalysisRequest) -> Result<Overlay, StudioError> {
+    let (handle, params, request) = request.resolve::<OverlayOptions>(catalog)?;
+    let method = (request.method.as_str(), request.tol);
+    let setup = Plane::of(handle, params, request.axes, &request.through, method)?;
+    for (axis, r) in request.ranges.iter().enumerate() {
+        if !(r[0] < r[1]) {
+            return Err(setup.bad(RequestProblem::Range { axis }));
+        }
+    }
+    let ranges = request.ranges.map(|r| (r[0], r[1]));
+    let (grid, count) = (request.grid, request.levels);
     let model = setup.model;
     let params = &setup.params;
     let second_order = match request.order {

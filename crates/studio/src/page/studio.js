@@ -111,7 +111,7 @@ studio.attractorColor = (label) => attractorColor(label);
 let dirty = true;
 function redraw() { dirty = true; }
 function frame() {
-  if (dirty) { dirty = false; draw(ctx, canvas.width, canvas.height); }
+  if (dirty) { dirty = false; draw(ctx, canvas.width, canvas.height); saveAddress(); }
   drawMechanism(performance.now());
   requestAnimationFrame(frame);
 }
@@ -419,17 +419,17 @@ const mctx = mechanismCanvas.getContext("2d");
 let mechanismController = null;
 
 // The mechanism from `seed` (the orbit's), over the time asked for, in
-// 601 frames played over 20 seconds whatever the model's time scale.
-const MECHANISM_FRAMES = 601, MECHANISM_SECONDS = 20;
+// the declared number of frames, played over 20 seconds whatever the
+// model's time scale.
+const MECHANISM_SECONDS = 20;
 async function startMechanism(seed) {
   if (mechanismController) mechanismController.abort();
   studio.mechanism = null;
   if (!studio.model.points.length) return;
   mechanismController = new AbortController();
   const duration = Number($("mechanism-time").value);
-  const frames = MECHANISM_FRAMES;
   try {
-    const m = await postJson("/api/mechanism", { ...setup(), seed, duration, frames }, mechanismController.signal);
+    const m = await postJson("/api/mechanism", { ...setup(), seed, duration }, mechanismController.signal);
     const xs = m.frames.flat().map((p) => p[0]), ys = m.frames.flat().map((p) => p[1]);
     m.box = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
     m.started = performance.now();
@@ -685,7 +685,7 @@ async function refreshOverlay() {
   if (!wanted || studio.model.kind !== "hamiltonian") { studio.overlay = null; redraw(); return; }
   try {
     studio.overlay = await postJson("/api/overlay",
-      { ...setup(), ranges: viewRanges(), grid: 160, levels: 14, order: Number($("order").value) }, overlayController.signal);
+      { ...setup(), ranges: viewRanges(), order: Number($("order").value) }, overlayController.signal);
     redraw();
   } catch (e) {
     if (!aborted(e)) say(`overlay: ${e.message}`);
@@ -819,10 +819,9 @@ function defaultView(model) {
   studio.view = { x: model.default_ranges[0].slice(), y: model.default_ranges[1].slice() };
 }
 
-async function chooseModel(name) {
+async function chooseModel(name, address = new URLSearchParams()) {
   const model = studio.models.find((m) => m.name === name);
   if (!model) return;
-  history.replaceState(null, "", `?model=${encodeURIComponent(name)}`);
   removeOrbits(0);
   studio.ready = false;
   studio.model = model;
@@ -857,7 +856,7 @@ async function chooseModel(name) {
     constrained: `model '${name}' is constrained: a click seeds an orbit on its constraints (the axes' components held, the others follow from the constraints), a shift-click continues it in the chart of the axes (one degree of freedom on the constraints), the mechanism moves above the parameters; the level sets and equilibria are not drawn for it`,
   };
   say(notes[model.kind] ?? (model.fast_phase ? "" : `model '${name}' has no fast phase: no period map; the level sets of H and the equilibria are shown`));
-  history.replaceState(null, "", `#${name}`);
+  applyAddress(address);
   redraw();
   refreshOverlays();
   try {
@@ -1025,11 +1024,64 @@ function wire() {
   }, 1000);
 }
 
+// ---------- the address ----------
+// The page's state lives in its address, so that a view can be shared and
+// reloaded: /?model=kapitza&A=1.2&axes=0,1&x=-3.14,3.14&y=-2,2&show=levels,chaos
+// (the parameters that differ from the model file's, the axes, the view's
+// ranges, the overlays shown).
+const shownInAddress = ["levels", "equilibria", "chaos", "basins", "manifolds"];
+
+function addressOf() {
+  const a = new URLSearchParams({ model: studio.model.name });
+  for (const p of studio.model.parameters) {
+    if (studio.params[p.name] !== p.default) a.set(p.name, studio.params[p.name]);
+  }
+  const round = (v) => Number(v.toPrecision(6));
+  a.set("axes", studio.axes.join(","));
+  a.set("x", studio.view.x.map(round).join(","));
+  a.set("y", studio.view.y.map(round).join(","));
+  a.set("show", shownInAddress.filter((id) => $(`show-${id}`).checked).join(","));
+  return `?${a}`;
+}
+
+const saveAddress = debounce(() => {
+  if (studio.ready && studio.model) history.replaceState(null, "", addressOf());
+}, 300);
+
+function applyAddress(a) {
+  for (const p of studio.model.parameters) {
+    const value = Number(a.get(p.name));
+    if (!a.has(p.name) || !Number.isFinite(value)) continue;
+    studio.params[p.name] = value;
+    $(`param-${p.name}`).value = value;
+    $(`value-${p.name}`).value = value;
+  }
+  const pair = (key) => {
+    const v = (a.get(key) || "").split(",").map(Number);
+    return v.length === 2 && v.every(Number.isFinite) ? v : null;
+  };
+  const axes = pair("axes"), states = studio.model.state.length;
+  if (axes && axes[0] !== axes[1] && axes.every((i) => Number.isInteger(i) && i >= 0 && i < states)) {
+    studio.axes = axes;
+    buildAxes(studio.model);
+  }
+  const [x, y] = [pair("x"), pair("y")];
+  if (x && y && x[0] < x[1] && y[0] < y[1]) studio.view = { x, y };
+  if (a.has("show")) {
+    const shown = new Set(a.get("show").split(","));
+    for (const id of shownInAddress) $(`show-${id}`).checked = shown.has(id);
+  }
+}
+
 // The analyses' settings as the library declares them (GET /api/schema):
 // the page's inputs for them start from the declared defaults, or the
 // studio's interactive values where it has lighter ones; no default is
 // written in this script.
-const declaredInputs = [["chaos-periods", "chaos_map", "periods"], ["basins-transient", "basins", "transient"]];
+const declaredInputs = [
+  ["chaos-periods", "chaos_map", "periods"], ["basins-transient", "basins", "transient"],
+  ["method", "orbit", "method"], ["tol", "orbit", "tol"], ["periods", "orbit", "periods"],
+  ["mechanism-time", "mechanism", "duration"],
+];
 
 function applySchema(schema) {
   studio.schema = Object.fromEntries(schema.map((s) => [s.analysis, s]));
@@ -1052,10 +1104,11 @@ async function start() {
     return;
   }
   $("model").innerHTML = studio.models.map((m) => `<option value="${m.name}">${m.name}</option>`).join("");
-  // The model in the address (`/?model=four_bar`, or `#four_bar`).
-  const wanted = new URLSearchParams(location.search).get("model") || location.hash.slice(1);
+  // The view in the address (`/?model=four_bar&…`, or `#four_bar`).
+  const address = new URLSearchParams(location.search);
+  const wanted = address.get("model") || location.hash.slice(1);
   const first = studio.models.find((m) => m.name === wanted) || studio.models.find((m) => m.name === "kapitza") || studio.models[0];
-  await chooseModel(first.name);
+  await chooseModel(first.name, first.name === wanted ? address : undefined);
 }
 
 start();
