@@ -43,8 +43,8 @@ pub fn study_scene<T: Study>() -> Result<(), SceneError> {
     write_outputs(&scene, &outcome)
 }
 
-/// Prints a result's lines and writes its figures, tables and summary.
-pub fn write_outputs<O: Outputs>(scene: &Scene, outcome: &O) -> Result<(), SceneError> {
+/// Prints a result's lines and writes its figures, texts and tables.
+pub fn write_files<O: Outputs>(scene: &Scene, outcome: &O) -> Result<(), SceneError> {
     for line in outcome.lines() {
         println!("{line}");
     }
@@ -57,6 +57,13 @@ pub fn write_outputs<O: Outputs>(scene: &Scene, outcome: &O) -> Result<(), Scene
     for table in outcome.tables() {
         scene.write_bytes(&table.file, &table.csv)?;
     }
+    Ok(())
+}
+
+/// [`write_files`], then the result as `summary.json` (the scene's last
+/// step: its files are published together).
+pub fn write_outputs<O: Outputs>(scene: &Scene, outcome: &O) -> Result<(), SceneError> {
+    write_files(scene, outcome)?;
     scene.write_summary(outcome)?;
     Ok(())
 }

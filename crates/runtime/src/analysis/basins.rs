@@ -830,3 +830,44 @@ impl Basins {
         figure
     }
 }
+
+impl crate::outputs::Outputs for Basins {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        vec![("basins.png".into(), self.figure())]
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let n = self.pixels;
+        let rows = self
+            .labels
+            .iter()
+            .enumerate()
+            .map(|(k, l)| (k % n, k / n, *l));
+        let header = ["column", "row", "attractor"];
+        vec![crate::outputs::Table::new("basins.csv", &header, rows)]
+    }
+    fn lines(&self) -> Vec<String> {
+        let mut lines: Vec<String> = self
+            .attractors
+            .iter()
+            .map(|a| {
+                let seen = if a.confirmed { "" } else { " (one start only)" };
+                format!(
+                    "{}: {:.4} ± {:.4} of the starts, at {:?}{seen}",
+                    a.kind, a.fraction, a.fraction_error, a.representative
+                )
+            })
+            .collect();
+        lines.push(format!(
+            "diverged: {}; {:.1} s",
+            self.diverged, self.seconds
+        ));
+        let b = &self.boundary;
+        lines.push(match (b.exponent, b.exponent_error, b.dimension) {
+            (Some(alpha), Some(error), Some(dimension)) => format!(
+                "boundary: uncertainty exponent {alpha:.3} ± {error:.3}, box dimension {dimension:.3}"
+            ),
+            _ => format!("boundary: {}", b.why_not.unwrap_or("not measured")),
+        });
+        lines
+    }
+}

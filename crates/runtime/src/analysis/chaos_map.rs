@@ -362,3 +362,21 @@ impl ChaosMap {
         })
     }
 }
+
+impl crate::outputs::Outputs for ChaosMap {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        let [grey, viridis] = self.figures();
+        vec![
+            ("chaos_map.png".into(), grey),
+            ("chaos_map_viridis.png".into(), viridis),
+        ]
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let rows = self.fli.iter().enumerate().map(|(k, fli)| {
+            let (a, b) = self.pixel(k);
+            (a, b, *fli)
+        });
+        let header = [self.axes[0].as_str(), self.axes[1].as_str(), "fli"];
+        vec![crate::outputs::Table::new("chaos_map.csv", &header, rows)]
+    }
+}

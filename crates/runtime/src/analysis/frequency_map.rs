@@ -439,3 +439,31 @@ impl FrequencyMap {
         figure
     }
 }
+
+impl crate::outputs::Outputs for FrequencyMap {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        vec![("frequency_map.png".into(), self.figure())]
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let pixels = self.pixels;
+        let rows = (0..pixels * pixels).filter_map(|k| {
+            let [nu1, nu2] = self.frequencies[k];
+            nu1.is_finite()
+                .then_some((k % pixels, k / pixels, nu1, nu2, self.diffusion[k]))
+        });
+        let header = ["column", "row", "nu1", "nu2", "diffusion_index"];
+        vec![crate::outputs::Table::new(
+            "frequency_map.csv",
+            &header,
+            rows,
+        )]
+    }
+    fn lines(&self) -> Vec<String> {
+        vec![format!(
+            "{} orbits, {:.1} % regular, in {:.1} s",
+            self.accessible,
+            100.0 * self.regular_fraction,
+            self.seconds
+        )]
+    }
+}

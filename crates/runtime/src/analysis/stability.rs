@@ -1595,3 +1595,24 @@ impl StabilityChart {
         figure
     }
 }
+
+impl crate::outputs::Outputs for Stability {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        self.figure()
+            .map(|figure| ("spectral_radius.png".into(), figure))
+            .into_iter()
+            .collect()
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let header = ["equilibrium", "amplitude", "spectral_radius"];
+        let rows = self.spectral_radius_rows();
+        vec![crate::outputs::Table::new(
+            "spectral_radius.csv",
+            &header,
+            rows,
+        )]
+    }
+    fn lines(&self) -> Vec<String> {
+        self.report(32)
+    }
+}

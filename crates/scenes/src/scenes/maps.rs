@@ -3,9 +3,10 @@
 
 use super::declared_scene;
 use super::{model_from_args, section_scene, share_tiles, tile_knobs, tiles_from, TileSharing};
-use crate::scene::{Progress, Scene, SceneError};
+use crate::scene::{Progress, SceneError};
+use crate::study::write_outputs;
 use mechlab_runtime::analysis::chaos_map::{
-    chaos_map, ChaosMap, ChaosMapError, ChaosMapOptions, ChaosMapSettings,
+    chaos_map, ChaosMapError, ChaosMapOptions, ChaosMapSettings,
 };
 use mechlab_runtime::registry::Catalog;
 
@@ -43,29 +44,11 @@ pub fn chaos_map_scene(
         };
         match chaos_map(model, &params, &settings, &row_done) {
             Err(ChaosMapError::Partial) => Ok(false),
-            map => write_chaos_map(&scene, &map?).map(|()| true),
+            map => write_outputs(&scene, &map?).map(|()| true),
         }
     };
     let rows = settings.pixels;
     share_tiles(&scene, sharing, settings.tiles.as_ref(), rows, &sweep)
-}
-
-/// The chaos map's figures, CSV and summary.
-fn write_chaos_map(scene: &Scene, map: &ChaosMap) -> Result<(), SceneError> {
-    let [grey, viridis] = map.figures();
-    scene.save_figure(&grey, "chaos_map.png")?;
-    scene.save_figure(&viridis, "chaos_map_viridis.png")?;
-    let rows = map.fli.iter().enumerate().map(|(k, fli)| {
-        let (a, b) = map.pixel(k);
-        (a, b, *fli)
-    });
-    scene.write_csv(
-        "chaos_map.csv",
-        &[map.axes[0].as_str(), map.axes[1].as_str(), "fli"],
-        rows,
-    )?;
-    scene.write_summary(map)?;
-    Ok(())
 }
 
 /// The `basins` scene: the basins of attraction of a period map on a
@@ -92,47 +75,11 @@ pub fn basins_scene(catalog: Catalog, sharing: Option<&dyn TileSharing>) -> Resu
         }
         match basins(model, &params, &settings, &|k| progress.advance(k)) {
             Err(BasinsError::Partial) => Ok(false),
-            result => write_basins(&scene, &result?).map(|()| true),
+            result => write_outputs(&scene, &result?).map(|()| true),
         }
     };
     let rows = settings.pixels;
     share_tiles(&scene, sharing, settings.tiles.as_ref(), rows, &sweep)
-}
-
-/// The basins' summary lines, figure, CSV and summary.
-fn write_basins(
-    scene: &Scene,
-    result: &mechlab_runtime::analysis::basins::Basins,
-) -> Result<(), SceneError> {
-    for a in &result.attractors {
-        let seen = if a.confirmed { "" } else { " (one start only)" };
-        eprintln!(
-            "{}: {:.4} ± {:.4} of the starts, at {:?}{seen}",
-            a.kind, a.fraction, a.fraction_error, a.representative
-        );
-    }
-    eprintln!("diverged: {}; {:.1} s", result.diverged, result.seconds);
-    let boundary = &result.boundary;
-    match (
-        boundary.exponent,
-        boundary.exponent_error,
-        boundary.dimension,
-    ) {
-        (Some(alpha), Some(error), Some(dimension)) => eprintln!(
-            "boundary: uncertainty exponent {alpha:.3} ± {error:.3}, box dimension {dimension:.3}"
-        ),
-        _ => eprintln!("boundary: {}", boundary.why_not.unwrap_or("not measured")),
-    }
-    scene.save_figure(&result.figure(), "basins.png")?;
-    let n = result.pixels;
-    let rows = result
-        .labels
-        .iter()
-        .enumerate()
-        .map(|(k, l)| (k % n, k / n, *l));
-    scene.write_csv("basins.csv", &["column", "row", "attractor"], rows)?;
-    scene.write_summary(result)?;
-    Ok(())
 }
 
 /// The `frequency_map` scene: Laskar's frequency map of a section at a
@@ -180,33 +127,5 @@ pub fn frequency_map_scene(catalog: Catalog) -> Result<(), SceneError> {
         &settings,
         &|k| progress.advance(k),
     )?;
-    write_frequency_map(&scene, &map)?;
-    scene.write_summary(&map)?;
-    Ok(())
-}
-
-/// A frequency map's summary line, figure and table.
-pub(super) fn write_frequency_map(
-    scene: &Scene,
-    map: &mechlab_runtime::analysis::frequency_map::FrequencyMap,
-) -> Result<(), SceneError> {
-    eprintln!(
-        "{} orbits, {:.1} % regular, in {:.1} s",
-        map.accessible,
-        100.0 * map.regular_fraction,
-        map.seconds
-    );
-    scene.save_figure(&map.figure(), "frequency_map.png")?;
-    let pixels = map.pixels;
-    let rows = (0..pixels * pixels).filter_map(|k| {
-        let [nu1, nu2] = map.frequencies[k];
-        nu1.is_finite()
-            .then_some((k % pixels, k / pixels, nu1, nu2, map.diffusion[k]))
-    });
-    scene.write_csv(
-        "frequency_map.csv",
-        &["column", "row", "nu1", "nu2", "diffusion_index"],
-        rows,
-    )?;
-    Ok(())
+    write_outputs(&scene, &map)
 }

@@ -34,22 +34,7 @@ pub fn separatrix_scene(
     let params = scene.parameter_values(model.info)?;
     eprintln!("growing the manifolds of the hyperbolic fixed point …");
     let splitting = separatrix_splitting(model, &params, &settings)?;
-    if !splitting.resolved {
-        eprintln!(
-            "the lobe area is not resolved to 1e-6: action {:?}, polygon {:?} (the manifolds split by little more than the precision tells)",
-            splitting.lobe_area_action, splitting.lobe_area_polygon
-        );
-    }
-    scene.save_figure(&splitting.figure(), "separatrix_splitting.png")?;
-    let curves = [
-        ("unstable", &splitting.unstable),
-        ("stable", &splitting.stable),
-        ("lobe", &splitting.lobe),
-    ];
-    let rows = curves
-        .into_iter()
-        .flat_map(|(curve, points)| points.iter().map(move |y| (curve, y[0], y[1])));
-    scene.write_csv("manifolds.csv", &["curve", "q_lifted", "p"], rows)?;
+    crate::study::write_files(&scene, &splitting)?;
     let sweep = splitting_sweep_of(&scene, model, &params, &settings)?;
     #[derive(serde::Serialize)]
     struct Summary<'a> {

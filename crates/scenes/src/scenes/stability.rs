@@ -40,17 +40,7 @@ pub fn stability_scene(catalog: Catalog) -> Result<(), SceneError> {
     let params = scene.parameter_values(model.info)?;
     let settings = options.resolve(model)?;
     let result = stability(model, &params, &settings)?;
-    for line in result.report(32) {
-        eprintln!("{line}");
-    }
-    scene.write_csv(
-        "spectral_radius.csv",
-        &["equilibrium", "amplitude", "spectral_radius"],
-        result.spectral_radius_rows(),
-    )?;
-    if let Some(figure) = result.figure() {
-        scene.save_figure(&figure, "spectral_radius.png")?;
-    }
+    crate::study::write_files(&scene, &result)?;
     if scene.text("chart") != "none" && !write_chart(&scene, model, &params, &settings)? {
         return Ok(());
     }

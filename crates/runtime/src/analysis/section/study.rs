@@ -147,3 +147,71 @@ pub fn section_study(
         frequency_map,
     })
 }
+
+/// The section's figure and table, its MEGNO map's and its frequency
+/// map's, each where it was asked for.
+impl crate::outputs::Outputs for SectionStudy {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        let mut figures = Vec::new();
+        if let Some(section) = &self.section {
+            figures.push(("section.png".into(), section.figure()));
+        }
+        if let Some(map) = &self.frequency_map {
+            figures.extend(map.figures());
+        }
+        if let Some(map) = &self.megno_map {
+            figures.push(("section_megno.png".into(), map.figure()));
+        }
+        figures
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        use crate::outputs::Table;
+        let mut tables = Vec::new();
+        if let Some(section) = &self.section {
+            let rows = section
+                .orbits
+                .iter()
+                .enumerate()
+                .flat_map(|(k, o)| o.points.iter().map(move |p| (k, p[0], p[1])));
+            let header = ["orbit", section.axes[0].as_str(), section.axes[1].as_str()];
+            tables.push(Table::new("section.csv", &header, rows));
+        }
+        if let Some(map) = &self.frequency_map {
+            tables.extend(map.tables());
+        }
+        if let Some(map) = &self.megno_map {
+            let (window, pixels) = (map.window, map.pixels);
+            let at = move |k: usize, range: [f64; 2]| {
+                range[0] + (range[1] - range[0]) * (k as f64 + 0.5) / pixels as f64
+            };
+            let rows = map
+                .megno
+                .iter()
+                .enumerate()
+                .map(move |(k, v)| (at(k % pixels, window[0]), at(k / pixels, window[1]), *v));
+            let header = [map.axes[0].as_str(), map.axes[1].as_str(), "megno"];
+            tables.push(Table::new("section_megno.csv", &header, rows));
+        }
+        tables
+    }
+    fn lines(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(section) = &self.section {
+            lines.push(format!(
+                "largest |{} − E| on the section {:.1e}, largest distance from the plane {:.1e}",
+                section.energy_of, section.largest_energy_drift, section.largest_plane_distance
+            ));
+            lines.extend(section.ended_early().map(|(k, end)| {
+                let o = &section.orbits[k];
+                format!(
+                    "orbit {k} (seed {:?}) ended after {} points: {end}",
+                    o.points[0], o.crossings
+                )
+            }));
+        }
+        if let Some(map) = &self.frequency_map {
+            lines.extend(map.lines());
+        }
+        lines
+    }
+}

@@ -1768,3 +1768,31 @@ fn melnikov_along(
     }
     Ok(4.0 * eps * re.hypot(im))
 }
+
+impl crate::outputs::Outputs for Splitting {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        vec![("separatrix_splitting.png".into(), self.figure())]
+    }
+    /// The manifolds and the lobe, point by point (q lifted off the circle).
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let curves = [
+            ("unstable", &self.unstable),
+            ("stable", &self.stable),
+            ("lobe", &self.lobe),
+        ];
+        let rows = curves
+            .into_iter()
+            .flat_map(|(curve, points)| points.iter().map(move |y| (curve, y[0], y[1])));
+        let header = ["curve", "q_lifted", "p"];
+        vec![crate::outputs::Table::new("manifolds.csv", &header, rows)]
+    }
+    fn lines(&self) -> Vec<String> {
+        if self.resolved {
+            return Vec::new();
+        }
+        vec![format!(
+            "the lobe area is not resolved to 1e-6: action {:?}, polygon {:?} (the manifolds split by little more than the precision tells)",
+            self.lobe_area_action, self.lobe_area_polygon
+        )]
+    }
+}
