@@ -162,7 +162,13 @@ fn main() {
                 "evaluations per variant and round",
             )],
         )?;
-        let n = scene.count("evaluations")?;
+        let n: usize = scene.get(
+            "evaluations",
+            mechlab::settings::Range::Count {
+                min: 1,
+                max: usize::MAX,
+            },
+        )?;
         let kp = kapitza::Params {
             mu: 0.1,
             ..Default::default()

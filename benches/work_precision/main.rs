@@ -76,11 +76,18 @@ fn bench() -> Result<(), BenchError> {
             ),
         ],
     )?;
-    let periods = scene.count("periods")?;
+    use mechlab::settings::Range;
+    let periods: usize = scene.get(
+        "periods",
+        Range::Count {
+            min: 1,
+            max: usize::MAX,
+        },
+    )?;
     let runs = problems::run_all(
-        scene.non_negative("min_seconds")?,
+        scene.get("min_seconds", Range::NonNegative)?,
         periods,
-        scene.positive("budget")?,
+        scene.get("budget", Range::Positive)?,
     )?;
     let mut slopes = BTreeMap::new();
     for problem in PROBLEMS {
