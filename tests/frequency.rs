@@ -171,8 +171,9 @@ fn bad_signals_are_named() {
 }
 
 /// A period map's tunes: a libration about an offset centre, (3, 1) +
-/// r e^{−2πiνn}, and a circulating angle q = 0.3 + 2πνn (wrapped to
-/// [−π, π) as a plane shows it) give ν to 1e-10, and a constant tune a
+/// r e^{−2πiνn} (turning clockwise in (q, p), as Hamilton's equations turn
+/// a libration), and a circulating angle q = 0.3 + 2πνn (wrapped to
+/// [−π, π) as a plane shows it) give +ν to 1e-10, and a constant tune a
 /// diffusion index at the rounding.
 #[test]
 fn tunes_of_a_libration_and_a_circulation() {
@@ -185,7 +186,7 @@ fn tunes_of_a_libration_and_a_circulation() {
         })
         .collect();
     let (got, index) = tunes(&libration, &[false, false]);
-    assert!((got[0] + nu).abs() < 1e-10, "{got:?}");
+    assert!((got[0] - nu).abs() < 1e-10, "{got:?}");
     assert!(index < -9.0, "{index}");
     let circulation: Vec<Vec<f64>> = (0..1024)
         .map(|n| {
@@ -199,7 +200,7 @@ fn tunes_of_a_libration_and_a_circulation() {
 
 /// Kapitza's pendulum without vibration (A = 0) is the pendulum
 /// H = p²/2 + cos q: its period map (period 2πε) turns each libration of
-/// amplitude φ₀ about the hanging state by −ε ω(φ₀) turns, with
+/// amplitude φ₀ about the hanging state (clockwise) by ε ω(φ₀) turns, with
 /// ω = AGM(1, cos(φ₀/2)), the closed form derived in the test above. The
 /// frequency map's tunes equal it to 1e-8 at every pixel well inside the
 /// separatrix (E < 0.9), where the diffusion index is below −7.
@@ -237,7 +238,7 @@ fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
             continue;
         }
         let amplitude = (-energy).acos();
-        let expected = -eps * agm(1.0, (amplitude / 2.0).cos());
+        let expected = eps * agm(1.0, (amplitude / 2.0).cos());
         let got = map.frequencies[k][0];
         assert!(
             (got - expected).abs() < 1e-8,

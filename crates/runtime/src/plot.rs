@@ -143,6 +143,12 @@ enum Layer {
     },
     Contours(Vec<(f64, f64)>, Rgb, u32),
     Legend(Vec<(String, Rgb)>, bool),
+    /// Cells of a grid over the panel, each its own colour (None: white).
+    Cells {
+        columns: usize,
+        rows: usize,
+        colors: Vec<Option<Rgb>>,
+    },
 }
 
 /// A figure of one or more panels in a grid.
@@ -253,6 +259,20 @@ impl Figure {
         );
     }
 
+    /// Fills the panel with a grid of cells (row 0 at the bottom), each in
+    /// its own colour (None: left white), edge to edge: a map of
+    /// categories, such as the basins of attraction.
+    pub fn cells(&mut self, k: usize, columns: usize, rows: usize, colors: Vec<Option<Rgb>>) {
+        self.layers[k].insert(
+            0,
+            Layer::Cells {
+                columns,
+                rows,
+                colors,
+            },
+        );
+    }
+
     /// Level sets of `f` with spacing `step` (and the level `special`, drawn
     /// in `special_color`): marked where f crosses a level between
     /// neighbouring points of a 400 × 400 grid over the panel.
@@ -312,7 +332,7 @@ impl Figure {
         let mut points = 0;
         for layer in self.layers.iter().flatten() {
             points += match layer {
-                Layer::Map { .. } => return false,
+                Layer::Map { .. } | Layer::Cells { .. } => return false,
                 Layer::Points(p, ..)
                 | Layer::Line(p, _)
                 | Layer::Dashed(p, _)
@@ -478,7 +498,7 @@ where
         panel.x_range.0..panel.x_range.1,
         panel.y_range.0..panel.y_range.1,
     );
-    match (panel.log_x, panel.log_y) {
+    let (xs, ys) = match (panel.log_x, panel.log_y) {
         (false, false) => {
             let mut c = builder.build_cartesian_2d(x, y)?;
             fill(&mut c, panel, layers)
@@ -496,8 +516,58 @@ where
             fill(&mut c, panel, layers)
         }
     }?;
+    // The axes' names, a subscript set as one (p_φ₁: p with φ₁ below).
+    let (left, top) = plot_area.get_base_pixel();
+    let middle = |r: &std::ops::Range<i32>| (r.start + r.end) / 2;
+    let below = (middle(&xs) - left, ys.end - top + 24);
+    axis_name(&plot_area, &panel.x_label, below, false)?;
+    let beside = (xs.start - left - 56, middle(&ys) - top);
+    axis_name(&plot_area, &panel.y_label, beside, true)?;
     if let (Some(bar), Some((map, label))) = (bar_area, map_label) {
         color_bar(&bar, map, &label)?;
+    }
+    Ok(())
+}
+
+/// Draws an axis's name centred at `at` (pixels of `area`; `upward`: the
+/// y axis's, read from below), the part after `_` as a subscript: smaller,
+/// and lowered.
+fn axis_name<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    name: &str,
+    at: (i32, i32),
+    upward: bool,
+) -> Result<(), PlotFailure>
+where
+    DB::ErrorType: 'static,
+{
+    let (base, subscript) = name.split_once('_').unwrap_or((name, ""));
+    let turn = if upward {
+        FontTransform::Rotate270
+    } else {
+        FontTransform::None
+    };
+    let big = TextStyle::from((FONT, 14).into_font());
+    let small = TextStyle::from((FONT, 11).into_font());
+    // (Measured upright: the length along the text.)
+    let width = |text: &str, style: &TextStyle| {
+        area.estimate_text_size(text, style)
+            .map(|(w, _)| w as i32)
+            .unwrap_or(0)
+    };
+    let (wide, sub_wide) = (width(base, &big), width(subscript, &small));
+    let (big, small) = (big.transform(turn.clone()), small.transform(turn));
+    let start = (wide + sub_wide) / 2;
+    let (text_at, sub_at) = if upward {
+        let y = at.1 + start;
+        ((at.0, y), (at.0 + 5, y - wide))
+    } else {
+        let x = at.0 - start;
+        ((x, at.1), (x + wide, at.1 + 5))
+    };
+    area.draw(&Text::new(base.to_string(), text_at, big))?;
+    if !subscript.is_empty() {
+        area.draw(&Text::new(subscript.to_string(), sub_at, small))?;
     }
     Ok(())
 }
@@ -539,7 +609,7 @@ fn fill<'a, DB, X, Y>(
     chart: &mut Chart<'a, DB, X, Y>,
     panel: &Panel,
     layers: &[Layer],
-) -> Result<(), PlotFailure>
+) -> Result<(std::ops::Range<i32>, std::ops::Range<i32>), PlotFailure>
 where
     DB: DrawingBackend + 'a,
     DB::ErrorType: 'static,
@@ -558,10 +628,7 @@ where
     };
     chart
         .configure_mesh()
-        .x_desc(&panel.x_label)
-        .y_desc(&panel.y_label)
         .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
         .light_line_style(RGBColor(235, 235, 235))
         .bold_line_style(RGBColor(215, 215, 215))
         .x_labels(6)
@@ -579,6 +646,11 @@ where
                 map,
                 ..
             } => draw_map(chart, panel, [*columns, *rows], values, *map)?,
+            Layer::Cells {
+                columns,
+                rows,
+                colors,
+            } => draw_cells(chart, panel, [*columns, *rows], colors)?,
             Layer::Points(pts, color, size) => {
                 let c = rgb(*color);
                 if *size <= 1 {
@@ -631,7 +703,7 @@ where
             Layer::Legend(entries, bottom) => draw_legend(chart, entries, *bottom)?,
         }
     }
-    Ok(())
+    Ok(chart.plotting_area().get_pixel_range())
 }
 
 /// A map layer: `values` (row-major, `columns` × `rows`) as cells filling
@@ -666,6 +738,35 @@ where
                 }),
         )
         .map_err(err)?;
+    Ok(())
+}
+
+/// A grid of cells, each filled with its colour edge to edge.
+fn draw_cells<'a, DB, X, Y>(
+    chart: &mut Chart<'a, DB, X, Y>,
+    panel: &Panel,
+    [columns, rows]: [usize; 2],
+    colors: &[Option<Rgb>],
+) -> Result<(), PlotFailure>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let (x0, x1) = panel.x_range;
+    let (y0, y1) = panel.y_range;
+    let (dx, dy) = ((x1 - x0) / columns as f64, (y1 - y0) / rows as f64);
+    let cells = colors.iter().enumerate().filter_map(|(k, color)| {
+        let (x, y) = (
+            x0 + (k % columns) as f64 * dx,
+            y0 + (k / columns) as f64 * dy,
+        );
+        color.map(|c| Rectangle::new([(x, y), (x + dx, y + dy)], rgb(c).filled()))
+    });
+    chart
+        .draw_series(cells)
+        .map_err(|e: DrawingAreaErrorKind<DB::ErrorType>| PlotFailure::from(e))?;
     Ok(())
 }
 

@@ -799,26 +799,12 @@ impl Basins {
             self.ranges[1],
         );
         let mut figure = Figure::single(760, 700, spec);
-        let (w, h) = (
-            (self.ranges[0].1 - self.ranges[0].0) / self.pixels as f64,
-            (self.ranges[1].1 - self.ranges[1].0) / self.pixels as f64,
-        );
-        for index in 0..self.attractors.len() {
-            let cells = self
-                .labels
-                .iter()
-                .enumerate()
-                .filter(|(_, &l)| l == index as i32)
-                .map(|(k, _)| {
-                    let (i, j) = (k % self.pixels, k / self.pixels);
-                    (
-                        self.ranges[0].0 + (i as f64 + 0.5) * w,
-                        self.ranges[1].0 + (j as f64 + 0.5) * h,
-                    )
-                });
-            let size = (760.0 / self.pixels as f64).ceil().max(1.0) as i64;
-            figure.points(0, cells, palette(index), size);
-        }
+        let colors = self
+            .labels
+            .iter()
+            .map(|&l| (l >= 0).then(|| palette(l as usize)))
+            .collect();
+        figure.cells(0, self.pixels, self.pixels, colors);
         for attractor in &self.points {
             figure.points(
                 0,

@@ -268,9 +268,11 @@ pub fn period_map_frequencies(
 
 /// The tunes of an orbit of a period map (its states one a period, angles
 /// wrapped or not), one per degree of freedom in turns per period, and its
-/// diffusion index: NAFF of q_j + i p_j less its mean, where an angle is
+/// diffusion index: NAFF of q_j − i p_j less its mean, where an angle is
 /// first unwrapped along the orbit; of e^{i q_j} for an angle that
-/// circulates (its unwrapped range passes 2π).
+/// circulates (its unwrapped range passes 2π). A libration turns
+/// clockwise in (q, p), as Hamilton's equations turn it (q′ = p), so
+/// q − i p makes its tune positive; a circulation's sign is its direction.
 pub fn tunes(run: &[Vec<f64>], periodic: &[bool]) -> (Vec<f64>, f64) {
     let dof = periodic.len() / 2;
     let signals: Vec<Vec<Complex<f64>>> = (0..dof)
@@ -289,7 +291,7 @@ pub fn tunes(run: &[Vec<f64>], periodic: &[bool]) -> (Vec<f64>, f64) {
             } else {
                 q.iter()
                     .zip(run)
-                    .map(|(&x, y)| Complex::new(x, y[j + dof]))
+                    .map(|(&x, y)| Complex::new(x, -y[j + dof]))
                     .collect()
             };
             // Less its mean: a constant term would be the largest.
@@ -317,11 +319,17 @@ fn unwrap(q: &mut [f64]) {
     }
 }
 
-/// An orbit's fundamental frequencies (q_j + i p_j, the largest term)
+/// An orbit's fundamental frequencies (q_j − i p_j, the largest term:
+/// positive for the clockwise turn of a libration in (q, p))
 /// over the whole orbit, and its diffusion index between its halves.
 fn analyse(orbit: &[[f64; 4]], dt: f64) -> ([f64; 2], f64) {
     let signals: Vec<Vec<Complex<f64>>> = (0..2)
-        .map(|j| orbit.iter().map(|y| Complex::new(y[j], y[j + 2])).collect())
+        .map(|j| {
+            orbit
+                .iter()
+                .map(|y| Complex::new(y[j], -y[j + 2]))
+                .collect()
+        })
         .collect();
     let (nu, index) = fundamentals(&signals, dt);
     ([nu[0], nu[1]], index)

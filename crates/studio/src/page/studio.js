@@ -253,10 +253,28 @@ function drawGrid(g, width, height) {
     }
   }
   g.fillStyle = "#222";
-  g.font = "italic 14px serif";
   const [xName, yName] = [axisName(0), axisName(1)];
-  g.fillText(xName, width - 12 - g.measureText(xName).width, height - 18);
-  g.fillText(yName, 30, 16);
+  drawName(g, xName, width - 12 - nameWidth(g, xName), height - 18);
+  drawName(g, yName, 30, 16);
+}
+
+// An axis's name as a paper sets it: the part after "_" a subscript
+// (p_φ₁: p with φ₁ below, smaller).
+const NAME_FONT = "italic 14px serif", SUBSCRIPT_FONT = "italic 10px serif";
+function nameWidth(g, name) {
+  const [base, sub = ""] = name.split("_");
+  g.font = NAME_FONT;
+  const wide = g.measureText(base).width;
+  g.font = SUBSCRIPT_FONT;
+  return wide + g.measureText(sub).width;
+}
+function drawName(g, name, x, y) {
+  const [base, sub = ""] = name.split("_");
+  g.font = NAME_FONT;
+  g.fillText(base, x, y);
+  const wide = g.measureText(base).width;
+  g.font = SUBSCRIPT_FONT;
+  g.fillText(sub, x + wide + 1, y + 4);
 }
 
 function niceStep(raw) {
