@@ -230,3 +230,125 @@ fn the_scene_and_the_studio_give_the_same_chaos_map() {
         assert_eq!(a, b);
     }
 }
+
+/// `value` without what differs run to run (timings) and what a scene adds
+/// (its name and its knobs).
+fn numbers_of(mut value: serde_json::Value) -> serde_json::Value {
+    fn strip(value: &mut serde_json::Value) {
+        match value {
+            serde_json::Value::Object(map) => {
+                map.retain(|k, _| !k.contains("seconds") && k != "scene" && k != "settings");
+                map.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(items) => items.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut value);
+    value
+}
+
+/// The scene of analysis `T` and the library's one driver (what the
+/// studio and Python call) on the same settings and parameters give the
+/// same summary, number for number. `scene_only` are the scene's own knobs
+/// (tiles).
+fn same_numbers<T>(
+    model: &str,
+    settings: &[(&str, &str)],
+    params: &[(&str, f64)],
+    scene_only: &[&str],
+) where
+    T: mechlab::analysis::declared::Analysis,
+    T::Output: serde::Serialize,
+{
+    let out = tempfile::tempdir().unwrap();
+    let mut command = Command::new(example(T::ANALYSIS));
+    command
+        .args(["--set", &format!("model={model}"), "--out"])
+        .arg(out.path());
+    for (name, text) in settings {
+        command.args(["--set", &format!("{name}={text}")]);
+    }
+    for (name, value) in params {
+        command.args(["--set", &format!("{name}={value}")]);
+    }
+    for knob in scene_only {
+        command.args(["--set", knob]);
+    }
+    let run = command.output().unwrap();
+    assert!(
+        run.status.success(),
+        "{}: {}",
+        T::ANALYSIS,
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("summary.json")).unwrap())
+            .unwrap();
+    // (The separatrix scene's summary holds the splitting beside its sweep.)
+    if let Some(splitting) = scene.get("splitting") {
+        scene = splitting.clone();
+    }
+    let handle = mechlab::models::by_name(model).unwrap();
+    let given: std::collections::BTreeMap<String, f64> =
+        params.iter().map(|(n, v)| (n.to_string(), *v)).collect();
+    let values = handle.values_with(&given).unwrap();
+    let options = T::default().with_texts(settings.iter().copied()).unwrap();
+    let library = options
+        .run(handle, &values, &mechlab::analysis::declared::no_progress)
+        .unwrap();
+    let library = serde_json::to_value(&library).unwrap();
+    assert_eq!(numbers_of(scene), numbers_of(library), "{}", T::ANALYSIS);
+}
+
+/// Same settings, same numbers: each declared analysis's scene against
+/// the library's driver, which the studio and Python call (`explore`'s
+/// scene writes a summary of its own, with the start and the energy's
+/// drift; its numbers are the tests' of `explore`).
+#[test]
+fn each_scene_gives_the_numbers_of_the_one_driver() {
+    use mechlab::analysis::*;
+    let (no, none): (&[(&str, f64)], &[&str]) = (&[], &[]);
+    same_numbers::<period_map::PeriodMapOptions>(
+        "kapitza",
+        &[("periods", "60"), ("count", "4")],
+        no,
+        none,
+    );
+    let attractor = [
+        ("points", "3000"),
+        ("transient", "100"),
+        ("lyapunov_periods", "400"),
+        ("pixels", "40"),
+    ];
+    same_numbers::<attractor::AttractorOptions>("ueda", &attractor, no, none);
+    let averaging = [("values", "geometric:100,400,3"), ("t_obs", "1")];
+    same_numbers::<averaging::AveragingOptions>("double_pendulum", &averaging, no, none);
+    let linkage = [("scan", "6"), ("orbits", "2"), ("periods", "20")];
+    same_numbers::<on_constraints::vibration::LinkageOptions>("four_bar", &linkage, no, none);
+    same_numbers::<stability::StabilityOptions>(
+        "kapitza",
+        &[("samples", "30")],
+        &[("eps", 0.2)],
+        none,
+    );
+    let splitting = [("spacing", "0.05"), ("lobe_points", "60")];
+    same_numbers::<separatrix::SplittingOptions>(
+        "kapitza",
+        &splitting,
+        &[("A", 1.0)],
+        &["sweep=none"],
+    );
+    same_numbers::<section::SectionOptions>(
+        "henon_heiles",
+        &[("crossings", "60"), ("orbits", "4")],
+        no,
+        none,
+    );
+    let chaos = [("pixels", "6"), ("periods", "30")];
+    same_numbers::<chaos_map::ChaosMapOptions>("kapitza", &chaos, &[("A", 1.2)], &["tile_rows=0"]);
+    let basins = [("pixels", "8"), ("transient", "40")];
+    same_numbers::<basins::BasinsOptions>("duffing", &basins, no, &["tile_rows=0"]);
+    let continuation = [("max_period", "2"), ("points", "200"), ("diagram", "0")];
+    same_numbers::<continuation::ContinuationOptions>("duffing", &continuation, no, none);
+}

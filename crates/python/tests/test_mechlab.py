@@ -269,3 +269,60 @@ class Analyses(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+def scene_summary(scene, settings, folder):
+    """The scene's summary.json with these settings (`cargo run` from the
+    workspace: the example binaries the tests of the workspace built)."""
+    import json
+    import subprocess
+    knobs = [a for name, value in settings.items() for a in ("--set", f"{name}={value}")]
+    subprocess.run(["cargo", "run", "--release", "--quiet", "--example", scene, "--", *knobs,
+                    "--out", folder], cwd=ROOT, check=True, capture_output=True)
+    with open(os.path.join(folder, "summary.json")) as f:
+        return json.load(f)
+
+
+def numbers(value):
+    """A summary without its timings and the scene's own record."""
+    if isinstance(value, dict):
+        return {k: numbers(v) for k, v in value.items()
+                if "seconds" not in k and k not in ("scene", "settings")}
+    if isinstance(value, (list, tuple)):
+        return [numbers(v) for v in value]
+    return value
+
+
+class SameNumbersAsTheScenes(unittest.TestCase):
+    """Same settings, same numbers: Python and the scene of each analysis,
+    field by field of the scene's summary."""
+
+    CASES = [
+        ("period_map", "kapitza", {"periods": 60, "count": 4}, {}),
+        ("attractor", "ueda", {"points": 3000, "transient": 100, "lyapunov_periods": 400,
+                               "pixels": 40}, {}),
+        ("averaging", "double_pendulum", {"values": "geometric:100,400,3", "t_obs": 1.0}, {}),
+        ("linkage", "four_bar", {"scan": 6, "orbits": 2, "periods": 20}, {}),
+        ("stability", "kapitza", {"samples": 30}, {"eps": 0.2}),
+        ("chaos_map", "kapitza", {"pixels": 6, "periods": 30}, {"A": 1.2}),
+        ("basins", "duffing", {"pixels": 8, "transient": 40}, {}),
+    ]
+
+    def test_each_analysis(self):
+        import tempfile
+        for analysis, model, settings, params in self.CASES:
+            with self.subTest(analysis=analysis), tempfile.TemporaryDirectory() as folder:
+                knobs = {"model": model, **settings, **params}
+                if analysis in ("chaos_map", "basins"):
+                    knobs["tile_rows"] = 0
+                scene = numbers(scene_summary(analysis, knobs, folder))
+                method = getattr(mechlab.model(model), analysis)
+                extra = {"progress": False} if analysis in ("chaos_map", "basins") else {}
+                result = method(params=params, **settings, **extra)
+                for key, value in scene.items():
+                    got = result[key]
+                    got = got.tolist() if hasattr(got, "tolist") else got
+                    self.assertEqual(numbers(got), value, f"{analysis}: {key}")
