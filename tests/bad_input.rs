@@ -153,3 +153,32 @@ fn too_large_requests_are_refused_before_any_work() {
         "{e}"
     );
 }
+
+/// A tolerance below what double precision holds is refused before any
+/// step, naming the floor (it took ten million steps to end before).
+#[test]
+fn a_tolerance_below_the_rounding_is_refused_by_name() {
+    use mechlab::analysis::declared::{no_progress, Analysis};
+    use mechlab::explore::ExploreOptions;
+    use mechlab::settings::Declared;
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let options = ExploreOptions::default()
+        .with_texts([("method", "dop853"), ("tol", "1e-20")])
+        .unwrap();
+    let error = options
+        .run(model, &model.dynamic.defaults(), &no_progress)
+        .expect_err("refused");
+    let message = error.to_string();
+    assert!(
+        message.contains("below what double precision can reach") && message.contains("1e-20"),
+        "{message}"
+    );
+    assert_eq!(
+        mechlab::classify::Classify::class(&error),
+        mechlab::classify::ErrorClass::BadValue
+    );
+    // At the floor it runs.
+    let floor = mechlab::ode::PRECISION_FLOOR;
+    assert!(mechlab::ode::Method::parse("radau5", floor).is_ok());
+    assert!(mechlab::ode::Method::parse("radau5", 0.5 * floor).is_err());
+}

@@ -428,17 +428,23 @@ fn every_model_s_taylor_runs_agree_with_dop853() {
             explore(handle, &params, &y0, &settings("taylor")),
             explore(handle, &params, &y0, &settings("dop853")),
         );
+        // Both runs stop, or neither: a model that Taylor's method runs and
+        // DOP853 cannot (or the reverse) is a disagreement, not a skip.
         let (taylor, dop853) = match runs {
             (Ok(t), Ok(d)) => (t, d),
-            (t, d) => {
+            (Err(t), Err(d)) => {
                 eprintln!(
-                    "{}: skipped (a run from the default start failed: {:?} {:?})",
-                    info.name,
-                    t.err(),
-                    d.err()
+                    "{}: skipped (both runs from the default start stop: {t}; {d})",
+                    info.name
                 );
                 continue;
             }
+            (t, d) => panic!(
+                "{}: one method runs from the default start and the other stops: taylor {:?}, dop853 {:?}",
+                info.name,
+                t.err(),
+                d.err()
+            ),
         };
         let pairs = [
             ("exact", Some(&taylor.exact), Some(&dop853.exact)),

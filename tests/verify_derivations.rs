@@ -327,18 +327,44 @@ fn exact_solution_approaches_the_averaged_one_like_one_over_nu() {
     assert!(deviations[3] < 0.05, "{deviations:?}");
 }
 
+/// The generated Kapitza field against the one derived by hand from the
+/// model file: x = sin q, y = Aε cos θ + cos q, θ = t/ε, L = (ẋ² + ẏ²)/2 − y
+/// give p = q̇ + A sin θ sin q and ṗ = A sin θ cos q q̇ + sin q − μ q̇; the
+/// averaged system (μ = 0) is H̄ = p²/2 + cos q + (A²/4) sin²q, whose
+/// Jacobian is [[0, 1], [cos q − (A²/2) cos 2q, 0]]. Through the `System`
+/// trait and the free functions alike, at several states and phases.
 #[test]
-fn exact_system_trait_matches_the_free_functions() {
-    let params = kapitza::Params::default();
-    let y = [0.3, -0.2];
-    assert_eq!(
-        kapitza::Exact { params }.rhs(0.7, &y),
-        kapitza::exact_rhs(0.7, &y, &params)
-    );
-    assert_eq!(
-        kapitza::Averaged { params }.jacobian(0.0, &y),
-        Some(kapitza::averaged_jacobian(&y, &params))
-    );
+fn the_generated_kapitza_field_is_the_hand_derived_one() {
+    let (a, eps, mu) = (1.3, 0.07, 0.2);
+    let params = kapitza::Params { A: a, eps, mu };
+    let states: [(f64, f64, f64); 3] = [(0.7, 0.3, -0.2), (0.013, 2.9, 1.4), (1.9, -1.2, 0.05)];
+    for (t, q, p) in states {
+        let theta = t / eps;
+        let qd = p - a * theta.sin() * q.sin();
+        let expected = [qd, a * theta.sin() * q.cos() * qd + q.sin() - mu * qd];
+        for got in [
+            kapitza::Exact { params }.rhs(t, &[q, p]),
+            kapitza::exact_rhs(t, &[q, p], &params),
+        ] {
+            for (g, e) in got.iter().zip(expected) {
+                assert!(
+                    (g - e).abs() < 1e-14,
+                    "t = {t}, q = {q}: {got:?} against {expected:?}"
+                );
+            }
+        }
+        let still = kapitza::Params { mu: 0.0, ..params };
+        let jacobian = [[0.0, 1.0], [q.cos() - a * a / 2.0 * (2.0 * q).cos(), 0.0]];
+        let got = kapitza::Averaged { params: still }
+            .jacobian(0.0, &[q, p])
+            .unwrap();
+        for (g, e) in got.iter().flatten().zip(jacobian.iter().flatten()) {
+            assert!(
+                (g - e).abs() < 1e-14,
+                "q = {q}: {got:?} against {jacobian:?}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -137,6 +137,13 @@ pub fn exact_stability_window(
 
 /// The pendulum's parameters from the model's `values`: masses, lengths, g
 /// and ν positive, a and μ not negative.
+/// The model's description (not inlined, as [`study_params`]).
+#[inline(never)]
+pub fn info() -> &'static crate::registry::ModelInfo {
+    &model::INFO
+}
+
+#[inline(never)]
 pub fn study_params(values: &[f64]) -> Result<Params, StudyError> {
     for (name, value) in Params::NAMES.iter().zip(values) {
         let fine = match *name {

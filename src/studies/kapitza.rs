@@ -12,9 +12,40 @@ use crate::analysis::stability::{
 };
 use crate::models::kapitza::{self, Exact, Params, PERIODIC_STATE};
 use crate::ode::{Integrator, Method};
+use crate::outputs::{Outputs, Table};
 use crate::plot::{palette, Figure, PanelSpec, BLACK, BLUE, RED};
 use rayon::prelude::*;
 use std::f64::consts::{PI, SQRT_2};
+
+/// The parameters from the model's values in declaration order (not
+/// inlined: the study scenes' declarations call it without taking the
+/// generated code into their own codegen unit).
+/// The model's description (not inlined, as [`study_params`]).
+#[inline(never)]
+pub fn info() -> &'static crate::registry::ModelInfo {
+    &kapitza::INFO
+}
+
+#[inline(never)]
+pub fn study_params(values: &[f64]) -> Params {
+    Params::from_values(values)
+}
+
+/// A portrait for each amplitude of `presets`, the other parameters those
+/// of `params`.
+#[inline(never)]
+pub fn portraits(
+    params: Params,
+    presets: &[f64],
+    seeds: usize,
+    periods: usize,
+    method: Method,
+) -> Result<Vec<Portrait>, StudyError> {
+    presets
+        .iter()
+        .map(|&a| portrait(Params { A: a, ..params }, seeds, periods, method))
+        .collect()
+}
 
 /// The forcing period 2πε (2π over the generated phase rate).
 pub fn period(params: &Params) -> f64 {
@@ -647,5 +678,129 @@ impl Attractor {
         let fit = |x: f64| (x, self.box_intercept + self.dimension * x);
         figure.line(0, &[fit(x_lo), fit(x_hi)], RED);
         figure
+    }
+}
+
+/// A figure with its file name.
+fn named_figure(file: &str, figure: Figure) -> (String, Figure) {
+    (file.to_string(), figure)
+}
+
+impl Outputs for UpperPosition {
+    fn figures(&self) -> Vec<(String, Figure)> {
+        vec![
+            named_figure("orbits_near_upper_position.png", self.orbits_figure()),
+            named_figure("averaged_portraits.png", self.averaged_figure()),
+            named_figure("stability_chart.png", self.chart_figure()),
+        ]
+    }
+    fn tables(&self) -> Vec<Table> {
+        let header = ["A", "mu", "orbit", "period", "q", "p"];
+        vec![
+            Table::new("orbits_near_upper_position.csv", &header, self.orbit_rows()),
+            Table::new(
+                "stability_chart.csv",
+                &["eps", "A_boundary"],
+                self.chart_rows(),
+            ),
+        ]
+    }
+    fn lines(&self) -> Vec<String> {
+        let mut lines = vec![format!(
+            "ε = {}, μ = {}: A* = {:?} (averaged: √2, to second order: {:?}); at A = {}: multipliers {:?}, det M = {} (exp(−μT) = {}): {}",
+            self.eps, self.mu, self.a_star, self.a_star_second_order, self.A, self.multipliers,
+            self.determinant, self.determinant_expected, self.verdict
+        )];
+        lines.extend(self.a_star_by_eps.iter().map(|s| {
+            format!(
+                "ε = {}: A* = {:?}, second order {:?}",
+                s.eps, s.a_star, s.a_star_second_order
+            )
+        }));
+        lines
+    }
+}
+
+impl Outputs for Attractor {
+    fn figures(&self) -> Vec<(String, Figure)> {
+        vec![
+            named_figure("attractor.png", self.figure()),
+            named_figure("box_counting.png", self.box_counting_figure()),
+        ]
+    }
+    fn tables(&self) -> Vec<Table> {
+        let points = self.orbit.iter().map(|p| (p[0], p[1]));
+        let boxes = self.box_sides.iter().zip(&self.boxes);
+        vec![
+            Table::new("attractor.csv", &["q", "p"], points),
+            Table::new("box_counting.csv", &["box_side", "boxes"], boxes),
+        ]
+    }
+    fn lines(&self) -> Vec<String> {
+        let mut lines = vec![format!(
+            "Lyapunov exponents per period {:.4?}, sum {:.4} (−μT = {:.4}), box-counting dimension {:.3}, Kaplan–Yorke {:.3}",
+            self.lyapunov, self.lyapunov_sum, self.lyapunov_sum_expected,
+            self.dimension, self.kaplan_yorke_dimension
+        )];
+        if self.lyapunov[0] <= 0.0 {
+            lines.push("note: the largest exponent is not positive: at these parameters the attractor is not chaotic".into());
+        }
+        lines
+    }
+}
+
+/// The portraits of several amplitudes, or one orbit.
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+pub enum KapitzaOrbits {
+    Portraits {
+        eps: f64,
+        mu: f64,
+        method: &'static str,
+        portraits: Vec<Portrait>,
+    },
+    One(SingleOrbit),
+}
+
+impl Outputs for KapitzaOrbits {
+    fn figures(&self) -> Vec<(String, Figure)> {
+        match self {
+            KapitzaOrbits::One(orbit) => vec![named_figure("orbit.png", orbit.figure())],
+            KapitzaOrbits::Portraits { portraits, .. } => portraits
+                .iter()
+                .map(|p| (format!("portrait_A{}.png", p.A), p.figure()))
+                .collect(),
+        }
+    }
+    fn tables(&self) -> Vec<Table> {
+        match self {
+            KapitzaOrbits::One(orbit) => {
+                let rows = orbit
+                    .points
+                    .iter()
+                    .enumerate()
+                    .map(|(k, y)| (k, y[0], y[1]));
+                vec![Table::new("orbit.csv", &["period", "q", "p"], rows)]
+            }
+            KapitzaOrbits::Portraits { portraits, .. } => portraits
+                .iter()
+                .map(|p| {
+                    let header = ["orbit", "period", "q", "p"];
+                    Table::new(format!("orbits_A{}.csv", p.A), &header, p.rows())
+                })
+                .collect(),
+        }
+    }
+    fn lines(&self) -> Vec<String> {
+        match self {
+            KapitzaOrbits::One(o) => vec![format!(
+                "after {} periods: {:?} ({} f evaluations, {:.3} s)",
+                o.periods, o.final_state, o.f_evals, o.seconds
+            )],
+            KapitzaOrbits::Portraits { portraits, .. } => portraits
+                .iter()
+                .map(|p| format!("A = {}: {} orbits in {:.1} s", p.A, p.orbits, p.seconds))
+                .collect(),
+        }
     }
 }

@@ -61,6 +61,7 @@ impl Classify for OdeError {
         match self {
             OdeError::UnknownMethod(_)
             | OdeError::InvalidSetting { .. }
+            | OdeError::BelowPrecision { .. }
             | OdeError::NonFiniteInitialState { .. }
             | OdeError::StateLength { .. }
             | OdeError::TooLarge(_) => BadValue,

@@ -326,6 +326,13 @@ pub fn state_with_deformation(p: &Params, delta: f64, v: f64) -> [f64; 4] {
 
 /// The rod's parameters from the model's `values`: 0 < d < l, ε, k > 0,
 /// friction ≥ 0.
+/// The model's description (not inlined, as [`study_params`]).
+#[inline(never)]
+pub fn info() -> &'static crate::registry::ModelInfo {
+    &crate::models::painleve_klein::INFO
+}
+
+#[inline(never)]
 pub fn study_params(values: &[f64]) -> Result<Params, StudyError> {
     let p = Params::from_values(values);
     if !(p.d > 0.0

@@ -271,7 +271,15 @@ impl Method {
             Method::Rk4 { step } => positive("step", step),
             Method::Dop853 { rtol, atol } | Method::Radau5 { rtol, atol } => {
                 positive("relative tolerance", rtol)?;
-                positive("absolute tolerance", atol)
+                positive("absolute tolerance", atol)?;
+                if rtol < PRECISION_FLOOR {
+                    return Err(OdeError::BelowPrecision {
+                        method: self.name(),
+                        value: rtol,
+                        floor: PRECISION_FLOOR,
+                    });
+                }
+                Ok(())
             }
             Method::Gauss { stages, step } => {
                 if stages != 2 && stages != 3 {
@@ -317,6 +325,12 @@ impl std::ops::AddAssign for Stats {
     }
 }
 
+/// The smallest relative tolerance of the embedded Runge–Kutta methods:
+/// 10 units of double precision's rounding (Hairer's DOP853 and RADAU5
+/// refuse less). Below it the step controller asks for more than the
+/// arithmetic holds, and a run takes millions of steps to its end.
+pub const PRECISION_FLOOR: f64 = 10.0 * f64::EPSILON;
+
 /// Why an integration stopped.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum OdeError {
@@ -324,6 +338,14 @@ pub enum OdeError {
     UnknownMethod(String),
     #[error("invalid {what}: {value} (must be finite and positive)")]
     InvalidSetting { what: &'static str, value: f64 },
+    /// A tolerance below what the method can reach in double precision:
+    /// the run would take millions of steps and end at the rounding.
+    #[error("{method}'s relative tolerance {value:e} is below what double precision can reach ({floor:.1e}, 10 units of rounding, as Hairer's codes require): ask for at least that, or use taylor, which goes to the rounding itself")]
+    BelowPrecision {
+        method: &'static str,
+        value: f64,
+        floor: f64,
+    },
     /// The initial state or time is NaN or infinite.
     #[error("initial state is not finite: t = {t}, y = {y:?}")]
     NonFiniteInitialState { t: f64, y: Vec<f64> },
