@@ -268,6 +268,12 @@ function nameWidth(g, name) {
   g.font = SUBSCRIPT_FONT;
   return wide + g.measureText(sub).width;
 }
+// The same in HTML (the hover line): the subscript in <sub>.
+function nameHtml(name) {
+  const escape = (t) => t.replace(/&/g, "&amp;").replace(/</g, "&lt;");
+  const [base, sub] = escape(name).split("_");
+  return sub === undefined ? base : `${base}<sub>${sub}</sub>`;
+}
 function drawName(g, name, x, y) {
   const [base, sub = ""] = name.split("_");
   g.font = NAME_FONT;
@@ -896,7 +902,7 @@ canvas.addEventListener("mousedown", (e) => {
 canvas.addEventListener("mousemove", (e) => {
   if (studio.model) {
     const [x, y] = toWorld(e.offsetX, e.offsetY);
-    $("hover").textContent = `${axisName(0)} = ${x.toFixed(4)}, ${axisName(1)} = ${y.toFixed(4)}`;
+    $("hover").innerHTML = `${nameHtml(axisName(0))} = ${x.toFixed(4)}, ${nameHtml(axisName(1))} = ${y.toFixed(4)}`;
   }
   if (!press) return;
   const dx = e.offsetX - press.x, dy = e.offsetY - press.y;
