@@ -6,7 +6,7 @@
 //! the same settings give the same numbers through each door.
 
 use mechlab::settings::{schemas, Declaration, Declared};
-use mechlab::studies::declared::schemas as study_schemas;
+use mechlab_studies::schemas as study_schemas;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -56,7 +56,23 @@ fn check_generated(path: &Path, begin: &str, end: &str, generated: &str) {
 
 /// The stub of a Python method `name` taking `settings`.
 fn python_method(name: &str, about: &str, settings: &[Declaration]) -> String {
-    let mut s = format!("    def {name}(\n        self,\n        *,\n");
+    // The calls that are not analyses take arrays first and return arrays.
+    let (positional, returns) = match name {
+        "integrate" => (
+            "        y0: ArrayLike,\n        t: ArrayLike,\n",
+            "NDArray[np.float64]",
+        ),
+        "integrate_many" => (
+            "        y0: ArrayLike,\n        t: ArrayLike,\n",
+            "dict[str, Any]",
+        ),
+        "iterates" => (
+            "        starts: ArrayLike,\n        periods: int,\n",
+            "NDArray[np.float64]",
+        ),
+        _ => ("", "dict[str, Any]"),
+    };
+    let mut s = format!("    def {name}(\n        self,\n{positional}        *,\n");
     for d in settings {
         s += &format!("        {},\n", d.python_argument());
     }
@@ -64,7 +80,7 @@ fn python_method(name: &str, about: &str, settings: &[Declaration]) -> String {
     if ["chaos_map", "basins", "period_map_frequencies"].contains(&name) {
         s += "        progress: bool = True,\n";
     }
-    s += "    ) -> dict[str, Any]:\n";
+    s += &format!("    ) -> {returns}:\n");
     s += &format!("        \"\"\"{about}\"\"\"\n");
     s
 }
@@ -77,6 +93,13 @@ fn the_python_stub_is_generated_from_the_declarations() {
         .into_iter()
         .map(|s| (s.analysis.to_string(), s.about, s.settings))
         .collect();
+    for call in mechlab::analysis::states::call_schemas() {
+        if call.analysis == "integrate" {
+            let many = "The states at the times t from each row of y0 (in parallel); an orbit that stopped is NaN and listed in `failed`.";
+            methods.push(("integrate_many".into(), many.into(), call.settings.clone()));
+        }
+        methods.push((call.analysis.to_string(), call.about, call.settings));
+    }
     methods.push((
         "period_map_frequencies".into(),
         "The frequency map of the period map: the chaos map's settings, from the frequency_map scene's values.".into(),

@@ -2,7 +2,6 @@
 //! (the scene's summary, with the data its figures are drawn from), and the
 //! closed forms derived by hand that the generated code is tested against.
 
-pub mod declared;
 pub mod double_pendulum;
 pub mod kapitza;
 pub mod painleve;

@@ -23,9 +23,8 @@ use mechlab::analysis::period_map::PeriodMapOptions;
 use mechlab::analysis::section::SectionOptions;
 use mechlab::analysis::separatrix::SplittingOptions;
 use mechlab::analysis::stability::StabilityOptions;
-use mechlab::analysis::states::{states_at, states_of_starts};
+use mechlab::analysis::states::{states_at, states_of_starts, IntegrateOptions, IteratesOptions};
 use mechlab::explore::ExploreOptions;
-use mechlab::ode::Method;
 use mechlab::registry::{Kind, Model};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike1, PyArrayLike2};
@@ -298,18 +297,19 @@ impl PyModel {
     /// The states at the times `t` from `y0` at t[0] (dense output; a
     /// constrained model's start and states put on its constraints), one
     /// row per time.
-    #[pyo3(signature = (y0, t, *, method="dop853", tol=1e-10, params=None))]
+    #[pyo3(signature = (y0, t, *, params=None, **settings))]
     fn integrate<'py>(
         &self,
         py: Python<'py>,
         y0: PyArrayLike1<'py, f64, AllowTypeChange>,
         t: PyArrayLike1<'py, f64, AllowTypeChange>,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let values = parameter_values(self.model, params)?;
-        let method = Method::parse(method, tol).map_err(py_err)?;
+        let options: IntegrateOptions =
+            analyses::declared_from(IntegrateOptions::default(), settings)?;
+        let method = options.resolve().map_err(py_err)?;
         let (y0, times) = (y0.as_slice()?.to_vec(), t.as_slice()?.to_vec());
         let model = self.model;
         let states =
@@ -324,18 +324,19 @@ impl PyModel {
     /// The states at the times `t` from each row of `y0` (in parallel):
     /// `states[k, i]` is orbit k at t[i]; an orbit that stopped is NaN
     /// and listed in `failed` as (k, why).
-    #[pyo3(signature = (y0, t, *, method="dop853", tol=1e-10, params=None))]
+    #[pyo3(signature = (y0, t, *, params=None, **settings))]
     fn integrate_many<'py>(
         &self,
         py: Python<'py>,
         y0: PyArrayLike2<'py, f64, AllowTypeChange>,
         t: PyArrayLike1<'py, f64, AllowTypeChange>,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let values = parameter_values(self.model, params)?;
-        let method = Method::parse(method, tol).map_err(py_err)?;
+        let options: IntegrateOptions =
+            analyses::declared_from(IntegrateOptions::default(), settings)?;
+        let method = options.resolve().map_err(py_err)?;
         let starts: Vec<Vec<f64>> = y0
             .as_array()
             .rows()
@@ -514,20 +515,19 @@ impl PyModel {
     /// `iterates[k, i]` is start k after transient + 1 + i periods, NaN
     /// where its orbit stopped. A constrained model's starts are put on
     /// its constraints first.
-    #[pyo3(signature = (starts, periods, *, transient=0, method="taylor", tol=1e-10, params=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (starts, periods, *, params=None, **settings))]
     fn iterates<'py>(
         &self,
         py: Python<'py>,
         starts: PyArrayLike2<'py, f64, AllowTypeChange>,
         periods: usize,
-        transient: usize,
-        method: &str,
-        tol: f64,
         params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
         let values = parameter_values(self.model, params)?;
-        let method = Method::parse(method, tol).map_err(py_err)?;
+        let options: IteratesOptions =
+            analyses::declared_from(IteratesOptions::default(), settings)?;
+        let (transient, method) = (options.transient, options.resolve().map_err(py_err)?);
         let starts: Vec<Vec<f64>> = starts
             .as_array()
             .rows()

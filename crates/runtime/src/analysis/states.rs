@@ -131,3 +131,61 @@ fn orbit(
     let system = crate::analysis::flows(model)?.exact(params);
     Ok(system.states_from(method, y0, times)?)
 }
+
+crate::declare_settings! {
+    /// The states of a run at given times (`integrate`, `integrate_many`
+    /// in Python): the method and its tolerance.
+    pub struct IntegrateOptions for "integrate" {
+        /// The integration method.
+        method: String = "dop853".into(), crate::settings::Range::OneOf(crate::settings::METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, crate::settings::Range::Positive;
+    }
+}
+
+crate::declare_settings! {
+    /// The period map's iterates from many starts (`iterates` in Python;
+    /// the Taylor method runs them in the batch lanes).
+    pub struct IteratesOptions for "iterates" {
+        /// Periods dropped before the first recorded iterate.
+        transient: usize = 0, crate::settings::Range::Count { min: 0, max: 100_000_000 };
+        /// The integration method.
+        method: String = "taylor".into(), crate::settings::Range::OneOf(crate::settings::METHODS);
+        /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
+        /// gauss6).
+        tol: f64 = 1e-10, crate::settings::Range::Positive;
+    }
+}
+
+impl IntegrateOptions {
+    /// The method these settings name.
+    pub fn resolve(&self) -> Result<Method, crate::settings::SettingError> {
+        crate::settings::method(
+            <Self as crate::settings::Declared>::ANALYSIS,
+            &self.method,
+            self.tol,
+        )
+    }
+}
+
+impl IteratesOptions {
+    /// The method these settings name.
+    pub fn resolve(&self) -> Result<Method, crate::settings::SettingError> {
+        crate::settings::method(
+            <Self as crate::settings::Declared>::ANALYSIS,
+            &self.method,
+            self.tol,
+        )
+    }
+}
+
+/// The declarations of the calls that are not analyses (no scene, no
+/// studio route): Python's `integrate`, `integrate_many` and `iterates`.
+pub fn call_schemas() -> Vec<crate::settings::Schema> {
+    use crate::settings::Schema;
+    vec![
+        Schema::of::<IntegrateOptions>(),
+        Schema::of::<IteratesOptions>(),
+    ]
+}

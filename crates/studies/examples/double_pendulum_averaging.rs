@@ -8,10 +8,8 @@
 //! which differ by O(1) at the fast time scale: the velocities converge only
 //! weakly, not uniformly.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumAveraging>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::DoublePendulumAveraging>);
 }

@@ -8,8 +8,8 @@
 //! σo = −1. For the given parameters, every root R* of X* = Φ(R) for σ = ±1
 //! with its Painlevé case.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::PainlevePhi>);
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::PainlevePhi>);
 }

@@ -8,8 +8,8 @@
 //! of each graph class of `painleve_phi`, first ν = 0 then ν ≠ 0, and for the
 //! given parameters; equilibria marked (black: stable, red: unstable).
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveDelta>);
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::PainleveDelta>);
 }

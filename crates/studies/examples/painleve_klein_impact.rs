@@ -11,10 +11,8 @@
 //! `events.csv`. x2(0) = −0.65 starts inside the basin of the stable
 //! equilibrium of the deformation equation, −0.78 outside it.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveKleinImpact>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::PainleveKleinImpact>);
 }

@@ -9,10 +9,8 @@
 //! radius against ν, beside exp(max Re λ · 2π/ν) that the averaged
 //! eigenvalues predict.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumFriction>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::DoublePendulumFriction>);
 }

@@ -1,10 +1,9 @@
 //! The study scenes' declarations: each scene's settings written once
 //! (name, default, range, help), how the scene runs on them, and what its
 //! result writes (figures, tables, the headline lines). The scenes in
-//! `examples/` are then one line each ([`crate::scenes::study_scene`]).
-//! A module per study, each its own codegen unit, calling the studies
-//! through functions that are not inlined: editing one study's model
-//! recompiles that study's declarations only, and little of them.
+//! `examples/` are then one line each ([`mechlab::scenes::study_scene`]).
+//! A package of its own above the generated models: editing a model
+//! recompiles the `mechlab` package, and none of this.
 
 mod double_pendulum;
 mod kapitza;
@@ -14,7 +13,21 @@ pub use double_pendulum::*;
 pub use kapitza::*;
 pub use painleve::*;
 
-use crate::plot::Figure;
+use mechlab::plot::Figure;
+
+/// A study's result as its scene writes it (the results are the studies'
+/// types, in the `mechlab` package; what they write is said here, so that
+/// a model edit, which recompiles that package, does not compile it).
+#[derive(serde::Serialize)]
+#[serde(transparent)]
+pub struct Written<T>(pub T);
+
+impl<T> std::ops::Deref for Written<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.0
+    }
+}
 
 /// A figure with its file name.
 fn named(file: &str, figure: Figure) -> (String, Figure) {
@@ -23,9 +36,9 @@ fn named(file: &str, figure: Figure) -> (String, Figure) {
 
 /// The study scenes' declarations (the book's reference lists them after
 /// the analyses').
-pub fn schemas() -> Vec<crate::settings::Schema> {
-    use crate::analysis::standard_map::StandardMapOptions;
-    use crate::settings::Schema;
+pub fn schemas() -> Vec<mechlab::settings::Schema> {
+    use mechlab::analysis::standard_map::StandardMapOptions;
+    use mechlab::settings::Schema;
     vec![
         Schema::of::<KapitzaPeriodMap>(),
         Schema::of::<KapitzaStability>(),

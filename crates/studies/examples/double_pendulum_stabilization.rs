@@ -12,10 +12,10 @@
 //! lower edge is close to a*; its upper edge, where parametric resonance
 //! destabilises the equilibrium again, the averaged system does not have.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
     mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::DoublePendulumStabilization>,
+        mechlab::scenes::study_scene::<mechlab_studies::DoublePendulumStabilization>,
     );
 }

@@ -5,10 +5,8 @@
 //! larger A: a wide chaotic sea) or of the given A; with q0 and p0 it
 //! computes one orbit and reports its final state and cost.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaPeriodMap>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::KapitzaPeriodMap>);
 }

@@ -1,13 +1,13 @@
 //! Study 3's scenes: the graphs of Φ, the deformation equation, the
 //! worked example's impact, its stiff limit.
 
-use super::named;
-use crate::plot::Figure;
-use crate::registry::ModelInfo;
-use crate::scene::SceneError;
-use crate::scenes::{Outputs, Study, Table};
-use crate::settings::{method, Declared, Range, METHODS};
-use crate::studies::painleve::{self, deformation, graphs, impact, stiff_limit};
+use super::{named, Written};
+use mechlab::plot::Figure;
+use mechlab::registry::ModelInfo;
+use mechlab::scene::SceneError;
+use mechlab::scenes::{Outputs, Study, Table};
+use mechlab::settings::{method, Declared, Range, METHODS};
+use mechlab::studies::painleve::{self, deformation, graphs, impact, stiff_limit};
 use mechlab_runtime::declare_settings;
 
 declare_settings! {
@@ -20,19 +20,19 @@ declare_settings! {
 }
 
 impl Study for PainlevePhi {
-    type Outcome = graphs::PhiGraphs;
+    type Outcome = Written<graphs::PhiGraphs>;
     fn model() -> Option<&'static ModelInfo> {
         Some(painleve::info())
     }
-    fn run(&self, values: &[f64]) -> Result<graphs::PhiGraphs, SceneError> {
-        Ok(graphs::phi_graphs(
+    fn run(&self, values: &[f64]) -> Result<Self::Outcome, SceneError> {
+        Ok(Written(graphs::phi_graphs(
             &painleve::study_params(values)?,
             self.region_pixels,
-        ))
+        )))
     }
 }
 
-impl Outputs for graphs::PhiGraphs {
+impl Outputs for Written<graphs::PhiGraphs> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("phi.png", self.figure())]
     }
@@ -80,23 +80,23 @@ declare_settings! {
 }
 
 impl Study for PainleveDelta {
-    type Outcome = deformation::Deformation;
+    type Outcome = Written<deformation::Deformation>;
     fn model() -> Option<&'static ModelInfo> {
         Some(painleve::info())
     }
-    fn run(&self, values: &[f64]) -> Result<deformation::Deformation, SceneError> {
+    fn run(&self, values: &[f64]) -> Result<Self::Outcome, SceneError> {
         let sigma = if self.sigma >= 0.0 { 1.0 } else { -1.0 };
         let params = painleve::study_params(values)?;
-        Ok(deformation::deformation(
+        Ok(Written(deformation::deformation(
             &params,
             sigma,
             self.starts,
             self.t_end,
-        )?)
+        )?))
     }
 }
 
-impl Outputs for deformation::Deformation {
+impl Outputs for Written<deformation::Deformation> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("portraits.png", self.figure())]
     }
@@ -133,22 +133,22 @@ declare_settings! {
 }
 
 impl Study for PainleveKleinImpact {
-    type Outcome = impact::Impact;
+    type Outcome = Written<impact::Impact>;
     fn model() -> Option<&'static ModelInfo> {
         Some(painleve::info())
     }
-    fn run(&self, values: &[f64]) -> Result<impact::Impact, SceneError> {
-        Ok(impact::impact(&impact::ImpactSettings {
+    fn run(&self, values: &[f64]) -> Result<Self::Outcome, SceneError> {
+        Ok(Written(impact::impact(&impact::ImpactSettings {
             params: painleve::study_params(values)?,
             x2_starts: self.x2_starts.clone(),
             t_end: self.t_end,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
             samples: self.samples,
-        })?)
+        })?))
     }
 }
 
-impl Outputs for impact::Impact {
+impl Outputs for Written<impact::Impact> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("impact.png", self.figure())]
     }
@@ -208,12 +208,12 @@ declare_settings! {
 }
 
 impl Study for PainleveStiffLimit {
-    type Outcome = stiff_limit::StiffLimit;
+    type Outcome = Written<stiff_limit::StiffLimit>;
     fn model() -> Option<&'static ModelInfo> {
         None
     }
-    fn run(&self, _: &[f64]) -> Result<stiff_limit::StiffLimit, SceneError> {
-        Ok(stiff_limit::stiff_limit(
+    fn run(&self, _: &[f64]) -> Result<Self::Outcome, SceneError> {
+        Ok(Written(stiff_limit::stiff_limit(
             &stiff_limit::StiffLimitSettings {
                 eps_values: self.eps_values.clone(),
                 x2_regular: self.x2_regular,
@@ -221,11 +221,11 @@ impl Study for PainleveStiffLimit {
                 t_end: self.t_end,
                 method: method(Self::ANALYSIS, &self.method, self.tol)?,
             },
-        )?)
+        )?))
     }
 }
 
-impl Outputs for stiff_limit::StiffLimit {
+impl Outputs for Written<stiff_limit::StiffLimit> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("stiff_limit.png", self.figure())]
     }

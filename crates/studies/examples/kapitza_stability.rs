@@ -10,10 +10,8 @@
 //! portraits, the (ε, A) stability chart with its boundaries located by
 //! bisection, and A*(ε) against √2.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaStability>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::KapitzaStability>);
 }

@@ -7,10 +7,8 @@
 //! transients, a zoom on its layers, the box-counting plot, and reports the
 //! Lyapunov exponents (their sum is −μT) and the box-counting dimension.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::KapitzaAttractor>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::KapitzaAttractor>);
 }

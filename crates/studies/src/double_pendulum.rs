@@ -1,13 +1,13 @@
 //! Study 2's scenes: Theorem 2's cases, the equilibria's stabilisation,
 //! Theorem 3 with friction.
 
-use super::named;
-use crate::plot::Figure;
-use crate::registry::ModelInfo;
-use crate::scene::{Progress, SceneError};
-use crate::scenes::{Outputs, Study, Table};
-use crate::settings::{method, Declared, Range, METHODS};
-use crate::studies::double_pendulum::{self as dp, EQUILIBRIA};
+use super::{named, Written};
+use mechlab::plot::Figure;
+use mechlab::registry::ModelInfo;
+use mechlab::scene::{Progress, SceneError};
+use mechlab::scenes::{Outputs, Study, Table};
+use mechlab::settings::{method, Declared, Range, METHODS};
+use mechlab::studies::double_pendulum::{self as dp, EQUILIBRIA};
 use mechlab_runtime::declare_settings;
 
 declare_settings! {
@@ -30,23 +30,23 @@ declare_settings! {
 }
 
 impl Study for DoublePendulumAveraging {
-    type Outcome = dp::AveragingCases;
+    type Outcome = Written<dp::AveragingCases>;
     fn model() -> Option<&'static ModelInfo> {
         Some(dp::info())
     }
     const PARAMETERS: &'static [(&'static str, &'static str)] = &[("nu", "1000")];
-    fn run(&self, values: &[f64]) -> Result<dp::AveragingCases, SceneError> {
-        Ok(dp::averaging_cases(&dp::AveragingSettings {
+    fn run(&self, values: &[f64]) -> Result<Self::Outcome, SceneError> {
+        Ok(Written(dp::averaging_cases(&dp::AveragingSettings {
             params: dp::study_params(values)?,
             amplitudes: self.amplitudes.clone(),
             starts: self.starts.clone(),
             t_end: self.t_end,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
-        })?)
+        })?))
     }
 }
 
-impl Outputs for dp::AveragingCases {
+impl Outputs for Written<dp::AveragingCases> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("averaging.png", self.figure())]
     }
@@ -93,11 +93,11 @@ declare_settings! {
 }
 
 impl Study for DoublePendulumStabilization {
-    type Outcome = dp::EquilibriaStabilization;
+    type Outcome = Written<dp::EquilibriaStabilization>;
     fn model() -> Option<&'static ModelInfo> {
         Some(dp::info())
     }
-    fn run(&self, values: &[f64]) -> Result<dp::EquilibriaStabilization, SceneError> {
+    fn run(&self, values: &[f64]) -> Result<Self::Outcome, SceneError> {
         let progress = Progress::new("equilibria", EQUILIBRIA.len());
         let settings = dp::StabilizationSettings {
             params: dp::study_params(values)?,
@@ -108,13 +108,13 @@ impl Study for DoublePendulumStabilization {
             chart_points: self.chart_points,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
         };
-        Ok(dp::stabilization_study(&settings, &|done| {
+        Ok(Written(dp::stabilization_study(&settings, &|done| {
             progress.update(done)
-        })?)
+        })?))
     }
 }
 
-impl Outputs for dp::EquilibriaStabilization {
+impl Outputs for Written<dp::EquilibriaStabilization> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("stabilization.png", self.figure())]
     }
@@ -160,24 +160,24 @@ declare_settings! {
 }
 
 impl Study for DoublePendulumFriction {
-    type Outcome = dp::Friction;
+    type Outcome = Written<dp::Friction>;
     fn model() -> Option<&'static ModelInfo> {
         Some(dp::info())
     }
     const PARAMETERS: &'static [(&'static str, &'static str)] = &[("mu", "0.3")];
-    fn run(&self, values: &[f64]) -> Result<dp::Friction, SceneError> {
-        Ok(dp::friction(&dp::FrictionSettings {
+    fn run(&self, values: &[f64]) -> Result<Self::Outcome, SceneError> {
+        Ok(Written(dp::friction(&dp::FrictionSettings {
             params: dp::study_params(values)?,
             equilibrium: (self.equilibrium[0], self.equilibrium[1]),
             offset: self.offset,
             t_end: self.t_end,
             nus: self.nus.clone(),
             method: method(Self::ANALYSIS, "dop853", self.tol)?,
-        })?)
+        })?))
     }
 }
 
-impl Outputs for dp::Friction {
+impl Outputs for Written<dp::Friction> {
     fn figures(&self) -> Vec<(String, Figure)> {
         vec![named("friction.png", self.figure())]
     }

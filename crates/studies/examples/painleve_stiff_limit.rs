@@ -9,10 +9,8 @@
 //! method: Radau IIA 5 between switches. Reported per run: the event times,
 //! wall time and steps.
 //!
-//! Its settings are declared in `mechlab::studies::declared`.
+//! Its settings are declared in `mechlab_studies`.
 
 fn main() {
-    mechlab::scene::run(
-        mechlab::scenes::study_scene::<mechlab::studies::declared::PainleveStiffLimit>,
-    );
+    mechlab::scene::run(mechlab::scenes::study_scene::<mechlab_studies::PainleveStiffLimit>);
 }
