@@ -645,7 +645,14 @@ where
                 values,
                 map,
                 ..
-            } => draw_map(chart, panel, [*columns, *rows], values, *map)?,
+            } => {
+                // Non-finite values are left blank.
+                let colors: Vec<Option<Rgb>> = values
+                    .iter()
+                    .map(|&v| v.is_finite().then(|| map.rgb(v)))
+                    .collect();
+                draw_cells(chart, panel, [*columns, *rows], &colors)?
+            }
             Layer::Cells {
                 columns,
                 rows,
@@ -704,41 +711,6 @@ where
         }
     }
     Ok(chart.plotting_area().get_pixel_range())
-}
-
-/// A map layer: `values` (row-major, `columns` × `rows`) as cells filling
-/// the panel, non-finite ones left blank.
-fn draw_map<'a, DB, X, Y>(
-    chart: &mut Chart<'a, DB, X, Y>,
-    panel: &Panel,
-    [columns, rows]: [usize; 2],
-    values: &[f64],
-    map: ColorMap,
-) -> Result<(), PlotFailure>
-where
-    DB: DrawingBackend + 'a,
-    DB::ErrorType: 'static,
-    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
-    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
-{
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotFailure::from(e);
-    let (x0, x1) = panel.x_range;
-    let (y0, y1) = panel.y_range;
-    let (dx, dy) = ((x1 - x0) / columns as f64, (y1 - y0) / rows as f64);
-    chart
-        .draw_series(
-            (0..rows)
-                .flat_map(|j| (0..columns).map(move |i| (i, j)))
-                .filter_map(|(i, j)| {
-                    let v = values[j * columns + i];
-                    v.is_finite().then(|| {
-                        let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
-                        Rectangle::new([(x, y), (x + dx, y + dy)], map.color(v).filled())
-                    })
-                }),
-        )
-        .map_err(err)?;
-    Ok(())
 }
 
 /// A grid of cells, each filled with its colour edge to edge.

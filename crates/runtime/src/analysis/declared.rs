@@ -128,54 +128,6 @@ impl Analysis for BasinsOptions {
     }
 }
 
-impl Analysis for ContinuationOptions {
-    type Output = crate::analysis::continuation::Continuation;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(continuation(model, values, &self.resolve(model, values)?)?)
-    }
-}
-
-impl Analysis for SplittingOptions {
-    type Output = crate::analysis::separatrix::Splitting;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(separatrix_splitting(model, values, &self.resolve()?)?)
-    }
-}
-
-impl Analysis for SectionOptions {
-    type Output = crate::analysis::section::SectionStudy;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(section_study(model, values, self, &|_| ())?)
-    }
-}
-
-impl Analysis for StabilityOptions {
-    type Output = crate::analysis::stability::Stability;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(stability(model, values, &self.resolve(model)?)?)
-    }
-}
-
 impl Analysis for LinkageOptions {
     type Output = crate::analysis::on_constraints::vibration::Linkage;
     fn run(
@@ -195,42 +147,6 @@ impl Analysis for LinkageOptions {
     }
 }
 
-impl Analysis for AttractorOptions {
-    type Output = crate::analysis::attractor::Attractor;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(attractor(model, values, &self.resolve()?)?)
-    }
-}
-
-impl Analysis for AveragingOptions {
-    type Output = crate::analysis::averaging::AveragingConvergence;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(convergence(model, values, &self.resolve()?)?)
-    }
-}
-
-impl Analysis for PeriodMapOptions {
-    type Output = crate::analysis::period_map::Portrait;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(portrait(model, values, &self.resolve(model)?)?)
-    }
-}
-
 impl Analysis for ExploreOptions {
     type Output = crate::explore::Exploration;
     fn run(
@@ -242,4 +158,33 @@ impl Analysis for ExploreOptions {
         let (settings, y0) = self.resolve(model)?;
         Ok(explore(model, values, &y0, &settings)?)
     }
+}
+
+/// Analyses that report no progress: their output and the call that
+/// runs them (`options`, `model` and `values` in scope).
+macro_rules! without_progress {
+    ($($options:ty => $output:ty: |$o:ident, $model:ident, $values:ident| $run:expr;)+) => {$(
+        impl Analysis for $options {
+            type Output = $output;
+            fn run(
+                &self,
+                $model: &'static Model,
+                $values: &[f64],
+                _: Progress,
+            ) -> Result<Self::Output, AnalysisError> {
+                let $o = self;
+                Ok($run?)
+            }
+        }
+    )+};
+}
+
+without_progress! {
+    ContinuationOptions => crate::analysis::continuation::Continuation: |o, model, values| continuation(model, values, &o.resolve(model, values)?);
+    SplittingOptions => crate::analysis::separatrix::Splitting: |o, model, values| separatrix_splitting(model, values, &o.resolve()?);
+    SectionOptions => crate::analysis::section::SectionStudy: |o, model, values| section_study(model, values, o, &|_| ());
+    StabilityOptions => crate::analysis::stability::Stability: |o, model, values| stability(model, values, &o.resolve(model)?);
+    AttractorOptions => crate::analysis::attractor::Attractor: |o, model, values| attractor(model, values, &o.resolve()?);
+    AveragingOptions => crate::analysis::averaging::AveragingConvergence: |o, model, values| convergence(model, values, &o.resolve()?);
+    PeriodMapOptions => crate::analysis::period_map::Portrait: |o, model, values| portrait(model, values, &o.resolve(model)?);
 }
