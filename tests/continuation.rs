@@ -79,6 +79,7 @@ fn kapitzas_upright_changes_stability_at_the_exact_floquet_edges() {
             edge_tolerance: 1e-12,
             method: Method::Taylor { tol: 1e-13 },
             max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+            accuracy: None,
             first: Default::default(),
         },
     )
@@ -450,6 +451,7 @@ fn the_moved_uprights_window_tends_to_the_averaged_threshold_as_eps_squared() {
                     edge_tolerance: 1e-10,
                     method: Method::Taylor { tol: 1e-12 },
                     max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+                    accuracy: None,
                     first: Default::default(),
                 },
             )

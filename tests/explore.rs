@@ -330,6 +330,7 @@ fn stability_judges_the_spherical_pendulums_poles_as_explore_does() {
         edge_tolerance: 1e-9,
         method: Method::Taylor { tol: 1e-12 },
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+        accuracy: None,
         first: Default::default(),
     };
     let found = stability(&MODEL, &[1.6, 0.1], &settings).unwrap();

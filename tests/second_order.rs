@@ -3,10 +3,20 @@
 //! and the exact (Floquet) edges, and their order in ε.
 
 use crate::common::model_of;
-use mechlab::analysis::stability::{stability, Settings};
+use mechlab::analysis::stability::{stability, EquilibriumStability, Settings};
 use mechlab::models::{double_pendulum as dp, kapitza};
-use mechlab::ode::Method;
+use mechlab::ode::{Integrator, Method};
 use std::f64::consts::SQRT_2;
+
+/// What `stability` says of the upright equilibrium (q = 0) of a model.
+fn upright(model: &str, params: &[f64], settings: &Settings) -> EquilibriumStability {
+    let result = stability(model_of(model), params, settings).unwrap();
+    let upright = result
+        .equilibria
+        .into_iter()
+        .find(|e| e.q.iter().all(|x| x.abs() < 1e-9));
+    upright.expect("an upright equilibrium")
+}
 
 /// The exact lower edge, a*, and the second-order threshold at the
 /// upright equilibrium of a model.
@@ -18,14 +28,10 @@ fn thresholds(model: &str, params: &[f64], amplitude: &str, a_max: f64) -> (f64,
         edge_tolerance: 1e-12,
         method: Method::parse("dop853", 1e-13).unwrap(),
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+        accuracy: None,
         first: Default::default(),
     };
-    let result = stability(model_of(model), params, &settings).unwrap();
-    let upright = result
-        .equilibria
-        .iter()
-        .find(|e| e.q.iter().all(|x| x.abs() < 1e-9))
-        .unwrap();
+    let upright = upright(model, params, &settings);
     let exact = upright.exact_window.unwrap()[0].unwrap();
     let out = (
         exact,
@@ -331,5 +337,215 @@ fn second_order_averaging_refuses_friction() {
             assert!((divergence + 0.1).abs() < 1e-6, "{divergence}")
         }
         other => panic!("{other:?}"),
+    }
+}
+
+/// The upright's exact lower edge asked to `accuracy`, with its stated
+/// error, a* and the second-order threshold.
+fn edge_to_accuracy(model: &str, params: &[f64], a_max: f64, accuracy: f64) -> [f64; 4] {
+    let settings = Settings {
+        amplitude: model_of(model).info.amplitude.unwrap().into(),
+        a_max: Some(a_max),
+        samples: 20,
+        edge_tolerance: 1e-9,
+        method: Method::parse("dop853", 1e-10).unwrap(),
+        max_windows: 1,
+        accuracy: Some(accuracy),
+        first: mechlab::analysis::stability::FirstWindows::Highest,
+    };
+    let upright = upright(model, params, &settings);
+    let check = upright
+        .exact_window_check
+        .as_deref()
+        .unwrap_or_else(|| panic!("{upright:#?}"));
+    assert!(check.ends_with("reached"), "{check}");
+    assert!(!check.contains("NOT"), "{check}");
+    let edge = upright.exact_window.unwrap()[0].unwrap();
+    let error = upright.exact_window_error.unwrap()[0].unwrap();
+    eprintln!("{model} {params:?}: edge {edge:.13} ± {error:.1e} ({check})");
+    let (first, second) = (
+        upright.a_star.unwrap(),
+        upright.a_star_second_order.unwrap(),
+    );
+    [edge, error, first, second]
+}
+
+/// A fast vibration (ε from 1e-2 down to 1e-5 of the pendulum's time): the
+/// exact lower edge asked to 1e-10 lies within its stated error of the
+/// Mathieu series' threshold (DLMF 28.6.1), above √2 wherever the series
+/// puts it further above than that error, and its error is what was asked.
+#[test]
+fn kapitza_exact_edge_at_a_fast_vibration_meets_the_mathieu_series() {
+    for eps in [1e-2, 1e-3, 1e-4, 1e-5] {
+        let params = kapitza::Params {
+            A: 1.5,
+            eps,
+            mu: 0.0,
+        };
+        let [edge, error, _, second] = edge_to_accuracy("kapitza", &params.values(), 2.0, 1e-10);
+        let mathieu = mathieu_threshold(eps);
+        assert!(error <= 1e-10, "ε = {eps}: error {error:e}");
+        assert!(
+            (edge - mathieu).abs() <= error + 1e-12,
+            "ε = {eps}: exact {edge} vs Mathieu {mathieu} (stated error {error:e})"
+        );
+        if mathieu - SQRT_2 > 2.0 * error {
+            assert!(edge > SQRT_2, "ε = {eps}: {edge} below √2");
+        }
+        // Second-order averaging is O(ε⁴) from the exact edge.
+        assert!((edge - second).abs() <= error + 1e-12 + 0.1 * eps.powi(4));
+    }
+}
+
+/// The double pendulum at ν = 10⁴ (a vibration 10⁴ times faster than its
+/// pendulum's time): the exact lower edge of the upright asked to 1e-9
+/// meets the second-order threshold within its stated error, and lies
+/// above a* by the second order's shift.
+#[test]
+fn double_pendulum_exact_edge_at_a_fast_vibration_meets_second_order() {
+    let params = dp::Params {
+        a: 2.0,
+        nu: 1e4,
+        ..Default::default()
+    };
+    let [edge, error, first, second] =
+        edge_to_accuracy("double_pendulum", &params.values(), 2.0, 1e-9);
+    assert!(error <= 1e-9, "error {error:e}");
+    assert!(
+        (edge - second).abs() <= error + 1e-12,
+        "exact {edge} vs second order {second} (stated error {error:e})"
+    );
+    assert!(edge > first, "exact {edge} below a* = {first}");
+}
+
+/// The frequencies of a linearised Hamiltonian with Hessian `h` (state
+/// [q; p]): the moduli of the eigenvalues of J h, ascending, each once.
+fn frequencies(h: &nalgebra::DMatrix<f64>) -> Vec<f64> {
+    let n = h.nrows() / 2;
+    let j = nalgebra::DMatrix::from_fn(2 * n, 2 * n, |i, k| match (i < n, k < n) {
+        (true, false) if k == i + n => 1.0,
+        (false, true) if i == k + n => -1.0,
+        _ => 0.0,
+    });
+    let mut values: Vec<f64> = (j * h)
+        .complex_eigenvalues()
+        .iter()
+        .filter(|z| z.im > 0.0)
+        .map(|z| z.im)
+        .collect();
+    values.sort_by(f64::total_cmp);
+    values
+}
+
+/// The chains' second-order Hessians (from a Lie series solved at run
+/// time, with no closed form) against the exact system: the linearised
+/// K̄₂'s frequencies at the upright chain are the Floquet frequencies
+/// arg λ / T of the exact monodromy matrix up to O(ε³) (frequencies do not
+/// change under the near-identity transformation), where K̄'s (first
+/// order) are off by O(ε²), as the errors' fall from ν = 200 to 400 shows.
+#[test]
+fn chains_second_order_hessians_give_the_exact_floquet_frequencies() {
+    use mechlab::models::triple_pendulum as triple;
+    use mechlab_test_models::quadruple_pendulum as quadruple;
+    let cases = [
+        (
+            "triple_pendulum",
+            triple::Params {
+                nu: 100.0,
+                ..Default::default()
+            }
+            .values(),
+            "a",
+        ),
+        (
+            "quadruple_pendulum",
+            quadruple::Params {
+                nu: 100.0,
+                ..Default::default()
+            }
+            .values(),
+            "a",
+        ),
+    ];
+    for (name, params, amplitude) in cases {
+        let model = model_of(name).systems().unwrap();
+        let info = model_of(name).info;
+        let nu = info
+            .parameter_names
+            .iter()
+            .position(|p| *p == "nu")
+            .unwrap();
+        let a = info
+            .parameter_names
+            .iter()
+            .position(|p| *p == amplitude)
+            .unwrap();
+        let mut errors = Vec::new();
+        for rate in [200.0, 400.0] {
+            let mut p = params.clone();
+            p[nu] = rate;
+            // Inside the window: 1.3 times the first-order threshold.
+            let n = info.coordinates.len();
+            let y0 = vec![0.0; 2 * n];
+            let first = |p: &[f64]| {
+                let k = model.effective_potential_hessian(p, &vec![0.0; n]);
+                let inverse = model.mass_matrix(p, &vec![0.0; n]).try_inverse().unwrap();
+                nalgebra::DMatrix::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+                    (true, true) => k[(i, j)],
+                    (false, false) => inverse[(i - n, j - n)],
+                    _ => 0.0,
+                })
+            };
+            let no_windows = Settings {
+                amplitude: amplitude.into(),
+                a_max: None,
+                samples: 2,
+                edge_tolerance: 1e-9,
+                method: Method::parse("dop853", 1e-10).unwrap(),
+                max_windows: 0,
+                accuracy: None,
+                first: Default::default(),
+            };
+            let a_star = upright(name, &p, &no_windows).a_star.unwrap();
+            p[a] = 1.3 * a_star;
+            let exact = {
+                let period = model.phase_period(&p).unwrap();
+                let mut integrator =
+                    Integrator::new(Method::parse("dop853", 1e-13).unwrap()).unwrap();
+                let (_, m) = model.monodromy(&p, &mut integrator, period, &y0).unwrap();
+                let mut angles: Vec<f64> = m
+                    .complex_eigenvalues()
+                    .iter()
+                    .filter(|z| z.im > 0.0)
+                    .map(|z| z.im.atan2(z.re) / period)
+                    .collect();
+                angles.sort_by(f64::total_cmp);
+                angles
+            };
+            let second = frequencies(&model.averaged2_hessian(&p, &y0).unwrap());
+            let first = frequencies(&first(&p));
+            assert_eq!(
+                exact.len(),
+                n,
+                "{name} at ν = {rate}: not stable ({exact:?})"
+            );
+            let gap = |w: &[f64]| {
+                (0..n)
+                    .map(|k| ((w[k] - exact[k]) / exact[k]).abs())
+                    .fold(0.0, f64::max)
+            };
+            eprintln!(
+                "{name} ν = {rate}: exact {exact:?}, first off {:e}, second off {:e}",
+                gap(&first),
+                gap(&second)
+            );
+            errors.push((gap(&first), gap(&second)));
+        }
+        // Doubling ν: first order's error falls as ν⁻², second order's at
+        // least as ν⁻³, and at ν = 400 it is at least 20 times smaller.
+        let (first_fall, second_fall) = (errors[0].0 / errors[1].0, errors[0].1 / errors[1].1);
+        assert!((3.0..5.0).contains(&first_fall), "{name}: {errors:?}");
+        assert!(second_fall > 8.0, "{name}: {errors:?}");
+        assert!(errors[1].1 * 20.0 < errors[1].0, "{name}: {errors:?}");
     }
 }

@@ -20,6 +20,7 @@ mod events;
 mod explore;
 mod frequency;
 mod holonomic;
+mod indicators;
 mod integrators;
 mod mechanism;
 mod model_errors;

@@ -265,6 +265,7 @@ pub fn critical_amplitude(eps: f64, mu: f64, method: Method) -> Result<AStar, St
         edge_tolerance: 1e-10,
         method,
         max_windows: crate::analysis::stability::MAX_WINDOWS,
+        accuracy: None,
         first: Default::default(),
     };
     let params = Params { A: SQRT_2, eps, mu };

@@ -333,6 +333,7 @@ fn stability_settings(amplitude: &str) -> Settings {
         edge_tolerance: 1e-4,
         method: Method::parse("taylor", 1e-10).unwrap(),
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+        accuracy: None,
         first: Default::default(),
     }
 }

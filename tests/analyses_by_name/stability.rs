@@ -17,6 +17,7 @@ fn settings(amplitude: &str) -> Settings {
         edge_tolerance: 1e-11,
         method: Method::parse("dop853", 1e-12).unwrap(),
         max_windows: mechlab::analysis::stability::MAX_WINDOWS,
+        accuracy: None,
         first: Default::default(),
     }
 }
@@ -488,6 +489,7 @@ fn first_names_the_equilibria_that_get_a_window() {
     let windowed = |first: FirstWindows| -> Vec<Vec<f64>> {
         let one = Settings {
             max_windows: 1,
+            accuracy: None,
             samples: 20,
             edge_tolerance: 1e-6,
             first,

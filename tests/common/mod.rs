@@ -222,3 +222,83 @@ pub fn continuation_settings(
         chart: None,
     }
 }
+
+/// The first period doubling of Duffing's right-well orbit,
+/// x'' + δx' − x + x³ = γ cos ωt, in γ on (γ₀, γ₁), computed without
+/// mechlab: classical RK4 with `steps` steps a period on the orbit and its
+/// variational equations, Newton on P(x) − x for the orbit, and bisection
+/// on the Jury condition 1 + tr M + det M = 0 (a multiplier at −1).
+pub fn duffing_period_doubling(
+    delta: f64,
+    omega: f64,
+    (mut low, mut high): (f64, f64),
+    steps: usize,
+) -> f64 {
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let h = period / steps as f64;
+    // State (x, v, ∂(x, v)/∂(x₀, v₀) by columns).
+    let field = |gamma: f64, t: f64, s: &[f64; 6]| -> [f64; 6] {
+        let (x, v) = (s[0], s[1]);
+        let stiffness = 1.0 - 3.0 * x * x;
+        [
+            v,
+            -delta * v + x - x * x * x + gamma * (omega * t).cos(),
+            s[3],
+            stiffness * s[2] - delta * s[3],
+            s[5],
+            stiffness * s[4] - delta * s[5],
+        ]
+    };
+    let period_map = |gamma: f64, x0: [f64; 2]| -> ([f64; 2], [[f64; 2]; 2]) {
+        let mut s = [x0[0], x0[1], 1.0, 0.0, 0.0, 1.0];
+        for k in 0..steps {
+            let t = k as f64 * h;
+            let add = |a: &[f64; 6], b: &[f64; 6], c: f64| -> [f64; 6] {
+                std::array::from_fn(|i| a[i] + c * b[i])
+            };
+            let k1 = field(gamma, t, &s);
+            let k2 = field(gamma, t + 0.5 * h, &add(&s, &k1, 0.5 * h));
+            let k3 = field(gamma, t + 0.5 * h, &add(&s, &k2, 0.5 * h));
+            let k4 = field(gamma, t + h, &add(&s, &k3, h));
+            s = std::array::from_fn(|i| {
+                s[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+        }
+        ([s[0], s[1]], [[s[2], s[4]], [s[3], s[5]]])
+    };
+    // The orbit by Newton, continued from the last γ's.
+    let orbit = |gamma: f64, mut x: [f64; 2]| -> ([f64; 2], [[f64; 2]; 2]) {
+        for _ in 0..50 {
+            let (image, m) = period_map(gamma, x);
+            let (a, b, c, d) = (m[0][0] - 1.0, m[0][1], m[1][0], m[1][1] - 1.0);
+            let (r0, r1) = (image[0] - x[0], image[1] - x[1]);
+            let det = a * d - b * c;
+            let step = [(d * r0 - b * r1) / det, (a * r1 - c * r0) / det];
+            x = [x[0] - step[0], x[1] - step[1]];
+            if step[0].abs().max(step[1].abs()) < 1e-14 {
+                break;
+            }
+        }
+        let (_, m) = period_map(gamma, x);
+        (x, m)
+    };
+    let jury = |m: [[f64; 2]; 2]| 1.0 + m[0][0] + m[1][1] + (m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+    let mut start = [1.0, 0.0];
+    // Follow the orbit from γ = 0 (near the well's bottom x = 1) to γ₀.
+    for k in 0..=20 {
+        start = orbit(low * k as f64 / 20.0, start).0;
+    }
+    let (x, m) = orbit(low, start);
+    assert!(jury(m) > 0.0, "no doubling above γ = {low}");
+    start = x;
+    while high - low > 1e-13 {
+        let mid = 0.5 * (low + high);
+        let (x, m) = orbit(mid, start);
+        if jury(m) > 0.0 {
+            (low, start) = (mid, x);
+        } else {
+            high = mid;
+        }
+    }
+    0.5 * (low + high)
+}

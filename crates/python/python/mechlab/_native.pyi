@@ -156,6 +156,7 @@ class Model:
         max_windows: int = 64,
         first: str | Sequence[Sequence[float]] = "lowest",
         edge_tolerance: float = 1e-9,
+        accuracy: Optional[float] = None,
         method: str = "dop853",
         tol: float = 1e-10,
         params: Params = None,

@@ -14,7 +14,9 @@
 
 use super::continuation::{orbit_branch, OrbitBranch};
 use super::equilibria::cyclic_coordinates;
-use super::floquet::{multipliers_of, spectral_radius, window_in_batches};
+use super::floquet::{
+    first_onset_in_batches, multipliers_of, spectral_radius, stability_margin, window_in_batches,
+};
 use super::tiles::{fingerprint, run_tiles, TileError, Tiles};
 use super::vibrational_stability::generalized_eigenvalues_of;
 use crate::analysis::period_map::wrap_angle;
@@ -51,6 +53,12 @@ crate::declare_settings! {
         /// The window's edges (and a chart's boundaries) are bisected to
         /// this.
         edge_tolerance: f64 = 1e-9, Range::Positive;
+        /// The error wanted on the exact window's edges (auto: none asked,
+        /// each edge comes with the error of the run at `tol`). Given, the
+        /// edges are bisected to a quarter of it and `tol` is tightened a
+        /// hundredfold until their error is within it, or the result says
+        /// why it cannot be.
+        accuracy: Option<f64> = None, Range::Positive;
         /// The integration method of the monodromy matrices.
         method: String = "dop853".into(), Range::OneOf(METHODS);
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
@@ -80,6 +88,7 @@ impl StabilityOptions {
             a_max: self.a_max,
             samples: self.samples,
             edge_tolerance: self.edge_tolerance,
+            accuracy: self.accuracy,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
             max_windows: self.max_windows,
             first: self.first.clone(),
@@ -159,6 +168,9 @@ pub struct Settings {
     pub samples: usize,
     /// The edges are bisected to this (absolute) tolerance.
     pub edge_tolerance: f64,
+    /// The error wanted on the edges (None: the error of `method` is
+    /// reported, not chosen).
+    pub accuracy: Option<f64>,
     /// Integration method of the monodromy matrices.
     pub method: Method,
     /// At most this many equilibria get an exact window (a sweep of Floquet
@@ -191,6 +203,13 @@ pub struct EquilibriumStability {
     /// The first interval of the amplitude on which the exact system is
     /// stable at (q, 0): [lower, upper] (upper null if beyond a_max).
     pub exact_window: Option<[Option<f64>; 2]>,
+    /// Each edge's numerical error: its distance to the same edge found
+    /// with the run of `exact_window_check`, plus both bisections' half
+    /// brackets (null where that run finds no edge near it).
+    pub exact_window_error: Option<[Option<f64>; 2]>,
+    /// The runs the window and its error come from, and whether the
+    /// `accuracy` asked for was reached.
+    pub exact_window_check: Option<String>,
     /// Why there is no exact window, when there is none.
     pub exact_reason: Option<String>,
     /// (a, spectral radius of the monodromy matrix) where it was computed.
@@ -271,9 +290,21 @@ impl Stability {
                 true => String::new(),
                 false => format!(" (a pole: reduced by the coordinates {:?})", e.reduced_by),
             };
+            let window = match (e.exact_window, e.exact_window_error) {
+                (Some(edges), Some(errors)) => {
+                    let edge = |k: usize| match (edges[k], errors[k]) {
+                        (Some(a), Some(error)) => format!("{a} ± {error:.1e}"),
+                        (Some(a), None) => format!("{a} (error unknown)"),
+                        (None, _) => "beyond a_max".into(),
+                    };
+                    let check = e.exact_window_check.as_deref().unwrap_or("");
+                    format!("[{}, {}] ({check})", edge(0), edge(1))
+                }
+                (window, _) => format!("{window:?}"),
+            };
             format!(
-                "q = {:?}{pole}: λ = {:?}, a* = {:?} {reason}, exact window {:?} {exact_reason}",
-                e.q, e.lambdas, e.a_star, e.exact_window
+                "q = {:?}{pole}: λ = {:?}, a* = {:?} {reason}, exact window {window} {exact_reason}",
+                e.q, e.lambdas, e.a_star
             )
         }));
         lines
@@ -456,12 +487,12 @@ fn analyse(
                 continue;
             }
             let q = e.q.clone();
-            exact_window(model, params, amplitude, &q, settings, e)?;
+            checked_window(model, params, amplitude, &q, settings, e)?;
         }
         for e in result.equilibria.iter_mut() {
             if e.a_star.is_none() && e.exact_reason.is_none() {
                 let q = e.q.clone();
-                exact_window(model, params, amplitude, &q, settings, e)?;
+                checked_window(model, params, amplitude, &q, settings, e)?;
             }
         }
         for (rank, (q, averaged)) in moved.into_iter().enumerate() {
@@ -782,6 +813,8 @@ fn at_singular_chart(q: &[f64]) -> EquilibriumStability {
         a_star_second_order: None,
         reason: Some(SINGULAR_CHART.into()),
         exact_window: None,
+        exact_window_error: None,
+        exact_window_check: None,
         exact_reason: Some(SINGULAR_CHART.into()),
         spectral_radius: Vec::new(),
         reduced_by: Vec::new(),
@@ -826,6 +859,8 @@ fn reduced_verdict(
         a_star_second_order,
         reason,
         exact_window: None,
+        exact_window_error: None,
+        exact_window_check: None,
         exact_reason: None,
         spectral_radius: Vec::new(),
         reduced_by: Vec::new(),
@@ -1007,20 +1042,18 @@ fn second_order_threshold(
     Some(high)
 }
 
-/// Multipliers within this of the unit circle count as stable (the
-/// integration error of a conservative system's monodromy matrix).
-const STABLE_SLACK: f64 = 1e-6;
-
-/// The spectral radius of the exact system's monodromy matrix over one
-/// period of the phase from `y0`, at each parameter point of `points` (a
-/// sweep): on all cores, in batches of the method's width (the lanes of the
-/// batch Taylor method; each as its own scalar run, bit for bit).
-fn spectral_radii_at(
+/// The spectral radius and the stability margin
+/// ([`stability_margin`]: ≤ 0 stable) of the exact system's monodromy
+/// matrix over one period of the phase from `y0`, at each parameter point
+/// of `points` (a sweep): on all cores, in batches of the method's width
+/// (the lanes of the batch Taylor method; each as its own scalar run, bit
+/// for bit).
+fn floquet_at(
     model: &dyn Systems,
     points: &[Vec<f64>],
     y0: &[f64],
     method: Method,
-) -> Result<Vec<f64>, OdeError> {
+) -> Result<Vec<(f64, f64)>, OdeError> {
     use rayon::prelude::*;
     // Whole batches, about four tasks per thread.
     let width = method.batch_width();
@@ -1029,7 +1062,7 @@ fn spectral_radii_at(
         .div_ceil(4 * rayon::current_num_threads())
         .next_multiple_of(width)
         .max(width);
-    let radii: Vec<Vec<f64>> = points
+    let values: Vec<Vec<(f64, f64)>> = points
         .par_chunks(task)
         .map(|chunk| {
             let problems: Vec<_> = chunk
@@ -1040,11 +1073,19 @@ fn spectral_radii_at(
                 .monodromies(method, &problems, y0)
                 .0
                 .into_iter()
-                .map(|result| result.map(|(_, m)| spectral_radius(&multipliers_of(&m))))
+                .zip(&problems)
+                .map(|(result, (_, period))| {
+                    result.map(|(_, m)| {
+                        (
+                            spectral_radius(&multipliers_of(&m)),
+                            stability_margin(&m, *period),
+                        )
+                    })
+                })
                 .collect()
         })
         .collect::<Result<_, _>>()?;
-    Ok(radii.concat())
+    Ok(values.concat())
 }
 
 /// The parameters by name of a model with a fast phase, or why it cannot be
@@ -1062,8 +1103,9 @@ fn vibrating_model(
 }
 
 /// The exact system's stability window in the amplitude at (q, 0), from
-/// the spectral radius of its monodromy matrix over one period of the
-/// phase, if (q, 0) is a solution of the exact system for every amplitude.
+/// the stability margin of its monodromy matrix over one period of the
+/// phase ([`stability_margin`]), if (q, 0) is a solution of the exact
+/// system for every amplitude; each edge with its error.
 fn exact_window(
     model: &dyn Systems,
     params: &[f64],
@@ -1091,10 +1133,10 @@ fn exact_window(
     let curve = RefCell::new(Vec::new());
     let margins = |amplitudes: &[f64]| -> Result<Vec<f64>, OdeError> {
         let points: Vec<Vec<f64>> = amplitudes.iter().map(|&a| with(a)).collect();
-        let radii = spectral_radii_at(model, &points, &y0, settings.method)?;
+        let values = floquet_at(model, &points, &y0, settings.method)?;
         let mut curve = curve.borrow_mut();
-        curve.extend(amplitudes.iter().zip(&radii).map(|(&a, &r)| [a, r]));
-        Ok(radii.iter().map(|r| r - 1.0 - STABLE_SLACK).collect())
+        curve.extend(amplitudes.iter().zip(&values).map(|(&a, &(r, _))| [a, r]));
+        Ok(values.iter().map(|&(_, margin)| margin).collect())
     };
     let window = window_in_batches(
         &margins,
@@ -1104,14 +1146,126 @@ fn exact_window(
         settings.samples,
         settings.edge_tolerance,
     )?;
+    let reference = settings.method.tighter();
+    let checked = |amplitudes: &[f64]| -> Result<Vec<f64>, OdeError> {
+        let points: Vec<Vec<f64>> = amplitudes.iter().map(|&a| with(a)).collect();
+        let values = floquet_at(model, &points, &y0, reference)?;
+        Ok(values.iter().map(|&(_, margin)| margin).collect())
+    };
+    let error = |edge: f64, unstable_below: bool| {
+        let width = reference.batch_width();
+        edge_error(
+            &checked,
+            width,
+            edge,
+            unstable_below,
+            settings.edge_tolerance,
+        )
+    };
     match window {
-        Some((low, high)) => out.exact_window = Some([Some(low), high]),
+        Some((low, high)) => {
+            out.exact_window = Some([Some(low), high]);
+            let high_error = match high {
+                Some(high) => error(high, false)?,
+                None => None,
+            };
+            out.exact_window_error = Some([error(low, true)?, high_error]);
+            out.exact_window_check = Some(format!(
+                "{} against {}",
+                settings.method.describe(),
+                reference.describe()
+            ));
+        }
         None => out.exact_reason = Some(format!("not stable for any amplitude up to {a_max}")),
     }
     let mut curve = curve.into_inner();
     curve.sort_by(|x, y| x[0].total_cmp(&y[0]));
     out.spectral_radius = curve;
     Ok(())
+}
+
+/// [`exact_window`] with `settings.accuracy` met where it is asked: the
+/// edges bisected to a quarter of it, and the method's tolerance tightened
+/// a hundredfold while their error is larger, down to the precision floor
+/// (where the result says the accuracy was not reached, and why).
+fn checked_window(
+    model: &dyn Systems,
+    params: &[f64],
+    amplitude: usize,
+    q: &[f64],
+    settings: &Settings,
+    out: &mut EquilibriumStability,
+) -> Result<(), OdeError> {
+    let Some(accuracy) = settings.accuracy else {
+        return exact_window(model, params, amplitude, q, settings, out);
+    };
+    let mut settings = settings.clone();
+    settings.edge_tolerance = settings.edge_tolerance.min(0.25 * accuracy);
+    // An edge at a is known to a few units of rounding of a at best.
+    let floor = out.a_star.map_or(0.0, |a| 64.0 * f64::EPSILON * a);
+    if accuracy < floor {
+        out.exact_reason = Some(format!(
+            "accuracy {accuracy:e} is below what double precision resolves at a* = {}: about {floor:.1e}",
+            out.a_star.unwrap_or(0.0)
+        ));
+        return Ok(());
+    }
+    loop {
+        exact_window(model, params, amplitude, q, &settings, out)?;
+        let Some(errors) = out.exact_window_error else {
+            return Ok(());
+        };
+        let error = match errors {
+            [Some(low), None] if out.exact_window.is_some_and(|[_, high]| high.is_none()) => low,
+            [Some(low), Some(high)] => low.max(high),
+            _ => f64::INFINITY,
+        };
+        let tighter = settings.method.tighter();
+        let check = out.exact_window_check.take().unwrap_or_default();
+        if error <= accuracy {
+            out.exact_window_check = Some(format!("{check}: accuracy {accuracy:e} reached"));
+            return Ok(());
+        }
+        if !tighter.is_tighter_than(&settings.method) {
+            out.exact_window_check = Some(format!(
+                "{check}: accuracy {accuracy:e} NOT reached (error {error:.1e} at the precision floor)"
+            ));
+            return Ok(());
+        }
+        settings.method = tighter;
+    }
+}
+
+/// The error of an edge found at `edge` (unstable below it if
+/// `unstable_below`), from `margins` of a more accurate run: the same edge
+/// bracketed in intervals around it that widen sixteenfold (from 4 to
+/// about 4·10⁶ `tolerance`s), bisected to `tolerance`; their distance plus
+/// both bisections' half brackets, or None where that run has no edge
+/// there.
+fn edge_error(
+    margins: &dyn Fn(&[f64]) -> Result<Vec<f64>, OdeError>,
+    width: usize,
+    edge: f64,
+    unstable_below: bool,
+    tolerance: f64,
+) -> Result<Option<f64>, OdeError> {
+    let flipped = |values: &[f64]| -> Result<Vec<f64>, OdeError> {
+        Ok(margins(values)?.into_iter().map(|m| -m).collect())
+    };
+    let oriented: &dyn Fn(&[f64]) -> Result<Vec<f64>, OdeError> = match unstable_below {
+        true => margins,
+        false => &flipped,
+    };
+    let mut half = 4.0 * tolerance;
+    for _ in 0..6 {
+        let found =
+            first_onset_in_batches(oriented, width, edge - half, edge + half, 1, tolerance)?;
+        if let Some(again) = found {
+            return Ok(Some((again - edge).abs() + tolerance));
+        }
+        half *= 16.0;
+    }
+    Ok(None)
 }
 
 /// Whether the exact system at parameter values `params` moves the state
@@ -1194,7 +1348,7 @@ pub struct StabilityChart {
     pub y: String,
     pub x_values: Vec<f64>,
     pub y_values: Vec<f64>,
-    /// [x][y sample]: stable (spectral radius ≤ 1 + 1e-6).
+    /// [x][y sample]: stable (the stability margin of the monodromy matrix ≤ 0).
     pub stable: Vec<Vec<bool>>,
     /// \[x\]: the boundaries in y, ascending.
     pub boundaries: Vec<Vec<f64>>,
@@ -1259,8 +1413,8 @@ fn chart(
                     p
                 })
                 .collect();
-            let radii = spectral_radii_at(model, &points, &y0, settings.method)?;
-            Ok(radii.iter().map(|r| r - 1.0 - STABLE_SLACK).collect())
+            let values = floquet_at(model, &points, &y0, settings.method)?;
+            Ok(values.iter().map(|&(_, margin)| margin).collect())
         };
         let y_values: Vec<f64> = (1..=settings.y_samples)
             .map(|k| settings.y_max * k as f64 / settings.y_samples as f64)

@@ -258,6 +258,44 @@ impl Method {
         }
     }
 
+    /// The method of the run that checks this one's numbers: a hundredth of
+    /// its tolerance (not below [`PRECISION_FLOOR`]) or half its step; at
+    /// the floor already, itself.
+    pub fn tighter(&self) -> Method {
+        let tighter = |tol: f64| (tol / 100.0).max(PRECISION_FLOOR);
+        match *self {
+            Method::Rk4 { step } => Method::Rk4 { step: step / 2.0 },
+            Method::Gauss { stages, step } => Method::Gauss {
+                stages,
+                step: step / 2.0,
+            },
+            Method::Dop853 { rtol, atol } => Method::Dop853 {
+                rtol: tighter(rtol),
+                atol: tighter(atol),
+            },
+            Method::Radau5 { rtol, atol } => Method::Radau5 {
+                rtol: tighter(rtol),
+                atol: tighter(atol),
+            },
+            Method::Taylor { tol } => Method::Taylor { tol: tighter(tol) },
+        }
+    }
+
+    /// Whether this is the same method with a smaller tolerance or step.
+    pub fn is_tighter_than(&self, other: &Method) -> bool {
+        self.name() == other.name() && self.accuracy() < other.accuracy()
+    }
+
+    /// The method with its tolerance or step, as a summary states it
+    /// ("dop853, tol 1e-10").
+    pub fn describe(&self) -> String {
+        let what = match self {
+            Method::Rk4 { .. } | Method::Gauss { .. } => "step",
+            _ => "tol",
+        };
+        format!("{}, {what} {:e}", self.name(), self.accuracy())
+    }
+
     /// A positive, finite tolerance or step (0 or NaN is refused).
     pub fn validate(&self) -> Result<(), OdeError> {
         let positive = |what: &'static str, x: f64| {
