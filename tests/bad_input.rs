@@ -132,6 +132,7 @@ fn too_large_requests_are_refused_before_any_work() {
     let e = portrait(params, 24, 20_000_000, method).unwrap_err();
     assert!(too_large(&e), "{e}");
     let settings = ChaosMapSettings {
+        check: 0,
         axes: [0, 1],
         ranges: [None, None],
         p_max: 3.0,
@@ -181,4 +182,55 @@ fn a_tolerance_below_the_rounding_is_refused_by_name() {
     let floor = mechlab::ode::PRECISION_FLOOR;
     assert!(mechlab::ode::Method::parse("radau5", floor).is_ok());
     assert!(mechlab::ode::Method::parse("radau5", 0.5 * floor).is_err());
+}
+
+/// A run far longer than its step limit allows (a pendulum to t = 1e9 with
+/// steps of about 0.1, by DOP853 and by the Taylor method) stops after a
+/// hundredth of the limit with the steps it would take, not after the ten
+/// million the limit allows; a run just within the limit is not stopped.
+#[test]
+fn a_run_too_long_for_its_step_limit_stops_early_with_its_forecast() {
+    use mechlab::models::kapitza;
+    use mechlab::ode::{Integrator, Method, OdeError};
+    let system = kapitza::Exact {
+        params: kapitza::Params {
+            A: 1.5,
+            eps: 0.1,
+            mu: 0.0,
+        },
+    };
+    for method in [
+        Method::parse("dop853", 1e-10),
+        Method::parse("taylor", 1e-12),
+    ] {
+        let mut integrator = Integrator::new(method.unwrap()).unwrap();
+        let error = integrator
+            .advance(&system, 0.0, &[0.1, 0.0], 1e9)
+            .unwrap_err();
+        let OdeError::TooLong {
+            t_end,
+            forecast,
+            max_steps,
+            ..
+        } = error
+        else {
+            panic!("{error}");
+        };
+        assert_eq!(t_end, 1e9);
+        assert!(forecast > 100.0 * max_steps as f64, "{forecast}");
+        assert!(
+            integrator.stats.steps <= max_steps / 100,
+            "{}",
+            integrator.stats.steps
+        );
+        assert!(error.to_string().contains("shorten the run"), "{error}");
+    }
+    let mut integrator = Integrator::new(Method::parse("dop853", 1e-10).unwrap()).unwrap();
+    integrator.max_steps = 100_000;
+    integrator.advance(&system, 0.0, &[0.1, 0.0], 1e3).unwrap();
+    let steps = integrator.stats.steps + integrator.stats.rejected;
+    // Just within the limit: the run is not stopped by its forecast.
+    let mut integrator = Integrator::new(Method::parse("dop853", 1e-10).unwrap()).unwrap();
+    integrator.max_steps = steps + steps / 10;
+    integrator.advance(&system, 0.0, &[0.1, 0.0], 1e3).unwrap();
 }

@@ -219,6 +219,7 @@ fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
     let eps = 0.1;
     let ranges = [(1.2, 5.0), (-1.5, 1.5)];
     let settings = ChaosMapSettings {
+        check: 0,
         axes: [0, 1],
         ranges: ranges.map(Some),
         p_max: 1.0,
@@ -248,4 +249,64 @@ fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
         checked += 1;
     }
     assert!(checked > 60, "{checked} pixels inside the separatrix");
+}
+
+/// The tunes' stated error is their error: at a loose tolerance, where the
+/// integration decides it, the tune check (a rerun at a hundredth of the
+/// tolerance) states the largest and the median change within a factor 2
+/// of the tunes' distance to the closed form above, on librations well
+/// inside the separatrix.
+#[test]
+fn the_tunes_stated_error_is_their_distance_to_the_closed_form() {
+    use mechlab::analysis::chaos_map::ChaosMapSettings;
+    use mechlab::analysis::frequency_map::period_map_frequencies;
+    let agm = |mut a: f64, mut b: f64| {
+        for _ in 0..8 {
+            (a, b) = (0.5 * (a + b), (a * b).sqrt());
+        }
+        a
+    };
+    let model = mechlab::models::by_name("kapitza").unwrap();
+    let eps = 0.1;
+    let ranges = [(2.2, 4.0), (-0.6, 0.6)];
+    let settings = ChaosMapSettings {
+        check: 64,
+        axes: [0, 1],
+        ranges: ranges.map(Some),
+        p_max: 1.0,
+        through: None,
+        pixels: 8,
+        periods: 1024,
+        method: Method::Dop853 {
+            rtol: 1e-7,
+            atol: 1e-7,
+        },
+        tiles: None,
+    };
+    let map = period_map_frequencies(model, &[0.0, eps, 0.0], &settings, &|_| ()).unwrap();
+    let mut errors: Vec<f64> = (0..64)
+        .map(|k| {
+            let centre = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / 8.0;
+            let (q, p) = (centre(ranges[0], k % 8), centre(ranges[1], k / 8));
+            let amplitude = (-(p * p / 2.0 + q.cos())).acos();
+            (map.frequencies[k][0] - eps * agm(1.0, (amplitude / 2.0).cos())).abs()
+        })
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let check = map.tune_check.clone().unwrap();
+    let (median, largest) = (errors[32], errors[63]);
+    eprintln!("{check:?}: errors median {median:e}, largest {largest:e}");
+    assert_eq!(check.sampled, 64);
+    assert!(
+        largest > 1e-9,
+        "the integration does not decide the tunes: {largest}"
+    );
+    assert!(
+        (0.5..2.0).contains(&(check.largest / largest)),
+        "{check:?} vs {largest}"
+    );
+    assert!(
+        (0.5..2.0).contains(&(check.median / median)),
+        "{check:?} vs {median}"
+    );
 }

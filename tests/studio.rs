@@ -83,7 +83,7 @@ async fn models_and_page_are_served() {
         .iter()
         .find(|s| s["analysis"] == "chaos_map")
         .unwrap();
-    assert_eq!(chaos["interactive"], json!({"periods": 100}));
+    assert_eq!(chaos["interactive"], json!({"periods": 100, "check": 64}));
     let (status, kind, body) = call("GET", "/api/models", None).await;
     assert_eq!(status, StatusCode::OK);
     assert!(kind.starts_with("application/json"));
@@ -313,6 +313,7 @@ async fn chaos_levels_equal_the_library_map() {
     for level in &levels {
         let pixels = level["pixels"].as_u64().unwrap() as usize;
         let settings = ChaosMapSettings {
+            check: 0,
             axes: [0, 1],
             ranges: ranges.map(|r| Some((r[0], r[1]))),
             p_max: 1.0,

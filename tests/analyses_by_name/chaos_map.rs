@@ -11,6 +11,7 @@ use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
 fn settings(axes: [usize; 2], pixels: usize, periods: usize) -> ChaosMapSettings {
     ChaosMapSettings {
+        check: 0,
         axes,
         ranges: [None, None],
         p_max: 3.0,
@@ -336,4 +337,55 @@ fn a_map_nobody_waits_for_stops() {
         done <= block * (1 + rayon::current_num_threads()) && done < 64,
         "{done} of 64 rows in blocks of {block}"
     );
+}
+
+/// The map's class check counts, on its sample of pixels, exactly the
+/// class changes between the map and the same map at a hundredth of the
+/// tolerance (each pixel's orbit the same run bit for bit), and its
+/// estimate covers the share that changes over the whole map; at a tight
+/// tolerance none change and the error is the rule of three's bound.
+#[test]
+fn the_class_check_counts_the_pixels_a_tighter_run_reclassifies() {
+    use mechlab::analysis::check::sample_pixels;
+    use mechlab::analysis::lyapunov::fli_is_chaotic;
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    }
+    .values();
+    let map = |tol: f64, check: usize| {
+        let settings = ChaosMapSettings {
+            check,
+            method: Method::parse("taylor", tol).unwrap(),
+            ..settings([0, 1], 40, 100)
+        };
+        chaos_map(model_of("kapitza"), &params, &settings, &|| true).unwrap()
+    };
+    let (crude, tighter) = (map(1e-3, 400), map(1e-5, 0));
+    let check = crude.class_check.clone().unwrap();
+    let changed = |ks: &mut dyn Iterator<Item = usize>| {
+        ks.filter(|&k| fli_is_chaotic(crude.fli[k], 100) != fli_is_chaotic(tighter.fli[k], 100))
+            .count()
+    };
+    assert_eq!(check.sampled, 400);
+    assert_eq!(
+        check.changed,
+        changed(&mut sample_pixels(1600, 400).into_iter())
+    );
+    let whole = changed(&mut (0..1600)) as f64 / 1600.0;
+    eprintln!("{check:?}, whole map {whole}");
+    assert!(check.changed > 0, "{check:?}");
+    assert!(
+        (check.fraction - whole).abs() <= 3.0 * check.error,
+        "{check:?} vs {whole}"
+    );
+    assert!(
+        check.runs.contains("1e-3") && check.runs.contains("1e-5"),
+        "{}",
+        check.runs
+    );
+    let tight = map(1e-10, 400).class_check.unwrap();
+    assert_eq!(tight.changed, 0, "{tight:?}");
+    assert!((tight.error - 3.0 / 400.0).abs() < 1e-15);
 }

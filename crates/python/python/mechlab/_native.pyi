@@ -141,6 +141,7 @@ class Model:
         periods: int = 180,
         method: str = "taylor",
         tol: float = 1e-6,
+        check: int = 256,
         params: Params = None,
         progress: bool = True,
     ) -> dict[str, Any]:
@@ -264,6 +265,7 @@ class Model:
         periods: int = 1000,
         method: str = "taylor",
         tol: float = 1e-10,
+        check: int = 256,
         params: Params = None,
         progress: bool = True,
     ) -> dict[str, Any]:

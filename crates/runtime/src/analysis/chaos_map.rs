@@ -3,7 +3,8 @@
 //! state) shaded by the fast Lyapunov indicator of its orbit. For one degree
 //! of freedom the plane is the cylinder (q, p).
 
-use super::lyapunov::fli_shading;
+use super::check::{sample_pixels, ClassCheck};
+use super::lyapunov::{fli_is_chaotic, fli_shading};
 use super::tiles::{fingerprint, run_tiles};
 pub use super::tiles::{TileError, Tiles};
 use crate::analysis::Refusal;
@@ -41,8 +42,12 @@ crate::declare_settings! {
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
         /// gauss6).
         tol: f64 = 1e-6, Range::Positive;
+        /// Pixels run again at a hundredth of the tolerance, spread over the
+        /// map, to count those whose class (chaotic or regular) changes:
+        /// the map's numerical error (0: none).
+        check: usize = 256, Range::Count { min: 0, max: 16_000_000 };
     }
-    interactive { periods: 100 }
+    interactive { periods: 100, check: 64 }
 }
 
 impl ChaosMapOptions {
@@ -62,6 +67,7 @@ impl ChaosMapOptions {
             pixels: self.pixels,
             periods: self.periods,
             method,
+            check: self.check,
             tiles: None,
         })
     }
@@ -85,6 +91,9 @@ pub struct ChaosMapSettings {
     /// Periods of the phase per pixel.
     pub periods: usize,
     pub method: Method,
+    /// Pixels rerun at a hundredth of the tolerance to count those whose
+    /// class changes (0: none).
+    pub check: usize,
     /// Cut the map into tiles of whole rows, each written to a file when
     /// done (None: one run in memory).
     pub tiles: Option<Tiles>,
@@ -118,6 +127,10 @@ pub struct ChaosMap {
     pub without_state: usize,
     /// ln(periods): the FLI of a regular orbit.
     pub fli_regular_level: f64,
+    /// The share of pixels whose class changes in a run at a hundredth of
+    /// the tolerance, from a sample of them: the numerical error of
+    /// `chaotic_fraction` (None: not checked).
+    pub class_check: Option<ClassCheck>,
     pub seconds: f64,
     pub f_evals: u64,
     /// Row-major from the lower left: pixel (i, j) at index j·pixels + i.
@@ -169,37 +182,27 @@ pub fn chaos_map(
     } = request(info, params, settings, systems.base_state(params))?;
     let ranges = plane_ranges(settings, &periodic);
     crate::budget::check_map(settings.pixels).map_err(OdeError::from)?;
-    let n = through.len();
-    // √(1/n): for n = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
-    let w0 = vec![(1.0 / n as f64).sqrt(); n];
+    let plane = Plane {
+        systems,
+        params,
+        settings,
+        period,
+        ranges,
+        // √(1/n): for n = 2 exactly FRAC_1_SQRT_2, the Kapitza scene's vector.
+        w0: vec![(1.0 / through.len() as f64).sqrt(); through.len()],
+        through: &through,
+    };
     let pixels = settings.pixels;
-    // The FLI values of a block of rows and their f-evaluations.
+    let fli_of = |ks: &mut dyn Iterator<Item = usize>, method| plane.fli_of(ks, method);
     let stopped = std::sync::atomic::AtomicBool::new(false);
     let block = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
         if stopped.load(std::sync::atomic::Ordering::Relaxed) {
             return Ok((Vec::new(), 0));
         }
-        let mut starts = Vec::with_capacity(rows.len() * pixels * n);
-        for k in rows.start * pixels..rows.end * pixels {
-            let (x, y) = pixel_centre(&ranges, pixels, k);
-            let at = starts.len();
-            starts.extend_from_slice(&through);
-            starts[at + settings.axes[0]] = x;
-            starts[at + settings.axes[1]] = y;
-        }
-        let (values, f_evals) = systems.fli(
-            params,
+        let (values, f_evals) = fli_of(
+            &mut (rows.start * pixels..rows.end * pixels),
             settings.method,
-            period,
-            &starts,
-            &w0,
-            settings.periods,
-            &settings.axes,
         )?;
-        let values = values
-            .into_iter()
-            .map(pixel_value)
-            .collect::<Result<_, _>>()?;
         for _ in rows {
             if !row_done() {
                 stopped.store(true, std::sync::atomic::Ordering::Relaxed);
@@ -247,6 +250,10 @@ pub fn chaos_map(
             }
         }
     };
+    let class_check = match settings.check {
+        0 => None,
+        count => Some(class_check(&fli, count, settings, &fli_of)?),
+    };
     let seconds = start.elapsed().as_secs_f64();
     let shading = fli_shading(&fli, settings.periods);
     Ok(ChaosMap {
@@ -263,11 +270,90 @@ pub fn chaos_map(
         diverged: fli.iter().filter(|f| f.is_infinite()).count(),
         without_state: fli.iter().filter(|f| f.is_nan()).count(),
         fli_regular_level: shading.regular_level,
+        class_check,
         seconds,
         f_evals,
         fli,
         shades: shading.shades,
     })
+}
+
+/// A chaos map's plane of starts in a model's state space.
+struct Plane<'a> {
+    systems: &'static dyn crate::registry::Flows,
+    params: &'a [f64],
+    settings: &'a ChaosMapSettings,
+    period: f64,
+    ranges: [(f64, f64); 2],
+    through: &'a [f64],
+    /// The tangent vector every orbit starts with.
+    w0: Vec<f64>,
+}
+
+impl Plane<'_> {
+    /// The FLI of the pixels `ks` by `method`, and the f-evaluations spent.
+    fn fli_of(
+        &self,
+        ks: &mut dyn Iterator<Item = usize>,
+        method: Method,
+    ) -> Result<(Vec<f64>, u64), OdeError> {
+        let settings = self.settings;
+        let mut starts = Vec::new();
+        for k in ks {
+            let (x, y) = pixel_centre(&self.ranges, settings.pixels, k);
+            let at = starts.len();
+            starts.extend_from_slice(self.through);
+            starts[at + settings.axes[0]] = x;
+            starts[at + settings.axes[1]] = y;
+        }
+        let (values, f_evals) = self.systems.fli(
+            self.params,
+            method,
+            self.period,
+            &starts,
+            &self.w0,
+            settings.periods,
+            &settings.axes,
+        )?;
+        let values = values
+            .into_iter()
+            .map(pixel_value)
+            .collect::<Result<_, _>>()?;
+        Ok((values, f_evals))
+    }
+}
+
+/// The map's [`ClassCheck`]: `count` of its pixels spread over it run
+/// again by `fli_of` at a hundredth of the tolerance, on all cores, and
+/// their classes (chaotic or regular; none without a state) compared.
+fn class_check(
+    fli: &[f64],
+    count: usize,
+    settings: &ChaosMapSettings,
+    fli_of: &(dyn Fn(&mut dyn Iterator<Item = usize>, Method) -> Result<(Vec<f64>, u64), OdeError>
+          + Sync),
+) -> Result<ClassCheck, OdeError> {
+    let sample = sample_pixels(fli.len(), count);
+    let tighter = settings.method.tighter();
+    let chunk = sample
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
+        .max(8);
+    let again: Vec<Vec<f64>> = sample
+        .par_chunks(chunk)
+        .map(|ks| fli_of(&mut ks.iter().copied(), tighter).map(|(values, _)| values))
+        .collect::<Result<_, _>>()?;
+    let class = |f: f64| (!f.is_nan()).then(|| fli_is_chaotic(f, settings.periods));
+    let pairs = sample
+        .iter()
+        .zip(again.concat())
+        .map(|(&k, f)| (class(fli[k]), class(f)));
+    let runs = format!(
+        "{} against {}",
+        settings.method.describe(),
+        tighter.describe()
+    );
+    Ok(ClassCheck::new(pairs, runs))
 }
 
 /// The request read against the model: its parameters by name, the
@@ -378,5 +464,21 @@ impl crate::outputs::Outputs for ChaosMap {
         });
         let header = [self.axes[0].as_str(), self.axes[1].as_str(), "fli"];
         vec![crate::outputs::Table::new("chaos_map.csv", &header, rows)]
+    }
+    fn lines(&self) -> Vec<String> {
+        let check = match &self.class_check {
+            Some(c) => format!(
+                " ± {:.4} ({} of {} pixels change class in a run at a hundredth of the tolerance: {})",
+                c.fraction.max(c.error),
+                c.changed,
+                c.sampled,
+                c.runs
+            ),
+            None => String::new(),
+        };
+        vec![format!(
+            "chaotic fraction {:.4}{check}",
+            self.chaotic_fraction
+        )]
     }
 }

@@ -70,6 +70,9 @@ pub struct FrequencyMap {
     pub regular_fraction: f64,
     /// Orbits the integrator could not follow (NaN in both maps).
     pub failed: usize,
+    /// The tunes' integration error, from a sample rerun at a hundredth
+    /// of the tolerance (a period map's; None: not checked).
+    pub tune_check: Option<TuneCheck>,
     pub seconds: f64,
     /// (ν₁, ν₂) per pixel, row 0 at the bottom; NaN where the energy is
     /// not accessible (ν₂ NaN for a period map of one degree of freedom).
@@ -168,6 +171,7 @@ pub fn frequency_map(
         regular,
         regular_fraction: regular as f64 / (accessible - failed).max(1) as f64,
         failed,
+        tune_check: None,
         seconds: start.elapsed().as_secs_f64(),
         frequencies: pixels
             .iter()
@@ -211,43 +215,72 @@ pub fn period_map_frequencies(
         known: None,
         done,
     };
+    // The tunes and diffusion index of the pixels `ks` by `method`.
+    let tunes_of = |ks: &mut dyn Iterator<Item = usize>,
+                    method|
+     -> Result<Vec<([f64; 2], f64)>, super::period_map::PeriodMapError> {
+        let starts: Vec<Option<Vec<f64>>> = ks
+            .map(|k| {
+                let (x, y) = super::chaos_map::pixel_centre(&ranges, n, k);
+                let mut state = request.through.clone();
+                (state[settings.axes[0]], state[settings.axes[1]]) = (x, y);
+                flows
+                    .consistent(params, &mut state, &settings.axes)
+                    .ok()
+                    .map(|()| state)
+            })
+            .collect();
+        let flat: Vec<f64> = starts.iter().flatten().flatten().copied().collect();
+        let mut runs = flows
+            .iterates(params, method, period, &flat, &recording)?
+            .into_iter();
+        Ok(starts
+            .iter()
+            .map(
+                |start| match start.as_ref().and_then(|_| runs.next().flatten()) {
+                    Some(run) => {
+                        let (nu, index) = tunes(&run, &periodic);
+                        ([nu[0], nu.get(1).copied().unwrap_or(f64::NAN)], index)
+                    }
+                    None => ([f64::NAN; 2], f64::NAN),
+                },
+            )
+            .collect())
+    };
     // Rows in blocks: each block's orbits run together and are analysed
     // as they end, so only a block's iterates are held.
     let blocks: Vec<Vec<([f64; 2], f64)>> = super::row_blocks(0..n, n)
         .into_par_iter()
-        .map(|rows| -> Result<_, super::period_map::PeriodMapError> {
-            let starts: Vec<Option<Vec<f64>>> = (rows.start * n..rows.end * n)
-                .map(|k| {
-                    let (x, y) = super::chaos_map::pixel_centre(&ranges, n, k);
-                    let mut state = request.through.clone();
-                    (state[settings.axes[0]], state[settings.axes[1]]) = (x, y);
-                    flows
-                        .consistent(params, &mut state, &settings.axes)
-                        .ok()
-                        .map(|()| state)
-                })
-                .collect();
-            let flat: Vec<f64> = starts.iter().flatten().flatten().copied().collect();
-            let mut runs = flows
-                .iterates(params, settings.method, period, &flat, &recording)?
-                .into_iter();
-            Ok(starts
-                .iter()
-                .map(
-                    |start| match start.as_ref().and_then(|_| runs.next().flatten()) {
-                        Some(run) => {
-                            let (nu, index) = tunes(&run, &periodic);
-                            ([nu[0], nu.get(1).copied().unwrap_or(f64::NAN)], index)
-                        }
-                        None => ([f64::NAN; 2], f64::NAN),
-                    },
-                )
-                .collect())
-        })
+        .map(|rows| tunes_of(&mut (rows.start * n..rows.end * n), settings.method))
         .collect::<Result<_, _>>()?;
     let pixels: Vec<([f64; 2], f64)> = blocks.into_iter().flatten().collect();
     let failed = pixels.iter().filter(|(_, d)| d.is_nan()).count();
     let regular = pixels.iter().filter(|(_, d)| *d < REGULAR_INDEX).count();
+    let tune_check = match settings.check {
+        0 => None,
+        count => {
+            let sample = super::check::sample_pixels(n * n, count);
+            let tighter = settings.method.tighter();
+            let chunk = sample
+                .len()
+                .div_ceil(4 * rayon::current_num_threads())
+                .max(8);
+            let again: Vec<Vec<([f64; 2], f64)>> = sample
+                .par_chunks(chunk)
+                .map(|ks| tunes_of(&mut ks.iter().copied(), tighter))
+                .collect::<Result<_, _>>()?;
+            let pairs = sample
+                .iter()
+                .zip(again.concat())
+                .map(|(&k, (nu, _))| (pixels[k].0, nu));
+            let runs = format!(
+                "{} against {}",
+                settings.method.describe(),
+                tighter.describe()
+            );
+            Some(TuneCheck::new(pairs, runs))
+        }
+    };
     Ok(FrequencyMap {
         model: info.name.into(),
         surface: "the period map".into(),
@@ -260,10 +293,41 @@ pub fn period_map_frequencies(
         regular,
         regular_fraction: regular as f64 / (n * n - failed).max(1) as f64,
         failed,
+        tune_check,
         seconds: start.elapsed().as_secs_f64(),
         frequencies: pixels.iter().map(|(nu, _)| *nu).collect(),
         diffusion: pixels.iter().map(|(_, d)| *d).collect(),
     })
+}
+
+/// The tunes' numerical error: a sample of the map's orbits run again at a
+/// hundredth of the tolerance, and how far their tunes move (the
+/// integration's part; the diffusion index is NAFF's own).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TuneCheck {
+    /// Tunes compared (one or two an orbit: those both runs have).
+    pub sampled: usize,
+    /// The median and the largest change of a tune between the runs.
+    pub median: f64,
+    pub largest: f64,
+    /// The two runs ("taylor, tol 1e-10 against taylor, tol 1e-12").
+    pub runs: String,
+}
+
+impl TuneCheck {
+    fn new(pairs: impl Iterator<Item = ([f64; 2], [f64; 2])>, runs: String) -> TuneCheck {
+        let mut changes: Vec<f64> = pairs
+            .flat_map(|(a, b)| [(a[0] - b[0]).abs(), (a[1] - b[1]).abs()])
+            .filter(|d| d.is_finite())
+            .collect();
+        changes.sort_by(f64::total_cmp);
+        TuneCheck {
+            sampled: changes.len(),
+            median: changes.get(changes.len() / 2).copied().unwrap_or(f64::NAN),
+            largest: changes.last().copied().unwrap_or(f64::NAN),
+            runs,
+        }
+    }
 }
 
 /// The tunes of an orbit of a period map (its states one a period, angles
@@ -467,11 +531,18 @@ impl crate::outputs::Outputs for FrequencyMap {
         )]
     }
     fn lines(&self) -> Vec<String> {
-        vec![format!(
+        let mut lines = vec![format!(
             "{} orbits, {:.1} % regular, in {:.1} s",
             self.accessible,
             100.0 * self.regular_fraction,
             self.seconds
-        )]
+        )];
+        if let Some(c) = &self.tune_check {
+            lines.push(format!(
+                "tunes' integration error: median {:.1e}, largest {:.1e} over {} tunes rerun ({})",
+                c.median, c.largest, c.sampled, c.runs
+            ));
+        }
+        lines
     }
 }

@@ -9,6 +9,7 @@ pub mod attractor;
 pub mod averaging;
 pub mod basins;
 pub mod chaos_map;
+pub mod check;
 pub mod continuation;
 pub mod declared;
 pub mod dimension;

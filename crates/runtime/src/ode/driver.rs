@@ -186,7 +186,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
     t0: f64,
     y0: &[f64; N],
     t1: f64,
-    max_steps: u64,
+    (max_steps, to_the_end): (u64, bool),
     next_step: &mut Option<f64>,
     stats: &mut Stats,
     observe: Observer<'_, N>,
@@ -203,6 +203,9 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
     loop {
         if attempts >= max_steps {
             return Err(OdeError::TooManySteps { t, max_steps });
+        }
+        if to_the_end {
+            check_pace(attempts, max_steps, (t0, t, t1))?;
         }
         if super::stop::stop_requested() {
             return Err(OdeError::Stopped { t });
@@ -275,6 +278,26 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
 
 /// Number of equal fixed steps of at most `step` covering `t0..t1`, and
 /// their signed size.
+/// After a hundredth of the step limit, the steps a run would take to its
+/// end at its pace so far: more than a hundred times the limit (a run to
+/// t = 1e9, a tolerance the arithmetic cannot hold) stops it with that
+/// forecast, in a hundredth of the time the limit would take.
+fn check_pace(attempts: u64, max_steps: u64, (t0, t, t1): (f64, f64, f64)) -> Result<(), OdeError> {
+    if max_steps < 100 || attempts != max_steps / 100 {
+        return Ok(());
+    }
+    let forecast = attempts as f64 * ((t1 - t0) / (t - t0)).abs();
+    if forecast > 100.0 * max_steps as f64 {
+        return Err(OdeError::TooLong {
+            t,
+            t_end: t1,
+            forecast,
+            max_steps,
+        });
+    }
+    Ok(())
+}
+
 fn fixed_steps(t0: f64, t1: f64, step: f64, max_steps: u64) -> Result<(u64, f64), OdeError> {
     let n = ((t1 - t0).abs() / step).ceil().max(1.0);
     if n > max_steps as f64 {

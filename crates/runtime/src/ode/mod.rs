@@ -293,7 +293,11 @@ impl Method {
             Method::Rk4 { .. } | Method::Gauss { .. } => "step",
             _ => "tol",
         };
-        format!("{}, {what} {:e}", self.name(), self.accuracy())
+        // Six significant digits at most: a hundredth of 1e-7 is 1e-9.
+        let mantissa_and_exponent = format!("{:.5e}", self.accuracy());
+        let (mantissa, exponent) = mantissa_and_exponent.split_once('e').unwrap_or(("", ""));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        format!("{}, {what} {mantissa}e{exponent}", self.name())
     }
 
     /// A positive, finite tolerance or step (0 or NaN is refused).
@@ -395,6 +399,15 @@ pub enum OdeError {
     StepSizeUnderflow { t: f64, h: f64, y: Box<[f64]> },
     #[error("more than {max_steps} steps, stopped at t = {t}")]
     TooManySteps { t: f64, max_steps: u64 },
+    /// A run that would take far more steps than its limit, foreseen
+    /// from its pace over the first hundredth of them.
+    #[error("reaching t = {t_end} would take about {forecast:.1e} steps at the pace so far (t = {t} after a hundredth of the limit of {max_steps}): shorten the run or loosen the tolerance")]
+    TooLong {
+        t: f64,
+        t_end: f64,
+        forecast: f64,
+        max_steps: u64,
+    },
     /// A stop was requested ([`stop::request_stop`]: Ctrl-C).
     #[error("stopped at t = {t}: a stop was requested (Ctrl-C)")]
     Stopped { t: f64 },
@@ -456,7 +469,9 @@ impl Integrator {
         y0: &[f64; N],
         t1: f64,
     ) -> Result<[f64; N], OdeError> {
-        Ok(self.run(system, t0, y0, t1, &mut |_| Ok(Flow::Continue))?.1)
+        Ok(self
+            .run(system, t0, y0, t1, true, &mut |_| Ok(Flow::Continue))?
+            .1)
     }
 
     /// Runs one orbit from (0, y0) over `segments` segments of time
@@ -496,7 +511,7 @@ impl Integrator {
         let mut reached = 0;
         while reached < segments {
             let mut restart = None;
-            self.run(system, 0.0, &y, taylor_lanes::HORIZON, &mut |step| {
+            self.run(system, 0.0, &y, taylor_lanes::HORIZON, false, &mut |step| {
                 let (mut start, mut end) = (step.start().0, step.end().0);
                 let y_end = *step.end().1;
                 let mut retimed = false;
@@ -532,13 +547,16 @@ impl Integrator {
     }
 
     /// `advance`, `solve` and `stream` go through here, and every method
-    /// through [`driver::drive`].
+    /// through [`driver::drive`]; `to_the_end`: nothing but an error stops
+    /// the run before t1, so a pace that cannot reach it in the step limit
+    /// stops it early ([`driver::drive`]).
     fn run<S: System<N>, const N: usize>(
         &mut self,
         system: &S,
         t0: f64,
         y0: &[f64; N],
         t1: f64,
+        to_the_end: bool,
         observe: Observer<'_, N>,
     ) -> Result<(f64, [f64; N]), OdeError> {
         check_initial(t0, y0, t1)?;
@@ -554,7 +572,7 @@ impl Integrator {
                     t0,
                     y0,
                     t1,
-                    max_steps,
+                    (max_steps, to_the_end),
                     next_step,
                     stats,
                     observe,

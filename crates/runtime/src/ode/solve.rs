@@ -98,28 +98,36 @@ impl Integrator {
             samples.push(*y0);
             next += 1;
         }
-        let (t, y) = self.run(system, t0, y0, t1, &mut |step: &mut dyn Step<N>| {
-            let flow = match locator.as_mut() {
-                Some(locator) => locator.scan(step)?,
-                None => Flow::Continue,
-            };
-            let (limit, y_limit) = match flow {
-                Flow::Stop { t, y } => (t, y),
-                // (The event locator never retimes.)
-                Flow::Continue | Flow::Retime { .. } => (step.end().0, *step.end().1),
-            };
-            while next < times.len() && before(times[next], limit) {
-                samples.push(match times[next] == limit {
-                    true => y_limit,
-                    false => step.state_at(times[next])?,
-                });
-                next += 1;
-            }
-            if let Some(observe) = observer.as_mut() {
-                observe(limit, &y_limit);
-            }
-            Ok(flow)
-        })?;
+        let to_the_end = events.iter().all(|event| !event.terminal);
+        let (t, y) = self.run(
+            system,
+            t0,
+            y0,
+            t1,
+            to_the_end,
+            &mut |step: &mut dyn Step<N>| {
+                let flow = match locator.as_mut() {
+                    Some(locator) => locator.scan(step)?,
+                    None => Flow::Continue,
+                };
+                let (limit, y_limit) = match flow {
+                    Flow::Stop { t, y } => (t, y),
+                    // (The event locator never retimes.)
+                    Flow::Continue | Flow::Retime { .. } => (step.end().0, *step.end().1),
+                };
+                while next < times.len() && before(times[next], limit) {
+                    samples.push(match times[next] == limit {
+                        true => y_limit,
+                        false => step.state_at(times[next])?,
+                    });
+                    next += 1;
+                }
+                if let Some(observe) = observer.as_mut() {
+                    observe(limit, &y_limit);
+                }
+                Ok(flow)
+            },
+        )?;
         let (hits, terminated) = match locator {
             Some(locator) => (locator.hits, t != t1),
             None => (Vec::new(), false),

@@ -92,6 +92,9 @@ pub struct ChaosLevel {
     /// ln(periods): the FLI of a regular orbit.
     pub regular_level: f64,
     pub chaotic_fraction: f64,
+    /// The share of pixels a run at a hundredth of the tolerance
+    /// reclassifies, from a sample: the fraction's numerical error.
+    pub class_check: Option<mechlab_runtime::analysis::check::ClassCheck>,
     pub seconds: f64,
 }
 
@@ -119,6 +122,7 @@ pub fn chaos(
                 .collect(),
             regular_level: map.fli_regular_level,
             chaotic_fraction: map.chaotic_fraction,
+            class_check: map.class_check,
             seconds: map.seconds,
         };
         if !sink(level) {

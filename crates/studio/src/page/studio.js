@@ -728,7 +728,10 @@ async function refreshChaos() {
     await postStream("/api/chaos", request, chaosController.signal, (line) => {
       if (line.error) { say(`chaos map: ${line.error}`); return; }
       studio.chaos = { ...line, ranges, image: chaosImage(line) };
-      $("status").textContent = `FLI ${line.pixels}² in ${line.seconds.toFixed(2)} s, chaotic ${(100 * line.chaotic_fraction).toFixed(1)} %`;
+      const check = line.class_check
+        ? ` ± ${(100 * Math.max(line.class_check.fraction, line.class_check.error)).toFixed(1)} % (${line.class_check.changed} of ${line.class_check.sampled} pixels reclassified at a hundredth of the tolerance)`
+        : "";
+      $("status").textContent = `FLI ${line.pixels}² in ${line.seconds.toFixed(2)} s, chaotic ${(100 * line.chaotic_fraction).toFixed(1)} %${check}`;
       redraw();
     });
   } catch (e) {

@@ -1,0 +1,66 @@
+//! A map's numerical error as its users meet it: the share of its pixels
+//! whose class (chaotic or regular, one basin or another) changes when a
+//! sample of them is run again at a tighter tolerance.
+
+use serde::Serialize;
+
+/// How many of a map's pixels, rerun with a more accurate method, change
+/// class: the map's numerical error on the numbers drawn from its classes
+/// (a chaotic fraction, a basin's share), as a binomial estimate.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ClassCheck {
+    /// Pixels rerun (those with a class in both runs).
+    pub sampled: usize,
+    /// Those whose class changed.
+    pub changed: usize,
+    /// changed / sampled: the share of the map's pixels estimated to
+    /// change class.
+    pub fraction: f64,
+    /// The estimate's binomial standard error; where none changed, the 95 %
+    /// upper bound 3 / sampled (the rule of three) instead.
+    pub error: f64,
+    /// The two runs ("taylor, tol 1e-6 against taylor, tol 1e-8").
+    pub runs: String,
+}
+
+impl ClassCheck {
+    /// The check from the pairs of classes (None: no class, as a pixel
+    /// without a state) of the sampled pixels in the map's run and the
+    /// tighter one.
+    pub fn new<C: PartialEq>(
+        pairs: impl IntoIterator<Item = (Option<C>, Option<C>)>,
+        runs: String,
+    ) -> ClassCheck {
+        let (mut sampled, mut changed) = (0, 0);
+        for pair in pairs {
+            if let (Some(a), Some(b)) = pair {
+                sampled += 1;
+                changed += usize::from(a != b);
+            }
+        }
+        let n = sampled.max(1) as f64;
+        let fraction = changed as f64 / n;
+        let error = match changed {
+            0 => 3.0 / n,
+            _ => (fraction * (1.0 - fraction) / n).sqrt(),
+        };
+        ClassCheck {
+            sampled,
+            changed,
+            fraction,
+            error,
+            runs,
+        }
+    }
+}
+
+/// `count` of `total` pixels spread evenly over the map (all of them where
+/// `count` ≥ `total`), in increasing order.
+pub fn sample_pixels(total: usize, count: usize) -> Vec<usize> {
+    if count >= total {
+        return (0..total).collect();
+    }
+    (0..count)
+        .map(|i| ((i as f64 + 0.5) * total as f64 / count as f64) as usize)
+        .collect()
+}
