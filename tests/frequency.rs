@@ -198,6 +198,19 @@ fn tunes_of_a_libration_and_a_circulation() {
     assert!((got[0] - nu).abs() < 1e-10, "{got:?}");
 }
 
+/// The tune of the libration through (q, p) of the pendulum
+/// H = p²/2 + cos q under the period map of period 2πε: ε ω(φ₀), with
+/// ω = AGM(1, cos(φ₀/2)) at the amplitude φ₀ about the hanging state.
+fn pendulum_tune(q: f64, p: f64, eps: f64) -> f64 {
+    let amplitude = (-(p * p / 2.0 + q.cos())).acos();
+    // (Quadratic convergence: 8 steps reach the rounding from any a, b.)
+    let (mut a, mut b) = (1.0f64, (amplitude / 2.0).cos());
+    for _ in 0..8 {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    eps * a
+}
+
 /// Kapitza's pendulum without vibration (A = 0) is the pendulum
 /// H = p²/2 + cos q: its period map (period 2πε) turns each libration of
 /// amplitude φ₀ about the hanging state (clockwise) by ε ω(φ₀) turns, with
@@ -208,13 +221,6 @@ fn tunes_of_a_libration_and_a_circulation() {
 fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
     use mechlab::analysis::chaos_map::ChaosMapSettings;
     use mechlab::analysis::frequency_map::period_map_frequencies;
-    // (Quadratic convergence: 8 steps reach the rounding from any a, b.)
-    let agm = |mut a: f64, mut b: f64| {
-        for _ in 0..8 {
-            (a, b) = (0.5 * (a + b), (a * b).sqrt());
-        }
-        a
-    };
     let model = mechlab::models::by_name("kapitza").unwrap();
     let eps = 0.1;
     let ranges = [(1.2, 5.0), (-1.5, 1.5)];
@@ -238,8 +244,7 @@ fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
         if energy >= 0.9 {
             continue;
         }
-        let amplitude = (-energy).acos();
-        let expected = eps * agm(1.0, (amplitude / 2.0).cos());
+        let expected = pendulum_tune(q, p, eps);
         let got = map.frequencies[k][0];
         assert!(
             (got - expected).abs() < 1e-8,
@@ -260,12 +265,6 @@ fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
 fn the_tunes_stated_error_is_their_distance_to_the_closed_form() {
     use mechlab::analysis::chaos_map::ChaosMapSettings;
     use mechlab::analysis::frequency_map::period_map_frequencies;
-    let agm = |mut a: f64, mut b: f64| {
-        for _ in 0..8 {
-            (a, b) = (0.5 * (a + b), (a * b).sqrt());
-        }
-        a
-    };
     let model = mechlab::models::by_name("kapitza").unwrap();
     let eps = 0.1;
     let ranges = [(2.2, 4.0), (-0.6, 0.6)];
@@ -288,8 +287,7 @@ fn the_tunes_stated_error_is_their_distance_to_the_closed_form() {
         .map(|k| {
             let centre = |(lo, hi): (f64, f64), i: usize| lo + (hi - lo) * (i as f64 + 0.5) / 8.0;
             let (q, p) = (centre(ranges[0], k % 8), centre(ranges[1], k / 8));
-            let amplitude = (-(p * p / 2.0 + q.cos())).acos();
-            (map.frequencies[k][0] - eps * agm(1.0, (amplitude / 2.0).cos())).abs()
+            (map.frequencies[k][0] - pendulum_tune(q, p, eps)).abs()
         })
         .collect();
     errors.sort_by(f64::total_cmp);
