@@ -133,6 +133,7 @@ fn too_large_requests_are_refused_before_any_work() {
     assert!(too_large(&e), "{e}");
     let settings = ChaosMapSettings {
         check: 0,
+        accuracy: None,
         axes: [0, 1],
         ranges: [None, None],
         p_max: 3.0,

@@ -226,6 +226,7 @@ fn the_unshaken_pendulums_period_map_has_the_closed_form_tunes() {
     let ranges = [(1.2, 5.0), (-1.5, 1.5)];
     let settings = ChaosMapSettings {
         check: 0,
+        accuracy: None,
         axes: [0, 1],
         ranges: ranges.map(Some),
         p_max: 1.0,
@@ -270,6 +271,7 @@ fn the_tunes_stated_error_is_their_distance_to_the_closed_form() {
     let ranges = [(2.2, 4.0), (-0.6, 0.6)];
     let settings = ChaosMapSettings {
         check: 64,
+        accuracy: None,
         axes: [0, 1],
         ranges: ranges.map(Some),
         p_max: 1.0,

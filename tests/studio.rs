@@ -314,6 +314,7 @@ async fn chaos_levels_equal_the_library_map() {
         let pixels = level["pixels"].as_u64().unwrap() as usize;
         let settings = ChaosMapSettings {
             check: 0,
+            accuracy: None,
             axes: [0, 1],
             ranges: ranges.map(|r| Some((r[0], r[1]))),
             p_max: 1.0,

@@ -12,6 +12,7 @@ use std::f64::consts::{FRAC_1_SQRT_2, PI};
 fn settings(axes: [usize; 2], pixels: usize, periods: usize) -> ChaosMapSettings {
     ChaosMapSettings {
         check: 0,
+        accuracy: None,
         axes,
         ranges: [None, None],
         p_max: 3.0,
@@ -388,4 +389,34 @@ fn the_class_check_counts_the_pixels_a_tighter_run_reclassifies() {
     let tight = map(1e-10, 400).class_check.unwrap();
     assert_eq!(tight.changed, 0, "{tight:?}");
     assert!((tight.error - 3.0 / 400.0).abs() < 1e-15);
+}
+
+/// Asked for at most 0.2 % of pixels changing class, a map at 1e-3 (where
+/// 0.5 % of the checked ones change) is run again at 1e-5, which the check
+/// passes: the map returned is that run's, pixel for pixel.
+#[test]
+fn a_chaos_map_asked_for_an_accuracy_tightens_its_tolerance_until_its_check_passes() {
+    let params = kapitza::Params {
+        A: 1.0,
+        eps: 0.1,
+        mu: 0.0,
+    }
+    .values();
+    let map = |tol: f64, accuracy: Option<f64>| {
+        let settings = ChaosMapSettings {
+            check: 400,
+            accuracy,
+            method: Method::parse("taylor", tol).unwrap(),
+            ..settings([0, 1], 40, 100)
+        };
+        chaos_map(model_of("kapitza"), &params, &settings, &|| true).unwrap()
+    };
+    let asked = map(1e-3, Some(0.002));
+    let said = asked.accuracy.clone().unwrap();
+    assert!(
+        said.contains("0.002 reached") && said.contains("tol 1e-5"),
+        "{said}"
+    );
+    assert!(asked.class_check.as_ref().unwrap().fraction <= 0.002);
+    assert_eq!(asked.fli, map(1e-5, None).fli);
 }

@@ -364,6 +364,7 @@ fn portrait_settings(n: usize) -> PortraitSettings {
 fn map_settings(periods: usize) -> ChaosMapSettings {
     ChaosMapSettings {
         check: 0,
+        accuracy: None,
         axes: [0, 1],
         ranges: [None, None],
         p_max: 1.0,

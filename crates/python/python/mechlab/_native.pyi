@@ -142,6 +142,7 @@ class Model:
         method: str = "taylor",
         tol: float = 1e-6,
         check: int = 256,
+        accuracy: Optional[float] = None,
         params: Params = None,
         progress: bool = True,
     ) -> dict[str, Any]:
@@ -266,6 +267,7 @@ class Model:
         method: str = "taylor",
         tol: float = 1e-10,
         check: int = 256,
+        accuracy: Optional[float] = None,
         params: Params = None,
         progress: bool = True,
     ) -> dict[str, Any]:

@@ -46,6 +46,11 @@ crate::declare_settings! {
         /// map, to count those whose class (chaotic or regular) changes:
         /// the map's numerical error (0: none).
         check: usize = 256, Range::Count { min: 0, max: 16_000_000 };
+        /// The largest share of pixels that may change class in a run at a
+        /// hundredth of the tolerance (auto: none asked; the share is
+        /// reported). Given, the map is run again a hundredfold tighter
+        /// until the check's share is within it, or the result says why not.
+        accuracy: Option<f64> = None, Range::Between { low: 0.0, high: 1.0 };
     }
     interactive { periods: 100, check: 64 }
 }
@@ -68,6 +73,7 @@ impl ChaosMapOptions {
             periods: self.periods,
             method,
             check: self.check,
+            accuracy: self.accuracy,
             tiles: None,
         })
     }
@@ -94,6 +100,9 @@ pub struct ChaosMapSettings {
     /// Pixels rerun at a hundredth of the tolerance to count those whose
     /// class changes (0: none).
     pub check: usize,
+    /// The largest share of pixels that may change class (None: the share
+    /// is reported, not chosen).
+    pub accuracy: Option<f64>,
     /// Cut the map into tiles of whole rows, each written to a file when
     /// done (None: one run in memory).
     pub tiles: Option<Tiles>,
@@ -131,6 +140,9 @@ pub struct ChaosMap {
     /// the tolerance, from a sample of them: the numerical error of
     /// `chaotic_fraction` (None: not checked).
     pub class_check: Option<ClassCheck>,
+    /// Whether the `accuracy` asked for was reached, and by which run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     pub seconds: f64,
     pub f_evals: u64,
     /// Row-major from the lower left: pixel (i, j) at index j·pixels + i.
@@ -164,6 +176,38 @@ pub use super::period_map::PeriodMapError as ChaosMapError;
 /// skipped and the map ends with
 /// [`ChaosMapError::Cancelled`] (nobody is waiting for it any more).
 pub fn chaos_map(
+    model: &Model,
+    params: &[f64],
+    settings: &ChaosMapSettings,
+    row_done: &(dyn Fn() -> bool + Sync),
+) -> Result<ChaosMap, ChaosMapError> {
+    let Some(accuracy) = settings.accuracy else {
+        return map_once(model, params, settings, row_done);
+    };
+    let mut settings = settings.clone();
+    settings.check = settings.check.max(256);
+    loop {
+        let mut map = map_once(model, params, &settings, row_done)?;
+        let check = map
+            .class_check
+            .as_ref()
+            .map_or(f64::INFINITY, |c| c.fraction);
+        let tighter = settings.method.tighter();
+        let method = settings.method.describe();
+        if check <= accuracy || !tighter.is_tighter_than(&settings.method) {
+            let reached = match check <= accuracy {
+                true => "reached",
+                false => "NOT reached (the tolerance is at the precision floor)",
+            };
+            map.accuracy = Some(format!("accuracy {accuracy} {reached} with {method}: a share {check} of the checked pixels changes class"));
+            return Ok(map);
+        }
+        settings.method = tighter;
+    }
+}
+
+/// [`chaos_map`] at the settings' method, its class check included.
+fn map_once(
     model: &Model,
     params: &[f64],
     settings: &ChaosMapSettings,
@@ -271,6 +315,7 @@ pub fn chaos_map(
         without_state: fli.iter().filter(|f| f.is_nan()).count(),
         fli_regular_level: shading.regular_level,
         class_check,
+        accuracy: None,
         seconds,
         f_evals,
         fli,
@@ -476,9 +521,11 @@ impl crate::outputs::Outputs for ChaosMap {
             ),
             None => String::new(),
         };
-        vec![format!(
+        let mut lines = vec![format!(
             "chaotic fraction {:.4}{check}",
             self.chaotic_fraction
-        )]
+        )];
+        lines.extend(self.accuracy.clone());
+        lines
     }
 }
