@@ -93,6 +93,20 @@ impl Verdict {
         }
     }
 
+    /// The verdict of a monodromy matrix `m` over one `period`, on
+    /// [`stability_margin`]'s criterion (which holds however short the
+    /// period): unstable where the margin is positive; a damped flow's
+    /// (det M < 1) stable motion is asymptotically stable.
+    pub fn of_monodromy(m: &DMatrix<f64>, period: f64) -> Verdict {
+        if !(stability_margin(m, period) <= 0.0) {
+            Verdict::Unstable
+        } else if m.determinant() < 1.0 - CONSERVATIVE_DETERMINANT {
+            Verdict::AsymptoticallyStable
+        } else {
+            Verdict::Stable
+        }
+    }
+
     pub fn name(&self) -> &'static str {
         match self {
             Verdict::Unstable => "unstable",

@@ -588,10 +588,11 @@ fn moved_equilibrium(
             )),
         ),
     };
+    let period = model.phase_period(probe).unwrap_or(f64::NAN);
     let (periodic_orbit, multipliers, verdict) = match orbit {
         Some((y, m)) => {
             let multipliers = multipliers_of(&m);
-            let verdict = super::floquet::Verdict::from_multipliers(&multipliers, 1e-7);
+            let verdict = super::floquet::Verdict::of_monodromy(&m, period);
             (Some(y), multipliers, Some(verdict.name()))
         }
         None => (None, Vec::new(), None),
