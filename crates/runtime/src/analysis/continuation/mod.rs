@@ -1084,7 +1084,10 @@ fn branch_point(s: &Solution) -> BranchPoint {
         let scale = 1.0 + s.monodromy.amax();
         multipliers.iter().all(|(re, _)| *re <= 1e-7 * scale)
     } else {
-        Verdict::from_multipliers(&multipliers, 1e-7) != Verdict::Unstable
+        // Per iteration of the map (a damped map's growth rate per
+        // iterate): the criterion of the exact windows, which holds however
+        // short the forcing period.
+        Verdict::of_monodromy(&s.monodromy, 1.0) != Verdict::Unstable
     };
     BranchPoint {
         parameter: s.p,
