@@ -3,7 +3,7 @@
 //! state) shaded by the fast Lyapunov indicator of its orbit. For one degree
 //! of freedom the plane is the cylinder (q, p).
 
-use super::check::{sample_pixels, ClassCheck};
+use super::check::{rerun_sample, ClassCheck};
 use super::lyapunov::{fli_is_chaotic, fli_shading};
 use super::tiles::{fingerprint, run_tiles};
 pub use super::tiles::{TileError, Tiles};
@@ -237,13 +237,12 @@ fn map_once(
         through: &through,
     };
     let pixels = settings.pixels;
-    let fli_of = |ks: &mut dyn Iterator<Item = usize>, method| plane.fli_of(ks, method);
     let stopped = std::sync::atomic::AtomicBool::new(false);
     let block = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), OdeError> {
         if stopped.load(std::sync::atomic::Ordering::Relaxed) {
             return Ok((Vec::new(), 0));
         }
-        let (values, f_evals) = fli_of(
+        let (values, f_evals) = plane.fli_of(
             &mut (rows.start * pixels..rows.end * pixels),
             settings.method,
         )?;
@@ -296,7 +295,7 @@ fn map_once(
     };
     let class_check = match settings.check {
         0 => None,
-        count => Some(class_check(&fli, count, settings, &fli_of)?),
+        count => Some(class_check(&fli, count, &plane)?),
     };
     let seconds = start.elapsed().as_secs_f64();
     let shading = fli_shading(&fli, settings.periods);
@@ -371,34 +370,18 @@ impl Plane<'_> {
 /// The map's [`ClassCheck`]: `count` of its pixels spread over it run
 /// again by `fli_of` at a hundredth of the tolerance, on all cores, and
 /// their classes (chaotic or regular; none without a state) compared.
-fn class_check(
-    fli: &[f64],
-    count: usize,
-    settings: &ChaosMapSettings,
-    fli_of: &(dyn Fn(&mut dyn Iterator<Item = usize>, Method) -> Result<(Vec<f64>, u64), OdeError>
-          + Sync),
-) -> Result<ClassCheck, OdeError> {
-    let sample = sample_pixels(fli.len(), count);
-    let tighter = settings.method.tighter();
-    let chunk = sample
-        .len()
-        .div_ceil(4 * rayon::current_num_threads())
-        .max(8);
-    let again: Vec<Vec<f64>> = sample
-        .par_chunks(chunk)
-        .map(|ks| fli_of(&mut ks.iter().copied(), tighter).map(|(values, _)| values))
-        .collect::<Result<_, _>>()?;
-    let class = |f: f64| (!f.is_nan()).then(|| fli_is_chaotic(f, settings.periods));
-    let pairs = sample
-        .iter()
-        .zip(again.concat())
+fn class_check(fli: &[f64], count: usize, plane: &Plane) -> Result<ClassCheck, OdeError> {
+    let periods = plane.settings.periods;
+    let rerun = rerun_sample(fli.len(), count, plane.settings.method, |ks, method| {
+        plane
+            .fli_of(&mut ks.iter().copied(), method)
+            .map(|(values, _)| values)
+    })?;
+    let class = |f: f64| (!f.is_nan()).then(|| fli_is_chaotic(f, periods));
+    let pairs = (rerun.pixels.iter())
+        .zip(rerun.values)
         .map(|(&k, f)| (class(fli[k]), class(f)));
-    let runs = format!(
-        "{} against {}",
-        settings.method.describe(),
-        tighter.describe()
-    );
-    Ok(ClassCheck::new(pairs, runs))
+    Ok(ClassCheck::new(pairs, rerun.runs))
 }
 
 /// The request read against the model: its parameters by name, the

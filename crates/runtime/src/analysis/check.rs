@@ -2,6 +2,8 @@
 //! whose class (chaotic or regular, one basin or another) changes when a
 //! sample of them is run again at a tighter tolerance.
 
+use crate::ode::Method;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// How many of a map's pixels, rerun with a more accurate method, change
@@ -63,4 +65,38 @@ pub fn sample_pixels(total: usize, count: usize) -> Vec<usize> {
     (0..count)
         .map(|i| ((i as f64 + 0.5) * total as f64 / count as f64) as usize)
         .collect()
+}
+
+/// A sample of a map run again more accurately: its pixels, their values,
+/// and the two runs named ("taylor, tol 1e-6 against taylor, tol 1e-8").
+pub struct Rerun<T> {
+    pub pixels: Vec<usize>,
+    pub values: Vec<T>,
+    pub runs: String,
+}
+
+/// `count` of a map's `total` pixels spread over it ([`sample_pixels`]),
+/// each run again by `run` with the method of [`Method::tighter`] than
+/// `method`, in chunks on all cores.
+pub fn rerun_sample<T: Send, E: Send>(
+    total: usize,
+    count: usize,
+    method: Method,
+    run: impl Fn(&[usize], Method) -> Result<Vec<T>, E> + Sync,
+) -> Result<Rerun<T>, E> {
+    let pixels = sample_pixels(total, count);
+    let tighter = method.tighter();
+    let chunk = pixels
+        .len()
+        .div_ceil(4 * rayon::current_num_threads())
+        .max(8);
+    let values: Vec<Vec<T>> = pixels
+        .par_chunks(chunk)
+        .map(|ks| run(ks, tighter))
+        .collect::<Result<_, _>>()?;
+    Ok(Rerun {
+        pixels,
+        values: values.into_iter().flatten().collect(),
+        runs: format!("{} against {}", method.describe(), tighter.describe()),
+    })
 }

@@ -259,26 +259,13 @@ pub fn period_map_frequencies(
     let tune_check = match settings.check {
         0 => None,
         count => {
-            let sample = super::check::sample_pixels(n * n, count);
-            let tighter = settings.method.tighter();
-            let chunk = sample
-                .len()
-                .div_ceil(4 * rayon::current_num_threads())
-                .max(8);
-            let again: Vec<Vec<([f64; 2], f64)>> = sample
-                .par_chunks(chunk)
-                .map(|ks| tunes_of(&mut ks.iter().copied(), tighter))
-                .collect::<Result<_, _>>()?;
-            let pairs = sample
-                .iter()
-                .zip(again.concat())
+            let rerun = super::check::rerun_sample(n * n, count, settings.method, |ks, method| {
+                tunes_of(&mut ks.iter().copied(), method)
+            })?;
+            let pairs = (rerun.pixels.iter())
+                .zip(rerun.values)
                 .map(|(&k, (nu, _))| (pixels[k].0, nu));
-            let runs = format!(
-                "{} against {}",
-                settings.method.describe(),
-                tighter.describe()
-            );
-            Some(TuneCheck::new(pairs, runs))
+            Some(TuneCheck::new(pairs, rerun.runs))
         }
     };
     Ok(FrequencyMap {
