@@ -495,6 +495,10 @@ impl crate::outputs::Outputs for ChaosMap {
     }
     fn lines(&self) -> Vec<String> {
         let check = match &self.class_check {
+            Some(c) if c.changed == 0 => format!(
+                " (none of {} pixels changes class in a run at a hundredth of the tolerance, so under {:.4} would: {})",
+                c.sampled, c.error, c.runs
+            ),
             Some(c) => format!(
                 " ± {:.4} ({} of {} pixels change class in a run at a hundredth of the tolerance: {})",
                 c.fraction.max(c.error),

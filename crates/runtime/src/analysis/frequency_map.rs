@@ -262,8 +262,11 @@ pub fn period_map_frequencies(
             let rerun = super::check::rerun_sample(n * n, count, settings.method, |ks, method| {
                 tunes_of(&mut ks.iter().copied(), method)
             })?;
+            // A chaotic orbit's tunes move with any change of the run:
+            // only the regular orbits' tunes have an integration error.
             let pairs = (rerun.pixels.iter())
                 .zip(rerun.values)
+                .filter(|(&k, _)| pixels[k].1 < REGULAR_INDEX)
                 .map(|(&k, (nu, _))| (pixels[k].0, nu));
             Some(TuneCheck::new(pairs, rerun.runs))
         }
@@ -288,11 +291,13 @@ pub fn period_map_frequencies(
 }
 
 /// The tunes' numerical error: a sample of the map's orbits run again at a
-/// hundredth of the tolerance, and how far their tunes move (the
-/// integration's part; the diffusion index is NAFF's own).
+/// hundredth of the tolerance, and how far the regular ones' tunes move
+/// (the integration's part; the diffusion index is NAFF's own, and a
+/// chaotic orbit's tunes are not defined).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct TuneCheck {
-    /// Tunes compared (one or two an orbit: those both runs have).
+    /// Tunes compared (one or two an orbit: the sampled regular orbits'
+    /// that both runs have).
     pub sampled: usize,
     /// The median and the largest change of a tune between the runs.
     pub median: f64,
@@ -526,7 +531,7 @@ impl crate::outputs::Outputs for FrequencyMap {
         )];
         if let Some(c) = &self.tune_check {
             lines.push(format!(
-                "tunes' integration error: median {:.1e}, largest {:.1e} over {} tunes rerun ({})",
+                "regular orbits' tunes, integration error: median {:.1e}, largest {:.1e} over {} tunes rerun ({})",
                 c.median, c.largest, c.sampled, c.runs
             ));
         }

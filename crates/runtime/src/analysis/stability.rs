@@ -1637,10 +1637,17 @@ impl Stability {
             }
             let value = |a: Option<f64>| a.map_or("none".to_string(), |a| format!("{a:.7}"));
             let lower = e.exact_window.and_then(|[low, _]| low);
+            let error = match e.exact_window_error {
+                Some([Some(error), _]) => format!(" ± {error:.1e}"),
+                _ => String::new(),
+            };
             let mut legend = vec![
                 ("exact: spectral radius".to_string(), BLUE),
                 (format!("averaged: a* = {}", value(e.a_star)), BLACK),
-                (format!("exact window edges (lower {})", value(lower)), RED),
+                (
+                    format!("exact window edges (lower {}{error})", value(lower)),
+                    RED,
+                ),
             ];
             if e.a_star_second_order.is_some() {
                 let text = format!("second-order averaged: {}", value(e.a_star_second_order));

@@ -728,9 +728,11 @@ async function refreshChaos() {
     await postStream("/api/chaos", request, chaosController.signal, (line) => {
       if (line.error) { say(`chaos map: ${line.error}`); return; }
       studio.chaos = { ...line, ranges, image: chaosImage(line) };
-      const check = line.class_check
-        ? ` ± ${(100 * Math.max(line.class_check.fraction, line.class_check.error)).toFixed(1)} % (${line.class_check.changed} of ${line.class_check.sampled} pixels reclassified at a hundredth of the tolerance)`
-        : "";
+      // With none reclassified the error is the rule of three's bound.
+      const c = line.class_check;
+      const check = !c ? "" : c.changed === 0
+        ? ` (none of ${c.sampled} pixels reclassified at a hundredth of the tolerance: under ${(100 * c.error).toFixed(1)} % would be)`
+        : ` ± ${(100 * Math.max(c.fraction, c.error)).toFixed(1)} % (${c.changed} of ${c.sampled} pixels reclassified at a hundredth of the tolerance)`;
       $("status").textContent = `FLI ${line.pixels}² in ${line.seconds.toFixed(2)} s, chaotic ${(100 * line.chaotic_fraction).toFixed(1)} %${check}`;
       redraw();
     });
