@@ -235,3 +235,47 @@ fn a_run_too_long_for_its_step_limit_stops_early_with_its_forecast() {
     integrator.max_steps = steps + steps / 10;
     integrator.advance(&system, 0.0, &[0.1, 0.0], 1e3).unwrap();
 }
+
+/// A run that leaves a model's domain names the model file's expression
+/// that stopped being real: the bead on a circle written in x
+/// (`test_models/bead_on_circle.toml`, height −√(R² − x²)) thrown hard
+/// enough towards the wire's equator leaves its chart, and `explore`
+/// says `definitions.y` is NaN there, at an x past R, in the model's file.
+#[test]
+fn a_run_out_of_the_models_domain_names_the_expression() {
+    use mechlab::analysis::declared::{no_progress, Analysis, AnalysisError};
+    use mechlab::explore::ExploreOptions;
+    let model = &mechlab_test_models::bead_on_circle::MODEL;
+    let values = model.dynamic.defaults();
+    let options = ExploreOptions {
+        y0: Some(vec![0.5, 3.0]),
+        ..ExploreOptions::default()
+    };
+    let error = options
+        .run(model, &values, &no_progress)
+        .map_err(|e| e.located(model, &values))
+        .expect_err("the bead leaves the chart |x| < R");
+    let AnalysisError::OutsideDomain { domain, .. } = &error else {
+        panic!("not located: {error}");
+    };
+    assert_eq!(domain.undefined.key, "definitions.y", "{error}");
+    assert_eq!(
+        domain.undefined.expression.replace(' ', ""),
+        "-sqrt(R^2-x^2)",
+        "{error}"
+    );
+    assert!(domain.undefined.value.is_nan(), "{error}");
+    assert_eq!(domain.state[0].0, "x");
+    assert!(domain.state[0].1 > 1.0, "{error}");
+    let text = error.to_string();
+    assert!(
+        text.contains("bead_on_circle.toml") && text.contains("x = "),
+        "{text}"
+    );
+    // Within the chart the same model runs.
+    let inside = ExploreOptions {
+        y0: Some(vec![0.5, 0.0]),
+        ..ExploreOptions::default()
+    };
+    inside.run(model, &values, &no_progress).unwrap();
+}

@@ -116,12 +116,7 @@ fn uncoupled_oscillators_give_their_frequencies_and_amplitudes() {
 /// over 2000 time units gives it to 1e-11.
 #[test]
 fn the_pendulums_frequency_is_its_elliptic_closed_form() {
-    let agm = |mut a: f64, mut b: f64| {
-        while (a - b).abs() > 1e-16 * a {
-            (a, b) = (0.5 * (a + b), (a * b).sqrt());
-        }
-        a
-    };
+    use crate::common::agm;
     let model = &mechlab_test_models::bare_pendulum::MODEL;
     let system = model.systems().unwrap().exact(&[]);
     for theta in [0.5, 2.0, 3.0] {

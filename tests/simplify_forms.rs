@@ -17,7 +17,7 @@ fn vocabulary(keys: &[&str], phase: Option<&str>) -> simplify::Vocabulary {
 /// The readable form, checked against the input at random points.
 fn readable(text: &str, keys: &[&str], phase: Option<&str>) -> String {
     let e = simplify::simplify(text, &vocabulary(keys, phase)).unwrap();
-    simplify::verify(text, &e, 7).unwrap();
+    simplify::verify(text, &e, 7, &Default::default()).unwrap();
     e.to_string()
 }
 
@@ -117,14 +117,40 @@ fn random_expressions_keep_their_values() {
     for _ in 0..300 {
         let text = random_expression(&mut state, 3);
         let e = simplify::simplify(&text, &vocabulary(&["p"], Some("th"))).unwrap();
-        simplify::verify(&text, &e, 11).unwrap_or_else(|err| panic!("{text}: {err}"));
+        simplify::verify(&text, &e, 11, &Default::default())
+            .unwrap_or_else(|err| panic!("{text}: {err}"));
     }
 }
 
 #[test]
 fn verification_catches_a_wrong_form() {
     let wrong = Expr::parse("cos(q)^2").unwrap();
-    assert!(simplify::verify("sin(q)^2", &wrong, 3).is_err());
+    assert!(simplify::verify("sin(q)^2", &wrong, 3, &Default::default()).is_err());
     let right = Expr::parse("1-cos(q)^2").unwrap();
-    assert!(simplify::verify("sin(q)^2", &right, 3).is_ok());
+    assert!(simplify::verify("sin(q)^2", &right, 3, &Default::default()).is_ok());
+}
+
+/// A form defined only near the model's start (a bead's height
+/// −√(R² − x²)) is checked there: random points with x > R are skipped and
+/// the points drawn near the start instead, where a wrong form is still
+/// caught; a form undefined where the derived one is defined is wrong.
+#[test]
+fn verification_samples_where_the_model_is_defined() {
+    let start: simplify::Start = [("x".to_string(), 0.2), ("R".to_string(), 0.4)].into();
+    let derived = "-(R^2 - x^2)^(1/2)*x";
+    let right = Expr::parse("-x*sqrt(R^2 - x^2)").unwrap();
+    assert!(simplify::verify(derived, &right, 5, &start).is_ok());
+    let wrong = Expr::parse("-x*sqrt(R^2 - x^2 + x^4)").unwrap();
+    assert!(matches!(
+        simplify::verify(derived, &wrong, 5, &start),
+        Err(simplify::SimplifyError::Differs { .. })
+    ));
+    let narrower = Expr::parse("-x*sqrt(R - x)*sqrt(R + x)*sqrt(x - R/2)/sqrt(x - R/2)").unwrap();
+    assert!(simplify::verify(derived, &narrower, 5, &start).is_err());
+    // Undefined everywhere: named, not a NaN compared with a NaN.
+    let nowhere = Expr::parse("sqrt(-1 - x^2)").unwrap();
+    assert!(matches!(
+        simplify::verify("(-1 - x^2)^(1/2)", &nowhere, 5, &start),
+        Err(simplify::SimplifyError::Undefined { tried: 64 })
+    ));
 }

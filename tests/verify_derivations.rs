@@ -384,3 +384,61 @@ fn parameters_by_name() {
         .to_string()
         .contains("must be finite"));
 }
+
+/// The bead on a vertical circular wire written in its horizontal
+/// coordinate x (`test_models/bead_on_circle.toml`: height −√(R² − x²),
+/// real only for |x| ≤ R) is the pendulum in another chart, x = R sin θ:
+/// from rest at x₀ = R/2 (θ₀ = π/6) it passes the bottom after a quarter
+/// period K(k)√(R/g), k = sin(θ₀/2), with p_x = −m √(2gR(1 − cos θ₀)),
+/// and is back at x₀ after the period. The model's build samples it
+/// where it is defined; the run never leaves |x| ≤ x₀.
+#[test]
+fn the_bead_on_a_circle_in_its_cartesian_chart_is_the_pendulum() {
+    use crate::common::agm;
+    let model = &mechlab_test_models::bead_on_circle::MODEL;
+    let (radius, mass, g) = (2.0, 0.5, 3.0);
+    let system = model.systems().unwrap().exact(&[radius, mass, g]);
+    let theta0 = std::f64::consts::FRAC_PI_6;
+    let k = (theta0 / 2.0).sin();
+    let quarter =
+        std::f64::consts::FRAC_PI_2 / agm(1.0, (1.0 - k * k).sqrt()) * (radius / g).sqrt();
+    let start = [radius * theta0.sin(), 0.0];
+    for method in [
+        Method::Taylor { tol: 1e-15 },
+        Method::Dop853 {
+            rtol: 1e-13,
+            atol: 1e-13,
+        },
+    ] {
+        let states = system
+            .states_at(
+                method,
+                0.0,
+                &start,
+                &[quarter, 2.0 * quarter, 4.0 * quarter],
+            )
+            .unwrap();
+        let bottom = -mass * (2.0 * g * radius * (1.0 - theta0.cos())).sqrt();
+        let name = method.name();
+        assert!(
+            states[0][0].abs() < 1e-10,
+            "{name}: x at a quarter period {:e}",
+            states[0][0]
+        );
+        assert!(
+            (states[0][1] - bottom).abs() < 1e-10,
+            "{name}: p_x at the bottom {} against {bottom}",
+            states[0][1]
+        );
+        assert!(
+            (states[1][0] + start[0]).abs() < 1e-10,
+            "{name}: x at half a period {}",
+            states[1][0]
+        );
+        assert!(
+            (states[2][0] - start[0]).abs() < 1e-10 && states[2][1].abs() < 1e-10,
+            "{name}: after the period {:?}",
+            states[2]
+        );
+    }
+}

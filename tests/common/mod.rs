@@ -302,3 +302,12 @@ pub fn duffing_period_doubling(
     }
     0.5 * (low + high)
 }
+
+/// The arithmetic–geometric mean of a and b: the complete elliptic integral
+/// K(k) = π / (2 AGM(1, √(1 − k²))) of the pendulum's closed forms.
+pub fn agm(mut a: f64, mut b: f64) -> f64 {
+    while (a - b).abs() > 1e-16 * a {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    a
+}

@@ -275,6 +275,9 @@ pub struct Recorder {
     derived: Vec<Derived>,
     vocabulary: simplify::Vocabulary,
     names: Names,
+    /// The model's start and default parameters, near which a readable form
+    /// is checked where random points fall outside the model's domain.
+    start: simplify::Start,
 }
 
 impl Recorder {
@@ -302,8 +305,18 @@ impl Recorder {
                 .chain(phase.iter().map(|th| (th.clone(), None)))
                 .collect::<Vec<_>>(),
         );
+        let start = model
+            .coordinates
+            .iter()
+            .zip(model.start_or_zero())
+            .flat_map(|(c, q)| [(c.name.clone(), q), (c.velocity.clone(), 0.0)])
+            .chain(model.parameters.iter().map(|p| (p.name.clone(), p.default)))
+            .chain(phase.iter().map(|th| (th.clone(), 0.0)))
+            .chain([(model.time.clone(), 0.0)])
+            .collect();
         Recorder {
             derived: Vec::new(),
+            start,
             vocabulary: simplify::Vocabulary {
                 keys,
                 phase,
@@ -352,7 +365,7 @@ impl Recorder {
         let seed = key.bytes().fold(self.derived.len() as u64, |h, b| {
             h.wrapping_mul(31).wrapping_add(u64::from(b))
         });
-        simplify::verify(&derived.join("+"), &readable, seed).map_err(&failure)?;
+        simplify::verify(&derived.join("+"), &readable, seed, &self.start).map_err(&failure)?;
         let text = readable.to_string();
         self.derived.push(Derived {
             key,

@@ -1069,6 +1069,28 @@ impl Model {
         self.coordinates.len()
     }
 
+    /// The coordinates' starts at the default parameters, 0 where a file
+    /// gives none (or one that is not finite there): where the numerical
+    /// checks sample the model.
+    pub fn start_or_zero(&self) -> Vec<f64> {
+        let defaults = |s: &str| {
+            self.parameters
+                .iter()
+                .find(|p| p.name == s)
+                .map(|p| p.default)
+        };
+        self.coordinates
+            .iter()
+            .map(|c| {
+                c.start
+                    .as_ref()
+                    .and_then(|e| e.eval(&defaults).ok())
+                    .filter(|x| x.is_finite())
+                    .unwrap_or(0.0)
+            })
+            .collect()
+    }
+
     /// The Lagrangian with definitions substituted and `dot` expanded as a
     /// total time derivative: Σ ∂x/∂q_i q'_i + rate ∂x/∂θ + ∂x/∂t.
     /// Unsimplified; used for numerical checks (the build derives it again with Symbolica).
@@ -1159,8 +1181,15 @@ impl Model {
                 ));
             }
         }
-        for _sample in 0..5 {
-            let q: Vec<f64> = (0..n).map(|_| 3.0 * random()).collect();
+        // Samples around the coordinates' starts (0 where a file gives
+        // none), as far as 3 from them; a point where L is not finite lies
+        // outside the model's domain (a square root of a negative number, a
+        // chart's edge) and is replaced by one nearer the start, so that a
+        // model defined only near its start is checked there, not refused.
+        let centre = self.start_or_zero();
+        let (mut spread, mut checked, mut outside) = (3.0, 0, 0);
+        while checked < 5 {
+            let q: Vec<f64> = centre.iter().map(|c| c + spread * random()).collect();
             let v: Vec<f64> = (0..n).map(|_| random()).collect();
             let phase = 3.0 * random();
             let time = random();
@@ -1181,11 +1210,17 @@ impl Model {
                 .collect::<Result<_, _>>()
                 .map_err(|e| ("lagrangian".to_string(), e.to_string()))?;
             if l.iter().any(|x| !x.is_finite()) {
-                return Err((
-                    "lagrangian".into(),
-                    format!("not finite at q = {q:?}, q' = {v:?}"),
-                ));
+                outside += 1;
+                if outside == 40 {
+                    return Err((
+                        "lagrangian".into(),
+                        format!("not finite at any of 40 points near the start q = {centre:?} (the last at q = {q:?}, q' = {v:?}); give each coordinate a `start` where the model is defined"),
+                    ));
+                }
+                spread /= 2.0;
+                continue;
             }
+            checked += 1;
             let third_difference = l[3] - 3.0 * l[2] + 3.0 * l[1] - l[0];
             let scale = l.iter().map(|x| x.abs()).fold(1.0, f64::max);
             if third_difference.abs() > 1e-8 * scale {

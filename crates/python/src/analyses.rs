@@ -78,10 +78,12 @@ pub fn run<T: Analysis>(
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
     let result = detached(py, || {
-        options.run(model, &values, &|k| {
-            bar.inc(k as u64);
-            !mechlab::ode::stop::stop_requested()
-        })
+        options
+            .run(model, &values, &|k| {
+                bar.inc(k as u64);
+                !mechlab::ode::stop::stop_requested()
+            })
+            .map_err(|e| e.located(model, &values))
     })?
     .map_err(py_err)?;
     bar.finish_and_clear();

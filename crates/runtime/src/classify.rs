@@ -40,6 +40,12 @@ pub enum ErrorClass {
 /// An error of the library with its class.
 pub trait Classify: std::error::Error {
     fn class(&self) -> ErrorClass;
+    /// The integration's stop behind this error, if one is (a non-finite
+    /// step, a collapsed one): where [`crate::domain::explain`] looks for
+    /// the model's expression that stopped being real.
+    fn integration_stop(&self) -> Option<&OdeError> {
+        None
+    }
 }
 
 use ErrorClass::{BadValue, Integration, Stopped};
@@ -69,6 +75,9 @@ impl Classify for OdeError {
             _ => Integration,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        Some(self)
+    }
 }
 
 /// Errors that are always a bad value.
@@ -92,6 +101,12 @@ impl Classify for StatesError {
             _ => BadValue,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            StatesError::Ode(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for PeriodMapError {
@@ -101,6 +116,12 @@ impl Classify for PeriodMapError {
             PeriodMapError::Cancelled => Stopped,
             PeriodMapError::Ode(e) => e.class(),
             _ => BadValue,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            PeriodMapError::Ode(e) => Some(e),
+            _ => None,
         }
     }
 }
@@ -113,6 +134,12 @@ impl Classify for StabilityError {
             _ => BadValue,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            StabilityError::Ode(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for SectionError {
@@ -123,6 +150,12 @@ impl Classify for SectionError {
             _ => BadValue,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            SectionError::Method(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for BasinsError {
@@ -131,6 +164,12 @@ impl Classify for BasinsError {
             BasinsError::Refused(r) => r.class(),
             BasinsError::Ode(e) => e.class(),
             _ => BadValue,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            BasinsError::Ode(e) => Some(e),
+            _ => None,
         }
     }
 }
@@ -144,6 +183,12 @@ impl Classify for VibrationError {
             _ => Integration,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            VibrationError::Ode(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for AttractorError {
@@ -153,6 +198,12 @@ impl Classify for AttractorError {
             AttractorError::Ode(e) => e.class(),
             AttractorError::Constrained(_) => Integration,
             AttractorError::Setting(_) => BadValue,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            AttractorError::Ode(e) => Some(e),
+            _ => None,
         }
     }
 }
@@ -166,6 +217,12 @@ impl Classify for ContinuationError {
             _ => Integration,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            ContinuationError::Ode(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for SplittingError {
@@ -173,6 +230,12 @@ impl Classify for SplittingError {
         match self {
             SplittingError::Refused(r) => r.class(),
             _ => Integration,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            SplittingError::Ode(e) => Some(e),
+            _ => None,
         }
     }
 }
@@ -187,6 +250,12 @@ impl Classify for AveragingError {
             _ => Integration,
         }
     }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            AveragingError::Ode(e) => Some(e),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for ExploreError {
@@ -195,6 +264,12 @@ impl Classify for ExploreError {
             ExploreError::Ode(e) => e.class(),
             ExploreError::StateLength { .. } => BadValue,
             _ => Integration,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            ExploreError::Ode(e) => Some(e),
+            _ => None,
         }
     }
 }
@@ -206,6 +281,12 @@ impl Classify for MechanismError {
             MechanismError::NotDrawn { .. } => ErrorClass::Refused,
             MechanismError::Ode(e) => e.class(),
             _ => BadValue,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            MechanismError::Ode(e) => Some(e),
+            _ => None,
         }
     }
 }

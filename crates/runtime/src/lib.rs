@@ -15,6 +15,7 @@ pub mod budget;
 pub mod classify;
 pub mod constrained;
 pub mod contact;
+pub mod domain;
 pub mod explore;
 pub mod mathml;
 pub mod ode;

@@ -24,3 +24,22 @@ pub const ANDREWS_AT_0_03: [f64; 7] = [
     0.5347301163226948,
     0.1048080741042263e1,
 ];
+
+/// The car axis (`car_axis`) at t = 3 from the Test Set's start (xl, yl,
+/// xr, yr at 0, L0, L, L0; velocities −L0/L, 0, −L0/L, 0): the Test Set
+/// for IVP Solvers' reference solution, positions, velocities and the two
+/// multipliers (λ of M q'' = F + Gᵀλ, the axle's squareness then its
+/// length).
+#[allow(clippy::excessive_precision)] // the Test Set's digits, as published
+pub const CAR_AXIS_AT_3: [f64; 10] = [
+    0.4934557842755629e-1,
+    0.4969894602303324,
+    0.1041742524885400e1,
+    0.3739110272652214,
+    -0.7705836840321485e-1,
+    0.7446866596327776e-2,
+    0.1755681574942899e-1,
+    0.7703410437794031,
+    -0.4736886750784630e-2,
+    -0.1104680411345730e-2,
+];

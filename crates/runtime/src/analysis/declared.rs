@@ -15,6 +15,7 @@ use crate::analysis::separatrix::{separatrix_splitting, SplittingError, Splittin
 use crate::analysis::stability::{stability, StabilityError, StabilityOptions};
 use crate::analysis::Refusal;
 use crate::classify::{Classify, ErrorClass};
+use crate::domain::{explain, OutsideDomain};
 use crate::explore::{explore, ExploreError, ExploreOptions};
 use crate::registry::Model;
 use crate::settings::{Declared, SettingError};
@@ -73,6 +74,30 @@ pub enum AnalysisError {
     PeriodMap(#[from] PeriodMapError),
     #[error(transparent)]
     Explore(#[from] ExploreError),
+    /// A run left the model's domain: the analysis's error, then the model
+    /// file's expression that stopped being real and where.
+    #[error("{source}\n{domain}")]
+    OutsideDomain {
+        source: Box<AnalysisError>,
+        domain: Box<OutsideDomain>,
+    },
+}
+
+impl AnalysisError {
+    /// This error, with the model file's expression named where one of its
+    /// runs left the model's domain (see [`crate::domain`]).
+    pub fn located(self, model: &Model, values: &[f64]) -> AnalysisError {
+        match self
+            .integration_stop()
+            .and_then(|stop| explain(model, values, stop))
+        {
+            Some(domain) => AnalysisError::OutsideDomain {
+                source: Box::new(self),
+                domain: Box::new(domain),
+            },
+            None => self,
+        }
+    }
 }
 
 impl Classify for AnalysisError {
@@ -90,6 +115,23 @@ impl Classify for AnalysisError {
             AnalysisError::Averaging(e) => e.class(),
             AnalysisError::PeriodMap(e) => e.class(),
             AnalysisError::Explore(e) => e.class(),
+            AnalysisError::OutsideDomain { .. } => ErrorClass::Integration,
+        }
+    }
+    fn integration_stop(&self) -> Option<&crate::ode::OdeError> {
+        match self {
+            AnalysisError::Setting(_) | AnalysisError::Refusal(_) => None,
+            AnalysisError::Basins(e) => e.integration_stop(),
+            AnalysisError::Continuation(e) => e.integration_stop(),
+            AnalysisError::Splitting(e) => e.integration_stop(),
+            AnalysisError::Section(e) => e.integration_stop(),
+            AnalysisError::Stability(e) => e.integration_stop(),
+            AnalysisError::Vibration(e) => e.integration_stop(),
+            AnalysisError::Attractor(e) => e.integration_stop(),
+            AnalysisError::Averaging(e) => e.integration_stop(),
+            AnalysisError::PeriodMap(e) => e.integration_stop(),
+            AnalysisError::Explore(e) => e.integration_stop(),
+            AnalysisError::OutsideDomain { source, .. } => source.integration_stop(),
         }
     }
 }

@@ -604,10 +604,7 @@ impl<S: System<N>, const N: usize> Stepper<S, N> for Dop853<N> {
         if !err.is_finite() {
             // A non-finite stage: retry smaller, unless the step is already tiny.
             if !y_new.iter().all(|x| x.is_finite()) && h_try < 1e-10 * self.span {
-                return Err(OdeError::NonFinite {
-                    t,
-                    y: y_new.to_vec(),
-                });
+                return Err(OdeError::NonFinite { t, y: y.to_vec() });
             }
             return Ok(Attempt::Rejected { retry: h_try * 0.1 });
         }
@@ -617,7 +614,7 @@ impl<S: System<N>, const N: usize> Stepper<S, N> for Dop853<N> {
             });
         }
         let factor = (eighth_root(err) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
-        check_finite(t + hs, &y_new)?;
+        check_finite(t, y, &y_new)?;
         k[12] = system.rhs(t_end, &y_new);
         stats.f_evals += 1;
         self.first_same_as_last = true;

@@ -247,7 +247,7 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
         };
         after_rejection = false;
         clock.accept(carry_new);
-        check_finite(t_new, &y_new)?;
+        check_finite(t, &y, &y_new)?;
         if !last && t_new == t {
             return Err(OdeError::StepSizeUnderflow {
                 t,
@@ -316,8 +316,15 @@ pub(super) fn compensated_sum(t: f64, h: f64, carry: &mut f64) -> f64 {
     sum
 }
 
-pub(super) fn check_finite<const N: usize>(t: f64, y: &[f64; N]) -> Result<(), OdeError> {
-    if y.iter().all(|x| x.is_finite()) {
+/// A step from `y` at `t` to `y_new`: an error naming the last finite
+/// state (where a model defined only near its start can say which of its
+/// expressions stops being real) if `y_new` is not finite.
+pub(super) fn check_finite<const N: usize>(
+    t: f64,
+    y: &[f64; N],
+    y_new: &[f64; N],
+) -> Result<(), OdeError> {
+    if y_new.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
         Err(OdeError::NonFinite { t, y: y.to_vec() })

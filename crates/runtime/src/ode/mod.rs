@@ -391,8 +391,9 @@ pub enum OdeError {
     /// The initial state or time is NaN or infinite.
     #[error("initial state is not finite: t = {t}, y = {y:?}")]
     NonFiniteInitialState { t: f64, y: Vec<f64> },
-    /// The solution became NaN or infinite (the run diverged).
-    #[error("solution diverged (non-finite state) at t = {t}: y = {y:?}")]
+    /// The solution became NaN or infinite (the run diverged, or left the
+    /// model's domain) in a step from `y`, its last finite state, at `t`.
+    #[error("the solution became non-finite (it diverged or left the model's domain) in a step from t = {t}, y = {y:?}")]
     NonFinite { t: f64, y: Vec<f64> },
     /// The step collapsed at state `y` (a singular point, or a blow-up).
     #[error("step size underflow at t = {t} (h = {h:e}), y = {y:?}")]

@@ -352,15 +352,16 @@ impl DoubleDoubleTaylor {
                 _ => remaining,
             };
             let h = if forward { h } else { -h };
-            y = horner(c, h);
-            t = if h.abs() == remaining { t1 } else { t + h };
-            self.stats.steps += 1;
-            if y.iter().any(|x| !x.is_finite()) {
+            let y_new = horner(c, h);
+            if y_new.iter().any(|x| !x.is_finite()) {
                 return Err(OdeError::NonFinite {
                     t: t.to_f64(),
                     y: y.iter().map(|x| x.to_f64()).collect(),
                 });
             }
+            y = y_new;
+            t = if h.abs() == remaining { t1 } else { t + h };
+            self.stats.steps += 1;
         }
         Err(OdeError::TooManySteps {
             t: t.to_f64(),

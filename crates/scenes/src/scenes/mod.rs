@@ -106,7 +106,9 @@ where
     )?;
     eprintln!("{} on {} …", T::ANALYSIS, model.info.name);
     let values = scene.parameter_values(model.info)?;
-    let result = options.run(model, &values, &no_progress)?;
+    let result = options
+        .run(model, &values, &no_progress)
+        .map_err(|e| e.located(model, &values))?;
     crate::study::write_outputs(&scene, &result)
 }
 

@@ -72,6 +72,13 @@ pub enum StudioError {
     Levels { got: usize },
     #[error(transparent)]
     Ode(#[from] OdeError),
+    /// An orbit that left the model's domain: the integration's stop, then
+    /// the model file's expression that stopped being real and where.
+    #[error("{source}\n{domain}")]
+    OutsideDomain {
+        source: OdeError,
+        domain: Box<mechlab_runtime::domain::OutsideDomain>,
+    },
     #[error(transparent)]
     PeriodMap(#[from] PeriodMapError),
     #[error(transparent)]
@@ -95,7 +102,7 @@ impl mechlab_runtime::classify::Classify for StudioError {
             StudioError::Refused(e) => e.class(),
             StudioError::Parameter(e) => e.class(),
             StudioError::Setting(e) => e.class(),
-            StudioError::Ode(e) => e.class(),
+            StudioError::Ode(e) | StudioError::OutsideDomain { source: e, .. } => e.class(),
             StudioError::PeriodMap(e) => e.class(),
             StudioError::Splitting(e) => e.class(),
             StudioError::Continuation(e) => e.class(),

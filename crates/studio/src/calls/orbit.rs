@@ -120,7 +120,15 @@ pub fn orbit(
     if let Err(error) = run {
         // The points before the failure are the page's to keep.
         sink(OrbitChunk { points: chunk });
-        return Err(error.into());
+        return Err(
+            match mechlab_runtime::domain::explain(setup.handle, &setup.params, &error) {
+                Some(domain) => StudioError::OutsideDomain {
+                    source: error,
+                    domain: Box::new(domain),
+                },
+                None => error.into(),
+            },
+        );
     }
     if cancelled {
         return Ok(end(points - 1, true, &integrator));
