@@ -548,6 +548,31 @@ fn car_axis_reaches_the_test_sets_reference() {
     );
 }
 
+/// A chart whose held components the constraints fix: at t = 0 the car
+/// axis's road point lies on the x axis, so its moving constraint fixes
+/// the left wheel's horizontal speed at −L0 yb'/xb = −1/2. Holding it at
+/// 0.1 is refused as a singular chart (a start the run would drift from,
+/// its constraints violated more and more); holding it at −1/2 is the Test
+/// Set's start.
+#[test]
+fn held_components_the_constraints_fix_are_a_singular_chart() {
+    use mechlab::ode::holonomic::ConstraintError;
+    use mechlab_test_models::car_axis;
+    let model = car_axis::MODEL.constrained.unwrap();
+    let params = car_axis::Params::default().values();
+    let mut seed = model.start(&params);
+    seed[4] = 0.1;
+    let refused = model.consistent(&params, &mut seed, &[0, 4]);
+    assert!(
+        matches!(refused, Err(ConstraintError::SingularChart { .. })),
+        "{refused:?}"
+    );
+    let mut seed = model.start(&params);
+    seed[4] = -0.5;
+    model.consistent(&params, &mut seed, &[0, 4]).unwrap();
+    assert!((seed[6] + 0.5).abs() < 1e-12, "{seed:?}");
+}
+
 /// The fast Lyapunov indicator on the constraints: at the unstable upright
 /// of the Cartesian Kapitza pendulum below its threshold, the tangent
 /// vector (put on the constraints' tangent space) grows like the largest

@@ -5,6 +5,7 @@
 use mechlab::analysis::mechanism::{animate, Frames, MechanismError};
 use mechlab::analysis::Refusal;
 use mechlab::models::kapitza;
+use mechlab::ode::holonomic::ConstraintError;
 use mechlab::ode::Method;
 
 const METHOD: Method = Method::Dop853 {
@@ -88,6 +89,17 @@ fn every_drawn_model_moves_from_its_start() {
                     "{}: skipped, its motion from {start:?} stops: {e}",
                     info.name
                 );
+                continue;
+            }
+            // The speed given to the first coordinate, held, cannot be made
+            // consistent (a moving constraint that fixes it at t = 0).
+            Err(
+                e @ MechanismError::Inconsistent {
+                    source: ConstraintError::SingularChart { .. },
+                    ..
+                },
+            ) => {
+                println!("{}: skipped, {e}", info.name);
                 continue;
             }
             Err(e) => panic!("{}: {e}", info.name),

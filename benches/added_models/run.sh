@@ -5,8 +5,10 @@
 # printed reason. This adds model files written for the check (those of
 # benches/edit_loop/, one of them without an `amplitude` key and one with a
 # moving constraint, and the
-# 6- and 12-link chains of models/extra/, and the first chapter's model of
-# docs/first_model/, whose commands the docs test then checks) to models/, runs the test
+# 6- and 12-link chains of models/extra/, the first chapter's model of
+# docs/first_model/, whose commands the docs test then checks, and two
+# models defined only near their start: the bead on a circle in its
+# horizontal coordinate and the Test Set's car axis) to models/, runs the test
 # command, checks the 12-link chain's threshold from `stability` against
 # its closed form, and restores models/ however it ends.
 #
@@ -39,7 +41,8 @@ add_model() {
 }
 
 for f in benches/edit_loop/*.toml models/extra/six_link_pendulum.toml \
-    models/extra/twelve_link_pendulum.toml docs/first_model/my_pendulum.toml; do
+    models/extra/twelve_link_pendulum.toml docs/first_model/my_pendulum.toml \
+    test_models/bead_on_circle.toml test_models/car_axis.toml; do
     add_model "$f"
 done
 echo "added to models/: ${added[*]}"

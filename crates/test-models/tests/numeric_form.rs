@@ -159,6 +159,7 @@ fn every_model_follows_hamiltons_equations_of_its_hamiltonians() {
             params[k] = 0.0;
         }
         let periodic = model.periodic();
+        let mut inside = 0;
         for _ in 0..20 {
             let t = rng.between(0.0, 1.0);
             let mut y: Vec<f64> = (0..2 * n).map(|_| rng.between(-1.5, 1.5)).collect();
@@ -167,6 +168,22 @@ fn every_model_follows_hamiltons_equations_of_its_hamiltonians() {
                     y[i] = rng.between(0.8, 1.2); // lengths of springs
                 }
             }
+            // A model defined only near its start (a square root of a
+            // negative number past a chart's edge) is checked where the
+            // energy is finite a step of 5 % all round: near the edge, where
+            // the energy's derivatives grow without bound, the central
+            // differences lose their accuracy.
+            let defined = (0..2 * n).all(|k| {
+                [-0.05, 0.0, 0.05].iter().all(|d| {
+                    let mut z = y.clone();
+                    z[k] += d * (1.0 + z[k].abs());
+                    model.energy(&params, t, &z).is_finite()
+                })
+            });
+            if !defined {
+                continue;
+            }
+            inside += 1;
             let check = |field: &[f64], energy: &dyn Fn(&[f64]) -> f64, what: &str| {
                 for i in 0..n {
                     let name = format!("{} {what}", info.name);
@@ -200,6 +217,13 @@ fn every_model_follows_hamiltons_equations_of_its_hamiltonians() {
                     );
                 }
             }
+        }
+        if inside == 0 {
+            eprintln!(
+                "{}: skipped (none of 20 random states lies inside its domain)",
+                info.name
+            );
+            continue;
         }
         checked += 1;
     }

@@ -189,7 +189,17 @@ pub fn project_holding(
         }
     }
     let velocity = DVector::from_column_slice(v);
+    let scale = 1.0 + g.amax() * velocity.amax() + g_t.amax();
     let velocity_residual = (&g * velocity + g_t).amax();
+    // Held velocities the free ones cannot make consistent (the road's
+    // constraint at t = 0 fixes the very component held): a singular chart,
+    // not a start the run would drift from.
+    if !held.is_empty() && !(velocity_residual <= 1e-9 * scale) {
+        return Err(ConstraintError::SingularChart {
+            held: held.to_vec(),
+            y: y.to_vec(),
+        });
+    }
     Ok(Projection {
         newton_steps,
         position_residual,
