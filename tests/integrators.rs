@@ -612,3 +612,62 @@ fn distance_from_invariant_curve(method: Method) -> f64 {
     );
     worst
 }
+
+/// y' = −k (y − cos t) with k = 10⁹: DOP853 is held at steps of about
+/// 6/k by the decay, not by its accuracy, and its run (to t = 1, some 10⁸
+/// steps) stops at its step limit with the verdict that the run is stiff,
+/// naming the rate and the implicit method; RADAU5 follows it
+/// to the slow solution cos t + sin t / k + O(1/k²).
+#[test]
+fn a_stiff_run_says_it_is_stiff_and_radau5_follows_it() {
+    struct Decay(f64);
+    impl System<1> for Decay {
+        fn rhs(&self, t: f64, y: &[f64; 1]) -> [f64; 1] {
+            [-self.0 * (y[0] - t.cos())]
+        }
+        fn jacobian(&self, _t: f64, _y: &[f64; 1]) -> Option<[[f64; 1]; 1]> {
+            Some([[-self.0]])
+        }
+    }
+    let k = 1e9;
+    let explicit = Integrator::new(Method::Dop853 {
+        rtol: 1e-8,
+        atol: 1e-8,
+    })
+    .unwrap()
+    .solve(&Decay(k), 0.0, &[1.0], 1.0, Options::default());
+    match explicit {
+        Err(OdeError::Stiff {
+            method,
+            rate,
+            step,
+            source,
+            ..
+        }) => {
+            assert_eq!(method, "dop853");
+            assert!((rate / k - 1.0).abs() < 1e-12, "rate {rate:e}");
+            assert!(step * k > 3.0 && step * k < 7.0, "h k = {}", step * k);
+            assert!(
+                matches!(
+                    *source,
+                    OdeError::TooLong { .. } | OdeError::TooManySteps { .. }
+                ),
+                "{source}"
+            );
+        }
+        other => panic!("not called stiff: {other:?}"),
+    }
+    let implicit = Integrator::new(Method::Radau5 {
+        rtol: 1e-10,
+        atol: 1e-10,
+    })
+    .unwrap()
+    .solve(&Decay(k), 0.0, &[1.0], 1.0, Options::default())
+    .unwrap();
+    let slow = 1f64.cos() + 1f64.sin() / k;
+    assert!(
+        (implicit.y[0] - slow).abs() < 1e-9,
+        "{} against {slow}",
+        implicit.y[0]
+    );
+}

@@ -510,6 +510,11 @@ impl<S: System<N>, const N: usize> Stepper<S, N> for Dop853<N> {
         }
     }
 
+    /// DOP853's stability region reaches −6.1 on the real axis.
+    fn stability_reach(&self) -> Option<(&'static str, f64)> {
+        Some(("dop853", 6.1))
+    }
+
     fn begin(
         &mut self,
         system: &S,

@@ -50,6 +50,15 @@ pub(super) trait Stepper<S: System<N>, const N: usize> {
 
     fn schedule(&self) -> Schedule;
 
+    /// An explicit method's name and how far its stability region reaches
+    /// along the negative real axis (|h λ| at its edge): a run whose steps
+    /// the model's fastest decay holds at that edge is stiff. None for an
+    /// implicit method or one whose step follows the local solution.
+    #[inline(always)]
+    fn stability_reach(&self) -> Option<(&'static str, f64)> {
+        None
+    }
+
     /// Prepares a run from (t0, y0) towards t1 and returns the first step
     /// size to try (unsigned; adaptive methods), given the size `carried`
     /// from the previous call. Nothing to prepare by default.
@@ -202,10 +211,16 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
     let mut after_rejection = false;
     loop {
         if attempts >= max_steps {
-            return Err(OdeError::TooManySteps { t, max_steps });
+            return Err(stiff_or(
+                stepper,
+                system,
+                (t, &y, h),
+                OdeError::TooManySteps { t, max_steps },
+            ));
         }
         if to_the_end {
-            check_pace(attempts, max_steps, (t0, t, t1))?;
+            check_pace(attempts, max_steps, (t0, t, t1))
+                .map_err(|e| stiff_or(stepper, system, (t, &y, h), e))?;
         }
         if super::stop::stop_requested() {
             return Err(OdeError::Stopped { t });
@@ -278,6 +293,43 @@ pub(super) fn drive<S: System<N>, M: Stepper<S, N>, const N: usize>(
 
 /// Number of equal fixed steps of at most `step` covering `t0..t1`, and
 /// their signed size.
+/// `error` (a run past its step limit), or where an explicit method's
+/// step `h` at (t, y) is held at the edge of its stability region by the
+/// model's fastest rate (the spectral radius of ∂f/∂y, where the system
+/// knows it, at least half the reach over h): the verdict that the run is
+/// stiff there, with the implicit method to choose.
+fn stiff_or<S: System<N>, M: Stepper<S, N>, const N: usize>(
+    stepper: &M,
+    system: &S,
+    (t, y, h): (f64, &[f64; N], f64),
+    error: OdeError,
+) -> OdeError {
+    let Some((method, reach)) = stepper.stability_reach() else {
+        return error;
+    };
+    let Some(jacobian) = system.jacobian(t, y) else {
+        return error;
+    };
+    let matrix = nalgebra::DMatrix::from_fn(N, N, |i, j| jacobian[i][j]);
+    let rate = matrix
+        .complex_eigenvalues()
+        .iter()
+        .filter(|z| z.re < 0.0)
+        .map(|z| z.norm())
+        .fold(0.0, f64::max);
+    if rate.is_finite() && rate * h.abs() >= 0.5 * reach {
+        OdeError::Stiff {
+            method,
+            t,
+            step: h.abs(),
+            rate,
+            source: Box::new(error),
+        }
+    } else {
+        error
+    }
+}
+
 /// After a hundredth of the step limit, the steps a run would take to its
 /// end at its pace so far: more than a hundred times the limit (a run to
 /// t = 1e9, a tolerance the arithmetic cannot hold) stops it with that

@@ -409,6 +409,16 @@ pub enum OdeError {
         forecast: f64,
         max_steps: u64,
     },
+    /// An explicit method held at tiny steps by the model's fast decay,
+    /// not by its accuracy: the run is stiff there.
+    #[error("{source}: the run is stiff at t = {t}: the model's fastest decay (rate {rate:.1e}) holds {method}'s step at {step:.1e}, the edge of its stability region; choose method=radau5, which takes the steps its accuracy needs")]
+    Stiff {
+        method: &'static str,
+        t: f64,
+        step: f64,
+        rate: f64,
+        source: Box<OdeError>,
+    },
     /// A stop was requested ([`stop::request_stop`]: Ctrl-C).
     #[error("stopped at t = {t}: a stop was requested (Ctrl-C)")]
     Stopped { t: f64 },

@@ -60,6 +60,11 @@ impl<S: System<N>, const N: usize> Stepper<S, N> for Rk4 {
         }
     }
 
+    /// The classical Runge–Kutta method's region reaches −2.785.
+    fn stability_reach(&self) -> Option<(&'static str, f64)> {
+        Some(("rk4", 2.785))
+    }
+
     fn attempt(
         &mut self,
         system: &S,
