@@ -557,6 +557,7 @@ fn the_diffusion_index_is_small_on_tori_and_large_in_the_chaotic_sea() {
             t_max,
             samples: 2048,
             extent,
+            check: 0,
         };
         frequency_map(model, &[coupling], &settings).unwrap()
     };
@@ -705,4 +706,50 @@ fn sections_on_constraints_are_refused_where_they_do_not_apply() {
         Err(SectionError::Refused(r)) => assert!(r.to_string().contains("one coordinate"), "{r}"),
         other => panic!("{other:?}"),
     }
+}
+
+/// The section's frequency map states its tunes' integration error: on
+/// the uncoupled Hénon–Heiles oscillators every tune is exactly 1, so a
+/// loose tolerance's error in the tunes is their distance from 1, and the
+/// check (orbits rerun at a hundredth of the tolerance) states it within
+/// a factor 2, median and largest alike.
+#[test]
+fn the_section_frequency_maps_tune_check_states_its_error() {
+    use mechlab::analysis::frequency_map::{frequency_map, FrequencyMapSettings};
+    let model = models::by_name("henon_heiles").unwrap();
+    let pixels = 12;
+    let settings = FrequencyMapSettings {
+        section: SectionSettings {
+            tol: 1e-5,
+            ..settings(0.125)
+        },
+        pixels,
+        t_max: 1000.0,
+        samples: 2048,
+        extent: 1.0,
+        check: pixels * pixels,
+    };
+    let map = frequency_map(model, &[0.0], &settings).unwrap();
+    let mut errors: Vec<f64> = (map.frequencies.iter())
+        .zip(&map.diffusion)
+        .filter(|(nu, d)| nu[0].is_finite() && **d < -4.0)
+        .flat_map(|(nu, _)| nu.iter().map(|f| (f - 1.0).abs()))
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let (median, largest) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+    let check = map.tune_check.clone().unwrap();
+    eprintln!("{check:?}: errors median {median:e}, largest {largest:e}");
+    assert_eq!(check.sampled, errors.len());
+    assert!(
+        largest > 1e-9,
+        "the integration does not decide the tunes: {largest}"
+    );
+    assert!(
+        (0.5..2.0).contains(&(check.largest / largest)),
+        "{check:?} vs {largest}"
+    );
+    assert!(
+        (0.5..2.0).contains(&(check.median / median)),
+        "{check:?} vs {median}"
+    );
 }

@@ -290,6 +290,7 @@ class Model:
         frequencies: int = 0,
         map_time: float = 2000.0,
         samples: int = 4096,
+        check: int = 256,
         phase: float = 0.0,
         slab: float = 0.05,
         tol: float = 1e-12,

@@ -30,6 +30,9 @@ pub struct FrequencyMapSettings {
     pub samples: usize,
     /// The accessible region is searched for in [−extent, extent]².
     pub extent: f64,
+    /// Orbits run again at a hundredth of the tolerance to state the
+    /// tunes' integration error (0: none).
+    pub check: usize,
 }
 
 /// The frequency map of a period map reads the chaos map's plane and
@@ -71,7 +74,7 @@ pub struct FrequencyMap {
     /// Orbits the integrator could not follow (NaN in both maps).
     pub failed: usize,
     /// The tunes' integration error, from a sample rerun at a hundredth
-    /// of the tolerance (a period map's; None: not checked).
+    /// of the tolerance (None: not checked).
     pub tune_check: Option<TuneCheck>,
     pub seconds: f64,
     /// (ν₁, ν₂) per pixel, row 0 at the bottom; NaN where the energy is
@@ -116,37 +119,39 @@ pub fn frequency_map(
     let n = grid.pixels;
     let system = grid.fixed.exact(params);
     let dt = settings.t_max / settings.samples as f64;
+    // The tunes and diffusion index of the pixels `ks` by `method` (None
+    // where the energy is not accessible; NaN where the run failed).
+    let tunes_of = |ks: &[usize], method| -> Result<Vec<Option<([f64; 2], f64)>>, SectionError> {
+        let seeds: Vec<(usize, [f64; 4])> = (ks.iter().enumerate())
+            .filter_map(|(i, &k)| grid.seeds[k].map(|y| (i, y)))
+            .collect();
+        let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
+        let mut states: Vec<Vec<[f64; 4]>> = starts
+            .iter()
+            .map(|y| {
+                let mut v = Vec::with_capacity(settings.samples);
+                v.push(*y);
+                v
+            })
+            .collect();
+        let mut integrator = LaneIntegrator::new(method)?;
+        let orbits = Orbit::of_one_system(&system, dt, &starts);
+        let errors = integrator.stream(&orbits, |k, y| {
+            states[k].push(*y);
+            states[k].len() < settings.samples
+        });
+        let mut block = vec![None; ks.len()];
+        for (((i, _), orbit), error) in seeds.iter().zip(&states).zip(errors) {
+            block[*i] = match error {
+                None => Some(analyse(orbit, dt)),
+                Some(_) => Some(([f64::NAN; 2], f64::NAN)),
+            };
+        }
+        Ok(block)
+    };
     let blocks: Vec<Vec<Option<([f64; 2], f64)>>> = super::row_blocks(0..n, n)
         .into_par_iter()
-        .map(|rows| -> Result<_, SectionError> {
-            let offset = rows.start * n;
-            let seeds: Vec<(usize, [f64; 4])> = (offset..rows.end * n)
-                .filter_map(|k| grid.seeds[k].map(|y| (k - offset, y)))
-                .collect();
-            let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
-            let mut states: Vec<Vec<[f64; 4]>> = starts
-                .iter()
-                .map(|y| {
-                    let mut v = Vec::with_capacity(settings.samples);
-                    v.push(*y);
-                    v
-                })
-                .collect();
-            let mut integrator = LaneIntegrator::new(method)?;
-            let orbits = Orbit::of_one_system(&system, dt, &starts);
-            let errors = integrator.stream(&orbits, |k, y| {
-                states[k].push(*y);
-                states[k].len() < settings.samples
-            });
-            let mut block = vec![None; rows.len() * n];
-            for (((k, _), orbit), error) in seeds.iter().zip(&states).zip(errors) {
-                block[*k] = match error {
-                    None => Some(analyse(orbit, dt)),
-                    Some(_) => Some(([f64::NAN; 2], f64::NAN)),
-                };
-            }
-            Ok(block)
-        })
+        .map(|rows| tunes_of(&(rows.start * n..rows.end * n).collect::<Vec<_>>(), method))
         .collect::<Result<_, _>>()?;
     let pixels: Vec<Option<([f64; 2], f64)>> = blocks.into_iter().flatten().collect();
     let accessible = pixels.iter().flatten().count();
@@ -156,6 +161,21 @@ pub fn frequency_map(
         .flatten()
         .filter(|(_, d)| *d < REGULAR_INDEX)
         .count();
+    let tune_check = match settings.check {
+        0 => None,
+        count => {
+            let rerun = super::check::rerun_sample(n * n, count, method, |ks, method| {
+                tunes_of(ks, method)
+            })?;
+            // Only the regular orbits' tunes have an integration error.
+            let pairs = (rerun.pixels.iter())
+                .zip(rerun.values)
+                .filter_map(|(&k, again)| Some((pixels[k]?, again?)))
+                .filter(|((_, index), _)| *index < REGULAR_INDEX)
+                .map(|((nu, _), (again, _))| (nu, again));
+            Some(TuneCheck::new(pairs, rerun.runs))
+        }
+    };
     Ok(FrequencyMap {
         model: name,
         surface: format!(
@@ -171,7 +191,7 @@ pub fn frequency_map(
         regular,
         regular_fraction: regular as f64 / (accessible - failed).max(1) as f64,
         failed,
-        tune_check: None,
+        tune_check,
         seconds: start.elapsed().as_secs_f64(),
         frequencies: pixels
             .iter()

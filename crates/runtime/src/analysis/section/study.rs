@@ -47,6 +47,10 @@ crate::declare_settings! {
         map_time: f64 = 2000.0, Range::Positive;
         /// Samples of each orbit of the frequency map.
         samples: usize = 4096, Range::Count { min: 64, max: 100_000_000 };
+        /// Orbits of the frequency map run again at a hundredth of the
+        /// tolerance, spread over it, to state its tunes' integration error
+        /// (0: none).
+        check: usize = 256, Range::Count { min: 0, max: 100_000 };
         /// With a fast phase: the forcing's phase 2πt/T at which the period
         /// map samples.
         phase: f64 = 0.0, Range::Any;
@@ -56,7 +60,7 @@ crate::declare_settings! {
         /// DOP853's tolerance (the maps' Taylor method uses it too).
         tol: f64 = 1e-12, Range::Positive;
     }
-    interactive { orbits: 0, extent: 3.0 }
+    interactive { orbits: 0, extent: 3.0, check: 64 }
 }
 
 /// What [`section_study`] finds: each part the settings ask for.
@@ -124,6 +128,7 @@ pub fn section_study(
                 t_max: options.map_time,
                 samples: options.samples,
                 extent: options.extent,
+                check: options.check,
             };
             Some(frequency_map(model, params, &map)?)
         }
