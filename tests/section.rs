@@ -730,26 +730,10 @@ fn the_section_frequency_maps_tune_check_states_its_error() {
         check: pixels * pixels,
     };
     let map = frequency_map(model, &[0.0], &settings).unwrap();
-    let mut errors: Vec<f64> = (map.frequencies.iter())
+    let errors: Vec<f64> = (map.frequencies.iter())
         .zip(&map.diffusion)
         .filter(|(nu, d)| nu[0].is_finite() && **d < -4.0)
         .flat_map(|(nu, _)| nu.iter().map(|f| (f - 1.0).abs()))
         .collect();
-    errors.sort_by(f64::total_cmp);
-    let (median, largest) = (errors[errors.len() / 2], errors[errors.len() - 1]);
-    let check = map.tune_check.clone().unwrap();
-    eprintln!("{check:?}: errors median {median:e}, largest {largest:e}");
-    assert_eq!(check.sampled, errors.len());
-    assert!(
-        largest > 1e-9,
-        "the integration does not decide the tunes: {largest}"
-    );
-    assert!(
-        (0.5..2.0).contains(&(check.largest / largest)),
-        "{check:?} vs {largest}"
-    );
-    assert!(
-        (0.5..2.0).contains(&(check.median / median)),
-        "{check:?} vs {median}"
-    );
+    crate::common::assert_tune_check_states(&map.tune_check.unwrap(), errors);
 }

@@ -311,3 +311,29 @@ pub fn agm(mut a: f64, mut b: f64) -> f64 {
     }
     a
 }
+
+/// A frequency map's tune check states the tunes' true errors (`errors`,
+/// one a sampled tune, against a closed form): as many tunes, their
+/// median and largest within a factor 2, and the integration (not NAFF)
+/// deciding them.
+pub fn assert_tune_check_states(
+    check: &mechlab::analysis::frequency_map::TuneCheck,
+    mut errors: Vec<f64>,
+) {
+    errors.sort_by(f64::total_cmp);
+    let (median, largest) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+    eprintln!("{check:?}: errors median {median:e}, largest {largest:e}");
+    assert_eq!(check.sampled, errors.len());
+    assert!(
+        largest > 1e-9,
+        "the integration does not decide the tunes: {largest}"
+    );
+    assert!(
+        (0.5..2.0).contains(&(check.largest / largest)),
+        "{check:?} vs {largest}"
+    );
+    assert!(
+        (0.5..2.0).contains(&(check.median / median)),
+        "{check:?} vs {median}"
+    );
+}
