@@ -128,6 +128,7 @@ fn megno_maps_find_no_chaos_in_oscillators_and_chaos_growing_with_energy() {
             pixels: 24,
             t_max: 400.0,
             extent: 1.0,
+            check: 0,
         };
         section_map(model, &[coupling], &settings).unwrap()
     };
@@ -170,6 +171,7 @@ fn the_free_double_pendulum_goes_from_regular_to_chaotic_with_energy() {
             pixels: 24,
             t_max: 300.0,
             extent: 3.2,
+            check: 0,
         };
         section_map(model, &params, &settings).unwrap()
     };
@@ -511,6 +513,7 @@ fn a_model_with_a_fast_phase_gets_a_megno_map_of_its_slice() {
             pixels: 12,
             t_max: 100.0,
             extent: 3.2,
+            check: 0,
         };
         section_map(shaken, &params, &settings).unwrap()
     };
@@ -547,6 +550,7 @@ fn the_diffusion_index_is_small_on_tori_and_large_in_the_chaotic_sea() {
             pixels,
             t_max,
             extent,
+            check: 0,
         },
     )
     .unwrap();
@@ -736,4 +740,37 @@ fn the_section_frequency_maps_tune_check_states_its_error() {
         .flat_map(|(nu, _)| nu.iter().map(|f| (f - 1.0).abs()))
         .collect();
     crate::common::assert_tune_check_states(&map.tune_check.unwrap(), errors);
+}
+
+/// The MEGNO map's class check is the map's own reclassification: with
+/// every pixel sampled, its count of class changes is that between the
+/// map and the same map at a hundredth of the tolerance, pixel for pixel.
+#[test]
+fn the_megno_maps_class_check_counts_the_tighter_maps_changes() {
+    use mechlab::analysis::section_map::{section_map, SectionMapSettings, CHAOS_THRESHOLD};
+    let model = models::by_name("henon_heiles").unwrap();
+    let pixels = 16;
+    let map = |tol: f64, check: usize| {
+        let settings = SectionMapSettings {
+            section: SectionSettings {
+                tol,
+                ..settings(0.125)
+            },
+            pixels,
+            t_max: 400.0,
+            extent: 1.0,
+            check,
+        };
+        section_map(model, &[1.0], &settings).unwrap()
+    };
+    let (loose, tight) = (map(1e-3, pixels * pixels), map(1e-5, 0));
+    let class = |y: f64| y.is_finite().then_some(y > CHAOS_THRESHOLD);
+    let pairs: Vec<_> = (loose.megno.iter().zip(&tight.megno))
+        .filter_map(|(a, b)| Some((class(*a)?, class(*b)?)))
+        .collect();
+    let changed = pairs.iter().filter(|(a, b)| a != b).count();
+    let check = loose.class_check.unwrap();
+    eprintln!("{check:?}; {changed} of {} change", pairs.len());
+    assert_eq!((check.sampled, check.changed), (pairs.len(), changed));
+    assert!(check.sampled > 100 && check.changed > 0, "{check:?}");
 }

@@ -494,20 +494,10 @@ impl crate::outputs::Outputs for ChaosMap {
         vec![crate::outputs::Table::new("chaos_map.csv", &header, rows)]
     }
     fn lines(&self) -> Vec<String> {
-        let check = match &self.class_check {
-            Some(c) if c.changed == 0 => format!(
-                " (none of {} pixels changes class in a run at a hundredth of the tolerance, so under {:.4} would: {})",
-                c.sampled, c.error, c.runs
-            ),
-            Some(c) => format!(
-                " ± {:.4} ({} of {} pixels change class in a run at a hundredth of the tolerance: {})",
-                c.fraction.max(c.error),
-                c.changed,
-                c.sampled,
-                c.runs
-            ),
-            None => String::new(),
-        };
+        let check = self
+            .class_check
+            .as_ref()
+            .map_or(String::new(), ClassCheck::describe);
         let mut lines = vec![format!(
             "chaotic fraction {:.4}{check}",
             self.chaotic_fraction

@@ -26,6 +26,26 @@ pub struct ClassCheck {
 }
 
 impl ClassCheck {
+    /// What the check found, to follow the fraction it qualifies: "± e (k
+    /// of n pixels change class …)", or the rule of three's bound where
+    /// none did.
+    pub fn describe(&self) -> String {
+        if self.changed == 0 {
+            format!(
+                " (none of {} pixels changes class in a run at a hundredth of the tolerance, so under {:.4} would: {})",
+                self.sampled, self.error, self.runs
+            )
+        } else {
+            format!(
+                " ± {:.4} ({} of {} pixels change class in a run at a hundredth of the tolerance: {})",
+                self.fraction.max(self.error),
+                self.changed,
+                self.sampled,
+                self.runs
+            )
+        }
+    }
+
     /// The check from the pairs of classes (None: no class, as a pixel
     /// without a state) of the sampled pixels in the map's run and the
     /// tighter one.

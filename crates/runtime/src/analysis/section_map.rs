@@ -4,6 +4,7 @@
 //! in the batch Taylor lanes on all cores; the chaotic fraction of the
 //! accessible area.
 
+use super::check::ClassCheck;
 use super::lyapunov::megno_values;
 use super::section::{on_plane, Chart, SectionError, SectionSettings};
 use crate::analysis::Refusal;
@@ -26,6 +27,9 @@ pub struct SectionMapSettings {
     /// The accessible region is searched for in [−extent, extent]² of the
     /// other coordinate and its momentum.
     pub extent: f64,
+    /// Pixels run again at a hundredth of the tolerance to state how many
+    /// change class (0: none).
+    pub check: usize,
 }
 
 /// ⟨Y⟩ above this is chaos (regular orbits tend to 2, periodic ones to 0).
@@ -50,6 +54,10 @@ pub struct SectionMap {
     pub chaotic_fraction: f64,
     /// Orbits the integrator could not follow (left out of both counts).
     pub failed: usize,
+    /// The share of pixels a run at a hundredth of the tolerance
+    /// reclassifies, from a sample: the chaotic fraction's numerical error
+    /// (None: not checked).
+    pub class_check: Option<ClassCheck>,
     pub seconds: f64,
     /// ⟨Y⟩ per pixel, row 0 at the bottom; NaN where the energy is not
     /// accessible.
@@ -173,40 +181,46 @@ pub fn section_map(
     let system = fixed.exact(params);
     let chunks = (settings.t_max / chunk).ceil() as usize;
     let w0 = [0.5; 4];
-    // Rows in blocks, each streamed through one batch integrator.
-    let rows: Vec<(Vec<f64>, usize)> = super::row_blocks(0..n, n)
+    // ⟨Y⟩ of the pixels `ks` by `method`, streamed through one batch
+    // integrator: NaN where the energy is not accessible, +∞ where the run
+    // failed.
+    let megno_of = |ks: &[usize], method| -> Result<Vec<f64>, SectionError> {
+        let seeds: Vec<(usize, [f64; 4])> = (ks.iter().enumerate())
+            .filter_map(|(i, &k)| grid.seeds[k].map(|y| (i, y)))
+            .collect();
+        let mut block = vec![f64::NAN; ks.len()];
+        let mut integrator = LaneIntegrator::new(method)?;
+        let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
+        let values = megno_values::<_, 4, 8>(&mut integrator, &system, chunk, &starts, &w0, chunks);
+        for ((i, _), value) in seeds.iter().zip(values) {
+            block[*i] = value.unwrap_or(f64::INFINITY);
+        }
+        Ok(block)
+    };
+    let rows: Vec<Vec<f64>> = super::row_blocks(0..n, n)
         .into_par_iter()
-        .map(|rows| -> Result<(Vec<f64>, usize), SectionError> {
-            // The accessible pixels' states, by their place in the block.
-            let offset = rows.start * n;
-            let seeds: Vec<(usize, [f64; 4])> = (offset..rows.end * n)
-                .filter_map(|k| grid.seeds[k].map(|y| (k - offset, y)))
-                .collect();
-            let mut block = vec![f64::NAN; rows.len() * n];
-            let mut integrator = LaneIntegrator::new(method)?;
-            let starts: Vec<[f64; 4]> = seeds.iter().map(|(_, y)| *y).collect();
-            let values =
-                megno_values::<_, 4, 8>(&mut integrator, &system, chunk, &starts, &w0, chunks);
-            let mut failed = 0;
-            for ((k, _), value) in seeds.iter().zip(values) {
-                match value {
-                    Ok(v) => block[*k] = v,
-                    Err(_) => {
-                        block[*k] = f64::INFINITY;
-                        failed += 1;
-                    }
-                }
-            }
-            Ok((block, failed))
-        })
+        .map(|rows| megno_of(&(rows.start * n..rows.end * n).collect::<Vec<_>>(), method))
         .collect::<Result<_, _>>()?;
-    let failed = rows.iter().map(|(_, f)| f).sum();
-    let megno: Vec<f64> = rows.into_iter().flat_map(|(row, _)| row).collect();
+    let megno: Vec<f64> = rows.into_iter().flatten().collect();
+    let failed = megno.iter().filter(|v| **v == f64::INFINITY).count();
     let accessible = megno.iter().filter(|v| v.is_finite()).count();
     let chaotic = megno
         .iter()
         .filter(|v| v.is_finite() && **v > CHAOS_THRESHOLD)
         .count();
+    let class = |y: f64| y.is_finite().then_some(y > CHAOS_THRESHOLD);
+    let class_check = match settings.check {
+        0 => None,
+        count => {
+            let rerun = super::check::rerun_sample(n * n, count, method, |ks, method| {
+                megno_of(ks, method)
+            })?;
+            let pairs = (rerun.pixels.iter())
+                .zip(rerun.values)
+                .map(|(&k, again)| (class(megno[k]), class(again)));
+            Some(ClassCheck::new(pairs, rerun.runs))
+        }
+    };
     Ok(SectionMap {
         model: name,
         energy: s.energy,
@@ -219,6 +233,7 @@ pub fn section_map(
         chaotic,
         chaotic_fraction: chaotic as f64 / accessible.max(1) as f64,
         failed,
+        class_check,
         seconds: start.elapsed().as_secs_f64(),
         megno,
     })

@@ -47,9 +47,10 @@ crate::declare_settings! {
         map_time: f64 = 2000.0, Range::Positive;
         /// Samples of each orbit of the frequency map.
         samples: usize = 4096, Range::Count { min: 64, max: 100_000_000 };
-        /// Orbits of the frequency map run again at a hundredth of the
-        /// tolerance, spread over it, to state its tunes' integration error
-        /// (0: none).
+        /// Orbits of each map run again at a hundredth of the tolerance,
+        /// spread over it, to state its error: the share of the MEGNO map's
+        /// pixels that change class, the frequency map's tunes' change (0:
+        /// none).
         check: usize = 256, Range::Count { min: 0, max: 100_000 };
         /// With a fast phase: the forcing's phase 2πt/T at which the period
         /// map samples.
@@ -142,6 +143,7 @@ pub fn section_study(
                 pixels,
                 t_max: options.map_time,
                 extent: options.extent,
+                check: options.check,
             };
             Some(section_map(model, params, &map)?)
         }
@@ -216,6 +218,16 @@ impl crate::outputs::Outputs for SectionStudy {
         }
         if let Some(map) = &self.frequency_map {
             lines.extend(map.lines());
+        }
+        if let Some(map) = &self.megno_map {
+            let check = map
+                .class_check
+                .as_ref()
+                .map_or(String::new(), |c| c.describe());
+            lines.push(format!(
+                "MEGNO map: {} orbits, chaotic fraction {:.4}{check}, in {:.1} s",
+                map.accessible, map.chaotic_fraction, map.seconds
+            ));
         }
         lines
     }
