@@ -67,6 +67,9 @@ pub struct SectionMapView {
     pub pixels: usize,
     pub megno: Vec<Option<f64>>,
     pub chaotic_fraction: f64,
+    /// The share of pixels a run at a hundredth of the tolerance
+    /// reclassifies, from a sample: the fraction's numerical error.
+    pub class_check: Option<mechlab_runtime::analysis::check::ClassCheck>,
     pub seconds: f64,
 }
 
@@ -88,6 +91,7 @@ pub fn section_map(
             .map(|y| y.is_finite().then_some(*y))
             .collect(),
         chaotic_fraction: map.chaotic_fraction,
+        class_check: map.class_check.clone(),
         seconds: map.seconds,
     })
 }

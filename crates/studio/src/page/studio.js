@@ -587,6 +587,16 @@ function fitView(points) {
 
 let megnoController = null;
 
+// A map's class check after its chaotic fraction: ± the share of pixels a
+// run at a hundredth of the tolerance reclassifies; where none is, the rule
+// of three's bound.
+function classCheckText(c) {
+  if (!c) return "";
+  return c.changed === 0
+    ? ` (none of ${c.sampled} pixels reclassified at a hundredth of the tolerance: under ${(100 * c.error).toFixed(1)} % would be)`
+    : ` ± ${(100 * Math.max(c.fraction, c.error)).toFixed(1)} % (${c.changed} of ${c.sampled} pixels reclassified at a hundredth of the tolerance)`;
+}
+
 // The MEGNO map of the section, refined 32² → 64² → 128².
 async function refreshMegno() {
   if (megnoController) megnoController.abort();
@@ -601,7 +611,7 @@ async function refreshMegno() {
       const map = await postJson("/api/section_map", { ...sectionSettings(), map: pixels, map_time: t_max }, signal);
       studio.megno = { ranges: map.window, image: megnoImage(map) };
       studio.sectionAxes = map.axes;
-      $("megno-note").textContent = `(${pixels}², chaotic ${(100 * map.chaotic_fraction).toFixed(1)} %)`;
+      $("megno-note").textContent = `(${pixels}², chaotic ${(100 * map.chaotic_fraction).toFixed(1)} %${classCheckText(map.class_check)})`;
       if (pixels === 32 && !studio.megnoViewSet) {
         studio.view = { x: map.window[0].slice(), y: map.window[1].slice() };
         studio.megnoViewSet = true;
@@ -728,12 +738,7 @@ async function refreshChaos() {
     await postStream("/api/chaos", request, chaosController.signal, (line) => {
       if (line.error) { say(`chaos map: ${line.error}`); return; }
       studio.chaos = { ...line, ranges, image: chaosImage(line) };
-      // With none reclassified the error is the rule of three's bound.
-      const c = line.class_check;
-      const check = !c ? "" : c.changed === 0
-        ? ` (none of ${c.sampled} pixels reclassified at a hundredth of the tolerance: under ${(100 * c.error).toFixed(1)} % would be)`
-        : ` ± ${(100 * Math.max(c.fraction, c.error)).toFixed(1)} % (${c.changed} of ${c.sampled} pixels reclassified at a hundredth of the tolerance)`;
-      $("status").textContent = `FLI ${line.pixels}² in ${line.seconds.toFixed(2)} s, chaotic ${(100 * line.chaotic_fraction).toFixed(1)} %${check}`;
+      $("status").textContent = `FLI ${line.pixels}² in ${line.seconds.toFixed(2)} s, chaotic ${(100 * line.chaotic_fraction).toFixed(1)} %${classCheckText(line.class_check)}`;
       redraw();
     });
   } catch (e) {
