@@ -47,9 +47,10 @@ crate::declare_settings! {
         /// the map's numerical error (0: none).
         check: usize = 256, Range::Count { min: 0, max: 16_000_000 };
         /// The largest share of pixels that may change class in a run at a
-        /// hundredth of the tolerance (auto: none asked; the share is
-        /// reported). Given, the map is run again a hundredfold tighter
-        /// until the check's share is within it, or the result says why not.
+        /// hundredth of the tolerance (of a period map's frequency map: the
+        /// largest change of a regular orbit's tune) (auto: none asked; the
+        /// check is reported). Given, the map is run again a hundredfold
+        /// tighter until the check is within it, or the result says why not.
         accuracy: Option<f64> = None, Range::Between { low: 0.0, high: 1.0 };
     }
     interactive { periods: 100, check: 64 }

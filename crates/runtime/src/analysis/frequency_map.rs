@@ -76,6 +76,8 @@ pub struct FrequencyMap {
     /// The tunes' integration error, from a sample rerun at a hundredth
     /// of the tolerance (None: not checked).
     pub tune_check: Option<TuneCheck>,
+    /// Whether the `accuracy` asked for was reached, and by which run.
+    pub accuracy: Option<String>,
     pub seconds: f64,
     /// (ν₁, ν₂) per pixel, row 0 at the bottom; NaN where the energy is
     /// not accessible (ν₂ NaN for a period map of one degree of freedom).
@@ -192,6 +194,7 @@ pub fn frequency_map(
         regular_fraction: regular as f64 / (accessible - failed).max(1) as f64,
         failed,
         tune_check,
+        accuracy: None,
         seconds: start.elapsed().as_secs_f64(),
         frequencies: pixels
             .iter()
@@ -207,8 +210,42 @@ pub fn frequency_map(
 /// The frequency map of `model`'s period map on the chaos map's plane
 /// (`settings` as [`super::chaos_map::chaos_map`]'s; `periods` iterates
 /// per orbit, at least 64): each orbit's [`tunes`] and diffusion index.
-/// `done(k)` is told as blocks of k orbits end.
+/// `done(k)` is told as blocks of k orbits end. With `accuracy`, the map is
+/// run again a hundredfold tighter until its tune check's largest change
+/// is within it, or the tolerance reaches the precision floor.
 pub fn period_map_frequencies(
+    model: &Model,
+    params: &[f64],
+    settings: &super::chaos_map::ChaosMapSettings,
+    done: &(dyn Fn(usize) + Sync),
+) -> Result<FrequencyMap, super::period_map::PeriodMapError> {
+    let Some(accuracy) = settings.accuracy else {
+        return frequencies_once(model, params, settings, done);
+    };
+    let mut settings = settings.clone();
+    settings.check = settings.check.max(256);
+    loop {
+        let mut map = frequencies_once(model, params, &settings, done)?;
+        let largest = map.tune_check.as_ref().map_or(f64::INFINITY, |c| c.largest);
+        let tighter = settings.method.tighter();
+        if largest <= accuracy || !tighter.is_tighter_than(&settings.method) {
+            let reached = match largest <= accuracy {
+                true => "reached",
+                false => "NOT reached (the tolerance is at the precision floor)",
+            };
+            map.accuracy = Some(format!(
+                "accuracy {accuracy:e} {reached} with {}: a regular orbit's tune changes by at most {largest:.1e}",
+                settings.method.describe()
+            ));
+            return Ok(map);
+        }
+        settings.method = tighter;
+    }
+}
+
+/// [`period_map_frequencies`] at the settings' method, its tune check
+/// included.
+fn frequencies_once(
     model: &Model,
     params: &[f64],
     settings: &super::chaos_map::ChaosMapSettings,
@@ -304,6 +341,7 @@ pub fn period_map_frequencies(
         regular_fraction: regular as f64 / (n * n - failed).max(1) as f64,
         failed,
         tune_check,
+        accuracy: None,
         seconds: start.elapsed().as_secs_f64(),
         frequencies: pixels.iter().map(|(nu, _)| *nu).collect(),
         diffusion: pixels.iter().map(|(_, d)| *d).collect(),
@@ -555,6 +593,7 @@ impl crate::outputs::Outputs for FrequencyMap {
                 c.median, c.largest, c.sampled, c.runs
             ));
         }
+        lines.extend(self.accuracy.clone());
         lines
     }
 }
