@@ -539,3 +539,46 @@ fn van_der_pols_rest_state_has_its_hopf_point_at_zero() {
         );
     }
 }
+
+/// A bifurcation's stated error holds: Duffing's right-well orbit doubles
+/// its period where a hand-written RK4, Newton and Jury bisection put it;
+/// located by runs at loose tolerances, the parameter is off by what its
+/// stated error (twice the distance to the same doubling located at a
+/// hundredth of the tolerance) bounds, and within 100 times it.
+#[test]
+fn a_period_doublings_stated_error_bounds_its_error() {
+    use mechlab::analysis::continuation::{continuation, BifurcationKind};
+    let model = crate::common::model_of("duffing");
+    let values = model.dynamic.defaults();
+    let names = model.info.parameter_names;
+    let mut params = values.clone();
+    params[names.iter().position(|n| *n == "gamma").unwrap()] = 0.2;
+    let reference = crate::common::duffing_period_doubling(0.3, 1.2, (0.2, 0.28), 4000);
+    for tol in [1e-6, 1e-7, 1e-8] {
+        let method = Method::Dop853 {
+            rtol: tol,
+            atol: tol,
+        };
+        let settings = crate::common::continuation_settings("gamma", 0.28, &[1.0, 0.0], method);
+        let result = continuation(model, &params, &settings).unwrap();
+        let doubling = result
+            .bifurcations
+            .iter()
+            .find(|b| b.kind == BifurcationKind::PeriodDoubling)
+            .expect("a period doubling");
+        let stated = doubling.parameter_error.expect("an error");
+        let truth = (doubling.parameter - reference).abs();
+        eprintln!(
+            "tol {tol:e}: γ = {} off by {truth:.2e}, stated {stated:.2e}",
+            doubling.parameter
+        );
+        assert!(
+            truth <= stated,
+            "tol {tol:e}: off by {truth:e}, stated {stated:e}"
+        );
+        assert!(
+            stated <= 100.0 * truth.max(1e-9),
+            "tol {tol:e}: off by {truth:e}, stated {stated:e}"
+        );
+    }
+}

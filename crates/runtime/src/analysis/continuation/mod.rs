@@ -289,6 +289,10 @@ pub struct Bifurcation {
     pub branch: usize,
     pub period: usize,
     pub parameter: f64,
+    /// The parameter's numerical error: twice its distance to the same
+    /// bifurcation located from the same bracket with runs at a hundredth
+    /// of the tolerance (None where either was not located).
+    pub parameter_error: Option<f64>,
     pub state: Vec<f64>,
     pub multipliers: Vec<(f64, f64)>,
     /// The distance of the critical multiplier from +1 or −1 (or of the
@@ -425,7 +429,8 @@ pub fn continuation(
     let index = Refusal::parameter_index(info, &settings.parameter)?;
     let named = Refusal::named_values(info, params)?;
     let map = AtModel::new(systems, params, index, settings.method);
-    let mut result = run(&map, params[index], settings, &name)?;
+    let tighter = AtModel::new(systems, params, index, settings.method.tighter());
+    let mut result = run(&map, Some(&tighter), params[index], settings, &name)?;
     result.params = named;
     result.state_names = info.state_names();
     Ok(result)
@@ -466,7 +471,21 @@ fn on_constraints(
         start: map.chart(map.start()),
         ..settings.clone()
     };
-    let mut result = run(&map, params[index], &in_chart, &name)?;
+    let tighter = chart::ChartMap::new(
+        model,
+        params,
+        index,
+        settings.method.tighter(),
+        &start,
+        Some(map.held()),
+    )
+    .map_err(|source| ContinuationError::Start {
+        model: name.clone(),
+        guess: start.clone(),
+        parameter: params[index],
+        source,
+    })?;
+    let mut result = run(&map, Some(&tighter), params[index], &in_chart, &name)?;
     result.params = named;
     let names = info.state_names();
     result.state_names = map.held().iter().map(|&i| names[i]).collect();
@@ -523,7 +542,7 @@ pub(crate) fn orbit_branch(
             diagram: None,
             chart: None,
         };
-        let result = run(&map, p0, &settings, name)?;
+        let result = run(&map, None, p0, &settings, name)?;
         along.extend(
             result.branches[0]
                 .points
@@ -726,9 +745,12 @@ struct Job {
     sides: [(f64, bool); 2],
 }
 
-/// The continuation proper, on the erased map.
+/// The continuation proper, on the erased map (and, where given, the same
+/// at a hundredth of the tolerance, which locates each bifurcation again
+/// for its error).
 fn run(
     map: &dyn FamilyMap,
+    tighter: Option<&dyn FamilyMap>,
     p0: f64,
     settings: &ContinuationSettings,
     model: &str,
@@ -800,6 +822,7 @@ fn run(
             let pair = [&followed.points[i], &followed.points[i + 1]];
             let at = Located {
                 map,
+                tighter,
                 k,
                 branch: index,
                 kind,
@@ -849,6 +872,7 @@ fn run(
 /// found by the sign change of `test`.
 struct Located<'a> {
     map: &'a dyn FamilyMap,
+    tighter: Option<&'a dyn FamilyMap>,
     k: usize,
     branch: usize,
     kind: BifurcationKind,
@@ -870,6 +894,11 @@ impl Located<'_> {
             map, k, kind, test, ..
         } = *self;
         let (point, located) = branch::locate(map, k, a, b, test);
+        let parameter_error = self
+            .tighter
+            .filter(|_| located)
+            .map(|tighter| branch::locate(tighter, k, a, b, test))
+            .and_then(|(again, found)| found.then(|| 2.0 * (again.p - point.p).abs()));
         let at = bifurcations.len();
         let before = &a.tangent;
         let stable = |s: &Solution| branch_point(s).stable;
@@ -893,6 +922,7 @@ impl Located<'_> {
             branch: self.branch,
             period: k,
             parameter: point.p,
+            parameter_error,
             state: point.y.iter().copied().collect(),
             multipliers: multipliers_of(&point.monodromy),
             residual: residual(&point, kind),
