@@ -291,7 +291,8 @@ pub struct Bifurcation {
     pub parameter: f64,
     /// The parameter's numerical error: twice its distance to the same
     /// bifurcation located from the same bracket with runs at a hundredth
-    /// of the tolerance (None where either was not located).
+    /// of the tolerance, plus the locating's convergence, 10⁻¹² (1 + |p|)
+    /// (None where either was not located).
     pub parameter_error: Option<f64>,
     pub state: Vec<f64>,
     pub multipliers: Vec<(f64, f64)>,
@@ -898,7 +899,10 @@ impl Located<'_> {
             .tighter
             .filter(|_| located)
             .map(|tighter| branch::locate(tighter, k, a, b, test))
-            .and_then(|(again, found)| found.then(|| 2.0 * (again.p - point.p).abs()));
+            .and_then(|(again, found)| {
+                // (Plus the locating's own convergence, 10⁻¹² (1 + |p|).)
+                found.then(|| 2.0 * (again.p - point.p).abs() + 1e-12 * (1.0 + point.p.abs()))
+            });
         let at = bifurcations.len();
         let before = &a.tangent;
         let stable = |s: &Solution| branch_point(s).stable;
