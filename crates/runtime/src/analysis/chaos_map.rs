@@ -187,24 +187,32 @@ pub fn chaos_map(
     };
     let mut settings = settings.clone();
     settings.check = settings.check.max(256);
-    loop {
-        let mut map = map_once(model, params, &settings, row_done)?;
-        let check = map
-            .class_check
-            .as_ref()
-            .map_or(f64::INFINITY, |c| c.fraction);
-        let tighter = settings.method.tighter();
-        let method = settings.method.describe();
-        if check <= accuracy || !tighter.is_tighter_than(&settings.method) {
-            let reached = match check <= accuracy {
-                true => "reached",
-                false => "NOT reached (the tolerance is at the precision floor)",
-            };
-            map.accuracy = Some(format!("accuracy {accuracy} {reached} with {method}: a share {check} of the checked pixels changes class"));
-            return Ok(map);
-        }
-        settings.method = tighter;
-    }
+    let (mut map, method, check, reached) = super::check::until_accurate(
+        settings.method,
+        accuracy,
+        |method| {
+            map_once(
+                model,
+                params,
+                &ChaosMapSettings {
+                    method,
+                    ..settings.clone()
+                },
+                row_done,
+            )
+        },
+        |map| {
+            map.class_check
+                .as_ref()
+                .map_or(f64::INFINITY, |c| c.fraction)
+        },
+    )?;
+    map.accuracy = Some(format!(
+        "accuracy {accuracy} {} with {}: a share {check} of the checked pixels changes class",
+        super::check::reached_text(reached),
+        method.describe()
+    ));
+    Ok(map)
 }
 
 /// [`chaos_map`] at the settings' method, its class check included.

@@ -120,3 +120,34 @@ pub fn rerun_sample<T: Send, E: Send>(
         runs: format!("{} against {}", method.describe(), tighter.describe()),
     })
 }
+
+/// A result at the first method, from `method` on, each a hundredfold
+/// tighter ([`Method::tighter`]), whose checked error (`error`) is within
+/// `accuracy`, or at the precision floor if none is: the result, the
+/// method that made it, its error, and whether `accuracy` was reached.
+/// How a map asked for an accuracy is run (the chaos map's class check,
+/// the frequency map's tunes).
+pub fn until_accurate<T, E>(
+    mut method: Method,
+    accuracy: f64,
+    mut run: impl FnMut(Method) -> Result<T, E>,
+    error: impl Fn(&T) -> f64,
+) -> Result<(T, Method, f64, bool), E> {
+    loop {
+        let result = run(method)?;
+        let reached = error(&result);
+        let tighter = method.tighter();
+        if reached <= accuracy || !tighter.is_tighter_than(&method) {
+            return Ok((result, method, reached, reached <= accuracy));
+        }
+        method = tighter;
+    }
+}
+
+/// "reached", or why not, for a result of [`until_accurate`].
+pub fn reached_text(reached: bool) -> &'static str {
+    match reached {
+        true => "reached",
+        false => "NOT reached (the tolerance is at the precision floor)",
+    }
+}

@@ -224,23 +224,24 @@ pub fn period_map_frequencies(
     };
     let mut settings = settings.clone();
     settings.check = settings.check.max(256);
-    loop {
-        let mut map = frequencies_once(model, params, &settings, done)?;
-        let largest = map.tune_check.as_ref().map_or(f64::INFINITY, |c| c.largest);
-        let tighter = settings.method.tighter();
-        if largest <= accuracy || !tighter.is_tighter_than(&settings.method) {
-            let reached = match largest <= accuracy {
-                true => "reached",
-                false => "NOT reached (the tolerance is at the precision floor)",
+    let (mut map, method, largest, reached) = super::check::until_accurate(
+        settings.method,
+        accuracy,
+        |method| {
+            let at = super::chaos_map::ChaosMapSettings {
+                method,
+                ..settings.clone()
             };
-            map.accuracy = Some(format!(
-                "accuracy {accuracy:e} {reached} with {}: a regular orbit's tune changes by at most {largest:.1e}",
-                settings.method.describe()
-            ));
-            return Ok(map);
-        }
-        settings.method = tighter;
-    }
+            frequencies_once(model, params, &at, done)
+        },
+        |map| map.tune_check.as_ref().map_or(f64::INFINITY, |c| c.largest),
+    )?;
+    map.accuracy = Some(format!(
+        "accuracy {accuracy:e} {} with {}: a regular orbit's tune changes by at most {largest:.1e}",
+        super::check::reached_text(reached),
+        method.describe()
+    ));
+    Ok(map)
 }
 
 /// [`period_map_frequencies`] at the settings' method, its tune check
