@@ -356,8 +356,11 @@ impl SectionMap {
     /// ⟨Y⟩ from 0 to 8 (Viridis; white where the energy is not
     /// accessible).
     pub fn figure(&self) -> Figure {
+        let checked = self.class_check.as_ref().map_or(String::new(), |c| {
+            format!(" ({} of {} rechecked change)", c.changed, c.sampled)
+        });
         let title = format!(
-            "{}: MEGNO ⟨Y⟩ at {} = {}, t = {}; chaotic (⟨Y⟩ > {CHAOS_THRESHOLD}): {:.1} % of the area",
+            "{}: MEGNO ⟨Y⟩ at {} = {}, t = {}; ⟨Y⟩ > {CHAOS_THRESHOLD} on {:.1} %{checked}",
             self.model,
             self.energy_of,
             self.energy,
