@@ -472,6 +472,19 @@ async fn sections_without_a_fast_phase(client: &Client, folder: &std::path::Path
         .await
         .unwrap();
     wait_for(client, "studio.section && studio.megno !== null", 60).await;
+    // The map's chaotic fraction with its class check beside it.
+    let note = read_when(
+        client,
+        "document.getElementById('megno-note').textContent.includes('%')",
+        "return document.getElementById('megno-note').textContent;",
+        60,
+    )
+    .await;
+    let note = note.as_str().unwrap_or_default();
+    assert!(
+        note.contains("chaotic") && note.contains("reclassified at a hundredth of the tolerance"),
+        "{note}"
+    );
     client
         .execute("studio.sectionSeed(0.1, 0.0); return true;", vec![])
         .await
