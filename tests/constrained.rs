@@ -906,6 +906,7 @@ fn the_attractor_on_the_constraints_has_the_angle_models_exponents() {
         transient: 100,
         points: 200,
         lyapunov_periods: 2000,
+        accuracy: None,
         pixels: 20,
     };
     let model = &cartesian_kapitza::MODEL;
@@ -952,6 +953,7 @@ fn a_chaotic_attractor_on_the_constraints_has_the_angle_models_spectrum() {
         transient: 200,
         points: 400,
         lyapunov_periods: 2000,
+        accuracy: None,
         pixels: 20,
     };
     let angle = attractor(&kapitza::MODEL, &[a, eps, mu], &settings([2.0, 0.0])).unwrap();

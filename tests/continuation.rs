@@ -582,3 +582,42 @@ fn a_period_doublings_stated_error_bounds_its_error() {
         );
     }
 }
+
+/// Asked for an accuracy, a continuation is run again a hundredfold tighter
+/// until every bifurcation's stated error is within it: from DOP853 at
+/// 1e-6, `accuracy` 1e-9 is reached at 1e-8, and the period doubling is
+/// then within 1e-9 of the hand-written reference.
+#[test]
+fn a_continuation_asked_for_an_accuracy_tightens_until_its_bifurcations_errors_are_within_it() {
+    use mechlab::analysis::continuation::{continuation, BifurcationKind, ContinuationSettings};
+    let model = crate::common::model_of("duffing");
+    let mut params = model.dynamic.defaults();
+    let names = model.info.parameter_names;
+    params[names.iter().position(|n| *n == "gamma").unwrap()] = 0.2;
+    let method = Method::Dop853 {
+        rtol: 1e-6,
+        atol: 1e-6,
+    };
+    let settings = ContinuationSettings {
+        accuracy: Some(1e-9),
+        ..crate::common::continuation_settings("gamma", 0.28, &[1.0, 0.0], method)
+    };
+    let result = continuation(model, &params, &settings).unwrap();
+    let said = result.accuracy.clone().unwrap();
+    assert!(
+        said.contains("1e-9 reached") && said.contains("1e-8"),
+        "{said}"
+    );
+    let doubling = result
+        .bifurcations
+        .iter()
+        .find(|b| b.kind == BifurcationKind::PeriodDoubling)
+        .expect("a period doubling");
+    assert!(doubling.parameter_error.unwrap() <= 1e-9);
+    let reference = crate::common::duffing_period_doubling(0.3, 1.2, (0.2, 0.28), 4000);
+    assert!(
+        (doubling.parameter - reference).abs() <= 1e-9,
+        "{} against {reference}",
+        doubling.parameter
+    );
+}

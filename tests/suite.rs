@@ -37,4 +37,5 @@ mod study2;
 mod study3;
 mod taylor;
 mod taylor_lanes;
+mod trade;
 mod verify_derivations;

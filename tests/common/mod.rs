@@ -218,6 +218,7 @@ pub fn continuation_settings(
         min_step: 1e-8,
         max_step: 0.02,
         method,
+        accuracy: None,
         diagram: None,
         chart: None,
     }

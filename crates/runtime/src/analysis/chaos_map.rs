@@ -186,7 +186,12 @@ pub fn chaos_map(
         return map_once(model, params, settings, row_done);
     };
     let mut settings = settings.clone();
-    settings.check = settings.check.max(256);
+    // With none of n pixels changing class, the stated share is the rule of
+    // three's 3/n: the sample must be large enough to state the accuracy.
+    settings.check = settings
+        .check
+        .max(256)
+        .max((3.0 / accuracy).ceil() as usize);
     let (mut map, method, check, reached) = super::check::until_accurate(
         settings.method,
         accuracy,
@@ -204,7 +209,7 @@ pub fn chaos_map(
         |map| {
             map.class_check
                 .as_ref()
-                .map_or(f64::INFINITY, |c| c.fraction)
+                .map_or(f64::INFINITY, |c| c.fraction.max(c.error))
         },
     )?;
     map.accuracy = Some(format!(

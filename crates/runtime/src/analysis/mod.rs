@@ -28,6 +28,7 @@ pub mod stability;
 pub mod standard_map;
 pub mod states;
 pub mod tiles;
+pub mod trade;
 pub mod vibrational_stability;
 
 /// The tangent kernels, where the analyses have always found them.

@@ -15,6 +15,7 @@ mod orbits;
 mod section;
 mod separatrix;
 mod stability;
+mod trade;
 
 pub use crate::study::{study_scene, write_outputs, Outputs, Study, Table};
 pub use averaging::averaging_scene;
@@ -24,6 +25,7 @@ pub use orbits::{attractor_scene, explore_scene, period_map_scene};
 pub use section::section_scene;
 pub use separatrix::separatrix_scene;
 pub use stability::{linkage_scene, stability_scene};
+pub use trade::trade_scene;
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a
 /// clear error listing the known ones.

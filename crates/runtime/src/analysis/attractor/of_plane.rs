@@ -1,7 +1,7 @@
 //! The attractor of the period map of a model of one degree of freedom in
 //! its plane (q, p).
 
-use super::types::check_settings;
+use super::types::{check_settings, spectra_to_accuracy, Spectra};
 use super::{Attractor, AttractorError, AttractorSettings};
 use crate::analysis::dimension::{box_counting, kaplan_yorke_dimension};
 use crate::analysis::lyapunov::lyapunov_history;
@@ -53,7 +53,7 @@ pub(super) fn attractor(
     .last()
     .expect("the start at least");
     let second = [settled[0] + 1e-3, settled[1]];
-    let spectrum = |from: [f64; 2], every: usize| {
+    let spectrum = |from: [f64; 2], periods: usize, every: usize| {
         let mut integrator = Integrator::new(settings.method)?;
         lyapunov_history::<_, 2, 6>(
             &mut integrator,
@@ -61,14 +61,27 @@ pub(super) fn attractor(
             period,
             &from,
             0,
-            settings.lyapunov_periods,
+            periods,
             &wrap,
             every,
         )
     };
-    let every = (settings.lyapunov_periods / 200).max(1);
-    let ((first, other), points) = rayon::join(
-        || rayon::join(|| spectrum(settled, every), || spectrum(second, 0)),
+    let (spectra, points) = rayon::join(
+        || {
+            spectra_to_accuracy(settings, |periods| {
+                let every = (periods / 200).max(1);
+                let (first, other) = rayon::join(
+                    || spectrum(settled, periods, every),
+                    || spectrum(second, periods, 0),
+                );
+                let first = first?;
+                Ok::<_, OdeError>(Spectra {
+                    first: first.exponents,
+                    history: first.history,
+                    second: other?.exponents,
+                })
+            })
+        },
         || {
             orbit(
                 &mut integrator,
@@ -80,34 +93,31 @@ pub(super) fn attractor(
             )
         },
     );
-    let (first, other) = (first?, other?);
+    let (spectra, error, lyapunov_periods, accuracy) = spectra?;
     let points = points?;
     let divergence = mean_divergence(&system, period, &points[..points.len().min(200)])?;
     let sides: Vec<f64> = (2..=9).map(|k| 0.5f64.powi(k)).collect();
     let counted = box_counting(&points, &sides, 2..sides.len() - 1);
-    let error = first
-        .exponents
-        .iter()
-        .zip(&other.exponents)
-        .map(|(a, b)| (a - b).abs())
-        .collect();
+    let first = spectra.first;
     Ok(Attractor {
         model: name,
         params: named,
         period,
         points: points.len(),
-        lyapunov_per_time: first.exponents.iter().map(|l| l / period).collect(),
-        lyapunov_sum: first.exponents.iter().sum(),
-        kaplan_yorke_dimension: kaplan_yorke_dimension(&first.exponents),
-        lyapunov_second_start: other.exponents,
+        lyapunov_per_time: first.iter().map(|l| l / period).collect(),
+        lyapunov_sum: first.iter().sum(),
+        kaplan_yorke_dimension: kaplan_yorke_dimension(&first),
+        lyapunov_second_start: spectra.second,
         lyapunov_error: error,
-        lyapunov: first.exponents,
+        lyapunov_periods,
+        accuracy,
+        lyapunov: first,
         divergence_per_period: divergence,
         box_dimension: counted.dimension,
         box_sides: counted.sides,
         boxes: counted.boxes,
         seconds: start.elapsed().as_secs_f64(),
-        convergence: first.history,
+        convergence: spectra.history,
         orbit: points,
         periodic,
         pixels: settings.pixels,

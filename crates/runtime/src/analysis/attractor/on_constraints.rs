@@ -14,7 +14,7 @@
 
 use nalgebra::DMatrix;
 
-use super::types::check_settings;
+use super::types::{check_settings, spectra_to_accuracy, Spectra};
 use super::{Attractor, AttractorError, AttractorSettings};
 use crate::analysis::dimension::{box_counting, kaplan_yorke_dimension};
 use crate::analysis::on_constraints::ConstrainedError;
@@ -72,23 +72,37 @@ pub(super) fn attractor(
     };
     let settled = iterates(&y0, settings.transient)?.pop().unwrap_or(y0);
     let second = on_constraints([settled[0] + 1e-3, settled[n]])?;
-    let spectrum = |from: &[f64], every: usize| {
+    let spectrum = |from: &[f64], periods: usize, every: usize| {
         restricted_spectrum(
             constrained,
             params,
             settings.method,
             period,
             from,
-            settings.lyapunov_periods,
+            periods,
             every,
         )
     };
-    let every = (settings.lyapunov_periods / 200).max(1);
-    let ((first, other), orbit) = rayon::join(
-        || rayon::join(|| spectrum(&settled, every), || spectrum(&second, 0)),
+    let (spectra, orbit) = rayon::join(
+        || {
+            spectra_to_accuracy(settings, |periods| {
+                let every = (periods / 200).max(1);
+                let (first, other) = rayon::join(
+                    || spectrum(&settled, periods, every),
+                    || spectrum(&second, periods, 0),
+                );
+                let ((first, history), (second, _)) = (first?, other?);
+                Ok::<_, AttractorError>(Spectra {
+                    first,
+                    history,
+                    second,
+                })
+            })
+        },
         || iterates(&settled, settings.points),
     );
-    let ((first, history), (other, _)) = (first?, other?);
+    let (spectra, lyapunov_error, lyapunov_periods, accuracy) = spectra?;
+    let first = spectra.first;
     let orbit = orbit?;
     let periodic = model.dynamic.periodic()[0];
     let points: Vec<[f64; 2]> = orbit
@@ -111,19 +125,17 @@ pub(super) fn attractor(
         lyapunov_per_time: first.iter().map(|l| l / period).collect(),
         lyapunov_sum: first.iter().sum(),
         kaplan_yorke_dimension: kaplan_yorke_dimension(&first),
-        lyapunov_error: first
-            .iter()
-            .zip(&other)
-            .map(|(a, b)| (a - b).abs())
-            .collect(),
-        lyapunov_second_start: other,
+        lyapunov_error,
+        lyapunov_periods,
+        accuracy,
+        lyapunov_second_start: spectra.second,
         lyapunov: first,
         divergence_per_period: divergence,
         box_dimension: counted.dimension,
         box_sides: counted.sides,
         boxes: counted.boxes,
         seconds: clock.elapsed().as_secs_f64(),
-        convergence: history,
+        convergence: spectra.history,
         orbit: points,
         periodic,
         pixels: settings.pixels,

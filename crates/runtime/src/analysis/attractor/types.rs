@@ -23,6 +23,12 @@ crate::declare_settings! {
         lyapunov_periods: usize = 16_000, Range::Count { min: 2, max: 100_000_000 };
         /// Pixels per side of the density image.
         pixels: usize = 500, Range::Count { min: 2, max: 4000 };
+        /// The error wanted on the Lyapunov exponents (auto: none asked,
+        /// each comes with its error). Given, both runs are lengthened until
+        /// the error is within it (up to 10⁸ periods), or the result says
+        /// why not. The error is statistical: a tighter tolerance does not
+        /// lower it.
+        accuracy: Option<f64> = None, Range::Positive;
         /// The integration method.
         method: String = "taylor".into(), Range::OneOf(METHODS);
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
@@ -40,6 +46,7 @@ impl AttractorOptions {
             transient: self.transient,
             points: self.points,
             lyapunov_periods: self.lyapunov_periods,
+            accuracy: self.accuracy,
             pixels: self.pixels,
         })
     }
@@ -58,6 +65,8 @@ pub struct AttractorSettings {
     pub points: usize,
     /// Periods of each Lyapunov run.
     pub lyapunov_periods: usize,
+    /// The error wanted on the exponents (None: reported, not chosen).
+    pub accuracy: Option<f64>,
     /// Pixels per side of the density image.
     pub pixels: usize,
 }
@@ -90,9 +99,19 @@ pub struct Attractor {
     pub lyapunov: Vec<f64>,
     /// The same per unit time.
     pub lyapunov_per_time: Vec<f64>,
-    /// From the second start: |difference| is the error estimate.
+    /// From the second start, a check of the first.
     pub lyapunov_second_start: Vec<f64>,
+    /// Each exponent's error: three standard errors of the first run's
+    /// mean from the means of its blocks ([`BLOCKS`] of equal length), or
+    /// the two starts' difference where that is larger.
     pub lyapunov_error: Vec<f64>,
+    /// Periods of each of the two runs (more than `lyapunov_periods` where
+    /// an accuracy asked for more).
+    pub lyapunov_periods: usize,
+    /// Whether the `accuracy` asked for was reached, and with how long
+    /// runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     /// Σλ per period, and ∫₀ᵀ div f dt averaged along the orbit (measured
     /// from the Jacobian's trace, not from the tangent flow): equal for a
     /// correct spectrum (−k T for a damping k).
@@ -117,6 +136,82 @@ pub struct Attractor {
     /// The coordinate's and momentum's names, for the axes.
     #[serde(skip)]
     pub axes: [&'static str; 2],
+}
+
+/// The blocks a Lyapunov run is cut into for its statistical error.
+pub const BLOCKS: usize = 20;
+
+/// The two starts' Lyapunov runs: the first's exponents and running
+/// estimates, the second's exponents.
+pub(crate) struct Spectra {
+    pub first: Vec<f64>,
+    pub history: Vec<(usize, Vec<f64>)>,
+    pub second: Vec<f64>,
+}
+
+/// Each exponent's error (see [`Attractor::lyapunov_error`]): from the
+/// running estimates A(t) of the first run at `history`'s times, the
+/// blocks' means (t_j A_j − t_{j−1} A_{j−1}) / (t_j − t_{j−1}).
+pub(crate) fn lyapunov_errors(spectra: &Spectra) -> Vec<f64> {
+    let history = &spectra.history;
+    let blocks = BLOCKS.min(history.len());
+    let ends: Vec<&(usize, Vec<f64>)> = (1..=blocks)
+        .map(|j| &history[j * history.len() / blocks - 1])
+        .collect();
+    (0..spectra.first.len())
+        .map(|k| {
+            let difference = (spectra.first[k] - spectra.second[k]).abs();
+            if blocks < 4 {
+                return difference;
+            }
+            let (mut before, mut means) = ((0.0, 0.0), Vec::with_capacity(blocks));
+            for (t, a) in &ends {
+                let (t, sum) = (*t as f64, *t as f64 * a[k]);
+                means.push((sum - before.1) / (t - before.0));
+                before = (t, sum);
+            }
+            let mean = means.iter().sum::<f64>() / blocks as f64;
+            let variance =
+                means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (blocks - 1) as f64;
+            (3.0 * (variance / blocks as f64).sqrt()).max(difference)
+        })
+        .collect()
+}
+
+/// The longest runs an accuracy may ask for.
+const MOST_PERIODS: usize = 100_000_000;
+
+/// The two runs `run(periods)` at `settings.lyapunov_periods`, and where an
+/// accuracy is asked, again longer while the error is larger (a
+/// statistical error falls as 1/√periods: each rerun is as long as that
+/// predicts with a fifth more, and at least twice as long; none where it
+/// predicts more than [`MOST_PERIODS`]), with the periods run and what was
+/// reached.
+pub(crate) fn spectra_to_accuracy<E>(
+    settings: &AttractorSettings,
+    mut run: impl FnMut(usize) -> Result<Spectra, E>,
+) -> Result<(Spectra, Vec<f64>, usize, Option<String>), E> {
+    let mut periods = settings.lyapunov_periods;
+    loop {
+        let spectra = run(periods)?;
+        let errors = lyapunov_errors(&spectra);
+        let Some(accuracy) = settings.accuracy else {
+            return Ok((spectra, errors, periods, None));
+        };
+        let largest = errors.iter().copied().fold(0.0, f64::max);
+        if largest <= accuracy {
+            let said = format!("accuracy {accuracy:e} reached with runs of {periods} periods");
+            return Ok((spectra, errors, periods, Some(said)));
+        }
+        let wanted = periods as f64 * 1.2 * (largest / accuracy).powi(2);
+        if wanted > MOST_PERIODS as f64 {
+            let said = format!(
+                "accuracy {accuracy:e} NOT reached: error {largest:.1e} with runs of {periods} periods; the error is statistical, and {accuracy:e} would take about {wanted:.0e} periods, more than the {MOST_PERIODS:e} it runs"
+            );
+            return Ok((spectra, errors, periods, Some(said)));
+        }
+        periods = (wanted as usize).max(2 * periods).min(MOST_PERIODS);
+    }
 }
 
 /// The settings' sanity and the memory they ask for, as named errors.

@@ -72,6 +72,11 @@ crate::declare_settings! {
         /// the branches' coordinates (auto: those that parametrise its
         /// constraints best at the start).
         chart: Option<Vec<usize>> = None, Range::Any;
+        /// The error wanted on the bifurcations' parameters (auto: none
+        /// asked, each comes with its error). Given, the continuation is
+        /// run again a hundredfold tighter until every error is within it,
+        /// or the result says why not.
+        accuracy: Option<f64> = None, Range::Positive;
         /// The integration method.
         method: String = "taylor".into(), Range::OneOf(METHODS);
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
@@ -131,6 +136,7 @@ impl ContinuationOptions {
             min_step: self.min_step,
             max_step: self.max_step,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            accuracy: self.accuracy,
             diagram: (self.diagram > 0).then_some(DiagramSettings {
                 values: self.diagram,
                 transient: self.transient,
@@ -167,6 +173,9 @@ pub struct ContinuationSettings {
     pub min_step: f64,
     pub max_step: f64,
     pub method: Method,
+    /// The error wanted on the bifurcations' parameters (None: reported,
+    /// not chosen).
+    pub accuracy: Option<f64>,
     /// The orbit diagram beside the branches, if any.
     pub diagram: Option<DiagramSettings>,
     /// A constrained model's chart: the components of [q; q'] that are
@@ -367,6 +376,9 @@ pub struct Continuation {
     /// A constrained model's chart: the components of [q; q'] that the
     /// branches' states are (None: the full state).
     pub chart: Option<Vec<usize>>,
+    /// Whether the `accuracy` asked for was reached, and by which run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     /// The state's names, for the figure.
     #[serde(skip)]
     pub state_names: Vec<&'static str>,
@@ -416,6 +428,46 @@ trait FamilyMap: Sync {
 /// Continues the periodic orbits of `model` at `params` (declaration
 /// order) in the parameter `settings.parameter`.
 pub fn continuation(
+    model: &Model,
+    params: &[f64],
+    settings: &ContinuationSettings,
+) -> Result<Continuation, ContinuationError> {
+    let Some(accuracy) = settings.accuracy else {
+        return continuation_once(model, params, settings);
+    };
+    let (mut result, method, error, reached) = crate::analysis::check::until_accurate(
+        settings.method,
+        accuracy,
+        |method| {
+            continuation_once(
+                model,
+                params,
+                &ContinuationSettings {
+                    method,
+                    ..settings.clone()
+                },
+            )
+        },
+        |result| {
+            // A bifurcation without an error (not located again) leaves the
+            // accuracy unknown.
+            result
+                .bifurcations
+                .iter()
+                .map(|b| b.parameter_error.unwrap_or(f64::INFINITY))
+                .fold(0.0, f64::max)
+        },
+    )?;
+    result.accuracy = Some(format!(
+        "accuracy {accuracy:e} {} with {}: the largest error of a bifurcation's parameter is {error:.1e}",
+        crate::analysis::check::reached_text(reached),
+        method.describe()
+    ));
+    Ok(result)
+}
+
+/// [`continuation`] at `settings.method`, without an accuracy asked.
+fn continuation_once(
     model: &Model,
     params: &[f64],
     settings: &ContinuationSettings,
@@ -540,6 +592,7 @@ pub(crate) fn orbit_branch(
             min_step: 1e-9,
             max_step: 0.05 * (bounds.1 - bounds.0).max(1e-3),
             method,
+            accuracy: None,
             diagram: None,
             chart: None,
         };
@@ -865,6 +918,7 @@ fn run(
         seconds: clock.elapsed().as_secs_f64(),
         diagram,
         chart: None,
+        accuracy: None,
         state_names: Vec::new(),
     })
 }
