@@ -53,6 +53,11 @@ fn each_runs_stated_error_bounds_its_distance_to_the_most_accurate_run() {
         requested.largest_error
     );
     assert!(result.cost_ratio.is_some());
+    // Every stated number is a row of the table beside the figure.
+    let table = &mechlab::outputs::Outputs::tables(&result)[0];
+    let rows: usize = result.runs.iter().map(|r| r.stated.len()).sum();
+    let text = String::from_utf8(table.csv.clone()).unwrap();
+    assert_eq!(text.lines().count(), 1 + rows, "{text}");
 }
 
 /// The cheapest run within an error is the one of least time among those
@@ -65,6 +70,7 @@ fn the_cheapest_run_within_an_error_is_found() {
         seconds,
         stated: vec![Stated {
             what: "x".into(),
+            kind: "x",
             value: 1.0,
             error,
         }],

@@ -16,6 +16,9 @@ use std::time::Instant;
 pub struct Stated {
     /// What the number is ("λ₁", "q = [3.1416]: lower edge").
     pub what: String,
+    /// The kind of number, errors of one kind comparable ("edge", "share
+    /// of pixels", "tune"): a run's largest error is of its first kind.
+    pub kind: &'static str,
     /// Its value (NaN where the error qualifies many numbers, as a map's
     /// tunes).
     pub value: f64,
@@ -37,7 +40,8 @@ pub struct TradeRun {
     /// Wall-clock seconds of the run, its checks included.
     pub seconds: f64,
     pub stated: Vec<Stated>,
-    /// The largest stated error (NaN where none is stated).
+    /// The largest stated error of the first kind of number stated (the
+    /// headline's; NaN where none is stated).
     pub largest_error: f64,
     /// The largest distance of a headline number to the reference run's
     /// (None for the reference, or where none can be compared).
@@ -78,7 +82,8 @@ pub struct Trade {
 }
 
 /// The analysis `base` on `model` at `values` over `ladder` (method name and
-/// tolerance) and, where given, `request` (the same settings with an
+/// tolerance; the name only labels the runs of an analysis without a
+/// `method` setting) and, where given, `request` (the same settings with an
 /// `accuracy`); `progress` hears of each run done.
 pub fn trade<T: Analysis>(
     model: &'static Model,
@@ -112,9 +117,13 @@ where
     };
     let (mut runs, mut failed) = (Vec::new(), Vec::new());
     for (method, tol) in ladder {
-        let options = base
-            .clone()
-            .with_texts([("method", method.as_str()), ("tol", &tol.to_string())])?;
+        // An analysis of one method (the section's) takes the tolerance only.
+        let tol_text = tol.to_string();
+        let mut texts = vec![("tol", tol_text.as_str())];
+        if T::names().contains(&"method") {
+            texts.push(("method", method.as_str()));
+        }
+        let options = base.clone().with_texts(texts)?;
         match timed(&options, method, *tol) {
             Ok(run) => runs.push(run),
             Err(error) => failed.push(FailedRun {
@@ -187,11 +196,13 @@ impl TradeRun {
     }
 }
 
-/// The largest |value − reference's value| over the numbers both state
-/// (None where none is comparable).
+/// The largest |value − reference's value| over the numbers of the first
+/// kind both state (None where none is comparable).
 fn largest_distance(stated: &[Stated], reference: &[Stated]) -> Option<f64> {
+    let headline = stated.first().map(|s| s.kind);
     stated
         .iter()
+        .filter(|s| Some(s.kind) == headline)
         .filter_map(|s| {
             let r = reference.iter().find(|r| r.what == s.what)?;
             let d = (s.value - r.value).abs();
@@ -234,8 +245,13 @@ impl Trade {
                 (1e-3, 1.0)
             }
         };
+        let headline = self
+            .runs
+            .iter()
+            .find_map(|r| r.stated.first())
+            .map_or("headline number", |s| s.kind);
         let title = format!(
-            "{} on {}: stated error (lines), distance to the most accurate run (dots)",
+            "{} on {}, {headline}: stated error (lines), distance to the most accurate run (dots)",
             self.analysis, self.model,
         );
         let spec =
@@ -300,7 +316,8 @@ impl crate::outputs::Outputs for Trade {
                     let distance = reference
                         .and_then(|stated| largest_distance(std::slice::from_ref(s), stated));
                     (
-                        asked, &r.method, r.tol, r.seconds, &s.what, s.value, s.error, distance,
+                        asked, &r.method, r.tol, r.seconds, s.kind, &s.what, s.value, s.error,
+                        distance,
                     )
                 })
             });
@@ -311,6 +328,7 @@ impl crate::outputs::Outputs for Trade {
                 "method",
                 "tol",
                 "seconds",
+                "kind",
                 "what",
                 "value",
                 "stated_error",
@@ -333,6 +351,7 @@ impl StatedErrors for crate::analysis::stability::Stability {
                 if let (Some(value), Some(error)) = (edge, error) {
                     stated.push(Stated {
                         what: format!("q = {:.6?}: {side} edge", e.q),
+                        kind: "edge of an exact window",
                         value: *value,
                         error,
                     });
@@ -359,6 +378,7 @@ fn class_checked(
         .iter()
         .map(|c| Stated {
             what: what.into(),
+            kind: "share of pixels",
             value,
             error: c.fraction.max(c.error),
         })
@@ -374,6 +394,7 @@ impl StatedErrors for crate::analysis::attractor::Attractor {
             .enumerate()
             .map(|(k, (value, error))| Stated {
                 what: format!("lambda_{} per period", k + 1),
+                kind: "Lyapunov exponent",
                 value: *value,
                 error: *error,
             })
@@ -390,25 +411,12 @@ impl StatedErrors for crate::analysis::continuation::Continuation {
             .filter_map(|(k, b)| {
                 Some(Stated {
                     what: format!("bifurcation {k} ({:?}, period {})", b.kind, b.period),
+                    kind: "bifurcation's parameter",
                     value: b.parameter,
                     error: b.parameter_error?,
                 })
             })
             .collect()
-    }
-}
-
-/// The lobe area by the action route.
-impl StatedErrors for crate::analysis::separatrix::Splitting {
-    fn stated(&self) -> Vec<Stated> {
-        match (self.lobe_area_action, self.lobe_area_error) {
-            (Some(value), Some(error)) => vec![Stated {
-                what: "lobe area".into(),
-                value,
-                error,
-            }],
-            _ => Vec::new(),
-        }
     }
 }
 
@@ -430,6 +438,7 @@ impl StatedErrors for crate::analysis::section::SectionStudy {
         {
             stated.push(Stated {
                 what: "tunes (largest change)".into(),
+                kind: "tune",
                 value: f64::NAN,
                 error: check.largest,
             });
