@@ -140,3 +140,30 @@ fn bad_parameters_are_typed_errors() {
         "{error}"
     );
 }
+
+/// The upper position's verdict at a fast vibration (ε = 10⁻⁴) is right on
+/// either side of the exact edge (1.4142135686, the Mathieu series), 5·10⁻⁹
+/// below it unstable and above it stable. A verdict on the multipliers'
+/// distance from the unit circle (1e-7) called both stable: below the edge
+/// the multiplier is 1 + 5·10⁻⁸.
+#[test]
+fn the_upper_positions_verdict_is_right_on_both_sides_of_a_fast_vibrations_edge() {
+    let verdict = |a: f64| {
+        upper_position(&UpperPositionSettings {
+            params: Params {
+                A: a,
+                eps: 1e-4,
+                mu: 0.0,
+            },
+            periods: 2,
+            chart_eps: 2,
+            chart_a: 2,
+            chart_a_max: 2.0,
+            method: dop853(1e-12),
+        })
+        .unwrap()
+        .verdict
+    };
+    assert_eq!(verdict(1.4142135636), "unstable");
+    assert_eq!(verdict(1.4142135736), "stable");
+}

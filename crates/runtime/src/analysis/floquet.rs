@@ -81,16 +81,9 @@ pub enum Verdict {
 }
 
 impl Verdict {
-    /// `tolerance` absorbs the integration error on |λ| = 1.
-    pub fn from_multipliers(multipliers: &[(f64, f64)], tolerance: f64) -> Verdict {
-        let radius = spectral_radius(multipliers);
-        if radius > 1.0 + tolerance {
-            Verdict::Unstable
-        } else if radius < 1.0 - tolerance {
-            Verdict::AsymptoticallyStable
-        } else {
-            Verdict::Stable
-        }
+    /// [`Verdict::of_monodromy`] of a monodromy matrix as rows.
+    pub fn of_rows<const N: usize>(m: &[[f64; N]; N], period: f64) -> Verdict {
+        Verdict::of_monodromy(&DMatrix::from_fn(N, N, |i, j| m[i][j]), period)
     }
 
     /// The verdict of a monodromy matrix `m` over one `period`, on
