@@ -599,3 +599,125 @@ fn stated_edge_errors_bound_the_true_errors() {
         "the stated error is within 100 times the true one in {sharp} of {cases}"
     );
 }
+
+/// Whether the upright N-link chain is unstable at amplitude `a`, written
+/// out without mechlab: unit masses and lengths on a base shaken as
+/// w = (a/ν) cos νt, linearised about the upright chain,
+/// M φ'' = (g + w'') K φ with M_jk = Σ_{i ≥ max(j,k)} 1 and K_kk = Σ_{i ≥ k} 1;
+/// the monodromy matrix of that linear system by classical RK4 at n and 2n
+/// steps a period, Richardson-extrapolated (16 M_2n − M_n)/15; unstable
+/// where its largest multiplier's modulus exceeds 1 by 10⁻¹⁰.
+fn chain_unstable_by_hand(links: usize, g: f64, nu: f64, a: f64) -> bool {
+    use nalgebra::DMatrix;
+    let n = links;
+    let mass = DMatrix::from_fn(n, n, |j, k| (n - j.max(k)) as f64);
+    let stiffness = DMatrix::from_fn(n, n, |j, k| if j == k { (n - k) as f64 } else { 0.0 });
+    let a_k = mass.try_inverse().unwrap() * stiffness; // φ'' = (g + w'') A_K φ
+    let period = std::f64::consts::TAU / nu;
+    let monodromy = |steps: usize| {
+        let h = period / steps as f64;
+        let rate = |t: f64, z: &DMatrix<f64>| {
+            let (phi, phid) = (z.rows(0, n), z.rows(n, n));
+            let mut dz = DMatrix::zeros(2 * n, 2 * n);
+            dz.rows_mut(0, n).copy_from(&phid);
+            let gravity = g - a * nu * (nu * t).cos();
+            dz.rows_mut(n, n).copy_from(&(&a_k * phi * gravity));
+            dz
+        };
+        let mut z = DMatrix::<f64>::identity(2 * n, 2 * n);
+        for s in 0..steps {
+            let t = s as f64 * h;
+            let k1 = rate(t, &z);
+            let k2 = rate(t + h / 2.0, &(&z + &k1 * (h / 2.0)));
+            let k3 = rate(t + h / 2.0, &(&z + &k2 * (h / 2.0)));
+            let k4 = rate(t + h, &(&z + &k3 * h));
+            z += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+        }
+        z
+    };
+    let m = (monodromy(4000) * 16.0 - monodromy(2000)) / 15.0;
+    let radius = m
+        .complex_eigenvalues()
+        .iter()
+        .map(|l| l.norm())
+        .fold(0.0, f64::max);
+    radius > 1.0 + 1e-10
+}
+
+/// The lower edge of the upright chain's window by hand
+/// ([`chain_unstable_by_hand`]), bisected in `bracket` (unstable at its
+/// low end, stable at its high end) to 10⁻¹³ relative.
+fn chain_edge_by_hand(links: usize, g: f64, nu: f64, bracket: (f64, f64)) -> f64 {
+    let unstable = |a: f64| chain_unstable_by_hand(links, g, nu, a);
+    let (mut lo, mut hi) = bracket;
+    assert!(
+        unstable(lo) && !unstable(hi),
+        "{bracket:?} does not bracket the edge"
+    );
+    while hi - lo > 1e-13 * hi {
+        let mid = 0.5 * (lo + hi);
+        if unstable(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The 4-link chain's exact lower edge, asked of `stability` to 10⁻¹⁰,
+/// against the hand-written Floquet computation at ν = 10², 10³ and 10⁴
+/// (1/ν from 10⁻² to 10⁻⁴ of the chain's time; at 10⁻¹ it has no window,
+/// tested below): within 10⁻⁹ relative, and within the stated error.
+#[test]
+fn the_four_link_chains_exact_edge_meets_a_hand_written_floquet_computation() {
+    use mechlab_test_models::quadruple_pendulum as quadruple;
+    for nu in [100.0, 1000.0, 10_000.0] {
+        let params = quadruple::Params {
+            nu,
+            ..Default::default()
+        };
+        let [edge, error, _, _] =
+            edge_to_accuracy("quadruple_pendulum", &params.values(), 8.0, 1e-10);
+        let hand = chain_edge_by_hand(4, 1.0, nu, (edge * (1.0 - 1e-6), edge * (1.0 + 1e-6)));
+        eprintln!("ν = {nu}: edge {edge:.13} ± {error:.1e}, by hand {hand:.13}");
+        assert!(
+            (edge - hand).abs() <= 1e-9 * hand,
+            "ν = {nu}: {edge} against {hand}"
+        );
+        assert!(
+            (edge - hand).abs() <= error + 1e-12 * hand,
+            "ν = {nu}: {edge} ± {error:e} against {hand}"
+        );
+    }
+}
+
+/// At ν = 10 (1/ν = 10⁻¹ of the chain's time) the 4-link chain has no
+/// window up to a = 8, as `stability` says: the hand-written Floquet
+/// computation finds the upright unstable at every amplitude of a grid of
+/// 400 on (0, 8].
+#[test]
+fn the_four_link_chain_has_no_window_at_a_slow_vibration_by_hand_too() {
+    use mechlab_test_models::quadruple_pendulum as quadruple;
+    let params = quadruple::Params {
+        nu: 10.0,
+        ..Default::default()
+    };
+    let settings = Settings {
+        amplitude: "a".into(),
+        a_max: Some(8.0),
+        samples: 20,
+        edge_tolerance: 1e-9,
+        method: Method::parse("dop853", 1e-10).unwrap(),
+        max_windows: 1,
+        accuracy: None,
+        first: mechlab::analysis::stability::FirstWindows::Highest,
+    };
+    let upright = upright("quadruple_pendulum", &params.values(), &settings);
+    assert!(upright.exact_window.is_none(), "{upright:?}");
+    let stable: Vec<f64> = (1..=400)
+        .map(|k| 8.0 * k as f64 / 400.0)
+        .filter(|&a| !chain_unstable_by_hand(4, 1.0, 10.0, a))
+        .collect();
+    assert!(stable.is_empty(), "stable by hand at {stable:?}");
+}

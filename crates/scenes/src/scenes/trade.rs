@@ -11,8 +11,8 @@ use mechlab_runtime::settings::Range;
 
 /// The analyses whose stated errors are integration errors (or, for the
 /// attractor, statistical ones), each with the model the scene defaults
-/// to. The separatrix splitting's lobe area is not among them: its stated
-/// error is the rounding of its double-double sums alone.
+/// to. The separatrix splitting's lobe area is not among them: it is
+/// integrated in double-double at 10⁻³² whatever `tol`.
 const ANALYSES: &[(&str, &str)] = &[
     ("stability", "triple_pendulum"),
     ("chaos_map", "kapitza"),
