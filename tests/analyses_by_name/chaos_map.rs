@@ -344,7 +344,8 @@ fn a_map_nobody_waits_for_stops() {
 /// class changes between the map and the same map at a hundredth of the
 /// tolerance (each pixel's orbit the same run bit for bit), and its
 /// estimate covers the share that changes over the whole map; at a tight
-/// tolerance none change and the error is the rule of three's bound.
+/// tolerance none change and the error is the rule of three's bound; with
+/// every pixel checked, the share is the whole map's and has no error.
 #[test]
 fn the_class_check_counts_the_pixels_a_tighter_run_reclassifies() {
     use mechlab::analysis::check::sample_pixels;
@@ -389,6 +390,11 @@ fn the_class_check_counts_the_pixels_a_tighter_run_reclassifies() {
     let tight = map(1e-10, 400).class_check.unwrap();
     assert_eq!(tight.changed, 0, "{tight:?}");
     assert!((tight.error - 3.0 / 400.0).abs() < 1e-15);
+    // Every pixel checked: the share is counted, not estimated.
+    let census = map(1e-3, 1600).class_check.unwrap();
+    assert_eq!(census.sampled, 1600);
+    assert_eq!(census.fraction, whole);
+    assert_eq!(census.error, 0.0);
 }
 
 /// Asked for at most 0.2 % of pixels changing class, a map at 1e-3 (where

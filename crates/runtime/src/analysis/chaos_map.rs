@@ -392,10 +392,11 @@ fn class_check(fli: &[f64], count: usize, plane: &Plane) -> Result<ClassCheck, O
             .map(|(values, _)| values)
     })?;
     let class = |f: f64| (!f.is_nan()).then(|| fli_is_chaotic(f, periods));
+    let census = rerun.census;
     let pairs = (rerun.pixels.iter())
         .zip(rerun.values)
         .map(|(&k, f)| (class(fli[k]), class(f)));
-    Ok(ClassCheck::new(pairs, rerun.runs))
+    Ok(ClassCheck::new(pairs, rerun.runs, census))
 }
 
 /// The request read against the model: its parameters by name, the

@@ -19,7 +19,8 @@ pub struct ClassCheck {
     /// change class.
     pub fraction: f64,
     /// The estimate's binomial standard error; where none changed, the 95 %
-    /// upper bound 3 / sampled (the rule of three) instead.
+    /// upper bound 3 / sampled (the rule of three) instead; 0 where every
+    /// pixel was rerun (the share is then counted, not estimated).
     pub error: f64,
     /// The two runs ("taylor, tol 1e-6 against taylor, tol 1e-8").
     pub runs: String,
@@ -30,7 +31,12 @@ impl ClassCheck {
     /// of n pixels change class …)", or the rule of three's bound where
     /// none did.
     pub fn describe(&self) -> String {
-        if self.changed == 0 {
+        if self.error == 0.0 {
+            format!(
+                " ({} of all {} pixels change class in a run at a hundredth of the tolerance: {})",
+                self.changed, self.sampled, self.runs
+            )
+        } else if self.changed == 0 {
             format!(
                 " (none of {} pixels changes class in a run at a hundredth of the tolerance, so under {:.4} would: {})",
                 self.sampled, self.error, self.runs
@@ -48,10 +54,11 @@ impl ClassCheck {
 
     /// The check from the pairs of classes (None: no class, as a pixel
     /// without a state) of the sampled pixels in the map's run and the
-    /// tighter one.
+    /// tighter one; `census` where every pixel of the map was rerun.
     pub fn new<C: PartialEq>(
         pairs: impl IntoIterator<Item = (Option<C>, Option<C>)>,
         runs: String,
+        census: bool,
     ) -> ClassCheck {
         let (mut sampled, mut changed) = (0, 0);
         for pair in pairs {
@@ -62,9 +69,10 @@ impl ClassCheck {
         }
         let n = sampled.max(1) as f64;
         let fraction = changed as f64 / n;
-        let error = match changed {
-            0 => 3.0 / n,
-            _ => (fraction * (1.0 - fraction) / n).sqrt(),
+        let error = match (census, changed) {
+            (true, _) => 0.0,
+            (false, 0) => 3.0 / n,
+            (false, _) => (fraction * (1.0 - fraction) / n).sqrt(),
         };
         ClassCheck {
             sampled,
@@ -91,6 +99,8 @@ pub fn sample_pixels(total: usize, count: usize) -> Vec<usize> {
 /// and the two runs named ("taylor, tol 1e-6 against taylor, tol 1e-8").
 pub struct Rerun<T> {
     pub pixels: Vec<usize>,
+    /// Every pixel of the map was rerun.
+    pub census: bool,
     pub values: Vec<T>,
     pub runs: String,
 }
@@ -115,6 +125,7 @@ pub fn rerun_sample<T: Send, E: Send>(
         .map(|ks| run(ks, tighter))
         .collect::<Result<_, _>>()?;
     Ok(Rerun {
+        census: pixels.len() == total,
         pixels,
         values: values.into_iter().flatten().collect(),
         runs: format!("{} against {}", method.describe(), tighter.describe()),

@@ -215,10 +215,11 @@ pub fn section_map(
             let rerun = super::check::rerun_sample(n * n, count, method, |ks, method| {
                 megno_of(ks, method)
             })?;
-            let pairs = (rerun.pixels.iter())
+            let census = rerun.census;
+    let pairs = (rerun.pixels.iter())
                 .zip(rerun.values)
                 .map(|(&k, again)| (class(megno[k]), class(again)));
-            Some(ClassCheck::new(pairs, rerun.runs))
+            Some(ClassCheck::new(pairs, rerun.runs, census))
         }
     };
     Ok(SectionMap {

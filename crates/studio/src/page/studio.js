@@ -592,6 +592,7 @@ let megnoController = null;
 // of three's bound.
 function classCheckText(c) {
   if (!c) return "";
+  if (c.error === 0) return ` (${c.changed} of all ${c.sampled} pixels reclassified at a hundredth of the tolerance)`;
   return c.changed === 0
     ? ` (none of ${c.sampled} pixels reclassified at a hundredth of the tolerance: under ${(100 * c.error).toFixed(1)} % would be)`
     : ` ± ${(100 * Math.max(c.fraction, c.error)).toFixed(1)} % (${c.changed} of ${c.sampled} pixels reclassified at a hundredth of the tolerance)`;
