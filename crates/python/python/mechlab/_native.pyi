@@ -293,6 +293,7 @@ class Model:
         map_time: float = 2000.0,
         samples: int = 4096,
         check: int = 256,
+        accuracy: Optional[float] = None,
         phase: float = 0.0,
         slab: float = 0.05,
         tol: float = 1e-12,

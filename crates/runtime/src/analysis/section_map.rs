@@ -58,6 +58,10 @@ pub struct SectionMap {
     /// reclassifies, from a sample: the chaotic fraction's numerical error
     /// (None: not checked).
     pub class_check: Option<ClassCheck>,
+    /// Whether the `accuracy` asked for was reached, and at which
+    /// tolerance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     pub seconds: f64,
     /// ⟨Y⟩ per pixel, row 0 at the bottom; NaN where the energy is not
     /// accessible.
@@ -216,7 +220,7 @@ pub fn section_map(
                 megno_of(ks, method)
             })?;
             let census = rerun.census;
-    let pairs = (rerun.pixels.iter())
+            let pairs = (rerun.pixels.iter())
                 .zip(rerun.values)
                 .map(|(&k, again)| (class(megno[k]), class(again)));
             Some(ClassCheck::new(pairs, rerun.runs, census))
@@ -235,6 +239,7 @@ pub fn section_map(
         chaotic_fraction: chaotic as f64 / accessible.max(1) as f64,
         failed,
         class_check,
+        accuracy: None,
         seconds: start.elapsed().as_secs_f64(),
         megno,
     })

@@ -52,6 +52,12 @@ crate::declare_settings! {
         /// pixels that change class, the frequency map's tunes' change (0:
         /// none).
         check: usize = 256, Range::Count { min: 0, max: 100_000 };
+        /// The error wanted on the maps (auto: none asked, each states its
+        /// check): the MEGNO map's largest share of pixels that change
+        /// class, the frequency map's largest change of a tune. Given, each
+        /// map is run again with `tol` a hundredfold tighter until its check
+        /// is within it, or the result says why not.
+        accuracy: Option<f64> = None, Range::Positive;
         /// With a fast phase: the forcing's phase 2πt/T at which the period
         /// map samples.
         phase: f64 = 0.0, Range::Any;
@@ -123,29 +129,64 @@ pub fn section_study(
         0 => None,
         pixels => {
             say(format!("frequency map, {pixels}² orbits …"));
-            let map = FrequencyMapSettings {
-                section: settings.clone(),
+            let map = |tol: f64| FrequencyMapSettings {
+                section: SectionSettings {
+                    tol,
+                    ..settings.clone()
+                },
                 pixels,
                 t_max: options.map_time,
                 samples: options.samples,
                 extent: options.extent,
                 check: options.check,
             };
-            Some(frequency_map(model, params, &map)?)
+            let (mut result, said) = to_accuracy(
+                settings.tol,
+                options.accuracy,
+                |tol| frequency_map(model, params, &map(tol)),
+                |result| {
+                    result
+                        .tune_check
+                        .as_ref()
+                        .map_or(f64::INFINITY, |c| c.largest)
+                },
+            )?;
+            if said.is_some() {
+                result.accuracy = said;
+            }
+            Some(result)
         }
     };
     let megno_map = match options.map {
         0 => None,
         pixels => {
             say(format!("MEGNO map, {pixels}² orbits …"));
-            let map = SectionMapSettings {
-                section: settings.clone(),
+            // With none of n pixels changing class the stated share is 3/n:
+            // enough pixels are checked to state the accuracy.
+            let check = match options.accuracy {
+                Some(accuracy) => options.check.max((3.0 / accuracy).ceil() as usize),
+                None => options.check,
+            };
+            let map = |tol: f64| SectionMapSettings {
+                section: SectionSettings {
+                    tol,
+                    ..settings.clone()
+                },
                 pixels,
                 t_max: options.map_time,
                 extent: options.extent,
-                check: options.check,
+                check,
             };
-            Some(section_map(model, params, &map)?)
+            let (mut result, said) = to_accuracy(
+                settings.tol,
+                options.accuracy,
+                |tol| section_map(model, params, &map(tol)),
+                |result| {
+                    (result.class_check.as_ref()).map_or(f64::INFINITY, |c| c.fraction.max(c.error))
+                },
+            )?;
+            result.accuracy = said;
+            Some(result)
         }
     };
     Ok(SectionStudy {
@@ -153,6 +194,35 @@ pub fn section_study(
         megno_map,
         frequency_map,
     })
+}
+
+/// `run(tol)` at `tol`, and where an `accuracy` is asked, again a
+/// hundredfold tighter (as [`crate::ode::Method::tighter`]) while its
+/// `error` is larger, down to the precision floor: the result, and what
+/// was reached at which tolerance.
+fn to_accuracy<T>(
+    tol: f64,
+    accuracy: Option<f64>,
+    mut run: impl FnMut(f64) -> Result<T, SectionError>,
+    error: impl Fn(&T) -> f64,
+) -> Result<(T, Option<String>), SectionError> {
+    let Some(accuracy) = accuracy else {
+        return Ok((run(tol)?, None));
+    };
+    let mut tol = tol;
+    loop {
+        let result = run(tol)?;
+        let reached = error(&result);
+        let tighter = (tol / 100.0).max(crate::ode::PRECISION_FLOOR);
+        if reached <= accuracy || tighter >= tol {
+            let said = format!(
+                "accuracy {accuracy:e} {} at tol {tol:e}: the check's error is {reached:.1e}",
+                crate::analysis::check::reached_text(reached <= accuracy),
+            );
+            return Ok((result, Some(said)));
+        }
+        tol = tighter;
+    }
 }
 
 /// The section's figure and table, its MEGNO map's and its frequency
