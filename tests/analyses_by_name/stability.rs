@@ -526,3 +526,52 @@ fn first_names_the_equilibria_that_get_a_window() {
         other => panic!("{other:?}"),
     }
 }
+
+/// The multipliers of an orbit the forcing moves an equilibrium to come
+/// with their error, which holds: the linear oscillator
+/// x'' + c x' + x = F cos ωt has the multipliers exp(σ T), σ = −c/2 ±
+/// i √(1 − c²/4), T = 2π/ω, whatever its forced orbit; at DOP853 1e-5 and
+/// 1e-7 each is within its stated error of them.
+#[test]
+fn a_moved_orbits_multipliers_are_within_their_stated_error_of_the_closed_form() {
+    let model = &mechlab_test_models::forced_oscillator::MODEL;
+    let (c, omega) = (0.1, 1.3);
+    let params = [c, 0.0, 0.1, omega];
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let (decay, frequency) = (-c / 2.0, (1.0 - c * c / 4.0).sqrt());
+    let exact = [1.0, -1.0].map(|sign| {
+        let modulus = (decay * period).exp();
+        (
+            modulus * (sign * frequency * period).cos(),
+            modulus * (sign * frequency * period).sin(),
+        )
+    });
+    for tol in [1e-5, 1e-7] {
+        let result = stability(
+            model,
+            &params,
+            &Settings {
+                method: Method::parse("dop853", tol).unwrap(),
+                ..settings("F")
+            },
+        )
+        .unwrap();
+        let moved = &result.moved_by_vibration[0];
+        let error = moved.multipliers_error.expect("an error");
+        for (re, im) in &moved.multipliers {
+            let off = exact
+                .iter()
+                .map(|(er, ei)| (re - er).hypot(im - ei))
+                .fold(f64::INFINITY, f64::min);
+            eprintln!("tol {tol:e}: multiplier ({re}, {im}) off by {off:.1e}, stated {error:.1e}");
+            assert!(
+                off <= error,
+                "tol {tol:e}: off by {off:e}, stated {error:e}"
+            );
+            assert!(
+                error <= 100.0 * off.max(1e-14),
+                "tol {tol:e}: off by {off:e}, stated {error:e}"
+            );
+        }
+    }
+}

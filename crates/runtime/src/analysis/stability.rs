@@ -257,10 +257,11 @@ impl Stability {
             .iter()
             .map(|moved| match (&moved.periodic_orbit, moved.verdict) {
                 (Some(orbit), Some(verdict)) => format!(
-                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?}: {verdict}; stable for amplitudes {:?} {}",
+                    "q = {:?}: moved by the vibration; the periodic orbit near it at amplitude {} starts at {orbit:?}, multipliers {:?} (± {}): {verdict}; stable for amplitudes {:?} {}",
                     moved.q,
                     moved.amplitude,
                     moved.multipliers,
+                    moved.multipliers_error.map_or("?".into(), |e| format!("{e:.1e}")),
                     moved.exact_window,
                     moved.exact_reason.as_deref().unwrap_or(""),
                 ),
@@ -336,6 +337,10 @@ pub struct MovedEquilibrium {
     /// Its Floquet multipliers (re, im), largest modulus first, and the
     /// verdict they give.
     pub multipliers: Vec<(f64, f64)>,
+    /// The multipliers' numerical error: twice the largest distance of one
+    /// to the nearest of those of the same orbit found with a run at a
+    /// hundredth of the tolerance (None where that run finds no orbit).
+    pub multipliers_error: Option<f64>,
     pub verdict: Option<&'static str>,
     /// The first interval of the amplitude on which that orbit is stable,
     /// its edges the located stability changes along its branch (followed
@@ -504,6 +509,7 @@ fn analyse(
                         amplitude: probe[amplitude],
                         periodic_orbit: None,
                         multipliers: Vec::new(),
+                        multipliers_error: None,
                         verdict: None,
                         exact_window: None,
                         exact_reason: Some(skipped.clone()),
@@ -597,15 +603,44 @@ fn moved_equilibrium(
         }
         None => (None, Vec::new(), None),
     };
+    // The same orbit found again with a run at a hundredth of the
+    // tolerance, from the orbit found: twice the multipliers' distance, as
+    // the edges' error (the tighter run has an error of its own).
+    let multipliers_error = periodic_orbit.as_ref().and_then(|y| {
+        let (_, m) = periodic_orbit_near(model, probe, y, &settings.method.tighter())?;
+        Some(2.0 * multipliers_distance(&multipliers, &multipliers_of(&m)))
+    });
     MovedEquilibrium {
         q: q.to_vec(),
         amplitude: probe[amplitude],
         periodic_orbit,
         multipliers,
+        multipliers_error,
         verdict,
         exact_window,
         exact_reason,
     }
+}
+
+/// The largest distance from a multiplier of `a` to the nearest of `b`
+/// (each of `b` matched once, nearest pairs first).
+fn multipliers_distance(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    let mut free: Vec<(f64, f64)> = b.to_vec();
+    let mut largest: f64 = 0.0;
+    for &(re, im) in a {
+        let nearest = (0..free.len()).min_by(|&i, &j| {
+            let d = |k: usize| (free[k].0 - re).hypot(free[k].1 - im);
+            d(i).total_cmp(&d(j))
+        });
+        match nearest {
+            Some(k) => {
+                let (r, i) = free.swap_remove(k);
+                largest = largest.max((r - re).hypot(i - im));
+            }
+            None => return f64::INFINITY,
+        }
+    }
+    largest
 }
 
 /// The equilibria with a threshold a*, in the order their exact windows

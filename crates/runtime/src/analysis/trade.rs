@@ -339,7 +339,8 @@ impl crate::outputs::Outputs for Trade {
     }
 }
 
-/// The exact window's edges, each with its error.
+/// The exact window's edges, each with its error; the multipliers of the
+/// orbits the vibration moves equilibria to.
 impl StatedErrors for crate::analysis::stability::Stability {
     fn stated(&self) -> Vec<Stated> {
         let mut stated = Vec::new();
@@ -356,6 +357,19 @@ impl StatedErrors for crate::analysis::stability::Stability {
                         error,
                     });
                 }
+            }
+        }
+        for moved in &self.moved_by_vibration {
+            let Some(error) = moved.multipliers_error else {
+                continue;
+            };
+            for (k, (re, im)) in moved.multipliers.iter().enumerate() {
+                stated.push(Stated {
+                    what: format!("q = {:.6?} moved: |multiplier {k}|", moved.q),
+                    kind: "Floquet multiplier",
+                    value: re.hypot(*im),
+                    error,
+                });
             }
         }
         stated
