@@ -87,3 +87,24 @@ fn the_cheapest_run_within_an_error_is_found() {
     assert_eq!(cheapest_reaching(&runs, 1e-5), Some(0));
     assert_eq!(cheapest_reaching(&runs, 1e-11), None);
 }
+
+/// A ladder none of whose runs can give a result (stability on a model
+/// that names no amplitude) is the analysis's error, not an empty figure.
+#[test]
+fn a_trade_of_runs_that_all_fail_is_their_error() {
+    let model = model_of("ueda");
+    let ladder = [("dop853".to_string(), 1e-8), ("dop853".to_string(), 1e-10)];
+    let e = trade(
+        model,
+        &model.dynamic.defaults(),
+        &StabilityOptions::default(),
+        &ladder,
+        None,
+        &|_| (),
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("names no [fast_phase] amplitude"),
+        "{e}"
+    );
+}

@@ -83,7 +83,7 @@ pub struct Trade {
 
 /// The analysis `base` on `model` at `values` over `ladder` (method name and
 /// tolerance; the name only labels the runs of an analysis without a
-/// `method` setting) and, where given, `request` (the same settings with an
+/// `method` setting; the first run's error where none gives a result) and, where given, `request` (the same settings with an
 /// `accuracy`); `progress` hears of each run done.
 pub fn trade<T: Analysis>(
     model: &'static Model,
@@ -132,6 +132,11 @@ where
                 error: error.located(model, values),
             }),
         }
+    }
+    // A ladder none of whose runs gave a result has nothing to show: its
+    // first run's error is the trade's.
+    if runs.is_empty() && !failed.is_empty() {
+        return Err(failed.swap_remove(0).error);
     }
     let mut accuracy = None;
     let requested = match request {

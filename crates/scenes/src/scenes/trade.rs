@@ -122,6 +122,12 @@ where
             run.largest_distance.map_or("–".into(), |d| format!("{d:.2e}"))
         );
     }
+    for run in &result.failed {
+        println!(
+            "{:>8} tol {:<8.1e} failed: {}",
+            run.method, run.tol, run.error
+        );
+    }
     if let Some(ratio) = result.cost_ratio {
         println!("the accuracy asked cost {ratio:.2}× the cheapest run of the ladder that stated an error within it");
     }
