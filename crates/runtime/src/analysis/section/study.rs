@@ -197,9 +197,9 @@ pub fn section_study(
 }
 
 /// `run(tol)` at `tol`, and where an `accuracy` is asked, again a
-/// hundredfold tighter (as [`crate::ode::Method::tighter`]) while its
-/// `error` is larger, down to the precision floor: the result, and what
-/// was reached at which tolerance.
+/// hundredfold tighter while its `error` is larger, down to the precision
+/// floor ([`crate::analysis::check::until_accurate`], the maps' Taylor
+/// method): the result, and what was reached at which tolerance.
 fn to_accuracy<T>(
     tol: f64,
     accuracy: Option<f64>,
@@ -209,20 +209,18 @@ fn to_accuracy<T>(
     let Some(accuracy) = accuracy else {
         return Ok((run(tol)?, None));
     };
-    let mut tol = tol;
-    loop {
-        let result = run(tol)?;
-        let reached = error(&result);
-        let tighter = (tol / 100.0).max(crate::ode::PRECISION_FLOOR);
-        if reached <= accuracy || tighter >= tol {
-            let said = format!(
-                "accuracy {accuracy:e} {} at tol {tol:e}: the check's error is {reached:.1e}",
-                crate::analysis::check::reached_text(reached <= accuracy),
-            );
-            return Ok((result, Some(said)));
-        }
-        tol = tighter;
-    }
+    let (result, method, reached, within) = crate::analysis::check::until_accurate(
+        crate::ode::Method::Taylor { tol },
+        accuracy,
+        |method| run(method.accuracy()),
+        error,
+    )?;
+    let said = format!(
+        "accuracy {accuracy:e} {} at tol {:e}: the check's error is {reached:.1e}",
+        crate::analysis::check::reached_text(within),
+        method.accuracy()
+    );
+    Ok((result, Some(said)))
 }
 
 /// The section's figure and table, its MEGNO map's and its frequency
