@@ -361,6 +361,8 @@ async fn basins_levels_equal_the_library_basins() {
             cell: 0.05,
             method: Method::Taylor { tol: 1e-10 },
             stop_early: true,
+            check: 0,
+            accuracy: None,
             tiles: None,
         };
         let library = basins(model_of("duffing"), &[0.3, 0.0, 1.2], &settings, &|_| ()).unwrap();

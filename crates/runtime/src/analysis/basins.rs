@@ -44,8 +44,18 @@ crate::declare_settings! {
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
         /// gauss6).
         tol: f64 = 1e-10, Range::Positive;
+        /// Starts run again at a hundredth of the tolerance, spread over the
+        /// map, to count those that end on another attractor: the
+        /// fractions' numerical error (0: none).
+        check: usize = 256, Range::Count { min: 0, max: 16_000_000 };
+        /// The error wanted on every basin's fraction (auto: none asked,
+        /// each fraction comes with its error). Given, `tol` is tightened a
+        /// hundredfold while the check's share of starts that change
+        /// attractor is above it, and the pixels per side are raised while
+        /// the grid's error is, or the result says why not.
+        accuracy: Option<f64> = None, Range::Between { low: 0.0, high: 1.0 };
     }
-    interactive { transient: 200 }
+    interactive { transient: 200, check: 64 }
 }
 
 impl BasinsOptions {
@@ -65,6 +75,8 @@ impl BasinsOptions {
             cell: self.cell,
             method,
             stop_early: self.stop_early,
+            check: self.check,
+            accuracy: self.accuracy,
             tiles: None,
         })
     }
@@ -97,6 +109,11 @@ pub struct BasinSettings {
     /// its whole length: the same labels but for starts that shadow an
     /// attractor for `record` periods and then leave it, slower.
     pub stop_early: bool,
+    /// Starts rerun at a hundredth of the tolerance to count those that
+    /// end on another attractor (0: none).
+    pub check: usize,
+    /// The error wanted on the fractions (None: stated, not chosen).
+    pub accuracy: Option<f64>,
     /// Rows of starts in tiles written as they are done (resume, job
     /// arrays, MPI ranks).
     pub tiles: Option<Tiles>,
@@ -158,9 +175,16 @@ pub struct Attractor {
     /// Reached from a second start too (an attractor seen once may be a
     /// transient not yet settled).
     pub confirmed: bool,
-    /// The share of the grid's starts, and its standard error.
+    /// The share of the grid's starts, and its stated error: the larger
+    /// of the grid's (`grid_error`) and the numerical one (the class
+    /// check's share of starts that change attractor, where checked).
     pub fraction: f64,
     pub fraction_error: f64,
+    /// The grid's error on the fraction: twice the largest difference
+    /// between it and the fraction on one of the four interleaved grids of
+    /// half the pixels per side (whose mean it is), at least one pixel's
+    /// share where the map has more than one basin.
+    pub grid_error: f64,
 }
 
 /// A basin map.
@@ -178,6 +202,13 @@ pub struct Basins {
     pub diverged: usize,
     /// The basins' boundary: its uncertainty exponent and box dimension.
     pub boundary: Boundary,
+    /// The share of starts that end on another attractor in a run at a
+    /// hundredth of the tolerance, from a sample of them: the fractions'
+    /// numerical error (None: not checked).
+    pub class_check: Option<super::check::ClassCheck>,
+    /// Whether the `accuracy` asked for was reached, and by which run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     pub seconds: f64,
     /// Each pixel's attractor (an index of `attractors`, or [`DIVERGED`]),
     /// row 0 at the bottom.
@@ -189,8 +220,77 @@ pub struct Basins {
 }
 
 /// The basins of `model`'s period map at `params`; `done(k)` is told as
-/// each block of k orbits ends (progress).
+/// each block of k orbits ends (progress). With an `accuracy`, the map is
+/// run again, a hundredfold tighter while its class check is above it and
+/// with more pixels while its grid error is, until every fraction's error
+/// is within it.
 pub fn basins(
+    model: &Model,
+    params: &[f64],
+    settings: &BasinSettings,
+    done: &(dyn Fn(usize) + Sync),
+) -> Result<Basins, BasinsError> {
+    let Some(accuracy) = settings.accuracy else {
+        return basins_once(model, params, settings, done);
+    };
+    let mut settings = settings.clone();
+    // With none of n starts changing, the stated share is the rule of
+    // three's 3/n: the sample must be large enough to state the accuracy.
+    settings.check = settings
+        .check
+        .max(256)
+        .max((3.0 / accuracy).ceil() as usize);
+    loop {
+        let mut map = basins_once(model, params, &settings, done)?;
+        let numerical = map
+            .class_check
+            .as_ref()
+            .map_or(f64::INFINITY, |c| c.fraction.max(c.error));
+        let grid = (map.attractors.iter())
+            .map(|a| a.grid_error)
+            .fold(0.0, f64::max);
+        let tighter = settings.method.tighter();
+        let why_not = if numerical > accuracy {
+            if tighter.is_tighter_than(&settings.method) {
+                settings.method = tighter;
+                continue;
+            }
+            Some("the tolerance is at the precision floor".to_string())
+        } else if grid > accuracy {
+            // The grid's error falls as the pixel's side to the power of
+            // the boundary's uncertainty exponent (1 for a smooth one).
+            let alpha = map.boundary.exponent.unwrap_or(1.0).clamp(0.05, 1.0);
+            let wanted = settings.pixels as f64 * (grid / accuracy).powf(1.0 / alpha);
+            let pixels = (wanted.ceil() as usize).max(2 * settings.pixels);
+            if pixels <= MAX_PIXELS {
+                settings.pixels = pixels;
+                continue;
+            }
+            Some(format!(
+                "the grid's error {grid:.2e} at {} pixels per side would take about {wanted:.0} (more than {MAX_PIXELS}; the boundary's uncertainty exponent {alpha:.2})",
+                settings.pixels
+            ))
+        } else {
+            None
+        };
+        let error = numerical.max(grid);
+        map.accuracy = Some(match why_not {
+            None => format!(
+                "accuracy {accuracy} reached with {} at {} pixels per side: every fraction within {error:.2e}",
+                settings.method.describe(),
+                settings.pixels
+            ),
+            Some(why) => format!("accuracy {accuracy} NOT reached: {why}"),
+        });
+        return Ok(map);
+    }
+}
+
+/// The most pixels per side an `accuracy` may ask for (the setting's range).
+const MAX_PIXELS: usize = 4000;
+
+/// [`basins`] at the settings' method and pixels, its check included.
+fn basins_once(
     model: &Model,
     params: &[f64],
     settings: &BasinSettings,
@@ -247,7 +347,12 @@ pub fn basins(
     let Some(records) = grid.all_records(name)? else {
         return Err(BasinsError::Partial);
     };
-    let (labels, attractors, points) = grid.find(&records)?;
+    let (labels, mut attractors, points) = grid.find(&records)?;
+    let class_check = match settings.check {
+        0 => None,
+        count => Some(grid.class_check(&records, &labels, count)?),
+    };
+    stated_errors(&mut attractors, &labels, n, class_check.as_ref());
     let diverged = labels.iter().filter(|&&l| l == DIVERGED).count();
     Ok(Basins {
         model: name.into(),
@@ -258,6 +363,8 @@ pub fn basins(
         attractors,
         diverged,
         boundary: Boundary::of_labels(&labels, n),
+        class_check,
+        accuracy: None,
         seconds: start.elapsed().as_secs_f64(),
         labels,
         points,
@@ -296,12 +403,13 @@ impl Grid<'_> {
             .map(|()| y)
     }
 
-    /// The records of the starts `pixels`, stopped early on the `known`
-    /// attractors if any.
+    /// The records of the starts `pixels` by `method`, stopped early on the
+    /// `known` attractors if any.
     fn records(
         &self,
         pixels: &[usize],
         known: Option<&KnownAttractors>,
+        method: Method,
     ) -> Result<Vec<Record>, BasinsError> {
         let settings = self.settings;
         let starts: Vec<Option<Vec<f64>>> = pixels.par_iter().map(|&k| self.start(k)).collect();
@@ -315,7 +423,7 @@ impl Grid<'_> {
         };
         let mut runs = self
             .flows
-            .iterates(self.params, settings.method, self.period, &flat, &recording)?
+            .iterates(self.params, method, self.period, &flat, &recording)?
             .into_iter();
         Ok(starts
             .iter()
@@ -461,6 +569,67 @@ impl Grid<'_> {
             .collect())
     }
 
+    /// The fractions' numerical error: `count` starts spread over the map
+    /// run again at a hundredth of the tolerance, each labelled by the
+    /// attractor whose cells (or cells touching them) its record visits
+    /// most, [`DIVERGED`] where its orbit stopped, and a label of its own
+    /// where it visits none (an attractor the map did not find).
+    fn class_check(
+        &self,
+        records: &[Record],
+        labels: &[i32],
+        count: usize,
+    ) -> Result<super::check::ClassCheck, BasinsError> {
+        const ELSEWHERE: i32 = -2;
+        let mut owner: HashMap<Vec<i64>, i32> = HashMap::new();
+        for (record, &label) in records.iter().zip(labels) {
+            for y in record.iter().flatten() {
+                let mut key = Vec::new();
+                self.cells.of(y, &mut key);
+                owner.insert(key, label);
+            }
+        }
+        let label_of = |record: &Record| -> i32 {
+            let Some(record) = record else {
+                return DIVERGED;
+            };
+            let mut votes: HashMap<i32, usize> = HashMap::new();
+            for y in record {
+                let mut key = Vec::new();
+                self.cells.of(y, &mut key);
+                let mut found = owner.get(&key).copied();
+                if found.is_none() {
+                    self.cells.touching(&key, |neighbour| {
+                        found = found.or_else(|| owner.get(neighbour).copied());
+                    });
+                }
+                if let Some(label) = found {
+                    *votes.entry(label).or_default() += 1;
+                }
+            }
+            (votes.into_iter())
+                .max_by_key(|&(label, n)| (n, -label))
+                .map_or(ELSEWHERE, |(label, _)| label)
+        };
+        let rerun = super::check::rerun_sample(
+            labels.len(),
+            count,
+            self.settings.method,
+            |pixels, method| {
+                let records = self.records(pixels, None, method)?;
+                Ok::<_, BasinsError>(records.iter().map(label_of).collect::<Vec<_>>())
+            },
+        )?;
+        let pairs = (rerun.pixels.iter())
+            .zip(&rerun.values)
+            .map(|(&k, &label)| (Some(labels[k]), Some(label)));
+        Ok(super::check::ClassCheck::new(
+            pairs,
+            rerun.runs,
+            rerun.census,
+        ))
+    }
+
     /// Whether pixel k is a scout: with early stops, every 4th start each
     /// way runs first, and the attractors the scouts confirm are known to
     /// the other orbits, which stop once on one of them.
@@ -476,7 +645,7 @@ impl Grid<'_> {
     fn scout(&self) -> Result<(Vec<Record>, KnownAttractors), BasinsError> {
         let n = self.settings.pixels;
         let scouts: Vec<usize> = (0..n * n).filter(|&k| self.is_scout(k)).collect();
-        let records = self.records(&scouts, None)?;
+        let records = self.records(&scouts, None, self.settings.method)?;
         let mut known = KnownAttractors::new(self.cells.clone());
         let (labels, attractors, _) = self.find(&records)?;
         for (index, _) in attractors.iter().enumerate().filter(|(_, a)| a.confirmed) {
@@ -502,7 +671,7 @@ impl Grid<'_> {
         let rows_of = |rows: std::ops::Range<usize>| -> Result<(Vec<f64>, u64), BasinsError> {
             let pixels = rows.start * n..rows.end * n;
             let others: Vec<usize> = pixels.clone().filter(|&k| !self.is_scout(k)).collect();
-            let mut runs = self.records(&others, known)?.into_iter();
+            let mut runs = self.records(&others, known, settings.method)?.into_iter();
             let mut values = Vec::with_capacity(pixels.len() * settings.record * dim);
             for k in pixels {
                 let record = if self.is_scout(k) {
@@ -654,6 +823,7 @@ fn identify(
                 confirmed: false,
                 fraction: 0.0,
                 fraction_error: 0.0,
+                grid_error: 0.0,
             });
             points.push(
                 record
@@ -669,9 +839,41 @@ fn identify(
     for a in &mut attractors {
         a.confirmed = a.starts >= 2;
         a.fraction = a.starts as f64 / total;
-        a.fraction_error = (a.fraction * (1.0 - a.fraction) / total).sqrt();
     }
     (labels, attractors, points)
+}
+
+/// Each attractor's grid error ([`Attractor::grid_error`]) and its stated
+/// error, the larger of that and the class check's share.
+fn stated_errors(
+    attractors: &mut [Attractor],
+    labels: &[i32],
+    n: usize,
+    check: Option<&super::check::ClassCheck>,
+) {
+    let numerical = check.map_or(0.0, |c| c.fraction.max(c.error));
+    let basins = attractors.len() + usize::from(labels.contains(&DIVERGED));
+    let pixel = if basins > 1 { 1.0 / labels.len() as f64 } else { 0.0 };
+    for (index, a) in attractors.iter_mut().enumerate() {
+        let mut spread: f64 = 0.0;
+        for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let (mut on, mut all) = (0usize, 0usize);
+            for j in (dj..n).step_by(2) {
+                for i in (di..n).step_by(2) {
+                    all += 1;
+                    on += usize::from(labels[j * n + i] == index as i32);
+                }
+            }
+            if all > 0 {
+                spread = spread.max((on as f64 / all as f64 - a.fraction).abs());
+            }
+        }
+        // Twice the spread: one sample of the error, as the exact window's
+        // edges (measured on the double well's areas: docs/accuracy.md).
+        let grid = (2.0 * spread).max(pixel);
+        a.grid_error = grid;
+        a.fraction_error = grid.max(numerical);
+    }
 }
 
 /// "period k" if the record repeats with the least such k (within
@@ -847,6 +1049,14 @@ impl crate::outputs::Outputs for Basins {
             "diverged: {}; {:.1} s",
             self.diverged, self.seconds
         ));
+        lines.push(match &self.class_check {
+            Some(check) => format!(
+                "fractions' error: the grid's (four interleaved half grids) and the numerical{}",
+                check.describe().replace("pixels change class", "starts change attractor")
+            ),
+            None => "fractions' error: the grid's (four interleaved half grids); no numerical check (check = 0)".into(),
+        });
+        lines.extend(self.accuracy.clone());
         let b = &self.boundary;
         lines.push(match (b.exponent, b.exponent_error, b.dimension) {
             (Some(alpha), Some(error), Some(dimension)) => format!(

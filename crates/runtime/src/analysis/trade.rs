@@ -465,3 +465,18 @@ impl StatedErrors for crate::analysis::section::SectionStudy {
         stated
     }
 }
+
+/// Each basin's fraction, its error the grid's or the class check's.
+impl StatedErrors for crate::analysis::basins::Basins {
+    fn stated(&self) -> Vec<Stated> {
+        (self.attractors.iter())
+            .enumerate()
+            .map(|(k, a)| Stated {
+                what: format!("attractor {} ({}): fraction", k + 1, a.kind),
+                kind: "basin's fraction",
+                value: a.fraction,
+                error: a.fraction_error,
+            })
+            .collect()
+    }
+}

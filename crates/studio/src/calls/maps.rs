@@ -152,6 +152,9 @@ pub struct BasinsLevel {
     /// Each attractor's recorded iterates on the view's axes.
     pub points: Vec<Vec<[f64; 2]>>,
     pub boundary: mechlab_runtime::analysis::basins::Boundary,
+    /// The share of starts that end elsewhere in a run at a hundredth of
+    /// the tolerance, from a sample: the fractions' numerical error.
+    pub class_check: Option<mechlab_runtime::analysis::check::ClassCheck>,
     pub seconds: f64,
 }
 
@@ -171,6 +174,7 @@ pub fn basins(
             attractors: map.attractors,
             points: map.points,
             boundary: map.boundary,
+            class_check: map.class_check,
             seconds: map.seconds,
         };
         if !sink(level) {

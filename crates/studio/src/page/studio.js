@@ -379,10 +379,18 @@ function attractorAt(x, y) {
   return b.labels[j * b.pixels + i];
 }
 
+// The basins' class check: the share of starts that end on another
+// attractor at a hundredth of the tolerance, the fractions' numerical error.
+function basinsCheckText(c) {
+  if (!c) return "";
+  const share = c.error === 0 || c.changed > 0 ? `${c.changed} of ${c.sampled}` : `none of ${c.sampled} (under ${(100 * c.error).toFixed(1)} %)`;
+  return `; ${share} starts end elsewhere at a hundredth of the tolerance`;
+}
+
 function attractorName(label) {
   if (label < 0) return "diverged";
   const a = studio.basins.attractors[label];
-  return `attractor ${label + 1}: ${a.kind}, ${(100 * a.fraction).toFixed(1)} % of the starts`;
+  return `attractor ${label + 1}: ${a.kind}, ${(100 * a.fraction).toFixed(1)} ± ${(100 * a.fraction_error).toFixed(1)} % of the starts`;
 }
 
 function drawImage(g, { image, ranges }) {
@@ -765,7 +773,7 @@ async function refreshBasins() {
       studio.basins = { ...line, ranges, image: basinsImage(line) };
       const d = line.boundary.dimension;
       $("basins-note").textContent = `(${line.attractors.length} attractor${line.attractors.length === 1 ? "" : "s"}${d == null ? "" : `, boundary dimension ${d.toFixed(2)}`})`;
-      $("status").textContent = `basins ${line.pixels}² in ${line.seconds.toFixed(2)} s`;
+      $("status").textContent = `basins ${line.pixels}² in ${line.seconds.toFixed(2)} s${basinsCheckText(line.class_check)}`;
       listOrbits();
       redraw();
     });
