@@ -830,6 +830,8 @@ fn a_large_constrained_model_refuses_the_taylor_method_and_keeps_its_jacobian() 
         p_max: 0.1,
         periods: 3,
         method: Method::Taylor { tol: 1e-10 },
+        check: 0,
+        accuracy: None,
     };
     let error = portrait(model, &model.dynamic.defaults(), &settings).unwrap_err();
     assert!(
@@ -996,6 +998,8 @@ fn a_velocity_is_labelled_as_the_coordinates_rate() {
         p_max: 0.1,
         periods: 2,
         method: Method::Taylor { tol: 1e-10 },
+        check: 0,
+        accuracy: None,
     };
     let drawn = portrait(model, &model.dynamic.defaults(), &settings).unwrap();
     assert_eq!(drawn.labels, ["φ₁".to_string(), "φ₁′".to_string()]);

@@ -199,6 +199,8 @@ async fn a_constrained_models_orbit_is_its_portrait_on_the_constraints() {
             rtol: 1e-10,
             atol: 1e-10,
         },
+        check: 0,
+        accuracy: None,
     };
     let expected = portrait(
         model,

@@ -213,6 +213,8 @@ fn portraits_are_the_period_map_iterated() {
         p_max: 1.0,
         periods: 50,
         method: Method::parse("taylor", 1e-12).unwrap(),
+        check: 0,
+        accuracy: None,
     };
     let result = portrait(model_of("kapitza"), &params.values(), &settings).unwrap();
     let mut integrator = Integrator::new(settings.method).unwrap();
@@ -425,4 +427,168 @@ fn a_chaos_map_asked_for_an_accuracy_tightens_its_tolerance_until_its_check_pass
     );
     assert!(asked.class_check.as_ref().unwrap().fraction <= 0.002);
     assert_eq!(asked.fli, map(1e-5, None).fli);
+}
+
+/// x'' + x = F cos(ωt) from (x0, v0), at t = kT (T = 2π/ω): the particular
+/// solution A cos ωt (A = F/(1 − ω²)) is A, 0 there; the free one turns by
+/// ωT per period.
+fn undamped_forced_period_map(f: f64, omega: f64, (x0, v0): (f64, f64), k: usize) -> (f64, f64) {
+    let amplitude = f / (1.0 - omega * omega);
+    let t = k as f64 * 2.0 * PI / omega;
+    let (c1, c2) = (x0 - amplitude, v0);
+    (
+        amplitude + c1 * t.cos() + c2 * t.sin(),
+        -c1 * t.sin() + c2 * t.cos(),
+    )
+}
+
+/// The period map's drawn points against the undamped forced oscillator's
+/// closed form, over 400 periods from five seeds at three tolerances of two
+/// methods: each orbit's stated error bounds its largest distance to the
+/// closed form, and is within 100 times it.
+#[test]
+fn the_period_maps_stated_errors_bound_the_distance_to_the_closed_form() {
+    use mechlab::analysis::period_map::{portrait, PortraitSettings};
+    let model = &mechlab_test_models::forced_oscillator::MODEL;
+    let (f, omega) = (0.1, 1.3);
+    let params = [0.0, 0.0, f, omega];
+    let seeds: Vec<Vec<f64>> = [
+        (0.5, 0.0),
+        (-1.0, 0.3),
+        (2.0, -1.0),
+        (0.0, 1.5),
+        (-0.3, -0.7),
+    ]
+    .iter()
+    .map(|&(x, v)| vec![x, v])
+    .collect();
+    let mut cases = 0;
+    for (name, tol) in [
+        ("dop853", 1e-6),
+        ("dop853", 1e-8),
+        ("dop853", 1e-10),
+        ("taylor", 1e-6),
+        ("taylor", 1e-9),
+    ] {
+        let settings = PortraitSettings {
+            axes: [0, 1],
+            seeds: Some(seeds.clone()),
+            count: seeds.len(),
+            p_max: 1.0,
+            periods: 400,
+            method: Method::parse(name, tol).unwrap(),
+            check: seeds.len(),
+            accuracy: None,
+        };
+        let drawn = portrait(model, &params, &settings).unwrap();
+        assert_eq!(drawn.checks.len(), seeds.len());
+        for check in &drawn.checks {
+            let seed = &seeds[check.orbit];
+            let distance = drawn.orbits[check.orbit]
+                .iter()
+                .enumerate()
+                .map(|(k, &(x, v))| {
+                    let (cx, cv) = undamped_forced_period_map(f, omega, (seed[0], seed[1]), k);
+                    (x - cx).hypot(v - cv)
+                })
+                .fold(0.0, f64::max);
+            println!(
+                "{name} {tol:e}, orbit {}: stated {:.2e}, off by {distance:.2e}",
+                check.orbit, check.error
+            );
+            assert!(
+                distance <= check.error,
+                "{name} {tol:e}: {check:?} against {distance:e}"
+            );
+            assert!(
+                check.error <= 100.0 * distance.max(1e-14),
+                "{name} {tol:e}: {check:?} against {distance:e}"
+            );
+            cases += 1;
+        }
+    }
+    assert_eq!(cases, 25);
+}
+
+/// `accuracy` on the period map: reached on the oscillator from DOP853 1e-5
+/// (its points then within it of the closed form); on Kapitza's chaotic
+/// sea it cannot be, and the result says for how many periods each orbit
+/// is within it.
+#[test]
+fn a_period_map_asked_for_an_accuracy_reaches_it_or_says_for_how_long() {
+    use mechlab::analysis::period_map::{portrait, PortraitSettings};
+    let model = &mechlab_test_models::forced_oscillator::MODEL;
+    let (f, omega) = (0.1, 1.3);
+    let settings = PortraitSettings {
+        axes: [0, 1],
+        seeds: Some(vec![vec![0.5, 0.0], vec![-1.0, 0.3]]),
+        count: 2,
+        p_max: 1.0,
+        periods: 300,
+        method: Method::parse("dop853", 1e-5).unwrap(),
+        check: 2,
+        accuracy: Some(1e-9),
+    };
+    let drawn = portrait(model, &[0.0, 0.0, f, omega], &settings).unwrap();
+    let verdict = drawn.accuracy.clone().unwrap();
+    println!("{verdict}");
+    assert!(verdict.contains(" reached"), "{verdict}");
+    for (orbit, seed) in drawn.orbits.iter().zip([(0.5, 0.0), (-1.0, 0.3)]) {
+        for (k, &(x, v)) in orbit.iter().enumerate() {
+            let (cx, cv) = undamped_forced_period_map(f, omega, seed, k);
+            assert!((x - cx).hypot(v - cv) <= 1e-9, "period {k}");
+        }
+    }
+    // Kapitza's chaotic layer about the unstable upright at A = 1.
+    let kapitza = model_of("kapitza");
+    let values = [1.0, 0.1, 0.0]; // A, eps, mu: the upright unstable
+    let chaotic = PortraitSettings {
+        axes: [0, 1],
+        seeds: Some(vec![vec![0.05, 0.0]]),
+        count: 1,
+        p_max: 1.0,
+        periods: 2000,
+        method: Method::parse("taylor", 1e-8).unwrap(),
+        check: 1,
+        accuracy: Some(1e-6),
+    };
+    let drawn = portrait(kapitza, &values, &chaotic).unwrap();
+    let verdict = drawn.accuracy.clone().unwrap();
+    println!("{verdict}");
+    assert!(verdict.contains("NOT reached"), "{verdict}");
+    let within = drawn.checks[0].periods_within.unwrap();
+    assert!(within > 0 && within < 2000, "{verdict}");
+}
+
+/// A run at the precision floor has no tighter run to check it: its
+/// points' error is not stated (a check against itself would give 0).
+#[test]
+fn a_period_map_at_the_precision_floor_states_no_error() {
+    use mechlab::analysis::period_map::{portrait, PortraitSettings};
+    use mechlab::ode::PRECISION_FLOOR;
+    let settings = PortraitSettings {
+        axes: [0, 1],
+        seeds: Some(vec![vec![0.5, 0.0]]),
+        count: 1,
+        p_max: 1.0,
+        periods: 10,
+        method: Method::Taylor {
+            tol: PRECISION_FLOOR,
+        },
+        check: 1,
+        accuracy: None,
+    };
+    let model = &mechlab_test_models::forced_oscillator::MODEL;
+    let drawn = portrait(model, &[0.0, 0.0, 0.1, 1.3], &settings).unwrap();
+    assert!(drawn.checks.is_empty(), "{:?}", drawn.checks);
+    assert!(
+        drawn.check_runs.contains("precision floor"),
+        "{}",
+        drawn.check_runs
+    );
+    assert!(Method::Taylor {
+        tol: PRECISION_FLOOR
+    }
+    .check_run()
+    .is_none());
 }

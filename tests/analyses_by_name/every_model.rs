@@ -135,6 +135,8 @@ fn constrained_model_on_its_constraints(name: &str, params: &[f64]) {
             rtol: 1e-10,
             atol: 1e-10,
         },
+        check: 0,
+        accuracy: None,
     };
     match portrait(handle, params, &settings) {
         Ok(result) => {
@@ -362,6 +364,8 @@ fn portrait_settings(n: usize) -> PortraitSettings {
         p_max: 0.5,
         periods: 20,
         method: Method::parse("taylor", 1e-10).unwrap(),
+        check: 0,
+        accuracy: None,
     }
 }
 

@@ -109,6 +109,8 @@ class Model:
         stop_early: bool = True,
         method: str = "taylor",
         tol: float = 1e-10,
+        check: int = 256,
+        accuracy: Optional[float] = None,
         params: Params = None,
         progress: bool = True,
     ) -> dict[str, Any]:
@@ -125,6 +127,8 @@ class Model:
         periods: int = 500,
         method: str = "taylor",
         tol: float = 1e-10,
+        check: int = 24,
+        accuracy: Optional[float] = None,
         params: Params = None,
     ) -> dict[str, Any]:
         """Orbits of the period map of any model with a fast phase, projected on two state components."""

@@ -853,7 +853,11 @@ fn stated_errors(
 ) {
     let numerical = check.map_or(0.0, |c| c.fraction.max(c.error));
     let basins = attractors.len() + usize::from(labels.contains(&DIVERGED));
-    let pixel = if basins > 1 { 1.0 / labels.len() as f64 } else { 0.0 };
+    let pixel = if basins > 1 {
+        1.0 / labels.len() as f64
+    } else {
+        0.0
+    };
     for (index, a) in attractors.iter_mut().enumerate() {
         let mut spread: f64 = 0.0;
         for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {

@@ -20,7 +20,8 @@ pub struct ClassCheck {
     pub fraction: f64,
     /// The estimate's binomial standard error; where none changed, the 95 %
     /// upper bound 3 / sampled (the rule of three) instead; 0 where every
-    /// pixel was rerun (the share is then counted, not estimated).
+    /// pixel was rerun (the share is then counted, not estimated); 1 where
+    /// none could be (a run at the precision floor: the share unknown).
     pub error: f64,
     /// The two runs ("taylor, tol 1e-6 against taylor, tol 1e-8").
     pub runs: String,
@@ -31,7 +32,9 @@ impl ClassCheck {
     /// of n pixels change class …)", or the rule of three's bound where
     /// none did.
     pub fn describe(&self) -> String {
-        if self.error == 0.0 {
+        if self.sampled == 0 {
+            format!(" (not checked: {})", self.runs)
+        } else if self.error == 0.0 {
             format!(
                 " ({} of all {} pixels change class in a run at a hundredth of the tolerance: {})",
                 self.changed, self.sampled, self.runs
@@ -70,6 +73,8 @@ impl ClassCheck {
         let n = sampled.max(1) as f64;
         let fraction = changed as f64 / n;
         let error = match (census, changed) {
+            // Nothing compared (a run at the precision floor): unknown.
+            _ if sampled == 0 => 1.0,
             (true, _) => 0.0,
             (false, 0) => 3.0 / n,
             (false, _) => (fraction * (1.0 - fraction) / n).sqrt(),
@@ -114,8 +119,18 @@ pub fn rerun_sample<T: Send, E: Send>(
     method: Method,
     run: impl Fn(&[usize], Method) -> Result<Vec<T>, E> + Sync,
 ) -> Result<Rerun<T>, E> {
+    let Some(tighter) = method.check_run() else {
+        return Ok(Rerun {
+            pixels: Vec::new(),
+            census: false,
+            values: Vec::new(),
+            runs: format!(
+                "{} is at the precision floor, with no tighter run to check it",
+                method.describe()
+            ),
+        });
+    };
     let pixels = sample_pixels(total, count);
-    let tighter = method.tighter();
     let chunk = pixels
         .len()
         .div_ceil(4 * rayon::current_num_threads())
@@ -147,8 +162,10 @@ pub fn until_accurate<T, E>(
     loop {
         let result = run(method)?;
         let reached = error(&result);
+        // The tighter run must itself be checkable: a run at the precision
+        // floor has no tighter one, and its error would be unknown.
         let tighter = method.tighter();
-        if reached <= accuracy || !tighter.is_tighter_than(&method) {
+        if reached <= accuracy || tighter.check_run().is_none() {
             return Ok((result, method, reached, reached <= accuracy));
         }
         method = tighter;
@@ -159,6 +176,6 @@ pub fn until_accurate<T, E>(
 pub fn reached_text(reached: bool) -> &'static str {
     match reached {
         true => "reached",
-        false => "NOT reached (the tolerance is at the precision floor)",
+        false => "NOT reached (a tighter tolerance would be at the precision floor, where no run checks it)",
     }
 }

@@ -140,6 +140,14 @@ crate::declare_settings! {
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
         /// gauss6).
         tol: f64 = 1e-10, Range::Positive;
+        /// Orbits run again at a hundredth of the tolerance, spread over the
+        /// seeds, to state the error of their drawn points (0: none).
+        check: usize = 24, Range::Count { min: 0, max: 100_000 };
+        /// The error wanted on the drawn points (auto: none asked, each
+        /// checked orbit states its error). Given, `tol` is tightened a
+        /// hundredfold until every checked orbit's points are within it, or
+        /// the result says how many periods of each orbit are.
+        accuracy: Option<f64> = None, Range::Positive;
     }
 }
 
@@ -153,6 +161,8 @@ impl PeriodMapOptions {
             p_max: self.p_max,
             periods: self.periods,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            check: self.check,
+            accuracy: self.accuracy,
         })
     }
 }
@@ -174,6 +184,23 @@ pub struct PortraitSettings {
     pub p_max: f64,
     pub periods: usize,
     pub method: Method,
+    /// Orbits rerun at a hundredth of the tolerance (0: none).
+    pub check: usize,
+    /// The error wanted on the drawn points (None: stated, not chosen).
+    pub accuracy: Option<f64>,
+}
+
+/// The error of one orbit's drawn points: twice their largest distance
+/// (angles modulo 2π) to the same orbit run at a hundredth of the
+/// tolerance.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct OrbitCheck {
+    pub orbit: usize,
+    pub error: f64,
+    /// With an `accuracy`: the periods from the seed over which twice the
+    /// distance stays within it (None: the whole orbit, or none asked). On
+    /// a chaotic orbit it grows only as the logarithm of the tolerance.
+    pub periods_within: Option<usize>,
 }
 
 /// An orbit that stopped: its index among the seeds and the integrator's
@@ -205,6 +232,13 @@ pub struct Portrait {
     pub periods: usize,
     /// Orbits that stopped, with the reason (the others are in `orbits`).
     pub failed: Vec<Stopped>,
+    /// The checked orbits' errors (empty: `check` = 0), and the two runs
+    /// compared ("taylor, tol 1e-10 against taylor, tol 1e-12").
+    pub checks: Vec<OrbitCheck>,
+    pub check_runs: String,
+    /// Whether the `accuracy` asked for was reached, and by which run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     pub seconds: f64,
     /// Per seed, the projected points (empty for a failed orbit).
     #[serde(skip)]
@@ -296,8 +330,65 @@ pub fn iterates_of_starts(
     Ok(systems.iterates(params, method, period, &flat, &recording)?)
 }
 
-/// The orbits of `model` with parameter values `params`.
+/// The orbits of `model` with parameter values `params`. With an
+/// `accuracy`, the tolerance is tightened a hundredfold until every
+/// checked orbit's points are within it.
 pub fn portrait(
+    model: &Model,
+    params: &[f64],
+    settings: &PortraitSettings,
+) -> Result<Portrait, PeriodMapError> {
+    let Some(accuracy) = settings.accuracy else {
+        return portrait_once(model, params, settings);
+    };
+    let settings = PortraitSettings {
+        check: settings.check.max(1),
+        ..settings.clone()
+    };
+    let (mut portrait, method, error, reached) = super::check::until_accurate(
+        settings.method,
+        accuracy,
+        |method| {
+            portrait_once(
+                model,
+                params,
+                &PortraitSettings {
+                    method,
+                    ..settings.clone()
+                },
+            )
+        },
+        // No check (at the precision floor): the error is unknown.
+        |portrait| match portrait.checks.is_empty() {
+            true => f64::INFINITY,
+            false => portrait.checks.iter().map(|c| c.error).fold(0.0, f64::max),
+        },
+    )?;
+    let short: Vec<String> = (portrait.checks.iter())
+        .filter_map(|c| {
+            Some(format!(
+                "orbit {} for {} periods",
+                c.orbit, c.periods_within?
+            ))
+        })
+        .collect();
+    let within = match short.is_empty() {
+        true => String::new(),
+        false => format!(
+            "; within it only {} (an orbit's error grows with its length, on a chaotic one exponentially)",
+            short.join(", ")
+        ),
+    };
+    portrait.accuracy = Some(format!(
+        "accuracy {accuracy} {} with {}: the checked points within {error:.2e}{within}",
+        super::check::reached_text(reached),
+        method.describe()
+    ));
+    Ok(portrait)
+}
+
+/// [`portrait`] at the settings' method, its check included.
+fn portrait_once(
     model: &Model,
     params: &[f64],
     settings: &PortraitSettings,
@@ -325,31 +416,33 @@ pub fn portrait(
     orbit_budget(seeds.len(), settings.periods, wrap.len())?;
     let start = std::time::Instant::now();
     let system = systems.exact(params);
-    let runs: Vec<Result<Vec<(f64, f64)>, OdeError>> = seeds
-        .par_iter()
-        .map(|y0| {
-            let mut integrator = Integrator::new(settings.method)?;
-            let mut points = Vec::with_capacity(settings.periods + 1);
-            let [a, b] = settings.axes;
-            let mut keep = |y: &[f64]| {
-                points.push((y[a], y[b]));
-                true
-            };
-            stream_orbit(
-                &mut integrator,
-                &*system,
-                period,
-                y0,
-                settings.periods,
-                &wrap,
-                &mut keep,
-            )?;
-            Ok(points)
-        })
-        .collect();
+    let run = |seeds: &[Vec<f64>], method: Method| -> Vec<Result<Vec<(f64, f64)>, OdeError>> {
+        seeds
+            .par_iter()
+            .map(|y0| {
+                let mut integrator = Integrator::new(method)?;
+                let mut points = Vec::with_capacity(settings.periods + 1);
+                let [a, b] = settings.axes;
+                let mut keep = |y: &[f64]| {
+                    points.push((y[a], y[b]));
+                    true
+                };
+                stream_orbit(
+                    &mut integrator,
+                    &*system,
+                    period,
+                    y0,
+                    settings.periods,
+                    &wrap,
+                    &mut keep,
+                )?;
+                Ok(points)
+            })
+            .collect()
+    };
     let (mut projected, mut failed) = (Vec::new(), Vec::new());
-    for (k, run) in runs.into_iter().enumerate() {
-        match run {
+    for (k, orbit) in run(&seeds, settings.method).into_iter().enumerate() {
+        match orbit {
             Ok(points) => projected.push(points),
             Err(e) => {
                 failed.push(Stopped { orbit: k, error: e });
@@ -357,6 +450,37 @@ pub fn portrait(
             }
         }
     }
+    // The check: orbits spread over the seeds run again more tightly.
+    let checked: Vec<usize> = super::check::sample_pixels(seeds.len(), settings.check)
+        .into_iter()
+        .filter(|&k| !projected[k].is_empty())
+        .collect();
+    // At the precision floor no tighter run exists: nothing is checked.
+    let tighter = settings.method.check_run();
+    let checked = if tighter.is_some() {
+        checked
+    } else {
+        Vec::new()
+    };
+    let chosen: Vec<Vec<f64>> = checked.iter().map(|&k| seeds[k].clone()).collect();
+    let wraps = settings.axes.map(|a| wrap[a]);
+    let again = tighter.map_or_else(Vec::new, |tighter| run(&chosen, tighter));
+    let checks = checked
+        .iter()
+        .zip(again)
+        .filter_map(|(&k, again)| {
+            let distances = distances(&projected[k], &again.ok()?, wraps);
+            let error = 2.0 * distances.iter().fold(0.0, |m: f64, &d| m.max(d));
+            let periods_within = settings
+                .accuracy
+                .and_then(|a| distances.iter().position(|&d| 2.0 * d > a));
+            Some(OrbitCheck {
+                orbit: k,
+                error,
+                periods_within,
+            })
+        })
+        .collect();
     Ok(Portrait {
         model: info.name.into(),
         params: named,
@@ -365,9 +489,37 @@ pub fn portrait(
         seeds,
         periods: settings.periods,
         failed,
+        checks,
+        check_runs: match tighter {
+            Some(tighter) => format!(
+                "{} against {}",
+                settings.method.describe(),
+                tighter.describe()
+            ),
+            None => format!(
+                "{} is at the precision floor, with no tighter run to check it",
+                settings.method.describe()
+            ),
+        },
+        accuracy: None,
         seconds: start.elapsed().as_secs_f64(),
         orbits: projected,
     })
+}
+
+/// The distance between two orbits' points, period by period, the
+/// components flagged in `wrap` compared modulo 2π (NaN where the second
+/// stopped first counts as infinitely far).
+fn distances(orbit: &[(f64, f64)], again: &[(f64, f64)], wrap: [bool; 2]) -> Vec<f64> {
+    let apart = |a: f64, b: f64, w: bool| if w { wrap_angle(a - b) } else { a - b };
+    orbit
+        .iter()
+        .enumerate()
+        .map(|(k, p)| match again.get(k) {
+            Some(q) => apart(p.0, q.0, wrap[0]).hypot(apart(p.1, q.1, wrap[1])),
+            None => f64::INFINITY,
+        })
+        .collect()
 }
 
 /// The period of the model's fast phase, or the refusal of a model
@@ -486,9 +638,31 @@ impl crate::outputs::Outputs for Portrait {
         vec![crate::outputs::Table::new("orbits.csv", &header, rows)]
     }
     fn lines(&self) -> Vec<String> {
-        self.failed
-            .iter()
+        let mut lines: Vec<String> = (self.failed.iter())
             .map(|stopped| format!("orbit {} stopped: {}", stopped.orbit, stopped.error))
-            .collect()
+            .collect();
+        if self.checks.is_empty() && self.check_runs.contains("floor") {
+            lines.push(format!(
+                "the drawn points' error: not checked ({})",
+                self.check_runs
+            ));
+        }
+        if !self.checks.is_empty() {
+            let mut errors: Vec<f64> = self.checks.iter().map(|c| c.error).collect();
+            errors.sort_by(f64::total_cmp);
+            let worst = (self.checks.iter())
+                .max_by(|a, b| a.error.total_cmp(&b.error))
+                .map_or(0, |c| c.orbit);
+            lines.push(format!(
+                "the drawn points' error ({} of {} orbits checked, {}): median {:.1e}, largest {:.1e} (orbit {worst})",
+                self.checks.len(),
+                self.orbits.len(),
+                self.check_runs,
+                errors[errors.len() / 2],
+                errors[errors.len() - 1],
+            ));
+        }
+        lines.extend(self.accuracy.clone());
+        lines
     }
 }

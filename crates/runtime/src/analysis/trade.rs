@@ -480,3 +480,17 @@ impl StatedErrors for crate::analysis::basins::Basins {
             .collect()
     }
 }
+
+/// Each checked orbit's drawn points.
+impl StatedErrors for crate::analysis::period_map::Portrait {
+    fn stated(&self) -> Vec<Stated> {
+        (self.checks.iter())
+            .map(|c| Stated {
+                what: format!("orbit {}: its points", c.orbit),
+                kind: "point of an orbit",
+                value: f64::NAN,
+                error: c.error,
+            })
+            .collect()
+    }
+}

@@ -281,6 +281,14 @@ impl Method {
         }
     }
 
+    /// The run that checks this one's numbers ([`Method::tighter`]), or
+    /// None at the precision floor, where no tighter run exists: a check
+    /// against itself would state an error of 0.
+    pub fn check_run(&self) -> Option<Method> {
+        let tighter = self.tighter();
+        tighter.is_tighter_than(self).then_some(tighter)
+    }
+
     /// Whether this is the same method with a smaller tolerance or step.
     pub fn is_tighter_than(&self, other: &Method) -> bool {
         self.name() == other.name() && self.accuracy() < other.accuracy()

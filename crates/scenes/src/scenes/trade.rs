@@ -19,6 +19,8 @@ const ANALYSES: &[(&str, &str)] = &[
     ("attractor", "ueda"),
     ("continuation", "duffing"),
     ("section", "henon_heiles"),
+    ("basins", "duffing"),
+    ("period_map", "duffing"),
 ];
 
 /// Scene `trade`: `--set analysis=…` (one of [`ANALYSES`]), its settings
@@ -26,8 +28,9 @@ const ANALYSES: &[(&str, &str)] = &[
 /// `tols`).
 pub fn trade_scene(catalog: Catalog) -> Result<(), SceneError> {
     use mechlab_runtime::analysis::{
-        attractor::AttractorOptions, chaos_map::ChaosMapOptions, continuation::ContinuationOptions,
-        section::SectionOptions, stability::StabilityOptions,
+        attractor::AttractorOptions, basins::BasinsOptions, chaos_map::ChaosMapOptions,
+        continuation::ContinuationOptions, period_map::PeriodMapOptions, section::SectionOptions,
+        stability::StabilityOptions,
     };
     let analysis = Scene::peek("analysis").unwrap_or_else(|| "stability".into());
     let Some(&(_, model)) = ANALYSES.iter().find(|(name, _)| *name == analysis) else {
@@ -46,6 +49,8 @@ pub fn trade_scene(catalog: Catalog) -> Result<(), SceneError> {
         "chaos_map" => trade_of::<ChaosMapOptions>(catalog, model),
         "attractor" => trade_of::<AttractorOptions>(catalog, model),
         "continuation" => trade_of::<ContinuationOptions>(catalog, model),
+        "basins" => trade_of::<BasinsOptions>(catalog, model),
+        "period_map" => trade_of::<PeriodMapOptions>(catalog, model),
         _ => trade_of::<SectionOptions>(catalog, model),
     }
 }

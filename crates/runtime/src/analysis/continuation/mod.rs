@@ -482,8 +482,10 @@ fn continuation_once(
     let index = Refusal::parameter_index(info, &settings.parameter)?;
     let named = Refusal::named_values(info, params)?;
     let map = AtModel::new(systems, params, index, settings.method);
-    let tighter = AtModel::new(systems, params, index, settings.method.tighter());
-    let mut result = run(&map, Some(&tighter), params[index], settings, &name)?;
+    // No tighter run at the precision floor: the errors are not stated.
+    let tighter = (settings.method.check_run()).map(|m| AtModel::new(systems, params, index, m));
+    let tighter = tighter.as_ref().map(|t| t as &dyn FamilyMap);
+    let mut result = run(&map, tighter, params[index], settings, &name)?;
     result.params = named;
     result.state_names = info.state_names();
     Ok(result)
@@ -524,21 +526,17 @@ fn on_constraints(
         start: map.chart(map.start()),
         ..settings.clone()
     };
-    let tighter = chart::ChartMap::new(
-        model,
-        params,
-        index,
-        settings.method.tighter(),
-        &start,
-        Some(map.held()),
-    )
-    .map_err(|source| ContinuationError::Start {
-        model: name.clone(),
-        guess: start.clone(),
-        parameter: params[index],
-        source,
-    })?;
-    let mut result = run(&map, Some(&tighter), params[index], &in_chart, &name)?;
+    let tighter = (settings.method.check_run())
+        .map(|m| chart::ChartMap::new(model, params, index, m, &start, Some(map.held())))
+        .transpose()
+        .map_err(|source| ContinuationError::Start {
+            model: name.clone(),
+            guess: start.clone(),
+            parameter: params[index],
+            source,
+        })?;
+    let tighter = tighter.as_ref().map(|t| t as &dyn FamilyMap);
+    let mut result = run(&map, tighter, params[index], &in_chart, &name)?;
     result.params = named;
     let names = info.state_names();
     result.state_names = map.held().iter().map(|&i| names[i]).collect();
