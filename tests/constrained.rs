@@ -196,6 +196,7 @@ fn a_linkages_vibrational_threshold_is_its_hand_reduced_ones() {
         stable,
         windows,
         moduli,
+        ..
     } = &result.exact
     else {
         panic!(
@@ -1019,6 +1020,8 @@ fn averaging_on_the_constraints_converges_as_one_over_the_frequency() {
     let model = mechlab::models::by_name("four_bar").unwrap();
     let params = model.dynamic.defaults();
     let settings = ConvergenceSettings {
+        check: false,
+        accuracy: None,
         parameter: None,
         values: Some(vec![100.0, 200.0, 400.0, 800.0]),
         y0: None,
@@ -1078,4 +1081,75 @@ fn a_rolling_disk_stays_up_above_rouths_spin_and_tips_below() {
         "{drift_up:e} {drift_down:e}"
     );
     assert!(residual.1 < 1e-12, "{residual:?}");
+}
+
+/// `linkage` on Kapitza's pendulum seen from its pivot (a bob on a fixed
+/// ring): the exact window's lower edge against the Mathieu series'
+/// threshold (DLMF 28.6.1) at six ε from 0.02 to 1e-4 and two
+/// tolerances. The stated error bounds the distance in every case, within
+/// 100 times it. On the old criterion (every modulus within 1e-7 of the
+/// circle) this fails at ε = 1e-4: the edge was 2.1e-8 low, stated 7e-9.
+/// An `accuracy` of 1e-11 is reached.
+#[test]
+fn linkages_exact_edges_meet_the_mathieu_series_within_their_stated_errors() {
+    use mechlab::analysis::on_constraints::vibration::{
+        vibration_stability, Exact, VibrationSettings,
+    };
+    let model = &mechlab_test_models::ring_kapitza::SYSTEMS;
+    let mut ratios = Vec::new();
+    for eps in [0.02, 0.01, 0.005, 0.002, 1e-3, 1e-4] {
+        let reference = crate::second_order::mathieu_threshold(eps);
+        for tol in [1e-8, 1e-10] {
+            let settings = VibrationSettings {
+                scan: 20,
+                max_amplitude: Some(2.0),
+                method: Method::parse("dop853", tol).unwrap(),
+                check: true,
+                ..VibrationSettings::default()
+            };
+            let result = vibration_stability(model, &[1.5, eps], &settings).unwrap();
+            let Exact::Periodic {
+                windows,
+                window_errors,
+                ..
+            } = &result.exact
+            else {
+                panic!("{:?}", result.exact)
+            };
+            let (edge, error) = (windows[0][0], window_errors[0][0].unwrap());
+            let distance = (edge - reference).abs();
+            println!("ε = {eps}, tol {tol:e}: {edge:.13} ± {error:.1e} against {reference:.13} (off by {distance:.1e})");
+            assert!(distance <= error, "ε = {eps}, tol {tol:e}");
+            ratios.push(error / distance.max(1e-15));
+        }
+    }
+    println!("stated over distance: {ratios:.1?}");
+    assert!(ratios.iter().all(|&r| r <= 100.0), "{ratios:?}");
+    let asked = VibrationSettings {
+        scan: 20,
+        max_amplitude: Some(2.0),
+        method: Method::parse("dop853", 1e-7).unwrap(),
+        accuracy: Some(1e-11),
+        ..VibrationSettings::default()
+    };
+    let result = vibration_stability(model, &[1.5, 0.01], &asked).unwrap();
+    let Exact::Periodic {
+        windows,
+        window_errors,
+        check,
+        ..
+    } = &result.exact
+    else {
+        panic!("{:?}", result.exact)
+    };
+    let check = check.clone().unwrap();
+    println!("{check}");
+    assert!(check.contains(" reached"), "{check}");
+    assert!(window_errors[0][0].unwrap() <= 1e-11);
+    let reference = crate::second_order::mathieu_threshold(0.01);
+    assert!(
+        (windows[0][0] - reference).abs() <= 1e-11,
+        "{} against {reference}",
+        windows[0][0]
+    );
 }

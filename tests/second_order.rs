@@ -74,7 +74,7 @@ fn kapitza_hessian_matches_the_hand_derivation() {
 /// The boundary a0(h) of the Mathieu equation w'' + (a − 2h cos 2z) w = 0
 /// (DLMF 28.6.1): the linearised Kapitza pendulum at q = 0 is one with
 /// z = θ/2, a = −4ε², h = 2εA, so A*(ε) solves −4ε² = a0(2εA).
-fn mathieu_threshold(eps: f64) -> f64 {
+pub(crate) fn mathieu_threshold(eps: f64) -> f64 {
     let a0 = |h: f64| {
         let h2 = h * h;
         -h2 / 2.0 + 7.0 * h2 * h2 / 128.0 - 29.0 * h2.powi(3) / 2304.0
@@ -210,6 +210,8 @@ fn second_order_trajectories_deviate_like_one_over_nu_squared() {
     let params = dp::Params::default();
     for (order, expected) in [(1, -1.0), (2, -2.0)] {
         let settings = ConvergenceSettings {
+            check: false,
+            accuracy: None,
             parameter: Some("nu".into()),
             values: Some(vec![400.0, 800.0, 1600.0, 3200.0]),
             y0: None,
@@ -231,6 +233,8 @@ fn second_order_trajectories_deviate_like_one_over_nu_squared() {
         mu: 0.0,
     };
     let settings = ConvergenceSettings {
+        check: false,
+        accuracy: None,
         parameter: Some("eps".into()),
         values: Some(vec![0.02, 0.01, 0.005, 0.0025]),
         y0: Some(vec![2.5, 0.3]),
@@ -253,6 +257,8 @@ fn an_order_not_derived_is_an_error() {
     use mechlab::analysis::averaging::{convergence, AveragingError, ConvergenceSettings};
     let params = mechlab::models::triple_pendulum::Params::default();
     let settings = ConvergenceSettings {
+        check: false,
+        accuracy: None,
         parameter: None,
         values: None,
         y0: None,
@@ -267,6 +273,8 @@ fn an_order_not_derived_is_an_error() {
 /// The averaging analysis to second order at its automatic sweep.
 fn second_order_sweep() -> mechlab::analysis::averaging::ConvergenceSettings {
     mechlab::analysis::averaging::ConvergenceSettings {
+        check: false,
+        accuracy: None,
         parameter: None,
         values: None,
         y0: None,

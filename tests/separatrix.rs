@@ -411,3 +411,38 @@ fn the_splitting_angle_in_double_double_follows_the_lobe_area() {
         previous = ratio;
     }
 }
+
+/// The double-precision lobe area's stated error (the action route's own
+/// estimate) against the area in double-double (32 digits, the symmetric
+/// orbits' actions) at five ε: it bounds the distance in every case, within
+/// 100 times it. And an `accuracy` below double's error is met in
+/// double-double.
+#[test]
+fn the_lobe_areas_stated_error_bounds_its_distance_to_double_double() {
+    let model = models::by_name("kapitza").unwrap();
+    for eps in [0.2, 0.15, 0.12, 0.1, 0.08] {
+        let double = separatrix_splitting(model, &kapitza_at(eps), &coarse()).unwrap();
+        let precise = separatrix_splitting(model, &kapitza_at(eps), &in_double_double()).unwrap();
+        let (area, error) = (double.lobe_area().unwrap(), double.lobe_area_error.unwrap());
+        let reference = precise.lobe_area_action.unwrap();
+        let distance = (area - reference).abs();
+        println!(
+            "ε = {eps}: {area:.12e} ± {error:.1e} against {reference:.12e} ± {:.1e} (off by {distance:.1e})",
+            precise.lobe_area_error.unwrap()
+        );
+        assert!(
+            distance <= error && error <= 100.0 * distance.max(1e-16),
+            "ε = {eps}"
+        );
+    }
+    let asked = SplittingSettings {
+        precision: Precision::Double,
+        accuracy: Some(1e-22),
+        ..coarse()
+    };
+    let s = separatrix_splitting(model, &kapitza_at(0.1), &asked).unwrap();
+    let verdict = s.accuracy.clone().unwrap();
+    println!("{verdict}");
+    assert!(verdict.contains(" reached in double-double"), "{verdict}");
+    assert_eq!(s.precision, Precision::DoubleDouble);
+}

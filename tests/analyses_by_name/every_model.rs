@@ -153,6 +153,7 @@ fn constrained_model_on_its_constraints(name: &str, params: &[f64]) {
         params,
         &VibrationSettings {
             scan: 4,
+            check: false,
             ..Default::default()
         },
     ) {
@@ -346,6 +347,8 @@ fn stability_settings(amplitude: &str) -> Settings {
 
 fn averaging_settings() -> ConvergenceSettings {
     ConvergenceSettings {
+        check: false,
+        accuracy: None,
         parameter: None,
         values: None,
         y0: None,

@@ -147,6 +147,8 @@ pub fn asymptotic_slopes(
         let proportional = ((f[1] / f[0]) / (v[1] / v[0]) - 1.0).abs() < 1e-6;
         let factor = if proportional { 8.0 } else { 1.0 / 8.0 };
         let higher = mechlab::analysis::averaging::ConvergenceSettings {
+            check: false,
+            accuracy: None,
             values: Some(v.iter().map(|x| x * factor).collect()),
             parameter: Some(last.parameter.clone()),
             ..settings.clone()

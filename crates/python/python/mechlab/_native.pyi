@@ -182,6 +182,8 @@ class Model:
         periods: int = 300,
         method: str = "dop853",
         tol: float = 1e-12,
+        check: bool = True,
+        accuracy: Optional[float] = None,
         params: Params = None,
     ) -> dict[str, Any]:
         """Stabilisation by vibration on the constraints of a constrained model: its equilibrium near the start, the averaged thresholds, and the exact Floquet multipliers on the constraints against the amplitude."""
@@ -241,6 +243,7 @@ class Model:
         precision: str = "auto",
         method: str = "taylor",
         tol: float = 1e-14,
+        accuracy: Optional[float] = None,
         params: Params = None,
     ) -> dict[str, Any]:
         """The splitting of the separatrices of the period map's hyperbolic fixed point (a model of one degree of freedom with a fast phase): the manifolds, their homoclinic points and the lobe area by the action and by the polygon."""
@@ -256,6 +259,8 @@ class Model:
         order: int = 1,
         method: str = "dop853",
         tol: float = 1e-11,
+        check: bool = True,
+        accuracy: Optional[float] = None,
         params: Params = None,
     ) -> dict[str, Any]:
         """Exact against averaged (Theorem 2 on any model): the largest deviation of each coordinate between the exact and averaged runs from the same state, against the frequency of the fast phase, and its fitted slope."""

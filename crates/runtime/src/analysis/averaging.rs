@@ -160,6 +160,14 @@ crate::declare_settings! {
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
         /// gauss6).
         tol: f64 = 1e-11, Range::Positive;
+        /// Run the sweep again at a hundredth of the tolerance, to state
+        /// each deviation's and slope's numerical error (no: none).
+        check: bool = true, Range::Any;
+        /// The relative error wanted on every deviation (auto: none asked;
+        /// with `check`, each comes with its error). Given, `tol` is
+        /// tightened a hundredfold until every deviation's error is within
+        /// this share of it, or the result says why not.
+        accuracy: Option<f64> = None, Range::Positive;
     }
 }
 
@@ -173,6 +181,8 @@ impl AveragingOptions {
             t_obs: self.t_obs,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
             order: self.order,
+            check: self.check,
+            accuracy: self.accuracy,
         })
     }
 }
@@ -198,6 +208,11 @@ pub struct ConvergenceSettings {
     /// transformed state y′ = y − J∇(εχ₁) and mapped back along its run
     /// (deviation O(1/ν²)).
     pub order: usize,
+    /// Run again at a hundredth of the tolerance to state the errors.
+    pub check: bool,
+    /// The relative error wanted on every deviation (None: stated, not
+    /// chosen).
+    pub accuracy: Option<f64>,
 }
 
 /// Theorem 2 on any model by name: the maximal deviation of each coordinate
@@ -232,6 +247,18 @@ pub struct AveragingConvergence {
     /// is small at these frequencies, or a chaotic run whose constant grows
     /// like e^(λ t)): raise the frequencies to see it.
     pub settled_slope: Vec<Option<f64>>,
+    /// Each deviation's numerical error, `[coordinate][value]`: twice its
+    /// distance to the same sweep run at a hundredth of the tolerance
+    /// (empty: not checked).
+    pub deviation_error: Vec<Vec<f64>>,
+    /// Each fitted slope's numerical error, the same way (empty: not
+    /// checked).
+    pub slope_error: Vec<f64>,
+    /// The two runs compared, or why none was.
+    pub check: Option<String>,
+    /// Whether the `accuracy` asked for was reached, and by which run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
 }
 
 /// How closely the last three local slopes agree where the sweep has
@@ -332,8 +359,57 @@ pub fn second_order_deviation(
 }
 
 /// Runs [`AveragingConvergence`] on `model` with parameter values
-/// `params` (declaration order).
+/// `params` (declaration order); with `check`, again at a hundredth of
+/// the tolerance for the errors; with an `accuracy`, a hundredfold tighter
+/// until every deviation's error is within it.
 pub fn convergence(
+    model: &Model,
+    params: &[f64],
+    settings: &ConvergenceSettings,
+) -> Result<AveragingConvergence, AveragingError> {
+    let at = |method: Method| {
+        let settings = ConvergenceSettings {
+            method,
+            ..settings.clone()
+        };
+        convergence_once(model, params, &settings)
+    };
+    let mut method = settings.method;
+    let mut current = at(method)?;
+    if !settings.check && settings.accuracy.is_none() {
+        return Ok(current);
+    }
+    loop {
+        let Some(tighter) = method.check_run() else {
+            current.check = Some(format!(
+                "{} is at the precision floor, with no tighter run to check it",
+                method.describe()
+            ));
+            current.accuracy = (settings.accuracy).map(|a| {
+                format!("accuracy {a:e} NOT reached: no run at the precision floor is checked")
+            });
+            return Ok(current);
+        };
+        let again = at(tighter)?;
+        current.checked_against(&again, method, tighter);
+        let Some(accuracy) = settings.accuracy else {
+            return Ok(current);
+        };
+        let worst = current.worst_relative_error();
+        if worst <= accuracy || tighter.check_run().is_none() {
+            current.accuracy = Some(format!(
+                "accuracy {accuracy:e} {} with {}: every deviation within {worst:.1e} of itself",
+                super::check::reached_text(worst <= accuracy),
+                method.describe()
+            ));
+            return Ok(current);
+        }
+        (method, current) = (tighter, again);
+    }
+}
+
+/// [`convergence`] at the settings' method, unchecked.
+fn convergence_once(
     model: &Model,
     params: &[f64],
     settings: &ConvergenceSettings,
@@ -449,6 +525,41 @@ fn summarised(
         level: run.fits.iter().map(|f| f.intercept.exp()).collect(),
         settled_slope: local.iter().map(|l| settled(l)).collect(),
         local_slopes: local,
+        deviation_error: Vec::new(),
+        slope_error: Vec::new(),
+        check: None,
+        accuracy: None,
+    }
+}
+
+impl AveragingConvergence {
+    /// The errors of this sweep (by `method`) from `again`, the same sweep
+    /// by `tighter`: twice the distances.
+    fn checked_against(&mut self, again: &AveragingConvergence, method: Method, tighter: Method) {
+        self.deviation_error = (self.max_deviation.iter())
+            .zip(&again.max_deviation)
+            .map(|(a, b)| a.iter().zip(b).map(|(x, y)| 2.0 * (x - y).abs()).collect())
+            .collect();
+        self.slope_error = (self.slope.iter())
+            .zip(&again.slope)
+            .map(|(a, b)| 2.0 * (a - b).abs())
+            .collect();
+        self.check = Some(format!(
+            "{} against {}",
+            method.describe(),
+            tighter.describe()
+        ));
+    }
+
+    /// The largest error of a deviation over the deviation (∞ unchecked).
+    fn worst_relative_error(&self) -> f64 {
+        if self.deviation_error.is_empty() {
+            return f64::INFINITY;
+        }
+        (self.deviation_error.iter().flatten())
+            .zip(self.max_deviation.iter().flatten())
+            .map(|(e, d)| e / d.abs())
+            .fold(0.0, f64::max)
     }
 }
 
@@ -706,6 +817,7 @@ impl crate::outputs::Outputs for AveragingConvergence {
                     self.frequencies[k],
                     name.clone(),
                     self.max_deviation[c][k],
+                    self.deviation_error.get(c).map_or(f64::NAN, |e| e[k]),
                     self.frequency_times_deviation[c][k],
                 )
             })
@@ -715,15 +827,30 @@ impl crate::outputs::Outputs for AveragingConvergence {
             "frequency",
             "coordinate",
             "max_deviation",
+            "max_deviation_error",
             "frequency_times_max_deviation",
         ];
         vec![crate::outputs::Table::new("convergence.csv", &header, rows)]
     }
     fn lines(&self) -> Vec<String> {
-        self.coordinates
-            .iter()
-            .zip(&self.slope)
-            .map(|(c, s)| format!("{c}: max deviation ∝ ν^{s:.4}"))
-            .collect()
+        let mut lines: Vec<String> = (self.coordinates.iter().zip(&self.slope).enumerate())
+            .map(|(k, (c, s))| match self.slope_error.get(k) {
+                Some(e) => {
+                    format!("{c}: max deviation ∝ ν^{s:.4} (numerical error of the slope {e:.1e})")
+                }
+                None => format!("{c}: max deviation ∝ ν^{s:.4}"),
+            })
+            .collect();
+        if let Some(check) = &self.check {
+            let worst = self.worst_relative_error();
+            lines.push(match worst.is_finite() {
+                true => format!(
+                    "deviations' numerical error: at most {worst:.1e} of a deviation ({check})"
+                ),
+                false => format!("deviations' numerical error: not stated ({check})"),
+            });
+        }
+        lines.extend(self.accuracy.clone());
+        lines
     }
 }

@@ -494,3 +494,68 @@ impl StatedErrors for crate::analysis::period_map::Portrait {
             .collect()
     }
 }
+
+/// Each deviation between the exact and the averaged runs.
+impl StatedErrors for crate::analysis::averaging::AveragingConvergence {
+    fn stated(&self) -> Vec<Stated> {
+        let mut stated = Vec::new();
+        for (c, errors) in self.deviation_error.iter().enumerate() {
+            for (k, error) in errors.iter().enumerate() {
+                stated.push(Stated {
+                    what: format!(
+                        "{} at nu = {}: max deviation",
+                        self.coordinates[c], self.frequencies[k]
+                    ),
+                    kind: "deviation",
+                    value: self.max_deviation[c][k],
+                    error: *error,
+                });
+            }
+        }
+        stated
+    }
+}
+
+/// The exact windows' edges on the constraints.
+impl StatedErrors for crate::analysis::on_constraints::vibration::Linkage {
+    fn stated(&self) -> Vec<Stated> {
+        use crate::analysis::on_constraints::vibration::Exact;
+        let Exact::Periodic {
+            windows,
+            window_errors,
+            ..
+        } = &self.stability.exact
+        else {
+            return Vec::new();
+        };
+        let mut stated = Vec::new();
+        for (k, (window, errors)) in windows.iter().zip(window_errors).enumerate() {
+            for (side, name) in [(0, "lower"), (1, "upper")] {
+                if let Some(error) = errors[side] {
+                    stated.push(Stated {
+                        what: format!("window {k}: {name} edge"),
+                        kind: "edge of an exact window",
+                        value: window[side],
+                        error,
+                    });
+                }
+            }
+        }
+        stated
+    }
+}
+
+/// The lobe area.
+impl StatedErrors for crate::analysis::separatrix::Splitting {
+    fn stated(&self) -> Vec<Stated> {
+        let (Some(value), Some(error)) = (self.lobe_area(), self.lobe_area_error) else {
+            return Vec::new();
+        };
+        vec![Stated {
+            what: "lobe area".into(),
+            kind: "lobe area",
+            value,
+            error,
+        }]
+    }
+}

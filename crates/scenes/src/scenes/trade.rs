@@ -21,6 +21,8 @@ const ANALYSES: &[(&str, &str)] = &[
     ("section", "henon_heiles"),
     ("basins", "duffing"),
     ("period_map", "duffing"),
+    ("averaging", "double_pendulum"),
+    ("linkage", "four_bar"),
 ];
 
 /// Scene `trade`: `--set analysis=…` (one of [`ANALYSES`]), its settings
@@ -28,9 +30,10 @@ const ANALYSES: &[(&str, &str)] = &[
 /// `tols`).
 pub fn trade_scene(catalog: Catalog) -> Result<(), SceneError> {
     use mechlab_runtime::analysis::{
-        attractor::AttractorOptions, basins::BasinsOptions, chaos_map::ChaosMapOptions,
-        continuation::ContinuationOptions, period_map::PeriodMapOptions, section::SectionOptions,
-        stability::StabilityOptions,
+        attractor::AttractorOptions, averaging::AveragingOptions, basins::BasinsOptions,
+        chaos_map::ChaosMapOptions, continuation::ContinuationOptions,
+        on_constraints::vibration::LinkageOptions, period_map::PeriodMapOptions,
+        section::SectionOptions, stability::StabilityOptions,
     };
     let analysis = Scene::peek("analysis").unwrap_or_else(|| "stability".into());
     let Some(&(_, model)) = ANALYSES.iter().find(|(name, _)| *name == analysis) else {
@@ -51,6 +54,8 @@ pub fn trade_scene(catalog: Catalog) -> Result<(), SceneError> {
         "continuation" => trade_of::<ContinuationOptions>(catalog, model),
         "basins" => trade_of::<BasinsOptions>(catalog, model),
         "period_map" => trade_of::<PeriodMapOptions>(catalog, model),
+        "averaging" => trade_of::<AveragingOptions>(catalog, model),
+        "linkage" => trade_of::<LinkageOptions>(catalog, model),
         _ => trade_of::<SectionOptions>(catalog, model),
     }
 }

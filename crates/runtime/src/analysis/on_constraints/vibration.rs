@@ -62,6 +62,14 @@ crate::declare_settings! {
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
         /// gauss6).
         tol: f64 = 1e-12, Range::Positive;
+        /// Run the exact scan again at a hundredth of the tolerance, to
+        /// state each window edge's error (no: none).
+        check: bool = true, Range::Any;
+        /// The error wanted on the exact windows' edges (auto: none asked;
+        /// with `check`, each edge comes with its error). Given, `tol` is
+        /// tightened a hundredfold until every edge's error is within it,
+        /// or the result says why not.
+        accuracy: Option<f64> = None, Range::Positive;
     }
 }
 
@@ -74,6 +82,8 @@ impl LinkageOptions {
             start: self.start.clone(),
             scan: self.scan,
             method: method(Self::ANALYSIS, &self.method, self.tol)?,
+            check: self.check,
+            accuracy: self.accuracy,
         })
     }
 }
@@ -93,6 +103,10 @@ pub struct VibrationSettings {
     /// Amplitudes scanned between 0 and the largest.
     pub scan: usize,
     pub method: Method,
+    /// Scan again at a hundredth of the tolerance for the edges' errors.
+    pub check: bool,
+    /// The error wanted on the edges (None: stated, not chosen).
+    pub accuracy: Option<f64>,
 }
 
 /// The declared defaults.
@@ -109,12 +123,21 @@ impl Default for VibrationSettings {
 pub enum Exact {
     /// At rest relative to the base it is a periodic orbit of the exact
     /// system: its Floquet multipliers' moduli at the amplitude, whether
-    /// they are all within 1e-7 of the unit circle or inside it, and the
-    /// intervals of scanned amplitudes where they are (edges by bisection).
+    /// it is stable (by the monodromy criterion that holds however short
+    /// the period, [`crate::analysis::floquet::stability_margin`]), and
+    /// the intervals of scanned amplitudes where it is (edges by
+    /// bisection), each edge with its error: twice its distance to the
+    /// same edge in a scan at a hundredth of the tolerance, plus the
+    /// bisection's bracket (None: not checked, or a window's upper end
+    /// that is the scan's end).
     Periodic {
         moduli: Vec<f64>,
         stable: bool,
         windows: Vec<[f64; 2]>,
+        window_errors: Vec<[Option<f64>; 2]>,
+        /// The two scans compared, or why none was; with an `accuracy`,
+        /// whether it was reached.
+        check: Option<String>,
     },
     /// The vibration moves the orbit off the averaged equilibrium (|P(y₀) − y₀|
     /// is `gap` after one period): its multipliers need the period map's
@@ -395,8 +418,7 @@ pub fn vibration_stability(
         .map(|k| most * k as f64 / settings.scan.max(1) as f64)
         .collect();
     let (thresholds, lowest_along) = thresholds_along(&at, &amplitudes, &found.q, &amplitude)?;
-    let (exact, largest) =
-        exact_verdict(model, params, index, &found.q, &amplitudes, settings.method)?;
+    let (exact, largest) = checked_verdict(model, params, index, &found.q, &amplitudes, settings)?;
     let scan = amplitudes
         .iter()
         .zip(lowest_along)
@@ -483,8 +505,9 @@ fn exact_verdict(
 ) -> Result<(Exact, Vec<Option<f64>>), VibrationError> {
     let mut y0 = q.to_vec();
     y0.resize(2 * q.len(), 0.0);
-    // The moduli of the multipliers at amplitude a, or the orbit's gap.
-    let moduli_at = |a: f64| -> Result<Result<Vec<f64>, f64>, VibrationError> {
+    // The moduli of the multipliers at amplitude a and whether they are
+    // stable, or the orbit's gap.
+    let moduli_at = |a: f64| -> Result<Result<(Vec<f64>, bool), f64>, VibrationError> {
         let mut p = params.to_vec();
         p[index] = a;
         let period = model
@@ -509,18 +532,18 @@ fn exact_verdict(
             .map(|z| z.norm())
             .collect();
         moduli.sort_by(f64::total_cmp);
-        Ok(Ok(moduli))
+        let stable = crate::analysis::floquet::stability_margin(&restricted, period) <= 0.0;
+        Ok(Ok((moduli, stable)))
     };
-    let stable = |moduli: &[f64]| moduli.iter().all(|m| *m <= 1.0 + 1e-7);
-    let moduli = match moduli_at(params[index])? {
-        Ok(moduli) => moduli,
+    let (moduli, stable_here) = match moduli_at(params[index])? {
+        Ok(found) => found,
         Err(gap) => {
             let none = vec![None; amplitudes.len()];
             return Ok((Exact::MovedByVibration { gap }, none));
         }
     };
     let verdict = |a: f64| -> Result<Option<bool>, VibrationError> {
-        Ok(moduli_at(a)?.ok().map(|m| stable(&m)))
+        Ok(moduli_at(a)?.ok().map(|(_, stable)| stable))
     };
     let mut windows: Vec<[f64; 2]> = Vec::new();
     let mut largest = Vec::with_capacity(amplitudes.len());
@@ -528,8 +551,8 @@ fn exact_verdict(
     let mut last: Option<(f64, bool)> = None;
     for &a in amplitudes {
         let here = moduli_at(a)?.ok();
-        largest.push(here.as_ref().and_then(|m| m.last().copied()));
-        let Some(now) = here.map(|m| stable(&m)) else {
+        largest.push(here.as_ref().and_then(|(m, _)| m.last().copied()));
+        let Some(now) = here.map(|(_, stable)| stable) else {
             continue;
         };
         let edge = match last {
@@ -559,11 +582,133 @@ fn exact_verdict(
         windows.push([o, a]);
     }
     let exact = Exact::Periodic {
-        stable: stable(&moduli),
+        stable: stable_here,
         moduli,
+        window_errors: vec![[None, None]; windows.len()],
         windows,
+        check: None,
     };
     Ok((exact, largest))
+}
+
+impl Exact {
+    /// The verdict in words: the moduli, the windows with their edges'
+    /// errors, the check.
+    pub fn describe(&self) -> String {
+        let Exact::Periodic {
+            moduli,
+            stable,
+            windows,
+            window_errors,
+            check,
+        } = self
+        else {
+            return format!("exact: {self:?}");
+        };
+        let error = |e: &Option<f64>| e.map_or(String::new(), |e| format!(" ± {e:.1e}"));
+        let windows: Vec<String> = (windows.iter().zip(window_errors))
+            .map(|(w, e)| format!("[{}{}, {}{}]", w[0], error(&e[0]), w[1], error(&e[1])))
+            .collect();
+        let verdict = if *stable { "stable" } else { "unstable" };
+        let check = check.as_ref().map_or(String::new(), |c| format!(" ({c})"));
+        format!(
+            "exact: {verdict}, moduli {moduli:?}; stable for {}{check}",
+            match windows.is_empty() {
+                true => "no scanned amplitude".to_string(),
+                false => windows.join(", "),
+            }
+        )
+    }
+}
+
+/// [`exact_verdict`] with its edges' errors where `settings.check` asks
+/// for them, from the scan again at a hundredth of the tolerance; with an
+/// `accuracy`, the tolerance tightened a hundredfold until every edge's
+/// error is within it.
+fn checked_verdict(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    index: usize,
+    q: &[f64],
+    amplitudes: &[f64],
+    settings: &VibrationSettings,
+) -> Result<(Exact, Vec<Option<f64>>), VibrationError> {
+    let scan = |method: Method| exact_verdict(model, params, index, q, amplitudes, method);
+    let mut method = settings.method;
+    let mut current = scan(method)?;
+    if !settings.check && settings.accuracy.is_none() {
+        return Ok(current);
+    }
+    // The bisection's bracket: 40 halvings of the scan's step.
+    let step = amplitudes.get(1).map_or(0.0, |a| a - amplitudes[0]);
+    let bracket = step / 2f64.powi(40);
+    let scan_end = amplitudes.last().copied().unwrap_or(0.0);
+    loop {
+        let Some(tighter) = method.check_run() else {
+            if let Exact::Periodic { check, .. } = &mut current.0 {
+                *check = Some(format!(
+                    "{} is at the precision floor, with no tighter run to check it{}",
+                    method.describe(),
+                    settings
+                        .accuracy
+                        .map_or(String::new(), |a| format!(": accuracy {a:e} NOT reached"))
+                ));
+            }
+            return Ok(current);
+        };
+        let again = scan(tighter)?;
+        let worst = edge_errors(&mut current.0, &again.0, bracket, scan_end);
+        let runs = format!("{} against {}", method.describe(), tighter.describe());
+        let Exact::Periodic { check, .. } = &mut current.0 else {
+            return Ok(current);
+        };
+        let Some(accuracy) = settings.accuracy else {
+            *check = Some(runs);
+            return Ok(current);
+        };
+        if worst <= accuracy || tighter.check_run().is_none() {
+            *check = Some(format!(
+                "{runs}: accuracy {accuracy:e} {}",
+                crate::analysis::check::reached_text(worst <= accuracy)
+            ));
+            return Ok(current);
+        }
+        (method, current) = (tighter, again);
+    }
+}
+
+/// Each window edge's error in `exact` from the same scan's `again`:
+/// twice the distance to the nearest edge of its side there, plus the
+/// bisection's `bracket` (None where `again` has none, or for an upper end
+/// at the scan's end); the largest (∞ where one is None).
+fn edge_errors(exact: &mut Exact, again: &Exact, bracket: f64, scan_end: f64) -> f64 {
+    let (
+        Exact::Periodic {
+            windows,
+            window_errors,
+            ..
+        },
+        Exact::Periodic {
+            windows: others, ..
+        },
+    ) = (exact, again)
+    else {
+        return f64::INFINITY;
+    };
+    let mut worst: f64 = 0.0;
+    for (window, errors) in windows.iter().zip(window_errors.iter_mut()) {
+        for side in 0..2 {
+            if side == 1 && window[1] == scan_end {
+                continue;
+            }
+            let nearest = (others.iter())
+                .map(|w| (w[side] - window[side]).abs())
+                .min_by(f64::total_cmp);
+            errors[side] = nearest.map(|d| 2.0 * d + bracket);
+            worst = worst.max(errors[side].unwrap_or(f64::INFINITY));
+        }
+    }
+    worst
 }
 
 impl VibrationStability {
@@ -802,7 +947,7 @@ impl crate::outputs::Outputs for Linkage {
                 result.amplitude,
                 result.averaged_thresholds
             ),
-            format!("exact: {:?}", result.exact),
+            result.exact.describe(),
         ]
     }
 }

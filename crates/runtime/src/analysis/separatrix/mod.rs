@@ -60,6 +60,11 @@ crate::declare_settings! {
         /// Its tolerance (taylor, dop853, radau5) or step size (rk4, gauss4,
         /// gauss6).
         tol: f64 = 1e-14, Range::Positive;
+        /// The error wanted on the lobe area (auto: none asked, the area
+        /// comes with its error). Given, where double precision's error is
+        /// larger, the area is measured again in double-double, or the
+        /// result says why it cannot be.
+        accuracy: Option<f64> = None, Range::Positive;
     }
     interactive { spacing: 0.03, lobe_points: 100 }
 }
@@ -76,6 +81,7 @@ impl SplittingOptions {
             p_max: self.p_max,
             lobe_points: self.lobe_points,
             precision: Precision::parse(&self.precision).expect("validated by its range"),
+            accuracy: self.accuracy,
         })
     }
 }
@@ -105,6 +111,8 @@ pub struct SplittingSettings {
     /// orbits of a reversible model, for areas below 10⁻¹⁶ of the actions;
     /// or double-double where double precision does not resolve the area.
     pub precision: Precision,
+    /// The error wanted on the lobe area (None: stated, not chosen).
+    pub accuracy: Option<f64>,
 }
 
 /// A reversing symmetry of the flow: the map (q, p) ↦ (c − q, p) or
@@ -189,9 +197,15 @@ pub struct Splitting {
     /// The lobe area from the two orbits' actions (None where the map does
     /// not preserve area, |det − 1| > 1e-9).
     pub lobe_area_action: Option<f64>,
-    /// An estimate of the action route's error (double-double: the
-    /// rounding of its sums and the tails cut near the fixed point).
+    /// An estimate of the lobe area's error: the action route's rounding
+    /// of its sums (10⁻³¹ of their terms in double-double, 10⁻¹⁶ in
+    /// double), the tails cut near the fixed point and the squares of the
+    /// points' jumps off a true orbit; without the action (a map that does
+    /// not preserve area), the polygon's Richardson correction.
     pub lobe_area_error: Option<f64>,
+    /// Whether the `accuracy` asked for was reached, and how.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
     /// The lobe area from the polygon between the manifold pieces,
     /// Richardson-extrapolated from two resolutions (double precision only:
     /// in double-double the manifolds are drawn, not resolved).
@@ -350,7 +364,48 @@ pub enum SplittingError {
 
 /// The separatrix splitting of `model` (one degree of freedom, a fast
 /// phase) at parameter values `params`.
+/// The splitting of `model`'s separatrices at `params`; with an
+/// `accuracy` its area's error is not within, in double-double where
+/// `precision` allowed double.
 pub fn separatrix_splitting(
+    model: &Model,
+    params: &[f64],
+    settings: &SplittingSettings,
+) -> Result<Splitting, SplittingError> {
+    let mut splitting = splitting_once(model, params, settings)?;
+    let Some(accuracy) = settings.accuracy else {
+        return Ok(splitting);
+    };
+    let error = |s: &Splitting| s.lobe_area_error.unwrap_or(f64::INFINITY);
+    let mut how = match splitting.precision {
+        Precision::DoubleDouble => "in double-double",
+        _ => "in double",
+    }
+    .to_string();
+    if error(&splitting) > accuracy && splitting.precision != Precision::DoubleDouble {
+        let precise = SplittingSettings {
+            precision: Precision::DoubleDouble,
+            ..settings.clone()
+        };
+        match splitting_once(model, params, &precise) {
+            Ok(precise) => {
+                splitting = precise;
+                how = "in double-double, double's error being larger".into();
+            }
+            Err(why) => how = format!("in double; double-double cannot be had here: {why}"),
+        }
+    }
+    let reached = error(&splitting) <= accuracy;
+    splitting.accuracy = Some(format!(
+        "accuracy {accuracy:e} {} {how}: the lobe area's error {:.1e}",
+        if reached { "reached" } else { "NOT reached" },
+        error(&splitting)
+    ));
+    Ok(splitting)
+}
+
+/// [`separatrix_splitting`] at the settings' precision.
+fn splitting_once(
     model: &Model,
     params: &[f64],
     settings: &SplittingSettings,
@@ -441,6 +496,7 @@ fn in_double(
         }
         _ => None,
     };
+    let action_error = actions.map(|w| w[0].error + w[1].error);
     let lobe_area_action = actions.map(|w| {
         homoclinic[0].action = Some(w[0].value);
         homoclinic[1].action = Some(w[1].value);
@@ -468,8 +524,12 @@ fn in_double(
         homoclinic,
         shift: found.shift,
         symmetry: None,
+        lobe_area_error: Some(match action_error {
+            Some(error) => error,
+            None => (polygon.areas[1] - polygon.extrapolated).abs(),
+        }),
         lobe_area_action,
-        lobe_area_error: None,
+        accuracy: None,
         lobe_area_polygon: Some(polygon.extrapolated),
         lobe_area_polygons: Some(polygon.areas),
         lobe_area_melnikov: None,

@@ -300,6 +300,7 @@ fn splitting(
         }),
         lobe_area_action: Some(area),
         lobe_area_error: Some(error),
+        accuracy: None,
         lobe_area_polygon: None,
         lobe_area_polygons: None,
         lobe_area_melnikov: None,
