@@ -180,7 +180,7 @@ class Model:
         orbits: int = 6,
         kick: float = 0.6,
         periods: int = 300,
-        method: str = "dop853",
+        method: str = "taylor",
         tol: float = 1e-12,
         check: bool = True,
         accuracy: Optional[float] = None,

@@ -163,10 +163,10 @@ crate::declare_settings! {
         /// Run the sweep again at a hundredth of the tolerance, to state
         /// each deviation's and slope's numerical error (no: none).
         check: bool = true, Range::Any;
-        /// The relative error wanted on every deviation (auto: none asked;
-        /// with `check`, each comes with its error). Given, `tol` is
-        /// tightened a hundredfold until every deviation's error is within
-        /// this share of it, or the result says why not.
+        /// The error wanted on every deviation (auto: none asked; with
+        /// `check`, each comes with its error). Given, `tol` is tightened a
+        /// hundredfold until every deviation's error is within it, or the
+        /// result says why not.
         accuracy: Option<f64> = None, Range::Positive;
     }
 }
@@ -210,8 +210,7 @@ pub struct ConvergenceSettings {
     pub order: usize,
     /// Run again at a hundredth of the tolerance to state the errors.
     pub check: bool,
-    /// The relative error wanted on every deviation (None: stated, not
-    /// chosen).
+    /// The error wanted on every deviation (None: stated, not chosen).
     pub accuracy: Option<f64>,
 }
 
@@ -395,10 +394,10 @@ pub fn convergence(
         let Some(accuracy) = settings.accuracy else {
             return Ok(current);
         };
-        let worst = current.worst_relative_error();
+        let worst = current.worst_error();
         if worst <= accuracy || tighter.check_run().is_none() {
             current.accuracy = Some(format!(
-                "accuracy {accuracy:e} {} with {}: every deviation within {worst:.1e} of itself",
+                "accuracy {accuracy:e} {} with {}: every deviation's error within {worst:.1e}",
                 super::check::reached_text(worst <= accuracy),
                 method.describe()
             ));
@@ -551,15 +550,12 @@ impl AveragingConvergence {
         ));
     }
 
-    /// The largest error of a deviation over the deviation (∞ unchecked).
-    fn worst_relative_error(&self) -> f64 {
+    /// The largest error of a deviation (∞ unchecked).
+    fn worst_error(&self) -> f64 {
         if self.deviation_error.is_empty() {
             return f64::INFINITY;
         }
-        (self.deviation_error.iter().flatten())
-            .zip(self.max_deviation.iter().flatten())
-            .map(|(e, d)| e / d.abs())
-            .fold(0.0, f64::max)
+        (self.deviation_error.iter().flatten()).fold(0.0, |m: f64, &e| m.max(e))
     }
 }
 
@@ -842,11 +838,9 @@ impl crate::outputs::Outputs for AveragingConvergence {
             })
             .collect();
         if let Some(check) = &self.check {
-            let worst = self.worst_relative_error();
+            let worst = self.worst_error();
             lines.push(match worst.is_finite() {
-                true => format!(
-                    "deviations' numerical error: at most {worst:.1e} of a deviation ({check})"
-                ),
+                true => format!("deviations' numerical error: at most {worst:.1e} ({check})"),
                 false => format!("deviations' numerical error: not stated ({check})"),
             });
         }
