@@ -830,3 +830,63 @@ fn the_sections_maps_asked_for_an_accuracy_reach_it() {
     );
     assert!(check.fraction.max(check.error) <= 0.02, "{check:?}");
 }
+
+/// The section's crossings' stated error against the closed form: for the
+/// uncoupled oscillators (Hénon–Heiles at λ = 0) both motions have period
+/// 2π, so every crossing of x = 0 is the seed itself. Over 200 crossings of
+/// three orbits at three tolerances, each orbit's stated error bounds its
+/// largest distance to the seed, within 100 times it; asked for 1e-9 from
+/// 1e-5, the crossings are within it.
+#[test]
+fn the_sections_crossings_stated_errors_bound_their_distance_to_the_closed_form() {
+    use mechlab::analysis::section::{section_study, SectionOptions};
+    use mechlab::settings::Declared;
+    let model = models::by_name("henon_heiles").unwrap();
+    let seeds = [[0.1, 0.05], [0.3, -0.1], [-0.2, 0.2]];
+    let settings = |tol: &str, accuracy: Option<&str>| {
+        let mut texts = vec![
+            ("seeds", "0.1,0.05;0.3,-0.1;-0.2,0.2"),
+            ("crossings", "200"),
+            ("tol", tol),
+            ("check", "1"),
+        ];
+        texts.extend(accuracy.map(|a| ("accuracy", a)));
+        SectionOptions::default().with_texts(texts).unwrap()
+    };
+    let distance = |orbit: &mechlab::analysis::section::SectionOrbit, seed: [f64; 2]| {
+        (orbit.points.iter())
+            .map(|p| (p[0] - seed[0]).hypot(p[1] - seed[1]))
+            .fold(0.0, f64::max)
+    };
+    for tol in ["1e-6", "1e-8", "1e-10"] {
+        let section = section_study(model, &[0.0], &settings(tol, None), &|_| ())
+            .unwrap()
+            .section
+            .unwrap();
+        assert_eq!(section.crossing_errors.len(), 3);
+        for ((orbit, error), seed) in section
+            .orbits
+            .iter()
+            .zip(&section.crossing_errors)
+            .zip(seeds)
+        {
+            assert_eq!(orbit.points.len(), 200);
+            let off = distance(orbit, seed);
+            println!("tol {tol}: stated {error:.2e}, off by {off:.2e}");
+            assert!(
+                off <= *error && *error <= 100.0 * off.max(1e-15),
+                "tol {tol}: {error:e} against {off:e}"
+            );
+        }
+    }
+    let asked = section_study(model, &[0.0], &settings("1e-5", Some("1e-9")), &|_| ())
+        .unwrap()
+        .section
+        .unwrap();
+    let said = asked.accuracy.clone().unwrap();
+    println!("{said}");
+    assert!(said.contains(" reached"), "{said}");
+    for (orbit, seed) in asked.orbits.iter().zip(seeds) {
+        assert!(distance(orbit, seed) <= 1e-9, "{said}");
+    }
+}

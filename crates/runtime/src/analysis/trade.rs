@@ -439,7 +439,8 @@ impl StatedErrors for crate::analysis::continuation::Continuation {
     }
 }
 
-/// The MEGNO map's chaotic fraction and the frequency map's tunes.
+/// The MEGNO map's chaotic fraction, the frequency map's tunes and the
+/// orbits' crossings.
 impl StatedErrors for crate::analysis::section::SectionStudy {
     fn stated(&self) -> Vec<Stated> {
         let mut stated = Vec::new();
@@ -461,6 +462,16 @@ impl StatedErrors for crate::analysis::section::SectionStudy {
                 value: f64::NAN,
                 error: check.largest,
             });
+        }
+        if let Some(section) = &self.section {
+            for (k, error) in section.crossing_errors.iter().enumerate() {
+                stated.push(Stated {
+                    what: format!("orbit {k}: its crossings"),
+                    kind: "crossing",
+                    value: f64::NAN,
+                    error: *error,
+                });
+            }
         }
         stated
     }

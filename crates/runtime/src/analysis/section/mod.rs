@@ -163,6 +163,39 @@ pub struct Section {
     /// max |H − E| and max |q_c − value| over every orbit's crossings.
     pub largest_energy_drift: f64,
     pub largest_plane_distance: f64,
+    /// Each orbit's crossings' error: twice their largest distance on the
+    /// plane to the same orbit's at a hundredth of the tolerance (∞ where
+    /// the two have not as many crossings; empty: not checked).
+    pub crossing_errors: Vec<f64>,
+    /// The two runs compared, or why none was.
+    pub crossing_check: Option<String>,
+    /// Whether the `accuracy` asked for was reached, and at which tolerance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<String>,
+}
+
+impl Section {
+    /// The crossings' errors from `again`, the same seeds at `tighter`.
+    pub fn checked_against(&mut self, again: &Section, runs: String) {
+        self.crossing_errors = (self.orbits.iter())
+            .zip(&again.orbits)
+            .map(|(a, b)| match a.points.len() == b.points.len() {
+                true => (a.points.iter().zip(&b.points))
+                    .map(|(p, q)| 2.0 * (p[0] - q[0]).hypot(p[1] - q[1]))
+                    .fold(0.0, f64::max),
+                false => f64::INFINITY,
+            })
+            .collect();
+        self.crossing_check = Some(runs);
+    }
+
+    /// The largest error of a crossing (∞ unchecked).
+    pub fn largest_crossing_error(&self) -> f64 {
+        match self.crossing_errors.is_empty() {
+            true => f64::INFINITY,
+            false => self.crossing_errors.iter().fold(0.0, |m: f64, &e| m.max(e)),
+        }
+    }
 }
 
 impl Section {
@@ -389,6 +422,9 @@ impl Sections<'_> {
         Ok(Section {
             largest_energy_drift: largest(|o| o.energy_drift),
             largest_plane_distance: largest(|o| o.plane_distance),
+            crossing_errors: Vec::new(),
+            crossing_check: None,
+            accuracy: None,
             model: name,
             energy: s.energy,
             energy_of: if stroboscope.is_some() { "H̄" } else { "H" },

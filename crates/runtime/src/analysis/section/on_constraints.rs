@@ -61,6 +61,9 @@ pub(super) fn section(
     Ok(Section {
         largest_energy_drift: largest(|o| o.energy_drift),
         largest_plane_distance: largest(|o| o.plane_distance),
+        crossing_errors: Vec::new(),
+        crossing_check: None,
+        accuracy: None,
         model: name,
         energy: s.energy,
         energy_of: "H",

@@ -49,14 +49,15 @@ crate::declare_settings! {
         samples: usize = 4096, Range::Count { min: 64, max: 100_000_000 };
         /// Orbits of each map run again at a hundredth of the tolerance,
         /// spread over it, to state its error: the share of the MEGNO map's
-        /// pixels that change class, the frequency map's tunes' change (0:
+        /// pixels that change class, the frequency map's tunes' change; and
+        /// the section's orbits again, for their crossings' error (0:
         /// none).
         check: usize = 256, Range::Count { min: 0, max: 100_000 };
-        /// The error wanted on the maps (auto: none asked, each states its
-        /// check): the MEGNO map's largest share of pixels that change
-        /// class, the frequency map's largest change of a tune. Given, each
-        /// map is run again with `tol` a hundredfold tighter until its check
-        /// is within it, or the result says why not.
+        /// The error wanted (auto: none asked, each states its check): on
+        /// the orbits' crossings, the MEGNO map's largest share of pixels
+        /// that change class, the frequency map's largest change of a tune.
+        /// Given, each is run again with `tol` a hundredfold tighter until
+        /// its check is within it, or the result says why not.
         accuracy: Option<f64> = None, Range::Positive;
         /// With a fast phase: the forcing's phase 2πt/T at which the period
         /// map samples.
@@ -123,7 +124,7 @@ pub fn section_study(
             seeds.len(),
             settings.energy
         ));
-        Some(section(model, params, &seeds, &settings)?)
+        Some(checked_section(model, params, &seeds, &settings, options)?)
     };
     let frequency_map = match options.frequencies {
         0 => None,
@@ -194,6 +195,65 @@ pub fn section_study(
         megno_map,
         frequency_map,
     })
+}
+
+/// The section's orbits with their crossings' errors (where `check` is
+/// not 0: the same seeds again at a hundredth of the tolerance); with an
+/// `accuracy`, the tolerance tightened a hundredfold until every crossing's
+/// error is within it.
+fn checked_section(
+    model: &Model,
+    params: &[f64],
+    seeds: &[[f64; 2]],
+    settings: &SectionSettings,
+    options: &SectionOptions,
+) -> Result<Section, SectionError> {
+    let at = |tol: f64| {
+        let settings = SectionSettings {
+            tol,
+            ..settings.clone()
+        };
+        section(model, params, seeds, &settings)
+    };
+    let mut tol = settings.tol;
+    let mut current = at(tol)?;
+    if options.check == 0 && options.accuracy.is_none() {
+        return Ok(current);
+    }
+    loop {
+        let method = crate::ode::Method::Dop853 {
+            rtol: tol,
+            atol: tol,
+        };
+        let Some(tighter) = method.check_run() else {
+            current.crossing_check = Some(format!(
+                "{} is at the precision floor, with no tighter run to check it",
+                method.describe()
+            ));
+            current.accuracy = (options.accuracy).map(|a| {
+                format!("accuracy {a:e} NOT reached: no run at the precision floor is checked")
+            });
+            return Ok(current);
+        };
+        let again = at(tighter.accuracy())?;
+        current.checked_against(
+            &again,
+            format!("{} against {}", method.describe(), tighter.describe()),
+        );
+        let Some(accuracy) = options.accuracy else {
+            return Ok(current);
+        };
+        let worst = current.largest_crossing_error();
+        if worst <= accuracy || tighter.check_run().is_none() {
+            current.accuracy = Some(format!(
+                "accuracy {accuracy:e} {} with {}: every crossing within {worst:.1e}",
+                crate::analysis::check::reached_text(worst <= accuracy),
+                method.describe()
+            ));
+            return Ok(current);
+        }
+        (tol, current) = (tighter.accuracy(), again);
+    }
 }
 
 /// `run(tol)` at `tol`, and where an `accuracy` is asked, again a
@@ -276,6 +336,14 @@ impl crate::outputs::Outputs for SectionStudy {
                 "largest |{} − E| on the section {:.1e}, largest distance from the plane {:.1e}",
                 section.energy_of, section.largest_energy_drift, section.largest_plane_distance
             ));
+            if let Some(check) = &section.crossing_check {
+                let worst = section.largest_crossing_error();
+                lines.push(match worst.is_finite() {
+                    true => format!("the crossings' error: at most {worst:.1e} ({check})"),
+                    false => format!("the crossings' error: not stated ({check})"),
+                });
+            }
+            lines.extend(section.accuracy.clone());
             lines.extend(section.ended_early().map(|(k, end)| {
                 let o = &section.orbits[k];
                 format!(
