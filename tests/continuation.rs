@@ -621,3 +621,38 @@ fn a_continuation_asked_for_an_accuracy_tightens_until_its_bifurcations_errors_a
         doubling.parameter
     );
 }
+
+/// A branch's states' stated error against the linear oscillator's closed
+/// form (ω from 0.5 to 1.5 through resonance) at DOP853 1e-6, 1e-8 and
+/// Taylor 1e-8: it bounds every point's distance, within 100 times the
+/// largest.
+#[test]
+fn a_branchs_stated_state_error_bounds_its_distance_to_the_closed_form() {
+    let (c, f) = (0.01, 0.1);
+    for (name, tol) in [("dop853", 1e-6), ("dop853", 1e-8), ("taylor", 1e-8)] {
+        let settings = crate::common::continuation_settings(
+            "omega",
+            1.5,
+            &[0.0, 0.0],
+            Method::parse(name, tol).unwrap(),
+        );
+        let result = continuation(&FORCED, &forced(c, 0.0, f, 0.5), &settings).unwrap();
+        let branch = &result.branches[0];
+        let largest = (branch.points.iter())
+            .map(|point| {
+                let w = point.parameter;
+                let d = (1.0 - w * w).powi(2) + (c * w).powi(2);
+                let (a, b) = (f * (1.0 - w * w) / d, f * c * w / d);
+                (point.state[0] - a)
+                    .abs()
+                    .max((point.state[1] - b * w).abs())
+            })
+            .fold(0.0, f64::max);
+        let stated = branch.state_error.unwrap();
+        println!("{name} {tol:e}: stated {stated:.2e}, largest distance {largest:.2e}");
+        assert!(
+            largest <= stated && stated <= 100.0 * largest,
+            "{name} {tol:e}"
+        );
+    }
+}

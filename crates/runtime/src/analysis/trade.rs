@@ -421,21 +421,26 @@ impl StatedErrors for crate::analysis::attractor::Attractor {
     }
 }
 
-/// The located bifurcations' parameters.
+/// The located bifurcations' parameters, then the branches' states.
 impl StatedErrors for crate::analysis::continuation::Continuation {
     fn stated(&self) -> Vec<Stated> {
-        self.bifurcations
-            .iter()
-            .enumerate()
-            .filter_map(|(k, b)| {
-                Some(Stated {
-                    what: format!("bifurcation {k} ({:?}, period {})", b.kind, b.period),
-                    kind: "bifurcation's parameter",
-                    value: b.parameter,
-                    error: b.parameter_error?,
-                })
+        let bifurcations = self.bifurcations.iter().enumerate().filter_map(|(k, b)| {
+            Some(Stated {
+                what: format!("bifurcation {k} ({:?}, period {})", b.kind, b.period),
+                kind: "bifurcation's parameter",
+                value: b.parameter,
+                error: b.parameter_error?,
             })
-            .collect()
+        });
+        let branches = self.branches.iter().enumerate().filter_map(|(k, b)| {
+            Some(Stated {
+                what: format!("branch {k} (period {}): its states", b.period),
+                kind: "branch's state",
+                value: f64::NAN,
+                error: b.state_error?,
+            })
+        });
+        bifurcations.chain(branches).collect()
     }
 }
 

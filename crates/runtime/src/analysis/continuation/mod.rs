@@ -27,6 +27,7 @@ use crate::registry::{Model, Systems};
 use crate::settings::{method, Declared, Range, SettingError, METHODS};
 use branch::{Origin, Solution, Steps};
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -288,6 +289,12 @@ pub struct Branch {
     pub born_at: Option<usize>,
     pub points: Vec<BranchPoint>,
     pub end: BranchEnd,
+    /// The states' numerical error: at up to 8 points spread over the
+    /// branch, the fixed point found again at the same parameter with runs
+    /// at a hundredth of the tolerance; twice the largest distance, plus
+    /// the corrector's convergence (None: not checked, or Newton did not
+    /// converge at any of them, as at a fold).
+    pub state_error: Option<f64>,
 }
 
 /// A located bifurcation.
@@ -887,13 +894,11 @@ fn run(
             born_at: job.born_at,
             points: followed.points.iter().map(branch_point).collect(),
             end: followed.end,
+            state_error: tighter.and_then(|t| state_error(t, k, &followed.points)),
         });
     }
     let cascade = cascade(&branches, &bifurcations);
-    let feigenbaum_ratios = cascade
-        .windows(3)
-        .map(|w| (w[1] - w[0]) / (w[2] - w[1]))
-        .collect();
+    let feigenbaum_ratios = feigenbaum_ratios(&cascade);
     // A flow has no period map to draw the attractor of.
     let diagram = settings
         .diagram
@@ -919,6 +924,34 @@ fn run(
         accuracy: None,
         state_names: Vec::new(),
     })
+}
+
+/// (p₂ − p₁)/(p₃ − p₂) of each three successive period doublings.
+fn feigenbaum_ratios(cascade: &[f64]) -> Vec<f64> {
+    (cascade.windows(3))
+        .map(|w| (w[1] - w[0]) / (w[2] - w[1]))
+        .collect()
+}
+
+/// The error of a branch's states ([`Branch::state_error`]) from the
+/// `tighter` map.
+fn state_error(tighter: &dyn FamilyMap, k: usize, points: &[Solution]) -> Option<f64> {
+    let periodic = tighter.periodic();
+    let distances: Vec<f64> = crate::analysis::check::sample_pixels(points.len(), 8)
+        .into_par_iter()
+        .filter_map(|i| {
+            let point = &points[i];
+            let again = branch::first_point(tighter, k, point.y.as_slice(), point.p, true).ok()?;
+            let apart = (point.y.iter().zip(again.y.iter()).zip(periodic))
+                .map(|((a, b), &angle)| match angle {
+                    true => crate::ode::wrap_angle(a - b).abs(),
+                    false => (a - b).abs(),
+                })
+                .fold(0.0, f64::max);
+            Some(2.0 * apart + 1e-11 * (1.0 + point.y.norm()))
+        })
+        .collect();
+    distances.into_iter().reduce(f64::max)
 }
 
 /// A bifurcation between two points of branch `branch` (of period `k`),
