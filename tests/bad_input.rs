@@ -279,3 +279,55 @@ fn a_run_out_of_the_models_domain_names_the_expression() {
     };
     inside.run(model, &values, &no_progress).unwrap();
 }
+
+/// An `accuracy` below what double precision resolves on the numbers it
+/// asks about is refused before any run, naming the floor: the period
+/// map's points, the averaging's deviations, the linkage's edges, the
+/// continuation's parameters and the section's crossings.
+#[test]
+fn an_accuracy_below_the_precision_floor_is_refused_before_any_run() {
+    use mechlab::analysis::declared::{no_progress, Analysis, AnalysisError};
+    let cases: Vec<(&str, Result<(), AnalysisError>)> = vec![
+        (
+            "period_map",
+            run::<mechlab::analysis::period_map::PeriodMapOptions>("kapitza"),
+        ),
+        (
+            "averaging",
+            run::<mechlab::analysis::averaging::AveragingOptions>("kapitza"),
+        ),
+        (
+            "linkage",
+            run::<mechlab::analysis::on_constraints::vibration::LinkageOptions>("four_bar"),
+        ),
+        (
+            "continuation",
+            run::<mechlab::analysis::continuation::ContinuationOptions>("duffing"),
+        ),
+        (
+            "section",
+            run::<mechlab::analysis::section::SectionOptions>("henon_heiles"),
+        ),
+    ];
+    fn run<T: Analysis>(model: &str) -> Result<(), AnalysisError> {
+        let model = mechlab::models::by_name(model).unwrap();
+        let options = T::default().with_texts([("accuracy", "1e-20")]).unwrap();
+        options
+            .run(model, &model.dynamic.defaults(), &no_progress)
+            .map(|_| ())
+    }
+    for (analysis, result) in cases {
+        let error = result
+            .err()
+            .unwrap_or_else(|| panic!("{analysis}: not refused"));
+        let text = error.to_string();
+        assert!(
+            matches!(
+                error,
+                AnalysisError::Refusal(mechlab::analysis::Refusal::BelowPrecision { .. })
+            ) || text.contains("below what double precision resolves"),
+            "{analysis}: {text}"
+        );
+        assert!(text.contains("64 units of rounding"), "{analysis}: {text}");
+    }
+}

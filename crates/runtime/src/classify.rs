@@ -56,7 +56,8 @@ impl Classify for Refusal {
             Refusal::Parameter(_)
             | Refusal::ParameterCount { .. }
             | Refusal::StateLength { .. }
-            | Refusal::Setting { .. } => BadValue,
+            | Refusal::Setting { .. }
+            | Refusal::BelowPrecision { .. } => BadValue,
             _ => ErrorClass::Refused,
         }
     }

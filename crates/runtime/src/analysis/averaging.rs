@@ -373,6 +373,14 @@ pub fn convergence(
         };
         convergence_once(model, params, &settings)
     };
+    // The deviations are differences of states of about the start's size.
+    let magnitude = (settings.y0.iter().flatten()).fold(1.0, |m: f64, x| m.max(x.abs()));
+    Refusal::accuracy_within_reach(
+        model.info.name,
+        "the deviations",
+        settings.accuracy,
+        magnitude,
+    )?;
     let mut method = settings.method;
     let mut current = at(method)?;
     if !settings.check && settings.accuracy.is_none() {

@@ -100,6 +100,40 @@ pub enum Refusal {
     /// not accept.
     #[error(transparent)]
     Parameter(#[from] crate::registry::ParameterError),
+    /// An `accuracy` below what double precision resolves on numbers of
+    /// this size: refused before any run.
+    #[error("model '{model}': accuracy {accuracy:e} on {what} is below what double precision resolves on numbers of about {magnitude:.3}: about {floor:.1e} (64 units of rounding)")]
+    BelowPrecision {
+        model: String,
+        what: &'static str,
+        accuracy: f64,
+        magnitude: f64,
+        floor: f64,
+    },
+}
+
+impl Refusal {
+    /// The refusal of an `accuracy` on `what` (numbers of about
+    /// `magnitude`) that double precision cannot reach: below 64 units of
+    /// rounding of the magnitude.
+    pub fn accuracy_within_reach(
+        model: &str,
+        what: &'static str,
+        accuracy: Option<f64>,
+        magnitude: f64,
+    ) -> Result<(), Refusal> {
+        let floor = 64.0 * f64::EPSILON * magnitude.abs();
+        match accuracy {
+            Some(accuracy) if accuracy < floor => Err(Refusal::BelowPrecision {
+                model: model.into(),
+                what,
+                accuracy,
+                magnitude,
+                floor,
+            }),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// The model's systems, or the refusal of a contact or a constrained

@@ -341,6 +341,16 @@ pub fn portrait(
     let Some(accuracy) = settings.accuracy else {
         return portrait_once(model, params, settings);
     };
+    // The seeds' size: a point is known to a few units of its rounding.
+    let magnitude = (settings.seeds.iter().flatten().flatten())
+        .map(|x| x.abs())
+        .fold(settings.p_max.max(PI), f64::max);
+    Refusal::accuracy_within_reach(
+        model.info.name,
+        "the points of the orbits",
+        Some(accuracy),
+        magnitude,
+    )?;
     let settings = PortraitSettings {
         check: settings.check.max(1),
         ..settings.clone()

@@ -442,6 +442,8 @@ pub fn continuation(
     let Some(accuracy) = settings.accuracy else {
         return continuation_once(model, params, settings);
     };
+    let what = "the bifurcations' parameters";
+    Refusal::accuracy_within_reach(model.info.name, what, Some(accuracy), settings.to.abs())?;
     let (mut result, method, error, reached) = crate::analysis::check::until_accurate(
         settings.method,
         accuracy,

@@ -633,6 +633,9 @@ fn checked_verdict(
     amplitudes: &[f64],
     settings: &VibrationSettings,
 ) -> Result<(Exact, Vec<Option<f64>>), VibrationError> {
+    let scan_end = amplitudes.last().copied().unwrap_or(0.0);
+    let name = model.info().name;
+    Refusal::accuracy_within_reach(name, "the windows' edges", settings.accuracy, scan_end)?;
     let scan = |method: Method| exact_verdict(model, params, index, q, amplitudes, method);
     let mut method = settings.method;
     let mut current = scan(method)?;
@@ -642,7 +645,6 @@ fn checked_verdict(
     // The bisection's bracket: 40 halvings of the scan's step.
     let step = amplitudes.get(1).map_or(0.0, |a| a - amplitudes[0]);
     let bracket = step / 2f64.powi(40);
-    let scan_end = amplitudes.last().copied().unwrap_or(0.0);
     loop {
         let Some(tighter) = method.check_run() else {
             if let Exact::Periodic { check, .. } = &mut current.0 {

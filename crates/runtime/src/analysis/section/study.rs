@@ -6,6 +6,7 @@
 use super::{parse_plane, section, seeds_across, Section, SectionError, SectionSettings};
 use crate::analysis::frequency_map::{frequency_map, FrequencyMap, FrequencyMapSettings};
 use crate::analysis::section_map::{section_map, SectionMap, SectionMapSettings};
+use crate::analysis::Refusal;
 use crate::registry::Model;
 use crate::settings::Range;
 
@@ -215,6 +216,8 @@ fn checked_section(
         };
         section(model, params, seeds, &settings)
     };
+    let name = model.info.name;
+    Refusal::accuracy_within_reach(name, "the crossings", options.accuracy, options.extent)?;
     let mut tol = settings.tol;
     let mut current = at(tol)?;
     if options.check == 0 && options.accuracy.is_none() {
