@@ -381,38 +381,18 @@ pub fn convergence(
         settings.accuracy,
         magnitude,
     )?;
-    let mut method = settings.method;
-    let mut current = at(method)?;
-    if !settings.check && settings.accuracy.is_none() {
-        return Ok(current);
+    let (mut result, checked) = super::check::checked_run(
+        settings.method,
+        settings.check,
+        settings.accuracy,
+        at,
+        AveragingConvergence::checked_against,
+        AveragingConvergence::worst_error,
+    )?;
+    if let Some(checked) = checked {
+        (result.check, result.accuracy) = (Some(checked.runs), checked.accuracy);
     }
-    loop {
-        let Some(tighter) = method.check_run() else {
-            current.check = Some(format!(
-                "{} is at the precision floor, with no tighter run to check it",
-                method.describe()
-            ));
-            current.accuracy = (settings.accuracy).map(|a| {
-                format!("accuracy {a:e} NOT reached: no run at the precision floor is checked")
-            });
-            return Ok(current);
-        };
-        let again = at(tighter)?;
-        current.checked_against(&again, method, tighter);
-        let Some(accuracy) = settings.accuracy else {
-            return Ok(current);
-        };
-        let worst = current.worst_error();
-        if worst <= accuracy || tighter.check_run().is_none() {
-            current.accuracy = Some(format!(
-                "accuracy {accuracy:e} {} with {}: every deviation's error within {worst:.1e}",
-                super::check::reached_text(worst <= accuracy),
-                method.describe()
-            ));
-            return Ok(current);
-        }
-        (method, current) = (tighter, again);
-    }
+    Ok(result)
 }
 
 /// [`convergence`] at the settings' method, unchecked.
@@ -540,9 +520,9 @@ fn summarised(
 }
 
 impl AveragingConvergence {
-    /// The errors of this sweep (by `method`) from `again`, the same sweep
-    /// by `tighter`: twice the distances.
-    fn checked_against(&mut self, again: &AveragingConvergence, method: Method, tighter: Method) {
+    /// The errors of this sweep from `again`, the same sweep at a
+    /// hundredth of the tolerance: twice the distances.
+    fn checked_against(&mut self, again: &AveragingConvergence) {
         self.deviation_error = (self.max_deviation.iter())
             .zip(&again.max_deviation)
             .map(|(a, b)| a.iter().zip(b).map(|(x, y)| 2.0 * (x - y).abs()).collect())
@@ -551,11 +531,6 @@ impl AveragingConvergence {
             .zip(&again.slope)
             .map(|(a, b)| 2.0 * (a - b).abs())
             .collect();
-        self.check = Some(format!(
-            "{} against {}",
-            method.describe(),
-            tighter.describe()
-        ));
     }
 
     /// The largest error of a deviation (∞ unchecked).
@@ -846,11 +821,8 @@ impl crate::outputs::Outputs for AveragingConvergence {
             })
             .collect();
         if let Some(check) = &self.check {
-            let worst = self.worst_error();
-            lines.push(match worst.is_finite() {
-                true => format!("deviations' numerical error: at most {worst:.1e} ({check})"),
-                false => format!("deviations' numerical error: not stated ({check})"),
-            });
+            let what = "deviations' numerical error";
+            lines.push(super::check::error_line(what, self.worst_error(), check));
         }
         lines.extend(self.accuracy.clone());
         lines

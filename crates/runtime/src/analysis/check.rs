@@ -179,3 +179,78 @@ pub fn reached_text(reached: bool) -> &'static str {
         false => "NOT reached (a tighter tolerance would be at the precision floor, where no run checks it)",
     }
 }
+
+/// What a [`checked_run`] found: the two runs compared (or why none was),
+/// and with an `accuracy`, whether it was reached.
+pub struct Checked {
+    pub runs: String,
+    pub accuracy: Option<String>,
+}
+
+/// `run` at `method`, its errors stated (`compare(result, again)` from
+/// the same run at [`Method::check_run`]) where `check` or an `accuracy`
+/// asks; with an `accuracy`, the method tightened a hundredfold (each run
+/// checked by the next) until `error` is within it, or one step above
+/// the precision floor. None: not checked.
+pub fn checked_run<T, E>(
+    mut method: Method,
+    check: bool,
+    accuracy: Option<f64>,
+    mut run: impl FnMut(Method) -> Result<T, E>,
+    compare: impl Fn(&mut T, &T),
+    error: impl Fn(&T) -> f64,
+) -> Result<(T, Option<Checked>), E> {
+    let mut current = run(method)?;
+    if !check && accuracy.is_none() {
+        return Ok((current, None));
+    }
+    loop {
+        let Some(tighter) = method.check_run() else {
+            let runs = format!(
+                "{} is at the precision floor, with no tighter run to check it",
+                method.describe()
+            );
+            let accuracy = accuracy.map(|a| {
+                format!("accuracy {a:e} NOT reached: no run at the precision floor is checked")
+            });
+            return Ok((current, Some(Checked { runs, accuracy })));
+        };
+        let again = run(tighter)?;
+        compare(&mut current, &again);
+        let runs = format!("{} against {}", method.describe(), tighter.describe());
+        let Some(asked) = accuracy else {
+            return Ok((
+                current,
+                Some(Checked {
+                    runs,
+                    accuracy: None,
+                }),
+            ));
+        };
+        let worst = error(&current);
+        if worst <= asked || tighter.check_run().is_none() {
+            let said = format!(
+                "accuracy {asked:e} {} with {}: the largest error {worst:.1e}",
+                reached_text(worst <= asked),
+                method.describe()
+            );
+            return Ok((
+                current,
+                Some(Checked {
+                    runs,
+                    accuracy: Some(said),
+                }),
+            ));
+        }
+        (method, current) = (tighter, again);
+    }
+}
+
+/// The line a summary gives a checked error: "{what}: at most {worst}
+/// ({runs})", or "not stated" where the check could not be made.
+pub fn error_line(what: &str, worst: f64, runs: &str) -> String {
+    match worst.is_finite() {
+        true => format!("{what}: at most {worst:.1e} ({runs})"),
+        false => format!("{what}: not stated ({runs})"),
+    }
+}

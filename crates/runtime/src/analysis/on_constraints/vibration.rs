@@ -637,53 +637,53 @@ fn checked_verdict(
     let name = model.info().name;
     Refusal::accuracy_within_reach(name, "the windows' edges", settings.accuracy, scan_end)?;
     let scan = |method: Method| exact_verdict(model, params, index, q, amplitudes, method);
-    let mut method = settings.method;
-    let mut current = scan(method)?;
-    if !settings.check && settings.accuracy.is_none() {
-        return Ok(current);
-    }
     // The bisection's bracket: 40 halvings of the scan's step.
     let step = amplitudes.get(1).map_or(0.0, |a| a - amplitudes[0]);
     let bracket = step / 2f64.powi(40);
-    loop {
-        let Some(tighter) = method.check_run() else {
-            if let Exact::Periodic { check, .. } = &mut current.0 {
-                *check = Some(format!(
-                    "{} is at the precision floor, with no tighter run to check it{}",
-                    method.describe(),
-                    settings
-                        .accuracy
-                        .map_or(String::new(), |a| format!(": accuracy {a:e} NOT reached"))
-                ));
-            }
-            return Ok(current);
-        };
-        let again = scan(tighter)?;
-        let worst = edge_errors(&mut current.0, &again.0, bracket, scan_end);
-        let runs = format!("{} against {}", method.describe(), tighter.describe());
-        let Exact::Periodic { check, .. } = &mut current.0 else {
-            return Ok(current);
-        };
-        let Some(accuracy) = settings.accuracy else {
-            *check = Some(runs);
-            return Ok(current);
-        };
-        if worst <= accuracy || tighter.check_run().is_none() {
-            *check = Some(format!(
-                "{runs}: accuracy {accuracy:e} {}",
-                crate::analysis::check::reached_text(worst <= accuracy)
-            ));
-            return Ok(current);
-        }
-        (method, current) = (tighter, again);
+    let (mut result, checked) = crate::analysis::check::checked_run(
+        settings.method,
+        settings.check,
+        settings.accuracy,
+        scan,
+        |current, again| edge_errors(&mut current.0, &again.0, bracket, scan_end),
+        |current| largest_edge_error(&current.0, scan_end),
+    )?;
+    if let (Some(checked), Exact::Periodic { check, .. }) = (checked, &mut result.0) {
+        *check = Some(match checked.accuracy {
+            Some(accuracy) => format!("{}: {accuracy}", checked.runs),
+            None => checked.runs,
+        });
     }
+    Ok(result)
+}
+
+/// The largest error of a window's edge (∞ where one is not stated; an
+/// upper end at the scan's end is not an edge).
+fn largest_edge_error(exact: &Exact, scan_end: f64) -> f64 {
+    let Exact::Periodic {
+        windows,
+        window_errors,
+        ..
+    } = exact
+    else {
+        return f64::INFINITY;
+    };
+    let mut worst: f64 = 0.0;
+    for (window, errors) in windows.iter().zip(window_errors) {
+        for side in 0..2 {
+            if side == 0 || window[1] != scan_end {
+                worst = worst.max(errors[side].unwrap_or(f64::INFINITY));
+            }
+        }
+    }
+    worst
 }
 
 /// Each window edge's error in `exact` from the same scan's `again`:
 /// twice the distance to the nearest edge of its side there, plus the
 /// bisection's `bracket` (None where `again` has none, or for an upper end
-/// at the scan's end); the largest (∞ where one is None).
-fn edge_errors(exact: &mut Exact, again: &Exact, bracket: f64, scan_end: f64) -> f64 {
+/// at the scan's end).
+fn edge_errors(exact: &mut Exact, again: &Exact, bracket: f64, scan_end: f64) {
     let (
         Exact::Periodic {
             windows,
@@ -695,9 +695,8 @@ fn edge_errors(exact: &mut Exact, again: &Exact, bracket: f64, scan_end: f64) ->
         },
     ) = (exact, again)
     else {
-        return f64::INFINITY;
+        return;
     };
-    let mut worst: f64 = 0.0;
     for (window, errors) in windows.iter().zip(window_errors.iter_mut()) {
         for side in 0..2 {
             if side == 1 && window[1] == scan_end {
@@ -707,10 +706,8 @@ fn edge_errors(exact: &mut Exact, again: &Exact, bracket: f64, scan_end: f64) ->
                 .map(|w| (w[side] - window[side]).abs())
                 .min_by(f64::total_cmp);
             errors[side] = nearest.map(|d| 2.0 * d + bracket);
-            worst = worst.max(errors[side].unwrap_or(f64::INFINITY));
         }
     }
-    worst
 }
 
 impl VibrationStability {

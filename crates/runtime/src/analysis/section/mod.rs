@@ -175,8 +175,9 @@ pub struct Section {
 }
 
 impl Section {
-    /// The crossings' errors from `again`, the same seeds at `tighter`.
-    pub fn checked_against(&mut self, again: &Section, runs: String) {
+    /// The crossings' errors from `again`, the same seeds at a hundredth
+    /// of the tolerance.
+    pub fn checked_against(&mut self, again: &Section) {
         self.crossing_errors = (self.orbits.iter())
             .zip(&again.orbits)
             .map(|(a, b)| match a.points.len() == b.points.len() {
@@ -186,7 +187,6 @@ impl Section {
                 false => f64::INFINITY,
             })
             .collect();
-        self.crossing_check = Some(runs);
     }
 
     /// The largest error of a crossing (∞ unchecked).

@@ -218,45 +218,21 @@ fn checked_section(
     };
     let name = model.info.name;
     Refusal::accuracy_within_reach(name, "the crossings", options.accuracy, options.extent)?;
-    let mut tol = settings.tol;
-    let mut current = at(tol)?;
-    if options.check == 0 && options.accuracy.is_none() {
-        return Ok(current);
+    let (mut result, checked) = crate::analysis::check::checked_run(
+        crate::ode::Method::Dop853 {
+            rtol: settings.tol,
+            atol: settings.tol,
+        },
+        options.check > 0,
+        options.accuracy,
+        |method| at(method.accuracy()),
+        Section::checked_against,
+        Section::largest_crossing_error,
+    )?;
+    if let Some(checked) = checked {
+        (result.crossing_check, result.accuracy) = (Some(checked.runs), checked.accuracy);
     }
-    loop {
-        let method = crate::ode::Method::Dop853 {
-            rtol: tol,
-            atol: tol,
-        };
-        let Some(tighter) = method.check_run() else {
-            current.crossing_check = Some(format!(
-                "{} is at the precision floor, with no tighter run to check it",
-                method.describe()
-            ));
-            current.accuracy = (options.accuracy).map(|a| {
-                format!("accuracy {a:e} NOT reached: no run at the precision floor is checked")
-            });
-            return Ok(current);
-        };
-        let again = at(tighter.accuracy())?;
-        current.checked_against(
-            &again,
-            format!("{} against {}", method.describe(), tighter.describe()),
-        );
-        let Some(accuracy) = options.accuracy else {
-            return Ok(current);
-        };
-        let worst = current.largest_crossing_error();
-        if worst <= accuracy || tighter.check_run().is_none() {
-            current.accuracy = Some(format!(
-                "accuracy {accuracy:e} {} with {}: every crossing within {worst:.1e}",
-                crate::analysis::check::reached_text(worst <= accuracy),
-                method.describe()
-            ));
-            return Ok(current);
-        }
-        (tol, current) = (tighter.accuracy(), again);
-    }
+    Ok(result)
 }
 
 /// `run(tol)` at `tol`, and where an `accuracy` is asked, again a
@@ -341,10 +317,8 @@ impl crate::outputs::Outputs for SectionStudy {
             ));
             if let Some(check) = &section.crossing_check {
                 let worst = section.largest_crossing_error();
-                lines.push(match worst.is_finite() {
-                    true => format!("the crossings' error: at most {worst:.1e} ({check})"),
-                    false => format!("the crossings' error: not stated ({check})"),
-                });
+                let line = crate::analysis::check::error_line("the crossings' error", worst, check);
+                lines.push(line);
             }
             lines.extend(section.accuracy.clone());
             lines.extend(section.ended_early().map(|(k, end)| {
