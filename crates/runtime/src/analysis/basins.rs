@@ -1056,7 +1056,9 @@ impl crate::outputs::Outputs for Basins {
         lines.push(match &self.class_check {
             Some(check) => format!(
                 "fractions' error: the grid's (four interleaved half grids) and the numerical{}",
-                check.describe().replace("pixels change class", "starts change attractor")
+                (check.describe())
+                    .replace("pixels change class", "starts change attractor")
+                    .replace("pixels changes class", "starts changes attractor")
             ),
             None => "fractions' error: the grid's (four interleaved half grids); no numerical check (check = 0)".into(),
         });

@@ -671,6 +671,13 @@ impl crate::outputs::Outputs for Portrait {
                 errors[errors.len() / 2],
                 errors[errors.len() - 1],
             ));
+            // An error as large as the orbit: its points are right in
+            // distribution only (a chaotic orbit's error grows exponentially).
+            if errors[errors.len() - 1] > 1e-2 {
+                lines.push(format!(
+                    "orbit {worst}'s points are not individually right over the whole run: an orbit's error grows with its length, on a chaotic orbit exponentially (`accuracy` says for how many periods each is within it)"
+                ));
+            }
         }
         lines.extend(self.accuracy.clone());
         lines
