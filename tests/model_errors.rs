@@ -582,3 +582,25 @@ fn malformed_points_name_the_problem() {
         "a model with contacts cannot be drawn yet",
     );
 }
+
+/// A body's rotation that is not a sequence of X(angle), Y(angle), Z(angle)
+/// is refused with the body's key; a body whose centre's name is taken by
+/// a definition is refused with the definition's; a well-formed body is
+/// accepted.
+#[test]
+fn a_malformed_body_is_named() {
+    let body = |rotation: &str| {
+        format!(
+            "{GOOD}\n[[bodies]]\nname = \"bob\"\nmass = \"1\"\ninertia = [\"1\", \"1\", \"1\"]\nposition = [\"sin(q)\", \"0\", \"-cos(q)\"]\nrotation = \"{rotation}\"\n"
+        )
+    };
+    assert_error(
+        &body("W(q)"),
+        "bodies[0].rotation",
+        "X(angle), Y(angle) or Z(angle)",
+    );
+    assert_error(&body("Y q"), "bodies[0].rotation", "parentheses");
+    let clash = body("Y(q)").replace("[[bodies]]", "[definitions]\nbob_x = \"q\"\n\n[[bodies]]");
+    assert_error(&clash, "definitions.bob_x", "the centre of a body");
+    Model::parse("models/toy.toml", &body("Y(q)")).expect("a body about its y axis");
+}

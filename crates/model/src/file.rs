@@ -46,6 +46,10 @@ pub struct ModelFile {
     /// expression of the positions, joined by bars to earlier points.
     #[serde(default)]
     pub points: Vec<PointSpec>,
+    /// Rigid bodies: each one's kinetic energy is added to the Lagrangian
+    /// (see [`crate::bodies`]).
+    #[serde(default)]
+    pub bodies: Vec<crate::bodies::BodySpec>,
     /// How q' = A⁻¹(p − b) is computed: "symbolic" (cofactors) or
     /// "numeric" (A(q) emitted, solved by Cholesky in the generated code).
     /// Default: symbolic up to [`SYMBOLIC_INVERSE_MAX_DOF`] degrees of freedom.
@@ -343,7 +347,7 @@ impl Model {
                 ),
             ));
         }
-        let spec: ModelFile = toml::from_str(text).map_err(|e| {
+        let mut spec: ModelFile = toml::from_str(text).map_err(|e| {
             let message = e.message().to_string();
             let key = match e.span() {
                 Some(span) => key_at(text, span.start),
@@ -351,6 +355,15 @@ impl Model {
             };
             err(&key, message)
         })?;
+        let (centres, energy) =
+            crate::bodies::expand(&spec.bodies).map_err(|(key, reason)| err(&key, reason))?;
+        for (name, at) in centres {
+            if spec.definitions.insert(name.clone(), at).is_some() {
+                let reason = format!("'{name}' is the centre of a body and a definition too");
+                return Err(err(&format!("definitions.{name}"), reason));
+            }
+        }
+        spec.lagrangian += &energy;
         spec.validate(file)
     }
 }

@@ -1,6 +1,7 @@
 //! Model files: the expression language and the validated model description.
 //! Shared by the derivation (`mechlab-derive`, at build time) and the runtime.
 
+pub mod bodies;
 pub mod domain;
 pub mod expr;
 pub mod file;
