@@ -124,10 +124,7 @@ pub fn rerun_sample<T: Send, E: Send>(
             pixels: Vec::new(),
             census: false,
             values: Vec::new(),
-            runs: format!(
-                "{} is at the precision floor, with no tighter run to check it",
-                method.describe()
-            ),
+            runs: runs_compared(method),
         });
     };
     let pixels = sample_pixels(total, count);
@@ -143,7 +140,7 @@ pub fn rerun_sample<T: Send, E: Send>(
         census: pixels.len() == total,
         pixels,
         values: values.into_iter().flatten().collect(),
-        runs: format!("{} against {}", method.describe(), tighter.describe()),
+        runs: runs_compared(method),
     })
 }
 
@@ -206,10 +203,7 @@ pub fn checked_run<T, E>(
     }
     loop {
         let Some(tighter) = method.check_run() else {
-            let runs = format!(
-                "{} is at the precision floor, with no tighter run to check it",
-                method.describe()
-            );
+            let runs = runs_compared(method);
             let accuracy = accuracy.map(|a| {
                 format!("accuracy {a:e} NOT reached: no run at the precision floor is checked")
             });
@@ -217,7 +211,7 @@ pub fn checked_run<T, E>(
         };
         let again = run(tighter)?;
         compare(&mut current, &again);
-        let runs = format!("{} against {}", method.describe(), tighter.describe());
+        let runs = runs_compared(method);
         let Some(asked) = accuracy else {
             return Ok((
                 current,
@@ -252,5 +246,17 @@ pub fn error_line(what: &str, worst: f64, runs: &str) -> String {
     match worst.is_finite() {
         true => format!("{what}: at most {worst:.1e} ({runs})"),
         false => format!("{what}: not stated ({runs})"),
+    }
+}
+
+/// The two runs a check compares ("taylor, tol 1e-6 against taylor, tol
+/// 1e-8"), or, at the precision floor, that none can check `method`.
+pub fn runs_compared(method: Method) -> String {
+    match method.check_run() {
+        Some(tighter) => format!("{} against {}", method.describe(), tighter.describe()),
+        None => format!(
+            "{} is at the precision floor, with no tighter run to check it",
+            method.describe()
+        ),
     }
 }

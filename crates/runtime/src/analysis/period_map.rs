@@ -500,17 +500,7 @@ fn portrait_once(
         periods: settings.periods,
         failed,
         checks,
-        check_runs: match tighter {
-            Some(tighter) => format!(
-                "{} against {}",
-                settings.method.describe(),
-                tighter.describe()
-            ),
-            None => format!(
-                "{} is at the precision floor, with no tighter run to check it",
-                settings.method.describe()
-            ),
-        },
+        check_runs: super::check::runs_compared(settings.method),
         accuracy: None,
         seconds: start.elapsed().as_secs_f64(),
         orbits: projected,

@@ -1211,17 +1211,7 @@ fn exact_window(
                 None => None,
             };
             out.exact_window_error = Some([error(low, true)?, high_error]);
-            out.exact_window_check = Some(match reference {
-                Some(reference) => format!(
-                    "{} against {}",
-                    settings.method.describe(),
-                    reference.describe()
-                ),
-                None => format!(
-                    "{} is at the precision floor, with no tighter run to check it",
-                    settings.method.describe()
-                ),
-            });
+            out.exact_window_check = Some(super::check::runs_compared(settings.method));
         }
         None => out.exact_reason = Some(format!("not stable for any amplitude up to {a_max}")),
     }
