@@ -234,12 +234,7 @@ pub fn basins(
         return basins_once(model, params, settings, done);
     };
     let mut settings = settings.clone();
-    // With none of n starts changing, the stated share is the rule of
-    // three's 3/n: the sample must be large enough to state the accuracy.
-    settings.check = settings
-        .check
-        .max(256)
-        .max((3.0 / accuracy).ceil() as usize);
+    settings.check = super::check::pixels_to_state(settings.check.max(256), accuracy);
     loop {
         let mut map = basins_once(model, params, &settings, done)?;
         let numerical = map

@@ -186,12 +186,7 @@ pub fn chaos_map(
         return map_once(model, params, settings, row_done);
     };
     let mut settings = settings.clone();
-    // With none of n pixels changing class, the stated share is the rule of
-    // three's 3/n: the sample must be large enough to state the accuracy.
-    settings.check = settings
-        .check
-        .max(256)
-        .max((3.0 / accuracy).ceil() as usize);
+    settings.check = super::check::pixels_to_state(settings.check.max(256), accuracy);
     let (mut map, method, check, reached) = super::check::until_accurate(
         settings.method,
         accuracy,

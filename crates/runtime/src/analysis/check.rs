@@ -260,3 +260,10 @@ pub fn runs_compared(method: Method) -> String {
         ),
     }
 }
+
+/// The pixels a map asked for a share `accuracy` checks: at least `check`
+/// and enough to state it where none changes class (the rule of three's
+/// 3/n).
+pub fn pixels_to_state(check: usize, accuracy: f64) -> usize {
+    check.max((3.0 / accuracy).ceil() as usize)
+}

@@ -163,10 +163,8 @@ pub fn section_study(
         0 => None,
         pixels => {
             say(format!("MEGNO map, {pixels}² orbits …"));
-            // With none of n pixels changing class the stated share is 3/n:
-            // enough pixels are checked to state the accuracy.
             let check = match options.accuracy {
-                Some(accuracy) => options.check.max((3.0 / accuracy).ceil() as usize),
+                Some(accuracy) => crate::analysis::check::pixels_to_state(options.check, accuracy),
                 None => options.check,
             };
             let map = |tol: f64| SectionMapSettings {
