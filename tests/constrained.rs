@@ -1154,10 +1154,12 @@ fn linkages_exact_edges_meet_the_mathieu_series_within_their_stated_errors() {
     );
 }
 
-/// A model file's rigid body gives the kinetic energy written out by hand:
-/// the tipping disk as `[[bodies]]` (mass, principal moments, centre,
-/// rotation sequence Z(φ) X(θ) Y(ψ)) and as its hand-written Lagrangian
-/// have the same constrained field at random states, to rounding.
+/// A model file's rigid body gives the kinetic energy, gravity and rolling
+/// written out by hand: the tipping disk as `[[bodies]]` (mass, principal
+/// moments, centre, rotation sequence Z(φ) X(θ) Y(ψ), gravity as a vector,
+/// rolling at its lowest point) and as its hand-written Lagrangian and
+/// constraints have the same constrained field at random states, to
+/// rounding.
 #[test]
 fn a_body_in_a_model_file_moves_as_its_hand_written_lagrangian() {
     use mechlab::registry::Flows;

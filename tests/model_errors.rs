@@ -215,7 +215,8 @@ fn zero_phase_rate() {
 #[test]
 fn missing_lagrangian() {
     let e = error(&GOOD.replace("lagrangian = \"qd^2/2 + k*cos(q)\"", ""));
-    assert!(e.reason.contains("missing field `lagrangian`"), "{e}");
+    assert_eq!(e.key, "lagrangian", "{e}");
+    assert!(e.reason.contains("missing"), "{e}");
 }
 
 const CONTACTS: &str = r#"
@@ -602,5 +603,53 @@ fn a_malformed_body_is_named() {
     assert_error(&body("Y q"), "bodies[0].rotation", "parentheses");
     let clash = body("Y(q)").replace("[[bodies]]", "[definitions]\nbob_x = \"q\"\n\n[[bodies]]");
     assert_error(&clash, "definitions.bob_x", "the centre of a body");
+    assert_error(&body("Y(w)"), "bodies[0].rotation", "unknown symbol 'w'");
+    let tensor = |inertia: &str| body("Y(q)").replace("[\"1\", \"1\", \"1\"]", inertia);
+    assert_error(
+        &tensor("[[1, 2, 0], [3, 1, 0], [0, 0, 1]]"),
+        "bodies[0].inertia",
+        "not symmetric",
+    );
+    assert_error(
+        &tensor("[1, 2]"),
+        "bodies[0].inertia",
+        "three principal moments",
+    );
+    assert_error(
+        &tensor("[\"1\", \"q\", \"1\"]"),
+        "bodies[0].inertia",
+        "unknown symbol 'q'",
+    );
+    let gravity = body("Y(q)").replace(
+        "[[coordinates]]",
+        "gravity = [0, 0, \"-g\"]\n\n[[coordinates]]",
+    );
+    assert_error(&gravity, "gravity", "unknown symbol 'g'");
     Model::parse("models/toy.toml", &body("Y(q)")).expect("a body about its y axis");
+    Model::parse("models/toy.toml", &body("Y(-q) X(k/2)")).expect("angles as expressions");
+}
+
+/// A rolling body's constraint names its body, and its contact must be
+/// where the body touches the plane.
+#[test]
+fn a_rolling_constraint_is_checked_against_its_body() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../test_models/tipping_disk_body.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let file = "test_models/tipping_disk_body.toml";
+    Model::parse(file, &text).expect("the disk rolls at its lowest point");
+    let elsewhere = text.replace(
+        "contact = [\"x\", \"y\", 0]",
+        "contact = [\"disk_x\", \"disk_y\", 0]",
+    );
+    assert_ne!(elsewhere, text);
+    let e = Model::parse(file, &elsewhere).unwrap_err();
+    assert_eq!(e.key, "constraints[0].contact", "{e}");
+    assert!(e.reason.contains("moves off the plane"), "{e}");
+    let no_body = text.replace("rolling = \"disk\"", "rolling = \"wheel\"");
+    let e = Model::parse(file, &no_body).unwrap_err();
+    assert_eq!(e.key, "constraints[0].rolling", "{e}");
+    assert!(
+        e.reason.contains("not one of the model's [[bodies]]"),
+        "{e}"
+    );
 }

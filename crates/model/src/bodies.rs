@@ -1,66 +1,185 @@
 //! Rigid bodies in model files (`[[bodies]]`): each body's kinetic energy,
-//! ½ m v·v + ½ ωᵀ I ω, written out as text and added to the Lagrangian
-//! before the file is validated, so that the derivation sees one
-//! Lagrangian as for any model. The centre's coordinates become
-//! definitions (`<body>_x`, `<body>_y`, `<body>_z`) whose `dot()` gives
-//! its velocity; the body's angular velocity in its own axes comes from
-//! its rotation sequence.
+//! ½ m v·v + ½ ωᵀ I ω, and gravity's potential, written out as text and
+//! added to the Lagrangian, so that the derivation sees one Lagrangian as
+//! for any model. The centre's coordinates become definitions (`<body>_x`,
+//! `<body>_y`, `<body>_z`) whose `dot()` gives its velocity; the body's
+//! angular velocity comes from its rotation sequence. A point of a body
+//! has the velocity v_c + ω × (p − c): the rolling constraints.
 
+use crate::file::NumberSpec;
 use serde::Deserialize;
 
-/// A rigid body: its mass, its principal moments of inertia about its
-/// centre along its own axes x, y, z, the centre's position and the
-/// body's orientation as a sequence of rotations about its own axes.
+/// A rigid body: its mass, its inertia about its centre in its own axes,
+/// the centre's position and the body's orientation as a sequence of
+/// rotations about its own axes.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
-    pub mass: String,
-    /// I_x, I_y, I_z: principal moments about the centre, in the body's axes.
-    pub inertia: [String; 3],
-    /// The centre of mass (x, y, z) in the fixed frame (z up, as gravity
-    /// in the Lagrangian is written by the model).
-    pub position: [String; 3],
+    pub mass: NumberSpec,
+    /// Principal moments [I_x, I_y, I_z], or the tensor
+    /// [[I_xx, I_xy, I_xz], [I_xy, I_yy, I_yz], [I_xz, I_yz, I_zz]], both
+    /// about the centre in the body's axes (read by [`inertia`]).
+    pub inertia: toml::Value,
+    /// The centre of mass (x, y, z) in the fixed frame.
+    pub position: [NumberSpec; 3],
     /// Rotations about the body's own axes, each applied to the frame the
     /// ones before left: "Z(phi) X(theta) Y(psi)" (empty: the body does
-    /// not turn).
+    /// not turn). An angle is a coordinate or definition (it turns) or an
+    /// expression of the parameters (a fixed tilt, as a steering head's).
     #[serde(default)]
     pub rotation: String,
     #[serde(default)]
     pub description: String,
+    /// The rotation's turns, read by [`name_turns`] before validation.
+    #[serde(skip)]
+    pub turns: Vec<Turn>,
 }
 
-/// Why a body cannot be read: the key and the reason.
-pub type BodyError = (String, String);
+/// The text of a number or expression.
+pub fn text(value: &NumberSpec) -> String {
+    match value {
+        NumberSpec::Value(v) => format!("{v:?}"),
+        NumberSpec::Expression(e) => e.clone(),
+    }
+}
 
-/// The definitions each body adds (its centre's coordinates) and the
-/// kinetic energies to add to the Lagrangian.
-pub fn expand(bodies: &[BodySpec]) -> Result<(Vec<(String, String)>, String), BodyError> {
+/// Why part of a body cannot be read: the key's last part and the reason.
+pub type BodyError = (&'static str, String);
+
+/// One elementary rotation of a sequence: the body axis (0, 1, 2 for
+/// x, y, z), the angle as written and the name its rate is `dot()` of:
+/// the angle itself where it is a name, else a definition made for it
+/// (`<body>_turn<k>`).
+#[derive(Clone, Debug)]
+pub struct Turn {
+    pub axis: usize,
+    pub angle: String,
+    pub name: String,
+}
+
+/// Reads each body's rotation into its turns and returns the definitions
+/// the angles that are not plain names need, or the failing body's index
+/// and reason.
+pub fn name_turns(bodies: &mut [BodySpec]) -> Result<Vec<(String, String)>, (usize, BodyError)> {
     let mut definitions = Vec::new();
-    let mut energy = String::new();
-    for (k, body) in bodies.iter().enumerate() {
-        let centre: Vec<String> = ["x", "y", "z"]
-            .iter()
-            .map(|axis| format!("{}_{axis}", body.name))
-            .collect();
-        for (name, at) in centre.iter().zip(&body.position) {
-            definitions.push((name.clone(), at.clone()));
-        }
-        let speed = centre
-            .iter()
-            .map(|c| format!("dot({c})^2"))
-            .collect::<Vec<_>>()
-            .join(" + ");
-        energy += &format!(" + ({})*({speed})/2", body.mass);
-        let omega = angular_velocity(&body.rotation)
-            .map_err(|reason| (format!("bodies[{k}].rotation"), reason))?;
-        for (moment, w) in body.inertia.iter().zip(omega) {
-            if let Some(w) = w {
-                energy += &format!(" + ({moment})*({w})^2/2");
+    for (k, body) in bodies.iter_mut().enumerate() {
+        body.turns = rotation(&body.rotation).map_err(|e| (k, e))?;
+        for (i, turn) in body.turns.iter_mut().enumerate() {
+            if !crate::file::is_identifier(&turn.angle) {
+                turn.name = format!("{}_turn{}", body.name, i + 1);
+                definitions.push((turn.name.clone(), turn.angle.clone()));
             }
         }
     }
-    Ok((definitions, energy))
+    Ok(definitions)
+}
+
+/// Reads "A1(q1) A2(q2) …" into its turns.
+pub fn rotation(sequence: &str) -> Result<Vec<Turn>, BodyError> {
+    let bad = |why: &str| Err(("rotation", format!("'{sequence}': {why}")));
+    let mut turns = Vec::new();
+    let mut rest = sequence.trim();
+    while !rest.is_empty() {
+        let axis =
+            match rest.as_bytes()[0] {
+                b'X' => 0,
+                b'Y' => 1,
+                b'Z' => 2,
+                _ => return bad(
+                    "each rotation is X(angle), Y(angle) or Z(angle), about the body's own axis",
+                ),
+            };
+        let inner = rest[1..].trim_start();
+        if !inner.starts_with('(') {
+            return bad("a rotation's angle goes in parentheses, as Z(phi)");
+        }
+        // The angle may itself hold parentheses: find the matching one.
+        let mut depth = 0;
+        let close = inner.char_indices().find_map(|(i, ch)| {
+            match ch {
+                '(' => depth += 1,
+                ')' => depth -= 1,
+                _ => {}
+            }
+            (depth == 0).then_some(i)
+        });
+        let Some(close) = close else {
+            return bad("a rotation's parentheses do not close");
+        };
+        let angle = inner[1..close].trim();
+        if angle.is_empty() {
+            return bad("each rotation is an axis and an angle, as Z(phi)");
+        }
+        turns.push(Turn {
+            axis,
+            angle: angle.to_string(),
+            name: angle.to_string(),
+        });
+        rest = inner[close + 1..].trim_start();
+    }
+    Ok(turns)
+}
+
+/// The inertia tensor's entries (None: zero), symmetric; principal
+/// moments give a diagonal one.
+pub fn inertia(value: &toml::Value) -> Result<[[Option<String>; 3]; 3], BodyError> {
+    let usage = "give three principal moments [I_x, I_y, I_z] or the symmetric tensor [[I_xx, I_xy, I_xz], [I_xy, I_yy, I_yz], [I_xz, I_yz, I_zz]] about the centre, in the body's axes";
+    let entry = |v: &toml::Value| -> Result<Option<String>, BodyError> {
+        match v {
+            toml::Value::String(s) => Ok(Some(s.clone())),
+            toml::Value::Integer(0) => Ok(None),
+            toml::Value::Integer(i) => Ok(Some(i.to_string())),
+            toml::Value::Float(f) if *f == 0.0 => Ok(None),
+            toml::Value::Float(f) => Ok(Some(format!("{f:?}"))),
+            _ => Err(("inertia", usage.to_string())),
+        }
+    };
+    let rows = match value {
+        toml::Value::Array(rows) if rows.len() == 3 => rows,
+        _ => return Err(("inertia", usage.to_string())),
+    };
+    let mut tensor: [[Option<String>; 3]; 3] = Default::default();
+    if rows.iter().all(|r| !r.is_array()) {
+        for (i, moment) in rows.iter().enumerate() {
+            tensor[i][i] = entry(moment)?;
+        }
+        return Ok(tensor);
+    }
+    for (i, row) in rows.iter().enumerate() {
+        match row {
+            toml::Value::Array(row) if row.len() == 3 => {
+                for (j, v) in row.iter().enumerate() {
+                    tensor[i][j] = entry(v)?;
+                }
+            }
+            _ => return Err(("inertia", usage.to_string())),
+        }
+    }
+    for i in 0..3 {
+        for j in i + 1..3 {
+            let same = match (&tensor[i][j], &tensor[j][i]) {
+                (Some(a), Some(b)) => a.replace(' ', "") == b.replace(' ', ""),
+                (a, b) => a == b,
+            };
+            if !same {
+                let axes = ["x", "y", "z"];
+                return Err((
+                    "inertia",
+                    format!(
+                        "the tensor is not symmetric: I_{}{} and I_{}{} differ",
+                        axes[i], axes[j], axes[j], axes[i]
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(tensor)
+}
+
+/// The names of a body's centre coordinates, which are definitions.
+pub fn centre(body: &str) -> [String; 3] {
+    ["x", "y", "z"].map(|axis| format!("{body}_{axis}"))
 }
 
 /// A component of a vector written out: None is 0.
@@ -75,65 +194,170 @@ fn sum(a: Component, b: Component) -> Component {
 }
 
 fn times(factor: &str, a: &Component) -> Component {
-    a.as_ref().map(|a| format!("{factor}*({a})"))
+    a.as_ref().map(|a| format!("({factor})*({a})"))
+}
+
+fn product(a: &Component, b: &Component) -> Component {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(format!("({a})*({b})")),
+        _ => None,
+    }
 }
 
 fn minus(a: Component) -> Component {
     a.map(|a| format!("-({a})"))
 }
 
-/// The body's angular velocity in its own axes for the rotation sequence
-/// "A1(q1) A2(q2) …": ω = R_nᵀ(… R_2ᵀ(R_1ᵀ e_1 q1' + e_2 q2') …), each
+/// The rate of a turn's angle: `dot(name)` where the angle may move (a
+/// coordinate or definition), none where it is a parameter.
+fn rate(turn: &Turn, moves: &dyn Fn(&str) -> bool) -> Component {
+    moves(&turn.name).then(|| format!("dot({})", turn.name))
+}
+
+/// The body's angular velocity in its own axes for the turns
+/// A1(q1) A2(q2) …: ω = R_nᵀ(… R_2ᵀ(R_1ᵀ e_1 q1' + e_2 q2') …), each
 /// elementary rotation leaving its own axis unchanged.
-fn angular_velocity(sequence: &str) -> Result<[Component; 3], String> {
+pub fn body_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
     let mut w: [Component; 3] = [None, None, None];
-    let text = sequence.replace(' ', "");
-    let mut rest = text.as_str();
-    while !rest.is_empty() {
-        let axis = match rest.as_bytes()[0] {
-            b'X' => 0,
-            b'Y' => 1,
-            b'Z' => 2,
-            _ => {
-                return Err(format!(
-                    "'{sequence}': each rotation is X(angle), Y(angle) or Z(angle), about the body's own axis"
-                ))
-            }
-        };
-        let (Some(open), Some(close)) = (rest.find('('), rest.find(')')) else {
-            return Err(format!(
-                "'{sequence}': a rotation's angle goes in parentheses, as Z(phi)"
-            ));
-        };
-        let angle = &rest[open + 1..close];
-        if open != 1 || angle.is_empty() {
-            return Err(format!(
-                "'{sequence}': each rotation is an axis and a coordinate, as Z(phi)"
-            ));
-        }
-        rest = &rest[close + 1..];
-        // w + e_axis q'
-        w[axis] = sum(w[axis].take(), Some(format!("dot({angle})")));
+    for turn in turns {
+        let axis = turn.axis;
+        w[axis] = sum(w[axis].take(), rate(turn, moves));
         // Rᵀ about `axis` applied to w: the other two components turn by −q.
-        let (c, s) = (format!("cos({angle})"), format!("sin({angle})"));
+        let (c, s) = (
+            format!("cos({})", turn.angle),
+            format!("sin({})", turn.angle),
+        );
         let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
         let (wi, wj) = (w[i].take(), w[j].take());
         w[i] = sum(times(&c, &wi), times(&s, &wj));
         w[j] = sum(minus(times(&s, &wi)), times(&c, &wj));
     }
-    Ok(w)
+    w
+}
+
+/// The body's angular velocity in the fixed frame: ω = Σ_k R_1…R_{k−1}
+/// e_k q_k', each turn's axis carried by the turns before it.
+pub fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
+    // Columns of R_1…R_k: the body's axes in the fixed frame.
+    let one = || Some("1".to_string());
+    let mut axes: [[Component; 3]; 3] = [
+        [one(), None, None],
+        [None, one(), None],
+        [None, None, one()],
+    ];
+    let mut w: [Component; 3] = [None, None, None];
+    for turn in turns {
+        if let Some(r) = rate(turn, moves) {
+            for (wi, ai) in w.iter_mut().zip(&axes[turn.axis]) {
+                *wi = sum(wi.take(), product(ai, &Some(r.clone())));
+            }
+        }
+        // R·R_a(q): e_i → c e_i + s e_j, e_j → −s e_i + c e_j.
+        let (c, s) = (
+            format!("cos({})", turn.angle),
+            format!("sin({})", turn.angle),
+        );
+        let (i, j) = ((turn.axis + 1) % 3, (turn.axis + 2) % 3);
+        let (ei, ej) = (axes[i].clone(), axes[j].clone());
+        for k in 0..3 {
+            axes[i][k] = sum(times(&c, &ei[k]), times(&s, &ej[k]));
+            axes[j][k] = sum(minus(times(&s, &ei[k])), times(&c, &ej[k]));
+        }
+    }
+    w
+}
+
+/// The kinetic energy ½ m v·v + ½ ωᵀ I ω of a body (ω in its own axes),
+/// plus m g·c where the model gives gravity.
+pub fn energy(
+    body: &BodySpec,
+    tensor: &[[Option<String>; 3]; 3],
+    turns: &[Turn],
+    gravity: Option<&[NumberSpec; 3]>,
+    moves: &dyn Fn(&str) -> bool,
+) -> String {
+    let mass = text(&body.mass);
+    let centre = centre(&body.name);
+    let speed = centre
+        .iter()
+        .map(|c| format!("dot({c})^2"))
+        .collect::<Vec<_>>()
+        .join(" + ");
+    let mut energy = format!("({mass})*({speed})/2");
+    let w = body_rates(turns, moves);
+    for i in 0..3 {
+        for j in 0..3 {
+            if let (Some(moment), Some(wi), Some(wj)) = (&tensor[i][j], &w[i], &w[j]) {
+                energy += &format!(" + ({moment})*({wi})*({wj})/2");
+            }
+        }
+    }
+    if let Some(g) = gravity {
+        for (gi, c) in g.iter().zip(&centre) {
+            energy += &format!(" + ({mass})*({})*{c}", text(gi));
+        }
+    }
+    energy
+}
+
+/// The velocity (x, y, z) of the body's material point at `point`: v_c +
+/// ω × (p − c), ω in the fixed frame.
+pub fn point_velocity(
+    body: &str,
+    turns: &[Turn],
+    point: &[String; 3],
+    moves: &dyn Fn(&str) -> bool,
+) -> [String; 3] {
+    let centre = centre(body);
+    let w = world_rates(turns, moves);
+    let arm: Vec<Component> = point
+        .iter()
+        .zip(&centre)
+        .map(|(p, c)| Some(format!("({p}) - {c}")))
+        .collect();
+    std::array::from_fn(|i| {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let turning = sum(product(&w[j], &arm[k]), minus(product(&w[k], &arm[j])));
+        match turning {
+            Some(t) => format!("dot({}) + {t}", centre[i]),
+            None => format!("dot({})", centre[i]),
+        }
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// About one axis the rate is the angle's.
+    /// About one axis the rate is the angle's; a parameter has none.
     #[test]
     fn one_rotation_turns_about_its_own_axis() {
-        let w = angular_velocity("Z(phi)").unwrap();
-        assert_eq!(w, [None, None, Some("dot(phi)".into())]);
-        assert!(angular_velocity("W(phi)").is_err());
-        assert!(angular_velocity("Z phi").is_err());
+        let moves = |s: &str| s == "phi";
+        let turns = rotation("Z(phi)").unwrap();
+        assert_eq!(
+            body_rates(&turns, &moves),
+            [None, None, Some("dot(phi)".into())]
+        );
+        assert_eq!(
+            body_rates(&rotation("X(lambda)").unwrap(), &moves),
+            [None, None, None]
+        );
+        assert!(rotation("W(phi)").is_err());
+        assert!(rotation("Z phi").is_err());
+        assert!(rotation("Z(phi").is_err());
+        assert_eq!(rotation("Y(pi/2 - (a))").unwrap()[0].angle, "pi/2 - (a)");
+    }
+
+    #[test]
+    fn inertia_is_principal_or_a_symmetric_tensor() {
+        let read = |s: &str| inertia(&toml::from_str::<toml::Table>(s).unwrap()["i"]);
+        let diagonal = read("i = ['a', 2, 0.0]").unwrap();
+        assert_eq!(diagonal[0][0].as_deref(), Some("a"));
+        assert_eq!(diagonal[2][2], None);
+        assert_eq!(diagonal[0][1], None);
+        let full = read("i = [['a', 'c', 0], ['c', 'b', 0], [0, 0, 'a+b']]").unwrap();
+        assert_eq!(full[1][0].as_deref(), Some("c"));
+        assert!(read("i = [['a', 'c', 0], ['d', 'b', 0], [0, 0, 1]]").is_err());
+        assert!(read("i = ['a', 'b']").is_err());
     }
 }

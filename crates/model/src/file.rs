@@ -28,6 +28,8 @@ pub struct ModelFile {
     /// Named positions (functions of coordinates, time and the fast phase).
     #[serde(default)]
     pub definitions: BTreeMap<String, String>,
+    /// L = T − V; with bodies, what their energies leave out (none: 0).
+    #[serde(default)]
     pub lagrangian: String,
     /// Non-potential generalised force per coordinate name.
     #[serde(default)]
@@ -50,6 +52,9 @@ pub struct ModelFile {
     /// (see [`crate::bodies`]).
     #[serde(default)]
     pub bodies: Vec<crate::bodies::BodySpec>,
+    /// Gravity's acceleration (x, y, z) in the fixed frame: each body gets
+    /// the potential −m g·c (none given: the Lagrangian writes its own).
+    pub gravity: Option<[NumberSpec; 3]>,
     /// How q' = A⁻¹(p − b) is computed: "symbolic" (cofactors) or
     /// "numeric" (A(q) emitted, solved by Cholesky in the generated code).
     /// Default: symbolic up to [`SYMBOLIC_INVERSE_MAX_DOF`] degrees of freedom.
@@ -112,6 +117,13 @@ pub struct ConstraintSpec {
     pub name: String,
     pub position: Option<String>,
     pub velocity: Option<String>,
+    /// A body rolling without slipping on a horizontal plane at its point
+    /// `contact`: the material point there has no horizontal velocity
+    /// (two constraints, `<name>_x` and `<name>_y`).
+    pub rolling: Option<String>,
+    /// Where the rolling body touches the plane (x, y, z), in the
+    /// coordinates.
+    pub contact: Option<[NumberSpec; 3]>,
     #[serde(default)]
     pub description: String,
 }
@@ -135,7 +147,7 @@ pub struct PointSpec {
 pub const MAX_POINTS: usize = 64;
 
 /// A number in a model file: a value, or an expression in the parameters.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(untagged)]
 pub enum NumberSpec {
     Value(f64),
@@ -281,6 +293,11 @@ pub struct Constraint {
     pub name: String,
     pub kind: ConstraintKind,
     pub description: String,
+    /// The file's key that gave it (`constraints[2].position`), for messages.
+    pub key: String,
+    /// A rolling constraint's contact velocity along the plane's normal,
+    /// which the body's geometry must hold at zero.
+    pub normal: Option<Expr>,
 }
 
 /// What vanishes along the motion.
@@ -323,7 +340,7 @@ const RUST_KEYWORDS: &[&str] = &[
 /// Names that the generated code or the expression reader take for themselves.
 const RESERVED: &[&str] = &["params", "pi", "e", "i"];
 
-fn is_identifier(name: &str) -> bool {
+pub(crate) fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_alphabetic())
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
@@ -355,15 +372,26 @@ impl Model {
             };
             err(&key, message)
         })?;
-        let (centres, energy) =
-            crate::bodies::expand(&spec.bodies).map_err(|(key, reason)| err(&key, reason))?;
-        for (name, at) in centres {
-            if spec.definitions.insert(name.clone(), at).is_some() {
-                let reason = format!("'{name}' is the centre of a body and a definition too");
+        // A body's centre is a definition, declared with the others, and
+        // so is an angle of its rotation written as an expression.
+        let turns = crate::bodies::name_turns(&mut spec.bodies)
+            .map_err(|(k, (part, reason))| err(&format!("bodies[{k}].{part}"), reason))?;
+        for (name, angle) in turns {
+            if spec.definitions.insert(name.clone(), angle).is_some() {
+                let reason = format!("'{name}' is an angle of a body and a definition too");
                 return Err(err(&format!("definitions.{name}"), reason));
             }
         }
-        spec.lagrangian += &energy;
+        for body in &spec.bodies {
+            let centre = crate::bodies::centre(&body.name);
+            for (name, at) in centre.into_iter().zip(&body.position) {
+                let at = crate::bodies::text(at);
+                if spec.definitions.insert(name.clone(), at).is_some() {
+                    let reason = format!("'{name}' is the centre of a body and a definition too");
+                    return Err(err(&format!("definitions.{name}"), reason));
+                }
+            }
+        }
         spec.validate(file)
     }
 }
@@ -597,6 +625,7 @@ impl ModelFile {
             }
             None => None,
         };
+        let bodies = self.validate_bodies(file, names, &parse)?;
         // Definitions are positions: no velocities, and no cycles.
         let mut parsed_defs = BTreeMap::new();
         for (name, text) in &self.definitions {
@@ -606,7 +635,17 @@ impl ModelFile {
         }
         let definitions = order_definitions(&parsed_defs, &err)?;
         let all = names.all();
-        let lagrangian = parse("lagrangian", &self.lagrangian, &all, true)?;
+        let lagrangian = match self.lagrangian.trim() {
+            "" if bodies.is_empty() => {
+                return Err(err(
+                    "lagrangian",
+                    "missing: give L = T − V, or the model's [[bodies]]".into(),
+                ))
+            }
+            "" => Expr::num(0),
+            text => parse("lagrangian", text, &all, true)?,
+        };
+        let lagrangian = Expr::sum(std::iter::once(lagrangian).chain(bodies).collect());
         if let Some(name) = self.forces.keys().find(|n| !names.coordinates.contains(n)) {
             return Err(err(
                 &format!("forces.{name}"),
@@ -986,6 +1025,122 @@ impl ModelFile {
         Ok(points)
     }
 
+    /// Constraint `i`'s rolling body's material velocity at its contact
+    /// point (x, y, z), the z one to be held at zero by the geometry.
+    fn rolling_velocity(
+        &self,
+        i: usize,
+        body: &str,
+        contact: &[NumberSpec; 3],
+        file: &str,
+        names: &Names,
+        parse: &ExprParser,
+    ) -> Result<[Expr; 3], ModelError> {
+        let err = error_at(file);
+        let Some(k) = self.bodies.iter().position(|b| b.name == body) else {
+            return Err(err(
+                format!("constraints[{i}].rolling"),
+                format!("'{body}' is not one of the model's [[bodies]]"),
+            ));
+        };
+        let key = format!("constraints[{i}].contact");
+        let contact = contact.clone().map(|p| crate::bodies::text(&p));
+        for p in &contact {
+            parse(&key, p, &names.positions(), false)?;
+        }
+        let turns = &self.bodies[k].turns;
+        let moves = |s: &str| {
+            names
+                .coordinates
+                .iter()
+                .chain(&names.definitions)
+                .any(|n| n == s)
+        };
+        let velocity = crate::bodies::point_velocity(body, turns, &contact, &moves);
+        let mut parsed = Vec::new();
+        for v in velocity {
+            parsed.push(parse(&key, &v, &names.all(), true)?);
+        }
+        Ok(parsed.try_into().expect("three components"))
+    }
+
+    /// Bodies: each one's parts read with its own key, then its kinetic
+    /// energy and gravity's potential as terms of the Lagrangian.
+    fn validate_bodies(
+        &self,
+        file: &str,
+        names: &Names,
+        parse: &ExprParser,
+    ) -> Result<Vec<Expr>, ModelError> {
+        let err = error_at(file);
+        let parameters = [&names.parameters];
+        let positions = names.positions();
+        if let Some(gravity) = &self.gravity {
+            if self.bodies.is_empty() {
+                return Err(err("gravity".into(), "gravity acts on the model's [[bodies]] and this model has none: write its potential in the Lagrangian".into()));
+            }
+            for g in gravity {
+                parse("gravity", &crate::bodies::text(g), &parameters, false)?;
+            }
+        }
+        let mut energies = Vec::new();
+        for (k, body) in self.bodies.iter().enumerate() {
+            let key = |part: &str| format!("bodies[{k}].{part}");
+            if !is_identifier(&body.name) {
+                return Err(err(
+                    key("name"),
+                    format!("'{}' is not an identifier", body.name),
+                ));
+            }
+            if self.bodies[..k].iter().any(|b| b.name == body.name) {
+                return Err(err(
+                    key("name"),
+                    format!("'{}' names two bodies", body.name),
+                ));
+            }
+            parse(
+                &key("mass"),
+                &crate::bodies::text(&body.mass),
+                &parameters,
+                false,
+            )?;
+            let tensor = crate::bodies::inertia(&body.inertia)
+                .map_err(|(part, reason)| err(key(part), reason))?;
+            for moment in tensor.iter().flatten().flatten() {
+                parse(&key("inertia"), moment, &parameters, false)?;
+            }
+            for at in &body.position {
+                parse(
+                    &key("position"),
+                    &crate::bodies::text(at),
+                    &positions,
+                    false,
+                )?;
+            }
+            for turn in &body.turns {
+                parse(&key("rotation"), &turn.angle, &positions, false)?;
+            }
+            let turns = &body.turns;
+            let moves = |s: &str| {
+                names
+                    .coordinates
+                    .iter()
+                    .chain(&names.definitions)
+                    .any(|n| n == s)
+            };
+            let energy =
+                crate::bodies::energy(body, &tensor, turns, self.gravity.as_ref(), &moves);
+            let energy = Expr::parse(&energy).map_err(|e| {
+                err(
+                    key("name"),
+                    format!("its kinetic energy cannot be read back ({e})"),
+                )
+            })?;
+            energies.push(energy);
+        }
+        Ok(energies)
+    }
+
     /// Constraints: each a position or a velocity expression, named once;
     /// fewer than the coordinates; not with contacts; and a start for
     /// every coordinate. Returns them and the coordinates' starts.
@@ -1025,7 +1180,12 @@ impl ModelFile {
                     .into(),
             ));
         }
-        let (k, n) = (self.constraints.len(), self.coordinates.len());
+        let k: usize = self
+            .constraints
+            .iter()
+            .map(|c| if c.rolling.is_some() { 2 } else { 1 })
+            .sum();
+        let n = self.coordinates.len();
         if k >= n {
             return Err(err(
                 "constraints".into(),
@@ -1047,31 +1207,45 @@ impl ModelFile {
                     format!("'{}' names two constraints", c.name),
                 ));
             }
-            let kind = match (&c.position, &c.velocity) {
-                (Some(text), None) => ConstraintKind::Position(parse(
+            let made = |kind, name: String, normal| Constraint {
+                key: match (&kind, &c.rolling) {
+                    (_, Some(_)) => format!("constraints[{i}].rolling"),
+                    (ConstraintKind::Position(_), None) => format!("constraints[{i}].position"),
+                    (ConstraintKind::Velocity(_), None) => format!("constraints[{i}].velocity"),
+                },
+                name,
+                kind,
+                description: c.description.clone(),
+                normal,
+            };
+            let kind = match (&c.position, &c.velocity, &c.rolling, &c.contact) {
+                (Some(text), None, None, None) => ConstraintKind::Position(parse(
                     &format!("constraints[{i}].position"),
                     text,
                     &positions,
                     false,
                 )?),
-                (None, Some(text)) => ConstraintKind::Velocity(parse(
+                (None, Some(text), None, None) => ConstraintKind::Velocity(parse(
                     &format!("constraints[{i}].velocity"),
                     text,
                     &names.all(),
                     true,
                 )?),
+                (None, None, Some(body), Some(contact)) => {
+                    let [along_x, along_y, normal] =
+                        self.rolling_velocity(i, body, contact, file, names, parse)?;
+                    constraints.push(made(ConstraintKind::Velocity(along_x), format!("{}_x", c.name), None));
+                    constraints.push(made(ConstraintKind::Velocity(along_y), format!("{}_y", c.name), Some(normal)));
+                    continue;
+                }
                 _ => {
                     return Err(err(
                         format!("constraints[{i}]"),
-                        "give exactly one of `position` (an expression of the positions that vanishes) and `velocity` (one linear in the velocities that vanishes)".into(),
+                        "give exactly one of `position` (an expression of the positions that vanishes), `velocity` (one linear in the velocities that vanishes) and `rolling` (a body's name) with `contact` (where it touches the plane)".into(),
                     ))
                 }
             };
-            constraints.push(Constraint {
-                name: c.name.clone(),
-                kind,
-                description: c.description.clone(),
-            });
+            constraints.push(made(kind, c.name.clone(), None));
         }
         Ok((constraints, starts))
     }
@@ -1268,6 +1442,7 @@ impl Model {
 
 /// A model's expressions evaluated at coordinates, velocities, phase and
 /// time with the default parameters (for the numerical checks).
+#[derive(Clone)]
 struct Sample<'m> {
     model: &'m Model,
     q: Vec<f64>,
@@ -1374,7 +1549,7 @@ impl Model {
                     let residual = at_start.eval(&expanded);
                     if !(residual.abs() <= 1e-9 * size * gradient.max(1.0)) {
                         return Err((
-                            format!("constraints[{r}].position"),
+                            constraint.key.clone(),
                             format!("the coordinates' starts violate '{}': its value there is {residual:.3e} (t = 0, default parameters); give starts that satisfy every position constraint", constraint.name),
                         ));
                     }
@@ -1385,12 +1560,94 @@ impl Model {
             }
             rows.push(values);
         }
+        self.check_contacts_stay_on_the_plane(&at_start)?;
         let rank = rank(rows.clone());
         if rank < rows.len() {
             return Err((
                 "constraints".into(),
                 format!("the constraints are redundant or inconsistent at the starts: their rows (∂g/∂q of a position constraint, ∂c/∂q' of a velocity one) have rank {rank}, not {}; remove the dependent ones", rows.len()),
             ));
+        }
+        Ok(())
+    }
+
+    /// A rolling body's contact point is where it touches the plane: its
+    /// material velocity along the normal vanishes for every motion the
+    /// constraints allow (their rows' null space, at random), at the start
+    /// and, where no position constraint pins the configuration, near it.
+    fn check_contacts_stay_on_the_plane(&self, at_start: &Sample) -> Result<(), (String, String)> {
+        if self.constraints.iter().all(|c| c.normal.is_none()) {
+            return Ok(());
+        }
+        let n = self.dof();
+        let rows: Vec<Vec<Expr>> = self
+            .constraints
+            .iter()
+            .map(|c| {
+                let expanded = self.expanded(c.kind.expression());
+                self.coordinates
+                    .iter()
+                    .map(|q| match &c.kind {
+                        ConstraintKind::Position(_) => expanded.derivative(&q.name),
+                        ConstraintKind::Velocity(_) => expanded.derivative(&q.velocity),
+                    })
+                    .collect()
+            })
+            .collect();
+        let pinned = self
+            .constraints
+            .iter()
+            .any(|c| matches!(c.kind, ConstraintKind::Position(_)));
+        let mut random = uniform(0x9E37_79B9_7F4A_7C15);
+        for sample in 0..4 {
+            let q: Vec<f64> = at_start
+                .q
+                .iter()
+                .map(|x| {
+                    if sample == 0 || pinned {
+                        *x
+                    } else {
+                        x + 0.5 * random()
+                    }
+                })
+                .collect();
+            let point = Sample {
+                q,
+                ..at_start.clone()
+            };
+            let values: Vec<Vec<f64>> = rows
+                .iter()
+                .map(|row| row.iter().map(|e| point.eval(e)).collect())
+                .collect();
+            let v = project_out(&values, (0..n).map(|_| random()).collect());
+            let moving = Sample { v, ..point.clone() };
+            for constraint in &self.constraints {
+                let Some(normal) = &constraint.normal else {
+                    continue;
+                };
+                // The scale: the contact's velocity along the plane and
+                // across it, per unit speed.
+                let normal = self.expanded(normal);
+                let along = self.expanded(constraint.kind.expression());
+                let gradient: f64 = self
+                    .coordinates
+                    .iter()
+                    .map(|c| {
+                        let across = point.eval(&normal.derivative(&c.velocity));
+                        let on = point.eval(&along.derivative(&c.velocity));
+                        across * across + on * on
+                    })
+                    .sum::<f64>()
+                    .sqrt();
+                let speed = moving.v.iter().map(|x| x * x).sum::<f64>().sqrt();
+                let off = moving.eval(&normal);
+                if !(off.abs() <= 1e-8 * gradient * speed) {
+                    return Err((
+                        constraint.key.replace(".rolling", ".contact"),
+                        format!("the body's material point at the contact moves off the plane (normal velocity {off:.3e} in a motion the constraints allow near the start): `contact` is not where the body touches the plane"),
+                    ));
+                }
+            }
         }
         Ok(())
     }
@@ -1405,7 +1662,7 @@ impl Model {
         row: &[Expr],
         at_start: &Sample,
     ) -> Result<(), (String, String)> {
-        let key = format!("constraints[{r}].velocity");
+        let key = self.constraints[r].key.clone();
         let name = &self.constraints[r].name;
         let n = self.dof();
         let mut random = uniform(0x2545_F491_4F6C_DD1D);
@@ -1505,6 +1762,31 @@ fn rank(mut rows: Vec<Vec<f64>>) -> usize {
         rank += 1;
     }
     rank
+}
+
+/// `v` less its components along `rows` (modified Gram–Schmidt): a
+/// vector of their null space.
+fn project_out(rows: &[Vec<f64>], mut v: Vec<f64>) -> Vec<f64> {
+    let mut basis: Vec<Vec<f64>> = Vec::new();
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    for row in rows {
+        let mut u = row.clone();
+        for b in &basis {
+            let along = dot(&u, b);
+            u.iter_mut().zip(b).for_each(|(x, y)| *x -= along * y);
+        }
+        let length = dot(&u, &u).sqrt();
+        if length > 1e-9 * dot(row, row).sqrt() {
+            basis.push(u.iter().map(|x| x / length).collect());
+        }
+    }
+    for _ in 0..2 {
+        for b in &basis {
+            let along = dot(&v, b);
+            v.iter_mut().zip(b).for_each(|(x, y)| *x -= along * y);
+        }
+    }
+    v
 }
 
 /// A reproducible stream of numbers uniform in [−1, 1) (xorshift), for the
