@@ -633,7 +633,10 @@ fn a_malformed_body_is_named() {
 /// where the body touches the plane.
 #[test]
 fn a_rolling_constraint_is_checked_against_its_body() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../test_models/tipping_disk_body.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../test_models/tipping_disk_body.toml"
+    );
     let text = std::fs::read_to_string(path).unwrap();
     let file = "test_models/tipping_disk_body.toml";
     Model::parse(file, &text).expect("the disk rolls at its lowest point");

@@ -1128,8 +1128,7 @@ impl ModelFile {
                     .chain(&names.definitions)
                     .any(|n| n == s)
             };
-            let energy =
-                crate::bodies::energy(body, &tensor, turns, self.gravity.as_ref(), &moves);
+            let energy = crate::bodies::energy(body, &tensor, turns, self.gravity.as_ref(), &moves);
             let energy = Expr::parse(&energy).map_err(|e| {
                 err(
                     key("name"),
