@@ -462,13 +462,21 @@ fn a_constrained_model_needs_a_start_for_every_coordinate() {
     assert_error(&text, "coordinates[0].start", "needs a start for 'x'");
 }
 
+/// A constraint that repeats others is kept (its reaction is
+/// indeterminate, the motion the same); one that contradicts them is named.
 #[test]
-fn redundant_constraints_are_named_with_their_rank() {
-    let text = ROD.replace("- g*y", "+ dot(z)^2/2 - g*y").replace(
-        "[[parameters]]\nname = \"g\"",
-        "[[constraints]]\nname = \"again\"\nposition = \"2*(x^2 + y^2 - l^2)\"\n\n[[coordinates]]\nname = \"z\"\nvelocity = \"zd\"\nstart = 0\n\n[[parameters]]\nname = \"g\"",
-    );
-    assert_error(&text, "constraints", "rank 1, not 2");
+fn redundant_constraints_are_kept_and_inconsistent_ones_named() {
+    let with = |extra: &str| {
+        ROD.replace("- g*y", "+ dot(z)^2/2 - g*y").replace(
+            "[[parameters]]\nname = \"g\"",
+            &format!("{extra}[[coordinates]]\nname = \"z\"\nvelocity = \"zd\"\nstart = 0\n\n[[parameters]]\nname = \"g\""),
+        )
+    };
+    let again = "[[constraints]]\nname = \"again\"\nposition = \"2*(x^2 + y^2 - l^2)\"\n\n";
+    let model = Model::parse("models/toy.toml", &with(again)).expect("a redundant constraint");
+    assert_eq!(model.constraints.len(), 2);
+    let moving = "[[constraints]]\nname = \"slide\"\nposition = \"z - t\"\n\n[[constraints]]\nname = \"stop\"\nposition = \"2*z\"\n\n";
+    assert_error(&with(moving), "constraints", "inconsistent");
 }
 
 #[test]

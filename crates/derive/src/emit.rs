@@ -43,6 +43,10 @@ pub struct Solve {
     pub matrix: Vec<Vec<usize>>,
     pub columns: Vec<Vec<usize>>,
     pub names: Option<Vec<Vec<String>>>,
+    /// A positive semidefinite matrix (the constraints' Schur complement,
+    /// singular where constraints are redundant): its dependent rows are
+    /// skipped, their unknowns 0 (`Cholesky::semidefinite`).
+    pub semidefinite: bool,
 }
 
 /// One step of a generated function's evaluation.
@@ -50,12 +54,14 @@ pub struct Solve {
 pub enum Step {
     /// Named expressions (of the inputs and earlier outputs).
     Values(Vec<(String, String)>),
-    /// A X = R solved numerically (A symmetric positive definite): the
-    /// entries are expressions, X's columns become the outputs `names`.
+    /// A X = R solved numerically (A symmetric positive definite, or
+    /// semidefinite with consistent R): the entries are expressions, X's
+    /// columns become the outputs `names`.
     Solve {
         matrix: Vec<Vec<String>>,
         columns: Vec<Vec<String>>,
         names: Vec<Vec<String>>,
+        semidefinite: bool,
     },
     /// Named derivatives of earlier outputs: (name, output, the variables
     /// to differentiate by in turn), by forward mode through the DAG.
@@ -430,7 +436,8 @@ impl Emitter {
                 matrix,
                 columns,
                 names,
-            } => self.solve_stage(matrix, columns, names),
+                semidefinite,
+            } => self.solve_stage(matrix, columns, names, *semidefinite),
             Step::Derivatives(list) => {
                 let mut stage = Vec::new();
                 for (name, output, variables) in list {
@@ -472,6 +479,7 @@ impl Emitter {
         matrix: &[Vec<String>],
         columns: &[Vec<String>],
         names: &[Vec<String>],
+        semidefinite: bool,
     ) -> Result<(), EmitError> {
         let matrix = matrix
             .iter()
@@ -481,7 +489,7 @@ impl Emitter {
             .iter()
             .map(|col| col.iter().map(|t| self.node(t)).collect())
             .collect::<Result<Vec<Vec<usize>>, EmitError>>()?;
-        let solve = self.add_solve(matrix, columns, Some(names.to_vec()));
+        let solve = self.add_solve(matrix, columns, Some(names.to_vec()), semidefinite);
         let mut stage = Vec::new();
         for (column, col_names) in names.iter().enumerate() {
             for (row, name) in col_names.iter().enumerate() {
@@ -498,11 +506,13 @@ impl Emitter {
         matrix: Vec<Vec<usize>>,
         columns: Vec<Vec<usize>>,
         names: Option<Vec<Vec<String>>>,
+        semidefinite: bool,
     ) -> usize {
         self.solves.push(Solve {
             matrix,
             columns,
             names,
+            semidefinite,
         });
         self.solves.len() - 1
     }
@@ -655,7 +665,10 @@ impl Emitter {
             return s;
         }
         let Solve {
-            matrix, columns, ..
+            matrix,
+            columns,
+            semidefinite,
+            ..
         } = self.solves[solve].clone();
         let n = matrix.len();
         let d_matrix: Vec<Vec<Option<usize>>> = matrix
@@ -687,7 +700,7 @@ impl Emitter {
             }
             new_columns.push(new_column);
         }
-        let s = any.then(|| self.add_solve(matrix, new_columns, None));
+        let s = any.then(|| self.add_solve(matrix, new_columns, None, semidefinite));
         self.solve_derivatives.insert(key, s);
         s
     }
@@ -763,6 +776,7 @@ impl Emitter {
             matrix,
             columns,
             names,
+            semidefinite,
         } = self.solves[solve].clone();
         let factor = match self.factors.get(&matrix) {
             Some(f) => f.clone(),
@@ -781,8 +795,9 @@ impl Emitter {
                     })
                     .collect();
                 self.lines.push(format!(
-                    "let {name} = {}::new([{}]);",
+                    "let {name} = {}::{}([{}]);",
                     self.factorisation.unwrap_or("crate::linalg::Cholesky"),
+                    if semidefinite { "semidefinite" } else { "new" },
                     rows.join(", ")
                 ));
                 self.factors.insert(matrix.clone(), name.clone());

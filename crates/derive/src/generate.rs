@@ -471,7 +471,8 @@ fn constrained_functions(
 /// The Taylor recurrences of the equations on the constraints, y = [q; q']:
 /// the same Schur complement as the runtime's, as two solves of the DAG,
 /// M [x_F, x_G] = [F, Gᵀ] and (G x_G) λ = −h − G x_F, then
-/// q'' = x_F + x_G λ. Their recurrences solve with the factors of order 0
+/// q'' = x_F + x_G λ; G x_G is singular where constraints are redundant,
+/// and solved with their rows skipped. Their recurrences solve with the factors of order 0
 /// at every order (`crates/derive/src/taylor.rs`), so a step costs what
 /// the model's size asks and no inverse is formed.
 fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<Step>, Vec<String>) {
@@ -535,12 +536,16 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
             matrix: names("mass", n),
             columns,
             names: solutions,
+            semidefinite: false,
         },
         Step::Values(reduced),
         Step::Solve {
             matrix: names("schur", k),
             columns: vec![(0..k).map(|r| format!("reduced__{r}")).collect()],
             names: vec![lambda],
+            // Redundant constraints make it singular: their reactions are
+            // left at 0, the motion is the same.
+            semidefinite: true,
         },
         Step::Values(rates),
     ];

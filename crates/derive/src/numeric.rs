@@ -88,6 +88,7 @@ fn vibrational_steps(derivation: &Derivation, form: &NumericForm) -> Vec<Step> {
             names: (0..form.modes.len())
                 .map(|s| (0..n).map(|i| format!("solved{s}__{i}")).collect())
                 .collect(),
+            semidefinite: false,
         });
     }
     let w_vibr = mode_quadratic_form(n, &form.mode_products);
@@ -140,6 +141,7 @@ fn exact_steps(
             matrix: names("mass", n),
             columns: vec![(0..n).map(|i| format!("residual__{i}")).collect()],
             names: vec![cx.velocities()],
+            semidefinite: false,
         },
         Step::Values(rates),
     ];
@@ -169,6 +171,7 @@ fn averaged_steps(
         matrix: names("mass", n),
         columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
         names: vec![cx.velocities()],
+        semidefinite: false,
     });
     steps.push(Step::Values(vec![(
         "w__".into(),
@@ -620,6 +623,7 @@ pub fn second_order(
             matrix: names("mass", n),
             columns,
             names: solved,
+            semidefinite: false,
         },
         Step::Values(scalars),
     ];
@@ -714,6 +718,7 @@ fn averaged_velocity_steps(cx: &Context, derivation: &Derivation, form: &Numeric
             matrix: names("mass", n),
             columns: vec![(0..n).map(|i| format!("residual_mean__{i}")).collect()],
             names: vec![cx.velocities()],
+            semidefinite: false,
         },
     ]
 }

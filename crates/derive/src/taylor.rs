@@ -67,6 +67,8 @@ enum Op {
 struct Solve {
     matrix: Vec<Vec<usize>>,
     columns: Vec<Vec<usize>>,
+    /// Factorised by `Cholesky::semidefinite` (see `emit::Solve`).
+    semidefinite: bool,
     /// Its solution nodes, column by column.
     solutions: Vec<Vec<usize>>,
 }
@@ -332,7 +334,8 @@ impl Lowering<'_> {
                                     .collect::<Result<Vec<_>, _>>()?,
                             );
                         }
-                        let s = self.add_solve(matrix, columns);
+                        let semidefinite = self.dag.solves[solve].semidefinite;
+                        let s = self.add_solve(matrix, columns, semidefinite);
                         self.solve_memo.insert(solve, s);
                         s
                     }
@@ -361,12 +364,18 @@ impl Lowering<'_> {
 
     /// Adds a lowered system and interns its solution nodes together (so
     /// that they are consecutive: one place computes them all).
-    fn add_solve(&mut self, matrix: Vec<Vec<usize>>, columns: Vec<Vec<usize>>) -> usize {
+    fn add_solve(
+        &mut self,
+        matrix: Vec<Vec<usize>>,
+        columns: Vec<Vec<usize>>,
+        semidefinite: bool,
+    ) -> usize {
         let s = self.solves.len();
         let (rows, count) = (matrix.len(), columns.len());
         self.solves.push(Solve {
             matrix,
             columns,
+            semidefinite,
             solutions: Vec::new(),
         });
         let solutions = (0..count)
@@ -402,6 +411,7 @@ impl Lowering<'_> {
             matrix,
             columns,
             solutions,
+            semidefinite,
         } = self.solves[solve].clone();
         let d_matrix: Vec<Vec<Option<usize>>> = matrix
             .iter()
@@ -428,7 +438,7 @@ impl Lowering<'_> {
             }
             new_columns.push(new_column);
         }
-        let d = any.then(|| self.add_solve(matrix, new_columns));
+        let d = any.then(|| self.add_solve(matrix, new_columns, semidefinite));
         self.tangent_solves.insert((solve, t), d);
         d
     }
@@ -979,8 +989,13 @@ impl Writer<'_> {
             })
             .collect();
         format!(
-            "let {} = crate::linalg::Cholesky::new([{}]);",
+            "let {} = crate::linalg::Cholesky::{}([{}]);",
             self.factor_name(s),
+            if s.semidefinite {
+                "semidefinite"
+            } else {
+                "new"
+            },
             rows.join(", ")
         )
     }

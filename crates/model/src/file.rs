@@ -1179,18 +1179,6 @@ impl ModelFile {
                     .into(),
             ));
         }
-        let k: usize = self
-            .constraints
-            .iter()
-            .map(|c| if c.rolling.is_some() { 2 } else { 1 })
-            .sum();
-        let n = self.coordinates.len();
-        if k >= n {
-            return Err(err(
-                "constraints".into(),
-                format!("{k} constraints on {n} coordinates leave no motion: a model needs fewer constraints than coordinates"),
-            ));
-        }
         let positions = names.positions();
         let mut constraints = Vec::new();
         for (i, c) in self.constraints.iter().enumerate() {
@@ -1560,14 +1548,55 @@ impl Model {
             rows.push(values);
         }
         self.check_contacts_stay_on_the_plane(&at_start)?;
-        let rank = rank(rows.clone());
-        if rank < rows.len() {
+        // Redundant constraints are kept (the runtime skips their rows);
+        // inconsistent ones, or ones that leave no motion, are not.
+        let rank_of_rows = rank(rows.clone());
+        let augmented: Vec<Vec<f64>> = rows
+            .iter()
+            .zip(&self.constraints)
+            .map(|(row, c)| {
+                let mut row = row.clone();
+                row.push(at_start.eval(&self.constraint_rate(c)));
+                row
+            })
+            .collect();
+        if rank(augmented) > rank_of_rows {
             return Err((
                 "constraints".into(),
-                format!("the constraints are redundant or inconsistent at the starts: their rows (∂g/∂q of a position constraint, ∂c/∂q' of a velocity one) have rank {rank}, not {}; remove the dependent ones", rows.len()),
+                format!("the constraints are inconsistent at the starts: their rows (∂g/∂q of a position constraint, ∂c/∂q' of a velocity one) have rank {rank_of_rows}, but with their rates (∂g/∂t, the velocity constraints' terms free of velocities) more: no velocity satisfies them all"),
+            ));
+        }
+        if rank_of_rows >= n {
+            return Err((
+                "constraints".into(),
+                format!("the constraints leave no motion: at the starts they fix all {n} coordinates (their rows have rank {rank_of_rows}); a model needs fewer independent constraints than coordinates"),
             ));
         }
         Ok(())
+    }
+
+    /// What a constraint's velocity form has besides the velocities: ∂g/∂t
+    /// (with the fast phase's rate) of a position constraint, the terms
+    /// free of velocities of a velocity one (evaluated with q' = 0).
+    fn constraint_rate(&self, constraint: &Constraint) -> Expr {
+        let expanded = self.expanded(constraint.kind.expression());
+        match &constraint.kind {
+            ConstraintKind::Velocity(_) => expanded,
+            ConstraintKind::Position(_) => {
+                let mut rate = expanded.derivative(&self.time);
+                if let Some(phase) = &self.fast_phase {
+                    rate = Expr::sum(vec![
+                        rate,
+                        Expr::Bin(
+                            crate::expr::BinOp::Mul,
+                            Box::new(phase.rate.clone()),
+                            Box::new(expanded.derivative(&phase.name)),
+                        ),
+                    ]);
+                }
+                rate
+            }
+        }
     }
 
     /// A rolling body's contact point is where it touches the plane: its

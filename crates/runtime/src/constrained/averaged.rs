@@ -42,7 +42,7 @@ impl<const N: usize, const K: usize, const S: usize> AveragedOnConstraints<N, K,
         let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|r| mass.solve(g[r]));
         let schur: [[f64; K]; K] =
             std::array::from_fn(|a| std::array::from_fn(|c| dot(&g[a], &m_inv_gt[c])));
-        let schur = Cholesky::new(schur);
+        let schur = Cholesky::semidefinite(schur);
         let mut potential = 0.0;
         let couplings: Vec<[f64; N]> = (0..NODES)
             .map(|j| {

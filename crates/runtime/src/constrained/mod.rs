@@ -196,8 +196,9 @@ impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
 }
 
 /// q'' and λ of M q'' = F + Gᵀλ, G q'' + h = 0 by the Schur complement:
-/// λ = (G M⁻¹ Gᵀ)⁻¹ (−h − G M⁻¹ F), q'' = M⁻¹ (F + Gᵀλ). NaN where M or
-/// G M⁻¹ Gᵀ is not positive definite.
+/// λ = (G M⁻¹ Gᵀ)⁻¹ (−h − G M⁻¹ F), q'' = M⁻¹ (F + Gᵀλ); redundant
+/// constraints' rows skipped (their λ 0). NaN where M is not positive
+/// definite.
 #[inline]
 pub(crate) fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
     mass: [[Num; N]; N],
@@ -212,7 +213,7 @@ pub(crate) fn solve_constrained<Num: Scalar, const N: usize, const K: usize>(
         std::array::from_fn(|r| std::array::from_fn(|c| dot(&g[r], &m_inv_gt[c])));
     let m_inv_f = mass.solve(free);
     let rhs: [Num; K] = std::array::from_fn(|r| -h[r] - dot(&g[r], &m_inv_f));
-    let lambda = Cholesky::new(schur).solve(rhs);
+    let lambda = Cholesky::semidefinite(schur).solve(rhs);
     let accelerations = std::array::from_fn(|i| {
         let mut a = m_inv_f[i];
         for r in 0..K {
@@ -501,13 +502,17 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
             let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|row| mass.solve(g[row]));
             let schur: [[f64; K]; K] =
                 std::array::from_fn(|a| std::array::from_fn(|b| dot(&g[a], &m_inv_gt[b])));
-            let lambda = Cholesky::new(schur).solve(r);
+            let schur = Cholesky::semidefinite(schur);
+            let schur_kept = schur.rank() > 0;
+            let lambda = schur.solve(r);
             let step: [f64; N] = std::array::from_fn(|i| {
                 -(0..K)
                     .map(|row| m_inv_gt[row][i] * lambda[row])
                     .sum::<f64>()
             });
-            match step.iter().all(|x| x.is_finite()) {
+            // No row left (G = 0) with a residual to remove: degenerate.
+            let stalled = K > 0 && !schur_kept && r.iter().any(|x| *x != 0.0);
+            match step.iter().all(|x| x.is_finite()) && !stalled {
                 true => Ok(step),
                 false => Err(ConstraintError::Singular { q: q.to_vec() }),
             }

@@ -378,6 +378,12 @@ impl Scalar for DoubleDouble {
             DoubleDouble::from(f64::NAN)
         }
     }
+    fn semidefinite_inverse_sqrt(self, diagonal: DoubleDouble) -> DoubleDouble {
+        match self.hi.semidefinite_inverse_sqrt(diagonal.hi) {
+            r if r == 0.0 || r.is_nan() => DoubleDouble::from(r),
+            _ => self.sqrt().recip(),
+        }
+    }
     fn inverse(n: usize) -> DoubleDouble {
         DoubleDouble::ONE / n as f64
     }

@@ -246,6 +246,12 @@ impl<S: Scalar> Scalar for Dual<S> {
         self.chain(r, (r + r).recip())
     }
     #[inline(always)]
+    fn semidefinite_inverse_sqrt(self, diagonal: Dual<S>) -> Dual<S> {
+        // d(x^(-1/2)) = −x^(-3/2)/2 dx, 0 with the skipped row's 0.
+        let r = self.re.semidefinite_inverse_sqrt(diagonal.re);
+        self.chain(r, r * r * r * -0.5)
+    }
+    #[inline(always)]
     fn mul_add(self, a: Dual<S>, b: Dual<S>) -> Dual<S> {
         Dual {
             re: self.re.mul_add(a.re, b.re),
@@ -276,6 +282,16 @@ impl<const N: usize> Cholesky<N> {
     pub fn new(a: [[Dual; N]; N]) -> Self {
         Cholesky {
             value: super::linalg::Cholesky::new(a.map(|row| row.map(|x| x.re))),
+            slope: a.map(|row| row.map(|x| x.du)),
+        }
+    }
+
+    /// [`super::linalg::Cholesky::semidefinite`]'s twin: dependent rows
+    /// skipped in the value's factor, and so in the slope's solve.
+    #[inline]
+    pub fn semidefinite(a: [[Dual; N]; N]) -> Self {
+        Cholesky {
+            value: super::linalg::Cholesky::semidefinite(a.map(|row| row.map(|x| x.re))),
             slope: a.map(|row| row.map(|x| x.du)),
         }
     }

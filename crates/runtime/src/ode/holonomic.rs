@@ -74,7 +74,7 @@ pub struct Projection {
 struct Factors {
     m: Cholesky<f64, Dyn>,
     m_inv_gt: DMatrix<f64>,
-    schur: Cholesky<f64, Dyn>,
+    schur: Semidefinite,
 }
 
 impl Factors {
@@ -82,13 +82,72 @@ impl Factors {
         let singular = || ConstraintError::Singular { q: q.to_vec() };
         let m = m.clone().cholesky().ok_or_else(singular)?;
         let m_inv_gt = m.solve(&g.transpose());
-        let schur = (g * &m_inv_gt).cholesky().ok_or_else(singular)?;
+        let schur = Semidefinite::new(&(g * &m_inv_gt)).ok_or_else(singular)?;
         Ok(Factors { m, m_inv_gt, schur })
     }
 
     /// The correction −M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ r of a residual r.
     fn correction(&self, r: &DVector<f64>) -> DVector<f64> {
-        -(&self.m_inv_gt * self.schur.solve(r))
+        -(&self.m_inv_gt * self.schur.solve_vector(r))
+    }
+}
+
+/// [`crate::linalg::Cholesky::semidefinite`] at run-time sizes: the
+/// Schur complement G M⁻¹ Gᵀ of redundant constraints, their rows skipped.
+struct Semidefinite {
+    lower: DMatrix<f64>,
+    inverse_diagonal: DVector<f64>,
+}
+
+impl Semidefinite {
+    /// None where an entry is not finite, or no row is left (every
+    /// constraint degenerate: G = 0).
+    fn new(a: &DMatrix<f64>) -> Option<Semidefinite> {
+        use crate::ode::Scalar;
+        let n = a.nrows();
+        let mut lower = DMatrix::zeros(n, n);
+        let mut inverse_diagonal = DVector::zeros(n);
+        for j in 0..n {
+            let row = |i: usize, lower: &DMatrix<f64>| -> f64 {
+                (0..j).map(|k| lower[(i, k)] * lower[(j, k)]).sum()
+            };
+            let d = a[(j, j)] - row(j, &lower);
+            let inverse = d.semidefinite_inverse_sqrt(a[(j, j)]);
+            inverse_diagonal[j] = inverse;
+            for i in j + 1..n {
+                lower[(i, j)] = (a[(i, j)] - row(i, &lower)) * inverse;
+            }
+        }
+        let finite =
+            a.iter().all(|x| x.is_finite()) && inverse_diagonal.iter().all(|x| x.is_finite());
+        let kept = n == 0 || inverse_diagonal.iter().any(|x| *x != 0.0);
+        (finite && kept).then_some(Semidefinite {
+            lower,
+            inverse_diagonal,
+        })
+    }
+
+    fn solve_vector(&self, b: &DVector<f64>) -> DVector<f64> {
+        let n = b.len();
+        let mut y = DVector::zeros(n);
+        for i in 0..n {
+            let earlier: f64 = (0..i).map(|k| self.lower[(i, k)] * y[k]).sum();
+            y[i] = (b[i] - earlier) * self.inverse_diagonal[i];
+        }
+        let mut x = DVector::zeros(n);
+        for i in (0..n).rev() {
+            let later: f64 = (i + 1..n).map(|k| self.lower[(k, i)] * x[k]).sum();
+            x[i] = (y[i] - later) * self.inverse_diagonal[i];
+        }
+        x
+    }
+
+    fn solve(&self, b: &DMatrix<f64>) -> DMatrix<f64> {
+        let columns: Vec<DVector<f64>> = b
+            .column_iter()
+            .map(|c| self.solve_vector(&c.into_owned()))
+            .collect();
+        DMatrix::from_columns(&columns)
     }
 }
 
@@ -103,7 +162,7 @@ pub fn accelerations(
 ) -> Result<(DVector<f64>, DVector<f64>), ConstraintError> {
     let factors = Factors::at(m, g, q)?;
     let m_inv_f = factors.m.solve(f);
-    let lambda = factors.schur.solve(&(-h - g * &m_inv_f));
+    let lambda = factors.schur.solve_vector(&(-h - g * &m_inv_f));
     Ok((m_inv_f + &factors.m_inv_gt * &lambda, lambda))
 }
 
@@ -209,28 +268,38 @@ pub fn project_holding(
 
 /// An orthonormal basis (as columns) of the tangent space of the
 /// constrained phase space at a state: the kernel of the Jacobian `c`
-/// (2k × 2n) of the state's constraints [g; G q̇ + g_t]. None where `c`
-/// does not have full rank 2k (degenerate constraints).
+/// (2k × 2n) of the state's constraints [g; G q̇ + g_t]. Redundant
+/// constraints leave its rank r below 2k: the kernel has 2n − r columns,
+/// r the singular values above 1e-10 of the largest. None where nothing is
+/// left to move.
 pub fn tangent_basis(c: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let (rows, n) = c.shape();
     if rows == 0 {
         return Some(DMatrix::identity(n, n));
     }
-    if rows >= n {
-        return None;
-    }
-    // The full SVD's right singular vectors: the last n − rows span the
-    // kernel when the first `rows` singular values are not zero.
-    let svd = nalgebra::linalg::SVD::new(c.clone().insert_rows(rows, n - rows, 0.0), false, true);
+    // The full SVD's right singular vectors: those past the rank span the
+    // kernel.
+    let padded = match rows < n {
+        true => c.clone().insert_rows(rows, n - rows, 0.0),
+        false => c.clone(),
+    };
+    let svd = nalgebra::linalg::SVD::new(padded, false, true);
     let v_t = svd.v_t?;
-    let mut order: Vec<usize> = (0..n).collect();
+    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
     order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
     let largest = svd.singular_values[order[0]];
-    if !(svd.singular_values[order[rows - 1]] > 1e-12 * largest) {
+    if !largest.is_finite() {
         return None;
     }
-    Some(DMatrix::from_fn(n, n - rows, |i, j| {
-        v_t[(order[rows + j], i)]
+    let rank = order
+        .iter()
+        .take_while(|&&i| svd.singular_values[i] > 1e-10 * largest)
+        .count();
+    if rank >= n || v_t.nrows() < n {
+        return None;
+    }
+    Some(DMatrix::from_fn(n, n - rank, |i, j| {
+        v_t[(order[rank + j], i)]
     }))
 }
 
@@ -291,8 +360,13 @@ pub fn tangent_stability(
         return None;
     }
     let z = tangent_basis(g)?;
-    // μ from Gᵀμ = ∇U, by least squares (exact at an equilibrium).
-    let multipliers = (g * g.transpose()).cholesky()?.solve(&(g * gradient));
+    // μ from Gᵀμ = ∇U, by least squares (exact at an equilibrium); of
+    // least norm where constraints are redundant (any μ gives the same C_T).
+    let multipliers = g
+        .transpose()
+        .svd(true, true)
+        .solve(gradient, 1e-12 * g.norm())
+        .ok()?;
     let mut curvature = hessian.clone();
     for (mu, h) in multipliers.iter().zip(constraint_hessians) {
         curvature -= h * *mu;

@@ -221,6 +221,13 @@ impl Scalar for HyperDual {
             HyperDual::from(f64::NAN)
         }
     }
+    fn semidefinite_inverse_sqrt(self, diagonal: HyperDual) -> HyperDual {
+        if self.re.semidefinite_inverse_sqrt(diagonal.re) == 0.0 {
+            HyperDual::from(0.0)
+        } else {
+            self.sqrt().recip()
+        }
+    }
 }
 
 /// The state y with ε₁ on component i and ε₂ on component j.

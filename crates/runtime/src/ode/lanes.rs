@@ -202,6 +202,11 @@ impl Scalar for Lanes {
     fn positive_sqrt(self) -> Lanes {
         self.map(<f64 as Scalar>::positive_sqrt)
     }
+    fn semidefinite_inverse_sqrt(self, diagonal: Lanes) -> Lanes {
+        Lanes(std::array::from_fn(|l| {
+            self.0[l].semidefinite_inverse_sqrt(diagonal.0[l])
+        }))
+    }
     fn dyn_taylor<const N: usize>(
         system: &dyn DynSystem<N>,
         params: [&[f64]; LANES],

@@ -10,6 +10,12 @@
 
 use super::series::Scalar;
 
+/// A pivot of a semidefinite factorisation at most this share of its
+/// diagonal entry is a dependent row's: the row's part outside the span of
+/// the earlier ones is a sine of at most 1e-5 of it (rounding leaves about
+/// 1e-16 where rows are exactly dependent).
+pub const REDUNDANT: f64 = 1e-10;
+
 /// The Cholesky factor L (A = L Lᵀ) of a symmetric positive definite
 /// matrix, with the reciprocals of its diagonal; over f64, or over
 /// [`crate::ode::Lanes`] (one matrix per lane) in the batch recurrences.
@@ -27,13 +33,28 @@ impl<L: Scalar, const N: usize> Cholesky<L, N> {
     /// Factorises `a` (only its lower triangle is read).
     #[inline]
     pub fn new(a: [[L; N]; N]) -> Self {
+        Self::factor(a, |d, _| d.positive_sqrt().recip())
+    }
+
+    /// The factor of a positive semidefinite matrix whose rows may depend
+    /// on earlier ones (redundant constraints' Schur complement G M⁻¹ Gᵀ):
+    /// a row whose pivot is at most [`REDUNDANT`] of its diagonal entry adds
+    /// nothing new and is skipped, its unknown set to 0. For a consistent
+    /// right-hand side that is a solution; any gives the same Gᵀx.
+    #[inline]
+    pub fn semidefinite(a: [[L; N]; N]) -> Self {
+        Self::factor(a, L::semidefinite_inverse_sqrt)
+    }
+
+    /// L column by column, each pivot d (with its diagonal entry) turned
+    /// into 1/√d by `inverse_pivot`; L's diagonal itself is never read.
+    #[inline(always)]
+    fn factor(a: [[L; N]; N], inverse_pivot: impl Fn(L, L) -> L) -> Self {
         let mut lower = [[L::default(); N]; N];
         let mut inverse_diagonal = [L::default(); N];
         for j in 0..N {
             let d = a[j][j] - dot(&lower[j][..j], &lower[j][..j]);
-            let pivot = d.positive_sqrt();
-            lower[j][j] = pivot;
-            inverse_diagonal[j] = pivot.recip();
+            inverse_diagonal[j] = inverse_pivot(d, a[j][j]);
             for i in j + 1..N {
                 let s = a[i][j] - dot(&lower[i][..j], &lower[j][..j]);
                 lower[i][j] = s * inverse_diagonal[j];
@@ -43,6 +64,18 @@ impl<L: Scalar, const N: usize> Cholesky<L, N> {
             lower,
             inverse_diagonal,
         }
+    }
+
+    /// The rows kept by [`Cholesky::semidefinite`] (all of a positive
+    /// definite matrix's).
+    pub fn rank(&self) -> usize
+    where
+        L: PartialEq,
+    {
+        self.inverse_diagonal
+            .iter()
+            .filter(|x| **x != L::default())
+            .count()
     }
 
     /// x with A x = b: forward substitution with L, back substitution with

@@ -51,6 +51,10 @@ pub trait Scalar:
     fn recip(self) -> Self;
     /// √x where x > 0, NaN elsewhere (a Cholesky pivot).
     fn positive_sqrt(self) -> Self;
+    /// 1/√x for a pivot x of a semidefinite factorisation whose diagonal
+    /// entry was `diagonal`, or 0 where x ≤ [`REDUNDANT`](super::linalg::REDUNDANT)
+    /// · diagonal (a dependent row, skipped); decided on the leading value.
+    fn semidefinite_inverse_sqrt(self, diagonal: Self) -> Self;
     /// self·a + b: one rounding for f64 and lanes where the processor fuses
     /// (see [`fused`]), two for number types that do not.
     #[inline(always)]
@@ -138,6 +142,16 @@ impl Scalar for f64 {
             f64::sqrt(self)
         } else {
             f64::NAN
+        }
+    }
+    #[inline(always)]
+    fn semidefinite_inverse_sqrt(self, diagonal: f64) -> f64 {
+        if self > super::linalg::REDUNDANT * diagonal && self > 0.0 {
+            f64::sqrt(self).recip()
+        } else if self.is_nan() || diagonal.is_nan() {
+            f64::NAN
+        } else {
+            0.0
         }
     }
     fn dyn_taylor<const N: usize>(

@@ -42,6 +42,15 @@ pub trait ConstrainedSystems: Flows {
     /// there its reactions and energy.
     fn output(&self, params: &[f64], t: f64, y: &mut [f64]) -> Result<Output, ConstraintError>;
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError>;
+    /// The singular values of the constraints' Jacobian G at (t, q),
+    /// largest first: how far the mechanism is from a singular position
+    /// (where some of them fall to 0).
+    fn constraint_singular_values(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Vec<f64>, OdeError>;
     /// An orthonormal basis (columns) of the tangent space of the
     /// constrained phase space at (t, y), or None where the constraints
     /// are degenerate.
@@ -377,6 +386,20 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
             }
         }
         Ok(hessians)
+    }
+    fn constraint_singular_values(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Vec<f64>, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        let q: [f64; N] = std::array::from_fn(|i| y[i]);
+        let g = self.equations(params).0.constraint_jacobian(t, &q);
+        let g = DMatrix::from_fn(K, N, |r, i| g[r][i]);
+        let mut values: Vec<f64> = g.singular_values().iter().copied().collect();
+        values.sort_by(|a, b| b.total_cmp(a));
+        Ok(values)
     }
     fn tangent_basis(
         &self,

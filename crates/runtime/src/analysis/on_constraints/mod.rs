@@ -58,6 +58,61 @@ pub enum ConstrainedError {
     /// Output times that do not increase from the start.
     #[error("the output times must increase from t0 = {t0} and be finite")]
     Times { t0: f64 },
+    /// The integration stopped where the constraints lose rank: a singular
+    /// position of the mechanism (a four-bar's links aligned), which the
+    /// run cannot pass yet.
+    #[error("model '{model}' stopped at t = {t}, at a singular position: its constraints' Jacobian, of rank {rank} at the start (smallest singular value {at_start:.1e}), has one of {smallest:.1e} there, so its rank drops; passing a singular position is not supported yet ({source})")]
+    SingularPosition {
+        model: &'static str,
+        t: f64,
+        /// The constraints' rank at the start, and their singular value of
+        /// that rank there and where the run stopped.
+        rank: usize,
+        at_start: f64,
+        smallest: f64,
+        source: OdeError,
+    },
+}
+
+/// The constraints' rank at a regular state (singular values of G above
+/// 1e-10 of the largest) and the smallest of those singular values.
+fn regular_rank(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    t: f64,
+    y: &[f64],
+) -> Option<(usize, f64)> {
+    let values = model.constraint_singular_values(params, t, y).ok()?;
+    let largest = values.first().copied().filter(|v| *v > 0.0)?;
+    let rank = values.iter().take_while(|&&v| v > 1e-10 * largest).count();
+    Some((rank, values[rank - 1]))
+}
+
+/// A step size that underflowed where the constraints have (nearly) lost
+/// rank, their `rank`-th singular value below 1e-4 of its value at the
+/// start, is named as a singular position; any other error is passed on.
+fn named_singularity(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    regular: Option<(usize, f64)>,
+    error: OdeError,
+) -> ConstrainedError {
+    if let (OdeError::StepSizeUnderflow { t, y, .. }, Some((rank, at_start))) = (&error, regular) {
+        if let Ok(values) = model.constraint_singular_values(params, *t, y) {
+            let smallest = values.get(rank - 1).copied().unwrap_or(0.0);
+            if smallest < 1e-4 * at_start {
+                return ConstrainedError::SingularPosition {
+                    model: model.info().name,
+                    t: *t,
+                    smallest,
+                    at_start,
+                    rank,
+                    source: error,
+                };
+            }
+        }
+    }
+    error.into()
 }
 
 /// A run on the constraints: at each output time the state (projected),
@@ -164,7 +219,8 @@ pub fn states(
 /// The integration of [`run`]: through groups of output times with dense
 /// output, the integrated state projected at each group's end; each
 /// output (not yet projected) goes to `report`. Returns the start after
-/// its projection and the steps taken.
+/// its projection and the steps taken; a run that stops at a singular
+/// position says so.
 fn follow(
     model: &dyn ConstrainedSystems,
     params: &[f64],
@@ -194,6 +250,7 @@ fn follow(
     }
     model.project(params, t0, &mut y).map_err(constraint(t0))?;
     let start = y.clone();
+    let regular = regular_rank(model, params, t0, &y);
     let system = model.exact(params);
     let mut integrator = Integrator::new(method)?;
     // Each reported state is projected too (a step cut short at every
@@ -203,13 +260,15 @@ fn follow(
         let t1 = group[group.len() - 1];
         let samples = match t1 > t {
             true => {
-                let solution = system.solve(
-                    &mut integrator,
-                    t,
-                    &y,
-                    t1,
-                    AnyOptions::default().times(group),
-                )?;
+                let solution = system
+                    .solve(
+                        &mut integrator,
+                        t,
+                        &y,
+                        t1,
+                        AnyOptions::default().times(group),
+                    )
+                    .map_err(|e| named_singularity(model, params, regular, e))?;
                 y = solution.y;
                 solution.samples
             }
