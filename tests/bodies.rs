@@ -119,3 +119,111 @@ fn the_released_heavy_top_nods_with_lagrange_cubics_period_and_amplitude() {
     let quarter = run(&y0, &[0.0, period / 4.0]);
     assert!((quarter[1][1] - theta0).abs() > 0.05);
 }
+
+/// A body's inertia given as a tensor with products of inertia, in axes
+/// turned by a fixed angle α about the body's z axis, is the same body as
+/// the principal moments in the principal axes: the tensor
+/// R_z(α)ᵀ diag(I₁, I₂, I₃) R_z(α) with the rotation sequence continued by
+/// Z(alpha) gives the same Lagrangian at random states (to rounding), and
+/// the tensor with its products' sign flipped does not.
+#[test]
+fn an_inertia_tensor_with_products_is_the_principal_body_turned() {
+    use mechlab_model::Model;
+    let body = |inertia: &str, rotation: &str| {
+        format!(
+            r#"
+name = "body"
+description = "a free rigid body about a fixed point"
+gravity = [0, 0, "-1"]
+
+[[coordinates]]
+name = "phi"
+velocity = "phid"
+
+[[coordinates]]
+name = "theta"
+velocity = "thetad"
+start = 0.7
+
+[[coordinates]]
+name = "psi"
+velocity = "psid"
+
+[[parameters]]
+name = "alpha"
+default = 0.4
+description = "the turn of the tensor's axes from the principal ones"
+
+[[bodies]]
+name = "b"
+mass = 1.3
+inertia = {inertia}
+position = ["0.2*sin(theta)*sin(phi)", "-0.2*sin(theta)*cos(phi)", "0.2*cos(theta)"]
+rotation = "{rotation}"
+"#
+        )
+    };
+    let (i1, i2, i3, alpha) = (1.0_f64, 2.5, 3.2, 0.4_f64);
+    let (c, s) = (alpha.cos(), alpha.sin());
+    // R_z(α)ᵀ diag(I₁, I₂, I₃) R_z(α).
+    let (ixx, iyy, ixy) = (
+        i1 * c * c + i2 * s * s,
+        i1 * s * s + i2 * c * c,
+        (i2 - i1) * s * c,
+    );
+    let tensor = |sign: f64| {
+        format!(
+            "[[{ixx:?}, {:?}, 0], [{:?}, {iyy:?}, 0], [0, 0, {i3:?}]]",
+            sign * ixy,
+            sign * ixy
+        )
+    };
+    let principal = Model::parse(
+        "body.toml",
+        &body("[1.0, 2.5, 3.2]", "Z(phi) X(theta) Z(psi)"),
+    )
+    .unwrap();
+    let turned = Model::parse(
+        "body.toml",
+        &body(&tensor(1.0), "Z(phi) X(theta) Z(psi) Z(alpha)"),
+    )
+    .unwrap();
+    let flipped = Model::parse(
+        "body.toml",
+        &body(&tensor(-1.0), "Z(phi) X(theta) Z(psi) Z(alpha)"),
+    )
+    .unwrap();
+    let (a, b, f) = (
+        principal.expanded_lagrangian(),
+        turned.expanded_lagrangian(),
+        flipped.expanded_lagrangian(),
+    );
+    let mut seed = 0.61_f64;
+    let mut next = || {
+        seed = (seed * 997.0 + 0.123).fract();
+        2.0 * seed - 1.0
+    };
+    let mut largest_flipped: f64 = 0.0;
+    for _ in 0..20 {
+        let values: Vec<(&str, f64)> = ["phi", "theta", "psi", "phid", "thetad", "psid"]
+            .into_iter()
+            .map(|name| (name, 2.0 * next()))
+            .chain([("alpha", alpha)])
+            .collect();
+        let env = |s: &str| values.iter().find(|(n, _)| *n == s).map(|(_, v)| *v);
+        let (la, lb, lf) = (
+            a.eval(&env).unwrap(),
+            b.eval(&env).unwrap(),
+            f.eval(&env).unwrap(),
+        );
+        assert!(
+            (la - lb).abs() < 1e-13 * (1.0 + la.abs()),
+            "{la} against {lb}"
+        );
+        largest_flipped = largest_flipped.max((la - lf).abs());
+    }
+    assert!(
+        largest_flipped > 0.01,
+        "the products' sign should matter: {largest_flipped}"
+    );
+}
