@@ -729,3 +729,20 @@ fn the_four_link_chain_has_no_window_at_a_slow_vibration_by_hand_too() {
         .collect();
     assert!(stable.is_empty(), "stable by hand at {stable:?}");
 }
+
+/// Study 2's averaging on a rigid body: a uniform rod of length L on
+/// Kapitza's vibrating pivot, written as one `[[bodies]]` table, stands
+/// upright for A² > 4 g L / 3 (2 g J/(m d), J = m L²/3 about the hinge,
+/// d = L/2; a point mass's is 2 g l): the first-order threshold is that to
+/// 1e-12, and at ε = 0.01 the exact (Floquet) edge is within 1e-3 of it.
+#[test]
+fn a_rod_on_a_vibrating_pivot_stands_above_the_rigid_bodys_threshold() {
+    let params = [1.5, 0.01, 1.0, 1.0, 1.0]; // A, ε, m, L, g
+    let (exact, first, _) = thresholds("physical_pendulum_body", &params, "A", 4.0);
+    let closed_form = (4.0_f64 / 3.0).sqrt();
+    assert!(
+        (first - closed_form).abs() < 1e-12,
+        "{first} not {closed_form}"
+    );
+    assert!((exact - closed_form).abs() < 1e-3, "exact edge {exact}");
+}

@@ -9,6 +9,7 @@ pub fn model_of(name: &str) -> &'static Model {
     match name {
         // A test model (test_models/): the scenes' build does not compile it.
         "quadruple_pendulum" => &mechlab_test_models::quadruple_pendulum::MODEL,
+        "physical_pendulum_body" => &mechlab_test_models::physical_pendulum_body::MODEL,
         _ => mechlab::models::by_name(name).unwrap_or_else(|e| panic!("{e}")),
     }
 }
