@@ -42,6 +42,15 @@ pub trait ConstrainedSystems: Flows {
     /// there its reactions and energy.
     fn output(&self, params: &[f64], t: f64, y: &mut [f64]) -> Result<Output, ConstraintError>;
     fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> Result<f64, OdeError>;
+    /// The constraints whose reactions the motion does not determine at
+    /// (t, q): redundant ones, each in a dependency w of G's rows
+    /// (Gᵀw = 0, w_i ≠ 0), whose reactions can trade along w.
+    fn indeterminate_reactions(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Vec<usize>, OdeError>;
     /// The singular values of the constraints' Jacobian G at (t, q),
     /// largest first: how far the mechanism is from a singular position
     /// (where some of them fall to 0).
@@ -386,6 +395,31 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
             }
         }
         Ok(hessians)
+    }
+    fn indeterminate_reactions(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Vec<usize>, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        let q: [f64; N] = std::array::from_fn(|i| y[i]);
+        let g = self.equations(params).0.constraint_jacobian(t, &q);
+        let g = DMatrix::from_fn(K, N, |r, i| g[r][i]);
+        // The dependencies: eigenvectors of G Gᵀ at eigenvalue 0.
+        let gram = nalgebra::SymmetricEigen::new(&g * g.transpose());
+        let largest = gram.eigenvalues.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let mut indeterminate = Vec::new();
+        for (k, value) in gram.eigenvalues.iter().enumerate() {
+            if value.abs() <= crate::linalg::REDUNDANT * largest {
+                let w = gram.eigenvectors.column(k);
+                let scale = w.norm();
+                indeterminate.extend((0..K).filter(|&i| w[i].abs() > 1e-8 * scale));
+            }
+        }
+        indeterminate.sort_unstable();
+        indeterminate.dedup();
+        Ok(indeterminate)
     }
     fn constraint_singular_values(
         &self,

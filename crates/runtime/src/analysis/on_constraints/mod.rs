@@ -134,6 +134,10 @@ pub struct ConstrainedRun {
     /// Largest residuals after the projections.
     pub largest_residual: (f64, f64),
     pub steps: u64,
+    /// Redundant constraints (at the start) whose reactions the motion does
+    /// not determine: their multipliers are reported as 0, one choice of
+    /// many (the mechanism is statically indeterminate there).
+    pub indeterminate: Vec<&'static str>,
 }
 
 /// Runs `model` from `y0` (the model file's start at rest if None; made
@@ -160,6 +164,7 @@ pub fn run(
         largest_drift: (0.0, 0.0),
         largest_residual: (0.0, 0.0),
         steps: 0,
+        indeterminate: Vec::new(),
     };
     let (start, steps) = follow(model, params, y0, method, times, &mut |ts, mut sample| {
         let output = model.output(params, ts, &mut sample).map_err(|source| {
@@ -179,6 +184,13 @@ pub fn run(
         result.states.push(sample);
         Ok(())
     })?;
+    let t0 = times.first().copied().unwrap_or(0.0);
+    let names = model.constraint_names();
+    result.indeterminate = model
+        .indeterminate_reactions(params, t0, &start)?
+        .into_iter()
+        .map(|i| names[i])
+        .collect();
     (result.start, result.steps) = (start, steps);
     Ok(result)
 }
