@@ -171,6 +171,19 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
         OnConstraints::new(Forms::new(self.forms, params))
     }
 
+    /// G at (t, q) of the state y, at run-time size.
+    fn constraint_matrix(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<DMatrix<f64>, OdeError> {
+        let y = fixed_state::<S>(y)?;
+        let q: [f64; N] = std::array::from_fn(|i| y[i]);
+        let g = self.equations(params).0.constraint_jacobian(t, &q);
+        Ok(DMatrix::from_fn(K, N, |r, i| g[r][i]))
+    }
+
     /// The averaged motion, where the averaging applies.
     fn averaged(&self, params: &[f64]) -> Option<AveragedOnConstraints<N, K, S>> {
         let exact = self.equations(params);
@@ -402,10 +415,7 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
         t: f64,
         y: &[f64],
     ) -> Result<Vec<usize>, OdeError> {
-        let y = fixed_state::<S>(y)?;
-        let q: [f64; N] = std::array::from_fn(|i| y[i]);
-        let g = self.equations(params).0.constraint_jacobian(t, &q);
-        let g = DMatrix::from_fn(K, N, |r, i| g[r][i]);
+        let g = self.constraint_matrix(params, t, y)?;
         // The dependencies: eigenvectors of G Gᵀ at eigenvalue 0.
         let gram = nalgebra::SymmetricEigen::new(&g * g.transpose());
         let largest = gram.eigenvalues.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
@@ -427,10 +437,7 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
         t: f64,
         y: &[f64],
     ) -> Result<Vec<f64>, OdeError> {
-        let y = fixed_state::<S>(y)?;
-        let q: [f64; N] = std::array::from_fn(|i| y[i]);
-        let g = self.equations(params).0.constraint_jacobian(t, &q);
-        let g = DMatrix::from_fn(K, N, |r, i| g[r][i]);
+        let g = self.constraint_matrix(params, t, y)?;
         let mut values: Vec<f64> = g.singular_values().iter().copied().collect();
         values.sort_by(|a, b| b.total_cmp(a));
         Ok(values)
