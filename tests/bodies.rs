@@ -5,7 +5,7 @@
 //! angles and with the period of Lagrange's cubic; its hand-written
 //! Hamiltonian is conserved.
 
-use mechlab::analysis::states::states_at;
+use mechlab::analysis::states::{states_at, StatesError};
 use mechlab::ode::Method;
 
 /// m, l, A, C, g in the file's order.
@@ -226,4 +226,20 @@ rotation = "{rotation}"
         largest_flipped > 0.01,
         "the products' sign should matter: {largest_flipped}"
     );
+}
+
+/// At θ = 0 the Euler angles are a singular chart (φ and ψ turn about one
+/// axis, the mass matrix is singular): a run started there is refused
+/// with an error naming the state, not a NaN.
+#[test]
+fn the_top_started_in_its_singular_chart_is_refused_by_name() {
+    let method = Method::parse("dop853", 1e-10).unwrap();
+    let upright = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    match states_at(top(), &PARAMS, method, &upright, &[0.0, 1.0]) {
+        Err(StatesError::SingularChart { t, momenta, .. }) => {
+            // p_φ and p_ψ turn the top about the same axis there.
+            assert!(t == 0.0 && momenta.contains(&0) && momenta.contains(&2), "{momenta:?}");
+        }
+        other => panic!("a singular chart should be named: {other:?}"),
+    }
 }

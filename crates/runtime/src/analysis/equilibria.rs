@@ -459,7 +459,7 @@ pub(crate) fn cyclic_coordinates(model: &dyn DynamicModel, params: &[f64], n: us
 /// The momenta along which the mass matrix A is singular at q: H is
 /// ½ pᵀA⁻¹p + …, so the curvature of H along each momentum, read from
 /// three energies, is A⁻¹'s diagonal, which blows up where A is singular.
-fn singular_momenta(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> Vec<usize> {
+pub(crate) fn singular_momenta(model: &dyn DynamicModel, params: &[f64], q: &[f64]) -> Vec<usize> {
     let n = q.len();
     let energy = |p: &[f64]| {
         let mut y = q.to_vec();

@@ -23,6 +23,15 @@ pub enum StatesError {
         model: &'static str,
         source: crate::ode::holonomic::ConstraintError,
     },
+    /// A run that reached a point where the mass matrix is singular: the
+    /// coordinates are a singular chart there (Euler angles at θ = 0).
+    #[error("model '{model}' reached a singular chart at t = {t}, q = {q:?}: the mass matrix is singular there along the momenta {momenta:?}, so these coordinates cannot carry the motion through it (give the model other coordinates)")]
+    SingularChart {
+        model: &'static str,
+        t: f64,
+        q: Vec<f64>,
+        momenta: Vec<usize>,
+    },
     #[error(transparent)]
     Constrained(#[from] ConstrainedError),
     #[error(transparent)]
@@ -129,7 +138,27 @@ fn orbit(
         return Ok(states(constrained, params, &start, method, times)?);
     }
     let system = crate::analysis::flows(model)?.exact(params);
-    Ok(system.states_from(method, y0, times)?)
+    system
+        .states_from(method, y0, times)
+        .map_err(|error| singular_chart(model, params, error))
+}
+
+/// A run that became non-finite where the mass matrix is singular is
+/// named a singular chart; any other error is passed on.
+fn singular_chart(model: &Model, params: &[f64], error: OdeError) -> StatesError {
+    if let OdeError::NonFinite { t, y } | OdeError::NonFiniteInitialState { t, y } = &error {
+        let q = &y[..y.len() / 2];
+        let momenta = crate::analysis::equilibria::singular_momenta(model.dynamic, params, q);
+        if !momenta.is_empty() {
+            return StatesError::SingularChart {
+                model: model.info.name,
+                t: *t,
+                q: q.to_vec(),
+                momenta,
+            };
+        }
+    }
+    error.into()
 }
 
 crate::declare_settings! {
