@@ -635,6 +635,10 @@ fn a_malformed_body_is_named() {
     assert_error(&gravity, "gravity", "unknown symbol 'g'");
     Model::parse("models/toy.toml", &body("Y(q)")).expect("a body about its y axis");
     Model::parse("models/toy.toml", &body("Y(-q) X(k/2)")).expect("angles as expressions");
+    let both = body("Y(q)").replace("rotation =", "quaternion = [\"q\", \"q\", \"q\", \"q\"]\nrotation =");
+    assert_error(&both, "bodies[0].quaternion", "give the orientation once");
+    let unknown = body("").replace("rotation =", "quaternion = [\"q\", \"a\", \"b\", \"c\"]\nrotation =");
+    assert_error(&unknown, "bodies[0].quaternion", "'a' is not a coordinate");
 }
 
 /// A rolling body's constraint names its body, and its contact must be

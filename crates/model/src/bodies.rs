@@ -29,6 +29,10 @@ pub struct BodySpec {
     /// expression of the parameters (a fixed tilt, as a steering head's).
     #[serde(default)]
     pub rotation: String,
+    /// Instead of `rotation`: four coordinates (e0, e1, e2, e3), the Euler
+    /// parameters (unit quaternion) of the body's orientation, a chart with
+    /// no singular point; the unit norm is added as a constraint.
+    pub quaternion: Option<[String; 4]>,
     #[serde(default)]
     pub description: String,
     /// The rotation's turns, read by [`name_turns`] before validation.
@@ -267,12 +271,50 @@ pub fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 
     w
 }
 
+/// The angular velocity from Euler parameters e = (e0, e1, e2, e3):
+/// ω = 2 G(e) e' in the body's axes, 2 E(e) e' in the fixed frame.
+fn quaternion_rates(e: &[String; 4], in_body: bool) -> [Component; 3] {
+    let [w, x, y, z] = e;
+    let n = |s: &String| format!("-{s}");
+    let rows: [[String; 4]; 3] = match in_body {
+        true => [
+            [n(x), w.clone(), z.clone(), n(y)],
+            [n(y), n(z), w.clone(), x.clone()],
+            [n(z), y.clone(), n(x), w.clone()],
+        ],
+        false => [
+            [n(x), w.clone(), n(z), y.clone()],
+            [n(y), z.clone(), w.clone(), n(x)],
+            [n(z), n(y), x.clone(), w.clone()],
+        ],
+    };
+    rows.map(|row| {
+        let terms: Vec<String> = row
+            .iter()
+            .zip(e)
+            .map(|(a, c)| format!("({a})*dot({c})"))
+            .collect();
+        Some(format!("2*({})", terms.join(" + ")))
+    })
+}
+
+/// The body's angular velocity in its own axes or the fixed frame.
+fn rates(body: &BodySpec, in_body: bool, moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
+    match (&body.quaternion, in_body) {
+        (Some(e), _) => quaternion_rates(e, in_body),
+        (None, true) => body_rates(&body.turns, moves),
+        (None, false) => world_rates(&body.turns, moves),
+    }
+}
+
 /// The kinetic energy ½ m v·v + ½ ωᵀ I ω of a body (ω in its own axes),
-/// plus m g·c where the model gives gravity.
+/// plus m g·c where the model gives gravity. With Euler parameters, also
+/// ½ tr(I) (e·e')², which vanishes on their unit sphere (e·e' = 0) and
+/// adds nothing to the motion there, but gives the mass matrix the
+/// direction across it, along which ω does not move.
 pub fn energy(
     body: &BodySpec,
     tensor: &[[Option<String>; 3]; 3],
-    turns: &[Turn],
     gravity: Option<&[NumberSpec; 3]>,
     moves: &dyn Fn(&str) -> bool,
 ) -> String {
@@ -284,13 +326,18 @@ pub fn energy(
         .collect::<Vec<_>>()
         .join(" + ");
     let mut energy = format!("({mass})*({speed})/2");
-    let w = body_rates(turns, moves);
+    let w = rates(body, true, moves);
     for i in 0..3 {
         for j in 0..3 {
             if let (Some(moment), Some(wi), Some(wj)) = (&tensor[i][j], &w[i], &w[j]) {
                 energy += &format!(" + ({moment})*({wi})*({wj})/2");
             }
         }
+    }
+    if let Some(e) = &body.quaternion {
+        let trace: Vec<String> = (0..3).filter_map(|i| tensor[i][i].clone()).collect();
+        let along: Vec<String> = e.iter().map(|c| format!("{c}*dot({c})")).collect();
+        energy += &format!(" + ({})*({})^2/2", trace.join(" + "), along.join(" + "));
     }
     if let Some(g) = gravity {
         for (gi, c) in g.iter().zip(&centre) {
@@ -303,13 +350,12 @@ pub fn energy(
 /// The velocity (x, y, z) of the body's material point at `point`: v_c +
 /// ω × (p − c), ω in the fixed frame.
 pub fn point_velocity(
-    body: &str,
-    turns: &[Turn],
+    body: &BodySpec,
     point: &[String; 3],
     moves: &dyn Fn(&str) -> bool,
 ) -> [String; 3] {
-    let centre = centre(body);
-    let w = world_rates(turns, moves);
+    let centre = centre(&body.name);
+    let w = rates(body, false, moves);
     let arm: Vec<Component> = point
         .iter()
         .zip(&centre)

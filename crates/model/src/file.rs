@@ -382,6 +382,22 @@ impl Model {
                 return Err(err(&format!("definitions.{name}"), reason));
             }
         }
+        // Euler parameters have unit norm: a constraint of their own.
+        for body in &spec.bodies {
+            if let Some(e) = &body.quaternion {
+                spec.constraints.push(ConstraintSpec {
+                    name: format!("{}_unit", body.name),
+                    position: Some(format!(
+                        "{}^2 + {}^2 + {}^2 + {}^2 - 1",
+                        e[0], e[1], e[2], e[3]
+                    )),
+                    velocity: None,
+                    rolling: None,
+                    contact: None,
+                    description: format!("the Euler parameters of '{}' have unit norm", body.name),
+                });
+            }
+        }
         for body in &spec.bodies {
             let centre = crate::bodies::centre(&body.name);
             for (name, at) in centre.into_iter().zip(&body.position) {
@@ -1048,7 +1064,6 @@ impl ModelFile {
         for p in &contact {
             parse(&key, p, &names.positions(), false)?;
         }
-        let turns = &self.bodies[k].turns;
         let moves = |s: &str| {
             names
                 .coordinates
@@ -1056,7 +1071,7 @@ impl ModelFile {
                 .chain(&names.definitions)
                 .any(|n| n == s)
         };
-        let velocity = crate::bodies::point_velocity(body, turns, &contact, &moves);
+        let velocity = crate::bodies::point_velocity(&self.bodies[k], &contact, &moves);
         let mut parsed = Vec::new();
         for v in velocity {
             parsed.push(parse(&key, &v, &names.all(), true)?);
@@ -1120,7 +1135,14 @@ impl ModelFile {
             for turn in &body.turns {
                 parse(&key("rotation"), &turn.angle, &positions, false)?;
             }
-            let turns = &body.turns;
+            if let Some(e) = &body.quaternion {
+                if !body.rotation.trim().is_empty() {
+                    return Err(err(key("quaternion"), "give the orientation once: a `rotation` sequence or the `quaternion`'s four coordinates".into()));
+                }
+                if let Some(c) = e.iter().find(|c| !names.coordinates.contains(c)) {
+                    return Err(err(key("quaternion"), format!("'{c}' is not a coordinate: the Euler parameters are four of the model's coordinates")));
+                }
+            }
             let moves = |s: &str| {
                 names
                     .coordinates
@@ -1128,7 +1150,7 @@ impl ModelFile {
                     .chain(&names.definitions)
                     .any(|n| n == s)
             };
-            let energy = crate::bodies::energy(body, &tensor, turns, self.gravity.as_ref(), &moves);
+            let energy = crate::bodies::energy(body, &tensor, self.gravity.as_ref(), &moves);
             let energy = Expr::parse(&energy).map_err(|e| {
                 err(
                     key("name"),
