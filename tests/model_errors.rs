@@ -635,9 +635,15 @@ fn a_malformed_body_is_named() {
     assert_error(&gravity, "gravity", "unknown symbol 'g'");
     Model::parse("models/toy.toml", &body("Y(q)")).expect("a body about its y axis");
     Model::parse("models/toy.toml", &body("Y(-q) X(k/2)")).expect("angles as expressions");
-    let both = body("Y(q)").replace("rotation =", "quaternion = [\"q\", \"q\", \"q\", \"q\"]\nrotation =");
+    let both = body("Y(q)").replace(
+        "rotation =",
+        "quaternion = [\"q\", \"q\", \"q\", \"q\"]\nrotation =",
+    );
     assert_error(&both, "bodies[0].quaternion", "give the orientation once");
-    let unknown = body("").replace("rotation =", "quaternion = [\"q\", \"a\", \"b\", \"c\"]\nrotation =");
+    let unknown = body("").replace(
+        "rotation =",
+        "quaternion = [\"q\", \"a\", \"b\", \"c\"]\nrotation =",
+    );
     assert_error(&unknown, "bodies[0].quaternion", "'a' is not a coordinate");
 }
 

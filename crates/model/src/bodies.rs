@@ -6,7 +6,7 @@
 //! angular velocity comes from its rotation sequence. A point of a body
 //! has the velocity v_c + ω × (p − c): the rolling constraints.
 
-use crate::file::NumberSpec;
+use crate::file::{ConstraintSpec, ModelFile, NumberSpec};
 use serde::Deserialize;
 
 /// A rigid body: its mass, its inertia about its centre in its own axes,
@@ -62,10 +62,48 @@ pub struct Turn {
     pub name: String,
 }
 
+/// What the bodies add to a model file before it is validated: their
+/// centres, and their angles written as expressions, as definitions; the
+/// unit norm of Euler parameters as a constraint. Or the key and reason
+/// of a clash.
+pub fn declare(spec: &mut ModelFile) -> Result<(), (String, String)> {
+    let clash = |name: &String, what: &str| {
+        (
+            format!("definitions.{name}"),
+            format!("'{name}' is {what} and a definition too"),
+        )
+    };
+    let turns = name_turns(&mut spec.bodies)
+        .map_err(|(k, (part, reason))| (format!("bodies[{k}].{part}"), reason))?;
+    for (name, angle) in turns {
+        if spec.definitions.insert(name.clone(), angle).is_some() {
+            return Err(clash(&name, "an angle of a body"));
+        }
+    }
+    for body in &spec.bodies {
+        for (name, at) in centre(&body.name).into_iter().zip(&body.position) {
+            if spec.definitions.insert(name.clone(), text(at)).is_some() {
+                return Err(clash(&name, "the centre of a body"));
+            }
+        }
+        if let Some([e0, e1, e2, e3]) = &body.quaternion {
+            spec.constraints.push(ConstraintSpec {
+                name: format!("{}_unit", body.name),
+                position: Some(format!("{e0}^2 + {e1}^2 + {e2}^2 + {e3}^2 - 1")),
+                velocity: None,
+                rolling: None,
+                contact: None,
+                description: format!("the Euler parameters of '{}' have unit norm", body.name),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Reads each body's rotation into its turns and returns the definitions
 /// the angles that are not plain names need, or the failing body's index
 /// and reason.
-pub fn name_turns(bodies: &mut [BodySpec]) -> Result<Vec<(String, String)>, (usize, BodyError)> {
+fn name_turns(bodies: &mut [BodySpec]) -> Result<Vec<(String, String)>, (usize, BodyError)> {
     let mut definitions = Vec::new();
     for (k, body) in bodies.iter_mut().enumerate() {
         body.turns = rotation(&body.rotation).map_err(|e| (k, e))?;

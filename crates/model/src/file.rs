@@ -372,42 +372,7 @@ impl Model {
             };
             err(&key, message)
         })?;
-        // A body's centre is a definition, declared with the others, and
-        // so is an angle of its rotation written as an expression.
-        let turns = crate::bodies::name_turns(&mut spec.bodies)
-            .map_err(|(k, (part, reason))| err(&format!("bodies[{k}].{part}"), reason))?;
-        for (name, angle) in turns {
-            if spec.definitions.insert(name.clone(), angle).is_some() {
-                let reason = format!("'{name}' is an angle of a body and a definition too");
-                return Err(err(&format!("definitions.{name}"), reason));
-            }
-        }
-        // Euler parameters have unit norm: a constraint of their own.
-        for body in &spec.bodies {
-            if let Some(e) = &body.quaternion {
-                spec.constraints.push(ConstraintSpec {
-                    name: format!("{}_unit", body.name),
-                    position: Some(format!(
-                        "{}^2 + {}^2 + {}^2 + {}^2 - 1",
-                        e[0], e[1], e[2], e[3]
-                    )),
-                    velocity: None,
-                    rolling: None,
-                    contact: None,
-                    description: format!("the Euler parameters of '{}' have unit norm", body.name),
-                });
-            }
-        }
-        for body in &spec.bodies {
-            let centre = crate::bodies::centre(&body.name);
-            for (name, at) in centre.into_iter().zip(&body.position) {
-                let at = crate::bodies::text(at);
-                if spec.definitions.insert(name.clone(), at).is_some() {
-                    let reason = format!("'{name}' is the centre of a body and a definition too");
-                    return Err(err(&format!("definitions.{name}"), reason));
-                }
-            }
-        }
+        crate::bodies::declare(&mut spec).map_err(|(key, reason)| err(&key, reason))?;
         spec.validate(file)
     }
 }

@@ -445,8 +445,12 @@ fn sane_range((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
     if log {
         lo = lo.max(1e-300);
         hi = hi.max(lo * 10.0);
-    } else if hi - lo <= 1e-300 {
-        let pad = lo.abs().max(1.0) * 1e-3;
+    } else if hi - lo <= 1e-9 * lo.abs().max(hi.abs()) || hi - lo <= 1e-300 {
+        // A constant series (to rounding, as a conserved momentum): a
+        // range around it wide enough for the ticks to differ in their
+        // labels, the series a flat line in its middle.
+        let size = lo.abs().max(hi.abs());
+        let pad = if size > 0.0 { 0.05 * size } else { 1.0 };
         lo -= pad;
         hi += pad;
     }
@@ -776,4 +780,23 @@ where
         .draw()
         .map_err(err)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sane_range;
+
+    /// A constant series (a conserved momentum, to rounding) gets a range
+    /// of ±5 % around it, wide enough for its ticks to be told apart;
+    /// a varying one keeps its own.
+    #[test]
+    fn a_constant_series_gets_a_range_its_ticks_can_label() {
+        let (lo, hi) = sane_range((0.8, 0.8 + 1e-16), false);
+        assert!(
+            (lo - 0.76).abs() < 1e-12 && (hi - 0.84).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        assert_eq!(sane_range((0.0, 0.0), false), (-1.0, 1.0));
+        assert_eq!(sane_range((-8e-9, 1.5e-8), false), (-8e-9, 1.5e-8));
+    }
 }
