@@ -259,7 +259,7 @@ fn rate(turn: &Turn, moves: &dyn Fn(&str) -> bool) -> Component {
 /// The body's angular velocity in its own axes for the turns
 /// A1(q1) A2(q2) …: ω = R_nᵀ(… R_2ᵀ(R_1ᵀ e_1 q1' + e_2 q2') …), each
 /// elementary rotation leaving its own axis unchanged.
-pub fn body_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
+fn body_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
     let mut w: [Component; 3] = [None, None, None];
     for turn in turns {
         let axis = turn.axis;
@@ -279,7 +279,7 @@ pub fn body_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3
 
 /// The body's angular velocity in the fixed frame: ω = Σ_k R_1…R_{k−1}
 /// e_k q_k', each turn's axis carried by the turns before it.
-pub fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
+fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
     // Columns of R_1…R_k: the body's axes in the fixed frame.
     let one = || Some("1".to_string());
     let mut axes: [[Component; 3]; 3] = [

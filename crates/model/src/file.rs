@@ -733,6 +733,15 @@ impl Names {
         ]
     }
 
+    /// Whether a name may move with the motion: a coordinate or a
+    /// definition (a body's turn about it has a rate; a parameter's none).
+    fn moves(&self, name: &str) -> bool {
+        self.coordinates
+            .iter()
+            .chain(&self.definitions)
+            .any(|n| n == name)
+    }
+
     /// Every kind: what the Lagrangian, forces and Rayleigh function may use.
     fn all(&self) -> [&Vec<String>; 6] {
         [
@@ -1029,13 +1038,7 @@ impl ModelFile {
         for p in &contact {
             parse(&key, p, &names.positions(), false)?;
         }
-        let moves = |s: &str| {
-            names
-                .coordinates
-                .iter()
-                .chain(&names.definitions)
-                .any(|n| n == s)
-        };
+        let moves = |s: &str| names.moves(s);
         let velocity = crate::bodies::point_velocity(&self.bodies[k], &contact, &moves);
         let mut parsed = Vec::new();
         for v in velocity {
@@ -1108,13 +1111,7 @@ impl ModelFile {
                     return Err(err(key("quaternion"), format!("'{c}' is not a coordinate: the Euler parameters are four of the model's coordinates")));
                 }
             }
-            let moves = |s: &str| {
-                names
-                    .coordinates
-                    .iter()
-                    .chain(&names.definitions)
-                    .any(|n| n == s)
-            };
+            let moves = |s: &str| names.moves(s);
             let energy = crate::bodies::energy(body, &tensor, self.gravity.as_ref(), &moves);
             let energy = Expr::parse(&energy).map_err(|e| {
                 err(
