@@ -14,7 +14,11 @@
 //! F = ∂L/∂q − (∂²L/∂q'∂q) q' − ∂/∂t (∂L/∂q') + Q − ∂D/∂q'; Gᵀλ is the
 //! constraints' reaction in the coordinates. With a fast phase θ, ∂/∂t is
 //! rate · ∂/∂θ. The runtime (`mechlab::constrained`) solves them at each
-//! state and keeps the state on the constraints by projection.
+//! state and keeps the state on the constraints by projection. h is not
+//! derived here: the generated code differentiates c's code by forward
+//! mode (`generate::bias_steps`), since h written out is the longest
+//! expression of a model (a rolling wheel's contact under a square root,
+//! differentiated: 8 × 10⁵ characters for the bicycle's front wheel).
 //! Also derived: the energy function E = Σ q'∂L/∂q' − L, constant when
 //! neither L nor the constraints depend on time and nothing dissipates.
 
@@ -37,8 +41,6 @@ pub struct ConstrainedDerivation {
     pub jacobian: Vec<Vec<String>>,
     /// c_t = c at q' = 0: the velocity constraints read G q' + c_t = 0.
     pub rates: Vec<String>,
-    /// h = Σ ∂c/∂q_j q'_j + ∂c/∂t.
-    pub bias: Vec<String>,
     pub energy: String,
     /// V = −L at q' = 0 and b = ∂L/∂q' at q' = 0, for the averaging.
     pub potential: String,
@@ -168,12 +170,12 @@ impl<'m> Calculus<'m> {
                     still = false;
                     rows.residuals.push("0".into());
                     let c = kinematic(self.model, e)?;
-                    rec.record(
+                    // Differentiated in its readable form (as L is).
+                    atom(&rec.record(
                         format!("constraint[{r}]"),
                         format!("c = 0: the velocity constraint '{name}'"),
                         &c,
-                    )?;
-                    c
+                    )?)?
                 }
             };
             let mut row = Vec::new();
@@ -192,11 +194,6 @@ impl<'m> Calculus<'m> {
                 format!("constraint_rate[{r}]"),
                 format!("c_t: the part of '{name}''s velocity form free of q'"),
                 &rate_part.expand(),
-            )?);
-            rows.bias.push(rec.record(
-                format!("constraint_bias[{r}]"),
-                format!("h = d/dt c − G q'' of '{name}'"),
-                &self.total(&velocity_level).expand(),
             )?);
         }
         Ok((rows, still))
@@ -242,7 +239,6 @@ struct Rows {
     residuals: Vec<String>,
     jacobian: Vec<Vec<String>>,
     rates: Vec<String>,
-    bias: Vec<String>,
 }
 
 pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
@@ -250,11 +246,16 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
     let lagrangian = kinematic(model, &model.lagrangian)?;
     let rayleigh = kinematic(model, &model.rayleigh)?;
     let mut rec = Recorder::for_model(model, calculus.qd.iter().map(|v| v.to_string()).collect());
-    rec.record(
+    // Derived from its readable form: canonical in the angles' Fourier
+    // basis, where a rigid body's L written in the world's axes loses the
+    // terms that cancel by sin² + cos² = 1 (the bicycle's L falls from
+    // about 10⁶ characters to a few thousand), so that its derivatives
+    // are as short as the mechanics.
+    let lagrangian = atom(&rec.record(
         "lagrangian",
         "L(q, q', t) over all coordinates",
         &lagrangian,
-    )?;
+    )?)?;
     let phase_rate = match &calculus.rate {
         Some(rate) => Some(rec.record("phase_rate", "dθ/dt of the fast phase", rate)?),
         None => None,
@@ -281,7 +282,6 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         residuals: rows.residuals,
         jacobian: rows.jacobian,
         rates: rows.rates,
-        bias: rows.bias,
         energy,
         potential,
         linear_term,

@@ -376,14 +376,6 @@ fn constrained_forms(derivation: &ConstrainedDerivation) -> Vec<Form<'_>> {
             dual: Some(DualTimeCoordinates),
         }),
         Some(Form {
-            name: "constraint_bias",
-            prefix: "h",
-            doc: "h: d/dt c = G q'' + h.",
-            inputs: CoordinatesVelocities,
-            values: Values::Vector(&derivation.bias),
-            dual: None,
-        }),
-        Some(Form {
             name: "potential",
             prefix: "v",
             doc: "V = −L at q' = 0 (with the fast phase, for the averaging).",
@@ -465,6 +457,16 @@ fn constrained_functions(
             )?);
         }
     }
+    let k = derivation.jacobian.len();
+    let bias: Vec<String> = (0..k).map(|r| format!("bias__{r}")).collect();
+    functions.push(cx.function_steps(
+        "constraint_bias",
+        "h: d/dt c = G q'' + h, by forward-mode derivatives of each velocity form c = G q' + c_t.",
+        Inputs::CoordinatesVelocities,
+        format!("[f64; {k}]"),
+        &bias_steps(cx, derivation),
+        format!("[{}]", bias.join(", ")),
+    )?);
     Ok(functions)
 }
 
@@ -489,8 +491,6 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
         .collect();
     let mut forms = upper("mass", &derivation.mass_matrix);
     forms.extend(named("free", &derivation.free_forces));
-    forms.extend(matrix("jac", &derivation.jacobian).0);
-    forms.extend(named("bias", &derivation.bias));
     let mut columns = vec![free];
     columns.extend(rows.iter().cloned());
     let mut solutions = vec![solved_free.clone()];
@@ -530,7 +530,8 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
         .collect();
     rates.extend(accelerations);
     let outputs: Vec<String> = rates.iter().map(|(name, _)| name.clone()).collect();
-    let steps = [
+    let mut steps = bias_steps(cx, derivation);
+    steps.extend([
         Step::Values(forms),
         Step::Solve {
             matrix: names("mass", n),
@@ -548,8 +549,54 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
             semidefinite: true,
         },
         Step::Values(rates),
-    ];
-    (steps.to_vec(), outputs)
+    ]);
+    (steps, outputs)
+}
+
+/// The steps that give each constraint's row of G (`jac__{r}_{j}`) and
+/// h = d/dt c − G q'' = Σ_j ∂c/∂q_j q'_j + ∂c/∂t (`bias__{r}`), c = G q' +
+/// c_t, h by forward-mode derivatives of c's code (through the fast phase
+/// at its rate): the same number as the symbolic derivative, without
+/// writing that derivative out.
+fn bias_steps(cx: &Context, derivation: &ConstrainedDerivation) -> Vec<Step> {
+    let k = derivation.jacobian.len();
+    let coordinates = cx.coordinates();
+    let velocities = cx.velocities();
+    let time = cx.model.time.clone();
+    let phase = cx.model.fast_phase.as_ref().map(|f| f.name.clone());
+    let mut values = matrix("jac", &derivation.jacobian).0;
+    values.extend(named("ct", &derivation.rates));
+    values.extend((0..k).map(|r| {
+        let row: Vec<String> = (0..coordinates.len())
+            .map(|j| format!("jac__{r}_{j}"))
+            .collect();
+        (
+            format!("velocity_form__{r}"),
+            format!("ct__{r}+{}", crate::numeric::dot(&row, &velocities)),
+        )
+    }));
+    let mut derivatives = Vec::new();
+    let mut bias = Vec::new();
+    for r in 0..k {
+        let form = format!("velocity_form__{r}");
+        let mut terms = Vec::new();
+        for (j, (q, v)) in coordinates.iter().zip(&velocities).enumerate() {
+            derivatives.push((format!("dc__{r}_{j}"), form.clone(), vec![q.clone()]));
+            terms.push(format!("dc__{r}_{j}*{v}"));
+        }
+        derivatives.push((format!("dc__{r}_t"), form.clone(), vec![time.clone()]));
+        terms.push(format!("dc__{r}_t"));
+        if let (Some(phase), Some(rate)) = (&phase, &derivation.phase_rate) {
+            derivatives.push((format!("dc__{r}_phase"), form.clone(), vec![phase.clone()]));
+            terms.push(format!("({rate})*dc__{r}_phase"));
+        }
+        bias.push((format!("bias__{r}"), terms.join("+")));
+    }
+    vec![
+        Step::Values(values),
+        Step::Derivatives(derivatives),
+        Step::Values(bias),
+    ]
 }
 
 /// The Taylor recurrences of the motion on the constraints ([`constrained_steps`]).

@@ -1610,6 +1610,27 @@ impl Model {
             .constraints
             .iter()
             .any(|c| matches!(c.kind, ConstraintKind::Position(_)));
+        // Each contact's velocity across the plane and along it, and their
+        // gradients in the velocities (the scale), derived once.
+        let contacts: Vec<(&Constraint, Expr, Vec<(Expr, Expr)>)> = self
+            .constraints
+            .iter()
+            .filter_map(|constraint| {
+                let normal = self.expanded(constraint.normal.as_ref()?);
+                let along = self.expanded(constraint.kind.expression());
+                let gradients = self
+                    .coordinates
+                    .iter()
+                    .map(|c| {
+                        (
+                            normal.derivative(&c.velocity),
+                            along.derivative(&c.velocity),
+                        )
+                    })
+                    .collect();
+                Some((constraint, normal, gradients))
+            })
+            .collect();
         let mut random = uniform(0x9E37_79B9_7F4A_7C15);
         for sample in 0..4 {
             let q: Vec<f64> = at_start
@@ -1633,26 +1654,19 @@ impl Model {
                 .collect();
             let v = project_out(&values, (0..n).map(|_| random()).collect());
             let moving = Sample { v, ..point.clone() };
-            for constraint in &self.constraints {
-                let Some(normal) = &constraint.normal else {
-                    continue;
-                };
+            for (constraint, normal, gradients) in &contacts {
                 // The scale: the contact's velocity along the plane and
                 // across it, per unit speed.
-                let normal = self.expanded(normal);
-                let along = self.expanded(constraint.kind.expression());
-                let gradient: f64 = self
-                    .coordinates
+                let gradient: f64 = gradients
                     .iter()
-                    .map(|c| {
-                        let across = point.eval(&normal.derivative(&c.velocity));
-                        let on = point.eval(&along.derivative(&c.velocity));
+                    .map(|(across, on)| {
+                        let (across, on) = (point.eval(across), point.eval(on));
                         across * across + on * on
                     })
                     .sum::<f64>()
                     .sqrt();
                 let speed = moving.v.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let off = moving.eval(&normal);
+                let off = moving.eval(normal);
                 if !(off.abs() <= 1e-8 * gradient * speed) {
                     return Err((
                         constraint.key.replace(".rolling", ".contact"),
@@ -1679,6 +1693,16 @@ impl Model {
         let n = self.dof();
         let mut random = uniform(0x2545_F491_4F6C_DD1D);
         let mut integrable = true;
+        // ∂a/∂q, derived once (the four samples evaluate it).
+        let row_derivatives: Vec<Vec<Expr>> = row
+            .iter()
+            .map(|e| {
+                self.coordinates
+                    .iter()
+                    .map(|c| e.derivative(&c.name))
+                    .collect()
+            })
+            .collect();
         for sample in 0..4 {
             let q: Vec<f64> = at_start
                 .q
@@ -1712,14 +1736,9 @@ impl Model {
                 time: 0.0,
             };
             let a: Vec<f64> = row.iter().map(|e| point.eval(e)).collect();
-            let da: Vec<Vec<f64>> = row
+            let da: Vec<Vec<f64>> = row_derivatives
                 .iter()
-                .map(|e| {
-                    self.coordinates
-                        .iter()
-                        .map(|c| point.eval(&e.derivative(&c.name)))
-                        .collect()
-                })
+                .map(|row| row.iter().map(|e| point.eval(e)).collect())
                 .collect();
             // a·dq ∧ d(a·dq), component (i, j, k): a_i (∂_j a_k − ∂_k a_j) + cyclic.
             for i in 0..n {
