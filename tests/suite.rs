@@ -10,6 +10,7 @@ mod analyses_by_name;
 mod attractor;
 mod bad_input;
 mod basins;
+mod bicycle;
 mod bodies;
 mod constrained;
 mod continuation;

@@ -69,6 +69,16 @@ pub trait ConstrainedSystems: Flows {
         t: f64,
         y: &[f64],
     ) -> Result<Option<DMatrix<f64>>, OdeError>;
+    /// At (t, y): the Jacobian of the equations on the constraints with
+    /// respect to the state [q; q'] (2n × 2n), and that of the state's
+    /// constraints [g; G q' + c_t] (one row per position constraint, then
+    /// one per constraint), both exact by dual numbers.
+    fn linearisation(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), OdeError>;
     /// Whether the constraints are holonomic and fixed and M does not
     /// move with the phase (the averaging's conditions).
     fn stationary(&self) -> bool;
@@ -370,6 +380,23 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
         let y = fixed_state::<S>(y)?;
         let (q, v) = OnConstraints::<N, K, S>::split(&y);
         Ok((self.forms.energy)(params, t, &q, &v))
+    }
+    fn linearisation(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), OdeError> {
+        use crate::ode::System;
+        let y = fixed_state::<S>(y)?;
+        let equations = self.equations(params);
+        let field = equations
+            .jacobian(t, &y)
+            .expect("the equations on the constraints have an exact Jacobian");
+        Ok((
+            DMatrix::from_fn(S, S, |i, k| field[i][k]),
+            equations.state_constraints_jacobian(t, &y),
+        ))
     }
     fn stationary(&self) -> bool {
         self.forms.stationary

@@ -5,6 +5,7 @@
 //! [`vibration`] (the attractor of a period map on the constraints is
 //! `analysis::attractor::on_constraints`).
 
+pub mod steady;
 pub mod vibration;
 
 use nalgebra::DMatrix;

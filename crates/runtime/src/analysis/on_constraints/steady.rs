@@ -1,0 +1,476 @@
+//! The linearisation of a steady motion of a constrained model: a motion
+//! along which some coordinates (the *shape*: a bicycle's lean and steer)
+//! stay still while others advance at constant rates (its position on the
+//! ground, its heading, its wheels' rotations) and the model's equations,
+//! seen from the shape, do not change.
+//!
+//! Such a motion is not an equilibrium of the full state, and with
+//! nonholonomic constraints the tangent space of the constraints moves
+//! along it (a rolling wheel's constraints turn with its heading), so the
+//! restriction Zᵀ J Z of the field's Jacobian to an orthonormal basis of
+//! that tangent space is not the linearisation of the shape's motion. What
+//! is: the shape's accelerations as functions of the shape, its rates and
+//! the held speeds, every other component of the state following from the
+//! constraints. With y(r) the consistent state of the reduced coordinates
+//! r = (shape, shape rates, held speeds), the linearisation is
+//! A = P J S, where J is the field's exact Jacobian, S = ∂y/∂r solves the
+//! linearised constraints C S = 0 for the dependent components (chosen
+//! among the others by pivoting), and P picks the rates of r.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::ode::OdeError;
+use crate::registry::ConstrainedSystems;
+
+/// The linearisation of a steady motion ([`steady_motion`]).
+#[derive(Clone, Debug)]
+pub struct SteadyMotion {
+    /// The consistent state of the steady motion, [q; q'].
+    pub state: Vec<f64>,
+    /// The reduced state's names: the shape, its rates, then the held
+    /// speeds that couple to it (none when they decouple, as a bicycle's
+    /// speed does on its upright motion).
+    pub reduced: Vec<String>,
+    /// A: the reduced state's rates against the reduced state.
+    pub matrix: DMatrix<f64>,
+    /// A's eigenvalues (re, im), by decreasing real part.
+    pub eigenvalues: Vec<(f64, f64)>,
+}
+
+/// Why a steady motion could not be linearised.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SteadyMotionError {
+    #[error(transparent)]
+    Ode(#[from] OdeError),
+    #[error("model '{model}': the steady motion needs {what}")]
+    Setting { model: &'static str, what: String },
+    /// The constraints do not fix the other components from the shape and
+    /// the held speeds.
+    #[error("model '{model}': the constraints do not determine the state from the shape and the held speeds (at {coordinate}): name other speeds to hold")]
+    Undetermined {
+        model: &'static str,
+        coordinate: String,
+    },
+    /// The state is not steady: a shape coordinate accelerates.
+    #[error("model '{model}': the state is not a steady motion: '{coordinate}'' = {acceleration:e} (at most {tolerance:e})")]
+    NotSteady {
+        model: &'static str,
+        coordinate: String,
+        acceleration: f64,
+        tolerance: f64,
+    },
+    /// Moving a coordinate outside the shape changes the shape's motion,
+    /// so the shape alone does not describe the motion's stability.
+    #[error("model '{model}': moving '{coordinate}' changes the shape's accelerations by {effect:e} per unit: add it to the shape")]
+    NotSymmetric {
+        model: &'static str,
+        coordinate: String,
+        effect: f64,
+    },
+}
+
+/// A steady motion: the configuration, the shape coordinates (still along
+/// it) and the held speeds (coordinates' rates, with their values); every
+/// other rate follows from the constraints.
+pub struct SteadySettings<'a> {
+    pub q: &'a [f64],
+    pub shape: &'a [usize],
+    pub held: &'a [(usize, f64)],
+}
+
+/// Relative size below which a reduced rate counts as zero: the state's
+/// steadiness, the symmetry in the other coordinates, the held speeds'
+/// coupling (the field's Jacobian is exact to rounding).
+const STEADY: f64 = 1e-9;
+
+/// The linearisation of the steady motion `settings` of `model` at the
+/// parameter values `params` (see the module's comment).
+pub fn steady_motion(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    settings: &SteadySettings,
+) -> Result<SteadyMotion, SteadyMotionError> {
+    let name = model.info().name;
+    let names = model.info().coordinates;
+    let n = names.len();
+    let setting = |what: String| SteadyMotionError::Setting { model: name, what };
+    if settings.q.len() != n {
+        return Err(setting(format!(
+            "{n} coordinates, not {}",
+            settings.q.len()
+        )));
+    }
+    if settings.shape.is_empty() || settings.shape.iter().any(|&i| i >= n) {
+        return Err(setting("at least one shape coordinate of the model".into()));
+    }
+    let shape = settings.shape;
+    let held: Vec<usize> = settings.held.iter().map(|&(i, _)| i).collect();
+    if held.iter().any(|i| *i >= n || shape.contains(i)) {
+        return Err(setting(
+            "held speeds of coordinates outside the shape".into(),
+        ));
+    }
+    let state = steady_state(model, params, settings)?;
+    let (field, constraints) = model.linearisation(params, 0.0, &state)?;
+    let map = ConsistentMap::new(name, names, &constraints, shape, &held)?;
+    let scale = field.amax().max(1.0);
+    let accelerations = model.exact(params).rhs(0.0, &state)?;
+    for &i in shape {
+        let acceleration = accelerations[n + i];
+        let tolerance = STEADY * scale * (1.0 + state.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+        if acceleration.abs() > tolerance {
+            return Err(SteadyMotionError::NotSteady {
+                model: name,
+                coordinate: names[i].into(),
+                acceleration,
+                tolerance,
+            });
+        }
+    }
+    // The shape's rates and accelerations, and the held speeds' rates.
+    let rows: Vec<usize> = shape
+        .iter()
+        .copied()
+        .chain(shape.iter().map(|&i| n + i))
+        .chain(held.iter().map(|&i| n + i))
+        .collect();
+    let reduced_of = |column: &DVector<f64>| -> DVector<f64> {
+        let rates = &field * column;
+        DVector::from_iterator(rows.len(), rows.iter().map(|&r| rates[r]))
+    };
+    // The other coordinates must be symmetries: moving one (with the
+    // dependent components following) leaves the shape's motion alone.
+    for (j, &i) in map.free_positions.iter().enumerate() {
+        let effect = reduced_of(&map.free_position_columns[j])
+            .rows(0, 2 * shape.len())
+            .amax();
+        if effect > STEADY * scale {
+            return Err(SteadyMotionError::NotSymmetric {
+                model: name,
+                coordinate: names[i].into(),
+                effect,
+            });
+        }
+    }
+    let full = DMatrix::from_columns(&map.columns.iter().map(&reduced_of).collect::<Vec<_>>());
+    let s = 2 * shape.len();
+    // The held speeds drop out where they neither move the shape nor are
+    // moved by it.
+    let coupling = full
+        .view((0, s), (s, held.len()))
+        .amax()
+        .max(full.view((s, 0), (held.len(), s)).amax());
+    let (matrix, reduced) = if held.is_empty() || coupling <= STEADY * scale {
+        (
+            full.view((0, 0), (s, s)).into_owned(),
+            reduced_names(names, shape, &[]),
+        )
+    } else {
+        (full, reduced_names(names, shape, &held))
+    };
+    let mut eigenvalues: Vec<(f64, f64)> = matrix
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| (z.re, z.im))
+        .collect();
+    eigenvalues.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.total_cmp(&b.1)));
+    Ok(SteadyMotion {
+        state,
+        reduced,
+        matrix,
+        eigenvalues,
+    })
+}
+
+fn reduced_names(names: &[&str], shape: &[usize], held: &[usize]) -> Vec<String> {
+    shape
+        .iter()
+        .map(|&i| names[i].to_string())
+        .chain(shape.iter().map(|&i| format!("{}'", names[i])))
+        .chain(held.iter().map(|&i| format!("{}'", names[i])))
+        .collect()
+}
+
+/// The consistent state: q with the shape held, the shape's rates 0 and
+/// the held speeds given, the other components moved onto the
+/// constraints (positions by Newton's method, then the rates).
+fn steady_state(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    settings: &SteadySettings,
+) -> Result<Vec<f64>, SteadyMotionError> {
+    let n = settings.q.len();
+    let mut y = settings.q.to_vec();
+    y.resize(2 * n, 0.0);
+    for &(i, v) in settings.held {
+        y[n + i] = v;
+    }
+    let held: Vec<usize> = settings
+        .shape
+        .iter()
+        .flat_map(|&i| [i, n + i])
+        .chain(settings.held.iter().map(|&(i, _)| n + i))
+        .collect();
+    model
+        .consistent(params, &mut y, &held)
+        .map_err(|e| SteadyMotionError::Setting {
+            model: model.info().name,
+            what: format!("a state on the constraints with the shape and speeds given ({e})"),
+        })?;
+    Ok(y)
+}
+
+/// S = ∂y/∂r for the reduced state r = (shape, shape rates, held speeds),
+/// and the columns for moving each free (non-shape, non-dependent)
+/// coordinate, the dependent components solved from C S = 0.
+struct ConsistentMap {
+    columns: Vec<DVector<f64>>,
+    free_positions: Vec<usize>,
+    free_position_columns: Vec<DVector<f64>>,
+}
+
+impl ConsistentMap {
+    fn new(
+        model: &'static str,
+        names: &[&str],
+        constraints: &DMatrix<f64>,
+        shape: &[usize],
+        held: &[usize],
+    ) -> Result<Self, SteadyMotionError> {
+        let n = names.len();
+        let rows = constraints.nrows();
+        // Dependent components, chosen by pivoting among the others:
+        // positions (outside the shape), then rates (outside the shape
+        // and the held speeds).
+        let position_candidates: Vec<usize> = (0..n).filter(|i| !shape.contains(i)).collect();
+        let rate_candidates: Vec<usize> = (0..n)
+            .filter(|i| !shape.contains(i) && !held.contains(i))
+            .map(|i| n + i)
+            .collect();
+        let candidates: Vec<usize> = position_candidates
+            .iter()
+            .copied()
+            .chain(rate_candidates.iter().copied())
+            .collect();
+        let dependent = pivot_columns(constraints, &candidates);
+        if dependent.len() < rank(constraints) {
+            return Err(SteadyMotionError::Undetermined {
+                model,
+                coordinate: names[candidates.first().copied().unwrap_or(0) % n].into(),
+            });
+        }
+        let c_dep = DMatrix::from_fn(rows, dependent.len(), |r, c| constraints[(r, dependent[c])]);
+        let solver = c_dep.svd(true, true);
+        let complete = |known: usize| -> Result<DVector<f64>, SteadyMotionError> {
+            let mut column = DVector::zeros(2 * n);
+            column[known] = 1.0;
+            let rhs = -(constraints * &column);
+            let x = solver
+                .solve(&rhs, 1e-13 * constraints.amax().max(1.0))
+                .map_err(|_| SteadyMotionError::Undetermined {
+                    model,
+                    coordinate: names[known % n].into(),
+                })?;
+            for (c, &d) in dependent.iter().enumerate() {
+                column[d] = x[c];
+            }
+            Ok(column)
+        };
+        let reduced: Vec<usize> = shape
+            .iter()
+            .copied()
+            .chain(shape.iter().map(|&i| n + i))
+            .chain(held.iter().map(|&i| n + i))
+            .collect();
+        let columns = reduced
+            .iter()
+            .map(|&k| complete(k))
+            .collect::<Result<Vec<_>, _>>()?;
+        let free_positions: Vec<usize> = position_candidates
+            .into_iter()
+            .filter(|i| !dependent.contains(i))
+            .collect();
+        let free_position_columns = free_positions
+            .iter()
+            .map(|&k| complete(k))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(ConsistentMap {
+            columns,
+            free_positions,
+            free_position_columns,
+        })
+    }
+}
+
+fn rank(m: &DMatrix<f64>) -> usize {
+    let values = m.singular_values();
+    let largest = values.iter().fold(0.0_f64, |a, x| a.max(*x));
+    values.iter().filter(|&&s| s > 1e-10 * largest).count()
+}
+
+/// Columns of `m` among `candidates`, chosen greedily by the largest
+/// remaining norm after removing the chosen ones' span (a column-pivoted
+/// Gram–Schmidt), until the rest is negligible.
+fn pivot_columns(m: &DMatrix<f64>, candidates: &[usize]) -> Vec<usize> {
+    let mut remaining: Vec<(usize, DVector<f64>)> = candidates
+        .iter()
+        .map(|&c| (c, m.column(c).into_owned()))
+        .collect();
+    let scale = m.amax().max(f64::MIN_POSITIVE);
+    let mut chosen = Vec::new();
+    while let Some((k, _)) = remaining
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1 .1.norm().total_cmp(&b.1 .1.norm()))
+    {
+        let (column, vector) = remaining.swap_remove(k);
+        let norm = vector.norm();
+        if norm <= 1e-10 * scale {
+            break;
+        }
+        let unit = vector / norm;
+        for (_, v) in remaining.iter_mut() {
+            let projection = unit.dot(v);
+            *v -= &unit * projection;
+        }
+        chosen.push(column);
+    }
+    chosen
+}
+
+/// The linearisations along a family of steady motions, one held speed
+/// scaled ([`speed_sweep`]).
+#[derive(Clone, Debug)]
+pub struct SpeedSweep {
+    pub speeds: Vec<f64>,
+    /// At each speed, the eigenvalues (re, im) by decreasing real part.
+    pub eigenvalues: Vec<Vec<(f64, f64)>>,
+    /// Where the spectral abscissa (the largest real part) changes sign
+    /// between two of the speeds, located by bisection to 1e-12 (relative
+    /// to the speed): the family's stability boundaries, a bicycle's weave
+    /// and capsize speeds.
+    pub boundaries: Vec<Boundary>,
+}
+
+/// A speed where the steady motion gains or loses its stability.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Boundary {
+    pub speed: f64,
+    /// Whether the motion is stable just above this speed.
+    pub stable_above: bool,
+}
+
+/// [`steady_motion`] at each of `speeds`, the one held speed of
+/// `settings` set to speed × its rate (the rate per unit speed: the rear
+/// wheel's 1/rR for a bicycle's forward speed), and the stability
+/// boundaries between them.
+pub fn speed_sweep(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    settings: &SteadySettings,
+    speeds: &[f64],
+) -> Result<SpeedSweep, SteadyMotionError> {
+    let &[(held, per_unit)] = settings.held else {
+        return Err(SteadyMotionError::Setting {
+            model: model.info().name,
+            what: "exactly one held speed to sweep".into(),
+        });
+    };
+    let at = |speed: f64| -> Result<Vec<(f64, f64)>, SteadyMotionError> {
+        let held = [(held, speed * per_unit)];
+        let settings = SteadySettings {
+            held: &held,
+            ..*settings
+        };
+        Ok(steady_motion(model, params, &settings)?.eigenvalues)
+    };
+    let abscissa = |values: &[(f64, f64)]| values.first().map_or(f64::NEG_INFINITY, |e| e.0);
+    let eigenvalues = speeds
+        .iter()
+        .map(|&v| at(v))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut boundaries = Vec::new();
+    for k in 1..speeds.len() {
+        let (mut a, mut b) = (speeds[k - 1], speeds[k]);
+        let unstable_at_a = abscissa(&eigenvalues[k - 1]) > 0.0;
+        if unstable_at_a == (abscissa(&eigenvalues[k]) > 0.0) {
+            continue;
+        }
+        while (b - a).abs() > 1e-12 * (1.0 + a.abs().max(b.abs())) {
+            let middle = 0.5 * (a + b);
+            if (abscissa(&at(middle)?) > 0.0) == unstable_at_a {
+                a = middle;
+            } else {
+                b = middle;
+            }
+        }
+        boundaries.push(Boundary {
+            speed: 0.5 * (a + b),
+            stable_above: unstable_at_a == (speeds[k] > speeds[k - 1]),
+        });
+    }
+    Ok(SpeedSweep {
+        speeds: speeds.to_vec(),
+        eigenvalues,
+        boundaries,
+    })
+}
+
+impl SpeedSweep {
+    /// The eigenvalues against the speed (real parts blue, imaginary parts
+    /// grey, as in Meijaard et al.'s figure of the bicycle), each boundary
+    /// in the legend.
+    pub fn figure(&self, title: &str, speed_label: &str) -> crate::plot::Figure {
+        use crate::plot::{Figure, PanelSpec, BLUE, GREY, RED};
+        let points = |part: fn(&(f64, f64)) -> f64| -> Vec<(f64, f64)> {
+            self.speeds
+                .iter()
+                .zip(&self.eigenvalues)
+                .flat_map(|(&v, values)| values.iter().map(move |e| (v, part(e))))
+                .collect()
+        };
+        let (real, imaginary) = (points(|e| e.0), points(|e| e.1.abs()));
+        let x = self
+            .speeds
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        // The interesting range: the imaginary parts' and the real parts
+        // above the fastest decay's, clipped below at −10.
+        let top = imaginary
+            .iter()
+            .chain(&real)
+            .fold(0.0_f64, |m, p| m.max(p.1));
+        let mut figure = Figure::single(
+            900,
+            560,
+            PanelSpec::new(
+                title,
+                speed_label,
+                "eigenvalues: Re (blue), |Im| (grey)",
+                x,
+                (-10.0, top.max(1.0)),
+            ),
+        );
+        figure.points(0, imaginary, GREY, 2);
+        figure.points(0, real, BLUE, 2);
+        figure.line(0, &[(x.0, 0.0), (x.1, 0.0)], crate::plot::BLACK);
+        let legend: Vec<(String, crate::plot::Rgb)> = self
+            .boundaries
+            .iter()
+            .map(|b| {
+                let side = if b.stable_above {
+                    "stable above"
+                } else {
+                    "unstable above"
+                };
+                (format!("{:.9} ({side})", b.speed), RED)
+            })
+            .collect();
+        if !legend.is_empty() {
+            figure.legend(0, &legend);
+        }
+        figure
+    }
+}

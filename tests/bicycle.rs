@@ -1,0 +1,105 @@
+//! The Whipple–Carvallo bicycle written as four rigid bodies in a model
+//! file (`test_models/whipple_bicycle.toml`: its energy, gravity, the front
+//! wheel's contact and both wheels' rolling derived by mechlab), linearised
+//! about its upright straight-ahead motion by `steady_motion`, against the
+//! benchmark of Meijaard, Papadopoulos, Ruina and Schwab (2007), Proc. R.
+//! Soc. A 463, 1955–1982: the eigenvalues at 5 m/s (their Table 2) and the
+//! weave and capsize speeds bounding the self-stable range (their §5).
+
+use mechlab::analysis::on_constraints::steady::{
+    speed_sweep, steady_motion, SteadyMotion, SteadySettings,
+};
+use mechlab::registry::ConstrainedSystems;
+use mechlab_test_models::whipple_bicycle as bicycle;
+
+/// The published eigenvalues at v = 5 m/s (re, im): castering, weave,
+/// capsize.
+const AT_FIVE: [(f64, f64); 4] = [
+    (-14.07838969279822, 0.0),
+    (-0.77534188219585, 4.46486771378823),
+    (-0.77534188219585, -4.46486771378823),
+    (-0.32286642900409, 0.0),
+];
+const WEAVE_SPEED: f64 = 4.29238253634111;
+const CAPSIZE_SPEED: f64 = 6.02426201538837;
+
+fn model() -> &'static dyn ConstrainedSystems {
+    bicycle::MODEL.constrained.unwrap()
+}
+
+fn index(name: &str) -> usize {
+    let names = model().info().coordinates;
+    names.iter().position(|c| *c == name).unwrap()
+}
+
+/// The upright motion at forward speed v: the rear wheel turns at v/rR.
+fn linearised(v: f64) -> SteadyMotion {
+    let model = model();
+    let params = bicycle::Params::default().values();
+    let r_rear = bicycle::Params::default().get("rR").unwrap();
+    let q = vec![0.0; model.info().coordinates.len()];
+    let shape = [index("phi"), index("delta")];
+    let held = [(index("thetaR"), v / r_rear)];
+    steady_motion(
+        model,
+        &params,
+        &SteadySettings {
+            q: &q,
+            shape: &shape,
+            held: &held,
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn eigenvalues_at_five_metres_per_second_are_the_benchmarks() {
+    let motion = linearised(5.0);
+    // The speed decouples from lean and steer on the upright motion: the
+    // linearisation is the 4 × 4 of (phi, delta, phi', delta').
+    assert_eq!(motion.reduced, ["phi", "delta", "phi'", "delta'"]);
+    let mut got = motion.eigenvalues.clone();
+    got.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
+    for (g, w) in got.iter().zip(AT_FIVE) {
+        println!("{g:?} against {w:?}");
+        assert!(
+            (g.0 - w.0).abs() < 1e-10 && (g.1 - w.1).abs() < 1e-10,
+            "{g:?} against the benchmark's {w:?}"
+        );
+    }
+    // The rear wheel's centre moves forward at v.
+    let xd = motion.state[model().info().coordinates.len() + index("x")];
+    assert!((xd - 5.0).abs() < 1e-12, "x' = {xd}");
+}
+
+#[test]
+fn the_self_stable_range_is_the_benchmarks() {
+    let model = model();
+    let defaults = bicycle::Params::default();
+    let q = vec![0.0; model.info().coordinates.len()];
+    let shape = [index("phi"), index("delta")];
+    let held = [(index("thetaR"), 1.0 / defaults.get("rR").unwrap())];
+    let settings = SteadySettings {
+        q: &q,
+        shape: &shape,
+        held: &held,
+    };
+    let speeds: Vec<f64> = (0..=20).map(|k| 0.5 * k as f64).collect();
+    let sweep = speed_sweep(model, &defaults.values(), &settings, &speeds).unwrap();
+    let [weave, capsize] = sweep.boundaries[..] else {
+        panic!("two boundaries in 0..10 m/s, not {:?}", sweep.boundaries);
+    };
+    println!(
+        "weave {:.12} m/s, capsize {:.12} m/s",
+        weave.speed, capsize.speed
+    );
+    assert!(weave.stable_above && !capsize.stable_above);
+    assert!(
+        (weave.speed - WEAVE_SPEED).abs() < 1e-8,
+        "weave speed {weave:?}"
+    );
+    assert!(
+        (capsize.speed - CAPSIZE_SPEED).abs() < 1e-8,
+        "capsize speed {capsize:?}"
+    );
+}
