@@ -7,7 +7,7 @@
 //! weave and capsize speeds bounding the self-stable range (their §5).
 
 use mechlab::analysis::on_constraints::steady::{
-    speed_sweep, steady_motion, SteadyMotion, SteadySettings,
+    speed_sweep, steady_motion, SteadyMotion, SteadyMotionError, SteadySettings,
 };
 use mechlab::registry::ConstrainedSystems;
 use mechlab_test_models::whipple_bicycle as bicycle;
@@ -102,4 +102,35 @@ fn the_self_stable_range_is_the_benchmarks() {
         (capsize.speed - CAPSIZE_SPEED).abs() < 1e-8,
         "capsize speed {capsize:?}"
     );
+}
+
+/// A leaning bicycle is not a steady motion: the linearisation says so,
+/// naming the lean, instead of linearising about a falling state.
+#[test]
+fn a_leaning_bicycle_is_refused_as_not_steady() {
+    let model = model();
+    let defaults = bicycle::Params::default();
+    let mut q = vec![0.0; model.info().coordinates.len()];
+    q[index("phi")] = 0.1;
+    let shape = [index("phi"), index("delta")];
+    let held = [(index("thetaR"), 5.0 / defaults.get("rR").unwrap())];
+    let settings = SteadySettings {
+        q: &q,
+        shape: &shape,
+        held: &held,
+    };
+    match steady_motion(model, &defaults.values(), &settings) {
+        Err(e @ SteadyMotionError::NotSteady { .. }) => {
+            let text = e.to_string();
+            assert!(text.contains("'phi''") || text.contains("'delta''"), "{text}");
+        }
+        other => panic!("a leaning bicycle linearised: {other:?}"),
+    }
+    // No shape: a setting error naming what is missing.
+    let no_shape = SteadySettings {
+        shape: &[],
+        ..settings
+    };
+    let e = steady_motion(model, &defaults.values(), &no_shape).unwrap_err();
+    assert!(e.to_string().contains("shape coordinate"), "{e}");
 }
