@@ -122,7 +122,10 @@ fn a_leaning_bicycle_is_refused_as_not_steady() {
     match steady_motion(model, &defaults.values(), &settings) {
         Err(e @ SteadyMotionError::NotSteady { .. }) => {
             let text = e.to_string();
-            assert!(text.contains("'phi''") || text.contains("'delta''"), "{text}");
+            assert!(
+                text.contains("'phi''") || text.contains("'delta''"),
+                "{text}"
+            );
         }
         other => panic!("a leaning bicycle linearised: {other:?}"),
     }

@@ -123,7 +123,9 @@ fn key_expressions_stay_readable() {
 /// velocities, momenta p_{φ₁}; no ASCII names of Greek letters are left.
 #[test]
 fn latex_uses_greek_letters_and_subscripts() {
-    for model in mechlab::models::ALL {
+    // The bicycle's wheel angles thetaR and thetaF read θ_R and θ_F.
+    let bicycle = &mechlab_test_models::whipple_bicycle::INFO;
+    for model in mechlab::models::ALL.iter().chain([bicycle]) {
         for d in model.derivations {
             for word in ["phi", "alpha", "theta", "tau", "eps", "mu", "nu"] {
                 let bare = d
@@ -136,6 +138,9 @@ fn latex_uses_greek_letters_and_subscripts() {
     }
     // A two-digit index (the test model's parameter h10) is one subscript;
     // reading it as a name again sent the build into endless recursion.
+    let energy = bicycle.derivations.iter().find(|d| d.key == "energy");
+    let energy = energy.expect("the bicycle has an energy").latex;
+    assert!(energy.contains("\\dot{\\theta_R}"), "{energy}");
     let awkward = &mechlab_test_models::awkward_names::INFO;
     let potential = awkward.derivations.iter().find(|d| d.key == "potential");
     let latex = potential.expect("awkward_names has a potential").latex;

@@ -43,11 +43,15 @@ const GREEK: &[(&str, &str)] = &[
 pub fn default_name(name: &str) -> String {
     let (base, subscript) = match name.split_once('_') {
         Some((b, s)) => (b, s.to_string()),
-        None => {
-            let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
-            let (b, s) = name.split_at(name.len() - digits);
-            (b, s.to_string())
-        }
+        None => match greek_then_capitals(name) {
+            // `thetaR`: θ_R, a Greek letter and a capital suffix.
+            Some((b, s)) => (b, s.to_string()),
+            None => {
+                let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+                let (b, s) = name.split_at(name.len() - digits);
+                (b, s.to_string())
+            }
+        },
     };
     let base = GREEK
         .iter()
@@ -68,6 +72,20 @@ pub fn default_name(name: &str) -> String {
         s if s.chars().all(|c| c.is_ascii_digit()) => format!("{base}_{{{s}}}"),
         s => format!("{base}_{{{}}}", default_name(s)),
     }
+}
+
+/// A Greek letter's name followed by capitals and digits (`thetaR`,
+/// `phiB2`), split after the letter.
+fn greek_then_capitals(name: &str) -> Option<(&str, &str)> {
+    GREEK.iter().find_map(|(greek, _)| {
+        let rest = name.strip_prefix(greek)?;
+        let capital = rest.chars().next()?.is_ascii_uppercase();
+        (capital
+            && rest
+                .chars()
+                .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit()))
+        .then(|| name.split_at(greek.len()))
+    })
 }
 
 /// LaTeX names of the symbols of one model.
