@@ -1728,6 +1728,11 @@ impl Model {
                     format!("'{name}' is not linear in the velocities (a velocity constraint is a(q, t)·q' + b(q, t))"),
                 ));
             }
+            // One sample where the 1-form is not closed suffices: the
+            // others check linearity only.
+            if !integrable {
+                continue;
+            }
             let point = Sample {
                 model: self,
                 q,
