@@ -137,3 +137,63 @@ fn a_leaning_bicycle_is_refused_as_not_steady() {
     let e = steady_motion(model, &defaults.values(), &no_shape).unwrap_err();
     assert!(e.to_string().contains("shape coordinate"), "{e}");
 }
+
+/// A model file not written for the linearisation: the thin uniform disk
+/// of `test_models/tipping_disk_body.toml` (m = R = g = 1) rolling upright
+/// with spin ω about its axle. Routh's tilt equation,
+/// (A + mR²) θ'' + (C (C + mR²) ω²/A − m g R) θ = 0 with A = mR²/4 and
+/// C = mR²/2, gives λ² = (1 − 3ω²)·4/5: the disk stands up above
+/// ω² = 1/3. The heading is in the shape (the tilt turns it); what is
+/// left of the spectrum is the heading's double zero.
+#[test]
+fn a_rolling_disk_stands_up_above_routh_s_spin() {
+    use mechlab_test_models::tipping_disk_body as disk;
+    let model = disk::MODEL.constrained.unwrap();
+    let names = model.info().coordinates;
+    let at = |name: &str| names.iter().position(|c| *c == name).unwrap();
+    let q = vec![0.0; names.len()];
+    let shape = [at("theta"), at("phi")];
+    for spin in [0.3, 0.5, 0.577, 0.6, 1.0, 2.0] {
+        let held = [(at("psi"), spin)];
+        let settings = SteadySettings {
+            q: &q,
+            shape: &shape,
+            held: &held,
+        };
+        let motion = steady_motion(model, &disk::Params::default().values(), &settings).unwrap();
+        let squared = (1.0 - 3.0 * spin * spin) * 4.0 / 5.0;
+        let (re, im) = if squared > 0.0 {
+            (squared.sqrt(), 0.0)
+        } else {
+            (0.0, (-squared).sqrt())
+        };
+        let mut values = motion.eigenvalues.clone();
+        values.sort_by(|a, b| (b.0.hypot(b.1)).total_cmp(&a.0.hypot(a.1)));
+        println!("spin {spin}: {values:?}, Routh ±({re}, {im})");
+        for (k, value) in values.iter().enumerate() {
+            if k < 2 {
+                assert!(
+                    (value.0.abs() - re).abs() < 1e-10 && (value.1.abs() - im).abs() < 1e-10,
+                    "spin {spin}: {value:?} against Routh's ±({re}, {im})"
+                );
+            } else {
+                // The heading's zero is double and defective (φ and φ':
+                // a steady turn is a neighbouring steady motion), so
+                // rounding splits it by about √ε, and by 3e-7 next to the
+                // threshold, where the tilt's pair nears it.
+                assert!(value.0.hypot(value.1) < 1e-6, "spin {spin}: {value:?}");
+            }
+        }
+    }
+    // Without the heading in the shape, its rate is fixed by nothing: the
+    // linearisation says so rather than holding it silently.
+    let held = [(at("psi"), 1.0)];
+    let tilt_only = SteadySettings {
+        q: &q,
+        shape: &shape[..1],
+        held: &held,
+    };
+    let e = steady_motion(model, &disk::Params::default().values(), &tilt_only).unwrap_err();
+    assert!(matches!(e, SteadyMotionError::Undetermined { .. }), "{e}");
+    assert!(e.to_string().contains("'phi'"), "{e}");
+}

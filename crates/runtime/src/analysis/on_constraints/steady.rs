@@ -46,7 +46,7 @@ pub enum SteadyMotionError {
     Setting { model: &'static str, what: String },
     /// The constraints do not fix the other components from the shape and
     /// the held speeds.
-    #[error("model '{model}': the constraints do not determine the state from the shape and the held speeds (at {coordinate}): name other speeds to hold")]
+    #[error("model '{model}': the constraints do not determine '{coordinate}' or its rate from the shape and the held speeds: hold its speed or add it to the shape")]
     Undetermined {
         model: &'static str,
         coordinate: String,
@@ -112,7 +112,8 @@ pub fn steady_motion(
     }
     let state = steady_state(model, params, settings)?;
     let (field, constraints) = model.linearisation(params, 0.0, &state)?;
-    let map = ConsistentMap::new(name, names, &constraints, shape, &held)?;
+    let positions = constraints.nrows() - model.constraint_names().len();
+    let map = ConsistentMap::new(name, names, &constraints, positions, shape, &held)?;
     let scale = field.amax().max(1.0);
     let accelerations = model.exact(params).rhs(0.0, &state)?;
     for &i in shape {
@@ -127,13 +128,8 @@ pub fn steady_motion(
             });
         }
     }
-    // The shape's rates and accelerations, and the held speeds' rates.
-    let rows: Vec<usize> = shape
-        .iter()
-        .copied()
-        .chain(shape.iter().map(|&i| n + i))
-        .chain(held.iter().map(|&i| n + i))
-        .collect();
+    // The rates of the reduced state's components.
+    let rows = reduced_components(n, shape, &held);
     let reduced_of = |column: &DVector<f64>| -> DVector<f64> {
         let rates = &field * column;
         DVector::from_iterator(rows.len(), rows.iter().map(|&r| rates[r]))
@@ -230,61 +226,70 @@ struct ConsistentMap {
 }
 
 impl ConsistentMap {
+    /// `constraints`: C, its first `positions` rows the position
+    /// constraints' (zero in the rates' columns).
     fn new(
         model: &'static str,
         names: &[&str],
         constraints: &DMatrix<f64>,
+        positions: usize,
         shape: &[usize],
         held: &[usize],
     ) -> Result<Self, SteadyMotionError> {
         let n = names.len();
-        let rows = constraints.nrows();
-        // Dependent components, chosen by pivoting among the others:
-        // positions (outside the shape), then rates (outside the shape
-        // and the held speeds).
+        let undetermined = |i: usize| SteadyMotionError::Undetermined {
+            model,
+            coordinate: names[i % n].into(),
+        };
+        // Dependent positions, pivoted among those outside the shape on the
+        // position rows; then dependent rates, among those outside the
+        // shape and the held speeds, on the velocity rows. A rate left over
+        // is not fixed by the constraints: it must be held or in the shape.
+        let position_rows = constraints.rows(0, positions).into_owned();
+        let velocity_rows = constraints
+            .rows(positions, constraints.nrows() - positions)
+            .into_owned();
         let position_candidates: Vec<usize> = (0..n).filter(|i| !shape.contains(i)).collect();
         let rate_candidates: Vec<usize> = (0..n)
             .filter(|i| !shape.contains(i) && !held.contains(i))
             .map(|i| n + i)
             .collect();
-        let candidates: Vec<usize> = position_candidates
-            .iter()
-            .copied()
-            .chain(rate_candidates.iter().copied())
-            .collect();
-        let dependent = pivot_columns(constraints, &candidates);
-        if dependent.len() < rank(constraints) {
-            return Err(SteadyMotionError::Undetermined {
-                model,
-                coordinate: names[candidates.first().copied().unwrap_or(0) % n].into(),
-            });
+        let mut dependent = pivot_columns(&position_rows, &position_candidates);
+        if dependent.len() < rank(&position_rows) {
+            return Err(undetermined(
+                position_candidates.first().copied().unwrap_or(0),
+            ));
         }
-        let c_dep = DMatrix::from_fn(rows, dependent.len(), |r, c| constraints[(r, dependent[c])]);
-        let solver = c_dep.svd(true, true);
+        let dependent_rates = pivot_columns(&velocity_rows, &rate_candidates);
+        if let Some(&free) = rate_candidates
+            .iter()
+            .find(|c| !dependent_rates.contains(c))
+        {
+            return Err(undetermined(free));
+        }
+        dependent.extend(dependent_rates);
+        let c_dep = DMatrix::from_fn(constraints.nrows(), dependent.len(), |r, c| {
+            constraints[(r, dependent[c])]
+        });
+        let solver = (!c_dep.is_empty()).then(|| c_dep.svd(true, true));
         let complete = |known: usize| -> Result<DVector<f64>, SteadyMotionError> {
             let mut column = DVector::zeros(2 * n);
             column[known] = 1.0;
+            let Some(solver) = &solver else {
+                return Ok(column); // nothing depends on the others
+            };
             let rhs = -(constraints * &column);
             let x = solver
                 .solve(&rhs, 1e-13 * constraints.amax().max(1.0))
-                .map_err(|_| SteadyMotionError::Undetermined {
-                    model,
-                    coordinate: names[known % n].into(),
-                })?;
+                .map_err(|_| undetermined(known))?;
             for (c, &d) in dependent.iter().enumerate() {
                 column[d] = x[c];
             }
             Ok(column)
         };
-        let reduced: Vec<usize> = shape
-            .iter()
-            .copied()
-            .chain(shape.iter().map(|&i| n + i))
-            .chain(held.iter().map(|&i| n + i))
-            .collect();
-        let columns = reduced
-            .iter()
-            .map(|&k| complete(k))
+        let columns = reduced_components(n, shape, held)
+            .into_iter()
+            .map(complete)
             .collect::<Result<Vec<_>, _>>()?;
         let free_positions: Vec<usize> = position_candidates
             .into_iter()
@@ -302,7 +307,21 @@ impl ConsistentMap {
     }
 }
 
+/// The reduced state's components in [q; q']: the shape, its rates, the
+/// held speeds.
+fn reduced_components(n: usize, shape: &[usize], held: &[usize]) -> Vec<usize> {
+    shape
+        .iter()
+        .copied()
+        .chain(shape.iter().map(|&i| n + i))
+        .chain(held.iter().map(|&i| n + i))
+        .collect()
+}
+
 fn rank(m: &DMatrix<f64>) -> usize {
+    if m.is_empty() {
+        return 0; // (a model without position constraints: no rows)
+    }
     let values = m.singular_values();
     let largest = values.iter().fold(0.0_f64, |a, x| a.max(*x));
     values.iter().filter(|&&s| s > 1e-10 * largest).count()
