@@ -129,9 +129,10 @@ fn a_leaning_bicycle_is_refused_as_not_steady() {
         }
         other => panic!("a leaning bicycle linearised: {other:?}"),
     }
-    // No shape: a setting error naming what is missing.
+    // Neither shape nor speed: a setting error naming what is missing.
     let no_shape = SteadySettings {
         shape: &[],
+        held: &[],
         ..settings
     };
     let e = steady_motion(model, &defaults.values(), &no_shape).unwrap_err();
@@ -196,4 +197,161 @@ fn a_rolling_disk_stands_up_above_routh_s_spin() {
     let e = steady_motion(model, &disk::Params::default().values(), &tilt_only).unwrap_err();
     assert!(matches!(e, SteadyMotionError::Undetermined { .. }), "{e}");
     assert!(e.to_string().contains("'phi'"), "{e}");
+}
+
+/// The analysis by name (`steady_motion`, as the scene, the studio and
+/// Python run it) finds the speed (the rear wheel's forward motion x'),
+/// the shape (lean and steer) and what to hold by itself, and its stated
+/// errors bound its distance to the benchmark: the eigenvalues at 5 m/s
+/// and the weave and capsize speeds.
+#[test]
+fn the_analysis_by_name_finds_the_bicycle_s_shape_and_bounds_its_errors() {
+    use mechlab::analysis::declared::{no_progress, Analysis};
+    use mechlab::analysis::on_constraints::steady::study::SteadyMotionOptions;
+    use mechlab::analysis::on_constraints::steady::Verdict;
+    let options = SteadyMotionOptions {
+        at: Some(5.0),
+        sweep: 21,
+        sweep_range: Some([0.0, 10.0]),
+        ..Default::default()
+    };
+    let study = options
+        .run(
+            &bicycle::MODEL,
+            &bicycle::Params::default().values(),
+            &no_progress,
+        )
+        .unwrap();
+    assert_eq!(study.speed, "x");
+    let mut shape = study.shape.clone();
+    shape.sort();
+    assert_eq!(shape, ["delta", "phi"]);
+    let motion = &study.motion;
+    assert_eq!(motion.eigenvalues.len(), 4, "{:?}", motion.reduced);
+    assert_eq!(motion.verdict, Verdict::AsymptoticallyStable);
+    for (g, e) in motion.eigenvalues.iter().zip(&motion.errors) {
+        let missed = AT_FIVE
+            .iter()
+            .map(|w| (g.0 - w.0).hypot(g.1.abs() - w.1.abs()))
+            .fold(f64::INFINITY, f64::min);
+        println!("{g:?} ± {e:e}: {missed:e} from the benchmark");
+        // The benchmark's 14 digits: within its rounding or the bound.
+        assert!(
+            missed <= e + 1e-14 && *e < 1e-10,
+            "{g:?}: {missed:e} > {e:e}"
+        );
+    }
+    let sweep = study.sweep.unwrap();
+    let [weave, capsize] = sweep.boundaries[..] else {
+        panic!("two boundaries in 0..10 m/s, not {:?}", sweep.boundaries);
+    };
+    for (found, published) in [(weave, WEAVE_SPEED), (capsize, CAPSIZE_SPEED)] {
+        let missed = (found.speed - published).abs();
+        println!("{found:?}: {missed:e} from {published}");
+        assert!(
+            missed <= found.error + 1e-13 && found.error < 1e-8,
+            "{found:?}"
+        );
+    }
+}
+
+/// Chaplygin's sleigh gliding straight at speed u, by name on the model
+/// file of `models/` (written before steady motions were): the analysis
+/// finds no shape, holds the heading's rate (which the blade leaves free)
+/// and drops the speed (a neighbouring steady motion). The reduced
+/// equation J ω' = −m b u ω (J = I + m b²) gives the one eigenvalue
+/// −m b u / J: stable forwards, unstable backwards, the boundary at u = 0.
+#[test]
+fn a_sleigh_glides_stably_forwards_and_not_backwards() {
+    use mechlab::analysis::declared::{no_progress, Analysis};
+    use mechlab::analysis::on_constraints::steady::study::SteadyMotionOptions;
+    let model = mechlab::models::by_name("chaplygin_sleigh").unwrap();
+    let params = model.dynamic.defaults();
+    let value = |name: &str| {
+        params[model
+            .info
+            .parameter_names
+            .iter()
+            .position(|p| *p == name)
+            .unwrap()]
+    };
+    let (m, b, i) = (value("m"), value("b"), value("I"));
+    for u in [2.0, 0.5, -1.5] {
+        let options = SteadyMotionOptions {
+            at: Some(u),
+            sweep: 40,
+            ..Default::default()
+        };
+        let study = options.run(model, &params, &no_progress).unwrap();
+        assert_eq!((study.speed.as_str(), study.shape.len()), ("x", 0));
+        assert_eq!(study.motion.reduced, ["phi'"]);
+        let exact = -m * b * u / (i + m * b * b);
+        let (got, error) = (study.motion.eigenvalues[0], study.motion.errors[0]);
+        println!("u = {u}: {got:?} ± {error:e} against {exact}");
+        assert!(
+            (got.0 - exact).abs() <= error && got.1 == 0.0,
+            "{got:?} vs {exact}"
+        );
+        assert_eq!(study.motion.verdict.is_unstable(), u < 0.0);
+        let sweep = study.sweep.unwrap();
+        let [boundary] = sweep.boundaries[..] else {
+            panic!("one boundary, not {:?}", sweep.boundaries);
+        };
+        assert!(
+            boundary.stable_above && boundary.speed.abs() <= boundary.error + 1e-12,
+            "{boundary:?}"
+        );
+    }
+}
+
+/// The tipping disk by name: the analysis finds the tilt as the shape
+/// and holds the heading's rate; the tilt's pair is Routh's, as above.
+#[test]
+fn the_analysis_by_name_finds_the_disk_s_tilt() {
+    use mechlab::analysis::declared::{no_progress, Analysis};
+    use mechlab::analysis::on_constraints::steady::study::SteadyMotionOptions;
+    use mechlab_test_models::tipping_disk_body as disk;
+    for spin in [0.5, 2.0] {
+        let options = SteadyMotionOptions {
+            speed: Some("psi".into()),
+            at: Some(spin),
+            sweep: 0,
+            ..Default::default()
+        };
+        let study = options
+            .run(
+                &disk::MODEL,
+                &disk::Params::default().values(),
+                &no_progress,
+            )
+            .unwrap();
+        assert_eq!(study.shape, ["theta"]);
+        let squared = (1.0 - 3.0 * spin * spin) * 4.0 / 5.0;
+        let motion = &study.motion;
+        println!(
+            "{:?}: {:?} ± {:?}, {}",
+            motion.reduced, motion.eigenvalues, motion.errors, motion.verdict
+        );
+        let routh = motion
+            .eigenvalues
+            .iter()
+            .zip(&motion.errors)
+            .filter(|(v, e)| {
+                let (re, im) = (v.0.abs(), v.1.abs());
+                (re * re - im * im - squared).abs() <= 4.0 * (re + im + 1.0) * **e
+                    && re.max(im) > 0.1
+            });
+        assert_eq!(
+            routh.count(),
+            2,
+            "Routh's pair λ² = {squared} among {:?}",
+            motion.eigenvalues
+        );
+        assert_eq!(
+            motion.verdict.is_unstable(),
+            squared > 0.0,
+            "{}",
+            motion.verdict
+        );
+    }
 }

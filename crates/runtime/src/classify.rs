@@ -9,6 +9,7 @@ use crate::analysis::averaging::AveragingError;
 use crate::analysis::basins::BasinsError;
 use crate::analysis::continuation::ContinuationError;
 use crate::analysis::mechanism::MechanismError;
+use crate::analysis::on_constraints::steady::{study::SteadyError, SteadyMotionError};
 use crate::analysis::on_constraints::vibration::VibrationError;
 use crate::analysis::period_map::PeriodMapError;
 use crate::analysis::section::SectionError;
@@ -187,6 +188,24 @@ impl Classify for VibrationError {
     fn integration_stop(&self) -> Option<&OdeError> {
         match self {
             VibrationError::Ode(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl Classify for SteadyError {
+    fn class(&self) -> ErrorClass {
+        match self {
+            SteadyError::Setting(_) | SteadyError::Motion(SteadyMotionError::Setting { .. }) => {
+                BadValue
+            }
+            SteadyError::Motion(SteadyMotionError::Ode(e)) => e.class(),
+            SteadyError::Motion(_) | SteadyError::NoSpeed { .. } => ErrorClass::Refused,
+        }
+    }
+    fn integration_stop(&self) -> Option<&OdeError> {
+        match self {
+            SteadyError::Motion(SteadyMotionError::Ode(e)) => Some(e),
             _ => None,
         }
     }

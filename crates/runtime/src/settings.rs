@@ -138,6 +138,15 @@ pub enum SettingError {
         model: &'static str,
         known: &'static [&'static str],
     },
+    /// A coordinate's name the model does not have.
+    #[error("{analysis}: {name} = {value}: model '{model}' has no such coordinate ({})", known.join(", "))]
+    UnknownCoordinate {
+        analysis: &'static str,
+        name: &'static str,
+        value: String,
+        model: &'static str,
+        known: &'static [&'static str],
+    },
     /// Values that are each valid but do not fit together.
     #[error("{analysis}: {names}: {reason}")]
     Inconsistent {
@@ -265,6 +274,32 @@ impl SettingValue for String {
     }
     fn within(&self, range: &Range) -> bool {
         range.admits_name(self)
+    }
+}
+
+/// Names, comma-separated on the command line (a model's coordinates).
+impl SettingValue for Vec<String> {
+    const KIND: &'static str = "list of names";
+    const PYTHON: &'static str = "Sequence[str]";
+    fn from_text(text: &str) -> Option<Self> {
+        let names: Vec<String> = text.split(',').map(|n| n.trim().to_string()).collect();
+        names.iter().all(|n| !n.is_empty()).then_some(names)
+    }
+    fn from_json(value: &Value) -> Option<Self> {
+        match value {
+            Value::Array(items) => items.iter().map(String::from_json).collect(),
+            Value::String(text) => Self::from_text(text),
+            _ => None,
+        }
+    }
+    fn to_json(&self) -> Value {
+        serde_json::json!(self)
+    }
+    fn to_text(&self) -> String {
+        self.join(",")
+    }
+    fn within(&self, range: &Range) -> bool {
+        self.iter().all(|n| range.admits_name(n))
     }
 }
 
@@ -790,6 +825,7 @@ impl Schema {
 
 /// The schemas of every analysis declared so far, in the docs' order.
 pub fn schemas() -> Vec<Schema> {
+    use crate::analysis::on_constraints::steady::study::SteadyMotionOptions;
     use crate::analysis::on_constraints::vibration::LinkageOptions;
     use crate::analysis::{
         attractor, averaging, basins, chaos_map, continuation, period_map, section, separatrix,
@@ -803,6 +839,7 @@ pub fn schemas() -> Vec<Schema> {
         Schema::of::<section::SectionOptions>(),
         Schema::of::<stability::StabilityOptions>(),
         Schema::of::<LinkageOptions>(),
+        Schema::of::<SteadyMotionOptions>(),
         Schema::of::<attractor::AttractorOptions>(),
         Schema::of::<averaging::AveragingOptions>(),
         Schema::of::<period_map::PeriodMapOptions>(),

@@ -8,6 +8,9 @@ use crate::analysis::averaging::{convergence, AveragingError, AveragingOptions};
 use crate::analysis::basins::{basins, BasinsError, BasinsOptions};
 use crate::analysis::chaos_map::{chaos_map, ChaosMapOptions};
 use crate::analysis::continuation::{continuation, ContinuationError, ContinuationOptions};
+use crate::analysis::on_constraints::steady::study::{
+    steady_study, SteadyError, SteadyMotionOptions,
+};
 use crate::analysis::on_constraints::vibration::{linkage, LinkageOptions, VibrationError};
 use crate::analysis::period_map::{portrait, PeriodMapError, PeriodMapOptions};
 use crate::analysis::section::{section_study, SectionError, SectionOptions};
@@ -67,6 +70,8 @@ pub enum AnalysisError {
     #[error(transparent)]
     Vibration(#[from] VibrationError),
     #[error(transparent)]
+    Steady(#[from] SteadyError),
+    #[error(transparent)]
     Attractor(#[from] AttractorError),
     #[error(transparent)]
     Averaging(#[from] AveragingError),
@@ -111,6 +116,7 @@ impl Classify for AnalysisError {
             AnalysisError::Section(e) => e.class(),
             AnalysisError::Stability(e) => e.class(),
             AnalysisError::Vibration(e) => e.class(),
+            AnalysisError::Steady(e) => e.class(),
             AnalysisError::Attractor(e) => e.class(),
             AnalysisError::Averaging(e) => e.class(),
             AnalysisError::PeriodMap(e) => e.class(),
@@ -127,6 +133,7 @@ impl Classify for AnalysisError {
             AnalysisError::Section(e) => e.integration_stop(),
             AnalysisError::Stability(e) => e.integration_stop(),
             AnalysisError::Vibration(e) => e.integration_stop(),
+            AnalysisError::Steady(e) => e.integration_stop(),
             AnalysisError::Attractor(e) => e.integration_stop(),
             AnalysisError::Averaging(e) => e.integration_stop(),
             AnalysisError::PeriodMap(e) => e.integration_stop(),
@@ -186,6 +193,25 @@ impl Analysis for LinkageOptions {
             .into());
         };
         Ok(linkage(constrained, values, self)?)
+    }
+}
+
+impl Analysis for SteadyMotionOptions {
+    type Output = crate::analysis::on_constraints::steady::study::SteadyStudy;
+    fn run(
+        &self,
+        model: &'static Model,
+        values: &[f64],
+        _: Progress,
+    ) -> Result<Self::Output, AnalysisError> {
+        let Some(constrained) = model.constrained else {
+            return Err(Refusal::Setting {
+                model: model.info.name.into(),
+                requirement: "steady_motion runs on a model with [[constraints]] in its file (the equilibria of the others: `explore`, `stability`)",
+            }
+            .into());
+        };
+        Ok(steady_study(constrained, values, self)?)
     }
 }
 

@@ -17,24 +17,40 @@
 //! linearised constraints C S = 0 for the dependent components (chosen
 //! among the others by pivoting), and P picks the rates of r.
 
+pub mod spectrum;
+pub mod study;
+
 use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
 
 use crate::ode::OdeError;
 use crate::registry::ConstrainedSystems;
+pub use spectrum::Verdict;
 
 /// The linearisation of a steady motion ([`steady_motion`]).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize)]
 pub struct SteadyMotion {
     /// The consistent state of the steady motion, [q; q'].
     pub state: Vec<f64>,
     /// The reduced state's names: the shape, its rates, then the held
-    /// speeds that couple to it (none when they decouple, as a bicycle's
-    /// speed does on its upright motion).
+    /// speeds, each but those that neither move nor are moved by the rest
+    /// and stay where they are put (a neighbouring steady motion: a
+    /// bicycle's speed on its upright motion).
     pub reduced: Vec<String>,
     /// A: the reduced state's rates against the reduced state.
+    #[serde(serialize_with = "rows")]
     pub matrix: DMatrix<f64>,
     /// A's eigenvalues (re, im), by decreasing real part.
     pub eigenvalues: Vec<(f64, f64)>,
+    /// Each eigenvalue's numerical error ([`spectrum`]).
+    pub errors: Vec<f64>,
+    pub verdict: Verdict,
+}
+
+/// A matrix as its rows.
+fn rows<S: serde::Serializer>(m: &DMatrix<f64>, serializer: S) -> Result<S::Ok, S::Error> {
+    let rows: Vec<Vec<f64>> = m.row_iter().map(|r| r.iter().copied().collect()).collect();
+    rows.serialize(serializer)
 }
 
 /// Why a steady motion could not be linearised.
@@ -100,8 +116,12 @@ pub fn steady_motion(
             settings.q.len()
         )));
     }
-    if settings.shape.is_empty() || settings.shape.iter().any(|&i| i >= n) {
-        return Err(setting("at least one shape coordinate of the model".into()));
+    if (settings.shape.is_empty() && settings.held.is_empty())
+        || settings.shape.iter().any(|&i| i >= n)
+    {
+        return Err(setting(
+            "at least one shape coordinate or held speed of the model".into(),
+        ));
     }
     let shape = settings.shape;
     let held: Vec<usize> = settings.held.iter().map(|&(i, _)| i).collect();
@@ -115,8 +135,9 @@ pub fn steady_motion(
     let positions = constraints.nrows() - model.constraint_names().len();
     let map = ConsistentMap::new(name, names, &constraints, positions, shape, &held)?;
     let scale = field.amax().max(1.0);
+    // Steady: the shape's and the held speeds' accelerations vanish.
     let accelerations = model.exact(params).rhs(0.0, &state)?;
-    for &i in shape {
+    for &i in shape.iter().chain(&held) {
         let acceleration = accelerations[n + i];
         let tolerance = STEADY * scale * (1.0 + state.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
         if acceleration.abs() > tolerance {
@@ -135,11 +156,9 @@ pub fn steady_motion(
         DVector::from_iterator(rows.len(), rows.iter().map(|&r| rates[r]))
     };
     // The other coordinates must be symmetries: moving one (with the
-    // dependent components following) leaves the shape's motion alone.
+    // dependent components following) leaves the reduced motion alone.
     for (j, &i) in map.free_positions.iter().enumerate() {
-        let effect = reduced_of(&map.free_position_columns[j])
-            .rows(0, 2 * shape.len())
-            .amax();
+        let effect = reduced_of(&map.free_position_columns[j]).amax();
         if effect > STEADY * scale {
             return Err(SteadyMotionError::NotSymmetric {
                 model: name,
@@ -149,32 +168,32 @@ pub fn steady_motion(
         }
     }
     let full = DMatrix::from_columns(&map.columns.iter().map(&reduced_of).collect::<Vec<_>>());
+    // The first held speed drops out where it neither moves the rest nor
+    // is moved by it and stays put itself: a neighbouring steady motion,
+    // whose zero eigenvalue says nothing of this one's stability. (The
+    // other held rates are the motion's own, neutral or not.)
     let s = 2 * shape.len();
-    // The held speeds drop out where they neither move the shape nor are
-    // moved by it.
-    let coupling = full
-        .view((0, s), (s, held.len()))
-        .amax()
-        .max(full.view((s, 0), (held.len(), s)).amax());
-    let (matrix, reduced) = if held.is_empty() || coupling <= STEADY * scale {
-        (
-            full.view((0, 0), (s, s)).into_owned(),
-            reduced_names(names, shape, &[]),
-        )
-    } else {
-        (full, reduced_names(names, shape, &held))
+    let speed_apart = !held.is_empty() && full.nrows() > 1 && {
+        let coupled = (0..full.nrows())
+            .filter(|&r| r != s)
+            .any(|r| full[(r, s)].abs().max(full[(s, r)].abs()) > STEADY * scale);
+        !coupled && full[(s, s)].abs() <= STEADY * scale
     };
-    let mut eigenvalues: Vec<(f64, f64)> = matrix
-        .complex_eigenvalues()
-        .iter()
-        .map(|z| (z.re, z.im))
+    let kept: Vec<usize> = (0..full.nrows())
+        .filter(|&c| !(speed_apart && c == s))
         .collect();
-    eigenvalues.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.total_cmp(&b.1)));
+    let matrix = DMatrix::from_fn(kept.len(), kept.len(), |i, j| full[(kept[i], kept[j])]);
+    let all_names = reduced_names(names, shape, &held);
+    let reduced = kept.iter().map(|&k| all_names[k].clone()).collect();
+    let (eigenvalues, errors) = spectrum::eigenvalues_with_errors(&matrix);
+    let verdict = Verdict::of(&eigenvalues, &errors);
     Ok(SteadyMotion {
         state,
         reduced,
         matrix,
         eigenvalues,
+        errors,
+        verdict,
     })
 }
 
@@ -359,79 +378,112 @@ fn pivot_columns(m: &DMatrix<f64>, candidates: &[usize]) -> Vec<usize> {
 
 /// The linearisations along a family of steady motions, one held speed
 /// scaled ([`speed_sweep`]).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize)]
 pub struct SpeedSweep {
     pub speeds: Vec<f64>,
     /// At each speed, the eigenvalues (re, im) by decreasing real part.
     pub eigenvalues: Vec<Vec<(f64, f64)>>,
-    /// Where the spectral abscissa (the largest real part) changes sign
-    /// between two of the speeds, located by bisection to 1e-12 (relative
-    /// to the speed): the family's stability boundaries, a bicycle's weave
-    /// and capsize speeds.
+    /// Their errors.
+    pub errors: Vec<Vec<f64>>,
+    /// Where the motion turns unstable or stops being so (an eigenvalue's
+    /// real part above its error) between two of the speeds, located by
+    /// bisection to 1e-12 (relative to the speed): the family's stability
+    /// boundaries, a bicycle's weave and capsize speeds.
     pub boundaries: Vec<Boundary>,
 }
 
 /// A speed where the steady motion gains or loses its stability.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Boundary {
     pub speed: f64,
-    /// Whether the motion is stable just above this speed.
+    /// Its error: the bisection's bracket and the real part's error over
+    /// its slope there.
+    pub error: f64,
+    /// Whether the motion is unstable just below this speed (and not just
+    /// above it), or the other way round.
     pub stable_above: bool,
 }
 
-/// [`steady_motion`] at each of `speeds`, the one held speed of
-/// `settings` set to speed × its rate (the rate per unit speed: the rear
-/// wheel's 1/rR for a bicycle's forward speed), and the stability
-/// boundaries between them.
+/// [`steady_motion`] at each of `speeds`, the first held speed of
+/// `settings` set to speed × its rate there (the rate per unit speed: the
+/// rear wheel's 1/rR for a bicycle's forward speed; the others held as
+/// given), and the stability boundaries between them.
 pub fn speed_sweep(
     model: &dyn ConstrainedSystems,
     params: &[f64],
     settings: &SteadySettings,
     speeds: &[f64],
 ) -> Result<SpeedSweep, SteadyMotionError> {
-    let &[(held, per_unit)] = settings.held else {
+    let Some(&(swept, per_unit)) = settings.held.first() else {
         return Err(SteadyMotionError::Setting {
             model: model.info().name,
-            what: "exactly one held speed to sweep".into(),
+            what: "a held speed to sweep".into(),
         });
     };
-    let at = |speed: f64| -> Result<Vec<(f64, f64)>, SteadyMotionError> {
-        let held = [(held, speed * per_unit)];
+    let at = |speed: f64| -> Result<SteadyMotion, SteadyMotionError> {
+        let mut held = settings.held.to_vec();
+        held[0] = (swept, speed * per_unit);
         let settings = SteadySettings {
             held: &held,
             ..*settings
         };
-        Ok(steady_motion(model, params, &settings)?.eigenvalues)
+        steady_motion(model, params, &settings)
     };
-    let abscissa = |values: &[(f64, f64)]| values.first().map_or(f64::NEG_INFINITY, |e| e.0);
-    let eigenvalues = speeds
+    let motions = speeds
         .iter()
         .map(|&v| at(v))
         .collect::<Result<Vec<_>, _>>()?;
     let mut boundaries = Vec::new();
     for k in 1..speeds.len() {
-        let (mut a, mut b) = (speeds[k - 1], speeds[k]);
-        let unstable_at_a = abscissa(&eigenvalues[k - 1]) > 0.0;
-        if unstable_at_a == (abscissa(&eigenvalues[k]) > 0.0) {
+        let unstable_at_a = motions[k - 1].verdict.is_unstable();
+        if unstable_at_a == motions[k].verdict.is_unstable() {
             continue;
         }
+        let (mut a, mut b) = (speeds[k - 1], speeds[k]);
         while (b - a).abs() > 1e-12 * (1.0 + a.abs().max(b.abs())) {
             let middle = 0.5 * (a + b);
-            if (abscissa(&at(middle)?) > 0.0) == unstable_at_a {
+            if at(middle)?.verdict.is_unstable() == unstable_at_a {
                 a = middle;
             } else {
                 b = middle;
             }
         }
+        let speed = 0.5 * (a + b);
         boundaries.push(Boundary {
-            speed: 0.5 * (a + b),
+            speed,
+            error: (b - a).abs() + crossing_error(&at, speed)?,
             stable_above: unstable_at_a == (speeds[k] > speeds[k - 1]),
         });
     }
     Ok(SpeedSweep {
         speeds: speeds.to_vec(),
-        eigenvalues,
+        eigenvalues: motions.iter().map(|m| m.eigenvalues.clone()).collect(),
+        errors: motions.iter().map(|m| m.errors.clone()).collect(),
         boundaries,
+    })
+}
+
+/// How far a boundary at `speed` may be from the true one: the error of
+/// the real part that crosses there over that real part's slope.
+fn crossing_error(
+    at: &dyn Fn(f64) -> Result<SteadyMotion, SteadyMotionError>,
+    speed: f64,
+) -> Result<f64, SteadyMotionError> {
+    let h = 1e-6 * (1.0 + speed.abs());
+    let (below, above) = (at(speed - h)?, at(speed + h)?);
+    let crossing = |m: &SteadyMotion| {
+        m.eigenvalues
+            .iter()
+            .zip(&m.errors)
+            .min_by(|p, q| p.0 .0.abs().total_cmp(&q.0 .0.abs()))
+            .map_or((0.0, 0.0), |(v, e)| (v.0, *e))
+    };
+    let ((low, e_low), (high, e_high)) = (crossing(&below), crossing(&above));
+    let slope = (high - low).abs() / (2.0 * h);
+    Ok(if slope > 0.0 {
+        e_low.max(e_high) / slope
+    } else {
+        f64::INFINITY
     })
 }
 

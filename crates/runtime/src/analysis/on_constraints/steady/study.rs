@@ -1,0 +1,312 @@
+//! The steady-motion analysis by name (`steady_motion`): what to hold and
+//! what to linearise, found from the model where the user does not say,
+//! then the linearisation at one speed and against the speed.
+//!
+//! Found, not guessed: starting from no shape and the speed alone, each
+//! refusal of [`steady_motion`] names what is missing. A coordinate whose
+//! move changes the motion (`NotSymmetric`) joins the shape; a rate the
+//! constraints leave free (`Undetermined`) is held at its value in the
+//! model file's start (0 for a motion that goes straight) and linearised
+//! with the rest. The loop ends in the linearisation or in a refusal that
+//! no addition mends (a state that is not steady, a position the
+//! constraints do not fix).
+
+use serde::Serialize;
+
+use super::{
+    speed_sweep, steady_motion, SpeedSweep, SteadyMotion, SteadyMotionError, SteadySettings,
+};
+use crate::registry::ConstrainedSystems;
+use crate::settings::{Declared, Range, SettingError};
+
+crate::declare_settings! {
+    /// The linearisation of a steady motion of a constrained model (a
+    /// bicycle riding upright, a sleigh gliding straight, a disk rolling
+    /// upright): the eigenvalues with their errors and the verdict at one
+    /// speed, then against the speed with the stability boundaries.
+    pub struct SteadyMotionOptions for "steady_motion" {
+        /// The coordinate whose rate is the family's speed (auto: the
+        /// first for which a steady motion is found).
+        speed: Option<String> = None, Range::Any;
+        /// That rate on the motion linearised (auto: its start velocity in
+        /// the model file, or 1 where that is 0).
+        at: Option<f64> = None, Range::Any;
+        /// The shape: the coordinates that stay still along the motion and
+        /// on which its equations depend (auto: found by moving each).
+        shape: Option<Vec<String>> = None, Range::Any;
+        /// Speeds in the sweep (0: none).
+        sweep: usize = 101, Range::Count { min: 0, max: 100_000 };
+        /// The sweep's first and last speed (auto: −2|at| to 2|at|).
+        sweep_range: Option<[f64; 2]> = None, Range::Any;
+    }
+}
+
+/// The steady motion linearised at one speed and along the family.
+#[derive(Clone, Debug, Serialize)]
+pub struct SteadyStudy {
+    pub model: &'static str,
+    /// The coordinate whose rate is the speed.
+    pub speed: String,
+    /// Its rate on the motion linearised.
+    pub at: f64,
+    /// The shape, given or found.
+    pub shape: Vec<String>,
+    /// The other rates held (at their start values) because the
+    /// constraints leave them free.
+    pub held: Vec<String>,
+    pub motion: SteadyMotion,
+    pub sweep: Option<SpeedSweep>,
+}
+
+/// Why the steady-motion analysis gave no result.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SteadyError {
+    #[error(transparent)]
+    Motion(#[from] SteadyMotionError),
+    #[error(transparent)]
+    Setting(#[from] SettingError),
+    /// No coordinate's rate gives a steady motion from the start: the
+    /// last coordinate tried and why.
+    #[error("model '{model}': no coordinate's rate gives a steady motion from the model file's start (name one with `speed`); the last tried, '{tried}': {reason}")]
+    NoSpeed {
+        model: &'static str,
+        tried: String,
+        reason: Box<SteadyMotionError>,
+    },
+}
+
+/// The steady-motion analysis of `options` on `model`.
+pub fn steady_study(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    options: &SteadyMotionOptions,
+) -> Result<SteadyStudy, SteadyError> {
+    let info = model.info();
+    let names = info.coordinates;
+    let n = names.len();
+    let index = |name: &str, setting: &'static str| {
+        names
+            .iter()
+            .position(|c| *c == name)
+            .ok_or_else(|| SettingError::UnknownCoordinate {
+                analysis: SteadyMotionOptions::ANALYSIS,
+                name: setting,
+                value: name.to_string(),
+                model: info.name,
+                known: names,
+            })
+    };
+    let shape = match &options.shape {
+        Some(given) => Some(
+            given
+                .iter()
+                .map(|c| index(c, "shape"))
+                .collect::<Result<Vec<_>, _>>()?,
+        ),
+        None => None,
+    };
+    let start = model.start(params);
+    let q = &start[..n];
+    let rate_at = |i: usize| {
+        options.at.unwrap_or(if start[n + i] != 0.0 {
+            start[n + i]
+        } else {
+            1.0
+        })
+    };
+    let find = |speed: usize| {
+        let held = vec![(speed, rate_at(speed))];
+        found(model, params, q, &start[n..], shape.clone(), held)
+    };
+    let (speed, (shape, held, motion)) = match &options.speed {
+        Some(name) => {
+            let speed = index(name, "speed")?;
+            (speed, find(speed)?)
+        }
+        None => {
+            let mut last = None;
+            let mut result = None;
+            for speed in (0..n).filter(|i| shape.as_ref().is_none_or(|s| !s.contains(i))) {
+                match find(speed) {
+                    Ok(found) => {
+                        result = Some((speed, found));
+                        break;
+                    }
+                    Err(e) => last = Some((speed, e)),
+                }
+            }
+            match (result, last) {
+                (Some(found), _) => found,
+                (None, Some((tried, reason))) => {
+                    return Err(SteadyError::NoSpeed {
+                        model: info.name,
+                        tried: names[tried].into(),
+                        reason: Box::new(reason),
+                    })
+                }
+                (None, None) => unreachable!("a model has coordinates"),
+            }
+        }
+    };
+    let at = rate_at(speed);
+    let sweep = match options.sweep {
+        0 => None,
+        count => {
+            let [first, last] = options
+                .sweep_range
+                .unwrap_or([-2.0 * at.abs(), 2.0 * at.abs()]);
+            let speeds: Vec<f64> = (0..count)
+                .map(|k| first + (last - first) * k as f64 / (count.max(2) - 1) as f64)
+                .collect();
+            let mut held = held.clone();
+            held[0].1 = 1.0; // the sweep scales the speed's rate
+            let settings = SteadySettings {
+                q,
+                shape: &shape,
+                held: &held,
+            };
+            Some(speed_sweep(model, params, &settings, &speeds)?)
+        }
+    };
+    Ok(SteadyStudy {
+        model: info.name,
+        speed: names[speed].into(),
+        at,
+        shape: shape.iter().map(|&i| names[i].to_string()).collect(),
+        held: held[1..]
+            .iter()
+            .map(|&(i, _)| names[i].to_string())
+            .collect(),
+        motion,
+        sweep,
+    })
+}
+
+/// The linearisation with the speed held, the shape given or found and
+/// every rate the constraints leave free held at its start value (see the
+/// module's comment).
+#[allow(clippy::type_complexity)]
+fn found(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    q: &[f64],
+    start_rates: &[f64],
+    given_shape: Option<Vec<usize>>,
+    mut held: Vec<(usize, f64)>,
+) -> Result<(Vec<usize>, Vec<(usize, f64)>, SteadyMotion), SteadyMotionError> {
+    let names = model.info().coordinates;
+    let searching = given_shape.is_none();
+    let mut shape = given_shape.unwrap_or_default();
+    let index = |name: &str| names.iter().position(|c| *c == name);
+    // Each pass adds one coordinate to the shape or one held rate.
+    for _ in 0..=2 * names.len() {
+        let settings = SteadySettings {
+            q,
+            shape: &shape,
+            held: &held,
+        };
+        let refusal = match steady_motion(model, params, &settings) {
+            Ok(motion) => return Ok((shape, held, motion)),
+            Err(e) => e,
+        };
+        let new = |name: &str| {
+            index(name).filter(|i| !shape.contains(i) && held.iter().all(|h| h.0 != *i))
+        };
+        match &refusal {
+            SteadyMotionError::NotSymmetric { coordinate, .. } if searching => {
+                // A held rate's coordinate may join the shape (its rate is
+                // then the shape's); the speed's may not.
+                let Some(i) = index(coordinate).filter(|i| !shape.contains(i) && *i != held[0].0)
+                else {
+                    return Err(refusal);
+                };
+                held.retain(|h| h.0 != i);
+                shape.push(i);
+            }
+            SteadyMotionError::Undetermined { coordinate, .. } => {
+                let Some(i) = new(coordinate) else {
+                    return Err(refusal);
+                };
+                held.push((i, start_rates[i]));
+            }
+            _ => return Err(refusal),
+        }
+    }
+    unreachable!("each pass adds a coordinate to the shape or the held rates")
+}
+
+impl crate::outputs::Outputs for SteadyStudy {
+    fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
+        let Some(sweep) = &self.sweep else {
+            return Vec::new();
+        };
+        let title = format!(
+            "{}: linearised eigenvalues of the steady motion (shape {})",
+            self.model,
+            self.shape.join(", ")
+        );
+        let label = format!("rate of {}", self.speed);
+        vec![("eigenvalues.png".into(), sweep.figure(&title, &label))]
+    }
+    fn tables(&self) -> Vec<crate::outputs::Table> {
+        let mut tables = vec![crate::outputs::Table::new(
+            "linearisation.csv",
+            &["re", "im", "error"],
+            self.motion
+                .eigenvalues
+                .iter()
+                .zip(&self.motion.errors)
+                .map(|(&(re, im), &e)| (re, im, e)),
+        )];
+        if let Some(sweep) = &self.sweep {
+            let rows = sweep
+                .speeds
+                .iter()
+                .zip(sweep.eigenvalues.iter().zip(&sweep.errors))
+                .flat_map(|(&v, (values, errors))| {
+                    values
+                        .iter()
+                        .zip(errors)
+                        .map(move |(&(re, im), &e)| (v, re, im, e))
+                });
+            let header = [self.speed.as_str(), "re", "im", "error"];
+            tables.push(crate::outputs::Table::new("eigenvalues.csv", &header, rows));
+        }
+        tables
+    }
+    fn lines(&self) -> Vec<String> {
+        let motion = &self.motion;
+        let values: Vec<String> = motion
+            .eigenvalues
+            .iter()
+            .zip(&motion.errors)
+            .map(|((re, im), e)| format!("{re:.12} {im:+.12}i ± {e:.1e}"))
+            .collect();
+        let mut lines = vec![
+            format!(
+                "{}: steady motion at {}' = {} (shape {}; reduced state {}): {}",
+                self.model,
+                self.speed,
+                self.at,
+                self.shape.join(", "),
+                motion.reduced.join(", "),
+                motion.verdict
+            ),
+            format!("eigenvalues: {}", values.join(", ")),
+        ];
+        if let Some(sweep) = &self.sweep {
+            lines.extend(sweep.boundaries.iter().map(|b| {
+                let side = if b.stable_above {
+                    "unstable below, not above"
+                } else {
+                    "unstable above, not below"
+                };
+                format!(
+                    "boundary at {}' = {:.12} ± {:.1e} ({side})",
+                    self.speed, b.speed, b.error
+                )
+            }));
+        }
+        lines
+    }
+}
