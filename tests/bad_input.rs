@@ -305,6 +305,12 @@ fn an_accuracy_below_the_precision_floor_is_refused_before_any_run() {
             run::<mechlab::analysis::continuation::ContinuationOptions>("duffing"),
         ),
         (
+            "steady_motion",
+            run::<mechlab::analysis::on_constraints::steady::study::SteadyMotionOptions>(
+                "chaplygin_sleigh",
+            ),
+        ),
+        (
             "section",
             run::<mechlab::analysis::section::SectionOptions>("henon_heiles"),
         ),

@@ -349,6 +349,13 @@ fn each_scene_gives_the_numbers_of_the_one_driver() {
     same_numbers::<averaging::AveragingOptions>("double_pendulum", &averaging, no, none);
     let linkage = [("scan", "6"), ("orbits", "2"), ("periods", "20")];
     same_numbers::<on_constraints::vibration::LinkageOptions>("four_bar", &linkage, no, none);
+    let steady = [("at", "0.5"), ("sweep", "11")];
+    same_numbers::<on_constraints::steady::study::SteadyMotionOptions>(
+        "chaplygin_sleigh",
+        &steady,
+        &[("b", 0.3)],
+        none,
+    );
     same_numbers::<stability::StabilityOptions>(
         "kapitza",
         &[("samples", "30")],

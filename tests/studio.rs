@@ -301,6 +301,37 @@ async fn the_mechanism_moves_with_its_bars_rigid() {
     );
 }
 
+/// The steady motion through the studio: Chaplygin's sleigh gliding
+/// backwards at u = −1 is unstable with the eigenvalue −m b u/(I + m b²)
+/// = 2/3 (the heading's rate); a coordinate the model lacks, or a model
+/// without constraints, is a 400 naming it.
+#[tokio::test]
+async fn the_steady_motion_is_the_sleigh_s_closed_form() {
+    let request = json!({"model": "chaplygin_sleigh", "speed": "auto", "at": -1.0, "sweep": 5});
+    let (status, _, body) = call("POST", "/api/steady_motion", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let value = answer["motion"]["eigenvalues"][0][0].as_f64().unwrap();
+    let error = answer["motion"]["errors"][0].as_f64().unwrap();
+    assert!((value - 2.0 / 3.0).abs() <= error, "{body}");
+    assert!(
+        answer["motion"]["verdict"]["unstable"].is_object(),
+        "{body}"
+    );
+    assert_eq!(answer["sweep"]["speeds"].as_array().unwrap().len(), 5);
+    let request = json!({"model": "chaplygin_sleigh", "speed": "z"});
+    let (status, _, body) = call("POST", "/api/steady_motion", Some(request)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
+    assert!(
+        body.contains("speed = z") && body.contains("no such coordinate"),
+        "{body}"
+    );
+    let request = json!({"model": "kapitza"});
+    let (status, _, body) = call("POST", "/api/steady_motion", Some(request)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
+    assert!(body.contains("[[constraints]]"), "{body}");
+}
+
 /// Each refinement of the streamed chaos map is the library's map of the
 /// same view, pixel for pixel.
 #[tokio::test]

@@ -219,6 +219,7 @@ async fn browser_seeds_orbits_and_sweeps_a_parameter() {
     sections_without_a_fast_phase(&client, &folder).await;
     a_slice_of_the_period_map(&client, &folder).await;
     the_mechanism_moves(&client, &folder).await;
+    the_steady_motion_panel(&client, &folder).await;
     the_basins_layer(&client, &folder).await;
     the_address_and_the_declared_defaults(&client, &studio).await;
     client.close().await.unwrap();
@@ -594,6 +595,46 @@ async fn the_mechanism_moves(client: &Client, folder: &std::path::Path) {
     assert_eq!(frames, serde_json::json!(601));
     let png = client.screenshot().await.unwrap();
     std::fs::write(folder.join("mechanism.png"), png).unwrap();
+}
+
+/// Chaplygin's sleigh: the button linearises its straight glide; the
+/// panel says the verdict and paints the sweep's boundary at u = 0 (the
+/// red line at the canvas's middle for the sweep −2 … 2).
+async fn the_steady_motion_panel(client: &Client, folder: &std::path::Path) {
+    select_model(client, "chaplygin_sleigh").await;
+    client
+        .execute(
+            "document.getElementById('steady-at').value = '1'; studio.runSteady(); return true;",
+            vec![],
+        )
+        .await
+        .unwrap();
+    let boundary = "studio.steady && studio.steady.sweep && (() => { \
+         const c = document.getElementById('steady'), g = c.getContext('2d'); \
+         const d = g.getImageData(Math.round(c.width / 2), 10, 1, 1).data; return d[0] > 150 && d[1] < 100; })()";
+    let note = read_when(
+        client,
+        boundary,
+        "return document.getElementById('steady-note').textContent;",
+        60,
+    )
+    .await;
+    let note = note.as_str().unwrap();
+    assert!(
+        note.contains("asymptotically stable") && note.contains("-0.66666667"),
+        "{note}"
+    );
+    // The panel's canvas as the page drew it (below the window's fold),
+    // as a PNG data address, with the note.
+    let url = client
+        .execute(
+            "return document.getElementById('steady').toDataURL();",
+            vec![],
+        )
+        .await
+        .unwrap();
+    let text = format!("{}\n{note}\n", url.as_str().unwrap());
+    std::fs::write(folder.join("steady_motion.txt"), text).unwrap();
 }
 
 /// Kapitza's period map from the library: its exact system at `params`

@@ -10,6 +10,7 @@ use mechlab::analysis::basins::Basins;
 use mechlab::analysis::chaos_map::{ChaosMap, ChaosMapSettings};
 use mechlab::analysis::continuation::Continuation;
 use mechlab::analysis::declared::Analysis;
+use mechlab::analysis::on_constraints::steady::study::SteadyStudy;
 use mechlab::analysis::on_constraints::vibration::Linkage;
 use mechlab::analysis::period_map::Portrait;
 use mechlab::analysis::section::SectionStudy;
@@ -128,6 +129,28 @@ pub fn linkage<'py>(py: Python<'py>, result: &Linkage) -> PyResult<Bound<'py, Py
         };
         dict.set_item("orbits", arrays(&orbits.exact))?;
         dict.set_item("averaged_orbits", arrays(&orbits.averaged))?;
+    }
+    Ok(dict)
+}
+
+/// A steady motion's linearisation: its summary, with `matrix` the
+/// linearisation as an array and, with a sweep, `sweep_eigenvalues` as a
+/// (speeds, eigenvalues) complex array.
+pub fn steady_motion<'py>(py: Python<'py>, result: &SteadyStudy) -> PyResult<Bound<'py, PyDict>> {
+    let dict = summary(py, result)?;
+    let m = &result.motion.matrix;
+    let matrix = Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]);
+    dict.set_item("matrix", matrix.into_pyarray(py))?;
+    if let Some(sweep) = &result.sweep {
+        let width = sweep.eigenvalues.iter().map(Vec::len).max().unwrap_or(0);
+        let values = Array2::from_shape_fn((sweep.speeds.len(), width), |(k, j)| {
+            sweep.eigenvalues[k]
+                .get(j)
+                .map_or(numpy::Complex64::new(f64::NAN, f64::NAN), |&(re, im)| {
+                    numpy::Complex64::new(re, im)
+                })
+        });
+        dict.set_item("sweep_eigenvalues", values.into_pyarray(py))?;
     }
     Ok(dict)
 }

@@ -18,6 +18,7 @@ use mechlab::analysis::basins::BasinsOptions;
 use mechlab::analysis::chaos_map::ChaosMapOptions;
 use mechlab::analysis::continuation::ContinuationOptions;
 use mechlab::analysis::declared::Analysis;
+use mechlab::analysis::on_constraints::steady::study::SteadyMotionOptions;
 use mechlab::analysis::on_constraints::vibration::LinkageOptions;
 use mechlab::analysis::period_map::PeriodMapOptions;
 use mechlab::analysis::section::SectionOptions;
@@ -416,11 +417,28 @@ impl PyModel {
         analyses::linkage(py, &result)
     }
 
+    /// The linearisation of a constrained model's steady motion (the
+    /// `steady_motion` scene): eigenvalues with their errors and verdict,
+    /// and against the speed with the stability boundaries. Settings: the
+    /// `steady_motion` declaration (`mechlab.schema()`).
+    #[pyo3(signature = (*, params=None, **settings))]
+    fn steady_motion<'py>(
+        &self,
+        py: Python<'py>,
+        params: Option<BTreeMap<String, f64>>,
+        settings: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let result = self.run::<SteadyMotionOptions>(py, params, settings, false)?;
+        analyses::steady_motion(py, &result)
+    }
+
     /// Stabilisation by vibration: for each equilibrium the averaged
     /// threshold a* and the exact window of Floquet stability (settings:
-    /// the `stability` declaration); a constrained model's equilibrium near
-    /// its start on its constraints (settings: the `linkage` declaration),
-    /// as the `stability` scene does.
+    /// the `stability` declaration). A constrained model's stability is on
+    /// its constraints, as the `stability` scene runs it: with a fast
+    /// phase, its equilibrium held by vibration (settings: the `linkage`
+    /// declaration); without, its steady motion (the `steady_motion`
+    /// declaration).
     #[pyo3(signature = (*, params=None, **settings))]
     fn stability<'py>(
         &self,
@@ -429,7 +447,10 @@ impl PyModel {
         settings: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if self.model.constrained.is_some() {
-            return self.linkage(py, params, settings);
+            return match self.model.info.amplitude {
+                Some(_) => self.linkage(py, params, settings),
+                None => self.steady_motion(py, params, settings),
+            };
         }
         let result = self.run::<StabilityOptions>(py, params, settings, false)?;
         analyses::stability(py, &result)

@@ -296,6 +296,23 @@ def numbers(value):
     return value
 
 
+class SteadyMotion(unittest.TestCase):
+    """A constrained model without a fast phase: `stability` is its steady
+    motion's linearisation. Chaplygin's sleigh gliding at speed u has the
+    one eigenvalue -m b u / (I + m b^2) (the heading's rate)."""
+
+    def test_the_sleigh_against_its_closed_form(self):
+        sleigh = mechlab.model("chaplygin_sleigh")
+        for u in (1.5, -0.5):
+            result = sleigh.stability(at=u, sweep=0)
+            (re, im), = result["motion"]["eigenvalues"]
+            exact = -1.0 * 0.5 * u / (0.5 + 1.0 * 0.5 ** 2)
+            self.assertLessEqual(abs(re - exact), result["motion"]["errors"][0])
+            self.assertEqual(im, 0.0)
+            self.assertEqual("unstable" in result["motion"]["verdict"], u < 0)
+            self.assertEqual(result["matrix"].shape, (1, 1))
+
+
 class SameNumbersAsTheScenes(unittest.TestCase):
     """Same settings, same numbers: Python and the scene of each analysis,
     field by field of the scene's summary."""
@@ -306,6 +323,7 @@ class SameNumbersAsTheScenes(unittest.TestCase):
                                "pixels": 40}, {}),
         ("averaging", "double_pendulum", {"values": "geometric:100,400,3", "t_obs": 1.0}, {}),
         ("linkage", "four_bar", {"scan": 6, "orbits": 2, "periods": 20}, {}),
+        ("steady_motion", "chaplygin_sleigh", {"at": 0.5, "sweep": 11}, {"b": 0.3}),
         ("stability", "kapitza", {"samples": 30}, {"eps": 0.2}),
         ("chaos_map", "kapitza", {"pixels": 6, "periods": 30}, {"A": 1.2}),
         ("basins", "duffing", {"pixels": 8, "transient": 40}, {}),

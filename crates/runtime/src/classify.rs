@@ -200,6 +200,7 @@ impl Classify for SteadyError {
                 BadValue
             }
             SteadyError::Motion(SteadyMotionError::Ode(e)) => e.class(),
+            SteadyError::Refused(r) => r.class(),
             SteadyError::Motion(_) | SteadyError::NoSpeed { .. } => ErrorClass::Refused,
         }
     }

@@ -17,6 +17,7 @@
 //! | `POST /api/section_map` | the MEGNO map of that section, JSON |
 //! | `POST /api/basins` | the basins of attraction of a view at growing resolutions, NDJSON |
 //! | `POST /api/mechanism` | the mechanism's frames from a seed, JSON |
+//! | `POST /api/steady_motion` | a constrained model's steady motion linearised (the `steady_motion` declaration), JSON |
 //!
 //! The numerics run on blocking threads; a streamed answer stops computing
 //! when the page drops it (a superseded request). Every error is a JSON
@@ -126,6 +127,7 @@ pub fn router(catalog: Catalog) -> Router {
         .route("/api/section", json_route(studio::section))
         .route("/api/section_map", json_route(studio::section_map))
         .route("/api/mechanism", json_route(studio::mechanism))
+        .route("/api/steady_motion", json_route(studio::steady_motion))
         .route("/api/basins", post(basins))
         .fallback(|uri: axum::http::Uri| async move {
             ApiError::NotFound {

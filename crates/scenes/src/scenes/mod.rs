@@ -24,7 +24,7 @@ pub use maps::{basins_scene, chaos_map_scene, frequency_map_scene};
 pub use orbits::{attractor_scene, explore_scene, period_map_scene};
 pub use section::section_scene;
 pub use separatrix::separatrix_scene;
-pub use stability::{linkage_scene, stability_scene};
+pub use stability::{linkage_scene, stability_scene, steady_motion_scene};
 pub use trade::trade_scene;
 
 /// The model of `catalog` named by `--set model=…` (or `default`), with a

@@ -19,16 +19,33 @@ pub fn linkage_scene(
     super::analysis_scene::<LinkageOptions>(catalog, scene_name, "four_bar", overrides)
 }
 
+/// The `steady_motion` scene: the linearisation of a constrained model's
+/// steady motion (Chaplygin's sleigh gliding straight by default): its
+/// eigenvalues with their errors and verdict, and against the speed.
+pub fn steady_motion_scene(
+    catalog: Catalog,
+    scene_name: &'static str,
+    overrides: &[(&'static str, &'static str)],
+) -> Result<(), SceneError> {
+    use mechlab_runtime::analysis::on_constraints::steady::study::SteadyMotionOptions;
+    super::analysis_scene::<SteadyMotionOptions>(catalog, scene_name, "chaplygin_sleigh", overrides)
+}
+
 /// The `stability` scene: stabilisation by vibration of any model's
-/// equilibria (a constrained model's on its constraints: the `linkage`
-/// scene), with `chart=x,y` the stability chart of one equilibrium in two
-/// parameters.
+/// equilibria, with `chart=x,y` the stability chart of one equilibrium in
+/// two parameters. A constrained model's stability is on its constraints:
+/// with a fast phase, its stabilisation by vibration (the `linkage`
+/// scene); without, the linearisation of its steady motion (the
+/// `steady_motion` scene).
 pub fn stability_scene(catalog: Catalog) -> Result<(), SceneError> {
     use mechlab_runtime::analysis::stability::{stability, StabilityOptions};
     let model = model_from_args(catalog, "kapitza")?;
     if model.constrained.is_some() {
         let overrides = [("model", model.info.name)];
-        return linkage_scene(catalog, "stability", &overrides);
+        return match model.info.amplitude {
+            Some(_) => linkage_scene(catalog, "stability", &overrides),
+            None => steady_motion_scene(catalog, "stability", &overrides),
+        };
     }
     let (model, scene, options) = declared_scene::<StabilityOptions>(
         catalog,

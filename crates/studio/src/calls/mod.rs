@@ -13,6 +13,7 @@ mod mechanism;
 mod orbit;
 mod overlay;
 mod section;
+mod steady;
 mod views;
 
 pub use continuation::*;
@@ -21,6 +22,7 @@ pub use mechanism::*;
 pub use orbit::*;
 pub use overlay::*;
 pub use section::*;
+pub use steady::*;
 pub use views::*;
 
 use mechlab_runtime::analysis::basins::{BasinSettings, BasinsOptions};
@@ -91,6 +93,9 @@ pub enum StudioError {
     Mechanism(#[from] mechlab_runtime::analysis::mechanism::MechanismError),
     #[error(transparent)]
     Basins(#[from] mechlab_runtime::analysis::basins::BasinsError),
+    /// A declared analysis run whole (the steady motion).
+    #[error(transparent)]
+    Analysis(Box<mechlab_runtime::analysis::declared::AnalysisError>),
 }
 
 /// The library's classes, and the studio's own errors as bad values.
@@ -109,6 +114,7 @@ impl mechlab_runtime::classify::Classify for StudioError {
             StudioError::Section(e) => e.class(),
             StudioError::Mechanism(e) => e.class(),
             StudioError::Basins(e) => e.class(),
+            StudioError::Analysis(e) => e.class(),
             StudioError::BadRequest { .. }
             | StudioError::NoSeed
             | StudioError::NoMap

@@ -215,6 +215,76 @@ function buildContinuation(model) {
   $("cont-list").innerHTML = "";
 }
 
+// ---------- steady motion (constrained models) ----------
+
+let steadyController = null;
+
+function buildSteady(model) {
+  $("steady-controls").style.display = model.kind === "constrained" ? "" : "none";
+  $("steady-speed").innerHTML = `<option value="auto">auto</option>` +
+    model.coordinates.map((c) => `<option value="${c}">${c}</option>`).join("");
+  $("steady-at").value = "";
+  studio.steady = null;
+  drawSteady();
+}
+
+async function runSteady() {
+  const speed = $("steady-speed").value;
+  const atText = $("steady-at").value.trim();
+  const at = atText === "" ? "auto" : Number(atText);
+  if (at !== "auto" && !Number.isFinite(at)) { say("steady motion: `at` is not a number"); return; }
+  if (steadyController) steadyController.abort();
+  steadyController = new AbortController();
+  say("linearising the steady motion …");
+  try {
+    const request = { model: studio.model.name, params: studio.params, speed, at, sweep: 81 };
+    const answer = await postJson("/api/steady_motion", request, steadyController.signal);
+    studio.steady = answer;
+    drawSteady();
+    const m = answer.motion;
+    const values = m.eigenvalues.map(([re, im], k) => `${re.toPrecision(8)}${im >= 0 ? "+" : "−"}${Math.abs(im).toPrecision(8)}i ± ${m.errors[k].toExponential(0)}`);
+    const shape = answer.shape.length ? `shape ${answer.shape.join(", ")}` : "no shape coordinate";
+    const verdict = typeof m.verdict === "string" ? m.verdict.replaceAll("_", " ") : Object.keys(m.verdict)[0].replaceAll("_", " ");
+    const bounds = (answer.sweep?.boundaries ?? []).map((b) => `${b.speed.toPrecision(10)} ± ${b.error.toExponential(0)}`);
+    $("steady-note").textContent = `${answer.speed}' = ${answer.at} (${shape}): ${verdict}; eigenvalues ${values.join(", ")}` +
+      (bounds.length ? `; boundaries at ${answer.speed}' = ${bounds.join(", ")}` : "");
+    say("");
+  } catch (e) {
+    if (!aborted(e)) { studio.steady = null; drawSteady(); say(`steady motion: ${e.message}`); }
+  }
+}
+
+studio.runSteady = () => runSteady();
+
+// The sweep's eigenvalues against the speed: Re blue, |Im| grey, zero
+// black, boundaries red, the speed linearised dashed.
+function drawSteady() {
+  const c = $("steady"), g = c.getContext("2d");
+  g.clearRect(0, 0, c.width, c.height);
+  const sweep = studio.steady?.sweep;
+  if (!sweep) return;
+  const speeds = sweep.speeds;
+  const points = sweep.eigenvalues.flatMap((values, k) => values.map(([re, im]) => [speeds[k], re, Math.abs(im)]));
+  const x0 = Math.min(...speeds), x1 = Math.max(...speeds);
+  const top = Math.max(0, ...points.map((p) => Math.max(p[1], p[2])));
+  const bottom = Math.max(-10, Math.min(0, ...points.map((p) => p[1])));
+  const pad = 0.05 * Math.max(top - bottom, 1e-3);
+  const px = (x) => 4 + (x - x0) / (x1 - x0 || 1) * (c.width - 8);
+  const py = (y) => c.height - 4 - (y - bottom + pad) / (top - bottom + 2 * pad) * (c.height - 8);
+  g.strokeStyle = "#000"; g.beginPath(); g.moveTo(px(x0), py(0)); g.lineTo(px(x1), py(0)); g.stroke();
+  for (const [x, re, im] of points) {
+    g.fillStyle = "#999"; g.fillRect(px(x) - 1, py(im) - 1, 2, 2);
+    g.fillStyle = "#1f5fbf"; g.fillRect(px(x) - 1, py(re) - 1, 2, 2);
+  }
+  g.strokeStyle = "#c62828";
+  for (const b of sweep.boundaries) { g.beginPath(); g.moveTo(px(b.speed), 0); g.lineTo(px(b.speed), c.height); g.stroke(); }
+  g.setLineDash([3, 3]); g.strokeStyle = "#555";
+  g.beginPath(); g.moveTo(px(studio.steady.at), 0); g.lineTo(px(studio.steady.at), c.height); g.stroke();
+  g.setLineDash([]);
+  g.fillStyle = "#333"; g.font = "11px sans-serif";
+  g.fillText(`${x0.toPrecision(3)} … ${x1.toPrecision(3)}: rate of ${studio.steady.speed}`, 6, c.height - 6);
+}
+
 function drawManifolds(g) {
   g.lineWidth = 1.2;
   for (const [curve, color] of [["unstable", "rgba(200, 30, 30, 0.9)"], ["stable", "rgba(30, 60, 200, 0.9)"]]) {
@@ -884,6 +954,7 @@ async function chooseModel(name, address = new URLSearchParams()) {
   buildAxes(model);
   buildContinuation(model);
   buildSection(model);
+  buildSteady(model);
   $("order").disabled = !model.fast_phase;
   // A constrained model of more than 6 coordinates has no Taylor
   // recurrences: its orbits run with DOP853.
@@ -1012,6 +1083,7 @@ function exportCsv() {
 
 function wire() {
   $("model").addEventListener("change", () => chooseModel($("model").value));
+  $("steady-run").addEventListener("click", runSteady);
   $("undo").addEventListener("click", () => removeOrbits(studio.orbits.length - 1));
   $("clear").addEventListener("click", () => removeOrbits(0));
   $("reset-view").addEventListener("click", () => { defaultView(studio.model); redraw(); refreshOverlays(); });

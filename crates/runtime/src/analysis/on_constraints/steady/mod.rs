@@ -185,7 +185,7 @@ pub fn steady_motion(
     let matrix = DMatrix::from_fn(kept.len(), kept.len(), |i, j| full[(kept[i], kept[j])]);
     let all_names = reduced_names(names, shape, &held);
     let reduced = kept.iter().map(|&k| all_names[k].clone()).collect();
-    let (eigenvalues, errors) = spectrum::eigenvalues_with_errors(&matrix);
+    let (eigenvalues, errors) = spectrum::eigenvalues_with_errors(&matrix, field.amax());
     let verdict = Verdict::of(&eigenvalues, &errors);
     Ok(SteadyMotion {
         state,
@@ -448,10 +448,10 @@ pub fn speed_sweep(
                 b = middle;
             }
         }
-        let speed = 0.5 * (a + b);
+        let (speed, error) = crossing(&at, 0.5 * (a + b))?;
         boundaries.push(Boundary {
             speed,
-            error: (b - a).abs() + crossing_error(&at, speed)?,
+            error: error + (b - a).abs(),
             stable_above: unstable_at_a == (speeds[k] > speeds[k - 1]),
         });
     }
@@ -463,28 +463,38 @@ pub fn speed_sweep(
     })
 }
 
-/// How far a boundary at `speed` may be from the true one: the error of
-/// the real part that crosses there over that real part's slope.
-fn crossing_error(
+/// The boundary near `speed`, where the verdict changes (a real part at
+/// its error): moved by a secant step to where that real part is 0, and
+/// how far it may be from the true one (the real part's error over its
+/// slope there).
+fn crossing(
     at: &dyn Fn(f64) -> Result<SteadyMotion, SteadyMotionError>,
     speed: f64,
-) -> Result<f64, SteadyMotionError> {
+) -> Result<(f64, f64), SteadyMotionError> {
     let h = 1e-6 * (1.0 + speed.abs());
-    let (below, above) = (at(speed - h)?, at(speed + h)?);
-    let crossing = |m: &SteadyMotion| {
+    let nearest_axis = |m: &SteadyMotion| {
         m.eigenvalues
             .iter()
             .zip(&m.errors)
             .min_by(|p, q| p.0 .0.abs().total_cmp(&q.0 .0.abs()))
             .map_or((0.0, 0.0), |(v, e)| (v.0, *e))
     };
-    let ((low, e_low), (high, e_high)) = (crossing(&below), crossing(&above));
-    let slope = (high - low).abs() / (2.0 * h);
-    Ok(if slope > 0.0 {
-        e_low.max(e_high) / slope
+    let (here, below, above) = (at(speed)?, at(speed - h)?, at(speed + h)?);
+    let ((re, error), (low, _), (high, _)) = (
+        nearest_axis(&here),
+        nearest_axis(&below),
+        nearest_axis(&above),
+    );
+    let slope = (high - low) / (2.0 * h);
+    // A crossing the slope resolves (a real part through zero, not the
+    // square root of a pair meeting on the axis) moves to its zero.
+    if slope.abs() > 0.0 && (re / slope).abs() < h {
+        Ok((speed - re / slope, error / slope.abs()))
+    } else if slope.abs() > 0.0 {
+        Ok((speed, error / slope.abs()))
     } else {
-        f64::INFINITY
-    })
+        Ok((speed, f64::INFINITY))
+    }
 }
 
 impl SpeedSweep {
@@ -513,6 +523,8 @@ impl SpeedSweep {
             .iter()
             .chain(&real)
             .fold(0.0_f64, |m, p| m.max(p.1));
+        let bottom = real.iter().fold(0.0_f64, |m, p| m.min(p.1)).max(-10.0);
+        let margin = 0.05 * (top - bottom).max(1e-3);
         let mut figure = Figure::single(
             900,
             560,
@@ -521,7 +533,7 @@ impl SpeedSweep {
                 speed_label,
                 "eigenvalues: Re (blue), |Im| (grey)",
                 x,
-                (-10.0, top.max(1.0)),
+                (bottom - margin, top + margin),
             ),
         );
         figure.points(0, imaginary, GREY, 2);
@@ -532,11 +544,11 @@ impl SpeedSweep {
             .iter()
             .map(|b| {
                 let side = if b.stable_above {
-                    "stable above"
+                    "unstable below, not above"
                 } else {
-                    "unstable above"
+                    "unstable above, not below"
                 };
-                (format!("{:.9} ({side})", b.speed), RED)
+                (format!("{:.9} ± {:.0e} ({side})", b.speed, b.error), RED)
             })
             .collect();
         if !legend.is_empty() {

@@ -3,7 +3,8 @@
 //!
 //! A is exact to rounding (the field's Jacobian by dual numbers, the
 //! constraints solved by an SVD), so its error is taken as
-//! δ = 64 ε ‖A‖_F. A simple eigenvalue then moves by at most about
+//! δ = 64 ε max(‖A‖_F, s), s the size of the entries A was made from (the
+//! field's Jacobian: A may be small or zero by cancellation). A simple eigenvalue then moves by at most about
 //! κ δ, with κ = ‖x‖ ‖y‖ / |yᴴx| its condition number (x, y its right and
 //! left eigenvectors, found by inverse iteration). A defective pair (a
 //! Jordan block of two, such as the zero of a neighbouring steady motion)
@@ -14,15 +15,15 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 /// The eigenvalues (re, im) of `a` by decreasing real part, and each one's
-/// error bound.
-pub fn eigenvalues_with_errors(a: &DMatrix<f64>) -> (Vec<(f64, f64)>, Vec<f64>) {
+/// error bound; `made_from`: the size of the entries `a` was computed from.
+pub fn eigenvalues_with_errors(a: &DMatrix<f64>, made_from: f64) -> (Vec<(f64, f64)>, Vec<f64>) {
     let mut values: Vec<(f64, f64)> = a
         .complex_eigenvalues()
         .iter()
         .map(|z| (z.re, z.im))
         .collect();
     values.sort_by(|p, q| q.0.total_cmp(&p.0).then(p.1.total_cmp(&q.1)));
-    let norm = a.norm();
+    let norm = a.norm().max(made_from);
     let delta = 64.0 * f64::EPSILON * norm.max(f64::MIN_POSITIVE);
     let cap = 2.0 * (delta * norm.max(f64::MIN_POSITIVE)).sqrt();
     let errors = values
@@ -145,7 +146,7 @@ mod tests {
             1.0 / (1.0 + i as f64 + 2.0 * j as f64) + if i == j { 1.0 } else { 0.0 }
         });
         let a = &t * d * t.clone().try_inverse().unwrap();
-        let (values, errors) = eigenvalues_with_errors(&a);
+        let (values, errors) = eigenvalues_with_errors(&a, 0.0);
         for ((value, error), exact) in values.iter().zip(&errors).zip([2.0, 0.5, -1.0, -3.0]) {
             let missed = (value.0 - exact).hypot(value.1);
             assert!(
@@ -155,7 +156,7 @@ mod tests {
         }
         // A Jordan block of two at 0, rounded: the split is within the cap.
         let jordan = DMatrix::from_row_slice(2, 2, &[1e-17, 1.0, 1e-16, 0.0]);
-        let (values, errors) = eigenvalues_with_errors(&jordan);
+        let (values, errors) = eigenvalues_with_errors(&jordan, 0.0);
         for (value, error) in values.iter().zip(&errors) {
             assert!(value.0.hypot(value.1) <= *error, "{value:?}: {error:e}");
         }

@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::{
     speed_sweep, steady_motion, SpeedSweep, SteadyMotion, SteadyMotionError, SteadySettings,
 };
+use crate::analysis::Refusal;
 use crate::registry::ConstrainedSystems;
 use crate::settings::{Declared, Range, SettingError};
 
@@ -36,8 +37,14 @@ crate::declare_settings! {
         shape: Option<Vec<String>> = None, Range::Any;
         /// Speeds in the sweep (0: none).
         sweep: usize = 101, Range::Count { min: 0, max: 100_000 };
-        /// The sweep's first and last speed (auto: −2|at| to 2|at|).
+        /// The sweep's first and last speed (auto: from −2 to 2 times `at`).
         sweep_range: Option<[f64; 2]> = None, Range::Any;
+        /// The error wanted on the eigenvalues (auto: none asked; each
+        /// comes with its error). The linearisation is exact to rounding,
+        /// so nothing can tighten it: the result says whether the errors
+        /// are within it, and a request below double precision's reach is
+        /// refused.
+        accuracy: Option<f64> = None, Range::Positive;
     }
 }
 
@@ -55,6 +62,8 @@ pub struct SteadyStudy {
     /// constraints leave them free.
     pub held: Vec<String>,
     pub motion: SteadyMotion,
+    /// With an `accuracy`, whether every eigenvalue's error is within it.
+    pub accuracy: Option<String>,
     pub sweep: Option<SpeedSweep>,
 }
 
@@ -65,6 +74,8 @@ pub enum SteadyError {
     Motion(#[from] SteadyMotionError),
     #[error(transparent)]
     Setting(#[from] SettingError),
+    #[error(transparent)]
+    Refused(#[from] Refusal),
     /// No coordinate's rate gives a steady motion from the start: the
     /// last coordinate tried and why.
     #[error("model '{model}': no coordinate's rate gives a steady motion from the model file's start (name one with `speed`); the last tried, '{tried}': {reason}")]
@@ -149,6 +160,21 @@ pub fn steady_study(
         }
     };
     let at = rate_at(speed);
+    let accuracy = match options.accuracy {
+        None => None,
+        Some(wanted) => {
+            let magnitude = motion.matrix.amax();
+            Refusal::accuracy_within_reach(info.name, "the eigenvalues", Some(wanted), magnitude)?;
+            let worst = motion.errors.iter().fold(0.0_f64, |m, e| m.max(*e));
+            Some(if worst <= wanted {
+                format!(
+                    "accuracy {wanted:e} reached: every eigenvalue's error is at most {worst:.1e}"
+                )
+            } else {
+                format!("accuracy {wanted:e} NOT reached: an eigenvalue's error is {worst:.1e} (ill-conditioned; the linearisation is already exact to rounding)")
+            })
+        }
+    };
     let sweep = match options.sweep {
         0 => None,
         count => {
@@ -178,6 +204,7 @@ pub fn steady_study(
             .map(|&(i, _)| names[i].to_string())
             .collect(),
         motion,
+        accuracy,
         sweep,
     })
 }
@@ -235,15 +262,25 @@ fn found(
     unreachable!("each pass adds a coordinate to the shape or the held rates")
 }
 
+impl SteadyStudy {
+    /// The shape for titles: its coordinates, or that it has none.
+    fn shape_text(&self) -> String {
+        match self.shape.is_empty() {
+            true => "no shape coordinate".into(),
+            false => format!("shape {}", self.shape.join(", ")),
+        }
+    }
+}
+
 impl crate::outputs::Outputs for SteadyStudy {
     fn figures(&self) -> Vec<(String, crate::plot::Figure)> {
         let Some(sweep) = &self.sweep else {
             return Vec::new();
         };
         let title = format!(
-            "{}: linearised eigenvalues of the steady motion (shape {})",
+            "{}: linearised eigenvalues of the steady motion ({})",
             self.model,
-            self.shape.join(", ")
+            self.shape_text()
         );
         let label = format!("rate of {}", self.speed);
         vec![("eigenvalues.png".into(), sweep.figure(&title, &label))]
@@ -284,16 +321,17 @@ impl crate::outputs::Outputs for SteadyStudy {
             .collect();
         let mut lines = vec![
             format!(
-                "{}: steady motion at {}' = {} (shape {}; reduced state {}): {}",
+                "{}: steady motion at {}' = {} ({}; reduced state {}): {}",
                 self.model,
                 self.speed,
                 self.at,
-                self.shape.join(", "),
+                self.shape_text(),
                 motion.reduced.join(", "),
                 motion.verdict
             ),
             format!("eigenvalues: {}", values.join(", ")),
         ];
+        lines.extend(self.accuracy.clone());
         if let Some(sweep) = &self.sweep {
             lines.extend(sweep.boundaries.iter().map(|b| {
                 let side = if b.stable_above {
