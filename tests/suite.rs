@@ -26,6 +26,7 @@ mod indicators;
 mod integrators;
 mod mechanism;
 mod model_errors;
+mod rattleback;
 mod report;
 mod runtime;
 mod scene_output;

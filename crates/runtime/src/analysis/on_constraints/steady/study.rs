@@ -134,46 +134,12 @@ pub fn steady_study(
             let speed = index(name, "speed")?;
             (speed, find(speed)?)
         }
-        None => {
-            let mut last = None;
-            let mut result = None;
-            for speed in (0..n).filter(|i| shape.as_ref().is_none_or(|s| !s.contains(i))) {
-                match find(speed) {
-                    Ok(found) => {
-                        result = Some((speed, found));
-                        break;
-                    }
-                    Err(e) => last = Some((speed, e)),
-                }
-            }
-            match (result, last) {
-                (Some(found), _) => found,
-                (None, Some((tried, reason))) => {
-                    return Err(SteadyError::NoSpeed {
-                        model: info.name,
-                        tried: names[tried].into(),
-                        reason: Box::new(reason),
-                    })
-                }
-                (None, None) => unreachable!("a model has coordinates"),
-            }
-        }
+        None => first_speed(model, shape.as_deref(), &find)?,
     };
     let at = rate_at(speed);
     let accuracy = match options.accuracy {
         None => None,
-        Some(wanted) => {
-            let magnitude = motion.matrix.amax();
-            Refusal::accuracy_within_reach(info.name, "the eigenvalues", Some(wanted), magnitude)?;
-            let worst = motion.errors.iter().fold(0.0_f64, |m, e| m.max(*e));
-            Some(if worst <= wanted {
-                format!(
-                    "accuracy {wanted:e} reached: every eigenvalue's error is at most {worst:.1e}"
-                )
-            } else {
-                format!("accuracy {wanted:e} NOT reached: an eigenvalue's error is {worst:.1e} (ill-conditioned; the linearisation is already exact to rounding)")
-            })
-        }
+        Some(wanted) => Some(accuracy_reached(info.name, &motion, wanted)?),
     };
     let sweep = match options.sweep {
         0 => None,
@@ -209,10 +175,53 @@ pub fn steady_study(
     })
 }
 
+/// What [`found`] finds: the shape, the held rates (the speed first) and
+/// the linearisation.
+type Found = (Vec<usize>, Vec<(usize, f64)>, SteadyMotion);
+
+/// The first coordinate (outside a given shape) whose rate `find` turns
+/// into a steady motion, with what it found; or the last refusal.
+fn first_speed(
+    model: &dyn ConstrainedSystems,
+    shape: Option<&[usize]>,
+    find: &dyn Fn(usize) -> Result<Found, SteadyMotionError>,
+) -> Result<(usize, Found), SteadyError> {
+    let names = model.info().coordinates;
+    let mut last = None;
+    for speed in (0..names.len()).filter(|i| shape.is_none_or(|s| !s.contains(i))) {
+        match find(speed) {
+            Ok(found) => return Ok((speed, found)),
+            Err(e) => last = Some((speed, e)),
+        }
+    }
+    let (tried, reason) = last.expect("a model has coordinates outside its shape");
+    Err(SteadyError::NoSpeed {
+        model: model.info().name,
+        tried: names[tried].into(),
+        reason: Box::new(reason),
+    })
+}
+
+/// Whether every eigenvalue's error is within `wanted` (refused below
+/// what double precision resolves on the linearisation's entries).
+fn accuracy_reached(
+    model: &'static str,
+    motion: &SteadyMotion,
+    wanted: f64,
+) -> Result<String, Refusal> {
+    let magnitude = motion.matrix.amax();
+    Refusal::accuracy_within_reach(model, "the eigenvalues", Some(wanted), magnitude)?;
+    let worst = motion.errors.iter().fold(0.0_f64, |m, e| m.max(*e));
+    Ok(if worst <= wanted {
+        format!("accuracy {wanted:e} reached: every eigenvalue's error is at most {worst:.1e}")
+    } else {
+        format!("accuracy {wanted:e} NOT reached: an eigenvalue's error is {worst:.1e} (ill-conditioned; the linearisation is already exact to rounding)")
+    })
+}
+
 /// The linearisation with the speed held, the shape given or found and
 /// every rate the constraints leave free held at its start value (see the
 /// module's comment).
-#[allow(clippy::type_complexity)]
 fn found(
     model: &dyn ConstrainedSystems,
     params: &[f64],
@@ -220,7 +229,7 @@ fn found(
     start_rates: &[f64],
     given_shape: Option<Vec<usize>>,
     mut held: Vec<(usize, f64)>,
-) -> Result<(Vec<usize>, Vec<(usize, f64)>, SteadyMotion), SteadyMotionError> {
+) -> Result<Found, SteadyMotionError> {
     let names = model.info().coordinates;
     let searching = given_shape.is_none();
     let mut shape = given_shape.unwrap_or_default();
