@@ -93,7 +93,7 @@ fn the_self_stable_range_is_the_benchmarks() {
         "weave {:.12} m/s, capsize {:.12} m/s",
         weave.speed, capsize.speed
     );
-    assert!(weave.stable_above && !capsize.stable_above);
+    assert!(weave.unstable_below && !capsize.unstable_below);
     assert!(
         (weave.speed - WEAVE_SPEED).abs() < 1e-8,
         "weave speed {weave:?}"
@@ -298,7 +298,7 @@ fn a_sleigh_glides_stably_forwards_and_not_backwards() {
             panic!("one boundary, not {:?}", sweep.boundaries);
         };
         assert!(
-            boundary.stable_above && boundary.speed.abs() <= boundary.error + 1e-12,
+            boundary.unstable_below && boundary.speed.abs() <= boundary.error + 1e-12,
             "{boundary:?}"
         );
     }

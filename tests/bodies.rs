@@ -323,3 +323,64 @@ fn a_free_body_in_euler_parameters_follows_eulers_equations_through_its_flips() 
     }
     assert!(r.largest_residual.0 < 1e-12, "{:?}", r.largest_residual);
 }
+
+/// The steady precessions by name (`steady_motion`, a model without
+/// constraints): given Ω and the spin's rate ψ', the analysis finds the
+/// tilt θ₀ = 0.5 of the quadratic by Newton's method (the shape θ, the
+/// cyclic φ and ψ found by itself), and its linearisation nods at the
+/// frequency of the Routhian written here, U(θ) = (p_φ − p_ψ cos θ)²/
+/// (2A sin²θ) + m g l cos θ at the motion's p_φ, p_ψ: ω² = U''(θ₀)/A. The
+/// motion is conservative, so the verdict is that the first order cannot
+/// decide, with both roots on the imaginary axis.
+#[test]
+fn the_steady_precessions_nod_at_the_routhians_frequency() {
+    use mechlab::analysis::declared::{no_progress, Analysis};
+    use mechlab::analysis::on_constraints::steady::{study::SteadyMotionOptions, Verdict};
+    let [m, l, a, c, g] = PARAMS;
+    let (theta, spin) = (0.5_f64, 3.0);
+    let (qa, qb, qc) = (a * theta.cos(), -c * spin, m * g * l);
+    let root = (qb * qb - 4.0 * qa * qc).sqrt();
+    for omega in [(-qb - root) / (2.0 * qa), (-qb + root) / (2.0 * qa)] {
+        let psi_rate = spin - omega * theta.cos();
+        let options = SteadyMotionOptions {
+            at: Some(omega),
+            rates: Some(vec![omega, 0.0, psi_rate]),
+            start: Some(vec![0.0, 0.45, 0.0]),
+            sweep: 0,
+            ..Default::default()
+        };
+        let study = options.run(top(), &PARAMS, &no_progress).unwrap();
+        assert_eq!(
+            (study.speed.as_str(), &study.shape[..]),
+            ("phi", &["theta".to_string()][..])
+        );
+        let found = study.motion.state[1];
+        assert!((found - theta).abs() < 1e-9, "Ω = {omega}: θ₀ = {found}");
+        let (p_phi, p_psi) = (
+            a * omega * theta.sin().powi(2) + c * spin * theta.cos(),
+            c * spin,
+        );
+        let u = |t: f64| {
+            (p_phi - p_psi * t.cos()).powi(2) / (2.0 * a * t.sin().powi(2)) + m * g * l * t.cos()
+        };
+        let h = 1e-4;
+        let u2 = (u(theta + h) - 2.0 * u(theta) + u(theta - h)) / (h * h);
+        let nodding = (u2 / a).sqrt();
+        let motion = &study.motion;
+        println!(
+            "Ω = {omega}: {:?} ± {:?} against ±{nodding}i",
+            motion.eigenvalues, motion.errors
+        );
+        for ((re, im), e) in motion.eigenvalues.iter().zip(&motion.errors) {
+            assert!(re.abs() <= *e, "Ω = {omega}: {re} ± {e}");
+            assert!(
+                (im.abs() - nodding).abs() < 1e-6 * nodding,
+                "Ω = {omega}: {im} against {nodding}"
+            );
+        }
+        assert_eq!(
+            motion.verdict,
+            Verdict::InconclusiveAtFirstOrder { on_axis: 2 }
+        );
+    }
+}

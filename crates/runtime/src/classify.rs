@@ -201,7 +201,9 @@ impl Classify for SteadyError {
             }
             SteadyError::Motion(SteadyMotionError::Ode(e)) => e.class(),
             SteadyError::Refused(r) => r.class(),
-            SteadyError::Motion(_) | SteadyError::NoSpeed { .. } => ErrorClass::Refused,
+            SteadyError::Motion(_) | SteadyError::NoSpeed { .. } | SteadyError::NoCyclic { .. } => {
+                ErrorClass::Refused
+            }
         }
     }
     fn integration_stop(&self) -> Option<&OdeError> {

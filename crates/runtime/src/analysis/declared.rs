@@ -204,14 +204,7 @@ impl Analysis for SteadyMotionOptions {
         values: &[f64],
         _: Progress,
     ) -> Result<Self::Output, AnalysisError> {
-        let Some(constrained) = model.constrained else {
-            return Err(Refusal::Setting {
-                model: model.info.name.into(),
-                requirement: "steady_motion runs on a model with [[constraints]] in its file (the equilibria of the others: `explore`, `stability`)",
-            }
-            .into());
-        };
-        Ok(steady_study(constrained, values, self)?)
+        Ok(steady_study(model, values, self)?)
     }
 }
 

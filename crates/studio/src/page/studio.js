@@ -220,7 +220,8 @@ function buildContinuation(model) {
 let steadyController = null;
 
 function buildSteady(model) {
-  $("steady-controls").style.display = model.kind === "constrained" ? "" : "none";
+  const applies = model.kind === "constrained" || (model.kind === "hamiltonian" && !model.fast_phase);
+  $("steady-controls").style.display = applies ? "" : "none";
   $("steady-speed").innerHTML = `<option value="auto">auto</option>` +
     model.coordinates.map((c) => `<option value="${c}">${c}</option>`).join("");
   $("steady-at").value = "";

@@ -17,6 +17,7 @@
 //! linearised constraints C S = 0 for the dependent components (chosen
 //! among the others by pivoting), and P picks the rates of r.
 
+pub mod free;
 pub mod spectrum;
 pub mod study;
 
@@ -60,6 +61,14 @@ pub enum SteadyMotionError {
     Ode(#[from] OdeError),
     #[error("model '{model}': the steady motion needs {what}")]
     Setting { model: &'static str, what: String },
+    /// No state on the constraints with the shape and speeds given.
+    #[error(
+        "model '{model}': no state on the constraints with the shape and speeds given: {source}"
+    )]
+    OffConstraints {
+        model: &'static str,
+        source: crate::ode::holonomic::ConstraintError,
+    },
     /// The constraints do not fix the other components from the shape and
     /// the held speeds.
     #[error("model '{model}': the constraints do not determine '{coordinate}' or its rate from the shape and the held speeds: hold its speed or add it to the shape")]
@@ -67,7 +76,8 @@ pub enum SteadyMotionError {
         model: &'static str,
         coordinate: String,
     },
-    /// The state is not steady: a shape coordinate accelerates.
+    /// The state is not steady: a shape coordinate or a held speed
+    /// accelerates.
     #[error("model '{model}': the state is not a steady motion: '{coordinate}'' = {acceleration:e} (at most {tolerance:e})")]
     NotSteady {
         model: &'static str,
@@ -75,9 +85,13 @@ pub enum SteadyMotionError {
         acceleration: f64,
         tolerance: f64,
     },
-    /// Moving a coordinate outside the shape changes the shape's motion,
+    /// No steady state near the guess (a model without constraints, whose
+    /// shape is looked for by Newton's method).
+    #[error("model '{model}': no steady motion near the start at these rates: Newton's method {why}; give `start` nearer one, or other rates")]
+    NotFound { model: &'static str, why: String },
+    /// Moving a coordinate outside the shape changes the reduced motion,
     /// so the shape alone does not describe the motion's stability.
-    #[error("model '{model}': moving '{coordinate}' changes the shape's accelerations by {effect:e} per unit: add it to the shape")]
+    #[error("model '{model}': moving '{coordinate}' changes the rates of the shape and the held speeds by {effect:e} per unit: add it to the shape")]
     NotSymmetric {
         model: &'static str,
         coordinate: String,
@@ -226,12 +240,12 @@ fn steady_state(
         .flat_map(|&i| [i, n + i])
         .chain(settings.held.iter().map(|&(i, _)| n + i))
         .collect();
-    model
-        .consistent(params, &mut y, &held)
-        .map_err(|e| SteadyMotionError::Setting {
+    model.consistent(params, &mut y, &held).map_err(|source| {
+        SteadyMotionError::OffConstraints {
             model: model.info().name,
-            what: format!("a state on the constraints with the shape and speeds given ({e})"),
-        })?;
+            source,
+        }
+    })?;
     Ok(y)
 }
 
@@ -385,6 +399,9 @@ pub struct SpeedSweep {
     pub eigenvalues: Vec<Vec<(f64, f64)>>,
     /// Their errors.
     pub errors: Vec<Vec<f64>>,
+    /// The speeds asked for where the motion is not steady (a family of
+    /// steady motions that ends: a top too slow to precess steadily).
+    pub without_steady_motion: Vec<f64>,
     /// Where the motion turns unstable or stops being so (an eigenvalue's
     /// real part above its error) between two of the speeds, located by
     /// bisection to 1e-12 (relative to the speed): the family's stability
@@ -399,9 +416,9 @@ pub struct Boundary {
     /// Its error: the bisection's bracket and the real part's error over
     /// its slope there.
     pub error: f64,
-    /// Whether the motion is unstable just below this speed (and not just
-    /// above it), or the other way round.
-    pub stable_above: bool,
+    /// Whether the motion is unstable just below this speed and not just
+    /// above it (else the other way round).
+    pub unstable_below: bool,
 }
 
 /// [`steady_motion`] at each of `speeds`, the first held speed of
@@ -429,17 +446,35 @@ pub fn speed_sweep(
         };
         steady_motion(model, params, &settings)
     };
-    let motions = speeds
-        .iter()
-        .map(|&v| at(v))
-        .collect::<Result<Vec<_>, _>>()?;
+    sweep_with(&at, speeds)
+}
+
+/// The linearisations `at` each of `speeds` and the stability boundaries
+/// between them; a speed where the motion is not steady (a family of
+/// steady motions that ends) is listed, not linearised.
+pub fn sweep_with(
+    at: &dyn Fn(f64) -> Result<SteadyMotion, SteadyMotionError>,
+    speeds: &[f64],
+) -> Result<SpeedSweep, SteadyMotionError> {
+    let mut kept = Vec::new();
+    let mut without_steady_motion = Vec::new();
+    for &v in speeds {
+        match at(v) {
+            Ok(motion) => kept.push((v, motion)),
+            Err(SteadyMotionError::NotSteady { .. } | SteadyMotionError::NotFound { .. }) => {
+                without_steady_motion.push(v)
+            }
+            Err(e) => return Err(e),
+        }
+    }
     let mut boundaries = Vec::new();
-    for k in 1..speeds.len() {
-        let unstable_at_a = motions[k - 1].verdict.is_unstable();
-        if unstable_at_a == motions[k].verdict.is_unstable() {
+    for pair in kept.windows(2) {
+        let ((low, below), (high, above)) = (&pair[0], &pair[1]);
+        let unstable_at_a = below.verdict.is_unstable();
+        if unstable_at_a == above.verdict.is_unstable() {
             continue;
         }
-        let (mut a, mut b) = (speeds[k - 1], speeds[k]);
+        let (mut a, mut b) = (*low, *high);
         while (b - a).abs() > 1e-12 * (1.0 + a.abs().max(b.abs())) {
             let middle = 0.5 * (a + b);
             if at(middle)?.verdict.is_unstable() == unstable_at_a {
@@ -448,17 +483,18 @@ pub fn speed_sweep(
                 b = middle;
             }
         }
-        let (speed, error) = crossing(&at, 0.5 * (a + b))?;
+        let (speed, error) = crossing(at, 0.5 * (a + b))?;
         boundaries.push(Boundary {
             speed,
             error: error + (b - a).abs(),
-            stable_above: unstable_at_a == (speeds[k] > speeds[k - 1]),
+            unstable_below: unstable_at_a == (high > low),
         });
     }
     Ok(SpeedSweep {
-        speeds: speeds.to_vec(),
-        eigenvalues: motions.iter().map(|m| m.eigenvalues.clone()).collect(),
-        errors: motions.iter().map(|m| m.errors.clone()).collect(),
+        speeds: kept.iter().map(|k| k.0).collect(),
+        eigenvalues: kept.iter().map(|k| k.1.eigenvalues.clone()).collect(),
+        errors: kept.iter().map(|k| k.1.errors.clone()).collect(),
+        without_steady_motion,
         boundaries,
     })
 }
@@ -543,7 +579,7 @@ impl SpeedSweep {
             .boundaries
             .iter()
             .map(|b| {
-                let side = if b.stable_above {
+                let side = if b.unstable_below {
                     "unstable below, not above"
                 } else {
                     "unstable above, not below"

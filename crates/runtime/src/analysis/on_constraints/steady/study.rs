@@ -14,24 +14,33 @@
 use serde::Serialize;
 
 use super::{
-    speed_sweep, steady_motion, SpeedSweep, SteadyMotion, SteadyMotionError, SteadySettings,
+    free, speed_sweep, steady_motion, sweep_with, SpeedSweep, SteadyMotion, SteadyMotionError,
+    SteadySettings,
 };
 use crate::analysis::Refusal;
-use crate::registry::ConstrainedSystems;
+use crate::registry::{ConstrainedSystems, Kind, Model};
 use crate::settings::{Declared, Range, SettingError};
 
 crate::declare_settings! {
-    /// The linearisation of a steady motion of a constrained model (a
-    /// bicycle riding upright, a sleigh gliding straight, a disk rolling
-    /// upright): the eigenvalues with their errors and the verdict at one
+    /// The linearisation of a steady motion (a bicycle riding upright, a
+    /// sleigh gliding straight, a disk rolling upright, a top precessing
+    /// steadily): the eigenvalues with their errors and the verdict at one
     /// speed, then against the speed with the stability boundaries.
     pub struct SteadyMotionOptions for "steady_motion" {
         /// The coordinate whose rate is the family's speed (auto: the
         /// first for which a steady motion is found).
         speed: Option<String> = None, Range::Any;
-        /// That rate on the motion linearised (auto: its start velocity in
-        /// the model file, or 1 where that is 0).
+        /// That rate on the motion linearised (auto: its value in `rates`,
+        /// or 1 where that is 0).
         at: Option<f64> = None, Range::Any;
+        /// The coordinates' rates on the motion, the speed's replaced by
+        /// `at` and the shape's by 0 (auto: all 0): a top's spin.
+        rates: Option<Vec<f64>> = None, Range::Any;
+        /// The configuration (auto: the model file's start; without
+        /// constraints 0.3, 0.5, 0.7, …). A constrained model's is taken as
+        /// it is; a model without constraints has its shape moved from it
+        /// by Newton's method until the motion is steady.
+        start: Option<Vec<f64>> = None, Range::Any;
         /// The shape: the coordinates that stay still along the motion and
         /// on which its equations depend (auto: found by moving each).
         shape: Option<Vec<String>> = None, Range::Any;
@@ -76,6 +85,10 @@ pub enum SteadyError {
     Setting(#[from] SettingError),
     #[error(transparent)]
     Refused(#[from] Refusal),
+    /// A model without constraints whose every coordinate moves its
+    /// equations: no cyclic coordinate to advance.
+    #[error("model '{model}': every coordinate moves the model's equations: no cyclic coordinate's rate can be a steady motion's speed")]
+    NoCyclic { model: &'static str },
     /// No coordinate's rate gives a steady motion from the start: the
     /// last coordinate tried and why.
     #[error("model '{model}': no coordinate's rate gives a steady motion from the model file's start (name one with `speed`); the last tried, '{tried}': {reason}")]
@@ -86,15 +99,24 @@ pub enum SteadyError {
     },
 }
 
+/// A family of steady motions found: its speed, shape and held rates,
+/// the linearisation at `at`, and the sweep.
+struct Family {
+    speed: usize,
+    shape: Vec<usize>,
+    held: Vec<usize>,
+    motion: SteadyMotion,
+    sweep: Option<SpeedSweep>,
+}
+
 /// The steady-motion analysis of `options` on `model`.
 pub fn steady_study(
-    model: &dyn ConstrainedSystems,
+    model: &'static Model,
     params: &[f64],
     options: &SteadyMotionOptions,
 ) -> Result<SteadyStudy, SteadyError> {
-    let info = model.info();
+    let info = model.info;
     let names = info.coordinates;
-    let n = names.len();
     let index = |name: &str, setting: &'static str| {
         names
             .iter()
@@ -116,61 +138,194 @@ pub fn steady_study(
         ),
         None => None,
     };
-    let start = model.start(params);
-    let q = &start[..n];
-    let rate_at = |i: usize| {
-        options.at.unwrap_or(if start[n + i] != 0.0 {
-            start[n + i]
-        } else {
-            1.0
-        })
-    };
-    let find = |speed: usize| {
-        let held = vec![(speed, rate_at(speed))];
-        found(model, params, q, &start[n..], shape.clone(), held)
-    };
-    let (speed, (shape, held, motion)) = match &options.speed {
-        Some(name) => {
-            let speed = index(name, "speed")?;
-            (speed, find(speed)?)
+    let speed = options
+        .speed
+        .as_deref()
+        .map(|s| index(s, "speed"))
+        .transpose()?;
+    for (name, given) in [("rates", &options.rates), ("start", &options.start)] {
+        if let Some(values) = given.as_ref().filter(|v| v.len() != names.len()) {
+            return Err(SettingError::OutOfRange {
+                analysis: SteadyMotionOptions::ANALYSIS,
+                name,
+                value: format!("{values:?}"),
+                range: format!("one value per coordinate ({})", names.join(", ")),
+            }
+            .into());
         }
-        None => first_speed(model, shape.as_deref(), &find)?,
+    }
+    let rates = options
+        .rates
+        .clone()
+        .unwrap_or_else(|| vec![0.0; names.len()]);
+    let at_of = |i: usize| {
+        options
+            .at
+            .unwrap_or(if rates[i] != 0.0 { rates[i] } else { 1.0 })
     };
-    let at = rate_at(speed);
+    let speeds = |at: f64| -> Vec<f64> {
+        let [first, last] = options
+            .sweep_range
+            .unwrap_or([-2.0 * at.abs(), 2.0 * at.abs()]);
+        let count = options.sweep;
+        (0..count)
+            .map(|k| first + (last - first) * k as f64 / (count.max(2) - 1) as f64)
+            .collect()
+    };
+    let family = match (model.constrained, model.dynamic.kind()) {
+        (Some(constrained), _) => {
+            constrained_family(constrained, params, options, (shape, speed), &rates, &at_of, &speeds)?
+        }
+        (None, Kind::Hamiltonian { fast_phase: true, .. }) => {
+            return Err(Refusal::Setting {
+                model: info.name.into(),
+                requirement: "steady_motion runs on a model whose equations do not change with time (this one has a fast phase: its stabilisation is `stability`)",
+            }
+            .into())
+        }
+        (None, Kind::Hamiltonian { .. }) => {
+            free_family(model, params, options, (shape, speed), &rates, &at_of, &speeds)?
+        }
+        (None, _) => {
+            return Err(Refusal::Setting {
+                model: info.name.into(),
+                requirement: "steady_motion runs on a model with a Lagrangian (a contact model's motions are not smooth)",
+            }
+            .into())
+        }
+    };
+    let at = at_of(family.speed);
     let accuracy = match options.accuracy {
         None => None,
-        Some(wanted) => Some(accuracy_reached(info.name, &motion, wanted)?),
-    };
-    let sweep = match options.sweep {
-        0 => None,
-        count => {
-            let [first, last] = options
-                .sweep_range
-                .unwrap_or([-2.0 * at.abs(), 2.0 * at.abs()]);
-            let speeds: Vec<f64> = (0..count)
-                .map(|k| first + (last - first) * k as f64 / (count.max(2) - 1) as f64)
-                .collect();
-            let mut held = held.clone();
-            held[0].1 = 1.0; // the sweep scales the speed's rate
-            let settings = SteadySettings {
-                q,
-                shape: &shape,
-                held: &held,
-            };
-            Some(speed_sweep(model, params, &settings, &speeds)?)
-        }
+        Some(wanted) => Some(accuracy_reached(info.name, &family.motion, wanted)?),
     };
     Ok(SteadyStudy {
         model: info.name,
-        speed: names[speed].into(),
+        speed: names[family.speed].into(),
         at,
-        shape: shape.iter().map(|&i| names[i].to_string()).collect(),
-        held: held[1..]
-            .iter()
-            .map(|&(i, _)| names[i].to_string())
-            .collect(),
-        motion,
+        shape: family.shape.iter().map(|&i| names[i].to_string()).collect(),
+        held: family.held.iter().map(|&i| names[i].to_string()).collect(),
+        motion: family.motion,
         accuracy,
+        sweep: family.sweep,
+    })
+}
+
+/// A constrained model's family: its configuration as given, the shape
+/// and the rates to hold found from the refusals ([`found`]).
+fn constrained_family(
+    model: &dyn ConstrainedSystems,
+    params: &[f64],
+    options: &SteadyMotionOptions,
+    (shape, speed): (Option<Vec<usize>>, Option<usize>),
+    rates: &[f64],
+    at_of: &dyn Fn(usize) -> f64,
+    speeds: &dyn Fn(f64) -> Vec<f64>,
+) -> Result<Family, SteadyError> {
+    let n = model.info().coordinates.len();
+    let q = options
+        .start
+        .clone()
+        .unwrap_or_else(|| model.start(params)[..n].to_vec());
+    let find = |speed: usize| {
+        let held = vec![(speed, at_of(speed))];
+        found(model, params, &q, rates, shape.clone(), held)
+    };
+    let (speed, (shape, held, motion)) = match speed {
+        Some(speed) => (speed, find(speed)?),
+        None => first_speed(model, shape.as_deref(), &find)?,
+    };
+    let sweep = match options.sweep {
+        0 => None,
+        _ => {
+            let mut held = held.clone();
+            held[0].1 = 1.0; // the sweep scales the speed's rate
+            let settings = SteadySettings {
+                q: &q,
+                shape: &shape,
+                held: &held,
+            };
+            Some(speed_sweep(
+                model,
+                params,
+                &settings,
+                &speeds(at_of(speed)),
+            )?)
+        }
+    };
+    Ok(Family {
+        speed,
+        held: held[1..].iter().map(|h| h.0).collect(),
+        shape,
+        motion,
+        sweep,
+    })
+}
+
+/// A model without constraints: the shape the coordinates its equations
+/// depend on, the speed the first cyclic one, the shape moved by Newton's
+/// method until steady ([`free::free_steady_motion`]); the sweep follows
+/// the family from each speed's motion to the next.
+fn free_family(
+    model: &Model,
+    params: &[f64],
+    options: &SteadyMotionOptions,
+    (shape, speed): (Option<Vec<usize>>, Option<usize>),
+    rates: &[f64],
+    at_of: &dyn Fn(usize) -> f64,
+    speeds: &dyn Fn(f64) -> Vec<f64>,
+) -> Result<Family, SteadyError> {
+    let n = model.info.coordinates.len();
+    let guess = options
+        .start
+        .clone()
+        .unwrap_or_else(|| (0..n).map(|i| 0.3 + 0.2 * i as f64).collect());
+    let shape = match shape {
+        Some(shape) => shape,
+        None => {
+            let probe = free::with_rates(model, params, &guess, rates)?;
+            free::dependent_coordinates(model, params, &probe)?
+        }
+    };
+    let Some(speed) = speed.or_else(|| (0..n).find(|i| !shape.contains(i))) else {
+        return Err(SteadyError::NoCyclic {
+            model: model.info.name,
+        });
+    };
+    let rates_at = |v: f64| {
+        let mut r = rates.to_vec();
+        r[speed] = v;
+        shape.iter().for_each(|&i| r[i] = 0.0);
+        r
+    };
+    let motion = free::free_steady_motion(model, params, &guess, &rates_at(at_of(speed)), &shape)?;
+    let sweep = match options.sweep {
+        0 => None,
+        _ => {
+            // From the last speed's motion, else from the motion at `at`
+            // (a family that ended on the way may go on past a gap).
+            let anchor = motion.state[..n].to_vec();
+            let last = std::cell::RefCell::new(anchor.clone());
+            let at = |v: f64| {
+                let from_last = last.borrow().clone();
+                let found =
+                    free::free_steady_motion(model, params, &from_last, &rates_at(v), &shape)
+                        .or_else(|_| {
+                            free::free_steady_motion(model, params, &anchor, &rates_at(v), &shape)
+                        })?;
+                *last.borrow_mut() = found.state[..n].to_vec();
+                Ok(found)
+            };
+            Some(sweep_with(&at, &speeds(at_of(speed)))?)
+        }
+    };
+    Ok(Family {
+        speed,
+        held: (0..n)
+            .filter(|i| *i != speed && !shape.contains(i))
+            .collect(),
+        shape,
+        motion,
         sweep,
     })
 }
@@ -343,7 +498,7 @@ impl crate::outputs::Outputs for SteadyStudy {
         lines.extend(self.accuracy.clone());
         if let Some(sweep) = &self.sweep {
             lines.extend(sweep.boundaries.iter().map(|b| {
-                let side = if b.stable_above {
+                let side = if b.unstable_below {
                     "unstable below, not above"
                 } else {
                     "unstable above, not below"
