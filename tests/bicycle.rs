@@ -355,3 +355,78 @@ fn the_analysis_by_name_finds_the_disk_s_tilt() {
         );
     }
 }
+
+/// `steady_motion` on every model file of `models/`, at its defaults: a
+/// linearisation whose verdict follows from its eigenvalues and errors,
+/// whose eigenvalues sum to its matrix's trace and whose shape stands
+/// still, or a typed refusal that names the model. Never a panic or NaN.
+#[test]
+fn steady_motion_runs_on_every_model_or_says_why_not() {
+    use mechlab::analysis::declared::{no_progress, Analysis};
+    use mechlab::analysis::on_constraints::steady::study::SteadyMotionOptions;
+    use mechlab::analysis::on_constraints::steady::Verdict;
+    let options = SteadyMotionOptions {
+        sweep: 5,
+        ..Default::default()
+    };
+    let mut linearised = 0;
+    for info in mechlab::models::ALL {
+        let model = mechlab::models::by_name(info.name).unwrap();
+        match options.run(model, &model.dynamic.defaults(), &no_progress) {
+            Ok(study) => {
+                let motion = &study.motion;
+                assert_eq!(
+                    motion.eigenvalues.len(),
+                    motion.reduced.len(),
+                    "{}",
+                    info.name
+                );
+                let values = motion.eigenvalues.iter().flat_map(|v| [v.0, v.1]);
+                assert!(
+                    values
+                        .chain(motion.errors.iter().copied())
+                        .all(f64::is_finite),
+                    "{}: {:?}",
+                    info.name,
+                    motion.eigenvalues
+                );
+                assert_eq!(
+                    motion.verdict,
+                    Verdict::of(&motion.eigenvalues, &motion.errors)
+                );
+                let trace = motion.matrix.trace();
+                let sum: f64 = motion.eigenvalues.iter().map(|v| v.0).sum();
+                let bound: f64 = motion.errors.iter().sum::<f64>() + 1e-12 * (1.0 + trace.abs());
+                assert!(
+                    (trace - sum).abs() <= bound,
+                    "{}: trace {trace}, Σλ {sum}",
+                    info.name
+                );
+                let n = info.coordinates.len();
+                for name in &study.shape {
+                    let i = info.coordinates.iter().position(|c| c == name).unwrap();
+                    // A constrained model's state is [q; q']: the shape's rate is 0.
+                    if model.constrained.is_some() {
+                        assert!(motion.state[n + i].abs() < 1e-12, "{}: {name}'", info.name);
+                    }
+                }
+                linearised += 1;
+                println!(
+                    "{}: {} ({} eigenvalues)",
+                    info.name,
+                    motion.verdict,
+                    motion.eigenvalues.len()
+                );
+            }
+            Err(e) => {
+                let text = e.to_string();
+                println!("{}: refused: {text}", info.name);
+                assert!(
+                    text.contains(info.name),
+                    "the refusal names the model: {text}"
+                );
+            }
+        }
+    }
+    assert!(linearised > 0, "no model's steady motion was linearised");
+}

@@ -1296,3 +1296,65 @@ fn parallel_cranks_with_a_redundant_bar_swing_as_one_pendulum() {
         other => panic!("the turn should stop at the singular position: {other:?}"),
     }
 }
+
+/// The IFToMM benchmark library's simple pendulum (A01), in units where
+/// g = l = m = 1 (its 10 s at g = 9.81 m/s² are 31.3 units): a point on a
+/// rod in Cartesian coordinates (`cartesian_kapitza` with its pivot
+/// still), released at rest with the rod horizontal. Every half period
+/// 2K(1/√2) it is at rest with the rod horizontal again, on alternate
+/// sides: its positions there against that closed form, its energy and
+/// its constraint over the benchmark's span.
+#[test]
+fn the_iftomm_simple_pendulum_is_horizontal_at_each_half_period() {
+    let model = cartesian_kapitza::MODEL.constrained.unwrap();
+    let params = [0.0, 0.1, 0.0]; // A (the pivot still), ε, μ
+                                  // K(k) = π / (2 agm(1, √(1 − k²))), k² = 1/2.
+    let (mut a, mut b) = (1.0_f64, 0.5_f64.sqrt());
+    for _ in 0..8 {
+        (a, b) = ((a + b) / 2.0, (a * b).sqrt());
+    }
+    let half_period = std::f64::consts::PI / a; // 2K
+    let span = 10.0 * 9.81_f64.sqrt();
+    let crossings = (span / half_period) as usize;
+    let times: Vec<f64> = (0..=crossings).map(|j| j as f64 * half_period).collect();
+    let y0 = [1.0, 0.0, 0.0, 0.0];
+    let started = std::time::Instant::now();
+    let result = run(
+        model,
+        &params,
+        Some(&y0),
+        Method::Dop853 {
+            rtol: 1e-13,
+            atol: 1e-13,
+        },
+        &times,
+    )
+    .unwrap();
+    let seconds = started.elapsed().as_secs_f64();
+    let mut worst: f64 = 0.0;
+    for (j, state) in result.states.iter().enumerate() {
+        let side = if j % 2 == 0 { 1.0 } else { -1.0 };
+        let missed = [(state[0] - side), state[1], state[2], state[3]]
+            .iter()
+            .fold(0.0_f64, |m, e| m.max(e.abs()));
+        worst = worst.max(missed);
+    }
+    let drift = result
+        .energy
+        .iter()
+        .fold(0.0_f64, |m, e| m.max((e - result.energy[0]).abs()));
+    println!(
+        "{crossings} half periods of {half_period}: largest miss {worst:e}, energy {drift:e}, residuals {:?}, {} steps, {seconds:.4} s",
+        result.largest_residual, result.steps
+    );
+    assert!(
+        worst < 1e-9,
+        "positions and rates at the half periods: {worst:e}"
+    );
+    assert!(drift < 1e-10, "energy drift {drift:e}");
+    assert!(
+        result.largest_residual.0 < 1e-12,
+        "{:?}",
+        result.largest_residual
+    );
+}

@@ -417,8 +417,8 @@ impl PyModel {
         analyses::linkage(py, &result)
     }
 
-    /// The linearisation of a constrained model's steady motion (the
-    /// `steady_motion` scene): eigenvalues with their errors and verdict,
+    /// The linearisation of a steady motion (the `steady_motion` scene; a
+    /// model with constraints or without, not with a fast phase): eigenvalues with their errors and verdict,
     /// and against the speed with the stability boundaries. Settings: the
     /// `steady_motion` declaration (`mechlab.schema()`).
     #[pyo3(signature = (*, params=None, **settings))]

@@ -196,18 +196,6 @@ impl Analysis for LinkageOptions {
     }
 }
 
-impl Analysis for SteadyMotionOptions {
-    type Output = crate::analysis::on_constraints::steady::study::SteadyStudy;
-    fn run(
-        &self,
-        model: &'static Model,
-        values: &[f64],
-        _: Progress,
-    ) -> Result<Self::Output, AnalysisError> {
-        Ok(steady_study(model, values, self)?)
-    }
-}
-
 impl Analysis for ExploreOptions {
     type Output = crate::explore::Exploration;
     fn run(
@@ -248,4 +236,5 @@ without_progress! {
     AttractorOptions => crate::analysis::attractor::Attractor: |o, model, values| attractor(model, values, &o.resolve()?);
     AveragingOptions => crate::analysis::averaging::AveragingConvergence: |o, model, values| convergence(model, values, &o.resolve()?);
     PeriodMapOptions => crate::analysis::period_map::Portrait: |o, model, values| portrait(model, values, &o.resolve(model)?);
+    SteadyMotionOptions => crate::analysis::on_constraints::steady::study::SteadyStudy: |o, model, values| steady_study(model, values, o);
 }

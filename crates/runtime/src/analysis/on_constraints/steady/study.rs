@@ -87,7 +87,7 @@ pub enum SteadyError {
     Refused(#[from] Refusal),
     /// A model without constraints whose every coordinate moves its
     /// equations: no cyclic coordinate to advance.
-    #[error("model '{model}': every coordinate moves the model's equations: no cyclic coordinate's rate can be a steady motion's speed")]
+    #[error("model '{model}': every coordinate moves the model's equations: no cyclic coordinate's rate can be a steady motion's speed (its equilibria: `explore`)")]
     NoCyclic { model: &'static str },
     /// No coordinate's rate gives a steady motion from the start: the
     /// last coordinate tried and why.
@@ -179,7 +179,7 @@ pub fn steady_study(
         (None, Kind::Hamiltonian { fast_phase: true, .. }) => {
             return Err(Refusal::Setting {
                 model: info.name.into(),
-                requirement: "steady_motion runs on a model whose equations do not change with time (this one has a fast phase: its stabilisation is `stability`)",
+                requirement: "steady_motion needs equations that do not change with time, and this model has a fast phase (its periodic orbits: `continuation`, `stability`)",
             }
             .into())
         }
@@ -189,7 +189,7 @@ pub fn steady_study(
         (None, _) => {
             return Err(Refusal::Setting {
                 model: info.name.into(),
-                requirement: "steady_motion runs on a model with a Lagrangian (a contact model's motions are not smooth)",
+                requirement: "steady_motion does not run on a contact model (its motions switch between sticking and slipping)",
             }
             .into())
         }
