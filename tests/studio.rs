@@ -319,6 +319,37 @@ async fn the_steady_motion_is_the_sleigh_s_closed_form() {
         "{body}"
     );
     assert_eq!(answer["sweep"]["speeds"].as_array().unwrap().len(), 5);
+    // The heavy top hanging and precessing at Ω = 2 without spin (the
+    // studio's rates and start): cos θ₀ = −m g l/((A − C) Ω²) = −1/4, and
+    // it nods at √(U''(θ₀)/A) of the Routhian written here.
+    let request = json!({"model": "heavy_top", "speed": "phi", "at": 2.0,
+        "rates": [2.0, 0.0, 0.0], "start": [0.0, 1.5, 0.0], "sweep": 0});
+    let (status, _, body) = call("POST", "/api/steady_motion", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let answer: Value = serde_json::from_str(&body).unwrap();
+    let theta = answer["motion"]["state"][1].as_f64().unwrap();
+    assert!((theta.cos() + 0.25).abs() < 1e-9, "θ₀ = {theta}");
+    let (a, c, omega) = (2.0, 1.0, 2.0);
+    let spin = omega * theta.cos();
+    let (p_phi, p_psi) = (
+        a * omega * theta.sin().powi(2) + c * spin * theta.cos(),
+        c * spin,
+    );
+    let u = |t: f64| (p_phi - p_psi * t.cos()).powi(2) / (2.0 * a * t.sin().powi(2)) + t.cos();
+    let h = 1e-4;
+    let nodding = ((u(theta + h) - 2.0 * u(theta) + u(theta - h)) / (h * h) / a).sqrt();
+    let im = answer["motion"]["eigenvalues"][0][1]
+        .as_f64()
+        .unwrap()
+        .abs();
+    assert!(
+        (im - nodding).abs() < 1e-6 * nodding,
+        "{im} against {nodding}"
+    );
+    let request = json!({"model": "heavy_top", "rates": [1.0, "x", 0.0]});
+    let (status, _, body) = call("POST", "/api/steady_motion", Some(request)).await;
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");
+    assert!(body.contains("rates"), "{body}");
     let request = json!({"model": "chaplygin_sleigh", "speed": "z"});
     let (status, _, body) = call("POST", "/api/steady_motion", Some(request)).await;
     assert_eq!(status, StatusCode::BAD_REQUEST, "{body}");

@@ -46,10 +46,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..Default::default()
         };
         let linear = options.run(&rattleback::MODEL, &params, &no_progress)?;
-        println!(
-            "spun at {spin:+}: {} (eigenvalues {:?})",
-            linear.motion.verdict, linear.motion.eigenvalues
-        );
+        println!("spun at {spin:+}: {}", linear.motion.verdict);
+        for ((re, im), e) in linear.motion.eigenvalues.iter().zip(&linear.motion.errors) {
+            println!("  eigenvalue {re:.9} {im:+.9}i ± {e:.1e}");
+        }
         let mut y0 = vec![0.0; 10];
         (y0[3], y0[7]) = (0.005, spin);
         let result = run(

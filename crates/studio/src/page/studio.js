@@ -225,6 +225,8 @@ function buildSteady(model) {
   $("steady-speed").innerHTML = `<option value="auto">auto</option>` +
     model.coordinates.map((c) => `<option value="${c}">${c}</option>`).join("");
   $("steady-at").value = "";
+  $("steady-rates").value = "";
+  $("steady-start").value = "";
   studio.steady = null;
   drawSteady();
 }
@@ -238,7 +240,13 @@ async function runSteady() {
   steadyController = new AbortController();
   say("linearising the steady motion …");
   try {
-    const request = { model: studio.model.name, params: studio.params, speed, at, sweep: 81 };
+    // Empty lists are the declaration's auto; the library checks the rest.
+    const list = (id) => {
+      const text = $(id).value.trim();
+      return text === "" ? "auto" : text.split(",").map(Number);
+    };
+    const request = { model: studio.model.name, params: studio.params, speed, at,
+      rates: list("steady-rates"), start: list("steady-start"), sweep: 81 };
     const answer = await postJson("/api/steady_motion", request, steadyController.signal);
     studio.steady = answer;
     drawSteady();
