@@ -312,6 +312,19 @@ class SteadyMotion(unittest.TestCase):
             self.assertEqual("unstable" in result["motion"]["verdict"], u < 0)
             self.assertEqual(result["matrix"].shape, (1, 1))
 
+    def test_a_top_without_constraints_finds_its_tilt(self):
+        # The heavy top hanging and precessing at 2 without spin: the tilt
+        # found by Newton's method solves (A - C) W^2 cos(theta) + m g l = 0,
+        # cos(theta) = -1/4 at the defaults (A = 2, C = m = g = l = 1).
+        top = mechlab.model("heavy_top")
+        result = top.steady_motion(speed="phi", at=2.0, rates=(2.0, 0.0, 0.0),
+                                   start=(0.0, 1.5, 0.0), sweep=0)
+        self.assertEqual(result["shape"], ["theta"])
+        self.assertAlmostEqual(math.cos(result["motion"]["state"][1]), -0.25, places=9)
+        for (re, im), error in zip(result["motion"]["eigenvalues"], result["motion"]["errors"]):
+            self.assertLessEqual(abs(re), error)
+            self.assertGreater(abs(im), 1.0)
+
 
 class SameNumbersAsTheScenes(unittest.TestCase):
     """Same settings, same numbers: Python and the scene of each analysis,
