@@ -99,6 +99,20 @@ pub enum SteadyError {
     },
 }
 
+/// What both kinds of model's families are found from: the parameters,
+/// the settings, the shape and speed given (None: to be found), the
+/// rates, the speed's rate on the motion linearised (by coordinate) and
+/// the sweep's speeds (around that rate).
+struct Request<'a> {
+    params: &'a [f64],
+    options: &'a SteadyMotionOptions,
+    shape: Option<Vec<usize>>,
+    speed: Option<usize>,
+    rates: &'a [f64],
+    at_of: &'a dyn Fn(usize) -> f64,
+    speeds: &'a dyn Fn(f64) -> Vec<f64>,
+}
+
 /// A family of steady motions found: its speed, shape and held rates,
 /// the linearisation at `at`, and the sweep.
 struct Family {
@@ -172,9 +186,18 @@ pub fn steady_study(
             .map(|k| first + (last - first) * k as f64 / (count.max(2) - 1) as f64)
             .collect()
     };
+    let request = Request {
+        params,
+        options,
+        shape,
+        speed,
+        rates: &rates,
+        at_of: &at_of,
+        speeds: &speeds,
+    };
     let family = match (model.constrained, model.dynamic.kind()) {
         (Some(constrained), _) => {
-            constrained_family(constrained, params, options, (shape, speed), &rates, &at_of, &speeds)?
+            constrained_family(constrained, &request)?
         }
         (None, Kind::Hamiltonian { fast_phase: true, .. }) => {
             return Err(Refusal::Setting {
@@ -184,7 +207,7 @@ pub fn steady_study(
             .into())
         }
         (None, Kind::Hamiltonian { .. }) => {
-            free_family(model, params, options, (shape, speed), &rates, &at_of, &speeds)?
+            free_family(model, &request)?
         }
         (None, _) => {
             return Err(Refusal::Setting {
@@ -215,13 +238,10 @@ pub fn steady_study(
 /// and the rates to hold found from the refusals ([`found`]).
 fn constrained_family(
     model: &dyn ConstrainedSystems,
-    params: &[f64],
-    options: &SteadyMotionOptions,
-    (shape, speed): (Option<Vec<usize>>, Option<usize>),
-    rates: &[f64],
-    at_of: &dyn Fn(usize) -> f64,
-    speeds: &dyn Fn(f64) -> Vec<f64>,
+    request: &Request,
 ) -> Result<Family, SteadyError> {
+    let (params, options, at_of) = (request.params, request.options, request.at_of);
+    let (shape, speed) = (request.shape.clone(), request.speed);
     let n = model.info().coordinates.len();
     let q = options
         .start
@@ -229,7 +249,7 @@ fn constrained_family(
         .unwrap_or_else(|| model.start(params)[..n].to_vec());
     let find = |speed: usize| {
         let held = vec![(speed, at_of(speed))];
-        found(model, params, &q, rates, shape.clone(), held)
+        found(model, params, &q, request.rates, shape.clone(), held)
     };
     let (speed, (shape, held, motion)) = match speed {
         Some(speed) => (speed, find(speed)?),
@@ -249,7 +269,7 @@ fn constrained_family(
                 model,
                 params,
                 &settings,
-                &speeds(at_of(speed)),
+                &(request.speeds)(at_of(speed)),
             )?)
         }
     };
@@ -266,17 +286,12 @@ fn constrained_family(
 /// depend on, the speed the first cyclic one, the shape moved by Newton's
 /// method until steady ([`free::free_steady_motion`]); the sweep follows
 /// the family from each speed's motion to the next.
-fn free_family(
-    model: &Model,
-    params: &[f64],
-    options: &SteadyMotionOptions,
-    (shape, speed): (Option<Vec<usize>>, Option<usize>),
-    rates: &[f64],
-    at_of: &dyn Fn(usize) -> f64,
-    speeds: &dyn Fn(f64) -> Vec<f64>,
-) -> Result<Family, SteadyError> {
+fn free_family(model: &Model, request: &Request) -> Result<Family, SteadyError> {
+    let (params, at_of, rates) = (request.params, request.at_of, request.rates);
+    let shape = request.shape.clone();
     let n = model.info.coordinates.len();
-    let guess = options
+    let guess = request
+        .options
         .start
         .clone()
         .unwrap_or_else(|| (0..n).map(|i| 0.3 + 0.2 * i as f64).collect());
@@ -287,7 +302,10 @@ fn free_family(
             free::dependent_coordinates(model, params, &probe)?
         }
     };
-    let Some(speed) = speed.or_else(|| (0..n).find(|i| !shape.contains(i))) else {
+    let Some(speed) = request
+        .speed
+        .or_else(|| (0..n).find(|i| !shape.contains(i)))
+    else {
         return Err(SteadyError::NoCyclic {
             model: model.info.name,
         });
@@ -299,7 +317,7 @@ fn free_family(
         r
     };
     let motion = free::free_steady_motion(model, params, &guess, &rates_at(at_of(speed)), &shape)?;
-    let sweep = match options.sweep {
+    let sweep = match request.options.sweep {
         0 => None,
         _ => {
             // From the last speed's motion, else from the motion at `at`
@@ -316,7 +334,7 @@ fn free_family(
                 *last.borrow_mut() = found.state[..n].to_vec();
                 Ok(found)
             };
-            Some(sweep_with(&at, &speeds(at_of(speed)))?)
+            Some(sweep_with(&at, &(request.speeds)(at_of(speed)))?)
         }
     };
     Ok(Family {
