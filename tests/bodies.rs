@@ -126,6 +126,42 @@ fn the_released_heavy_top_nods_with_lagrange_cubics_period_and_amplitude() {
 /// R_z(α)ᵀ diag(I₁, I₂, I₃) R_z(α) with the rotation sequence continued by
 /// Z(alpha) gives the same Lagrangian at random states (to rounding), and
 /// the tensor with its products' sign flipped does not.
+/// The top is drawn as its frame: its z axis from its centre points
+/// along the centre's position l (sin θ sin φ, −sin θ cos φ, cos θ)
+/// written in the model file (the rotation Z(φ) X(θ) Z(ψ) turns the axis
+/// there), sqrt(tr I / 2m) = sqrt((2(A − m l²) + C)/2m) long, and the
+/// tip stays at the origin, joined to the centre.
+#[test]
+fn the_top_is_drawn_along_its_axis() {
+    use mechlab::analysis::mechanism::{animate, Frames};
+    let [m, l, a, c, _] = PARAMS;
+    let start = state(0.5, 0.3, 0.2, 4.0);
+    let frames = Frames {
+        duration: 5.0,
+        count: 51,
+    };
+    let method = Method::parse("dop853", TIGHT).unwrap();
+    let animation = animate(top(), &PARAMS, method, &start, &[], frames).unwrap();
+    assert!(animation.in_space);
+    assert_eq!(animation.up, [0.0, 0.0, 1.0], "against gravity (0, 0, −g)");
+    let length = ((2.0 * (a - m * l * l) + c) / (2.0 * m)).sqrt();
+    let [centre, _, _, z] = animation.body_frames[0];
+    let tip = animation.points.iter().position(|&p| p == "tip").unwrap();
+    assert_eq!(animation.bars, &[[centre, tip]]);
+    for (t, points) in animation.times.iter().zip(&animation.frames) {
+        assert_eq!(points[tip], [0.0; 3]);
+        for k in 0..3 {
+            let along = points[centre][k] / l * length;
+            assert!(
+                (points[z][k] - points[centre][k] - along).abs() < 1e-14,
+                "t = {t}: the z axis {:?} from the centre {:?}",
+                points[z],
+                points[centre]
+            );
+        }
+    }
+}
+
 #[test]
 fn an_inertia_tensor_with_products_is_the_principal_body_turned() {
     use mechlab_model::Model;
@@ -322,6 +358,38 @@ fn a_free_body_in_euler_parameters_follows_eulers_equations_through_its_flips() 
         }
     }
     assert!(r.largest_residual.0 < 1e-12, "{:?}", r.largest_residual);
+    // The drawing's frame is the body's orientation R(e): the angular
+    // momentum R I ω in the fixed frame is conserved with it (a frame
+    // turned the other way, Rᵀ, would not conserve it). The axes are
+    // drawn sqrt(tr I / 2m) = √3 long.
+    let drawing = free_body_quaternion::INFO.drawing.unwrap();
+    let momentum = |y: &[f64]| -> [f64; 3] {
+        let (e, d) = (&y[..4], &y[4..]);
+        let body = [
+            2.0 * (-e[1] * d[0] + e[0] * d[1] + e[3] * d[2] - e[2] * d[3]),
+            2.0 * (-e[2] * d[0] - e[3] * d[1] + e[0] * d[2] + e[1] * d[3]),
+            2.0 * (-e[3] * d[0] + e[2] * d[1] - e[1] * d[2] + e[0] * d[3]),
+        ];
+        let points = (drawing.at)(0.0, &y[..4], &moments);
+        let [centre, ax, ay, az] = drawing.body_frames[0];
+        std::array::from_fn(|k| {
+            [ax, ay, az]
+                .iter()
+                .enumerate()
+                .map(|(i, &tip)| {
+                    (points[tip][k] - points[centre][k]) / 3f64.sqrt() * moments[i] * body[i]
+                })
+                .sum()
+        })
+    };
+    let first = momentum(&r.states[0]);
+    for (t, y) in times.iter().zip(&r.states) {
+        let now = momentum(y);
+        assert!(
+            (0..3).all(|k| (now[k] - first[k]).abs() < 1e-8),
+            "t = {t}: R I ω = {now:?}, at the start {first:?}"
+        );
+    }
 }
 
 /// The steady precessions by name (`steady_motion`, a model without

@@ -50,16 +50,19 @@ fn kapitzas_bob_is_where_its_angle_puts_it() {
     }
 }
 
-/// Every model whose file names points is drawn from its start (a
-/// constrained model's start is on its constraints) over a few of its own
-/// periods: the first frame is the drawing of the start, every point of
-/// every frame finite (a singular one would be a named error). A motion
-/// that leaves the model's domain from there (a spring through zero
-/// length) is skipped with the integrator's named error.
+/// Every model whose file names points or bodies (the users' and the
+/// test models) is drawn from its start (a constrained model's start is on
+/// its constraints) over a few of its own periods: the first frame is the
+/// drawing of the start, every point of every frame finite (a singular one
+/// would be a named error), a drawing in the plane has z = 0 and each
+/// body's frame stays rigid ([`assert_rigid`]). A motion that leaves the
+/// model's domain from there (a spring through zero length) is skipped
+/// with the integrator's named error.
 #[test]
 fn every_drawn_model_moves_from_its_start() {
     let mut drawn = 0;
-    for handle in mechlab::models::MODELS.iter() {
+    let models = mechlab::models::MODELS.iter();
+    for handle in models.chain(mechlab_test_models::MODELS) {
         let (info, model) = (handle.info, handle.dynamic);
         let Some(drawing) = info.drawing else {
             println!("{}: names no points (not drawn)", info.name);
@@ -119,9 +122,57 @@ fn every_drawn_model_moves_from_its_start() {
                 "{}",
                 info.name
             );
+            assert!(
+                drawing.in_space || points.iter().all(|p| p[2] == 0.0),
+                "{}: drawn in the plane",
+                info.name
+            );
         }
+        assert_rigid(&animation);
     }
     assert!(drawn > 0, "no model was drawn");
+}
+
+/// Each body's frame is rigid and right-handed: its three axes (tip −
+/// centre) keep the length of the first frame's, equal for the three, and
+/// stay orthogonal, x × y along +z, to 1e-9 of their length (a body in
+/// Euler parameters keeps their unit norm to its constraint's tolerance).
+fn assert_rigid(animation: &mechlab::analysis::mechanism::Animation) {
+    let sub = |a: [f64; 3], b: [f64; 3]| std::array::from_fn(|i| a[i] - b[i]);
+    let dot = |a: [f64; 3], b: [f64; 3]| (0..3).map(|i| a[i] * b[i]).sum::<f64>();
+    for &[centre, x, y, z] in animation.body_frames {
+        let axes = |points: &[[f64; 3]]| -> [[f64; 3]; 3] {
+            [x, y, z].map(|tip| sub(points[tip], points[centre]))
+        };
+        let length = dot(axes(&animation.frames[0])[0], axes(&animation.frames[0])[0]).sqrt();
+        let name = animation.points[centre];
+        let tolerance = 1e-9 * length.max(1e-300);
+        for (t, points) in animation.times.iter().zip(&animation.frames) {
+            let [ax, ay, az] = axes(points);
+            for (i, a) in [ax, ay, az].into_iter().enumerate() {
+                let size = dot(a, a).sqrt();
+                assert!(
+                    (size - length).abs() <= tolerance,
+                    "{}: body '{name}', axis {i} of length {size} at t = {t}, not {length}",
+                    animation.model
+                );
+            }
+            let cross = [
+                ax[1] * ay[2] - ax[2] * ay[1],
+                ax[2] * ay[0] - ax[0] * ay[2],
+                ax[0] * ay[1] - ax[1] * ay[0],
+            ];
+            let square = length * length;
+            assert!(
+                dot(ax, ay).abs() <= tolerance * length
+                    && dot(ay, az).abs() <= tolerance * length
+                    && dot(az, ax).abs() <= tolerance * length
+                    && (dot(cross, az) - square * length).abs() <= 3.0 * tolerance * square,
+                "{}: body '{name}' is not an orthonormal right-handed frame at t = {t}",
+                animation.model
+            );
+        }
+    }
 }
 
 #[test]

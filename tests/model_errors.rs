@@ -562,9 +562,9 @@ fn malformed_points_name_the_problem() {
         "'hinge' is not a point declared before 'bob'",
     );
     assert_error(
-        &bob(r#"["bob_x", "cos(q)", "0"]"#, "[]"),
+        &bob(r#"["bob_x", "cos(q)", "0", "1"]"#, "[]"),
         "points[1].at",
-        "as [x, y]: 3 expressions given",
+        "as [x, y] or [x, y, z]: 4 expressions given",
     );
     assert_error(
         &bob(r#"["dot(bob_x)", "cos(q)"]"#, "[]"),
@@ -645,6 +645,21 @@ fn a_malformed_body_is_named() {
         "quaternion = [\"q\", \"a\", \"b\", \"c\"]\nrotation =",
     );
     assert_error(&unknown, "bodies[0].quaternion", "'a' is not a coordinate");
+    // The body is drawn as its frame, points named as the body and its
+    // axes' tips: the file's points may join them but not take their names.
+    let drawn = |point: &str, joined: &str| {
+        body("Y(q)")
+            + &format!("\n[[points]]\nname = \"{point}\"\nat = [\"0\", \"0\", \"0\"]\njoined_to = [\"{joined}\"]\n")
+    };
+    assert_error(
+        &drawn("bob_axis_y", "bob"),
+        "points[0].name",
+        "'bob_axis_y' names two points (each body is drawn as its frame",
+    );
+    let pivot =
+        Model::parse("models/toy.toml", &drawn("pivot", "bob")).expect("joined to the body");
+    assert_eq!(pivot.body_frames, [[0, 1, 2, 3]]);
+    assert_eq!(pivot.points[4].joined_to, [0]);
 }
 
 /// A rolling body's constraint names its body, and its contact must be

@@ -263,13 +263,18 @@ async fn the_mechanism_moves_with_its_bars_rigid() {
     let view: Value = serde_json::from_str(&body).unwrap();
     assert_eq!(view["points"], json!(["O1", "O2", "B", "C"]));
     assert_eq!(view["bars"], json!([[0, 1], [0, 2], [2, 3], [1, 3]]));
-    let frames: Vec<Vec<[f64; 2]>> = serde_json::from_value(view["frames"].clone()).unwrap();
+    assert_eq!(
+        (&view["in_space"], &view["up"], &view["body_frames"]),
+        (&json!(false), &json!([0.0, 1.0, 0.0]), &json!([]))
+    );
+    let frames: Vec<Vec<[f64; 3]>> = serde_json::from_value(view["frames"].clone()).unwrap();
     let times: Vec<f64> = serde_json::from_value(view["times"].clone()).unwrap();
     assert_eq!((frames.len(), times[60]), (61, 2.0));
     let p = mechlab::models::four_bar::Params::default();
-    let length = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let length = |a: [f64; 3], b: [f64; 3]| (a[0] - b[0]).hypot(a[1] - b[1]);
     for (f, points) in frames.iter().enumerate() {
         let [o1, o2, b, c] = [points[0], points[1], points[2], points[3]];
+        assert!(points.iter().all(|p| p[2] == 0.0), "in the plane");
         assert!((length(o1, b) - p.l).abs() < 1e-12, "crank, frame {f}");
         assert!((length(o2, c) - p.l).abs() < 1e-12, "rocker, frame {f}");
         assert!(
@@ -284,6 +289,26 @@ async fn the_mechanism_moves_with_its_bars_rigid() {
         frames[0][2][0],
         -p.d / 2.0 + p.l * 0.35f64.sin(),
         "the crank angle is held"
+    );
+    // The heavy top moves in space, drawn as its frame (its centre named
+    // as the body, then its axes' tips) with the tip joined to the centre,
+    // up against gravity.
+    let request = json!({"model": "heavy_top", "seed": [0.0, 0.5, 0.0, 1.0, 0.0, 4.0],
+        "duration": 1.0, "frames": 11});
+    let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;
+    assert_eq!(status, StatusCode::OK, "{body}");
+    let view: Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(
+        (&view["points"], &view["bars"], &view["body_frames"]),
+        (
+            &json!(["top", "top_axis_x", "top_axis_y", "top_axis_z", "tip"]),
+            &json!([[0, 4]]),
+            &json!([[0, 1, 2, 3]])
+        )
+    );
+    assert_eq!(
+        (&view["in_space"], &view["up"]),
+        (&json!(true), &json!([0.0, 0.0, 1.0]))
     );
     let request = json!({"model": "duffing", "seed": [0.1, 0.0], "duration": 1.0, "frames": 10});
     let (status, _, body) = call("POST", "/api/mechanism", Some(request)).await;

@@ -219,6 +219,7 @@ async fn browser_seeds_orbits_and_sweeps_a_parameter() {
     sections_without_a_fast_phase(&client, &folder).await;
     a_slice_of_the_period_map(&client, &folder).await;
     the_mechanism_moves(&client, &folder).await;
+    the_top_turns_in_space(&client, &folder).await;
     the_steady_motion_panel(&client, &folder).await;
     the_basins_layer(&client, &folder).await;
     the_address_and_the_declared_defaults(&client, &studio).await;
@@ -595,6 +596,71 @@ async fn the_mechanism_moves(client: &Client, folder: &std::path::Path) {
     assert_eq!(frames, serde_json::json!(601));
     let png = client.screenshot().await.unwrap();
     std::fs::write(folder.join("mechanism.png"), png).unwrap();
+}
+
+/// The heavy top found precessing steadily (hanging, Ω = 2) moves in
+/// space from that motion, drawn as its frame: its centre is painted where
+/// an orthographic view from azimuth a and elevation e about the way up z
+/// puts it (screen right (−sin a, cos a, 0), screen up (−sin e cos a,
+/// −sin e sin a, cos e), written here), and dragging the canvas 80 pixels
+/// to the left turns the view by 0.8 radians, the centre painted where the
+/// turned view puts it.
+async fn the_top_turns_in_space(client: &Client, folder: &std::path::Path) {
+    select_model(client, "heavy_top").await;
+    client
+        .execute(
+            "const set = (id, v) => { document.getElementById(id).value = v; }; \
+             set('steady-speed', 'phi'); set('steady-at', '2'); set('steady-rates', '2, 0, 0'); \
+             set('steady-start', '0, 1.5, 0'); studio.runSteady(); return true;",
+            vec![],
+        )
+        .await
+        .unwrap();
+    let centre_painted = "studio.mechanism && studio.mechanism.in_space && studio.mechanismFrame > 5 && (() => { \
+         const m = studio.mechanism, p = m.frames[studio.mechanismFrame][0], v = studio.mechanismView; \
+         const c = document.getElementById('mechanism'), g = c.getContext('2d'), w = c.width, h = c.height; \
+         const [a, e] = [v.azimuth, v.elevation], s = 0.85 * Math.min(w, h) / (2 * m.radius); \
+         const d = p.map((x, k) => x - m.middle[k]); \
+         const right = -Math.sin(a) * d[0] + Math.cos(a) * d[1]; \
+         const up = -Math.sin(e) * Math.cos(a) * d[0] - Math.sin(e) * Math.sin(a) * d[1] + Math.cos(e) * d[2]; \
+         const px = Math.round(w / 2 + right * s), py = Math.round(h / 2 - up * s); \
+         const pixel = g.getImageData(px, py, 1, 1).data; \
+         return pixel[0] > 150 && pixel[1] < 120; })()";
+    let before = read_when(
+        client,
+        centre_painted,
+        "return [studio.mechanismView.azimuth, studio.mechanism.up, studio.mechanism.body_frames];",
+        60,
+    )
+    .await;
+    assert_eq!(
+        before[1],
+        serde_json::json!([0, 0, 1]),
+        "up against gravity"
+    );
+    assert_eq!(before[2], serde_json::json!([[0, 1, 2, 3]]));
+    client
+        .execute(
+            "const c = document.getElementById('mechanism'); \
+             c.dispatchEvent(new PointerEvent('pointerdown', {clientX: 200, clientY: 100, pointerId: 7})); \
+             c.dispatchEvent(new PointerEvent('pointermove', {clientX: 120, clientY: 100, pointerId: 7})); \
+             c.dispatchEvent(new PointerEvent('pointerup', {clientX: 120, clientY: 100, pointerId: 7})); \
+             return true;",
+            vec![],
+        )
+        .await
+        .unwrap();
+    let after = read_when(
+        client,
+        centre_painted,
+        "return studio.mechanismView.azimuth;",
+        60,
+    )
+    .await;
+    let turned = after.as_f64().unwrap() - before[0].as_f64().unwrap();
+    assert!((turned - 0.8).abs() < 1e-12, "turned by {turned}");
+    let png = client.screenshot().await.unwrap();
+    std::fs::write(folder.join("mechanism_in_space.png"), png).unwrap();
 }
 
 /// Chaplygin's sleigh: the button linearises its straight glide; the

@@ -919,14 +919,15 @@ pub fn second_order_functions(
     Ok(functions)
 }
 
-/// The drawing's points at (t, q) as `[[x, y]; P]` (the model file's
-/// `[[points]]`, definitions substituted), or none when the file names no
-/// points. Both the Hamiltonian and the constrained templates have q first
+/// The drawing's points at (t, q) as `[[x, y, z]; P]` (the model file's
+/// `[[points]]` and its bodies' frames, definitions substituted) and
+/// gravity's acceleration where the file gives it, or none when nothing
+/// is drawn. Both the Hamiltonian and the constrained templates have q first
 /// in their state, so one form serves both.
-pub fn drawing_function(cx: &Context) -> Result<Option<Function>, DeriveError> {
+pub fn drawing_function(cx: &Context) -> Result<Vec<Function>, DeriveError> {
     let points = &cx.model.points;
     if points.is_empty() {
-        return Ok(None);
+        return Ok(Vec::new());
     }
     let rows = points
         .iter()
@@ -938,16 +939,31 @@ pub fn drawing_function(cx: &Context) -> Result<Option<Function>, DeriveError> {
         .collect::<Result<Vec<_>, _>>()?;
     let (outputs, result) = matrix("point", &rows);
     let names: Vec<&str> = points.iter().map(|p| p.name.as_str()).collect();
-    cx.function(
+    let mut functions = vec![cx.function(
         "mechanism_points",
         &format!(
-            "The mechanism's points ({}) in the figure's plane.",
+            "The mechanism's points ({}) in space (x, y, z).",
             names.join(", ")
         ),
         Inputs::TimeCoordinates,
-        format!("[[f64; 2]; {}]", points.len()),
+        format!("[[f64; 3]; {}]", points.len()),
         &[outputs],
         result,
-    )
-    .map(Some)
+    )?];
+    if let Some(gravity) = &cx.model.gravity {
+        let values = gravity
+            .iter()
+            .map(|g| Ok(crate::derive::kinematic(cx.model, g)?.to_string()))
+            .collect::<Result<Vec<String>, DeriveError>>()?;
+        let (outputs, result) = vector("gravity", &values);
+        functions.push(cx.function(
+            "gravity",
+            "Gravity's acceleration (x, y, z): the drawing's way down.",
+            Inputs::Params,
+            "[f64; 3]".into(),
+            &[outputs],
+            result,
+        )?);
+    }
+    Ok(functions)
 }

@@ -211,6 +211,9 @@ fn base_context(model: &Model, source_file: &str, derived: &[Derived]) -> tera::
         .collect();
     context.insert("point_names", &point_names);
     context.insert("bars", &bars);
+    context.insert("body_frames", &model.body_frames);
+    context.insert("drawn_in_space", &model.points.iter().any(|p| p.in_space));
+    context.insert("has_gravity", &model.gravity.is_some());
     context
 }
 

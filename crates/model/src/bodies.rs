@@ -277,16 +277,36 @@ fn body_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
     w
 }
 
-/// The body's angular velocity in the fixed frame: ω = Σ_k R_1…R_{k−1}
-/// e_k q_k', each turn's axis carried by the turns before it.
-fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
-    // Columns of R_1…R_k: the body's axes in the fixed frame.
+/// The fixed frame's axes as columns of the identity.
+fn identity() -> [[Component; 3]; 3] {
     let one = || Some("1".to_string());
-    let mut axes: [[Component; 3]; 3] = [
+    [
         [one(), None, None],
         [None, one(), None],
         [None, None, one()],
-    ];
+    ]
+}
+
+/// Carries the body's axes (columns of R_1…R_{k−1}, in the fixed frame)
+/// through one more turn: R·R_a(q) maps e_i → c e_i + s e_j and
+/// e_j → −s e_i + c e_j.
+fn turn_axes(axes: &mut [[Component; 3]; 3], turn: &Turn) {
+    let (c, s) = (
+        format!("cos({})", turn.angle),
+        format!("sin({})", turn.angle),
+    );
+    let (i, j) = ((turn.axis + 1) % 3, (turn.axis + 2) % 3);
+    let (ei, ej) = (axes[i].clone(), axes[j].clone());
+    for k in 0..3 {
+        axes[i][k] = sum(times(&c, &ei[k]), times(&s, &ej[k]));
+        axes[j][k] = sum(minus(times(&s, &ei[k])), times(&c, &ej[k]));
+    }
+}
+
+/// The body's angular velocity in the fixed frame: ω = Σ_k R_1…R_{k−1}
+/// e_k q_k', each turn's axis carried by the turns before it.
+fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
+    let mut axes = identity();
     let mut w: [Component; 3] = [None, None, None];
     for turn in turns {
         if let Some(r) = rate(turn, moves) {
@@ -294,19 +314,55 @@ fn world_rates(turns: &[Turn], moves: &dyn Fn(&str) -> bool) -> [Component; 3] {
                 *wi = sum(wi.take(), product(ai, &Some(r.clone())));
             }
         }
-        // R·R_a(q): e_i → c e_i + s e_j, e_j → −s e_i + c e_j.
-        let (c, s) = (
-            format!("cos({})", turn.angle),
-            format!("sin({})", turn.angle),
-        );
-        let (i, j) = ((turn.axis + 1) % 3, (turn.axis + 2) % 3);
-        let (ei, ej) = (axes[i].clone(), axes[j].clone());
-        for k in 0..3 {
-            axes[i][k] = sum(times(&c, &ei[k]), times(&s, &ej[k]));
-            axes[j][k] = sum(minus(times(&s, &ei[k])), times(&c, &ej[k]));
-        }
+        turn_axes(&mut axes, turn);
     }
     w
+}
+
+/// The body's axes in the fixed frame, the columns of its rotation R:
+/// the turns' product, or R(e) = (2e0² − 1) I + 2(e eᵀ + e0 ẽ) from Euler
+/// parameters (the rotation whose rates [`quaternion_rates`] gives).
+fn axes(body: &BodySpec) -> [[Component; 3]; 3] {
+    let Some([w, x, y, z]) = &body.quaternion else {
+        let mut axes = identity();
+        for turn in &body.turns {
+            turn_axes(&mut axes, turn);
+        }
+        return axes;
+    };
+    let e = [x, y, z];
+    let entry = |row: usize, column: usize| -> Component {
+        let product = format!("2*{}*{}", e[row], e[column]);
+        Some(match (row + 3 - column) % 3 {
+            0 => format!("2*{w}^2 - 1 + {product}"),
+            // ẽ[row][column] = −e_k for column = row + 1, +e_k for row = column + 1.
+            2 => format!("{product} - 2*{w}*{}", e[3 - row - column]),
+            _ => format!("{product} + 2*{w}*{}", e[3 - row - column]),
+        })
+    };
+    // Column i holds body axis i.
+    std::array::from_fn(|column| std::array::from_fn(|row| entry(row, column)))
+}
+
+/// How a body is drawn: its centre and the tips of its three axes, each
+/// of the length sqrt(tr I / 2m), the root-mean-square distance of its
+/// mass from its centre (tr I = 2 ∫ r² dm; a diagonal that cannot cancel,
+/// so the length is real for every inertia). Positions (x, y, z) as text.
+pub fn frame(body: &BodySpec, tensor: &[[Option<String>; 3]; 3]) -> [[String; 3]; 4] {
+    let centre = centre(&body.name);
+    let trace: Vec<String> = (0..3).filter_map(|i| tensor[i][i].clone()).collect();
+    let length = match trace.is_empty() {
+        true => "0".to_string(),
+        false => format!("sqrt(({})/(2*({})))", trace.join(" + "), text(&body.mass)),
+    };
+    let axes = axes(body);
+    let tip = |axis: usize| -> [String; 3] {
+        std::array::from_fn(|k| match &axes[axis][k] {
+            Some(a) => format!("{} + ({length})*({a})", centre[k]),
+            None => centre[k].clone(),
+        })
+    };
+    [centre.clone(), tip(0), tip(1), tip(2)]
 }
 
 /// The angular velocity from Euler parameters e = (e0, e1, e2, e3):

@@ -129,9 +129,9 @@ pub struct ConstraintSpec {
 }
 
 /// A point of the mechanism's drawing: `at = ["x", "y"]` in the plane of
-/// the figure (expressions of the coordinates, parameters, time and fast
-/// phase, definitions allowed), `joined_to` the earlier points a bar joins
-/// it to.
+/// the figure or `at = ["x", "y", "z"]` in space (expressions of the
+/// coordinates, parameters, time and fast phase, definitions allowed),
+/// `joined_to` the earlier points a bar joins it to.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointSpec {
@@ -271,8 +271,15 @@ pub struct Model {
     pub rayleigh: Expr,
     pub contacts: Vec<Contact>,
     pub constraints: Vec<Constraint>,
-    /// The mechanism's points, in the order of the file (empty: no drawing).
+    /// The mechanism's points, in the order of the file (empty: no
+    /// drawing), then each body's centre and axis tips.
     pub points: Vec<Point>,
+    /// Each body's frame in the drawing: the indices of its centre and of
+    /// its x, y and z axes' tips in `points`.
+    pub body_frames: Vec<[usize; 4]>,
+    /// Gravity's acceleration (x, y, z) where the file gives it, in the
+    /// parameters: the drawing's way down.
+    pub gravity: Option<[Expr; 3]>,
     pub inverse: Inverse,
 }
 
@@ -280,8 +287,11 @@ pub struct Model {
 #[derive(Clone, Debug)]
 pub struct Point {
     pub name: String,
-    /// (x, y) as written (definitions not yet substituted).
-    pub at: [Expr; 2],
+    /// (x, y, z) as written (definitions not yet substituted); z = 0 for a
+    /// point given in the plane.
+    pub at: [Expr; 3],
+    /// Whether the point was given in space (x, y, z).
+    pub in_space: bool,
     /// Indices of the earlier points a bar joins it to.
     pub joined_to: Vec<usize>,
     pub description: String,
@@ -606,7 +616,7 @@ impl ModelFile {
             }
             None => None,
         };
-        let bodies = self.validate_bodies(file, names, &parse)?;
+        let (bodies, gravity) = self.validate_bodies(file, names, &parse)?;
         // Definitions are positions: no velocities, and no cycles.
         let mut parsed_defs = BTreeMap::new();
         for (name, text) in &self.definitions {
@@ -648,7 +658,8 @@ impl ModelFile {
         let contacts =
             self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
         let (constraints, starts) = self.validate_constraints(file, names, &parse)?;
-        let points = self.validate_points(file, names, &parse)?;
+        let (mut points, body_frames) = self.body_frames(file, names, &parse)?;
+        self.validate_points(file, names, &parse, &mut points)?;
         let mut coordinates: Vec<Coordinate> =
             self.coordinates.into_iter().map(Coordinate::from).collect();
         for (c, start) in coordinates.iter_mut().zip(starts) {
@@ -668,6 +679,8 @@ impl ModelFile {
             contacts,
             constraints,
             points,
+            body_frames,
+            gravity,
             inverse,
         };
         model
@@ -943,10 +956,11 @@ impl ModelFile {
         file: &str,
         names: &Names,
         parse: &ExprParser,
-    ) -> Result<Vec<Point>, ModelError> {
+        points: &mut Vec<Point>,
+    ) -> Result<(), ModelError> {
         let err = error_at(file);
         if self.points.is_empty() {
-            return Ok(Vec::new());
+            return Ok(());
         }
         if !self.contacts.is_empty() {
             return Err(err(
@@ -964,7 +978,6 @@ impl ModelFile {
             ));
         }
         let positions = names.positions();
-        let mut points: Vec<Point> = Vec::new();
         for (i, p) in self.points.iter().enumerate() {
             if !is_identifier(&p.name) {
                 return Err(err(
@@ -975,23 +988,28 @@ impl ModelFile {
             if points.iter().any(|q| q.name == p.name) {
                 return Err(err(
                     format!("points[{i}].name"),
-                    format!("'{}' names two points", p.name),
+                    format!("'{}' names two points (each body is drawn as its frame: points named as the body and <body>_axis_x, _y, _z)", p.name),
                 ));
             }
-            let [x, y] = p.at.as_slice() else {
-                return Err(err(
-                    format!("points[{i}].at"),
-                    format!(
-                        "give the point '{}' as [x, y]: {} expressions given",
-                        p.name,
-                        p.at.len()
-                    ),
-                ));
+            let (x, y, z) = match p.at.as_slice() {
+                [x, y] => (x, y, "0"),
+                [x, y, z] => (x, y, z.as_str()),
+                _ => {
+                    return Err(err(
+                        format!("points[{i}].at"),
+                        format!(
+                            "give the point '{}' as [x, y] or [x, y, z]: {} expressions given",
+                            p.name,
+                            p.at.len()
+                        ),
+                    ))
+                }
             };
             let key = format!("points[{i}].at");
             let at = [
                 parse(&key, x, &positions, false)?,
                 parse(&key, y, &positions, false)?,
+                parse(&key, z, &positions, false)?,
             ];
             let joined_to = p
                 .joined_to
@@ -1008,11 +1026,60 @@ impl ModelFile {
             points.push(Point {
                 name: p.name.clone(),
                 at,
+                in_space: p.at.len() == 3,
                 joined_to,
                 description: p.description.clone(),
             });
         }
-        Ok(points)
+        Ok(())
+    }
+
+    /// Each body drawn as its frame: its centre (named as the body) and
+    /// its axes' tips (`<body>_axis_x`, …), the first points of the
+    /// drawing (the file's points may join them), and the frames' indices.
+    /// (A model with contacts is not drawn: its state holds the sliding
+    /// coordinates only.)
+    fn body_frames(
+        &self,
+        file: &str,
+        names: &Names,
+        parse: &ExprParser,
+    ) -> Result<(Vec<Point>, Vec<[usize; 4]>), ModelError> {
+        let err = error_at(file);
+        let positions = names.positions();
+        let (mut points, mut frames) = (Vec::new(), Vec::new());
+        if !self.contacts.is_empty() {
+            return Ok((points, frames));
+        }
+        for (k, body) in self.bodies.iter().enumerate() {
+            let key = format!("bodies[{k}]");
+            let tensor = crate::bodies::inertia(&body.inertia)
+                .map_err(|(part, reason)| err(format!("{key}.{part}"), reason))?;
+            let frame = crate::bodies::frame(body, &tensor);
+            let named = [
+                body.name.clone(),
+                format!("{}_axis_x", body.name),
+                format!("{}_axis_y", body.name),
+                format!("{}_axis_z", body.name),
+            ];
+            let mut indices = [0; 4];
+            for ((name, at), index) in named.into_iter().zip(frame).zip(&mut indices) {
+                let at = at
+                    .iter()
+                    .map(|c| parse(&format!("{key}.position"), c, &positions, false))
+                    .collect::<Result<Vec<_>, _>>()?;
+                *index = points.len();
+                points.push(Point {
+                    name,
+                    at: [at[0].clone(), at[1].clone(), at[2].clone()],
+                    in_space: true,
+                    joined_to: Vec::new(),
+                    description: format!("the frame of the body '{}'", body.name),
+                });
+            }
+            frames.push(indices);
+        }
+        Ok((points, frames))
     }
 
     /// Constraint `i`'s rolling body's material velocity at its contact
@@ -1048,24 +1115,27 @@ impl ModelFile {
     }
 
     /// Bodies: each one's parts read with its own key, then its kinetic
-    /// energy and gravity's potential as terms of the Lagrangian.
+    /// energy and gravity's potential as terms of the Lagrangian, and
+    /// gravity's acceleration.
     fn validate_bodies(
         &self,
         file: &str,
         names: &Names,
         parse: &ExprParser,
-    ) -> Result<Vec<Expr>, ModelError> {
+    ) -> Result<(Vec<Expr>, Option<[Expr; 3]>), ModelError> {
         let err = error_at(file);
         let parameters = [&names.parameters];
         let positions = names.positions();
-        if let Some(gravity) = &self.gravity {
-            if self.bodies.is_empty() {
-                return Err(err("gravity".into(), "gravity acts on the model's [[bodies]] and this model has none: write its potential in the Lagrangian".into()));
-            }
-            for g in gravity {
-                parse("gravity", &crate::bodies::text(g), &parameters, false)?;
-            }
+        if self.gravity.is_some() && self.bodies.is_empty() {
+            return Err(err("gravity".into(), "gravity acts on the model's [[bodies]] and this model has none: write its potential in the Lagrangian".into()));
         }
+        let gravity = match &self.gravity {
+            Some([x, y, z]) => {
+                let read = |c| parse("gravity", &crate::bodies::text(c), &parameters, false);
+                Some([read(x)?, read(y)?, read(z)?])
+            }
+            None => None,
+        };
         let mut energies = Vec::new();
         for (k, body) in self.bodies.iter().enumerate() {
             let key = |part: &str| format!("bodies[{k}].{part}");
@@ -1121,7 +1191,7 @@ impl ModelFile {
             })?;
             energies.push(energy);
         }
-        Ok(energies)
+        Ok((energies, gravity))
     }
 
     /// Constraints: each a position or a velocity expression, named once;

@@ -17,9 +17,16 @@ pub struct Animation {
     pub points: &'static [&'static str],
     /// Bars between points, by index.
     pub bars: &'static [[usize; 2]],
+    /// Each body's frame: its centre's and its axes' tips' indices.
+    pub body_frames: &'static [[usize; 4]],
+    /// Whether the mechanism moves in space (else in the plane z = 0).
+    pub in_space: bool,
+    /// The way up, a unit vector: against gravity where the model file
+    /// gives it, else z in space and y in the plane.
+    pub up: [f64; 3],
     pub times: Vec<f64>,
-    /// `frames[f][p]`: the point p at `times[f]`, (x, y).
-    pub frames: Vec<Vec<[f64; 2]>>,
+    /// `frames[f][p]`: the point p at `times[f]`, (x, y, z).
+    pub frames: Vec<Vec<[f64; 3]>>,
     /// The start the motion left from (on the constraints for a
     /// constrained model).
     pub start: Vec<f64>,
@@ -28,7 +35,7 @@ pub struct Animation {
 /// Why a mechanism cannot be drawn moving.
 #[derive(Debug, thiserror::Error)]
 pub enum MechanismError {
-    #[error("model '{model}' names no points: give its model file [[points]] entries (name, at = [x, y], joined_to) to draw it")]
+    #[error("model '{model}' names no points: give its model file [[points]] entries (name, at = [x, y] or [x, y, z], joined_to) or [[bodies]] to draw it")]
     NotDrawn { model: String },
     #[error(transparent)]
     Refused(#[from] Refusal),
@@ -124,10 +131,7 @@ pub fn animate(
         .zip(&states)
         .map(|(&t, y)| {
             let points = (drawing.at)(t, &y[..n], params);
-            match points
-                .iter()
-                .position(|p| !(p[0].is_finite() && p[1].is_finite()))
-            {
+            match points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
                 Some(p) => Err(MechanismError::NotFinite {
                     model: name.into(),
                     point: drawing.points[p],
@@ -141,8 +145,24 @@ pub fn animate(
         model: name,
         points: drawing.points,
         bars: drawing.bars,
+        body_frames: drawing.body_frames,
+        in_space: drawing.in_space,
+        up: up(drawing, params),
         times,
         frames,
         start,
     })
+}
+
+/// The drawing's way up: against gravity where the model gives a nonzero
+/// one, else z in space and y in the plane.
+fn up(drawing: &crate::registry::Drawing, params: &[f64]) -> [f64; 3] {
+    let g = drawing.gravity.map(|g| g(params)).unwrap_or_default();
+    let size = g.iter().map(|c| c * c).sum::<f64>().sqrt();
+    match (size > 0.0 && size.is_finite(), drawing.in_space) {
+        // (+ 0.0: no −0 in what is written.)
+        (true, _) => g.map(|c| -c / size + 0.0),
+        (false, true) => [0.0, 0.0, 1.0],
+        (false, false) => [0.0, 1.0, 0.0],
+    }
 }

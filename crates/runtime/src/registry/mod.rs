@@ -69,10 +69,19 @@ pub struct Drawing {
     pub points: &'static [&'static str],
     /// Bars between points, by index.
     pub bars: &'static [[usize; 2]],
-    /// The points at (t, q) with the parameters' values in declaration
-    /// order; empty if q is not of the coordinates' length (the caller
-    /// checks; see [`crate::analysis::mechanism`]).
-    pub at: fn(f64, &[f64], &[f64]) -> Vec<[f64; 2]>,
+    /// Each body's frame: the indices of its centre and of its x, y and z
+    /// axes' tips.
+    pub body_frames: &'static [[usize; 4]],
+    /// Whether the drawing is in space (a point given as (x, y, z), or a
+    /// body): else every z is 0 and the figure's plane is (x, y).
+    pub in_space: bool,
+    /// The points (x, y, z) at (t, q) with the parameters' values in
+    /// declaration order; empty if q is not of the coordinates' length
+    /// (the caller checks; see [`crate::analysis::mechanism`]).
+    pub at: fn(f64, &[f64], &[f64]) -> Vec<[f64; 3]>,
+    /// Gravity's acceleration at the parameters' values, where the model
+    /// file gives it: the drawing's way down.
+    pub gravity: Option<fn(&[f64]) -> [f64; 3]>,
 }
 
 impl ModelInfo {

@@ -7,9 +7,15 @@ use super::*;
 pub struct MechanismView {
     pub points: Vec<&'static str>,
     pub bars: Vec<[usize; 2]>,
+    /// Each body's centre and axes' tips, by index.
+    pub body_frames: Vec<[usize; 4]>,
+    /// Whether to draw in space (a view the user turns) or in the plane.
+    pub in_space: bool,
+    /// The way up (a unit vector).
+    pub up: [f64; 3],
     pub times: Vec<f64>,
-    /// `frames[f][p]`: the point p at `times[f]`.
-    pub frames: Vec<Vec<[f64; 2]>>,
+    /// `frames[f][p]`: the point p (x, y, z) at `times[f]`.
+    pub frames: Vec<Vec<[f64; 3]>>,
 }
 
 /// The mechanism of `request` moving, from the seed put on the constraints
@@ -39,6 +45,9 @@ pub fn mechanism(
     Ok(MechanismView {
         points: animation.points.to_vec(),
         bars: animation.bars.to_vec(),
+        body_frames: animation.body_frames.to_vec(),
+        in_space: animation.in_space,
+        up: animation.up,
         times: animation.times,
         frames: animation.frames,
     })

@@ -258,6 +258,7 @@ async function runSteady() {
     $("steady-note").textContent = `${answer.speed}' = ${answer.at} (${shape}): ${verdict}; eigenvalues ${values.join(", ")}` +
       (bounds.length ? `; boundaries at ${answer.speed}' = ${bounds.join(", ")}` : "");
     say("");
+    startMechanism(m.state, "the steady motion");
   } catch (e) {
     if (!aborted(e)) { studio.steady = null; drawSteady(); say(`steady motion: ${e.message}`); }
   }
@@ -533,7 +534,7 @@ let mechanismController = null;
 // the declared number of frames, played over 20 seconds whatever the
 // model's time scale.
 const MECHANISM_SECONDS = 20;
-async function startMechanism(seed) {
+async function startMechanism(seed, from = `orbit ${studio.orbits.length}'s seed`) {
   if (mechanismController) mechanismController.abort();
   studio.mechanism = null;
   if (!studio.model.points.length) return;
@@ -541,15 +542,62 @@ async function startMechanism(seed) {
   const duration = Number($("mechanism-time").value);
   try {
     const m = await postJson("/api/mechanism", { ...setup(), seed, duration }, mechanismController.signal);
-    const xs = m.frames.flat().map((p) => p[0]), ys = m.frames.flat().map((p) => p[1]);
-    m.box = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+    const all = m.frames.flat(), span = (k) => [Math.min(...all.map((p) => p[k])), Math.max(...all.map((p) => p[k]))];
+    const [[x0, x1], [y0, y1], [z0, z1]] = [span(0), span(1), span(2)];
+    m.box = [x0, x1, y0, y1];
+    // In space: the sphere about the box's middle that holds every frame,
+    // so that turning the view never moves the mechanism out of it.
+    m.middle = [(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2];
+    m.radius = Math.max(1e-9, ...all.map((p) => Math.hypot(p[0] - m.middle[0], p[1] - m.middle[1], p[2] - m.middle[2])));
+    m.tips = new Set(m.body_frames.flatMap(([, ...tips]) => tips));
     m.started = performance.now();
     studio.mechanism = m;
-    $("mechanism-note").textContent = `the mechanism from orbit ${studio.orbits.length}'s seed (${m.points.join(", ")})`;
+    const turn = m.in_space ? "; drag it to turn the view" : "";
+    $("mechanism-note").textContent = `the mechanism from ${from} (${m.points.filter((_, p) => !m.tips.has(p)).join(", ")})${turn}`;
   } catch (e) {
     if (!aborted(e)) $("mechanism-note").textContent = `mechanism: ${e.message}`;
   }
 }
+
+// The view of a mechanism in space, orthographic: from the azimuth about
+// the way up and the elevation above the horizontal (radians), turned by
+// dragging the canvas.
+studio.mechanismView = { azimuth: 0.6, elevation: 0.35 };
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const unit = (a) => { const n = Math.hypot(...a); return a.map((c) => c / n); };
+
+// The screen's right and up in space for the view: the horizontal h1 is
+// the fixed axis least along `up`, levelled; h2 = up × h1; the eye looks
+// from cos(e)(cos(a) h1 + sin(a) h2) + sin(e) up.
+function viewAxes(up, { azimuth, elevation }) {
+  const axes = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+  const level = axes.reduce((a, b) => (Math.abs(dot(b, up)) < Math.abs(dot(a, up)) ? b : a));
+  const h1 = unit(level.map((c, k) => c - dot(level, up) * up[k]));
+  const h2 = cross(up, h1);
+  const eye = [0, 1, 2].map((k) => Math.cos(elevation) * (Math.cos(azimuth) * h1[k] + Math.sin(azimuth) * h2[k]) + Math.sin(elevation) * up[k]);
+  const right = unit(cross(up, eye));
+  return { right, up: cross(eye, right) };
+}
+
+// Where a point (x, y, z) of `m` falls on a canvas w × h: the plane (x, y)
+// fitted to its box, or space seen from `studio.view`.
+function mechanismProjection(m, w, h) {
+  if (!m.in_space) {
+    const [x0, x1, y0, y1] = m.box;
+    const scale = 0.85 * Math.min(w / Math.max(x1 - x0, 1e-9), h / Math.max(y1 - y0, 1e-9));
+    return ([x, y]) => [w / 2 + (x - (x0 + x1) / 2) * scale, h / 2 - (y - (y0 + y1) / 2) * scale];
+  }
+  const { right, up } = viewAxes(m.up, studio.mechanismView);
+  const scale = (0.85 * Math.min(w, h)) / (2 * m.radius);
+  return (p) => {
+    const d = p.map((c, k) => c - m.middle[k]);
+    return [w / 2 + dot(d, right) * scale, h / 2 - dot(d, up) * scale];
+  };
+}
+studio.mechanismProjection = mechanismProjection;
+
+const AXIS_COLOURS = ["#c0392b", "#27ae60", "#2e6fbd"];
 
 function drawMechanism(now) {
   const g = mctx, w = mechanismCanvas.width, h = mechanismCanvas.height;
@@ -560,14 +608,28 @@ function drawMechanism(now) {
   const perSecond = (m.frames.length - 1) / MECHANISM_SECONDS;
   const f = Math.min(m.frames.length - 1, Math.floor(((now - m.started) / 1000) * perSecond));
   studio.mechanismFrame = f;
-  const [x0, x1, y0, y1] = m.box;
-  const scale = 0.85 * Math.min(w / Math.max(x1 - x0, 1e-9), h / Math.max(y1 - y0, 1e-9));
-  const at = ([x, y]) => [w / 2 + (x - (x0 + x1) / 2) * scale, h / 2 - (y - (y0 + y1) / 2) * scale];
+  const at = mechanismProjection(m, w, h);
+  if (m.in_space) {
+    // The fixed axes at the origin, faint, for the way the view is turned.
+    const o = at([0, 0, 0]);
+    g.lineWidth = 1;
+    g.font = "11px system-ui";
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]].forEach((e, k) => {
+      const tip = at(e.map((c) => 0.3 * m.radius * c));
+      g.strokeStyle = g.fillStyle = "rgba(90, 90, 90, 0.5)";
+      g.beginPath();
+      g.moveTo(...o);
+      g.lineTo(...tip);
+      g.stroke();
+      g.fillText("xyz"[k], tip[0] + 2, tip[1] - 2);
+    });
+  }
   // The last second's path of each point, faint.
   const trail = Math.round(perSecond);
   g.strokeStyle = "rgba(35, 57, 91, 0.25)";
   g.lineWidth = 1;
   for (let p = 0; p < m.points.length; p++) {
+    if (m.tips.has(p)) continue;
     g.beginPath();
     for (let k = Math.max(0, f - trail); k <= f; k++) {
       const [px, py] = at(m.frames[k][p]);
@@ -584,9 +646,21 @@ function drawMechanism(now) {
     g.lineTo(...points[b]);
     g.stroke();
   }
+  // Each body as its frame: x, y, z axes red, green, blue.
+  g.lineWidth = 2.5;
+  for (const [centre, ...tips] of m.body_frames) {
+    tips.forEach((tip, k) => {
+      g.strokeStyle = AXIS_COLOURS[k];
+      g.beginPath();
+      g.moveTo(...points[centre]);
+      g.lineTo(...points[tip]);
+      g.stroke();
+    });
+  }
   g.fillStyle = "#b5462f";
   g.font = "12px system-ui";
   points.forEach(([px, py], p) => {
+    if (m.tips.has(p)) return;
     g.beginPath();
     g.arc(px, py, 4.5, 0, 2 * Math.PI);
     g.fill();
@@ -596,15 +670,25 @@ function drawMechanism(now) {
   $("mechanism-clock").textContent = `t = ${m.times[f].toPrecision(4)} of ${end} (played over ${MECHANISM_SECONDS} s)`;
 }
 
+// Turns the view of a mechanism in space by (azimuth, elevation) radians,
+// the elevation kept short of the poles.
+studio.turnView = (azimuth, elevation) => {
+  const v = studio.mechanismView;
+  v.azimuth += azimuth;
+  v.elevation = Math.max(-1.5, Math.min(1.5, v.elevation + elevation));
+};
+
 function seedAt(x, y) {
   if (studio.section) { seedSection(x, y); return; }
-  if (!studio.model.fast_phase) {
-    say(`model '${studio.model.name}' has no fast phase: there is no period map to draw`);
-    return;
-  }
   const seed = studio.through.slice();
   seed[studio.axes[0]] = x;
   seed[studio.axes[1]] = y;
+  if (!studio.model.fast_phase) {
+    // No period map; the mechanism still moves from the state clicked.
+    say(`model '${studio.model.name}' has no fast phase: there is no period map to draw${studio.model.points.length ? "; the mechanism moves from the state clicked" : ""}`);
+    startMechanism(seed, "the state clicked");
+    return;
+  }
   const id = studio.nextId++;
   const orbit = { id, seed, color: orbitColor(id), periods: Math.max(1, Math.round(Number($("periods").value))), points: [] };
   studio.orbits.push(orbit);
@@ -972,7 +1056,7 @@ async function chooseModel(name, address = new URLSearchParams()) {
   studio.mechanism = null;
   $("mechanism-note").textContent = model.points.length
     ? "click the plane: the mechanism moves from the orbit's seed"
-    : `model '${name}' names no points: give its model file [[points]] (name, at = [x, y], joined_to) to draw it here`;
+    : `model '${name}' names no points: give its model file [[points]] (name, at = [x, y] or [x, y, z], joined_to) or [[bodies]] to draw it here`;
   defaultView(model);
   const notes = {
     contacts: `model '${name}' is a contact model: no phase plane here, its derivations are below`,
@@ -1135,6 +1219,18 @@ function wire() {
     refreshOverlays();
   });
   $("mechanism-replay").addEventListener("click", () => { if (studio.mechanism) studio.mechanism.started = performance.now(); });
+  // Dragging the mechanism in space turns the view.
+  let dragged = null;
+  mechanismCanvas.addEventListener("pointerdown", (e) => {
+    dragged = [e.clientX, e.clientY];
+    try { mechanismCanvas.setPointerCapture(e.pointerId); } catch { /* a pointer no longer down */ }
+  });
+  mechanismCanvas.addEventListener("pointerup", () => { dragged = null; });
+  mechanismCanvas.addEventListener("pointermove", (e) => {
+    if (!dragged || !studio.mechanism || !studio.mechanism.in_space) return;
+    studio.turnView(-0.01 * (e.clientX - dragged[0]), 0.01 * (e.clientY - dragged[1]));
+    dragged = [e.clientX, e.clientY];
+  });
   $("export-png").addEventListener("click", () => canvas.toBlob((blob) => download(`studio_${studio.model.name}.png`, blob)));
   $("export-svg").addEventListener("click", exportSvg);
   $("export-csv").addEventListener("click", exportCsv);

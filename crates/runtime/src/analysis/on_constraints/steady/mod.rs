@@ -31,7 +31,8 @@ pub use spectrum::Verdict;
 /// The linearisation of a steady motion ([`steady_motion`]).
 #[derive(Clone, Debug, Serialize)]
 pub struct SteadyMotion {
-    /// The consistent state of the steady motion, [q; q'].
+    /// The steady motion's state in the model's own form: [q; q'] on
+    /// constraints, [q; p] for a model without them.
     pub state: Vec<f64>,
     /// The reduced state's names: the shape, its rates, then the held
     /// speeds, each but those that neither move nor are moved by the rest
