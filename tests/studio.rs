@@ -117,6 +117,11 @@ async fn models_and_page_are_served() {
         ]
     );
     assert_eq!(k["periodic"], json!([true, false]));
+    assert_eq!(k["through"], json!([0.0, 0.0]), "no start in its file");
+    // The heavy top's plane passes through its file's start at rest,
+    // θ = 0.5, off the upright θ = 0 where its Euler angles are singular.
+    let top = &models[names.iter().position(|n| *n == "heavy_top").unwrap()];
+    assert_eq!(top["through"], json!([0.0, 0.5, 0.0, 0.0, 0.0, 0.0]));
 
     let (status, kind, page) = call("GET", "/", None).await;
     assert_eq!(status, StatusCode::OK);

@@ -919,6 +919,31 @@ pub fn second_order_functions(
     Ok(functions)
 }
 
+/// The coordinates' starts the model file gives (0 where it gives none),
+/// in the parameters, or none when it gives no start: a model without
+/// constraints starts there at rest (where a file says its origin is a
+/// singular chart, as the heavy top's upright θ = 0).
+pub fn starts_function(cx: &Context) -> Result<Option<Function>, DeriveError> {
+    let coordinates = &cx.model.coordinates;
+    if coordinates.iter().all(|c| c.start.is_none()) {
+        return Ok(None);
+    }
+    let values: Vec<String> = coordinates
+        .iter()
+        .map(|c| c.start.as_ref().map_or("0".into(), |s| s.to_string()))
+        .collect();
+    let (outputs, result) = vector("start", &values);
+    cx.function(
+        "coordinate_starts",
+        "The coordinates' starts of the model file (0 where it gives none).",
+        Inputs::Params,
+        format!("[f64; {}]", coordinates.len()),
+        &[outputs],
+        result,
+    )
+    .map(Some)
+}
+
 /// The drawing's points at (t, q) as `[[x, y, z]; P]` (the model file's
 /// `[[points]]` and its bodies' frames, definitions substituted) and
 /// gravity's acceleration where the file gives it, or none when nothing

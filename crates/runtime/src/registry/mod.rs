@@ -192,8 +192,10 @@ pub trait DynamicModel: Sync {
         periodic.resize(2 * periodic.len(), false);
         periodic
     }
-    /// The model file's start at rest, for a constrained model (whose
-    /// coordinates must satisfy its constraints).
+    /// The model file's start at rest: a constrained model's (whose
+    /// coordinates must satisfy its constraints), or the coordinates'
+    /// starts of a model without constraints whose file gives any (0 for
+    /// the others, the momenta 0).
     #[inline]
     fn start(&self, _params: &[f64]) -> Option<Vec<f64>> {
         None

@@ -172,8 +172,9 @@ pub struct ModelSummary {
     pub amplitude: Option<&'static str>,
     pub default_axes: [usize; 2],
     pub default_ranges: [[f64; 2]; 2],
-    /// The state the plane passes through by default: zero, or a
-    /// constrained model's start (its seeds are put on its constraints).
+    /// The state the plane passes through by default: the model file's
+    /// start at rest where it gives one (a constrained model's seeds are
+    /// put on its constraints), else zero.
     pub through: Vec<f64>,
     /// The mechanism's points, if its model file names them (the page
     /// draws the mechanism moving from each orbit's seed).
