@@ -1,6 +1,6 @@
 //! The mechanism moving: the points its model file names (`[[points]]`)
-//! along a motion of the exact system, frame by frame, for the studio's
-//! drawing and the scenes' strobe figures.
+//! and its bodies' frames along a motion of the exact system, frame by
+//! frame, in the plane or in space, for the studio's drawing.
 
 use super::Refusal;
 use crate::ode::holonomic::ConstraintError;
