@@ -283,6 +283,19 @@ pub struct Model {
     pub inverse: Inverse,
 }
 
+/// A body's inertia tensor about its centre in its axes, as written
+/// (None: zero).
+type Inertia = [[Option<String>; 3]; 3];
+
+/// The bodies read: each one's kinetic energy (with gravity's potential)
+/// as a term of the Lagrangian and its inertia, and gravity's
+/// acceleration.
+struct ReadBodies {
+    energies: Vec<Expr>,
+    tensors: Vec<Inertia>,
+    gravity: Option<[Expr; 3]>,
+}
+
 /// A validated point of the drawing.
 #[derive(Clone, Debug)]
 pub struct Point {
@@ -616,7 +629,7 @@ impl ModelFile {
             }
             None => None,
         };
-        let (bodies, gravity) = self.validate_bodies(file, names, &parse)?;
+        let bodies = self.validate_bodies(file, names, &parse)?;
         // Definitions are positions: no velocities, and no cycles.
         let mut parsed_defs = BTreeMap::new();
         for (name, text) in &self.definitions {
@@ -627,7 +640,7 @@ impl ModelFile {
         let definitions = order_definitions(&parsed_defs, &err)?;
         let all = names.all();
         let lagrangian = match self.lagrangian.trim() {
-            "" if bodies.is_empty() => {
+            "" if bodies.energies.is_empty() => {
                 return Err(err(
                     "lagrangian",
                     "missing: give L = T − V, or the model's [[bodies]]".into(),
@@ -636,7 +649,11 @@ impl ModelFile {
             "" => Expr::num(0),
             text => parse("lagrangian", text, &all, true)?,
         };
-        let lagrangian = Expr::sum(std::iter::once(lagrangian).chain(bodies).collect());
+        let lagrangian = Expr::sum(
+            std::iter::once(lagrangian)
+                .chain(bodies.energies.iter().cloned())
+                .collect(),
+        );
         if let Some(name) = self.forces.keys().find(|n| !names.coordinates.contains(n)) {
             return Err(err(
                 &format!("forces.{name}"),
@@ -658,7 +675,7 @@ impl ModelFile {
         let contacts =
             self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
         let (constraints, starts) = self.validate_constraints(file, names, &parse)?;
-        let (mut points, body_frames) = self.body_frames(file, names, &parse)?;
+        let (mut points, body_frames) = self.body_frames(names, &parse, &bodies.tensors)?;
         self.validate_points(file, names, &parse, &mut points)?;
         let mut coordinates: Vec<Coordinate> =
             self.coordinates.into_iter().map(Coordinate::from).collect();
@@ -680,7 +697,7 @@ impl ModelFile {
             constraints,
             points,
             body_frames,
-            gravity,
+            gravity: bodies.gravity,
             inverse,
         };
         model
@@ -1041,21 +1058,18 @@ impl ModelFile {
     /// coordinates only.)
     fn body_frames(
         &self,
-        file: &str,
         names: &Names,
         parse: &ExprParser,
+        tensors: &[Inertia],
     ) -> Result<(Vec<Point>, Vec<[usize; 4]>), ModelError> {
-        let err = error_at(file);
         let positions = names.positions();
         let (mut points, mut frames) = (Vec::new(), Vec::new());
         if !self.contacts.is_empty() {
             return Ok((points, frames));
         }
-        for (k, body) in self.bodies.iter().enumerate() {
+        for (k, (body, tensor)) in self.bodies.iter().zip(tensors).enumerate() {
             let key = format!("bodies[{k}]");
-            let tensor = crate::bodies::inertia(&body.inertia)
-                .map_err(|(part, reason)| err(format!("{key}.{part}"), reason))?;
-            let frame = crate::bodies::frame(body, &tensor);
+            let frame = crate::bodies::frame(body, tensor);
             let named = [
                 body.name.clone(),
                 format!("{}_axis_x", body.name),
@@ -1115,14 +1129,13 @@ impl ModelFile {
     }
 
     /// Bodies: each one's parts read with its own key, then its kinetic
-    /// energy and gravity's potential as terms of the Lagrangian, and
-    /// gravity's acceleration.
+    /// energy and gravity's potential as terms of the Lagrangian.
     fn validate_bodies(
         &self,
         file: &str,
         names: &Names,
         parse: &ExprParser,
-    ) -> Result<(Vec<Expr>, Option<[Expr; 3]>), ModelError> {
+    ) -> Result<ReadBodies, ModelError> {
         let err = error_at(file);
         let parameters = [&names.parameters];
         let positions = names.positions();
@@ -1136,7 +1149,7 @@ impl ModelFile {
             }
             None => None,
         };
-        let mut energies = Vec::new();
+        let (mut energies, mut tensors) = (Vec::new(), Vec::new());
         for (k, body) in self.bodies.iter().enumerate() {
             let key = |part: &str| format!("bodies[{k}].{part}");
             if !is_identifier(&body.name) {
@@ -1190,8 +1203,13 @@ impl ModelFile {
                 )
             })?;
             energies.push(energy);
+            tensors.push(tensor);
         }
-        Ok((energies, gravity))
+        Ok(ReadBodies {
+            energies,
+            tensors,
+            gravity,
+        })
     }
 
     /// Constraints: each a position or a velocity expression, named once;
