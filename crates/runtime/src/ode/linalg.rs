@@ -46,6 +46,22 @@ impl<L: Scalar, const N: usize> Cholesky<L, N> {
         Self::factor(a, L::semidefinite_inverse_sqrt)
     }
 
+    /// [`Cholesky::semidefinite`] with its own threshold: a row whose
+    /// pivot is at most `dependent` of its diagonal entry is skipped.
+    #[inline]
+    pub fn semidefinite_within(a: [[L; N]; N], dependent: f64) -> Self
+    where
+        L: PartialOrd,
+    {
+        Self::factor(a, |d, diagonal| {
+            if d > diagonal * dependent && d > L::default() {
+                d.positive_sqrt().recip()
+            } else {
+                L::default()
+            }
+        })
+    }
+
     /// L column by column, each pivot d (with its diagonal entry) turned
     /// into 1/√d by `inverse_pivot`; L's diagonal itself is never read.
     #[inline(always)]

@@ -188,6 +188,20 @@ pub enum Method {
 pub const METHOD_NAMES: [&str; 6] = ["rk4", "dop853", "gauss4", "gauss6", "radau5", "taylor"];
 
 impl Method {
+    /// DOP853 at this method's tolerance, or at `floor` where that is
+    /// tighter (a fixed-step method's step is not a tolerance: `floor`).
+    pub fn dop853_at_least(self, floor: f64) -> Method {
+        let tol = match self {
+            Method::Taylor { tol } => tol,
+            Method::Dop853 { rtol, atol } | Method::Radau5 { rtol, atol } => rtol.min(atol),
+            Method::Rk4 { .. } | Method::Gauss { .. } => floor,
+        };
+        Method::Dop853 {
+            rtol: tol.max(floor),
+            atol: tol.max(floor),
+        }
+    }
+
     /// A method by name: `rk4`, `gauss4`, `gauss6` take a step size, `dop853`
     /// and `radau5` a tolerance (used as both relative and absolute
     /// tolerance), `taylor` a tolerance (which sets its order).

@@ -25,6 +25,15 @@ pub trait ConstrainedSystems: Flows {
     fn constraint_names(&self) -> &'static [&'static str];
     /// Which constraints are holonomic.
     fn holonomic(&self) -> Vec<bool>;
+    /// The equations that pass singular positions
+    /// ([`crate::constrained::PassingSingular`]), their window set by G's
+    /// rows at the state `y` where a run starts.
+    fn passing_singular(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Box<dyn AnySystem>, OdeError>;
     /// The model file's start at rest, [q_start; 0] (not yet projected:
     /// a moving constraint may need velocities).
     fn start(&self, params: &[f64]) -> Vec<f64>;
@@ -326,6 +335,24 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
 {
     fn constraint_names(&self) -> &'static [&'static str] {
         self.forms.constraint_names
+    }
+    fn passing_singular(
+        &self,
+        params: &[f64],
+        t: f64,
+        y: &[f64],
+    ) -> Result<Box<dyn AnySystem>, OdeError> {
+        use crate::constrained::{PassingSingular, SINGULAR_WINDOW};
+        let g = self.constraint_matrix(params, t, y)?;
+        let lengths: Vec<f64> = g.row_iter().map(|row| row.norm()).collect();
+        let longest = lengths.iter().copied().fold(0.0, f64::max);
+        // A row (all but) vanished at the start takes the longest's scale.
+        let floors =
+            std::array::from_fn(|r| SINGULAR_WINDOW * lengths[r].max(SINGULAR_WINDOW * longest));
+        Ok(Box::new(crate::ode::SizedSystem(PassingSingular {
+            equations: self.equations(params),
+            floors,
+        })))
     }
     fn holonomic(&self) -> Vec<bool> {
         self.forms.holonomic.to_vec()

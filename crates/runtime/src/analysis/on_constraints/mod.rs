@@ -10,6 +10,7 @@ pub mod vibration;
 
 use nalgebra::DMatrix;
 
+use crate::constrained::PASSING_TOLERANCE;
 use crate::ode::holonomic::{restricted_monodromy, ConstraintError};
 use crate::ode::{AnyOptions, Integrator, Method, OdeError};
 use crate::registry::{ConstrainedSystems, ParameterError};
@@ -60,9 +61,9 @@ pub enum ConstrainedError {
     #[error("the output times must increase from t0 = {t0} and be finite")]
     Times { t0: f64 },
     /// The integration stopped where the constraints lose rank: a singular
-    /// position of the mechanism (a four-bar's links aligned), which the
-    /// run cannot pass yet.
-    #[error("model '{model}' stopped at t = {t}, at a singular position: its constraints' Jacobian, of rank {rank} at the start (smallest singular value {at_start:.1e}), has one of {smallest:.1e} there, so its rank drops; passing a singular position is not supported yet ({source})")]
+    /// position of the mechanism (a four-bar's links aligned), which even
+    /// the equations that pass them did not pass.
+    #[error("model '{model}' stopped at t = {t}, at a singular position: its constraints' Jacobian, of rank {rank} at the start (smallest singular value {at_start:.1e}), has one of {smallest:.1e} there, so its rank drops; the equations made to pass singular positions did not pass this one ({source})")]
     SingularPosition {
         model: &'static str,
         t: f64,
@@ -89,22 +90,28 @@ fn regular_rank(
     Some((rank, values[rank - 1]))
 }
 
-/// A step size that underflowed where the constraints have (nearly) lost
-/// rank, their `rank`-th singular value below 1e-4 of its value at the
-/// start, is named as a singular position; any other error is passed on.
+/// A step size that underflowed, or a state that stopped being finite,
+/// where the constraints have (nearly) lost rank, their `rank`-th singular
+/// value below 1e-4 of its value at the start, is named as a singular
+/// position; any other error is passed on.
 fn named_singularity(
     model: &dyn ConstrainedSystems,
     params: &[f64],
     regular: Option<(usize, f64)>,
     error: OdeError,
 ) -> ConstrainedError {
-    if let (OdeError::StepSizeUnderflow { t, y, .. }, Some((rank, at_start))) = (&error, regular) {
-        if let Ok(values) = model.constraint_singular_values(params, *t, y) {
+    let stopped = match &error {
+        OdeError::StepSizeUnderflow { t, y, .. } => Some((*t, &y[..])),
+        OdeError::NonFinite { t, y } => Some((*t, &y[..])),
+        _ => None,
+    };
+    if let (Some((t, y)), Some((rank, at_start))) = (stopped, regular) {
+        if let Ok(values) = model.constraint_singular_values(params, t, y) {
             let smallest = values.get(rank - 1).copied().unwrap_or(0.0);
             if smallest < 1e-4 * at_start {
                 return ConstrainedError::SingularPosition {
                     model: model.info().name,
-                    t: *t,
+                    t,
                     smallest,
                     at_start,
                     rank,
@@ -139,6 +146,11 @@ pub struct ConstrainedRun {
     /// not determine: their multipliers are reported as 0, one choice of
     /// many (the mechanism is statically indeterminate there).
     pub indeterminate: Vec<&'static str>,
+    /// Where the run met a singular position of the mechanism (its
+    /// constraints' rank dropping) and went on, from this time (the last
+    /// projected state before it), with the equations that pass them
+    /// ([`crate::constrained::PassingSingular`]); None if it met none.
+    pub passing_singular_from: Option<f64>,
 }
 
 /// Runs `model` from `y0` (the model file's start at rest if None; made
@@ -166,8 +178,9 @@ pub fn run(
         largest_residual: (0.0, 0.0),
         steps: 0,
         indeterminate: Vec::new(),
+        passing_singular_from: None,
     };
-    let (start, steps) = follow(model, params, y0, method, times, &mut |ts, mut sample| {
+    let followed = follow(model, params, y0, method, times, &mut |ts, mut sample| {
         let output = model.output(params, ts, &mut sample).map_err(|source| {
             ConstrainedError::Constraint {
                 model: name,
@@ -188,11 +201,13 @@ pub fn run(
     let t0 = times.first().copied().unwrap_or(0.0);
     let names = model.constraint_names();
     result.indeterminate = model
-        .indeterminate_reactions(params, t0, &start)?
+        .indeterminate_reactions(params, t0, &followed.start)?
         .into_iter()
         .map(|i| names[i])
         .collect();
-    (result.start, result.steps) = (start, steps);
+    result.start = followed.start;
+    result.steps = followed.steps;
+    result.passing_singular_from = followed.passing_from;
     Ok(result)
 }
 
@@ -232,8 +247,11 @@ pub fn states(
 /// The integration of [`run`]: through groups of output times with dense
 /// output, the integrated state projected at each group's end; each
 /// output (not yet projected) goes to `report`. Returns the start after
-/// its projection and the steps taken; a run that stops at a singular
-/// position says so.
+/// its projection and the steps taken. A run that meets a singular
+/// position goes on from the last projected state with the equations that
+/// pass them ([`crate::constrained::PassingSingular`], by DOP853 at the
+/// method's tolerance, at most [`PASSING_TOLERANCE`]: they have no
+/// recurrences and are noisy there); one that stops there even so says so.
 fn follow(
     model: &dyn ConstrainedSystems,
     params: &[f64],
@@ -241,7 +259,7 @@ fn follow(
     method: Method,
     times: &[f64],
     report: &mut dyn FnMut(f64, Vec<f64>) -> Result<(), ConstrainedError>,
-) -> Result<(Vec<f64>, u64), ConstrainedError> {
+) -> Result<Followed, ConstrainedError> {
     let name = model.info().name;
     let t0 = times.first().copied().unwrap_or(0.0);
     if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| !(w[1] > w[0])) {
@@ -264,8 +282,10 @@ fn follow(
     model.project(params, t0, &mut y).map_err(constraint(t0))?;
     let start = y.clone();
     let regular = regular_rank(model, params, t0, &y);
-    let system = model.exact(params);
+    let mut system = model.exact(params);
     let mut integrator = Integrator::new(method)?;
+    let mut passing_from = None;
+    let mut steps_before = 0;
     // Each reported state is projected too (a step cut short at every
     // output time cost the pendulum's run twice its steps).
     let mut t = t0;
@@ -273,15 +293,26 @@ fn follow(
         let t1 = group[group.len() - 1];
         let samples = match t1 > t {
             true => {
-                let solution = system
-                    .solve(
-                        &mut integrator,
-                        t,
-                        &y,
-                        t1,
-                        AnyOptions::default().times(group),
-                    )
-                    .map_err(|e| named_singularity(model, params, regular, e))?;
+                let options = || AnyOptions::default().times(group);
+                let named = |e| named_singularity(model, params, regular, e);
+                let solution = match system.solve(&mut integrator, t, &y, t1, options()) {
+                    Ok(solution) => solution,
+                    // Met a singular position: this group again, and the
+                    // rest, with the equations that pass them.
+                    Err(error) => match named(error) {
+                        ConstrainedError::SingularPosition { .. } if passing_from.is_none() => {
+                            system = model.passing_singular(params, t0, &start)?;
+                            steps_before = integrator.stats.steps;
+                            let passing = method.dop853_at_least(PASSING_TOLERANCE);
+                            integrator = Integrator::new(passing)?;
+                            passing_from = Some(t);
+                            system
+                                .solve(&mut integrator, t, &y, t1, options())
+                                .map_err(named)?
+                        }
+                        other => return Err(other),
+                    },
+                };
                 y = solution.y;
                 solution.samples
             }
@@ -296,7 +327,20 @@ fn follow(
             t = t1;
         }
     }
-    Ok((start, integrator.stats.steps))
+    Ok(Followed {
+        start,
+        steps: steps_before + integrator.stats.steps,
+        passing_from,
+    })
+}
+
+/// What [`follow`] found besides the outputs.
+struct Followed {
+    /// The start after its projection.
+    start: Vec<f64>,
+    steps: u64,
+    /// See [`ConstrainedRun::passing_singular_from`].
+    passing_from: Option<f64>,
 }
 
 /// Output times per projection of the integrated state.
