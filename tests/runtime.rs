@@ -381,3 +381,26 @@ fn a_models_systems_run_its_typed_system_bit_for_bit() {
         })
     );
 }
+
+/// The windowed factor of a semidefinite matrix: a row within the window
+/// of the earlier rows' span is skipped (its unknown 0; here x = (2, 0)
+/// solves [[1, 1], [1, 1 + ε]] x = (2, 2) with ε = 1e-8 inside a window of
+/// 1e-6, while 1e-10 keeps the row: x = (2, 0) too, the exact solution),
+/// and a NaN entry stays NaN rather than be skipped as a vanished row.
+#[test]
+fn the_windowed_factor_skips_dependent_rows_and_keeps_nan() {
+    use mechlab::linalg::Cholesky;
+    let a = [[1.0, 1.0], [1.0, 1.0 + 1e-8]];
+    for window in [1e-6, 1e-10] {
+        let factor = Cholesky::semidefinite_within(a, window);
+        assert_eq!(factor.rank(), if window > 1e-8 { 1 } else { 2 });
+        let x = factor.solve([2.0, 2.0]);
+        assert!((x[0] - 2.0).abs() < 1e-7 && x[1].abs() < 1e-7, "{x:?}");
+    }
+    let b = [[1.0, 0.0], [0.0, 1.0 + 1e-8]];
+    let x = Cholesky::semidefinite_within(b, 1e-6).solve([1.0, 1.0]);
+    assert!((x[1] - 1.0).abs() < 1e-7, "an independent row kept: {x:?}");
+    let nan = [[f64::NAN, 0.0], [0.0, 1.0]];
+    let x = Cholesky::semidefinite_within(nan, 1e-6).solve([1.0, 1.0]);
+    assert!(x[0].is_nan(), "{x:?}");
+}

@@ -20,7 +20,7 @@ pub mod averaged;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::linalg::Cholesky;
+use crate::linalg::{Cholesky, REDUNDANT};
 use crate::ode::any_size::fixed_state;
 use crate::ode::holonomic::{ConstraintError, Holonomic, Projection};
 use crate::ode::{
@@ -480,6 +480,36 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     }
 }
 
+/// At q: M's factor, M⁻¹Gᵀ and the factor of the Schur complement
+/// G M⁻¹ Gᵀ, a row within `dependent` of the earlier rows' span skipped
+/// ([`Cholesky::semidefinite_within`]): what a correction along the
+/// constraints' normals, in the metric of M, takes.
+struct Normals<const N: usize, const K: usize> {
+    mass: Cholesky<f64, N>,
+    m_inv_gt: [[f64; N]; K],
+    schur: Cholesky<f64, K>,
+}
+
+impl<const N: usize, const K: usize> Normals<N, K> {
+    fn new(mass: [[f64; N]; N], g: &[[f64; N]; K], dependent: f64) -> Self {
+        let mass = Cholesky::new(mass);
+        let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|r| mass.solve(g[r]));
+        let schur: [[f64; K]; K] =
+            std::array::from_fn(|r| std::array::from_fn(|c| dot(&g[r], &m_inv_gt[c])));
+        Normals {
+            mass,
+            m_inv_gt,
+            schur: Cholesky::semidefinite_within(schur, dependent),
+        }
+    }
+
+    /// M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ r.
+    fn along(&self, r: [f64; K]) -> [f64; N] {
+        let mu = self.schur.solve(r);
+        std::array::from_fn(|i| (0..K).map(|row| self.m_inv_gt[row][i] * mu[row]).sum())
+    }
+}
+
 impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// [`crate::ode::holonomic::project`] at the model's sizes, without
     /// allocating (a run projects every reported state): positions by
@@ -497,21 +527,11 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
         let forms = &self.0;
         // The correction −M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁻¹ r, or why it does not exist.
         let correction = |q: &[f64; N], r: [f64; K]| -> Result<[f64; N], ConstraintError> {
-            let mass = Cholesky::new(forms.mass_matrix(t, q));
             let g = forms.constraint_jacobian(t, q);
-            let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|row| mass.solve(g[row]));
-            let schur: [[f64; K]; K] =
-                std::array::from_fn(|a| std::array::from_fn(|b| dot(&g[a], &m_inv_gt[b])));
-            let schur = Cholesky::semidefinite(schur);
-            let schur_kept = schur.rank() > 0;
-            let lambda = schur.solve(r);
-            let step: [f64; N] = std::array::from_fn(|i| {
-                -(0..K)
-                    .map(|row| m_inv_gt[row][i] * lambda[row])
-                    .sum::<f64>()
-            });
+            let normals = Normals::new(forms.mass_matrix(t, q), &g, REDUNDANT);
+            let step = normals.along(r).map(|x| -x);
             // No row left (G = 0) with a residual to remove: degenerate.
-            let stalled = K > 0 && !schur_kept && r.iter().any(|x| *x != 0.0);
+            let stalled = K > 0 && normals.schur.rank() == 0 && r.iter().any(|x| *x != 0.0);
             match step.iter().all(|x| x.is_finite()) && !stalled {
                 true => Ok(step),
                 false => Err(ConstraintError::Singular { q: q.to_vec() }),
@@ -600,36 +620,28 @@ pub const PASSING_TOLERANCE: f64 = 1e-13;
 
 impl<const N: usize, const K: usize, const S: usize> PassingSingular<N, K, S> {
     /// G at q with its rows at unit length (their lengths returned), a
-    /// row shorter than its floor set to 0.
+    /// row shorter than its floor set to 0 (its length returned as 0).
     fn unit_rows(&self, t: f64, q: &[f64; N]) -> ([[f64; N]; K], [f64; K]) {
         let mut g = self.equations.0.constraint_jacobian(t, q);
         let mut lengths = [0.0; K];
         for (r, row) in g.iter_mut().enumerate() {
             let length = dot(row, row).sqrt();
-            let scale = if length > self.floors[r] {
-                length.recip()
+            // A NaN row stays NaN: never skipped as if it had vanished.
+            lengths[r] = if length > self.floors[r] || length.is_nan() {
+                length
             } else {
                 0.0
             };
+            let scale = per_length(&lengths, r, 1.0);
             row.iter_mut().for_each(|x| *x *= scale);
-            lengths[r] = if scale > 0.0 { length } else { 0.0 };
         }
         (g, lengths)
     }
 
-    /// M's factor, M⁻¹Ĝᵀ and the windowed factor of Ĝ M⁻¹ Ĝᵀ at q.
-    fn factors(
-        &self,
-        t: f64,
-        q: &[f64; N],
-        g: &[[f64; N]; K],
-    ) -> (Cholesky<f64, N>, [[f64; N]; K], Cholesky<f64, K>) {
-        let mass = Cholesky::new(self.equations.0.mass_matrix(t, q));
-        let m_inv_gt: [[f64; N]; K] = std::array::from_fn(|r| mass.solve(g[r]));
-        let schur: [[f64; K]; K] =
-            std::array::from_fn(|r| std::array::from_fn(|c| dot(&g[r], &m_inv_gt[c])));
+    /// The normals of the rows `g` kept at q, within the window.
+    fn normals(&self, t: f64, q: &[f64; N], g: &[[f64; N]; K]) -> Normals<N, K> {
         let window = SINGULAR_WINDOW * SINGULAR_WINDOW;
-        (mass, m_inv_gt, Cholesky::semidefinite_within(schur, window))
+        Normals::new(self.equations.0.mass_matrix(t, q), g, window)
     }
 
     /// Newton's method onto g = 0 from q, at most four steps, until a
@@ -641,17 +653,12 @@ impl<const N: usize, const K: usize, const S: usize> PassingSingular<N, K, S> {
                 return;
             }
             let (g, lengths) = self.unit_rows(t, q);
-            let (_, m_inv_gt, schur) = self.factors(t, q, &g);
-            let scaled: [f64; K] = std::array::from_fn(|r| match lengths[r] {
-                0.0 => 0.0,
-                length => residual[r] / length,
-            });
-            let mu = schur.solve(scaled);
+            let scaled: [f64; K] = std::array::from_fn(|r| per_length(&lengths, r, residual[r]));
+            let step = self.normals(t, q, &g).along(scaled);
             let mut largest = 0.0_f64;
-            for (i, x) in q.iter_mut().enumerate() {
-                let step: f64 = (0..K).map(|r| m_inv_gt[r][i] * mu[r]).sum();
-                *x -= step;
-                largest = largest.max(step.abs());
+            for (x, d) in q.iter_mut().zip(step) {
+                *x -= d;
+                largest = largest.max(d.abs());
             }
             if largest <= tolerance {
                 return;
@@ -666,26 +673,32 @@ impl<const N: usize, const K: usize, const S: usize> System<S> for PassingSingul
         let forms = &self.equations.0;
         self.onto_positions(t, &mut q, self.equations.position_tolerance(y));
         let (g, lengths) = self.unit_rows(t, &q);
-        let (mass, m_inv_gt, schur) = self.factors(t, &q, &g);
+        let normals = self.normals(t, &q, &g);
         let rates = forms.constraint_rates(t, &q);
-        let per_length = |r: usize, x: f64| match lengths[r] {
-            0.0 => 0.0,
-            length => x / length,
-        };
-        let broken: [f64; K] = std::array::from_fn(|r| dot(&g[r], &v) + per_length(r, rates[r]));
-        let mu = schur.solve(broken);
-        let v: [f64; N] =
-            std::array::from_fn(|i| v[i] - (0..K).map(|r| m_inv_gt[r][i] * mu[r]).sum::<f64>());
-        let free = mass.solve(forms.free_forces(t, &q, &v));
+        let broken: [f64; K] =
+            std::array::from_fn(|r| dot(&g[r], &v) + per_length(&lengths, r, rates[r]));
+        let off = normals.along(broken);
+        let v: [f64; N] = std::array::from_fn(|i| v[i] - off[i]);
+        let free = normals.mass.solve(forms.free_forces(t, &q, &v));
         let h = forms.constraint_bias(t, &q, &v);
-        let rhs: [f64; K] = std::array::from_fn(|r| -per_length(r, h[r]) - dot(&g[r], &free));
-        let lambda = schur.solve(rhs);
+        let rhs: [f64; K] =
+            std::array::from_fn(|r| -per_length(&lengths, r, h[r]) - dot(&g[r], &free));
+        let reaction = normals.along(rhs);
         let mut out = [0.0; S];
         for i in 0..N {
             out[i] = v[i];
-            out[N + i] = free[i] + (0..K).map(|r| m_inv_gt[r][i] * lambda[r]).sum::<f64>();
+            out[N + i] = free[i] + reaction[i];
         }
         out
+    }
+}
+
+/// A row's entry `x` over the row's length, for rows taken at unit
+/// length; 0 for a row skipped (its length 0).
+fn per_length<const K: usize>(lengths: &[f64; K], r: usize, x: f64) -> f64 {
+    match lengths[r] {
+        0.0 => 0.0,
+        length => x / length,
     }
 }
 

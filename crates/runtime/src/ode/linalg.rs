@@ -46,22 +46,6 @@ impl<L: Scalar, const N: usize> Cholesky<L, N> {
         Self::factor(a, L::semidefinite_inverse_sqrt)
     }
 
-    /// [`Cholesky::semidefinite`] with its own threshold: a row whose
-    /// pivot is at most `dependent` of its diagonal entry is skipped.
-    #[inline]
-    pub fn semidefinite_within(a: [[L; N]; N], dependent: f64) -> Self
-    where
-        L: PartialOrd,
-    {
-        Self::factor(a, |d, diagonal| {
-            if d > diagonal * dependent && d > L::default() {
-                d.positive_sqrt().recip()
-            } else {
-                L::default()
-            }
-        })
-    }
-
     /// L column by column, each pivot d (with its diagonal entry) turned
     /// into 1/√d by `inverse_pivot`; L's diagonal itself is never read.
     #[inline(always)]
@@ -115,6 +99,24 @@ impl<L: Scalar, const N: usize> Cholesky<L, N> {
             x[i] = (y[i] - later) * self.inverse_diagonal[i];
         }
         x
+    }
+}
+
+impl<const N: usize> Cholesky<f64, N> {
+    /// [`Cholesky::semidefinite`] with its own threshold: a row whose
+    /// pivot is at most `dependent` of its diagonal entry is skipped (a NaN
+    /// pivot stays NaN). At [`REDUNDANT`] it is `semidefinite` itself.
+    #[inline]
+    pub fn semidefinite_within(a: [[f64; N]; N], dependent: f64) -> Self {
+        Self::factor(a, |d, diagonal| {
+            if d > dependent * diagonal && d > 0.0 {
+                d.sqrt().recip()
+            } else if d.is_nan() || diagonal.is_nan() {
+                f64::NAN
+            } else {
+                0.0
+            }
+        })
     }
 }
 
