@@ -433,14 +433,18 @@ fn constrained_runs(
         },
         period_map,
         equilibria_not_searched: Some(NotSearched::OnConstraints),
-        switches: vec![format!(
+        switches: std::iter::once(format!(
             "constraints ({}): largest residual |g| {:.1e}, |G q' + c_t| {:.1e} after projection; {:.1e}, {:.1e} before",
             run.constraint_names.join(", "),
             run.largest_residual.0,
             run.largest_residual.1,
             run.largest_drift.0,
             run.largest_drift.1
-        )],
+        ))
+        .chain(run.passing_singular_from.map(|t| {
+            format!("a singular position met: from t = {t:.4} on, the equations that pass them (DOP853)")
+        }))
+        .collect(),
         reactions: Some(Reactions {
             names: run.constraint_names,
             values: run.reactions,

@@ -446,6 +446,23 @@ impl<const N: usize, const K: usize, const S: usize> Holonomic for OnConstraints
 /// to the coordinates' scale, see [`OnConstraints::position_tolerance`]).
 pub const PROJECTION_TOLERANCE: f64 = 1e-14;
 
+/// Whether a Newton step moves every coordinate by at most a few units in
+/// the last place of the largest: if the residual then stops falling, the
+/// positions are as close to the constraints as floating point puts them. An angle turned many times (a
+/// coupler at 256 rad, whose last place is 5.7e-14) leaves a residual
+/// above [`PROJECTION_TOLERANCE`] that no step can remove, and Newton's
+/// method spreads its correction over every coordinate.
+pub fn at_rounding(q: &[f64], step: &[f64]) -> bool {
+    let largest = q.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
+    step.iter().all(|d| d.abs() <= 4.0 * f64::EPSILON * largest)
+}
+
+/// How many times the projection's tolerance a residual may stay when
+/// Newton's steps have reached the coordinates' rounding ([`at_rounding`]):
+/// beyond it, a step that small means rows skipped as dependent, not
+/// rounding, and the state is refused.
+pub const ROUNDING_RESIDUAL: f64 = 1e4;
+
 impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// The Jacobian (2k × 2n) of the state's constraints [g; G q' + c_t]
     /// with respect to [q; q'] (a velocity constraint has no position
@@ -513,7 +530,8 @@ impl<const N: usize, const K: usize> Normals<N, K> {
 impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
     /// [`crate::ode::holonomic::project`] at the model's sizes, without
     /// allocating (a run projects every reported state): positions by
-    /// Newton's method in the metric of M until |g| ≤ `tolerance`, then
+    /// Newton's method in the metric of M until |g| ≤ `tolerance` (or its
+    /// steps reach the coordinates' rounding, [`at_rounding`]), then
     /// velocities exactly.
     pub fn project(
         &self,
@@ -540,12 +558,15 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
         const MAX_STEPS: usize = 20;
         let (mut q, mut v) = Self::split(y);
         let mut newton_steps = 0;
+        let (mut rounded, mut previous) = (false, f64::INFINITY);
         let position_residual = loop {
             let residual = forms.position_residuals(t, &q);
             let size = residual.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-            if size <= tolerance {
+            let stalled = rounded && size > previous / 2.0;
+            if size <= tolerance || (stalled && size <= ROUNDING_RESIDUAL * tolerance) {
                 break size;
             }
+            previous = size;
             if newton_steps == MAX_STEPS || !size.is_finite() {
                 return Err(ConstraintError::NoConvergence {
                     residual: size,
@@ -553,6 +574,7 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
                 });
             }
             let step = correction(&q, residual)?;
+            rounded = at_rounding(&q, &step);
             for (x, d) in q.iter_mut().zip(step) {
                 *x += d;
             }
@@ -645,7 +667,8 @@ impl<const N: usize, const K: usize, const S: usize> PassingSingular<N, K, S> {
     }
 
     /// Newton's method onto g = 0 from q, at most four steps, until a
-    /// step is below the projections' tolerance.
+    /// step is below the projections' tolerance: near a singular position
+    /// the residual is below rounding while the positions are still off.
     fn onto_positions(&self, t: f64, q: &mut [f64; N], tolerance: f64) {
         for _ in 0..4 {
             let residual = self.equations.0.position_residuals(t, q);

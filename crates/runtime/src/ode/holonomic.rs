@@ -17,6 +17,8 @@
 
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
+use crate::constrained::{at_rounding, ROUNDING_RESIDUAL};
+
 /// What a holonomically constrained system gives at (t, q).
 pub trait Holonomic {
     /// The number n of coordinates (the state is [q; q̇], 2n numbers).
@@ -168,7 +170,9 @@ pub fn accelerations(
 
 /// Projects the state `y` = [q; q̇] at time t onto the manifold g = 0,
 /// G q̇ + g_t = 0 in the metric of M: positions by Newton's method until
-/// |g| ≤ `tolerance` (at most 20 steps), then velocities exactly.
+/// |g| ≤ `tolerance`, or its steps reach the coordinates' rounding and |g|
+/// stops falling within [`ROUNDING_RESIDUAL`] times it (at most 20
+/// steps), then velocities exactly.
 pub fn project(
     system: &dyn Holonomic,
     t: f64,
@@ -212,12 +216,15 @@ pub fn project_holding(
     const MAX_STEPS: usize = 20;
     let (q, v) = y.split_at_mut(n);
     let mut newton_steps = 0;
+    let (mut rounded, mut previous) = (false, f64::INFINITY);
     let position_residual = loop {
         let residual = system.residual(t, q);
         let size = residual.amax();
-        if size <= tolerance {
+        let stalled = rounded && size > previous / 2.0;
+        if size <= tolerance || (stalled && size <= ROUNDING_RESIDUAL * tolerance) {
             break size;
         }
+        previous = size;
         if newton_steps == MAX_STEPS || !size.is_finite() {
             return Err(ConstraintError::NoConvergence {
                 residual: size,
@@ -227,6 +234,7 @@ pub fn project_holding(
         let (g, _) = system.jacobian(t, q);
         let m = restricted(system.mass(t, q), 0);
         let step = Factors::at(&m, &g, q)?.correction(&residual);
+        rounded = at_rounding(q, step.as_slice());
         for (i, (x, d)) in q.iter_mut().zip(step.iter()).enumerate() {
             if !held.contains(&i) {
                 *x += d;
