@@ -1220,7 +1220,7 @@ fn crank_pendulum(spin: f64, outputs: usize) -> Vec<[f64; 2]> {
 /// driven by the torque τ on crank 1 alone, M l² θ'' = −M g l sin θ + τ
 /// (integrated here by hand): the bar's reactions carry τ to the other
 /// cranks. Over 10 s each crank follows the hand-written pendulum to 1e-8,
-/// E = ½ M l² θ'² − M g l cos θ − τ θ holds to 1e-10 and the constraints to
+/// E = ½ M l² θ'² − M g l cos θ − τ θ holds to 1e-10 of itself and the constraints to
 /// 1e-12, with DOP853 and Taylor; the three conditions' reactions are named
 /// indeterminate. Spun fast enough to turn, the cranks pass θ = π/2 + kπ,
 /// where every condition's gradient vanishes, ten times: the run goes on
@@ -1238,7 +1238,8 @@ fn parallel_cranks_with_a_redundant_bar_swing_as_one_pendulum() {
         mass * l * l * rate * rate / 2.0 - mass * g * l * theta.cos() - tau * theta
     };
     // Each crank on the pendulum started at the bottom with `spin`, to
-    // `tolerance`; its energy integral to 1e-10, the constraints to 1e-12.
+    // `tolerance`; its energy integral to 1e-10 of itself, the constraints
+    // to 1e-12.
     let follows = |r: &ConstrainedRun, spin: f64, tolerance: f64, method: Method| {
         let reference = crank_pendulum(spin, times.len());
         let e0 = energy(0.0, spin);
@@ -1252,7 +1253,10 @@ fn parallel_cranks_with_a_redundant_bar_swing_as_one_pendulum() {
                 );
             }
             let e = energy(state[0], state[3]);
-            assert!((e - e0).abs() < 1e-10, "{method:?}: E = {e} not {e0}");
+            assert!(
+                (e - e0).abs() < 1e-10 * e0.abs(),
+                "{method:?}: E = {e} not {e0}"
+            );
         }
         let (positions, velocities) = r.largest_residual;
         assert!(
@@ -1293,10 +1297,15 @@ fn parallel_cranks_with_a_redundant_bar_swing_as_one_pendulum() {
             &times,
         )
         .unwrap();
-        // The regular equations may pass a singular position or two before
-        // one stops them.
-        let from = r.passing_singular_from.expect("a singular position met");
-        assert!(from < 9.0 && from > first - 1.7, "{method:?}: from {from}");
+        // One interval near each singular position, the first about it.
+        assert_eq!(
+            r.near_singular.len(),
+            10,
+            "{method:?}: {:?}",
+            r.near_singular
+        );
+        let [from, to] = r.near_singular[0];
+        assert!(from < first && to > first - 0.1, "{method:?}: {from}..{to}");
         follows(&r, spin, 1e-10, method);
         let passed = ((r.states[100][0] - FRAC_PI_2) / PI).floor() + 1.0;
         assert_eq!(passed, 10.0, "{method:?}");
@@ -1333,6 +1342,98 @@ fn a_coupler_turned_many_times_stays_on_its_constraints() {
         r.largest_residual
     );
 }
+
+/// The IFToMM benchmark library's N-four-bar mechanism (A02) with N = 2:
+/// three cranks and two couplers, 1 kg and 1 m each, started upright with
+/// the first crank's tip at 1 m/s. Its windows stay parallelograms, so it
+/// turns as the pendulum 3 θ'' = −3.5 g cos θ (integrated here by hand),
+/// through a singular position each time the cranks lie horizontal, where
+/// the branch on which a crank lies flat crosses its own. Over the
+/// benchmark's 10 s, with DOP853 and Taylor, the run keeps the
+/// parallelogram branch (every crank on that pendulum to 1e-8 and the
+/// couplers level; on the other branch they are off by 0.1 and more),
+/// passes each singular position in an interval of its own, holds the
+/// energy to 1e-9 of itself and the constraints to 1e-12. (The benchmark
+/// asks for 1e-10 of the energy: 2e-10 and 6e-11 here, but up to 4e-10 from
+/// other starts, see docs/constraints.md.)
+#[test]
+fn the_iftomm_n_four_bar_turns_through_its_singular_positions() {
+    use mechlab_test_models::iftomm_n_four_bar;
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+    let params = [1.0, 1.0, 1.0, 9.81]; // m, l, d, g
+    let (inertia, weight) = (3.0, 3.5 * 9.81);
+    let field = |y: [f64; 2]| [y[1], -weight * y[0].cos() / inertia];
+    let times: Vec<f64> = (0..=200).map(|k| 0.05 * k as f64).collect();
+    let mut reference = vec![[FRAC_PI_2, -1.0]];
+    let mut y = reference[0];
+    let h = 1e-4;
+    for _ in 1..times.len() {
+        for _ in 0..500 {
+            let k1 = field(y);
+            let k2 = field([y[0] + h / 2.0 * k1[0], y[1] + h / 2.0 * k1[1]]);
+            let k3 = field([y[0] + h / 2.0 * k2[0], y[1] + h / 2.0 * k2[1]]);
+            let k4 = field([y[0] + h * k3[0], y[1] + h * k3[1]]);
+            for i in 0..2 {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        reference.push(y);
+    }
+    let energy = |theta: f64, rate: f64| inertia * rate * rate / 2.0 + weight * theta.sin();
+    let e0 = energy(FRAC_PI_2, -1.0);
+    let start = [
+        FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, 0.0, 0.0, -1.0, -1.0, -1.0, 0.0, 0.0,
+    ];
+    // Horizontal cranks: θ = π/2 − (k + 1/2)π on the way down and round.
+    let singular = |theta: f64| ((FRAC_PI_2 - theta) / PI + 0.5).floor();
+    let passes = singular(reference[200][0]);
+    assert!(passes >= 8.0, "{passes}");
+    for method in [TIGHT, Method::Taylor { tol: 1e-14 }] {
+        let r = run(
+            &iftomm_n_four_bar::SYSTEMS,
+            &params,
+            Some(&start),
+            method,
+            &times,
+        )
+        .unwrap();
+        assert_eq!(
+            r.near_singular.len() as f64,
+            passes,
+            "{method:?}: {:?}",
+            r.near_singular
+        );
+        let (mut worst, mut drift) = (0.0_f64, 0.0_f64);
+        for (k, (state, expected)) in r.states.iter().zip(&reference).enumerate() {
+            for crank in 0..3 {
+                worst = worst
+                    .max((state[crank] - expected[0]).abs())
+                    .max((state[5 + crank] - expected[1]).abs());
+            }
+            for coupler in 3..5 {
+                let level = (state[coupler] + PI).rem_euclid(TAU) - PI;
+                worst = worst.max(level.abs()).max(state[5 + coupler].abs());
+            }
+            drift = drift.max((energy(state[0], state[5]) - e0).abs() / e0);
+            assert!(
+                worst < 1e-8,
+                "{method:?} at t = {}: {state:?} against {expected:?}",
+                times[k]
+            );
+        }
+        assert!(drift < 1e-9, "{method:?}: relative energy error {drift:e}");
+        assert_eq!(singular(r.states[200][0]), passes, "{method:?}");
+        let (positions, velocities) = r.largest_residual;
+        assert!(
+            positions < 1e-12 && velocities < 1e-12,
+            "{method:?}: {:?}",
+            r.largest_residual
+        );
+    }
+}
+
+/// The IFToMM benchmark library's simple pendulum (A01), in units where
+/// g = l = m = 1 (its 10 s at g = 9.81 m/s² are 31.3 units): a point on a
 
 /// The IFToMM benchmark library's simple pendulum (A01), in units where
 /// g = l = m = 1 (its 10 s at g = 9.81 m/s² are 31.3 units): a point on a

@@ -441,8 +441,11 @@ fn constrained_runs(
             run.largest_drift.0,
             run.largest_drift.1
         ))
-        .chain(run.passing_singular_from.map(|t| {
-            format!("a singular position met: from t = {t:.4} on, the equations that pass them (DOP853)")
+        .chain(run.near_singular.first().map(|[from, _]| {
+            format!(
+                "near a singular position {} time(s), the first from t = {from:.4}: passed by the equations made for them (DOP853)",
+                run.near_singular.len()
+            )
         }))
         .collect(),
         reactions: Some(Reactions {

@@ -11,7 +11,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{Integrator, Method, OdeError, Options, System};
+use super::{Direction, Event, EventSettings, Integrator, Method, OdeError, Options, System};
 
 /// A system behind a trait object whose state is a slice of [`AnySystem::dim`]
 /// numbers. Every method refuses a state of another length with
@@ -73,18 +73,27 @@ pub trait AnySystem: Sync {
     ) -> Result<(), OdeError>;
 }
 
-/// [`Options`] with states as slices: the output times. (Events and
-/// observers, which the fixed-size [`Options`] also take, are not asked
-/// for through this interface yet.)
+/// [`Options`] with states as slices: the output times, and a condition
+/// that stops the run where it falls through 0. (Observers and more
+/// events, which the fixed-size [`Options`] take, are not asked for
+/// through this interface yet.)
 #[derive(Default)]
 pub struct AnyOptions<'o> {
     times: &'o [f64],
+    stop_below: Option<&'o dyn Fn(f64, &[f64]) -> f64>,
 }
 
 impl<'o> AnyOptions<'o> {
     /// [`Options::times`].
     pub fn times(mut self, times: &'o [f64]) -> Self {
         self.times = times;
+        self
+    }
+
+    /// Stop the run just past where `condition(t, y)` falls from positive
+    /// to negative (a terminal [`Event`] of direction falling).
+    pub fn stop_below(mut self, condition: &'o dyn Fn(f64, &[f64]) -> f64) -> Self {
+        self.stop_below = Some(condition);
         self
     }
 }
@@ -94,7 +103,11 @@ impl<'o> AnyOptions<'o> {
 pub struct AnySolution {
     pub t: f64,
     pub y: Vec<f64>,
+    /// The states at the first `samples.len()` of the times asked for:
+    /// all of them unless the stop condition ended the run before the last.
     pub samples: Vec<Vec<f64>>,
+    /// True if the stop condition ended the run (at `t`, before t1).
+    pub stopped: bool,
 }
 
 /// A [`System`] at its own size N as an [`AnySystem`].
@@ -131,12 +144,21 @@ impl<S: System<N> + Sync, const N: usize> AnySystem for SizedSystem<S, N> {
         options: AnyOptions<'_>,
     ) -> Result<AnySolution, OdeError> {
         let y0 = fixed_state::<N>(y0)?;
-        let options = Options::default().times(options.times);
+        let condition = |t: f64, y: &[f64; N]| options.stop_below.map_or(1.0, |c| c(t, y));
+        let events = [Event::new(&condition).direction(Direction::Falling)];
+        let events = match options.stop_below {
+            Some(_) => &events[..],
+            None => &[],
+        };
+        let options = Options::default()
+            .times(options.times)
+            .events(events, EventSettings::default());
         let solution = integrator.solve(&self.0, t0, &y0, t1, options)?;
         Ok(AnySolution {
             t: solution.t,
             y: solution.y.to_vec(),
             samples: solution.samples.iter().map(|y| y.to_vec()).collect(),
+            stopped: solution.terminated,
         })
     }
 

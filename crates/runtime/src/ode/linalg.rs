@@ -108,7 +108,21 @@ impl<const N: usize> Cholesky<f64, N> {
     /// pivot stays NaN). At [`REDUNDANT`] it is `semidefinite` itself.
     #[inline]
     pub fn semidefinite_within(a: [[f64; N]; N], dependent: f64) -> Self {
-        Self::factor(a, |d, diagonal| {
+        Self::semidefinite_with_sines(a, dependent).0
+    }
+
+    /// [`Cholesky::semidefinite_within`], and each row's pivot over its
+    /// diagonal entry: the squared sine of its angle to the span of the
+    /// earlier rows kept (0 for a vanished row).
+    #[inline]
+    pub fn semidefinite_with_sines(a: [[f64; N]; N], dependent: f64) -> (Self, [f64; N]) {
+        let sines = std::cell::Cell::new([0.0; N]);
+        let row = std::cell::Cell::new(0);
+        let factor = Self::factor(a, |d, diagonal| {
+            let mut squared = sines.get();
+            squared[row.get()] = if diagonal > 0.0 { d / diagonal } else { 0.0 };
+            sines.set(squared);
+            row.set(row.get() + 1);
             if d > dependent * diagonal && d > 0.0 {
                 d.sqrt().recip()
             } else if d.is_nan() || diagonal.is_nan() {
@@ -116,7 +130,8 @@ impl<const N: usize> Cholesky<f64, N> {
             } else {
                 0.0
             }
-        })
+        });
+        (factor, sines.get())
     }
 }
 

@@ -12,7 +12,7 @@ use nalgebra::DMatrix;
 
 use crate::constrained::PASSING_TOLERANCE;
 use crate::ode::holonomic::{restricted_monodromy, ConstraintError};
-use crate::ode::{AnyOptions, Integrator, Method, OdeError};
+use crate::ode::{AnyOptions, AnySolution, AnySystem, Integrator, Method, OdeError};
 use crate::registry::{ConstrainedSystems, ParameterError};
 
 /// The monodromy matrix of the periodic orbit through the consistent state
@@ -146,11 +146,11 @@ pub struct ConstrainedRun {
     /// not determine: their multipliers are reported as 0, one choice of
     /// many (the mechanism is statically indeterminate there).
     pub indeterminate: Vec<&'static str>,
-    /// Where the run met a singular position of the mechanism (its
-    /// constraints' rank dropping) and went on, from this time (the last
-    /// projected state before it), with the equations that pass them
-    /// ([`crate::constrained::PassingSingular`]); None if it met none.
-    pub passing_singular_from: Option<f64>,
+    /// The intervals of time the run spent near singular positions of the
+    /// mechanism (its constraints' rank dropping), run by the equations
+    /// that pass them ([`crate::constrained::PassingSingular`]); empty if
+    /// it met none.
+    pub near_singular: Vec<[f64; 2]>,
 }
 
 /// Runs `model` from `y0` (the model file's start at rest if None; made
@@ -178,7 +178,7 @@ pub fn run(
         largest_residual: (0.0, 0.0),
         steps: 0,
         indeterminate: Vec::new(),
-        passing_singular_from: None,
+        near_singular: Vec::new(),
     };
     let followed = follow(model, params, y0, method, times, &mut |ts, mut sample| {
         let output = model.output(params, ts, &mut sample).map_err(|source| {
@@ -207,7 +207,7 @@ pub fn run(
         .collect();
     result.start = followed.start;
     result.steps = followed.steps;
-    result.passing_singular_from = followed.passing_from;
+    result.near_singular = followed.near_singular;
     Ok(result)
 }
 
@@ -247,11 +247,19 @@ pub fn states(
 /// The integration of [`run`]: through groups of output times with dense
 /// output, the integrated state projected at each group's end; each
 /// output (not yet projected) goes to `report`. Returns the start after
-/// its projection and the steps taken. A run that meets a singular
-/// position goes on from the last projected state with the equations that
-/// pass them ([`crate::constrained::PassingSingular`], by DOP853 at the
-/// method's tolerance, at most [`PASSING_TOLERANCE`]: they have no
-/// recurrences and are noisy there); one that stops there even so says so.
+/// its projection and the steps taken.
+///
+/// Near a singular position (the constraints' singular value of their
+/// regular rank below [`NEAR_SINGULAR`] of its value at the start) the run
+/// goes on with the equations that pass them
+/// ([`crate::constrained::PassingSingular`], by DOP853 at the method's
+/// tolerance, at most [`PASSING_TOLERANCE`]: they have no recurrences and
+/// are noisy there), and back with the method's own equations past
+/// [`CLEAR_OF_SINGULAR`]. Where branches of the constraints cross, the
+/// regular equations can step onto the wrong one without their step size
+/// collapsing, so the switch is made by an event before, not after a
+/// collapse (which still sends the run to the passing equations); one that
+/// stops even so says so.
 fn follow(
     model: &dyn ConstrainedSystems,
     params: &[f64],
@@ -265,13 +273,6 @@ fn follow(
     if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| !(w[1] > w[0])) {
         return Err(ConstrainedError::Times { t0 });
     }
-    let constraint = |t: f64| {
-        move |source| ConstrainedError::Constraint {
-            model: name,
-            t,
-            source,
-        }
-    };
     let mut y = match y0 {
         Some(y0) => y0.to_vec(),
         None => model.start(params),
@@ -279,59 +280,196 @@ fn follow(
     if y.iter().any(|x| !x.is_finite()) {
         return Err(OdeError::NonFiniteInitialState { t: t0, y }.into());
     }
-    model.project(params, t0, &mut y).map_err(constraint(t0))?;
+    let project = |t: f64, y: &mut Vec<f64>| {
+        model
+            .project(params, t, y)
+            .map(|_| ())
+            .map_err(|source| ConstrainedError::Constraint {
+                model: name,
+                t,
+                source,
+            })
+    };
+    project(t0, &mut y)?;
     let start = y.clone();
-    let regular = regular_rank(model, params, t0, &y);
-    let mut system = model.exact(params);
-    let mut integrator = Integrator::new(method)?;
-    let mut passing_from = None;
-    let mut steps_before = 0;
+    let mut modes = Modes::new(model, params, method, t0, &start)?;
     // Each reported state is projected too (a step cut short at every
     // output time cost the pendulum's run twice its steps).
     let mut t = t0;
     for group in times.chunks(OUTPUTS_PER_PROJECTION) {
         let t1 = group[group.len() - 1];
-        let samples = match t1 > t {
-            true => {
-                let options = || AnyOptions::default().times(group);
-                let named = |e| named_singularity(model, params, regular, e);
-                let solution = match system.solve(&mut integrator, t, &y, t1, options()) {
-                    Ok(solution) => solution,
-                    // Met a singular position: this group again, and the
-                    // rest, with the equations that pass them.
-                    Err(error) => match named(error) {
-                        ConstrainedError::SingularPosition { .. } if passing_from.is_none() => {
-                            system = model.passing_singular(params, t0, &start)?;
-                            steps_before = integrator.stats.steps;
-                            let passing = method.dop853_at_least(PASSING_TOLERANCE);
-                            integrator = Integrator::new(passing)?;
-                            passing_from = Some(t);
-                            system
-                                .solve(&mut integrator, t, &y, t1, options())
-                                .map_err(named)?
-                        }
-                        other => return Err(other),
-                    },
-                };
-                y = solution.y;
-                solution.samples
-            }
+        if t1 <= t {
             // The first output is the start itself.
-            false => vec![y.clone()],
-        };
-        for (&ts, sample) in group.iter().zip(samples) {
-            report(ts, sample)?;
+            for &ts in group {
+                report(ts, y.clone())?;
+            }
+            continue;
         }
-        if t1 > t {
-            model.project(params, t1, &mut y).map_err(constraint(t1))?;
-            t = t1;
+        let mut pending = group;
+        while t < t1 {
+            let solution = modes.solve(t, &y, t1, pending)?;
+            let (reported, rest) = pending.split_at(solution.samples.len());
+            for (&ts, sample) in reported.iter().zip(solution.samples) {
+                report(ts, sample)?;
+            }
+            pending = rest;
+            (t, y) = (solution.t, solution.y);
+            if solution.stopped {
+                project(t, &mut y)?;
+                modes.switch(t)?;
+            }
+        }
+        project(t1, &mut y)?;
+    }
+    Ok(modes.followed(start, t))
+}
+
+/// Below this fraction of its value at the start, the constraints'
+/// singular value of their regular rank sends a run to the equations that
+/// pass singular positions; the regular equations' noise there is about
+/// δ/σ² for a drift δ of the integrated state.
+pub const NEAR_SINGULAR: f64 = 0.05;
+
+/// Above this fraction of its value at the start, the singular value sends
+/// a run back to the method's own equations.
+pub const CLEAR_OF_SINGULAR: f64 = 0.1;
+
+/// The two sets of equations of [`follow`] and which one runs.
+struct Modes<'m> {
+    model: &'m dyn ConstrainedSystems,
+    params: &'m [f64],
+    method: Method,
+    distance: SingularDistance<'m>,
+    start: Vec<f64>,
+    t0: f64,
+    system: Box<dyn AnySystem>,
+    integrator: Integrator,
+    passing: bool,
+    /// The steps of the integrators switched from.
+    steps_before: u64,
+    /// The intervals run by the passing equations (an open one ends at the
+    /// run's end).
+    near_singular: Vec<[f64; 2]>,
+}
+
+impl<'m> Modes<'m> {
+    /// The regular equations, or the passing ones if the start is near a
+    /// singular position.
+    fn new(
+        model: &'m dyn ConstrainedSystems,
+        params: &'m [f64],
+        method: Method,
+        t0: f64,
+        start: &[f64],
+    ) -> Result<Self, ConstrainedError> {
+        let distance = SingularDistance {
+            model,
+            params,
+            regular: regular_rank(model, params, t0, start),
+        };
+        let mut modes = Modes {
+            model,
+            params,
+            method,
+            distance,
+            start: start.to_vec(),
+            t0,
+            system: model.exact(params),
+            integrator: Integrator::new(method)?,
+            passing: false,
+            steps_before: 0,
+            near_singular: Vec::new(),
+        };
+        if modes.distance.ratio(t0, start) < NEAR_SINGULAR {
+            modes.switch(t0)?;
+        }
+        Ok(modes)
+    }
+
+    /// From the regular equations to the passing ones at t, or back.
+    fn switch(&mut self, t: f64) -> Result<(), ConstrainedError> {
+        self.steps_before += self.integrator.stats.steps;
+        self.passing = !self.passing;
+        if self.passing {
+            let (model, params) = (self.model, self.params);
+            self.system = model.passing_singular(params, self.t0, &self.start)?;
+            self.integrator = Integrator::new(self.method.dop853_at_least(PASSING_TOLERANCE))?;
+            self.near_singular.push([t, f64::NAN]);
+        } else {
+            self.system = self.model.exact(self.params);
+            self.integrator = Integrator::new(self.method)?;
+            if let Some(interval) = self.near_singular.last_mut() {
+                interval[1] = t;
+            }
+        }
+        Ok(())
+    }
+
+    /// From (t, y) towards t1 through the output `times`, stopped where
+    /// the singular value crosses into (or out of) the passing equations'
+    /// range; a regular run whose step size collapses at a singular
+    /// position is run again from (t, y) with the passing equations.
+    fn solve(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        t1: f64,
+        times: &[f64],
+    ) -> Result<AnySolution, ConstrainedError> {
+        let distance = &self.distance;
+        let entering = |t: f64, y: &[f64]| distance.ratio(t, y) - NEAR_SINGULAR;
+        let leaving = |t: f64, y: &[f64]| CLEAR_OF_SINGULAR - distance.ratio(t, y);
+        let condition: &dyn Fn(f64, &[f64]) -> f64 = match self.passing {
+            false => &entering,
+            true => &leaving,
+        };
+        let options = AnyOptions::default().times(times).stop_below(condition);
+        let named = |e| named_singularity(self.model, self.params, distance.regular, e);
+        match self.system.solve(&mut self.integrator, t, y, t1, options) {
+            Ok(solution) => Ok(solution),
+            Err(error) => match (named(error), self.passing) {
+                (ConstrainedError::SingularPosition { .. }, false) => {
+                    self.switch(t)?;
+                    self.solve(t, y, t1, times)
+                }
+                (other, _) => Err(other),
+            },
         }
     }
-    Ok(Followed {
-        start,
-        steps: steps_before + integrator.stats.steps,
-        passing_from,
-    })
+
+    /// What [`follow`] found, at its end t.
+    fn followed(mut self, start: Vec<f64>, t: f64) -> Followed {
+        if let Some(interval) = self.near_singular.last_mut().filter(|i| i[1].is_nan()) {
+            interval[1] = t;
+        }
+        Followed {
+            start,
+            steps: self.steps_before + self.integrator.stats.steps,
+            near_singular: self.near_singular,
+        }
+    }
+}
+
+/// How far a state is from a singular position.
+struct SingularDistance<'m> {
+    model: &'m dyn ConstrainedSystems,
+    params: &'m [f64],
+    /// The regular rank and its singular value at the start.
+    regular: Option<(usize, f64)>,
+}
+
+impl SingularDistance<'_> {
+    /// The constraints' singular value of their regular rank at (t, y) over
+    /// its value at the start (infinite with no constraint to lose rank).
+    fn ratio(&self, t: f64, y: &[f64]) -> f64 {
+        let Some((rank, at_start)) = self.regular else {
+            return f64::INFINITY;
+        };
+        match self.model.constraint_singular_values(self.params, t, y) {
+            Ok(values) => values.get(rank - 1).copied().unwrap_or(0.0) / at_start,
+            Err(_) => f64::NAN,
+        }
+    }
 }
 
 /// What [`follow`] found besides the outputs.
@@ -339,8 +477,8 @@ struct Followed {
     /// The start after its projection.
     start: Vec<f64>,
     steps: u64,
-    /// See [`ConstrainedRun::passing_singular_from`].
-    passing_from: Option<f64>,
+    /// See [`ConstrainedRun::near_singular`].
+    near_singular: Vec<[f64; 2]>,
 }
 
 /// Output times per projection of the integrated state.
