@@ -2,11 +2,11 @@
 //! (chromedriver, through `fantoccini`): clicks seed orbits that equal the
 //! library's, a slider recomputes them, and every layer of the page is
 //! painted where its numbers say. Ignored unless asked for (it needs
-//! Chromium); a package of its own so that the test command does not
-//! compile a WebDriver client:
+//! Chromium); a package of its own, so that no other test binary links a
+//! WebDriver client:
 //!
 //! `apt-get install chromium chromium-driver`
-//! `cargo test --release -p mechlab-browser-test -- --ignored`
+//! `cargo test --release --test browser -- --ignored`
 
 use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
 use fantoccini::{Client, ClientBuilder, Locator};
