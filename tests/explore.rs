@@ -479,3 +479,24 @@ fn every_model_s_taylor_runs_agree_with_dop853() {
         }
     }
 }
+
+/// A vibrated four-bar whose vibration is set to amplitude 0 conserves its
+/// energy: its run says so (E(t) − E(0) at round-off), and its label does
+/// not say that the vibration does work, as it does at the file's
+/// amplitude, where E changes.
+#[test]
+fn a_vibration_at_amplitude_zero_is_not_said_to_do_work() {
+    let handle = mechlab::models::by_name("four_bar").unwrap();
+    let model = handle.dynamic;
+    let y0 = mechlab::explore::default_start(model);
+    let mut still = models::four_bar::Params::default();
+    still.set("a", 0.0).unwrap();
+    let at_rest = explore(handle, &still.values(), &y0, &settings()).unwrap();
+    let largest = at_rest.energy_change.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    assert!(largest < 1e-6, "E changed by {largest:e} without vibration");
+    assert_eq!(at_rest.energy_label, "E(t) − E(0) on the constraints");
+    let vibrated = explore(handle, &model.defaults(), &y0, &settings()).unwrap();
+    let largest = vibrated.energy_change.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    assert!(largest > 1e-3, "E changed by only {largest:e} under vibration");
+    assert!(vibrated.energy_label.contains("the vibration does work"));
+}

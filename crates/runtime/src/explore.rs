@@ -406,6 +406,15 @@ fn hamiltonian_runs(
     Ok(out)
 }
 
+/// The value of the parameter the model file names as its vibration's
+/// amplitude, if it names one.
+fn vibration_amplitude(model: &dyn ConstrainedSystems, params: &[f64]) -> Option<f64> {
+    let info = model.info();
+    let name = info.amplitude?;
+    let index = info.parameter_names.iter().position(|n| *n == name)?;
+    params.get(index).copied()
+}
+
 /// The run of a constrained model on its constraints (projected at each
 /// sample), and its period map if it has a fast phase.
 fn constrained_runs(
@@ -427,9 +436,12 @@ fn constrained_runs(
     };
     Ok(Exploration {
         energy_change: run.energy.iter().map(|e| e - e0).collect(),
-        energy_label: match period_map {
-            Some(_) => "E(t) − E(0) on the constraints (the vibration does work)",
-            None => "E(t) − E(0) on the constraints",
+        energy_label: match (&period_map, vibration_amplitude(model, params)) {
+            // A vibration set to amplitude 0 does no work: E is conserved.
+            (Some(_), amplitude) if amplitude != Some(0.0) => {
+                "E(t) − E(0) on the constraints (the vibration does work)"
+            }
+            _ => "E(t) − E(0) on the constraints",
         },
         period_map,
         equilibria_not_searched: Some(NotSearched::OnConstraints),

@@ -353,8 +353,8 @@ struct Modes<'m> {
 }
 
 impl<'m> Modes<'m> {
-    /// The regular equations, or the passing ones if the start is near a
-    /// singular position.
+    /// The regular equations at the start (the singular value's ratio is
+    /// 1 there by its definition).
     fn new(
         model: &'m dyn ConstrainedSystems,
         params: &'m [f64],
@@ -367,7 +367,7 @@ impl<'m> Modes<'m> {
             params,
             regular: regular_rank(model, params, t0, start),
         };
-        let mut modes = Modes {
+        Ok(Modes {
             model,
             params,
             method,
@@ -379,11 +379,7 @@ impl<'m> Modes<'m> {
             passing: false,
             steps_before: 0,
             near_singular: Vec::new(),
-        };
-        if modes.distance.ratio(t0, start) < NEAR_SINGULAR {
-            modes.switch(t0)?;
-        }
-        Ok(modes)
+        })
     }
 
     /// From the regular equations to the passing ones at t, or back.
