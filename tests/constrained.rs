@@ -1434,9 +1434,6 @@ fn the_iftomm_n_four_bar_turns_through_its_singular_positions() {
 
 /// The IFToMM benchmark library's simple pendulum (A01), in units where
 /// g = l = m = 1 (its 10 s at g = 9.81 m/s² are 31.3 units): a point on a
-
-/// The IFToMM benchmark library's simple pendulum (A01), in units where
-/// g = l = m = 1 (its 10 s at g = 9.81 m/s² are 31.3 units): a point on a
 /// rod in Cartesian coordinates (`cartesian_kapitza` with its pivot
 /// still), released at rest with the rod horizontal. Every half period
 /// 2K(1/√2) it is at rest with the rod horizontal again, on alternate

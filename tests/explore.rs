@@ -492,11 +492,20 @@ fn a_vibration_at_amplitude_zero_is_not_said_to_do_work() {
     let mut still = models::four_bar::Params::default();
     still.set("a", 0.0).unwrap();
     let at_rest = explore(handle, &still.values(), &y0, &settings()).unwrap();
-    let largest = at_rest.energy_change.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    let largest = at_rest
+        .energy_change
+        .iter()
+        .fold(0.0_f64, |m, e| m.max(e.abs()));
     assert!(largest < 1e-6, "E changed by {largest:e} without vibration");
     assert_eq!(at_rest.energy_label, "E(t) − E(0) on the constraints");
     let vibrated = explore(handle, &model.defaults(), &y0, &settings()).unwrap();
-    let largest = vibrated.energy_change.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
-    assert!(largest > 1e-3, "E changed by only {largest:e} under vibration");
+    let largest = vibrated
+        .energy_change
+        .iter()
+        .fold(0.0_f64, |m, e| m.max(e.abs()));
+    assert!(
+        largest > 1e-3,
+        "E changed by only {largest:e} under vibration"
+    );
     assert!(vibrated.energy_label.contains("the vibration does work"));
 }
