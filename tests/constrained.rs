@@ -1196,11 +1196,22 @@ fn a_body_in_a_model_file_moves_as_its_hand_written_lagrangian() {
 fn crank_pendulum(spin: f64, outputs: usize) -> Vec<[f64; 2]> {
     let (mass, l, g, tau) = (3.5, 1.0, 1.0, 0.3);
     let field = |y: [f64; 2]| [y[1], -(g / l) * y[0].sin() + tau / (mass * l * l)];
-    let mut reference = vec![[0.0, spin]];
-    let mut y = [0.0, spin];
-    let h = 1e-4;
+    rk4_outputs(field, [0.0, spin], 1e-4, 1000, outputs)
+}
+
+/// `outputs` states of y' = field(y) from y0 (y0 first), `per_output`
+/// classical Runge–Kutta steps of `h` apart: a reference written by hand.
+fn rk4_outputs(
+    field: impl Fn([f64; 2]) -> [f64; 2],
+    y0: [f64; 2],
+    h: f64,
+    per_output: usize,
+    outputs: usize,
+) -> Vec<[f64; 2]> {
+    let mut reference = vec![y0];
+    let mut y = y0;
     for _ in 1..outputs {
-        for _ in 0..1000 {
+        for _ in 0..per_output {
             let k1 = field(y);
             let k2 = field([y[0] + h / 2.0 * k1[0], y[1] + h / 2.0 * k1[1]]);
             let k3 = field([y[0] + h / 2.0 * k2[0], y[1] + h / 2.0 * k2[1]]);
@@ -1364,21 +1375,7 @@ fn the_iftomm_n_four_bar_turns_through_its_singular_positions() {
     let (inertia, weight) = (3.0, 3.5 * 9.81);
     let field = |y: [f64; 2]| [y[1], -weight * y[0].cos() / inertia];
     let times: Vec<f64> = (0..=200).map(|k| 0.05 * k as f64).collect();
-    let mut reference = vec![[FRAC_PI_2, -1.0]];
-    let mut y = reference[0];
-    let h = 1e-4;
-    for _ in 1..times.len() {
-        for _ in 0..500 {
-            let k1 = field(y);
-            let k2 = field([y[0] + h / 2.0 * k1[0], y[1] + h / 2.0 * k1[1]]);
-            let k3 = field([y[0] + h / 2.0 * k2[0], y[1] + h / 2.0 * k2[1]]);
-            let k4 = field([y[0] + h * k3[0], y[1] + h * k3[1]]);
-            for i in 0..2 {
-                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
-        }
-        reference.push(y);
-    }
+    let reference = rk4_outputs(field, [FRAC_PI_2, -1.0], 1e-4, 500, times.len());
     let energy = |theta: f64, rate: f64| inertia * rate * rate / 2.0 + weight * theta.sin();
     let e0 = energy(FRAC_PI_2, -1.0);
     let start = [
