@@ -1,7 +1,7 @@
 //! The studio: its HTTP API answers what the library computes for the same
 //! settings, and bad requests get errors that name the problem. The test
 //! in a real browser is a package of its own (`tests/browser/`), so that
-//! the test command does not compile a WebDriver client.
+//! no other test binary links a WebDriver client; it runs only when asked.
 
 mod common;
 use axum::body::Body;
