@@ -1199,6 +1199,17 @@ fn crank_pendulum(spin: f64, outputs: usize) -> Vec<[f64; 2]> {
     rk4_outputs(field, [0.0, spin], 1e-4, 1000, outputs)
 }
 
+/// Asserts that a run's states, after their projections, were on the
+/// constraints to 1e-12 in positions and velocities.
+fn kept_on_constraints(r: &mechlab::analysis::on_constraints::ConstrainedRun, label: &str) {
+    let (positions, velocities) = r.largest_residual;
+    assert!(
+        positions < 1e-12 && velocities < 1e-12,
+        "{label}: {:?}",
+        r.largest_residual
+    );
+}
+
 /// `outputs` states of y' = field(y) from y0 (y0 first), `per_output`
 /// classical Runge–Kutta steps of `h` apart: a reference written by hand.
 fn rk4_outputs(
@@ -1269,12 +1280,7 @@ fn parallel_cranks_with_a_redundant_bar_swing_as_one_pendulum() {
                 "{method:?}: E = {e} not {e0}"
             );
         }
-        let (positions, velocities) = r.largest_residual;
-        assert!(
-            positions < 1e-12 && velocities < 1e-12,
-            "{method:?}: {:?}",
-            r.largest_residual
-        );
+        kept_on_constraints(r, &format!("{method:?}"));
     };
     let spin = 1.0;
     let reference = crank_pendulum(spin, times.len());
@@ -1346,12 +1352,7 @@ fn a_coupler_turned_many_times_stays_on_its_constraints() {
         drift < 1e-10 * e0.abs().max(1.0),
         "energy {drift:e} off {e0}"
     );
-    let (positions, velocities) = r.largest_residual;
-    assert!(
-        positions < 1e-12 && velocities < 1e-12,
-        "{:?}",
-        r.largest_residual
-    );
+    kept_on_constraints(&r, "the four-bar");
 }
 
 /// The IFToMM benchmark library's N-four-bar mechanism (A02) with N = 2:
@@ -1420,12 +1421,7 @@ fn the_iftomm_n_four_bar_turns_through_its_singular_positions() {
         }
         assert!(drift < 1e-9, "{method:?}: relative energy error {drift:e}");
         assert_eq!(singular(r.states[200][0]), passes, "{method:?}");
-        let (positions, velocities) = r.largest_residual;
-        assert!(
-            positions < 1e-12 && velocities < 1e-12,
-            "{method:?}: {:?}",
-            r.largest_residual
-        );
+        kept_on_constraints(&r, &format!("{method:?}"));
     }
 }
 

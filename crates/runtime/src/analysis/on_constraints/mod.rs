@@ -336,13 +336,12 @@ pub const CLEAR_OF_SINGULAR: f64 = 0.1;
 
 /// The two sets of equations of [`follow`] and which one runs.
 struct Modes<'m> {
-    model: &'m dyn ConstrainedSystems,
-    params: &'m [f64],
     method: Method,
     distance: SingularDistance<'m>,
-    start: Vec<f64>,
-    t0: f64,
-    system: Box<dyn AnySystem>,
+    regular: Box<dyn AnySystem>,
+    /// The equations that pass singular positions, their windows taken
+    /// from the start's constraints.
+    passing_equations: Box<dyn AnySystem>,
     integrator: Integrator,
     passing: bool,
     /// The steps of the integrators switched from.
@@ -368,13 +367,10 @@ impl<'m> Modes<'m> {
             regular: regular_rank(model, params, t0, start),
         };
         Ok(Modes {
-            model,
-            params,
             method,
             distance,
-            start: start.to_vec(),
-            t0,
-            system: model.exact(params),
+            regular: model.exact(params),
+            passing_equations: model.passing_singular(params, t0, start)?,
             integrator: Integrator::new(method)?,
             passing: false,
             steps_before: 0,
@@ -387,12 +383,9 @@ impl<'m> Modes<'m> {
         self.steps_before += self.integrator.stats.steps;
         self.passing = !self.passing;
         if self.passing {
-            let (model, params) = (self.model, self.params);
-            self.system = model.passing_singular(params, self.t0, &self.start)?;
             self.integrator = Integrator::new(self.method.dop853_at_least(PASSING_TOLERANCE))?;
             self.near_singular.push([t, f64::NAN]);
         } else {
-            self.system = self.model.exact(self.params);
             self.integrator = Integrator::new(self.method)?;
             if let Some(interval) = self.near_singular.last_mut() {
                 interval[1] = t;
@@ -420,8 +413,12 @@ impl<'m> Modes<'m> {
             true => &leaving,
         };
         let options = AnyOptions::default().times(times).stop_below(condition);
-        let named = |e| named_singularity(self.model, self.params, distance.regular, e);
-        match self.system.solve(&mut self.integrator, t, y, t1, options) {
+        let named = |e| named_singularity(distance.model, distance.params, distance.regular, e);
+        let system = match self.passing {
+            false => &self.regular,
+            true => &self.passing_equations,
+        };
+        match system.solve(&mut self.integrator, t, y, t1, options) {
             Ok(solution) => Ok(solution),
             Err(error) => match (named(error), self.passing) {
                 (ConstrainedError::SingularPosition { .. }, false) => {
