@@ -593,9 +593,9 @@ fn malformed_points_name_the_problem() {
 }
 
 /// A body's rotation that is not a sequence of X(angle), Y(angle), Z(angle)
-/// is refused with the body's key; a body whose centre's name is taken by
-/// a definition is refused with the definition's; a well-formed body is
-/// accepted.
+/// is refused with the body's key; a body whose centre's or point's name
+/// is taken by a definition is refused with the definition's; a
+/// well-formed body is accepted.
 #[test]
 fn a_malformed_body_is_named() {
     let body = |rotation: &str| {
@@ -645,6 +645,34 @@ fn a_malformed_body_is_named() {
         "quaternion = [\"q\", \"a\", \"b\", \"c\"]\nrotation =",
     );
     assert_error(&unknown, "bodies[0].quaternion", "'a' is not a coordinate");
+    // Points fixed in the body and its centre: names, offsets in the
+    // parameters, and their definitions' names free.
+    let fixed = |extra: &str| body("Y(q)") + extra;
+    assert_error(
+        &fixed("points = { 2tip = [0, 0, 1] }\n"),
+        "bodies[0].points.2tip",
+        "not an identifier",
+    );
+    assert_error(
+        &fixed("points = { tip = [0, 0, \"q\"] }\n"),
+        "bodies[0].points.tip",
+        "unknown symbol 'q'",
+    );
+    assert_error(
+        &fixed("centre = [0, 0, \"w\"]\n"),
+        "bodies[0].centre",
+        "unknown symbol 'w'",
+    );
+    let taken = fixed("points = { tip = [0, 0, 1] }\n").replace(
+        "[[bodies]]",
+        "[definitions]\nbob_tip_z = \"q\"\n\n[[bodies]]",
+    );
+    assert_error(&taken, "definitions.bob_tip_z", "a point of a body");
+    Model::parse(
+        "models/toy.toml",
+        &fixed("centre = [0, 0, 0.5]\npoints = { tip = [0, 0, 1] }\n"),
+    )
+    .expect("a centre and a point fixed in the body");
     // The body is drawn as its frame, points named as the body and its
     // axes' tips: the file's points may join them but not take their names.
     let drawn = |point: &str, joined: &str| {

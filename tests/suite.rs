@@ -12,6 +12,7 @@ mod bad_input;
 mod basins;
 mod bicycle;
 mod bodies;
+mod bricard;
 mod constrained;
 mod continuation;
 mod declarations;

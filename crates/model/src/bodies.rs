@@ -3,11 +3,14 @@
 //! added to the Lagrangian, so that the derivation sees one Lagrangian as
 //! for any model. The centre's coordinates become definitions (`<body>_x`,
 //! `<body>_y`, `<body>_z`) whose `dot()` gives its velocity; the body's
-//! angular velocity comes from its rotation sequence. A point of a body
-//! has the velocity v_c + ω × (p − c): the rolling constraints.
+//! angular velocity comes from its rotation sequence. Points fixed in a
+//! body become definitions too (`<body>_<point>_x`, …), so that a chain of
+//! bodies hangs each one from the one before. A point of a body has the
+//! velocity v_c + ω × (p − c): the rolling constraints.
 
 use crate::file::{ConstraintSpec, ModelFile, NumberSpec};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 
 /// A rigid body: its mass, its inertia about its centre in its own axes,
 /// the centre's position and the body's orientation as a sequence of
@@ -21,8 +24,18 @@ pub struct BodySpec {
     /// [[I_xx, I_xy, I_xz], [I_xy, I_yy, I_yz], [I_xz, I_yz, I_zz]], both
     /// about the centre in the body's axes (read by [`inertia`]).
     pub inertia: toml::Value,
-    /// The centre of mass (x, y, z) in the fixed frame.
+    /// The body's origin (x, y, z) in the fixed frame: its centre of mass
+    /// unless `centre` puts that elsewhere.
     pub position: [NumberSpec; 3],
+    /// The centre of mass in the body's axes, from its origin (a rod hung
+    /// from its end: half its length along it). Default: at the origin.
+    pub centre: Option<[NumberSpec; 3]>,
+    /// Points fixed in the body, in its axes from its origin: each becomes
+    /// the definitions `<body>_<point>_x`, `_y`, `_z`, its place in the
+    /// fixed frame (where the next body of a chain hangs, or a joint's
+    /// axis for a closure).
+    #[serde(default)]
+    pub points: BTreeMap<String, [NumberSpec; 3]>,
     /// Rotations about the body's own axes, each applied to the frame the
     /// ones before left: "Z(phi) X(theta) Y(psi)" (empty: the body does
     /// not turn). An angle is a coordinate or definition (it turns) or an
@@ -81,9 +94,21 @@ pub fn declare(spec: &mut ModelFile) -> Result<(), (String, String)> {
         }
     }
     for body in &spec.bodies {
-        for (name, at) in centre(&body.name).into_iter().zip(&body.position) {
-            if spec.definitions.insert(name.clone(), text(at)).is_some() {
+        let centre_in_space = match &body.centre {
+            Some(offset) => in_space(body, offset),
+            None => body.position.clone().map(|at| text(&at)),
+        };
+        for (name, at) in centre(&body.name).into_iter().zip(centre_in_space) {
+            if spec.definitions.insert(name.clone(), at).is_some() {
                 return Err(clash(&name, "the centre of a body"));
+            }
+        }
+        for (point, offset) in &body.points {
+            let names = ["x", "y", "z"].map(|axis| format!("{}_{point}_{axis}", body.name));
+            for (name, at) in names.into_iter().zip(in_space(body, offset)) {
+                if spec.definitions.insert(name.clone(), at).is_some() {
+                    return Err(clash(&name, "a point of a body"));
+                }
             }
         }
         if let Some([e0, e1, e2, e3]) = &body.quaternion {
@@ -217,6 +242,22 @@ pub fn inertia(value: &toml::Value) -> Result<[[Option<String>; 3]; 3], BodyErro
         }
     }
     Ok(tensor)
+}
+
+/// Where a point fixed in the body, `offset` in its axes from its origin,
+/// is in the fixed frame: the origin plus R·offset, R's columns the body's
+/// axes (its rotation's turns are read by then).
+fn in_space(body: &BodySpec, offset: &[NumberSpec; 3]) -> [String; 3] {
+    let axes = axes(body);
+    std::array::from_fn(|k| {
+        let mut at = Some(text(&body.position[k]));
+        for (axis, along) in axes.iter().zip(offset) {
+            if !matches!(along, NumberSpec::Value(v) if *v == 0.0) {
+                at = sum(at, times(&text(along), &axis[k]));
+            }
+        }
+        at.expect("the origin's component")
+    })
 }
 
 /// The names of a body's centre coordinates, which are definitions.
@@ -486,6 +527,30 @@ mod tests {
         assert!(rotation("Z phi").is_err());
         assert!(rotation("Z(phi").is_err());
         assert_eq!(rotation("Y(pi/2 - (a))").unwrap()[0].angle, "pi/2 - (a)");
+    }
+
+    /// A point fixed in a body turned by Z(q) about its origin (1, 2, 3):
+    /// the origin plus the point's offset turned, and a zero offset's
+    /// components left out.
+    #[test]
+    fn a_point_of_a_body_is_its_offset_turned_from_the_origin() {
+        let body: BodySpec = toml::from_str(
+            "name = 'arm'\nmass = 1\ninertia = [1, 1, 1]\nposition = [1, 2, 3]\nrotation = 'Z(q)'\ncentre = ['l', 0, 0]",
+        )
+        .unwrap();
+        let body = BodySpec {
+            turns: rotation(&body.rotation).unwrap(),
+            ..body
+        };
+        let offset = body.centre.clone().unwrap();
+        assert_eq!(
+            in_space(&body, &offset),
+            [
+                "1.0 + (l)*((cos(q))*(1))",
+                "2.0 + (l)*((sin(q))*(1))",
+                "3.0"
+            ]
+        );
     }
 
     #[test]

@@ -1186,6 +1186,18 @@ impl ModelFile {
             for turn in &body.turns {
                 parse(&key("rotation"), &turn.angle, &positions, false)?;
             }
+            for at in body.centre.iter().flatten() {
+                parse(&key("centre"), &crate::bodies::text(at), &parameters, false)?;
+            }
+            for (point, offset) in &body.points {
+                let part = format!("points.{point}");
+                if !is_identifier(point) {
+                    return Err(err(key(&part), format!("'{point}' is not an identifier")));
+                }
+                for at in offset {
+                    parse(&key(&part), &crate::bodies::text(at), &parameters, false)?;
+                }
+            }
             if let Some(e) = &body.quaternion {
                 if !body.rotation.trim().is_empty() {
                     return Err(err(key("quaternion"), "give the orientation once: a `rotation` sequence or the `quaternion`'s four coordinates".into()));
