@@ -21,6 +21,7 @@ mod docs_commands;
 mod double_double;
 mod events;
 mod explore;
+mod flyball_governor;
 mod frequency;
 mod holonomic;
 mod indicators;

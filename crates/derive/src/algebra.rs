@@ -19,8 +19,14 @@ pub struct Derived {
     pub latex: String,
 }
 
+/// Symbolica's atom for an expression's text, its decimal numbers made
+/// exact rationals first: read as floats, they carry a precision of their
+/// own, and sums of such floats came out scaled by powers of ten
+/// (0.0 + 0.05 cos φ as 5 cos φ). The user typed a decimal; the
+/// derivation works with the number it names.
 pub fn atom(text: &str) -> Result<Atom, DeriveError> {
-    try_parse!(text).map_err(|e| DeriveError::Symbolica {
+    let exact = mechlab_model::expr::exact_decimals(text);
+    try_parse!(&exact).map_err(|e| DeriveError::Symbolica {
         text: text.to_string(),
         message: e.to_string(),
     })

@@ -153,6 +153,19 @@ pub fn kinematic(model: &Model, e: &Expr) -> Result<Atom, DeriveError> {
 }
 
 /// The names of the model's coordinates and of their velocities.
+/// The model's generalised forces Q: its `[forces]`, less the Rayleigh
+/// dissipation's ∂D/∂q' (D with its `dot()`s of definitions carried
+/// through the chain rule), in the coordinates and velocities.
+fn generalised_forces(model: &Model) -> Result<Vec<Atom>, DeriveError> {
+    let rayleigh = kinematic(model, &model.rayleigh)?;
+    model
+        .forces
+        .iter()
+        .zip(&model.coordinates)
+        .map(|(f, c)| Ok(atom(&f.to_string())? - rayleigh.derivative(symbol!(c.velocity.as_str()))))
+        .collect()
+}
+
 fn coordinates_and_velocities(model: &Model) -> (Vec<String>, Vec<String>) {
     model
         .coordinates
@@ -376,11 +389,7 @@ fn symbolic_exact(
     )?;
 
     // Exact equations: q' = A⁻¹(p − b), p' = ∂L/∂q + Q at that q'.
-    let forces: Vec<Atom> = model
-        .forces
-        .iter()
-        .map(|f| atom(&f.to_string()))
-        .collect::<Result<_, _>>()?;
+    let forces = generalised_forces(model)?;
     let rates: Vec<Atom> = (0..n)
         .map(|i| (lagrangian.derivative(symbol!(q[i].as_str())) + &forces[i]).expand())
         .collect();
@@ -799,11 +808,7 @@ fn numeric_form(
     let (q, qd) = coordinates_and_velocities(model);
     let p: Vec<String> = q.iter().map(|c| momentum_name(c)).collect();
     let phase = model.fast_phase.as_ref().map(|f| f.name.clone());
-    let forces: Vec<Atom> = model
-        .forces
-        .iter()
-        .map(|f| atom(&f.to_string()))
-        .collect::<Result<_, _>>()?;
+    let forces = generalised_forces(model)?;
     let mut momentum_rates = Vec::new();
     for i in 0..n {
         let rate_i = (lagrangian.derivative(symbol!(q[i].as_str())) + &forces[i]).expand();

@@ -560,3 +560,94 @@ impl fmt::Display for Expr {
         }
     }
 }
+
+/// `text` with each decimal literal (a point or an exponent: `0.05`,
+/// `5.e-2`, `8e5`) written as the exact rational it names, `(5/100)`,
+/// `800000`; names (`x1e5`) and integers are left as they are.
+pub fn exact_decimals(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let c = bytes[i];
+        if c.is_ascii_alphabetic() || c == b'_' {
+            let start = i;
+            while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                i += 1;
+            }
+            out.push_str(&text[start..i]);
+        } else if c.is_ascii_digit()
+            || (c == b'.' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit))
+        {
+            let start = i;
+            while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+                i += 1;
+            }
+            let mantissa_end = i;
+            let mut exponent = 0_i64;
+            if i < bytes.len() && (bytes[i] == b'e' || bytes[i] == b'E') {
+                let mut j = i + 1;
+                if j < bytes.len() && (bytes[j] == b'+' || bytes[j] == b'-') {
+                    j += 1;
+                }
+                if j < bytes.len() && bytes[j].is_ascii_digit() {
+                    while j < bytes.len() && bytes[j].is_ascii_digit() {
+                        j += 1;
+                    }
+                    exponent = text[i + 1..j].parse().unwrap_or(0);
+                    i = j;
+                }
+            }
+            let mantissa = &text[start..mantissa_end];
+            if i == mantissa_end && !mantissa.contains('.') {
+                out.push_str(mantissa);
+            } else {
+                out.push_str(&rational(mantissa, exponent));
+            }
+        } else {
+            out.push(c as char);
+            i += 1;
+        }
+    }
+    out
+}
+
+/// The decimal `mantissa` × 10^`exponent` as an integer or `(p/10^k)`.
+fn rational(mantissa: &str, exponent: i64) -> String {
+    let (whole, fraction) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+    let fraction = fraction.trim_end_matches('0');
+    let digits = format!("{whole}{fraction}");
+    let numerator = digits.trim_start_matches('0');
+    if numerator.is_empty() {
+        return "0".into();
+    }
+    let scale = (exponent - fraction.len() as i64).clamp(-400, 400);
+    match scale >= 0 {
+        true => format!("{numerator}{}", "0".repeat(scale as usize)),
+        false => format!("({numerator}/1{})", "0".repeat((-scale) as usize)),
+    }
+}
+
+#[cfg(test)]
+mod decimal_tests {
+    use super::exact_decimals;
+
+    /// Decimals become the exact rationals they name; names and integers
+    /// stay.
+    #[test]
+    fn decimals_are_written_as_exact_rationals() {
+        assert_eq!(
+            exact_decimals("0.0 + 0.05*cos(x1e5)"),
+            "0 + (5/100)*cos(x1e5)"
+        );
+        assert_eq!(
+            exact_decimals("8e5*k - 2.5e-3 + 12"),
+            "800000*k - (25/10000) + 12"
+        );
+        assert_eq!(
+            exact_decimals("5.e-2 + .5 + 1.250125e+2"),
+            "(5/100) + (5/10) + (1250125/10000)"
+        );
+        assert_eq!(exact_decimals("3.0^2"), "3^2");
+    }
+}
