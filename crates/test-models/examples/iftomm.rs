@@ -4,8 +4,9 @@
 //! overconstrained mechanism (A04) and the stiff flyball governor (A05),
 //! over the library's spans from its starts. Prints each run's CPU time,
 //! steps, energy error and constraint residual beside the OpenSim 3.2
-//! times its implementers published; writes `out/iftomm/<id>.csv` (time,
-//! state, energy) and `summary.json`. The tests in `tests/constrained.rs`,
+//! times its implementers published; writes `out/iftomm/iftomm.png` (each
+//! problem's energy change over its span; A05's slider), `<id>.csv`
+//! (time, state, energy) and `summary.json`. The tests in `tests/constrained.rs`,
 //! `tests/bricard.rs` and `tests/flyball_governor.rs` check each against
 //! references written out by hand.
 //!
@@ -13,6 +14,7 @@
 
 use mechlab_runtime::analysis::on_constraints::run;
 use mechlab_runtime::ode::{states_at, Method};
+use mechlab_runtime::plot::{Figure, PanelSpec, BLUE};
 use mechlab_runtime::registry::ConstrainedSystems;
 use mechlab_test_models as models;
 use std::f64::consts::TAU;
@@ -50,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::path::Path::new("out/iftomm");
     std::fs::create_dir_all(out)?;
     let benchmarks = benchmarks();
-    let mut rows = Vec::new();
+    let (mut rows, mut panels) = (Vec::new(), Vec::new());
     println!("id   model                 span     steps  CPU (s)   energy error  residual   OpenSim 3.2 (s)");
     for b in benchmarks
         .iter()
@@ -96,15 +98,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             csv += &format!("{t},{},{e:.17e}\n", state.join(","));
         }
         std::fs::write(out.join(format!("{}.csv", b.id)), csv)?;
+        let change = (0..r.energy.len())
+            .map(|k| (r.times[k], r.energy[k] - r.energy[0] - work(k)))
+            .collect();
+        panels.push((format!("{} {}", b.id, r.model), "E(t) − E(0)", change));
         rows.push(row);
     }
     if only.as_deref().is_none_or(|id| id == "A05") {
-        flyball_governor(out)?;
+        let slider = flyball_governor(out)?;
+        panels.push(("A05 iftomm_flyball_governor".into(), "slider s (m)", slider));
     }
     std::fs::write(
         out.join("summary.json"),
         serde_json::to_string_pretty(&rows)?,
     )?;
+    draw(&panels)?.save(&out.join("iftomm.png"))?;
     println!("wrote {}/", out.display());
     Ok(())
 }
@@ -154,7 +162,7 @@ fn benchmarks() -> [Benchmark; 4] {
 
 /// A05: the flyball governor is not constrained; its springs and
 /// dampers make it stiff, and Radau5 integrates it.
-fn flyball_governor(out: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+fn flyball_governor(out: &std::path::Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
     use models::iftomm_flyball_governor::{Exact, Params};
     let exact = Exact {
         params: Params::default(),
@@ -190,5 +198,26 @@ fn flyball_governor(out: &std::path::Path) -> Result<(), Box<dyn std::error::Err
         out.join("A05.csv"),
         format!("t,phi,s,b1,b2,p_phi,p_s,p_b1,p_b2\n{csv}"),
     )?;
-    Ok(())
+    Ok(times.iter().zip(&states).map(|(&t, y)| (t, y[1])).collect())
+}
+
+/// One panel a problem: the energy's change over its span (A05: the
+/// slider's height), each on its own scale.
+fn draw(panels: &[(String, &str, Vec<(f64, f64)>)]) -> Result<Figure, Box<dyn std::error::Error>> {
+    let specs: Vec<PanelSpec> = panels
+        .iter()
+        .map(|(title, label, series)| {
+            let (low, high) = series.iter().fold((f64::MAX, f64::MIN), |(l, h), (_, y)| {
+                (l.min(*y), h.max(*y))
+            });
+            let pad = 0.05 * (high - low).max(f64::MIN_POSITIVE) + 1e-300;
+            let span = series.last().map_or(1.0, |(t, _)| *t);
+            PanelSpec::new(title, "t", label, (0.0, span), (low - pad, high + pad))
+        })
+        .collect();
+    let mut figure = Figure::grid(specs.len(), 1, 320, 260, &specs);
+    for (k, (_, _, series)) in panels.iter().enumerate() {
+        figure.line(k, series, BLUE);
+    }
+    Ok(figure)
 }
