@@ -76,6 +76,7 @@ pub fn build_models(root: &str, folder: &str) {
 /// processes [`build_model`] starts.
 const DERIVE_FILE: &str = "MECHLAB_DERIVE_FILE";
 const DERIVE_OUT: &str = "MECHLAB_DERIVE_OUT";
+const DERIVE_LIMIT: &str = "MECHLAB_DERIVE_SECONDS";
 
 /// Runs `work` on a thread with the derivation's stack.
 fn on_derivation_thread(work: impl FnOnce() + Send + 'static) {
@@ -219,18 +220,45 @@ fn build_model(
 
 /// Derives the model `file` into `out` in a process of its own (this build
 /// script again; see the crate's comment), which says what went wrong on
-/// its standard error.
+/// its standard error. A derivation that runs past the time limit is
+/// stopped with an error naming the file, rather than holding the build.
 fn derive_in_own_process(file: &str, out: &Path) {
     let script = std::env::current_exe()
         .unwrap_or_else(|e| fail(format!("cannot find the build script to run again: {e}")));
-    let status = Command::new(script)
+    let mut child = Command::new(script)
         .env(DERIVE_FILE, file)
         .env(DERIVE_OUT, out)
-        .status()
+        .spawn()
         .unwrap_or_else(|e| fail(format!("{file}: cannot start its derivation: {e}")));
+    let limit = derivation_limit();
+    let started = Instant::now();
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) if started.elapsed().as_secs() >= limit => {
+                let _ = child.kill();
+                let _ = child.wait();
+                fail(format!(
+                    "{file}: its derivation did not finish in {limit} s and was stopped. One known cause: a length whose terms cancel only through sin² + cos² = 1 of a turning angle, under a root or in the `rayleigh` function (a spring between two bodies' points written in the fixed frame); written in the turning frame it derives in seconds. {DERIVE_LIMIT} sets the limit in seconds."
+                ))
+            }
+            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(50)),
+            Err(e) => fail(format!("{file}: cannot follow its derivation: {e}")),
+        }
+    };
     if !status.success() {
         fail(format!("{file}: its derivation failed (above)"));
     }
+}
+
+/// How long one model's derivation may run, in seconds: the environment's
+/// `MECHLAB_DERIVE_SECONDS`, else ten minutes (the largest model here, the
+/// bicycle, takes about a minute and a half).
+fn derivation_limit() -> u64 {
+    std::env::var(DERIVE_LIMIT)
+        .ok()
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or(600)
 }
 
 /// Removes the model's other cached versions (earlier texts or code).
