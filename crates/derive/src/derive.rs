@@ -152,7 +152,6 @@ pub fn kinematic(model: &Model, e: &Expr) -> Result<Atom, DeriveError> {
     Ok(result)
 }
 
-/// The names of the model's coordinates and of their velocities.
 /// The model's generalised forces Q: its `[forces]`, less the Rayleigh
 /// dissipation's ∂D/∂q' (D with its `dot()`s of definitions carried
 /// through the chain rule), in the coordinates and velocities.
@@ -166,6 +165,7 @@ fn generalised_forces(model: &Model) -> Result<Vec<Atom>, DeriveError> {
         .collect()
 }
 
+/// The names of the model's coordinates and of their velocities.
 fn coordinates_and_velocities(model: &Model) -> (Vec<String>, Vec<String>) {
     model
         .coordinates
