@@ -62,9 +62,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let started = Instant::now();
         let r = run(b.model, &b.params, b.start.as_deref(), tight, &times)?;
         let seconds = started.elapsed().as_secs_f64();
-        // A03's motor does work: its energy balance is T + V − τ(β − β₀).
+        // A03's motor does work: its energy balance is T + V − τ(β − β₀),
+        // τ the model's parameter `mom`.
+        let torque = models::andrews_squeezer::Params::default().mom;
         let work = |k: usize| match b.id {
-            "A03" => 0.033 * (r.states[k][0] - r.states[0][0]),
+            "A03" => torque * (r.states[k][0] - r.states[0][0]),
             _ => 0.0,
         };
         let energy_error = (0..r.energy.len())
