@@ -35,6 +35,23 @@ impl TaylorFunction {
     pub(crate) fn is_variational(&self) -> bool {
         self.variational
     }
+    /// The length of its written recurrences in bytes (what the compiler
+    /// is given, once per number type).
+    pub(crate) fn source_bytes(&self) -> usize {
+        let lines = self.parts.iter().flat_map(|p| &p.body);
+        let body: usize = self
+            .body
+            .iter()
+            .chain(lines)
+            .map(|line| line.len() + 5)
+            .sum();
+        let parts: usize = self
+            .parts
+            .iter()
+            .map(|p| p.args.len() + self.params.len())
+            .sum();
+        body + parts
+    }
 }
 
 #[derive(Serialize)]

@@ -658,6 +658,14 @@ fn constrained_rhs(
 /// the test command's build. A larger model runs the other methods.
 pub const TAYLOR_COORDINATES: usize = 6;
 
+/// The longest Taylor recurrences of a constrained model kept, in bytes
+/// of source. Past it a model's forms are long (Bricard's five rods in
+/// space: 1.3 MB of recurrences, three quarters of its module), each
+/// order costs what many steps of an explicit method cost (there Taylor
+/// ran 16 times slower than DOP853), and compiling them held the build.
+/// Such a model runs the other methods, as a larger one does.
+pub const TAYLOR_SOURCE_BYTES: usize = 300_000;
+
 /// Renders the generated module of a model with ideal constraints.
 pub fn render_constrained(
     tera: &tera::Tera,
@@ -676,14 +684,18 @@ pub fn render_constrained(
     let mut functions = constrained_functions(&cx, derivation)?;
     functions.extend(crate::functions::drawing_function(&cx)?);
     functions.push(constrained_rhs(&cx, derivation, false)?);
-    let has_taylor = n <= TAYLOR_COORDINATES;
-    let taylor_functions = match has_taylor {
-        true => vec![constrained_taylor(&cx, derivation)?],
-        false => {
-            functions.push(constrained_rhs(&cx, derivation, true)?);
-            Vec::new()
-        }
+    let taylor = match n <= TAYLOR_COORDINATES {
+        true => Some(constrained_taylor(&cx, derivation)?),
+        false => None,
     };
+    let taylor_functions: Vec<_> = taylor
+        .filter(|f| f.source_bytes() <= TAYLOR_SOURCE_BYTES)
+        .into_iter()
+        .collect();
+    let has_taylor = !taylor_functions.is_empty();
+    if !has_taylor {
+        functions.push(constrained_rhs(&cx, derivation, true)?);
+    }
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("dof", &n);
     context.insert("constraints", &k);
@@ -711,6 +723,7 @@ pub fn render_constrained(
     context.insert("has_taylor", &has_taylor);
     context.insert("state_velocities", &true);
     context.insert("taylor_coordinates", &TAYLOR_COORDINATES);
+    context.insert("taylor_source_bytes", &TAYLOR_SOURCE_BYTES);
     tera.render("constrained_model.rs.tera", &context)
         .map_err(|source| DeriveError::Template {
             template: "constrained_model.rs.tera",

@@ -169,7 +169,7 @@ pub fn period_map_flows(
 }
 
 /// Refuses the Taylor method for a model without Taylor recurrences (a
-/// constrained model of more than 6 coordinates): one refusal instead of
+/// constrained model of more than 6 coordinates or long forms): one refusal instead of
 /// every orbit stopping.
 pub(crate) fn method_applies(
     model: &crate::registry::Model,
@@ -181,7 +181,7 @@ pub(crate) fn method_applies(
     match (recurrences, method) {
         (false, crate::ode::Method::Taylor { .. }) => Err(Refusal::Setting {
             model: model.info.name.into(),
-            requirement: "a constrained model of more than 6 coordinates has no Taylor recurrences (compiled in three number types, they would cost its build more than the method saves): set method to dop853, radau5, gauss4, gauss6 or rk4",
+            requirement: "a constrained model of more than 6 coordinates, or whose recurrences would pass 300 kB of source, has no Taylor recurrences (compiled in three number types, they would cost its build more than the method saves): set method to dop853, radau5, gauss4, gauss6 or rk4",
         }),
         _ => Ok(()),
     }

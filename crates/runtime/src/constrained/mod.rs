@@ -73,7 +73,8 @@ pub struct FormsTable<const N: usize, const K: usize, const S: usize> {
     /// ∂f/∂y of the field, exact to round-off (by dual numbers).
     pub jacobian: fn(&[f64], f64, &[f64; S]) -> [[f64; S]; S],
     /// The generated Taylor recurrences, for a model of at most
-    /// `TAYLOR_COORDINATES` (6) coordinates.
+    /// `TAYLOR_COORDINATES` (6) coordinates whose recurrences are at most
+    /// `TAYLOR_SOURCE_BYTES` (300 kB) long.
     pub recurrences: Option<Recurrences<S>>,
 }
 

@@ -447,7 +447,7 @@ pub enum OdeError {
     /// The implicit stage equations did not converge.
     #[error("implicit stage equations did not converge at t = {t} with h = {h:e}, y = {y:?}")]
     NoConvergence { t: f64, h: f64, y: Vec<f64> },
-    #[error("method 'taylor' needs Taylor recurrences: the generated Hamiltonian models' systems (exact, averaged, and their variational equations) have them, and so have constrained models of at most 6 coordinates (a larger one: choose dop853, radau5, gauss4, gauss6 or rk4)")]
+    #[error("method 'taylor' needs Taylor recurrences: the generated Hamiltonian models' systems (exact, averaged, and their variational equations) have them, and so have constrained models of at most 6 coordinates whose recurrences are at most 300 kB of source (another: choose dop853, radau5, gauss4, gauss6 or rk4)")]
     TaylorUnavailable,
     /// A state of another length than the system's.
     #[error("a state of {given} numbers given to a system of {expected}")]

@@ -494,7 +494,7 @@ pub trait Flows: Sync {
         states_one_by_one(&*self.exact(params), method, starts, times)
     }
     /// Whether the model has Taylor recurrences (every Hamiltonian model;
-    /// a constrained one up to 6 coordinates).
+    /// a constrained one up to 6 coordinates and 300 kB of recurrences).
     fn has_taylor_recurrences(&self) -> bool {
         true
     }

@@ -1049,8 +1049,8 @@ async function chooseModel(name, address = new URLSearchParams()) {
   buildSection(model);
   buildSteady(model);
   $("order").disabled = !model.fast_phase;
-  // A constrained model of more than 6 coordinates has no Taylor
-  // recurrences: its orbits run with DOP853.
+  // A constrained model of more than 6 coordinates or long forms has no
+  // Taylor recurrences: its orbits run with DOP853.
   if (!model.taylor && $("method").value === "taylor") $("method").value = "dop853";
   $("order").value = "1";
   studio.mechanism = null;
