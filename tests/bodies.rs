@@ -309,14 +309,7 @@ fn a_free_body_in_euler_parameters_follows_eulers_equations_through_its_flips() 
     let h = 1e-4;
     for _ in 1..times.len() {
         for _ in 0..5000 {
-            let step = |w: [f64; 3], k: [f64; 3], a: f64| std::array::from_fn(|i| w[i] + a * k[i]);
-            let k1 = euler(w);
-            let k2 = euler(step(w, k1, h / 2.0));
-            let k3 = euler(step(w, k2, h / 2.0));
-            let k4 = euler(step(w, k3, h));
-            w = std::array::from_fn(|i| {
-                w[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
+            w = crate::common::rk4_step(euler, w, h);
         }
         reference.push(w);
     }

@@ -717,3 +717,36 @@ fn a_rolling_constraint_is_checked_against_its_body() {
         "{e}"
     );
 }
+
+/// A massless part (a coordinate without kinetic energy) is accepted when
+/// the constraints hold it; one they leave free, a model without any mass
+/// on its motion, and a kinetic energy negative along some velocity are
+/// named.
+#[test]
+fn massless_parts_are_accepted_where_the_constraints_hold_them() {
+    let with_z = |constraint: &str| {
+        ROD.replace(
+            "[[parameters]]\nname = \"g\"",
+            &format!("[[coordinates]]\nname = \"z\"\nvelocity = \"zd\"\nstart = 0.6\n\n{constraint}[[parameters]]\nname = \"g\""),
+        )
+    };
+    let held = "[[constraints]]\nname = \"follower\"\nposition = \"z - x\"\n\n";
+    let model = Model::parse("models/toy.toml", &with_z(held)).expect("a held massless part");
+    assert!(model.has_massless_parts());
+    assert!(!Model::parse("models/toy.toml", ROD)
+        .unwrap()
+        .has_massless_parts());
+    assert_error(
+        &with_z(""),
+        "lagrangian",
+        "singular along a motion the constraints allow",
+    );
+    let massless_point = ROD.replace("(dot(x)^2 + dot(y)^2)/2 - g*y", "-g*y");
+    assert_error(
+        &massless_point,
+        "lagrangian",
+        "singular along a motion the constraints allow",
+    );
+    let negative = ROD.replace("(dot(x)^2 + dot(y)^2)/2", "(dot(x)^2 - dot(y)^2)/2");
+    assert_error(&negative, "lagrangian", "not positive semidefinite");
+}

@@ -26,6 +26,7 @@ mod frequency;
 mod holonomic;
 mod indicators;
 mod integrators;
+mod massless;
 mod mechanism;
 mod model_errors;
 mod rattleback;

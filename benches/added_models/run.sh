@@ -8,7 +8,8 @@
 # 6- and 12-link chains of models/extra/, the first chapter's model of
 # docs/first_model/, whose commands the docs test then checks, and two
 # models defined only near their start: the bead on a circle in its
-# horizontal coordinate and the Test Set's car axis) to models/, runs the test
+# horizontal coordinate and the Test Set's car axis, and a slider-crank
+# whose connecting rod has no mass) to models/, runs the test
 # command, checks the 12-link chain's threshold from `stability` against
 # its closed form, and restores models/ however it ends.
 #
@@ -42,7 +43,8 @@ add_model() {
 
 for f in benches/edit_loop/*.toml models/extra/six_link_pendulum.toml \
     models/extra/twelve_link_pendulum.toml docs/first_model/my_pendulum.toml \
-    test_models/bead_on_circle.toml test_models/car_axis.toml; do
+    test_models/bead_on_circle.toml test_models/car_axis.toml \
+    test_models/massless_slider_crank.toml; do
     add_model "$f"
 done
 echo "added to models/: ${added[*]}"

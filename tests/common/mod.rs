@@ -341,3 +341,18 @@ pub fn assert_tune_check_states(
         "{check:?} vs {median}"
     );
 }
+
+/// One step of classical RK4, written out here for the tests' hand-made
+/// references (independent of the library's integrators).
+pub fn rk4_step<const D: usize>(
+    field: impl Fn([f64; D]) -> [f64; D],
+    y: [f64; D],
+    h: f64,
+) -> [f64; D] {
+    let add = |y: [f64; D], k: [f64; D], c: f64| std::array::from_fn(|i| y[i] + c * k[i]);
+    let k1 = field(y);
+    let k2 = field(add(y, k1, h / 2.0));
+    let k3 = field(add(y, k2, h / 2.0));
+    let k4 = field(add(y, k3, h));
+    std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+}

@@ -51,6 +51,9 @@ pub struct ConstrainedDerivation {
     pub stationary: bool,
     /// The coordinates' starts, expressions in the parameters.
     pub starts: Vec<String>,
+    /// Whether M is singular at the starts (massless parts): the field
+    /// then solves with M + α GᵀG and F − α Gᵀh, α = tr M / tr GᵀG.
+    pub massless: bool,
 }
 
 /// The model's coordinates and velocities, and the time derivatives the
@@ -287,5 +290,6 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         linear_term,
         stationary: mass_still && constraints_still,
         starts,
+        massless: model.has_massless_parts(),
     })
 }

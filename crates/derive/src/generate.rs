@@ -496,8 +496,14 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
     let solved_rows: Vec<Vec<String>> = (0..k)
         .map(|r| (0..n).map(|i| format!("solved_row{r}__{i}")).collect())
         .collect();
-    let mut forms = upper("mass", &derivation.mass_matrix);
-    forms.extend(named("free", &derivation.free_forces));
+    let forms = match derivation.massless {
+        false => {
+            let mut forms = upper("mass", &derivation.mass_matrix);
+            forms.extend(named("free", &derivation.free_forces));
+            vec![Step::Values(forms)]
+        }
+        true => massless_forms(derivation, &rows),
+    };
     let mut columns = vec![free];
     columns.extend(rows.iter().cloned());
     let mut solutions = vec![solved_free.clone()];
@@ -538,8 +544,8 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
     rates.extend(accelerations);
     let outputs: Vec<String> = rates.iter().map(|(name, _)| name.clone()).collect();
     let mut steps = bias_steps(cx, derivation);
+    steps.extend(forms);
     steps.extend([
-        Step::Values(forms),
         Step::Solve {
             matrix: names("mass", n),
             columns,
@@ -558,6 +564,51 @@ fn constrained_steps(cx: &Context, derivation: &ConstrainedDerivation) -> (Vec<S
         Step::Values(rates),
     ]);
     (steps, outputs)
+}
+
+/// M + α GᵀG (`mass__i_j`) and F − α Gᵀh (`free__i`) with α = tr M /
+/// tr GᵀG, for a model with massless parts: regular where M is on the
+/// constraints' motions, and the same accelerations and reactions (G q''
+/// = −h makes the added terms cancel). After the bias steps (G and h).
+fn massless_forms(derivation: &ConstrainedDerivation, rows: &[Vec<String>]) -> Vec<Step> {
+    use crate::numeric::{dot, upper};
+    let n = derivation.mass_matrix.len();
+    let mut forms = upper("inertia", &derivation.mass_matrix);
+    forms.extend(named("applied", &derivation.free_forces));
+    let trace: Vec<String> = (0..n).map(|i| format!("inertia__{i}_{i}")).collect();
+    let squares: Vec<String> = rows.iter().map(|row| dot(row, row)).collect();
+    let weight = (
+        "augmentation".to_string(),
+        format!("({})/({})", trace.join("+"), squares.join("+")),
+    );
+    let column = |i: usize| -> Vec<String> { rows.iter().map(|row| row[i].clone()).collect() };
+    let bias: Vec<String> = (0..rows.len()).map(|r| format!("bias__{r}")).collect();
+    let augmented: Vec<Vec<String>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    format!(
+                        "inertia__{}_{}+augmentation*{}",
+                        i.min(j),
+                        i.max(j),
+                        dot(&column(i), &column(j))
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let mut values = upper("mass", &augmented);
+    values.extend((0..n).map(|i| {
+        (
+            format!("free__{i}"),
+            format!("applied__{i}-augmentation*{}", dot(&column(i), &bias)),
+        )
+    }));
+    vec![
+        Step::Values(forms),
+        Step::Values(vec![weight]),
+        Step::Values(values),
+    ]
 }
 
 /// The steps that give each constraint's row of G (`jac__{r}_{j}`) and
@@ -717,6 +768,7 @@ pub fn render_constrained(
     context.insert("holonomic", &holonomic);
     context.insert("has_phase", &derivation.phase_rate.is_some());
     context.insert("stationary", &derivation.stationary);
+    context.insert("massless", &derivation.massless);
     context.insert("functions", &functions);
     context.insert("taylor_functions", &taylor_functions);
     context.insert("tangents_by_dual_numbers", &true);

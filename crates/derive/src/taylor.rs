@@ -1136,7 +1136,7 @@ impl Writer<'_> {
             },
             Op::Div(a, b) => match (self.constant(a), self.constant(b)) {
                 (_, true) => format!("{} / {}", at(a), self.value(b)),
-                (true, false) => format!("series::quotient({w}, 0.0, {}, n)", name(b)),
+                (true, false) => format!("series::quotient({w}, Num::from(0.0), {}, n)", name(b)),
                 _ => format!("series::quotient({w}, {}, {}, n)", at(a), name(b)),
             },
             Op::Square(a) => format!("series::square({}, n)", name(a)),

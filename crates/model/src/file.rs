@@ -1418,6 +1418,9 @@ impl Model {
     fn check_numerically(&self) -> Result<(), (String, String)> {
         let n = self.dof();
         let lagrangian = self.expanded_lagrangian();
+        // Massless parts: M may be singular, not indefinite; the
+        // constraints' check asks it to be regular on their motions.
+        let massless = self.has_massless_parts();
         let mut random = uniform(0x9E37_79B9_7F4A_7C15);
         let params = |s: &str| {
             self.parameters
@@ -1484,26 +1487,11 @@ impl Model {
             if third_difference.abs() > 1e-8 * scale {
                 return Err(("lagrangian".into(), "is not quadratic in the velocities (its third derivative along a velocity direction is non-zero)".into()));
             }
-            // Mass matrix by polarisation (exact for a quadratic).
-            let unit = |i: usize, j: usize, si: f64, sj: f64| {
-                let mut w = vec![0.0; n];
-                w[i] += si;
-                w[j] += sj;
-                at(&w).unwrap_or(f64::NAN)
-            };
-            let mut mass = vec![vec![0.0; n]; n];
-            for i in 0..n {
-                for j in 0..n {
-                    mass[i][j] = if i == j {
-                        unit(i, i, 1.0, 0.0) + unit(i, i, -1.0, 0.0) - 2.0 * unit(i, i, 0.0, 0.0)
-                    } else {
-                        (unit(i, j, 1.0, 1.0) - unit(i, j, 1.0, -1.0) - unit(i, j, -1.0, 1.0)
-                            + unit(i, j, -1.0, -1.0))
-                            / 4.0
-                    };
-                }
+            let mass = polarised_mass(n, |w| at(w).unwrap_or(f64::NAN));
+            if massless && !semidefinite(&mass) {
+                return Err(("lagrangian".into(), format!("mass matrix ∂²L/∂q'² = {mass:?} at q = {q:?} is not positive semidefinite: a kinetic energy that is negative along some velocity")));
             }
-            if !cholesky_ok(&mass) {
+            if !massless && !cholesky_ok(&mass) {
                 return Err(("lagrangian".into(), format!("mass matrix ∂²L/∂q'² = {mass:?} at q = {q:?} is singular or not positive definite")));
             }
         }
@@ -1656,7 +1644,48 @@ impl Model {
                 format!("the constraints leave no motion: at the starts they fix all {n} coordinates (their rows have rank {rank_of_rows}); a model needs fewer independent constraints than coordinates"),
             ));
         }
+        if let Some(mass) = self.mass_matrix_at_start().filter(|m| !cholesky_ok(m)) {
+            if !cholesky_ok(&augmented_mass(&mass, &rows)) {
+                return Err((
+                    "lagrangian".into(),
+                    format!("the mass matrix ∂²L/∂q'² = {mass:?} at the starts is singular along a motion the constraints allow: a massless part must be held by the constraints (M positive definite on the velocities they leave)"),
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// M = ∂²L/∂q'² at the coordinates' starts (t = 0, the fast phase 0,
+    /// the default parameters), by polarisation; None where L is not
+    /// finite there.
+    pub fn mass_matrix_at_start(&self) -> Option<Vec<Vec<f64>>> {
+        let lagrangian = self.expanded_lagrangian();
+        let n = self.dof();
+        let q = self.start_or_zero();
+        let mass = polarised_mass(n, |v| {
+            Sample {
+                model: self,
+                q: q.clone(),
+                v: v.to_vec(),
+                phase: 0.0,
+                time: 0.0,
+            }
+            .try_eval(&lagrangian)
+            .unwrap_or(f64::NAN)
+        });
+        mass.iter().flatten().all(|x| x.is_finite()).then_some(mass)
+    }
+
+    /// Whether the model has massless parts: constraints, and a mass
+    /// matrix that is singular at the starts. Its equations are then
+    /// solved with M + α GᵀG in place of M and F − α Gᵀh in place of F
+    /// (α = tr M / tr GᵀG), which gives the same accelerations and
+    /// reactions wherever M is regular on the constraints' motions.
+    pub fn has_massless_parts(&self) -> bool {
+        !self.constraints.is_empty()
+            && self
+                .mass_matrix_at_start()
+                .is_some_and(|mass| !cholesky_ok(&mass))
     }
 
     /// What a constraint's velocity form has besides the velocities: ∂g/∂t
@@ -1934,6 +1963,57 @@ fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     }
+}
+
+/// The mass matrix of a Lagrangian quadratic in the velocities, by
+/// polarisation of its values `at` velocities (exact for a quadratic).
+fn polarised_mass(n: usize, at: impl Fn(&[f64]) -> f64) -> Vec<Vec<f64>> {
+    let unit = |i: usize, j: usize, si: f64, sj: f64| {
+        let mut w = vec![0.0; n];
+        w[i] += si;
+        w[j] += sj;
+        at(&w)
+    };
+    let mut mass = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        for j in 0..n {
+            mass[i][j] = if i == j {
+                unit(i, i, 1.0, 0.0) + unit(i, i, -1.0, 0.0) - 2.0 * unit(i, i, 0.0, 0.0)
+            } else {
+                (unit(i, j, 1.0, 1.0) - unit(i, j, 1.0, -1.0) - unit(i, j, -1.0, 1.0)
+                    + unit(i, j, -1.0, -1.0))
+                    / 4.0
+            };
+        }
+    }
+    mass
+}
+
+/// M + α GᵀG with α = tr M / tr GᵀG (`rows` the rows of G): positive
+/// definite exactly where M is on the velocities the rows leave.
+fn augmented_mass(mass: &[Vec<f64>], rows: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let n = mass.len();
+    let trace: f64 = (0..n).map(|i| mass[i][i]).sum();
+    let norm: f64 = rows.iter().flatten().map(|x| x * x).sum();
+    let alpha = if norm > 0.0 { trace / norm } else { 0.0 };
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| mass[i][j] + alpha * rows.iter().map(|r| r[i] * r[j]).sum::<f64>())
+                .collect()
+        })
+        .collect()
+}
+
+/// Positive semidefinite to round-off: positive definite once a
+/// millionth of its largest diagonal entry is added to the diagonal.
+fn semidefinite(a: &[Vec<f64>]) -> bool {
+    let scale = (0..a.len()).map(|i| a[i][i].abs()).fold(0.0, f64::max);
+    let mut shifted = a.to_vec();
+    for (i, row) in shifted.iter_mut().enumerate() {
+        row[i] += 1e-6 * scale.max(f64::MIN_POSITIVE);
+    }
+    cholesky_ok(&shifted)
 }
 
 fn cholesky_ok(a: &[Vec<f64>]) -> bool {

@@ -45,6 +45,11 @@ pub struct FormsTable<const N: usize, const K: usize, const S: usize> {
     /// Whether the constraints are holonomic and fixed and M does not
     /// move with the phase (the averaging's conditions).
     pub stationary: bool,
+    /// Whether M is singular at the starts (massless parts): [`Forms`]
+    /// then gives M + α GᵀG for M and F − α Gᵀh for F (α = tr M / tr
+    /// GᵀG), regular where M is on the constraints' motions, with the
+    /// same accelerations and reactions, as the generated field does.
+    pub massless: bool,
     /// The model file's starts of the coordinates.
     pub start: fn(&[f64]) -> [f64; N],
     /// The period of the fast phase, if there is one.
@@ -125,13 +130,34 @@ impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
     pub fn phase_period(&self) -> Option<f64> {
         (self.table.phase_period)(&self.params)
     }
+    /// M, or M + α GᵀG for a model with massless parts.
     #[inline]
     pub fn mass_matrix(&self, t: f64, q: &[f64; N]) -> [[f64; N]; N] {
-        (self.table.mass_matrix)(&self.params, t, q)
+        let mut mass = (self.table.mass_matrix)(&self.params, t, q);
+        if self.table.massless {
+            let g = self.constraint_jacobian(t, q);
+            let alpha = augmentation(&mass, &g);
+            for (i, row) in mass.iter_mut().enumerate() {
+                for (j, m) in row.iter_mut().enumerate() {
+                    *m += alpha * g.iter().map(|r| r[i] * r[j]).sum::<f64>();
+                }
+            }
+        }
+        mass
     }
+    /// F, or F − α Gᵀh for a model with massless parts.
     #[inline]
     pub fn free_forces(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
-        (self.table.free_forces)(&self.params, t, q, v)
+        let mut free = (self.table.free_forces)(&self.params, t, q, v);
+        if self.table.massless {
+            let g = self.constraint_jacobian(t, q);
+            let alpha = augmentation(&(self.table.mass_matrix)(&self.params, t, q), &g);
+            let h = self.constraint_bias(t, q, v);
+            for (i, f) in free.iter_mut().enumerate() {
+                *f -= alpha * g.iter().zip(&h).map(|(r, h)| r[i] * h).sum::<f64>();
+            }
+        }
+        free
     }
     #[inline]
     pub fn position_residuals(&self, t: f64, q: &[f64; N]) -> [f64; K] {
@@ -276,6 +302,14 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
 }
 
 #[inline]
+/// α = tr M / tr GᵀG: the weight of GᵀG added to a singular M, of M's
+/// size whatever the constraints' units (the generated field's
+/// `augmentation`, the same expression).
+fn augmentation<const N: usize, const K: usize>(mass: &[[f64; N]; N], g: &[[f64; N]; K]) -> f64 {
+    let trace: f64 = (0..N).map(|i| mass[i][i]).sum();
+    trace / g.iter().flatten().map(|x| x * x).sum::<f64>()
+}
+
 pub(crate) fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Num {
     let mut sum = Num::from(0.0);
     for (x, y) in a.iter().zip(b) {
