@@ -1382,6 +1382,19 @@ fn the_iftomm_n_four_bar_turns_through_its_singular_positions() {
     let start = [
         FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, 0.0, 0.0, -1.0, -1.0, -1.0, 0.0, 0.0,
     ];
+    // The model file gives the first crank's rate (`start_rate`): its
+    // start holds it, and the closures give the others theirs.
+    let from_file = run(
+        &iftomm_n_four_bar::SYSTEMS,
+        &params,
+        None,
+        TIGHT,
+        &[0.0, 0.1],
+    )
+    .unwrap();
+    for (found, expected) in from_file.start.iter().zip(&start) {
+        assert!((found - expected).abs() < 1e-12, "{:?}", from_file.start);
+    }
     // Horizontal cranks: θ = π/2 − (k + 1/2)π on the way down and round.
     let singular = |theta: f64| ((FRAC_PI_2 - theta) / PI + 0.5).floor();
     let passes = singular(reference[200][0]);

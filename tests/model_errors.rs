@@ -750,3 +750,29 @@ fn massless_parts_are_accepted_where_the_constraints_hold_them() {
     let negative = ROD.replace("(dot(x)^2 + dot(y)^2)/2", "(dot(x)^2 - dot(y)^2)/2");
     assert_error(&negative, "lagrangian", "not positive semidefinite");
 }
+
+/// A starting rate is held at the start of a constrained model; rates the
+/// constraints cannot complete, and one in a model without constraints,
+/// are named.
+#[test]
+fn starting_rates_must_be_ones_the_constraints_allow() {
+    let rated = |x: &str, y: &str| {
+        ROD.replace("start = 0.6\n", &format!("start = 0.6\n{x}"))
+            .replace("start = \"-0.8*l\"\n", &format!("start = \"-0.8*l\"\n{y}"))
+    };
+    // 2x x' + 2y y' = 0 at (0.6, −0.8): y' = 0.75 x'.
+    let model = Model::parse("models/toy.toml", &rated("start_rate = 1.0\n", ""))
+        .expect("a rate the rod allows");
+    assert!(model.coordinates[0].start_rate.is_some());
+    assert_error(
+        &rated("start_rate = 1.0\n", "start_rate = 1.0\n"),
+        "coordinates[0].start_rate",
+        "leave no velocity of the other coordinates",
+    );
+    let free = GOOD.replace("periodic = true\n", "periodic = true\nstart_rate = 1.0\n");
+    assert_error(
+        &free,
+        "coordinates[0].start_rate",
+        "read by models with constraints",
+    );
+}

@@ -51,6 +51,10 @@ pub struct ConstrainedDerivation {
     pub stationary: bool,
     /// The coordinates' starts, expressions in the parameters.
     pub starts: Vec<String>,
+    /// The coordinates' starting rates, expressions in the parameters
+    /// ("0" where the file gives none), and which the file gives.
+    pub start_rates: Vec<String>,
+    pub rates_given: Vec<bool>,
     /// Whether M is singular at the starts (massless parts): the field
     /// then solves with M + α GᵀG and F − α Gᵀh, α = tr M / tr GᵀG.
     pub massless: bool,
@@ -290,6 +294,20 @@ pub fn derive(model: &Model) -> Result<ConstrainedDerivation, DeriveError> {
         linear_term,
         stationary: mass_still && constraints_still,
         starts,
+        start_rates: model
+            .coordinates
+            .iter()
+            .map(|c| {
+                c.start_rate
+                    .as_ref()
+                    .map_or_else(|| "0".into(), |e| e.to_string())
+            })
+            .collect(),
+        rates_given: model
+            .coordinates
+            .iter()
+            .map(|c| c.start_rate.is_some())
+            .collect(),
         massless: model.has_massless_parts(),
     })
 }

@@ -343,6 +343,14 @@ fn constrained_forms(derivation: &ConstrainedDerivation) -> Vec<Form<'_>> {
             dual: None,
         }),
         Some(Form {
+            name: "start_rates",
+            prefix: "qd",
+            doc: "The coordinates' starting rates of the model file (0 where it gives none; those it gives are held while the others are made consistent).",
+            inputs: Params,
+            values: Values::Vector(&derivation.start_rates),
+            dual: None,
+        }),
+        Some(Form {
             name: "mass_matrix",
             prefix: "m",
             doc: "Mass matrix M = ∂²L/∂q'².",
@@ -769,6 +777,7 @@ pub fn render_constrained(
     context.insert("has_phase", &derivation.phase_rate.is_some());
     context.insert("stationary", &derivation.stationary);
     context.insert("massless", &derivation.massless);
+    context.insert("rates_given", &derivation.rates_given);
     context.insert("functions", &functions);
     context.insert("taylor_functions", &taylor_functions);
     context.insert("tangents_by_dual_numbers", &true);

@@ -174,6 +174,10 @@ pub struct CoordinateSpec {
     /// constraints at t = 0 with the default parameters (models with
     /// constraints need one for every coordinate).
     pub start: Option<NumberSpec>,
+    /// Its rate at the start (models with constraints): held while the
+    /// other rates are made to satisfy the velocity constraints; without
+    /// one, a rate is what the constraints leave nearest rest.
+    pub start_rate: Option<NumberSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -229,6 +233,9 @@ pub struct Coordinate {
     /// Its value in the consistent start (models with constraints), an
     /// expression in the parameters.
     pub start: Option<Expr>,
+    /// Its rate at the start, held there (models with constraints), an
+    /// expression in the parameters.
+    pub start_rate: Option<Expr>,
 }
 
 #[derive(Clone, Debug)]
@@ -674,13 +681,14 @@ impl ModelFile {
         };
         let contacts =
             self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
-        let (constraints, starts) = self.validate_constraints(file, names, &parse)?;
+        let (constraints, starts, rates) = self.validate_constraints(file, names, &parse)?;
         let (mut points, body_frames) = self.body_frames(names, &parse, &bodies.tensors)?;
         self.validate_points(file, names, &parse, &mut points)?;
         let mut coordinates: Vec<Coordinate> =
             self.coordinates.into_iter().map(Coordinate::from).collect();
-        for (c, start) in coordinates.iter_mut().zip(starts) {
+        for ((c, start), rate) in coordinates.iter_mut().zip(starts).zip(rates) {
             c.start = start;
+            c.start_rate = rate;
         }
         let model = Model {
             name: self.name,
@@ -717,6 +725,7 @@ impl From<CoordinateSpec> for Coordinate {
             description: c.description,
             latex: c.latex,
             start: None,
+            start_rate: None,
         }
     }
 }
@@ -1226,14 +1235,23 @@ impl ModelFile {
 
     /// Constraints: each a position or a velocity expression, named once;
     /// fewer than the coordinates; not with contacts; and a start for
-    /// every coordinate. Returns them and the coordinates' starts.
+    /// every coordinate. Returns them, the coordinates' starts and their
+    /// starting rates.
+    #[allow(clippy::type_complexity)]
     fn validate_constraints(
         &self,
         file: &str,
         names: &Names,
         parse: &ExprParser,
-    ) -> Result<(Vec<Constraint>, Vec<Option<Expr>>), ModelError> {
+    ) -> Result<(Vec<Constraint>, Vec<Option<Expr>>, Vec<Option<Expr>>), ModelError> {
         let err = error_at(file);
+        let number = |key: String, spec: &NumberSpec, what: String| match spec {
+            NumberSpec::Value(v) if !v.is_finite() => {
+                Err(err(key, format!("{what} is not finite")))
+            }
+            NumberSpec::Value(v) => Ok(Expr::Num(format!("{v:?}"))),
+            NumberSpec::Expression(text) => parse(&key, text, &[&names.parameters], false),
+        };
         let starts = self
             .coordinates
             .iter()
@@ -1243,18 +1261,25 @@ impl ModelFile {
                 match &c.start {
                     None if !self.constraints.is_empty() => Err(err(key, format!("a model with constraints needs a start for '{}': its value in a configuration that satisfies the constraints at t = 0 with the default parameters", c.name))),
                     None => Ok(None),
-                    Some(NumberSpec::Value(v)) if !v.is_finite() => {
-                        Err(err(key, format!("the start of '{}' is not finite", c.name)))
-                    }
-                    Some(NumberSpec::Value(v)) => Ok(Some(Expr::Num(format!("{v:?}")))),
-                    Some(NumberSpec::Expression(text)) => {
-                        parse(&key, text, &[&names.parameters], false).map(Some)
-                    }
+                    Some(spec) => number(key, spec, format!("the start of '{}'", c.name)).map(Some),
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let rates = self
+            .coordinates
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let key = format!("coordinates[{i}].start_rate");
+                match &c.start_rate {
+                    None => Ok(None),
+                    Some(_) if self.constraints.is_empty() => Err(err(key, format!("a starting rate of '{}' is read by models with constraints, whose runs start from the file's start; a model without constraints starts from the state its run is given", c.name))),
+                    Some(spec) => number(key, spec, format!("the starting rate of '{}'", c.name)).map(Some),
                 }
             })
             .collect::<Result<Vec<_>, _>>()?;
         if self.constraints.is_empty() {
-            return Ok((Vec::new(), starts));
+            return Ok((Vec::new(), starts, rates));
         }
         if !self.contacts.is_empty() {
             return Err(err(
@@ -1318,7 +1343,7 @@ impl ModelFile {
             };
             constraints.push(made(kind, c.name.clone(), None));
         }
-        Ok((constraints, starts))
+        Ok((constraints, starts, rates))
     }
 }
 
@@ -1644,6 +1669,7 @@ impl Model {
                 format!("the constraints leave no motion: at the starts they fix all {n} coordinates (their rows have rank {rank_of_rows}); a model needs fewer independent constraints than coordinates"),
             ));
         }
+        self.check_start_rates(&rows, &at_start)?;
         if let Some(mass) = self.mass_matrix_at_start().filter(|m| !cholesky_ok(m)) {
             if !cholesky_ok(&augmented_mass(&mass, &rows)) {
                 return Err((
@@ -1651,6 +1677,61 @@ impl Model {
                     format!("the mass matrix ∂²L/∂q'² = {mass:?} at the starts is singular along a motion the constraints allow: a massless part must be held by the constraints (M positive definite on the velocities they leave)"),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// The starting rates the file gives leave the velocity constraints
+    /// solvable for the others at the starts: G_free v_free = −(c_t +
+    /// G_given v_given) has a solution (`rows` are G's rows there).
+    fn check_start_rates(
+        &self,
+        rows: &[Vec<f64>],
+        at_start: &Sample,
+    ) -> Result<(), (String, String)> {
+        let defaults = |s: &str| {
+            self.parameters
+                .iter()
+                .find(|p| p.name == s)
+                .map(|p| p.default)
+        };
+        let mut given = Vec::new();
+        for (i, c) in self.coordinates.iter().enumerate() {
+            if let Some(rate) = &c.start_rate {
+                let value = rate
+                    .eval(&defaults)
+                    .map_err(|e| (format!("coordinates[{i}].start_rate"), e.to_string()))?;
+                given.push((i, value));
+            }
+        }
+        if given.is_empty() {
+            return Ok(());
+        }
+        let free: Vec<usize> = (0..self.dof())
+            .filter(|i| given.iter().all(|(j, _)| j != i))
+            .collect();
+        let reduced: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|row| free.iter().map(|&i| row[i]).collect())
+            .collect();
+        let augmented: Vec<Vec<f64>> = rows
+            .iter()
+            .zip(&self.constraints)
+            .zip(&reduced)
+            .map(|((row, c), reduced)| {
+                let rest = at_start.eval(&self.constraint_rate(c))
+                    + given.iter().map(|&(i, v)| row[i] * v).sum::<f64>();
+                let mut reduced = reduced.clone();
+                reduced.push(rest);
+                reduced
+            })
+            .collect();
+        if rank(augmented) > rank(reduced) {
+            let (i, _) = given[0];
+            return Err((
+                format!("coordinates[{i}].start_rate"),
+                "the starting rates given leave no velocity of the other coordinates that satisfies the constraints at the starts (default parameters): give fewer, or rates the constraints allow".into(),
+            ));
         }
         Ok(())
     }

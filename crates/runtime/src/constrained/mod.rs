@@ -52,6 +52,10 @@ pub struct FormsTable<const N: usize, const K: usize, const S: usize> {
     pub massless: bool,
     /// The model file's starts of the coordinates.
     pub start: fn(&[f64]) -> [f64; N],
+    /// Their starting rates (0 where the file gives none), and which the
+    /// file gives: those are held when the start is made consistent.
+    pub start_rates: fn(&[f64]) -> [f64; N],
+    pub rates_given: [bool; N],
     /// The period of the fast phase, if there is one.
     pub phase_period: fn(&[f64]) -> Option<f64>,
     /// The field [q'; q''] at (t, y), its forms evaluated together.

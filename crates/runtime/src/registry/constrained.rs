@@ -34,9 +34,13 @@ pub trait ConstrainedSystems: Flows {
         t: f64,
         y: &[f64],
     ) -> Result<Box<dyn AnySystem>, OdeError>;
-    /// The model file's start at rest, [q_start; 0] (not yet projected:
-    /// a moving constraint may need velocities).
+    /// The model file's start, [q_start; q'_start] with the rates it
+    /// gives and 0 for the others (not yet projected: the others follow
+    /// from the velocity constraints, see [`Self::start_held`]).
     fn start(&self, params: &[f64]) -> Vec<f64>;
+    /// The components of [`Self::start`] the model file gives as rates:
+    /// held when the start is made consistent.
+    fn start_held(&self) -> Vec<usize>;
     /// Moves `y` onto the constraints at time t (see [`project`]).
     fn project(&self, params: &[f64], t: f64, y: &mut [f64])
         -> Result<Projection, ConstraintError>;
@@ -359,8 +363,14 @@ impl<const N: usize, const K: usize, const S: usize, const T: usize> Constrained
     }
     fn start(&self, params: &[f64]) -> Vec<f64> {
         let mut y = (self.forms.start)(params).to_vec();
-        y.resize(S, 0.0);
+        y.extend((self.forms.start_rates)(params));
         y
+    }
+    fn start_held(&self) -> Vec<usize> {
+        (0..N)
+            .filter(|&i| self.forms.rates_given[i])
+            .map(|i| N + i)
+            .collect()
     }
     fn project(
         &self,

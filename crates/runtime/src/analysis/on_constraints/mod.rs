@@ -290,7 +290,18 @@ fn follow(
                 source,
             })
     };
-    project(t0, &mut y)?;
+    // The file's start holds the rates it gives; the others follow.
+    let held = model.start_held();
+    match y0 {
+        None if !held.is_empty() => model.consistent(params, &mut y, &held).map_err(|source| {
+            ConstrainedError::Constraint {
+                model: name,
+                t: t0,
+                source,
+            }
+        })?,
+        _ => project(t0, &mut y)?,
+    }
     let start = y.clone();
     let mut modes = Modes::new(model, params, method, t0, &start)?;
     // Each reported state is projected too (a step cut short at every
