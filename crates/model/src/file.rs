@@ -1352,16 +1352,19 @@ impl Model {
         self.coordinates.len()
     }
 
+    /// A parameter's default value by name (None for another name).
+    fn default_of(&self, name: &str) -> Option<f64> {
+        self.parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.default)
+    }
+
     /// The coordinates' starts at the default parameters, 0 where a file
     /// gives none (or one that is not finite there): where the numerical
     /// checks sample the model.
     pub fn start_or_zero(&self) -> Vec<f64> {
-        let defaults = |s: &str| {
-            self.parameters
-                .iter()
-                .find(|p| p.name == s)
-                .map(|p| p.default)
-        };
+        let defaults = |s: &str| self.default_of(s);
         self.coordinates
             .iter()
             .map(|c| {
@@ -1447,12 +1450,7 @@ impl Model {
         // constraints' check asks it to be regular on their motions.
         let massless = self.has_massless_parts();
         let mut random = uniform(0x9E37_79B9_7F4A_7C15);
-        let params = |s: &str| {
-            self.parameters
-                .iter()
-                .find(|p| p.name == s)
-                .map(|p| p.default)
-        };
+        let params = |s: &str| self.default_of(s);
         if let Some(p) = &self.fast_phase {
             let rate = p
                 .rate
@@ -1577,12 +1575,7 @@ impl Model {
             return Ok(());
         }
         let n = self.dof();
-        let defaults = |s: &str| {
-            self.parameters
-                .iter()
-                .find(|p| p.name == s)
-                .map(|p| p.default)
-        };
+        let defaults = |s: &str| self.default_of(s);
         let mut start = Vec::new();
         for (i, c) in self.coordinates.iter().enumerate() {
             let value = c
@@ -1689,12 +1682,7 @@ impl Model {
         rows: &[Vec<f64>],
         at_start: &Sample,
     ) -> Result<(), (String, String)> {
-        let defaults = |s: &str| {
-            self.parameters
-                .iter()
-                .find(|p| p.name == s)
-                .map(|p| p.default)
-        };
+        let defaults = |s: &str| self.default_of(s);
         let mut given = Vec::new();
         for (i, c) in self.coordinates.iter().enumerate() {
             if let Some(rate) = &c.start_rate {

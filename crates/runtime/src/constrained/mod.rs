@@ -139,8 +139,7 @@ impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
     pub fn mass_matrix(&self, t: f64, q: &[f64; N]) -> [[f64; N]; N] {
         let mut mass = (self.table.mass_matrix)(&self.params, t, q);
         if self.table.massless {
-            let g = self.constraint_jacobian(t, q);
-            let alpha = augmentation(&mass, &g);
+            let (alpha, g) = self.augmentation(t, q, &mass);
             for (i, row) in mass.iter_mut().enumerate() {
                 for (j, m) in row.iter_mut().enumerate() {
                     *m += alpha * g.iter().map(|r| r[i] * r[j]).sum::<f64>();
@@ -149,13 +148,21 @@ impl<const N: usize, const K: usize, const S: usize> Forms<N, K, S> {
         }
         mass
     }
+    /// α = tr M / tr GᵀG at (t, q) with M the model's own `mass`, and G:
+    /// the weight of GᵀG added to a singular M, of M's size whatever the
+    /// constraints' units (the generated field's `augmentation`).
+    fn augmentation(&self, t: f64, q: &[f64; N], mass: &[[f64; N]; N]) -> (f64, [[f64; N]; K]) {
+        let g = self.constraint_jacobian(t, q);
+        let trace: f64 = (0..N).map(|i| mass[i][i]).sum();
+        (trace / g.iter().flatten().map(|x| x * x).sum::<f64>(), g)
+    }
     /// F, or F − α Gᵀh for a model with massless parts.
     #[inline]
     pub fn free_forces(&self, t: f64, q: &[f64; N], v: &[f64; N]) -> [f64; N] {
         let mut free = (self.table.free_forces)(&self.params, t, q, v);
         if self.table.massless {
-            let g = self.constraint_jacobian(t, q);
-            let alpha = augmentation(&(self.table.mass_matrix)(&self.params, t, q), &g);
+            let mass = (self.table.mass_matrix)(&self.params, t, q);
+            let (alpha, g) = self.augmentation(t, q, &mass);
             let h = self.constraint_bias(t, q, v);
             for (i, f) in free.iter_mut().enumerate() {
                 *f -= alpha * g.iter().zip(&h).map(|(r, h)| r[i] * h).sum::<f64>();
@@ -306,14 +313,6 @@ impl<const N: usize, const K: usize, const S: usize> OnConstraints<N, K, S> {
 }
 
 #[inline]
-/// α = tr M / tr GᵀG: the weight of GᵀG added to a singular M, of M's
-/// size whatever the constraints' units (the generated field's
-/// `augmentation`, the same expression).
-fn augmentation<const N: usize, const K: usize>(mass: &[[f64; N]; N], g: &[[f64; N]; K]) -> f64 {
-    let trace: f64 = (0..N).map(|i| mass[i][i]).sum();
-    trace / g.iter().flatten().map(|x| x * x).sum::<f64>()
-}
-
 pub(crate) fn dot<Num: Scalar, const N: usize>(a: &[Num; N], b: &[Num; N]) -> Num {
     let mut sum = Num::from(0.0);
     for (x, y) in a.iter().zip(b) {
