@@ -776,3 +776,98 @@ fn starting_rates_must_be_ones_the_constraints_allow() {
         "read by models with constraints",
     );
 }
+
+/// The tippe top in Euler angles (a model without constraints): its ball
+/// slides on the floor at the lowest point, k = (sin θ sin φ, −sin θ cos φ,
+/// cos θ) the symmetry axis.
+const SLIDING_BALL: &str = r#"
+name = "toy"
+description = "a ball with a low centre of mass sliding on the floor"
+gravity = [0, 0, "-g"]
+
+[[coordinates]]
+name = "x"
+velocity = "xd"
+
+[[coordinates]]
+name = "y"
+velocity = "yd"
+
+[[coordinates]]
+name = "phi"
+velocity = "phid"
+
+[[coordinates]]
+name = "theta"
+velocity = "thetad"
+start = 0.5
+
+[[coordinates]]
+name = "psi"
+velocity = "psid"
+
+[[sliding]]
+name = "floor"
+body = "ball"
+contact = ["x + a*sin(theta)*sin(phi)", "y - a*sin(theta)*cos(phi)", 0]
+damping = "mu"
+
+[[bodies]]
+name = "ball"
+mass = 1
+inertia = [0.9, 0.9, 1]
+position = ["x", "y", "1 - a*cos(theta)"]
+rotation = "Z(phi) X(theta) Z(psi)"
+
+[[parameters]]
+name = "a"
+default = 0.3
+description = "a"
+
+[[parameters]]
+name = "mu"
+default = 0.1
+description = "mu"
+
+[[parameters]]
+name = "g"
+default = 9.81
+description = "g"
+"#;
+
+/// A sliding contact adds its friction to the Rayleigh function, names its
+/// body, and must be where the body touches the plane, with or without
+/// constraints (the tippe top in Euler parameters and in Euler angles).
+#[test]
+fn a_sliding_contact_is_checked_against_its_body() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../test_models/tippe_top.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let file = "test_models/tippe_top.toml";
+    let model = Model::parse(file, &text).expect("the ball slides at its lowest point");
+    assert!(model.rayleigh.symbols().contains("mu"));
+    let under_the_centre = text.replace(
+        "contact = [\"x + a*kx\", \"y + a*ky\", 0]",
+        "contact = [\"x\", \"y\", 0]",
+    );
+    assert_ne!(under_the_centre, text);
+    let e = Model::parse(file, &under_the_centre).unwrap_err();
+    assert_eq!(e.key, "sliding[0].contact", "{e}");
+    assert!(e.reason.contains("moves off the plane"), "{e}");
+    let no_body = text.replace("body = \"top\"", "body = \"ball\"");
+    let e = Model::parse(file, &no_body).unwrap_err();
+    assert_eq!(e.key, "sliding[0].body", "{e}");
+    assert!(
+        e.reason.contains("not one of the model's [[bodies]]"),
+        "{e}"
+    );
+    let moving_damping = text.replace("damping = \"mu\"", "damping = \"mu*x\"");
+    assert_eq!(
+        Model::parse(file, &moving_damping).unwrap_err().key,
+        "sliding[0].damping"
+    );
+
+    let ball = Model::parse("models/toy.toml", SLIDING_BALL).expect("the ball in Euler angles");
+    assert!(ball.constraints.is_empty() && ball.sliding.len() == 1);
+    let off = SLIDING_BALL.replace("y - a*sin(theta)*cos(phi)", "y + a*sin(theta)*cos(phi)");
+    assert_error(&off, "sliding[0].contact", "moves off the plane");
+}

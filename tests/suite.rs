@@ -43,5 +43,6 @@ mod study2;
 mod study3;
 mod taylor;
 mod taylor_lanes;
+mod tippe_top;
 mod trade;
 mod verify_derivations;

@@ -7,7 +7,7 @@
 //! that the Lagrangian is quadratic in the velocities with a positive definite
 //! mass matrix.
 
-use super::expr::Expr;
+use super::expr::{BinOp, Expr};
 pub use mechlab_range::{Range, RangeError};
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -39,6 +39,10 @@ pub struct ModelFile {
     /// Coulomb contacts: points sliding along rough guides.
     #[serde(default)]
     pub contacts: Vec<ContactSpec>,
+    /// Bodies sliding on the horizontal plane with viscous friction at
+    /// their contact (a Rayleigh term derived from the body's geometry).
+    #[serde(default)]
+    pub sliding: Vec<SlidingSpec>,
     /// Constraints on the coordinates, ideal (their reactions do no work
     /// along the motions they allow): closed loops, rods between points,
     /// moving guides, rolling.
@@ -103,6 +107,24 @@ pub struct ContactSpec {
     pub at: String,
     /// The friction coefficient (an expression in the parameters).
     pub friction: String,
+    #[serde(default)]
+    pub description: String,
+}
+
+/// A body sliding on a horizontal plane at its point `contact`, with
+/// viscous friction: the plane pushes on the body's material point there
+/// with −`damping` × its horizontal velocity. It adds ½ damping |v|² to
+/// the Rayleigh function (the tippe top's sliding).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SlidingSpec {
+    pub name: String,
+    /// The sliding body's name.
+    pub body: String,
+    /// Where it touches the plane (x, y, z), in the coordinates.
+    pub contact: [NumberSpec; 3],
+    /// The friction's coefficient (N s/m), an expression in the parameters.
+    pub damping: NumberSpec,
     #[serde(default)]
     pub description: String,
 }
@@ -274,9 +296,12 @@ pub struct Model {
     pub lagrangian: Expr,
     /// One force per coordinate (zero where the file gives none).
     pub forces: Vec<Expr>,
-    /// The Rayleigh dissipation function (zero if none); `dot()` as in L.
+    /// The Rayleigh dissipation function (zero if none), the sliding
+    /// contacts' terms included; `dot()` as in L.
     pub rayleigh: Expr,
     pub contacts: Vec<Contact>,
+    /// The bodies sliding on the plane (their friction is in `rayleigh`).
+    pub sliding: Vec<Sliding>,
     pub constraints: Vec<Constraint>,
     /// The mechanism's points, in the order of the file (empty: no
     /// drawing), then each body's centre and axis tips.
@@ -328,6 +353,19 @@ pub struct Constraint {
     /// A rolling constraint's contact velocity along the plane's normal,
     /// which the body's geometry must hold at zero.
     pub normal: Option<Expr>,
+}
+
+/// A validated sliding contact: what the body's geometry must keep on
+/// the plane.
+#[derive(Clone, Debug)]
+pub struct Sliding {
+    pub name: String,
+    /// The file's key that gave it (`sliding[0].contact`), for messages.
+    pub key: String,
+    /// The material point's velocity across the plane, which the body's
+    /// geometry must hold at zero, and along it (x): the check's scale.
+    pub normal: Expr,
+    pub along: Expr,
 }
 
 /// What vanishes along the motion.
@@ -679,6 +717,8 @@ impl ModelFile {
             Some(text) => parse("rayleigh", text, &all, true)?,
             None => Expr::num(0),
         };
+        let (sliding, friction) = self.validate_sliding(file, names, &parse)?;
+        let rayleigh = Expr::sum(std::iter::once(rayleigh).chain(friction).collect());
         let contacts =
             self.validate_contacts(file, &names.coordinates, &names.parameters, &parse)?;
         let (constraints, starts, rates) = self.validate_constraints(file, names, &parse)?;
@@ -702,6 +742,7 @@ impl ModelFile {
             forces,
             rayleigh,
             contacts,
+            sliding,
             constraints,
             points,
             body_frames,
@@ -711,6 +752,7 @@ impl ModelFile {
         model
             .check_numerically()
             .and_then(|()| model.check_constraints_numerically())
+            .and_then(|()| model.check_sliding_without_constraints())
             .map_err(|(key, reason)| err(&key, reason))?;
         Ok(model)
     }
@@ -1105,11 +1147,12 @@ impl ModelFile {
         Ok((points, frames))
     }
 
-    /// Constraint `i`'s rolling body's material velocity at its contact
-    /// point (x, y, z), the z one to be held at zero by the geometry.
-    fn rolling_velocity(
+    /// The material velocity (x, y, z) of the body named at `body_key` at
+    /// its point `contact` (read with `contact_key`): a rolling
+    /// constraint's or a sliding contact's.
+    fn contact_velocity(
         &self,
-        i: usize,
+        (body_key, contact_key): (&str, &str),
         body: &str,
         contact: &[NumberSpec; 3],
         file: &str,
@@ -1119,22 +1162,68 @@ impl ModelFile {
         let err = error_at(file);
         let Some(k) = self.bodies.iter().position(|b| b.name == body) else {
             return Err(err(
-                format!("constraints[{i}].rolling"),
+                body_key.to_string(),
                 format!("'{body}' is not one of the model's [[bodies]]"),
             ));
         };
-        let key = format!("constraints[{i}].contact");
         let contact = contact.clone().map(|p| crate::bodies::text(&p));
         for p in &contact {
-            parse(&key, p, &names.positions(), false)?;
+            parse(contact_key, p, &names.positions(), false)?;
         }
         let moves = |s: &str| names.moves(s);
         let velocity = crate::bodies::point_velocity(&self.bodies[k], &contact, &moves);
         let mut parsed = Vec::new();
         for v in velocity {
-            parsed.push(parse(&key, &v, &names.all(), true)?);
+            parsed.push(parse(contact_key, &v, &names.all(), true)?);
         }
         Ok(parsed.try_into().expect("three components"))
+    }
+
+    /// The sliding contacts, and their friction's terms of the Rayleigh
+    /// function, ½ damping (v_x² + v_y²) of each contact's material velocity.
+    fn validate_sliding(
+        &self,
+        file: &str,
+        names: &Names,
+        parse: &ExprParser,
+    ) -> Result<(Vec<Sliding>, Vec<Expr>), ModelError> {
+        let err = error_at(file);
+        let (mut sliding, mut terms) = (Vec::new(), Vec::new());
+        for (i, s) in self.sliding.iter().enumerate() {
+            if !is_identifier(&s.name) || self.sliding[..i].iter().any(|o| o.name == s.name) {
+                return Err(err(
+                    format!("sliding[{i}].name"),
+                    format!("'{}' is not an identifier, or names two contacts", s.name),
+                ));
+            }
+            let key = format!("sliding[{i}].contact");
+            let [x, y, normal] = self.contact_velocity(
+                (&format!("sliding[{i}].body"), &key),
+                &s.body,
+                &s.contact,
+                file,
+                names,
+                parse,
+            )?;
+            let damping = parse(
+                &format!("sliding[{i}].damping"),
+                &crate::bodies::text(&s.damping),
+                &[&names.parameters],
+                false,
+            )?;
+            let bin = |op, a: Expr, b: Expr| Expr::Bin(op, Box::new(a), Box::new(b));
+            let square = |v: Expr| bin(BinOp::Pow, v, Expr::num(2));
+            let speed = Expr::sum(vec![square(x.clone()), square(y)]);
+            let half = bin(BinOp::Div, damping, Expr::num(2));
+            terms.push(bin(BinOp::Mul, half, speed));
+            sliding.push(Sliding {
+                name: s.name.clone(),
+                key,
+                normal,
+                along: x,
+            });
+        }
+        Ok((sliding, terms))
     }
 
     /// Bodies: each one's parts read with its own key, then its kinetic
@@ -1328,8 +1417,14 @@ impl ModelFile {
                     true,
                 )?),
                 (None, None, Some(body), Some(contact)) => {
-                    let [along_x, along_y, normal] =
-                        self.rolling_velocity(i, body, contact, file, names, parse)?;
+                    let [along_x, along_y, normal] = self.contact_velocity(
+                        (&format!("constraints[{i}].rolling"), &format!("constraints[{i}].contact")),
+                        body,
+                        contact,
+                        file,
+                        names,
+                        parse,
+                    )?;
                     constraints.push(made(ConstraintKind::Velocity(along_x), format!("{}_x", c.name), None));
                     constraints.push(made(ConstraintKind::Velocity(along_y), format!("{}_y", c.name), Some(normal)));
                     continue;
@@ -1781,12 +1876,42 @@ impl Model {
         }
     }
 
-    /// A rolling body's contact point is where it touches the plane: its
-    /// material velocity along the normal vanishes for every motion the
-    /// constraints allow (their rows' null space, at random), at the start
-    /// and, where no position constraint pins the configuration, near it.
+    /// A sliding contact's plane, in a model without constraints: checked
+    /// as a rolling one's, at its start (or 0).
+    fn check_sliding_without_constraints(&self) -> Result<(), (String, String)> {
+        if self.sliding.is_empty() || !self.constraints.is_empty() {
+            return Ok(());
+        }
+        let at_start = Sample {
+            model: self,
+            q: self.start_or_zero(),
+            v: vec![0.0; self.dof()],
+            phase: 0.0,
+            time: 0.0,
+        };
+        self.check_contacts_stay_on_the_plane(&at_start)
+    }
+
+    /// A rolling or sliding body's contact point is where it touches the
+    /// plane: its material velocity along the normal vanishes for every
+    /// motion the constraints allow (their rows' null space, at random), at
+    /// the start and, where no position constraint pins the configuration,
+    /// near it.
     fn check_contacts_stay_on_the_plane(&self, at_start: &Sample) -> Result<(), (String, String)> {
-        if self.constraints.iter().all(|c| c.normal.is_none()) {
+        let rolling = self.constraints.iter().filter_map(|c| {
+            let normal = c.normal.as_ref()?;
+            Some((
+                c.key.replace(".rolling", ".contact"),
+                normal,
+                c.kind.expression(),
+            ))
+        });
+        let sliding = self
+            .sliding
+            .iter()
+            .map(|s| (s.key.clone(), &s.normal, &s.along));
+        let on_planes: Vec<(String, &Expr, &Expr)> = rolling.chain(sliding).collect();
+        if on_planes.is_empty() {
             return Ok(());
         }
         let n = self.dof();
@@ -1810,12 +1935,11 @@ impl Model {
             .any(|c| matches!(c.kind, ConstraintKind::Position(_)));
         // Each contact's velocity across the plane and along it, and their
         // gradients in the velocities (the scale), derived once.
-        let contacts: Vec<(&Constraint, Expr, Vec<(Expr, Expr)>)> = self
-            .constraints
-            .iter()
-            .filter_map(|constraint| {
-                let normal = self.expanded(constraint.normal.as_ref()?);
-                let along = self.expanded(constraint.kind.expression());
+        let contacts: Vec<(String, Expr, Vec<(Expr, Expr)>)> = on_planes
+            .into_iter()
+            .map(|(key, normal, along)| {
+                let normal = self.expanded(normal);
+                let along = self.expanded(along);
                 let gradients = self
                     .coordinates
                     .iter()
@@ -1826,7 +1950,7 @@ impl Model {
                         )
                     })
                     .collect();
-                Some((constraint, normal, gradients))
+                (key, normal, gradients)
             })
             .collect();
         let mut random = uniform(0x9E37_79B9_7F4A_7C15);
@@ -1852,7 +1976,7 @@ impl Model {
                 .collect();
             let v = project_out(&values, (0..n).map(|_| random()).collect());
             let moving = Sample { v, ..point.clone() };
-            for (constraint, normal, gradients) in &contacts {
+            for (key, normal, gradients) in &contacts {
                 // The scale: the contact's velocity along the plane and
                 // across it, per unit speed.
                 let gradient: f64 = gradients
@@ -1867,7 +1991,7 @@ impl Model {
                 let off = moving.eval(normal);
                 if !(off.abs() <= 1e-8 * gradient * speed) {
                     return Err((
-                        constraint.key.replace(".rolling", ".contact"),
+                        key.clone(),
                         format!("the body's material point at the contact moves off the plane (normal velocity {off:.3e} in a motion the constraints allow near the start): `contact` is not where the body touches the plane"),
                     ));
                 }
