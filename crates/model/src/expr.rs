@@ -420,6 +420,49 @@ impl Expr {
         })
     }
 
+    /// The value and the derivative along one direction (forward mode):
+    /// `env` gives each symbol's value and rate. A numerical check's
+    /// gradient without the symbolic derivative's tree.
+    pub fn eval_rate(
+        &self,
+        env: &dyn Fn(&str) -> Option<(f64, f64)>,
+    ) -> Result<(f64, f64), EvalError> {
+        Ok(match self {
+            Expr::Num(_) => (self.eval(&|_| None)?, 0.0),
+            Expr::Sym(s) => env(s).ok_or_else(|| EvalError::NoValue(s.clone()))?,
+            Expr::Neg(a) => {
+                let (x, dx) = a.eval_rate(env)?;
+                (-x, -dx)
+            }
+            Expr::Bin(op, a, b) => {
+                let ((x, dx), (y, dy)) = (a.eval_rate(env)?, b.eval_rate(env)?);
+                match op {
+                    BinOp::Add => (x + y, dx + dy),
+                    BinOp::Sub => (x - y, dx - dy),
+                    BinOp::Mul => (x * y, dx * y + x * dy),
+                    BinOp::Div => (x / y, (dx * y - x * dy) / (y * y)),
+                    BinOp::Pow if dy == 0.0 => (x.powf(y), y * x.powf(y - 1.0) * dx),
+                    BinOp::Pow => {
+                        let p = x.powf(y);
+                        (p, p * (dy * x.ln() + y * dx / x))
+                    }
+                }
+            }
+            Expr::Call(name, args) => {
+                let (x, dx) = args[0].eval_rate(env)?;
+                match name.as_str() {
+                    "sin" => (x.sin(), x.cos() * dx),
+                    "cos" => (x.cos(), -x.sin() * dx),
+                    "tan" => (x.tan(), dx / (x.cos() * x.cos())),
+                    "exp" => (x.exp(), x.exp() * dx),
+                    "log" => (x.ln(), dx / x),
+                    "sqrt" => (x.sqrt(), dx / (2.0 * x.sqrt())),
+                    _ => return Err(EvalError::UnknownFunction(name.clone())),
+                }
+            }
+        })
+    }
+
     /// Symbolic partial derivative (unsimplified, for numerical checks).
     pub fn derivative(&self, var: &str) -> Expr {
         use BinOp::*;
@@ -429,12 +472,14 @@ impl Expr {
             Expr::Num(_) => zero(),
             Expr::Sym(s) => Expr::num(i64::from(s == var)),
             Expr::Neg(a) => Expr::Neg(Box::new(a.derivative(var))),
+            // A sum's terms are not cloned: a long sum is a deep tree, and
+            // a clone at each of its nodes made the derivative quadratic.
+            Expr::Bin(op @ (Add | Sub), a, b) => bin(*op, a.derivative(var), b.derivative(var)),
             Expr::Bin(op, a, b) => {
                 let (a, b) = (a.as_ref().clone(), b.as_ref().clone());
                 let (da, db) = (a.derivative(var), b.derivative(var));
                 match op {
-                    Add => bin(Add, da, db),
-                    Sub => bin(Sub, da, db),
+                    Add | Sub => unreachable!("sums are differentiated above"),
                     Mul => bin(Add, bin(Mul, da, b), bin(Mul, a, db)),
                     Div => bin(
                         Div,

@@ -313,6 +313,9 @@ pub struct Model {
     /// parameters: the drawing's way down.
     pub gravity: Option<[Expr; 3]>,
     pub inverse: Inverse,
+    /// The definitions resolved (each with the others substituted), made
+    /// once: every numerical check expands its expressions with them.
+    resolved: std::sync::OnceLock<Vec<(String, Expr)>>,
 }
 
 /// A body's inertia tensor about its centre in its axes, as written
@@ -748,6 +751,7 @@ impl ModelFile {
             body_frames,
             gravity: bodies.gravity,
             inverse,
+            resolved: std::sync::OnceLock::new(),
         };
         model
             .check_numerically()
@@ -1482,7 +1486,7 @@ impl Model {
     /// An expression of the file with definitions substituted and `dot`
     /// expanded as in [`Model::expanded_lagrangian`].
     pub fn expanded(&self, e: &Expr) -> Expr {
-        let resolved = self.resolved_definitions();
+        let resolved = self.resolved.get_or_init(|| self.resolved_definitions());
         let lookup = |s: &str| {
             resolved
                 .iter()
@@ -1512,10 +1516,18 @@ impl Model {
             }
             Expr::sum(terms)
         };
+        // Each name's rate derived once (a body's centre appears in its
+        // energy once per axis and again in every contact).
+        let mut rates: BTreeMap<String, Expr> = BTreeMap::new();
         e.rewrite_calls(&mut |name, args| match (name, &args[0]) {
-            ("dot", Expr::Sym(s)) => Some(total_derivative(
-                &lookup(s).unwrap_or_else(|| Expr::Sym(s.clone())),
-            )),
+            ("dot", Expr::Sym(s)) => Some(
+                rates
+                    .entry(s.clone())
+                    .or_insert_with(|| {
+                        total_derivative(&lookup(s).unwrap_or_else(|| Expr::Sym(s.clone())))
+                    })
+                    .clone(),
+            ),
             _ => None,
         })
         .substitute(&lookup)
@@ -1656,6 +1668,16 @@ impl Sample<'_> {
 
     fn eval(&self, e: &Expr) -> f64 {
         self.try_eval(e).unwrap_or(f64::NAN)
+    }
+
+    /// ∂e/∂q_j here (forward mode; NaN where e cannot be evaluated).
+    fn rate_along(&self, e: &Expr, j: usize) -> f64 {
+        let name = &self.model.coordinates[j].name;
+        e.eval_rate(&|s| {
+            self.value(s)
+                .map(|x| (x, if s == name { 1.0 } else { 0.0 }))
+        })
+        .map_or(f64::NAN, |(_, rate)| rate)
     }
 }
 
@@ -2015,16 +2037,6 @@ impl Model {
         let n = self.dof();
         let mut random = uniform(0x2545_F491_4F6C_DD1D);
         let mut integrable = true;
-        // ∂a/∂q, derived once (the four samples evaluate it).
-        let row_derivatives: Vec<Vec<Expr>> = row
-            .iter()
-            .map(|e| {
-                self.coordinates
-                    .iter()
-                    .map(|c| e.derivative(&c.name))
-                    .collect()
-            })
-            .collect();
         for sample in 0..4 {
             let q: Vec<f64> = at_start
                 .q
@@ -2063,9 +2075,10 @@ impl Model {
                 time: 0.0,
             };
             let a: Vec<f64> = row.iter().map(|e| point.eval(e)).collect();
-            let da: Vec<Vec<f64>> = row_derivatives
+            // ∂a_k/∂q_j, by forward mode along each coordinate.
+            let da: Vec<Vec<f64>> = row
                 .iter()
-                .map(|row| row.iter().map(|e| point.eval(e)).collect())
+                .map(|e| (0..n).map(|j| point.rate_along(e, j)).collect())
                 .collect();
             // a·dq ∧ d(a·dq), component (i, j, k): a_i (∂_j a_k − ∂_k a_j) + cyclic.
             for i in 0..n {

@@ -48,6 +48,9 @@ fn gcd(a: i128, b: i128) -> i128 {
 impl Q {
     fn new(n: i128, d: i128) -> Q {
         assert!(d != 0, "zero denominator");
+        if d == 1 {
+            return Q { n, d };
+        }
         let g = gcd(n, d).max(1) * d.signum();
         Q { n: n / g, d: d / g }
     }
@@ -58,9 +61,15 @@ impl Q {
         self.n == 0
     }
     fn add(self, o: Q) -> Q {
+        if self.d == 1 && o.d == 1 {
+            return Q::int(self.n + o.n);
+        }
         Q::new(self.n * o.d + o.n * self.d, self.d * o.d)
     }
     fn mul(self, o: Q) -> Q {
+        if self.d == 1 && o.d == 1 {
+            return Q::int(self.n * o.n);
+        }
         let (g1, g2) = (gcd(self.n, o.d).max(1), gcd(o.n, self.d).max(1));
         Q::new((self.n / g1) * (o.n / g2), (self.d / g2) * (o.d / g1))
     }
@@ -85,19 +94,82 @@ impl Q {
     }
 }
 
-/// Exponents per variable index (sparse, only nonzero).
-type Monomial = BTreeMap<usize, i32>;
+/// Exponents per variable index (sparse, only nonzero), sorted by the
+/// index: ordered as the map from index to exponent would be, and
+/// compared and cloned as one vector.
+#[derive(Clone, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
+struct Monomial(Vec<(usize, i32)>);
+
+impl Monomial {
+    fn new() -> Monomial {
+        Monomial(Vec::new())
+    }
+    fn iter(&self) -> impl Iterator<Item = (&usize, &i32)> + '_ {
+        self.0.iter().map(|(v, e)| (v, e))
+    }
+    fn get(&self, v: &usize) -> Option<&i32> {
+        self.0
+            .binary_search_by_key(v, |(w, _)| *w)
+            .ok()
+            .map(|i| &self.0[i].1)
+    }
+}
+
+impl FromIterator<(usize, i32)> for Monomial {
+    /// Sorted by index, equal indices added, zero exponents dropped.
+    fn from_iter<I: IntoIterator<Item = (usize, i32)>>(items: I) -> Monomial {
+        let mut entries: Vec<(usize, i32)> = items.into_iter().collect();
+        entries.sort_by_key(|(v, _)| *v);
+        let mut merged: Vec<(usize, i32)> = Vec::with_capacity(entries.len());
+        for (v, e) in entries {
+            match merged.last_mut() {
+                Some((w, f)) if *w == v => *f += e,
+                _ => merged.push((v, e)),
+            }
+        }
+        merged.retain(|(_, e)| *e != 0);
+        Monomial(merged)
+    }
+}
+
+impl<'a> IntoIterator for &'a Monomial {
+    type Item = (&'a usize, &'a i32);
+    type IntoIter = std::iter::Map<
+        std::slice::Iter<'a, (usize, i32)>,
+        fn(&'a (usize, i32)) -> (&'a usize, &'a i32),
+    >;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter().map(|(v, e)| (v, e))
+    }
+}
 
 fn mono_mul(a: &Monomial, b: &Monomial) -> Monomial {
-    let mut m = a.clone();
-    for (&v, &e) in b {
-        let x = m.entry(v).or_insert(0);
-        *x += e;
-        if *x == 0 {
-            m.remove(&v);
+    let (a, b) = (&a.0, &b.0);
+    let mut m = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].0.cmp(&b[j].0) {
+            std::cmp::Ordering::Less => {
+                m.push(a[i]);
+                i += 1;
+            }
+            std::cmp::Ordering::Greater => {
+                m.push(b[j]);
+                j += 1;
+            }
+            std::cmp::Ordering::Equal => {
+                let e = a[i].1 + b[j].1;
+                if e != 0 {
+                    m.push((a[i].0, e));
+                }
+                i += 1;
+                j += 1;
+            }
         }
     }
-    m
+    m.extend_from_slice(&a[i..]);
+    m.extend_from_slice(&b[j..]);
+    Monomial(m)
 }
 
 /// cos(k·φ) or sin(k·φ); k is canonical: its first nonzero entry is positive,
@@ -178,18 +250,32 @@ impl Poly {
         self.0.is_empty()
     }
     fn add_term(&mut self, m: Monomial, h: Harmonic, c: Q) {
-        let key = (m, h);
-        let value = self.0.get(&key).copied().unwrap_or(Q::int(0)).add(c);
-        if value.is_zero() {
-            self.0.remove(&key);
-        } else {
-            self.0.insert(key, value);
+        use std::collections::btree_map::Entry;
+        match self.0.entry((m, h)) {
+            Entry::Occupied(mut entry) => {
+                let value = entry.get().add(c);
+                match value.is_zero() {
+                    true => drop(entry.remove()),
+                    false => *entry.get_mut() = value,
+                }
+            }
+            Entry::Vacant(entry) => {
+                if !c.is_zero() {
+                    entry.insert(c);
+                }
+            }
         }
     }
-    fn add(&self, o: &Poly) -> Poly {
-        let mut r = self.clone();
-        for ((m, h), c) in &o.0 {
-            r.add_term(m.clone(), h.clone(), *c);
+    /// The sum, the smaller added into the larger: a long sum read term
+    /// by term stays linear in its length (a clone per term made the
+    /// bicycle's Lagrangian quadratic).
+    fn add(self, o: Poly) -> Poly {
+        let (mut r, o) = match self.0.len() >= o.0.len() {
+            true => (self, o),
+            false => (o, self),
+        };
+        for ((m, h), c) in o.0 {
+            r.add_term(m, h, c);
         }
         r
     }
@@ -354,12 +440,12 @@ fn to_fraction(e: &Expr, cx: &mut Context) -> Fraction {
                     };
                     if x.den == y.den {
                         Fraction {
-                            num: x.num.add(&y_num),
+                            num: x.num.add(y_num),
                             den: x.den,
                         }
                     } else {
                         Fraction {
-                            num: x.num.mul(&y.den).add(&y_num.mul(&x.den)),
+                            num: x.num.mul(&y.den).add(y_num.mul(&x.den)),
                             den: x.den.mul(&y.den),
                         }
                     }
@@ -392,11 +478,20 @@ fn to_fraction(e: &Expr, cx: &mut Context) -> Fraction {
 type Plain = BTreeMap<Monomial, Q>;
 
 fn plain_add(p: &mut Plain, m: Monomial, c: Q) {
-    let v = p.get(&m).copied().unwrap_or(Q::int(0)).add(c);
-    if v.is_zero() {
-        p.remove(&m);
-    } else {
-        p.insert(m, v);
+    use std::collections::btree_map::Entry;
+    match p.entry(m) {
+        Entry::Occupied(mut entry) => {
+            let value = entry.get().add(c);
+            match value.is_zero() {
+                true => drop(entry.remove()),
+                false => *entry.get_mut() = value,
+            }
+        }
+        Entry::Vacant(entry) => {
+            if !c.is_zero() {
+                entry.insert(c);
+            }
+        }
     }
 }
 
@@ -538,7 +633,7 @@ fn reduce_squares(p: &Plain, keep_cosine: bool, angles: usize, cx: &mut Context)
         let s = trig_var(cx, true, &unit);
         let c = trig_var(cx, false, &unit);
         let (drop, keep) = if keep_cosine { (s, c) } else { (c, s) };
-        let drop_index = *drop.keys().next().unwrap().keys().next().unwrap();
+        let drop_index = drop.keys().next().unwrap().0[0].0;
         // 1 − keep²
         let mut one_minus = plain_mul(&keep, &keep);
         one_minus.values_mut().for_each(|v| *v = v.neg());
@@ -546,11 +641,13 @@ fn reduce_squares(p: &Plain, keep_cosine: bool, angles: usize, cx: &mut Context)
         let mut out = Plain::new();
         for (m, c) in &r {
             let e = m.get(&drop_index).copied().unwrap_or(0);
-            let mut rest = m.clone();
-            rest.remove(&drop_index);
-            if e % 2 == 1 {
-                rest.insert(drop_index, 1);
-            }
+            let odd = (e % 2 == 1).then_some((drop_index, 1));
+            let rest: Monomial = m
+                .iter()
+                .filter(|(v, _)| **v != drop_index)
+                .map(|(v, e)| (*v, *e))
+                .chain(odd)
+                .collect();
             let mut term: Plain = [(rest, *c)].into_iter().collect();
             for _ in 0..e / 2 {
                 term = plain_mul(&term, &one_minus);
@@ -698,9 +795,10 @@ fn print_grouped(p: &Plain, order: &[Class], cx: &Context) -> (bool, Expr) {
     let p = &plain_divide(p, content, &content_mono);
     let mut groups: BTreeMap<Monomial, Plain> = BTreeMap::new();
     for (m, c) in p {
-        let (inside, outside): (Monomial, Monomial) = m
-            .iter()
-            .partition(|(&v, _)| class_of(&cx.vars[v], cx) == first);
+        let (inside, outside): (Vec<(usize, i32)>, Vec<(usize, i32)>) =
+            m.0.iter()
+                .partition(|(v, _)| class_of(&cx.vars[*v], cx) == first);
+        let (inside, outside) = (Monomial(inside), Monomial(outside));
         plain_add(groups.entry(inside).or_default(), outside, *c);
     }
     let mut ordered: Vec<(Monomial, Plain)> = groups.into_iter().collect();
@@ -709,7 +807,7 @@ fn print_grouped(p: &Plain, order: &[Class], cx: &Context) -> (bool, Expr) {
     let direction = if first == Class::Key { -1 } else { 1 };
     ordered.sort_by_key(|(m, _)| {
         (
-            direction * m.values().sum::<i32>(),
+            direction * m.0.iter().map(|(_, e)| e).sum::<i32>(),
             monomial_expr(m, cx).to_string(),
         )
     });
