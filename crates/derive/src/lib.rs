@@ -253,7 +253,7 @@ fn derive_in_own_process(file: &str, out: &Path) {
 
 /// How long one model's derivation may run, in seconds: the environment's
 /// `MECHLAB_DERIVE_SECONDS`, else ten minutes (the largest model here, the
-/// bicycle, takes about a minute and a half).
+/// bicycle, takes about 25 s).
 fn derivation_limit() -> u64 {
     std::env::var(DERIVE_LIMIT)
         .ok()

@@ -242,27 +242,29 @@ class Analyses(unittest.TestCase):
         with self.assertRaises(mechlab.Refused):
             mechlab.model("henon_heiles").period_map_frequencies(pixels=4, progress=False)
 
+    def interrupt_after(self, seconds):
+        """Ctrl-C in `seconds`, with Python's own handler: a process
+        started in the background by a shell without job control inherits
+        SIGINT ignored, and Python then keeps it ignored."""
+        previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+        self.addCleanup(signal.signal, signal.SIGINT, previous)
+        timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+        self.addCleanup(timer.cancel)
+        timer.start()
+
     def test_ctrl_c_stops_a_chaos_map(self):
         m = mechlab.model("kapitza")
-        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
-        timer.start()
-        try:
-            with self.assertRaises(KeyboardInterrupt):
-                m.chaos_map(pixels=400, periods=4000, progress=False)
-        finally:
-            timer.cancel()
+        self.interrupt_after(0.5)
+        with self.assertRaises(KeyboardInterrupt):
+            m.chaos_map(pixels=400, periods=4000, progress=False)
 
     def test_ctrl_c_stops_any_analysis_and_the_next_call_runs(self):
         # An attractor of ten million points: no hook of its own, its
         # integrations stop at their next step.
         m = mechlab.model("ueda")
-        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
-        timer.start()
-        try:
-            with self.assertRaises(KeyboardInterrupt):
-                m.attractor(points=10_000_000, lyapunov_periods=100_000)
-        finally:
-            timer.cancel()
+        self.interrupt_after(0.5)
+        with self.assertRaises(KeyboardInterrupt):
+            m.attractor(points=10_000_000, lyapunov_periods=100_000)
         s = mechlab.model("kapitza").stability(samples=6)
         self.assertAlmostEqual(s.equilibria[1].a_star, math.sqrt(2.0), places=9)
 
