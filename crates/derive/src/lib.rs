@@ -308,6 +308,7 @@ fn code_version() -> u64 {
         PathBuf::from("templates"),
         derivation_code.join("src"),
         derivation_code.join("../model/src"),
+        derivation_code.join("../simplify/src"),
     ];
     while let Some(path) = pending.pop() {
         if path.is_dir() {

@@ -250,21 +250,7 @@ impl Poly {
         self.0.is_empty()
     }
     fn add_term(&mut self, m: Monomial, h: Harmonic, c: Q) {
-        use std::collections::btree_map::Entry;
-        match self.0.entry((m, h)) {
-            Entry::Occupied(mut entry) => {
-                let value = entry.get().add(c);
-                match value.is_zero() {
-                    true => drop(entry.remove()),
-                    false => *entry.get_mut() = value,
-                }
-            }
-            Entry::Vacant(entry) => {
-                if !c.is_zero() {
-                    entry.insert(c);
-                }
-            }
-        }
+        accumulate(&mut self.0, (m, h), c);
     }
     /// The sum, the smaller added into the larger: a long sum read term
     /// by term stays linear in its length (a clone per term made the
@@ -474,12 +460,11 @@ fn to_fraction(e: &Expr, cx: &mut Context) -> Fraction {
     }
 }
 
-/// A plain polynomial over (extended) variables, for printing.
-type Plain = BTreeMap<Monomial, Q>;
-
-fn plain_add(p: &mut Plain, m: Monomial, c: Q) {
+/// Adds c to the coefficient of `key`, dropping it where the sum is zero;
+/// one lookup of the key.
+fn accumulate<K: Ord>(map: &mut BTreeMap<K, Q>, key: K, c: Q) {
     use std::collections::btree_map::Entry;
-    match p.entry(m) {
+    match map.entry(key) {
         Entry::Occupied(mut entry) => {
             let value = entry.get().add(c);
             match value.is_zero() {
@@ -493,6 +478,13 @@ fn plain_add(p: &mut Plain, m: Monomial, c: Q) {
             }
         }
     }
+}
+
+/// A plain polynomial over (extended) variables, for printing.
+type Plain = BTreeMap<Monomial, Q>;
+
+fn plain_add(p: &mut Plain, m: Monomial, c: Q) {
+    accumulate(p, m, c);
 }
 
 fn plain_mul(a: &Plain, b: &Plain) -> Plain {
