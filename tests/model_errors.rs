@@ -690,31 +690,43 @@ fn a_malformed_body_is_named() {
     assert_eq!(pivot.points[4].joined_to, [0]);
 }
 
+/// A file of `test_models/` and its text.
+fn test_model(name: &str) -> (String, String) {
+    let path = format!("{}/../test_models/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).unwrap();
+    (format!("test_models/{name}.toml"), text)
+}
+
+/// `text` with `from` replaced by `to` is refused at `key`, for a reason
+/// that contains `reason`.
+fn assert_edit_named(file: &str, text: &str, (from, to): (&str, &str), key: &str, reason: &str) {
+    let edited = text.replace(from, to);
+    assert_ne!(edited, text, "'{from}' is not in {file}");
+    let e = Model::parse(file, &edited).unwrap_err();
+    assert_eq!(e.key, key, "{e}");
+    assert!(e.reason.contains(reason), "{e}");
+}
+
 /// A rolling body's constraint names its body, and its contact must be
 /// where the body touches the plane.
 #[test]
 fn a_rolling_constraint_is_checked_against_its_body() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../test_models/tipping_disk_body.toml"
-    );
-    let text = std::fs::read_to_string(path).unwrap();
-    let file = "test_models/tipping_disk_body.toml";
-    Model::parse(file, &text).expect("the disk rolls at its lowest point");
-    let elsewhere = text.replace(
+    let (file, text) = test_model("tipping_disk_body");
+    Model::parse(&file, &text).expect("the disk rolls at its lowest point");
+    let edit = |from: &str, to: &str, key: &str, reason: &str| {
+        assert_edit_named(&file, &text, (from, to), key, reason)
+    };
+    edit(
         "contact = [\"x\", \"y\", 0]",
         "contact = [\"disk_x\", \"disk_y\", 0]",
+        "constraints[0].contact",
+        "moves off the plane",
     );
-    assert_ne!(elsewhere, text);
-    let e = Model::parse(file, &elsewhere).unwrap_err();
-    assert_eq!(e.key, "constraints[0].contact", "{e}");
-    assert!(e.reason.contains("moves off the plane"), "{e}");
-    let no_body = text.replace("rolling = \"disk\"", "rolling = \"wheel\"");
-    let e = Model::parse(file, &no_body).unwrap_err();
-    assert_eq!(e.key, "constraints[0].rolling", "{e}");
-    assert!(
-        e.reason.contains("not one of the model's [[bodies]]"),
-        "{e}"
+    edit(
+        "rolling = \"disk\"",
+        "rolling = \"wheel\"",
+        "constraints[0].rolling",
+        "not one of the model's [[bodies]]",
     );
 }
 
@@ -840,34 +852,42 @@ description = "g"
 /// constraints (the tippe top in Euler parameters and in Euler angles).
 #[test]
 fn a_sliding_contact_is_checked_against_its_body() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../test_models/tippe_top.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    let file = "test_models/tippe_top.toml";
-    let model = Model::parse(file, &text).expect("the ball slides at its lowest point");
+    let (file, text) = test_model("tippe_top");
+    let model = Model::parse(&file, &text).expect("the ball slides at its lowest point");
     assert!(model.rayleigh.symbols().contains("mu"));
-    let under_the_centre = text.replace(
+    let edit = |from: &str, to: &str, key: &str, reason: &str| {
+        assert_edit_named(&file, &text, (from, to), key, reason)
+    };
+    edit(
         "contact = [\"x + a*kx\", \"y + a*ky\", 0]",
         "contact = [\"x\", \"y\", 0]",
+        "sliding[0].contact",
+        "moves off the plane",
     );
-    assert_ne!(under_the_centre, text);
-    let e = Model::parse(file, &under_the_centre).unwrap_err();
-    assert_eq!(e.key, "sliding[0].contact", "{e}");
-    assert!(e.reason.contains("moves off the plane"), "{e}");
-    let no_body = text.replace("body = \"top\"", "body = \"ball\"");
-    let e = Model::parse(file, &no_body).unwrap_err();
-    assert_eq!(e.key, "sliding[0].body", "{e}");
-    assert!(
-        e.reason.contains("not one of the model's [[bodies]]"),
-        "{e}"
+    edit(
+        "body = \"top\"",
+        "body = \"ball\"",
+        "sliding[0].body",
+        "not one of the model's [[bodies]]",
     );
-    let moving_damping = text.replace("damping = \"mu\"", "damping = \"mu*x\"");
-    assert_eq!(
-        Model::parse(file, &moving_damping).unwrap_err().key,
-        "sliding[0].damping"
+    edit(
+        "damping = \"mu\"",
+        "damping = \"mu*x\"",
+        "sliding[0].damping",
+        "",
     );
 
     let ball = Model::parse("models/toy.toml", SLIDING_BALL).expect("the ball in Euler angles");
     assert!(ball.constraints.is_empty() && ball.sliding.len() == 1);
+    let block = "[[sliding]]\nname = \"floor\"\n";
+    let twice = SLIDING_BALL.replacen(
+        block,
+        &format!(
+            "{block}body = \"ball\"\ncontact = [\"x\", \"y\", 0]\ndamping = \"mu\"\n\n{block}"
+        ),
+        1,
+    );
+    assert_error(&twice, "sliding[1].name", "names two sliding contacts");
     let off = SLIDING_BALL.replace("y - a*sin(theta)*cos(phi)", "y + a*sin(theta)*cos(phi)");
     assert_error(&off, "sliding[0].contact", "moves off the plane");
 }

@@ -1194,10 +1194,17 @@ impl ModelFile {
         let err = error_at(file);
         let (mut sliding, mut terms) = (Vec::new(), Vec::new());
         for (i, s) in self.sliding.iter().enumerate() {
-            if !is_identifier(&s.name) || self.sliding[..i].iter().any(|o| o.name == s.name) {
+            let clash = match is_identifier(&s.name) {
+                false => Some("is not an identifier"),
+                true if self.sliding[..i].iter().any(|o| o.name == s.name) => {
+                    Some("names two sliding contacts")
+                }
+                true => None,
+            };
+            if let Some(why) = clash {
                 return Err(err(
                     format!("sliding[{i}].name"),
-                    format!("'{}' is not an identifier, or names two contacts", s.name),
+                    format!("'{}' {why}", s.name),
                 ));
             }
             let key = format!("sliding[{i}].contact");
