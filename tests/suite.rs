@@ -45,4 +45,5 @@ mod taylor;
 mod taylor_lanes;
 mod tippe_top;
 mod trade;
+mod turning_arm_spring;
 mod verify_derivations;

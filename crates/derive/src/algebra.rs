@@ -4,6 +4,7 @@
 //! keeps each derived expression in its readable form (text and LaTeX).
 
 use crate::latex::Names;
+use crate::model::expr::BinOp;
 use crate::model::{Expr, Model};
 use crate::simplify;
 use symbolica::prelude::*;
@@ -232,9 +233,95 @@ pub(crate) fn inverse(m: &[Vec<Atom>]) -> (Atom, Vec<Vec<Atom>>) {
 
 /// Canonical form modulo sin²x + cos²x = 1 for the angle `x`: as a
 /// polynomial in S = sin x, every S^k becomes S^(k mod 2) (1 − C²)^(k div 2).
-/// Applied to the Lagrangian (a polynomial in these), so that everything
-/// derived from it is free of sin² + cos² leftovers.
+/// Applied to the Lagrangian and the Rayleigh function, so that everything
+/// derived from them is free of sin² + cos² leftovers. A part that is not
+/// polynomial in S and C (a root, a quotient, another function of the
+/// angle) is reduced inside and held as one symbol while the polynomial
+/// around it is reduced: a spring's length written in the fixed frame,
+/// √(cos²x a² + sin²x a² + …), loses its turn under the root, and the
+/// reduction ends for any expression.
 pub(crate) fn reduce_pythagorean(e: &Atom, angle: &str) -> Result<Atom, DeriveError> {
+    let parsed = read_back(e)?;
+    if !parsed.symbols().contains(angle) {
+        return Ok(e.clone());
+    }
+    let mut held = Vec::new();
+    let polynomial = hold_non_polynomial(&parsed, angle, &mut held)?;
+    let mut reduced = reduce_polynomial(&atom(&polynomial.to_string())?, angle)?;
+    for (name, part) in held.iter().rev() {
+        reduced = subst(&reduced, name, part);
+    }
+    Ok(reduced)
+}
+
+/// Symbolica's printed form of `e` read back as a model-file expression.
+fn read_back(e: &Atom) -> Result<Expr, DeriveError> {
+    let text = e.to_string();
+    Expr::parse(&text).map_err(|err| DeriveError::Model {
+        key: "lagrangian".into(),
+        reason: format!("cannot read back '{text}': {err}"),
+    })
+}
+
+/// `e` with each part that is not polynomial in sin and cos of `angle`
+/// and holds the angle replaced by a symbol `held__k`, its reduced value
+/// kept in `held`.
+fn hold_non_polynomial(
+    e: &Expr,
+    angle: &str,
+    held: &mut Vec<(String, Atom)>,
+) -> Result<Expr, DeriveError> {
+    let holds_angle = |x: &Expr| x.symbols().contains(angle);
+    let hold = |part: Expr, held: &mut Vec<(String, Atom)>| -> Result<Expr, DeriveError> {
+        let name = format!("held__{}", held.len());
+        held.push((name.clone(), atom(&part.to_string())?));
+        Ok(Expr::Sym(name))
+    };
+    let reduced = |x: &Expr| -> Result<Expr, DeriveError> {
+        read_back(&reduce_pythagorean(&atom(&x.to_string())?, angle)?)
+    };
+    Ok(match e {
+        _ if !holds_angle(e) => e.clone(),
+        Expr::Num(_) | Expr::Sym(_) => e.clone(),
+        Expr::Neg(a) => Expr::Neg(Box::new(hold_non_polynomial(a, angle, held)?)),
+        Expr::Bin(BinOp::Pow, base, exponent) if matches!(&**exponent, Expr::Num(n) if n.parse::<u32>().is_ok()) =>
+        {
+            let base = hold_non_polynomial(base, angle, held)?;
+            Expr::Bin(BinOp::Pow, Box::new(base), exponent.clone())
+        }
+        Expr::Bin(BinOp::Div, a, b) if holds_angle(b) => {
+            let a = hold_non_polynomial(a, angle, held)?;
+            let inverse = Expr::Bin(BinOp::Div, Box::new(Expr::num(1)), Box::new(reduced(b)?));
+            Expr::Bin(BinOp::Mul, Box::new(a), Box::new(hold(inverse, held)?))
+        }
+        Expr::Bin(BinOp::Pow, base, exponent) => {
+            let part = Expr::Bin(
+                BinOp::Pow,
+                Box::new(reduced(base)?),
+                Box::new(reduced(exponent)?),
+            );
+            hold(part, held)?
+        }
+        Expr::Bin(op, a, b) => Expr::Bin(
+            *op,
+            Box::new(hold_non_polynomial(a, angle, held)?),
+            Box::new(hold_non_polynomial(b, angle, held)?),
+        ),
+        Expr::Call(name, args)
+            if (name == "sin" || name == "cos") && args == &[Expr::Sym(angle.to_string())] =>
+        {
+            e.clone()
+        }
+        Expr::Call(name, args) => {
+            let args = args.iter().map(reduced).collect::<Result<Vec<_>, _>>()?;
+            hold(Expr::Call(name.clone(), args), held)?
+        }
+    })
+}
+
+/// [`reduce_pythagorean`] of an expression polynomial in sin and cos of
+/// `angle` (its Taylor coefficients in S end).
+fn reduce_polynomial(e: &Atom, angle: &str) -> Result<Atom, DeriveError> {
     let (s_name, c_name) = ("angle__sin", "angle__cos");
     let sin = atom(&format!("sin({angle})"))?;
     let cos = atom(&format!("cos({angle})"))?;

@@ -154,9 +154,13 @@ pub fn kinematic(model: &Model, e: &Expr) -> Result<Atom, DeriveError> {
 
 /// The model's generalised forces Q: its `[forces]`, less the Rayleigh
 /// dissipation's ∂D/∂q' (D with its `dot()`s of definitions carried
-/// through the chain rule), in the coordinates and velocities.
+/// through the chain rule), in the coordinates and velocities; D reduced
+/// by sin² + cos² = 1 of each turning angle, as L is.
 fn generalised_forces(model: &Model) -> Result<Vec<Atom>, DeriveError> {
-    let rayleigh = kinematic(model, &model.rayleigh)?;
+    let mut rayleigh = kinematic(model, &model.rayleigh)?;
+    for c in model.coordinates.iter().filter(|c| c.periodic) {
+        rayleigh = reduce_pythagorean(&rayleigh, &c.name)?;
+    }
     model
         .forces
         .iter()

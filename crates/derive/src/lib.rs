@@ -239,7 +239,7 @@ fn derive_in_own_process(file: &str, out: &Path) {
                 let _ = child.kill();
                 let _ = child.wait();
                 fail(format!(
-                    "{file}: its derivation did not finish in {limit} s and was stopped. One known cause: a length whose terms cancel only through sin² + cos² = 1 of a turning angle, under a root or in the `rayleigh` function (a spring between two bodies' points written in the fixed frame); written in the turning frame it derives in seconds. {DERIVE_LIMIT} sets the limit in seconds."
+                    "{file}: its derivation did not finish in {limit} s and was stopped. Its time grows with the number of terms its expressions expand to (many bodies, high powers of long sums); the bicycle, four bodies, takes about 25 s. {DERIVE_LIMIT} sets the limit in seconds."
                 ))
             }
             Ok(None) => std::thread::sleep(std::time::Duration::from_millis(50)),
