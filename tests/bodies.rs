@@ -41,6 +41,23 @@ fn run(y0: &[f64; 6], times: &[f64]) -> Vec<Vec<f64>> {
     states_at(top(), &PARAMS, method, y0, times).unwrap()
 }
 
+/// The file's start (tilt 0.5, spin rate ψ' = 10, the axis still) has
+/// the momenta of its rates: p_φ = C ψ' cos θ, p_θ = 0, p_ψ = C ψ'.
+#[test]
+fn the_file_starts_the_top_spinning_with_the_momenta_of_its_rates() {
+    let start = top()
+        .dynamic
+        .start(&PARAMS)
+        .expect("the file gives a start");
+    let expected = state(0.5, 0.0, 0.0, 10.0);
+    for (got, want) in start.iter().zip(expected) {
+        assert!(
+            (got - want).abs() < 1e-14,
+            "start {start:?}, by hand {expected:?}"
+        );
+    }
+}
+
 /// Both steady precessions: θ stays put to 1e-10 and φ turns at Ω.
 #[test]
 fn the_heavy_top_precesses_steadily_at_both_roots_of_the_quadratic() {

@@ -763,9 +763,9 @@ fn massless_parts_are_accepted_where_the_constraints_hold_them() {
     assert_error(&negative, "lagrangian", "not positive semidefinite");
 }
 
-/// A starting rate is held at the start of a constrained model; rates the
-/// constraints cannot complete, and one in a model without constraints,
-/// are named.
+/// A starting rate is held at the start of a constrained model and read
+/// by one without constraints; rates the constraints cannot complete, and
+/// one in a model with contacts, are named.
 #[test]
 fn starting_rates_must_be_ones_the_constraints_allow() {
     let rated = |x: &str, y: &str| {
@@ -782,10 +782,16 @@ fn starting_rates_must_be_ones_the_constraints_allow() {
         "leave no velocity of the other coordinates",
     );
     let free = GOOD.replace("periodic = true\n", "periodic = true\nstart_rate = 1.0\n");
+    let model = Model::parse("models/toy.toml", &free).expect("a rate of a free model");
+    assert!(model.coordinates[0].start_rate.is_some());
+    let in_contact = CONTACTS.replace(
+        "velocity = \"xd\"\n",
+        "velocity = \"xd\"\nstart_rate = 1.0\n",
+    );
     assert_error(
-        &free,
+        &in_contact,
         "coordinates[0].start_rate",
-        "read by models with constraints",
+        "not read by a model with contacts",
     );
 }
 

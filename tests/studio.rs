@@ -118,10 +118,19 @@ async fn models_and_page_are_served() {
     );
     assert_eq!(k["periodic"], json!([true, false]));
     assert_eq!(k["through"], json!([0.0, 0.0]), "no start in its file");
-    // The heavy top's plane passes through its file's start at rest,
-    // θ = 0.5, off the upright θ = 0 where its Euler angles are singular.
+    // The heavy top's plane passes through its file's start, θ = 0.5
+    // (off the upright θ = 0 where its Euler angles are singular), spun
+    // at ψ' = 10 (C = 1): p_φ = C ψ' cos θ, p_ψ = C ψ'.
     let top = &models[names.iter().position(|n| *n == "heavy_top").unwrap()];
-    assert_eq!(top["through"], json!([0.0, 0.5, 0.0, 0.0, 0.0, 0.0]));
+    let by_hand = [0.0, 0.5, 0.0, 10.0 * 0.5f64.cos(), 0.0, 10.0];
+    let through: Vec<f64> = serde_json::from_value(top["through"].clone()).unwrap();
+    assert!(
+        through
+            .iter()
+            .zip(by_hand)
+            .all(|(a, b)| (a - b).abs() < 1e-14),
+        "through {through:?}, by hand {by_hand:?}"
+    );
 
     let (status, kind, page) = call("GET", "/", None).await;
     assert_eq!(status, StatusCode::OK);

@@ -937,28 +937,47 @@ pub fn second_order_functions(
 }
 
 /// The coordinates' starts the model file gives (0 where it gives none),
-/// in the parameters, or none when it gives no start: a model without
-/// constraints starts there at rest (where a file says its origin is a
+/// in the parameters, and their starting rates where it gives any; none
+/// when it gives neither: a model without constraints starts there, at
+/// rest unless rates are given (where a file says its origin is a
 /// singular chart, as the heavy top's upright θ = 0).
-pub fn starts_function(cx: &Context) -> Result<Option<Function>, DeriveError> {
+pub fn starts_functions(cx: &Context) -> Result<Vec<Function>, DeriveError> {
     let coordinates = &cx.model.coordinates;
-    if coordinates.iter().all(|c| c.start.is_none()) {
-        return Ok(None);
+    let mut functions = Vec::new();
+    let given = |value: fn(&mechlab_model::file::Coordinate) -> &Option<crate::model::Expr>| {
+        coordinates.iter().any(|c| value(c).is_some()).then(|| {
+            coordinates
+                .iter()
+                .map(|c| value(c).as_ref().map_or("0".into(), |s| s.to_string()))
+                .collect::<Vec<String>>()
+        })
+    };
+    let rates = given(|c| &c.start_rate);
+    if let Some(values) =
+        given(|c| &c.start).or_else(|| rates.as_ref().map(|r| vec!["0".into(); r.len()]))
+    {
+        let (outputs, result) = vector("start", &values);
+        functions.push(cx.function(
+            "coordinate_starts",
+            "The coordinates' starts of the model file (0 where it gives none).",
+            Inputs::Params,
+            format!("[f64; {}]", coordinates.len()),
+            &[outputs],
+            result,
+        )?);
     }
-    let values: Vec<String> = coordinates
-        .iter()
-        .map(|c| c.start.as_ref().map_or("0".into(), |s| s.to_string()))
-        .collect();
-    let (outputs, result) = vector("start", &values);
-    cx.function(
-        "coordinate_starts",
-        "The coordinates' starts of the model file (0 where it gives none).",
-        Inputs::Params,
-        format!("[f64; {}]", coordinates.len()),
-        &[outputs],
-        result,
-    )
-    .map(Some)
+    if let Some(values) = rates {
+        let (outputs, result) = vector("rate", &values);
+        functions.push(cx.function(
+            "coordinate_start_rates",
+            "The coordinates' starting rates of the model file (0 where it gives none); the start's momenta are theirs.",
+            Inputs::Params,
+            format!("[f64; {}]", coordinates.len()),
+            &[outputs],
+            result,
+        )?);
+    }
+    Ok(functions)
 }
 
 /// The drawing's points at (t, q) as `[[x, y, z]; P]` (the model file's

@@ -69,8 +69,9 @@ pub fn render(
         None => symbolic_functions(&cx, derivation)?,
     };
     functions.extend(crate::functions::drawing_function(&cx)?);
-    let starts = crate::functions::starts_function(&cx)?;
-    let has_starts = starts.is_some();
+    let starts = crate::functions::starts_functions(&cx)?;
+    let has_starts = !starts.is_empty();
+    let has_start_rates = starts.len() == 2;
     functions.extend(starts);
 
     // Functions of q alone must not depend on anything else.
@@ -99,6 +100,7 @@ pub fn render(
 
     let mut context = base_context(model, source_file, &derivation.derived);
     context.insert("has_starts", &has_starts);
+    context.insert("has_start_rates", &has_start_rates);
     context.insert("dof", &n);
     context.insert("state_dim", &m);
     context.insert("coordinates", &cx.coordinates());

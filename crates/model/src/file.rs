@@ -196,9 +196,10 @@ pub struct CoordinateSpec {
     /// constraints at t = 0 with the default parameters (models with
     /// constraints need one for every coordinate).
     pub start: Option<NumberSpec>,
-    /// Its rate at the start (models with constraints): held while the
-    /// other rates are made to satisfy the velocity constraints; without
-    /// one, a rate is what the constraints leave nearest rest.
+    /// Its rate at the start: with constraints, held while the other
+    /// rates are made to satisfy the velocity constraints (without one, a
+    /// rate is what the constraints leave nearest rest); without, the
+    /// start's momenta are those of these rates (0 where none is given).
     pub start_rate: Option<NumberSpec>,
 }
 
@@ -255,8 +256,8 @@ pub struct Coordinate {
     /// Its value in the consistent start (models with constraints), an
     /// expression in the parameters.
     pub start: Option<Expr>,
-    /// Its rate at the start, held there (models with constraints), an
-    /// expression in the parameters.
+    /// Its rate at the start, an expression in the parameters (with
+    /// constraints, held there while the others are made consistent).
     pub start_rate: Option<Expr>,
 }
 
@@ -1373,7 +1374,7 @@ impl ModelFile {
                 let key = format!("coordinates[{i}].start_rate");
                 match &c.start_rate {
                     None => Ok(None),
-                    Some(_) if self.constraints.is_empty() => Err(err(key, format!("a starting rate of '{}' is read by models with constraints, whose runs start from the file's start; a model without constraints starts from the state its run is given", c.name))),
+                    Some(_) if !self.contacts.is_empty() => Err(err(key, format!("a starting rate of '{}' is not read by a model with contacts, whose runs start from the state they are given", c.name))),
                     Some(spec) => number(key, spec, format!("the starting rate of '{}'", c.name)).map(Some),
                 }
             })

@@ -247,8 +247,10 @@ impl PyModel {
         parameter_values(self.model, params)
     }
 
-    /// The start the scenes take when none is given (q = 0.3, 0.5, …,
-    /// p = 0; a constrained model's file start, on its constraints).
+    /// The start the scenes take when none is given (the model file's
+    /// start where it gives one, with the momenta of its starting rates;
+    /// else q = 0.3, 0.5, …, p = 0; a constrained model's file start, on
+    /// its constraints).
     #[pyo3(signature = (params=None))]
     fn start<'py>(
         &self,

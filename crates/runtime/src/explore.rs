@@ -24,8 +24,10 @@ crate::declare_settings! {
     /// with a fast phase; stick–slip for a contact model), portraits, the
     /// energy's change, the equilibria and a constrained model's reactions.
     pub struct ExploreOptions for "explore" {
-        /// The initial state, [q; p] or [s; s'] (auto: q = 0.3, 0.5, …,
-        /// p = 0; contacts: s = 0, −0.3, …, s' = 1).
+        /// The initial state, [q; p] or [s; s'] (auto: the model file's
+        /// start where it gives one, its momenta those of its starting
+        /// rates; else q = 0.3, 0.5, …, p = 0; contacts: s = 0, −0.3, …,
+        /// s' = 1).
         y0: Option<Vec<f64>> = None, Range::Any;
         /// The length of the run.
         t_end: f64 = 20.0, Range::Positive;
@@ -105,15 +107,19 @@ pub struct Reactions {
     pub values: Vec<Vec<f64>>,
 }
 
-/// The start a scene uses when none is given: q = 0.3, 0.5, …, p = 0; for
-/// a contact model s = 0, −0.3, …, s' = 1; for a constrained model its
-/// file's start at rest (which the run makes consistent).
+/// The start a scene uses when none is given: the model file's start
+/// where it gives one (its coordinates' starts, the momenta of its
+/// starting rates); else q = 0.3, 0.5, …, p = 0; for a contact model
+/// s = 0, −0.3, …, s' = 1; for a constrained model its file's start
+/// (which the run makes consistent).
 pub fn default_start(model: &dyn DynamicModel) -> Vec<f64> {
     match model.kind() {
-        Kind::Hamiltonian { dof, .. } => (0..dof)
-            .map(|i| 0.3 + 0.2 * i as f64)
-            .chain((0..dof).map(|_| 0.0))
-            .collect(),
+        Kind::Hamiltonian { dof, .. } => model.start(&model.defaults()).unwrap_or_else(|| {
+            (0..dof)
+                .map(|i| 0.3 + 0.2 * i as f64)
+                .chain((0..dof).map(|_| 0.0))
+                .collect()
+        }),
         Kind::Contacts { count } => (0..count)
             .map(|i| -0.3 * i as f64)
             .chain((0..count).map(|_| 1.0))
