@@ -943,7 +943,6 @@ pub fn second_order_functions(
 /// singular chart, as the heavy top's upright θ = 0).
 pub fn starts_functions(cx: &Context) -> Result<Vec<Function>, DeriveError> {
     let coordinates = &cx.model.coordinates;
-    let mut functions = Vec::new();
     let given = |value: fn(&mechlab_model::file::Coordinate) -> &Option<crate::model::Expr>| {
         coordinates.iter().any(|c| value(c).is_some()).then(|| {
             coordinates
@@ -953,31 +952,19 @@ pub fn starts_functions(cx: &Context) -> Result<Vec<Function>, DeriveError> {
         })
     };
     let rates = given(|c| &c.start_rate);
-    if let Some(values) =
-        given(|c| &c.start).or_else(|| rates.as_ref().map(|r| vec!["0".into(); r.len()]))
-    {
-        let (outputs, result) = vector("start", &values);
-        functions.push(cx.function(
-            "coordinate_starts",
-            "The coordinates' starts of the model file (0 where it gives none).",
-            Inputs::Params,
-            format!("[f64; {}]", coordinates.len()),
-            &[outputs],
-            result,
-        )?);
-    }
-    if let Some(values) = rates {
-        let (outputs, result) = vector("rate", &values);
-        functions.push(cx.function(
-            "coordinate_start_rates",
-            "The coordinates' starting rates of the model file (0 where it gives none); the start's momenta are theirs.",
-            Inputs::Params,
-            format!("[f64; {}]", coordinates.len()),
-            &[outputs],
-            result,
-        )?);
-    }
-    Ok(functions)
+    let starts = given(|c| &c.start).or_else(|| rates.as_ref().map(|r| vec!["0".into(); r.len()]));
+    [
+        ("coordinate_starts", "start", "The coordinates' starts of the model file (0 where it gives none).", starts),
+        ("coordinate_start_rates", "rate", "The coordinates' starting rates of the model file (0 where it gives none); the start's momenta are theirs.", rates),
+    ]
+    .into_iter()
+    .filter_map(|(name, prefix, doc, values)| Some((name, prefix, doc, values?)))
+    .map(|(name, prefix, doc, values)| {
+        let (outputs, result) = vector(prefix, &values);
+        let output = format!("[f64; {}]", coordinates.len());
+        cx.function(name, doc, Inputs::Params, output, &[outputs], result)
+    })
+    .collect()
 }
 
 /// The drawing's points at (t, q) as `[[x, y, z]; P]` (the model file's
