@@ -154,3 +154,17 @@ fn verification_samples_where_the_model_is_defined() {
         Err(simplify::SimplifyError::Undefined { tried: 64 })
     ));
 }
+
+/// Symbolica prints exp(x) as 𝑒^x; its printed results are read back
+/// with exp() in its place, equal in value.
+#[test]
+fn symbolicas_euler_powers_are_read_as_exp() {
+    let printed = "1/2*𝑒^(x^2)-𝑒^cos(x)*𝑒+log(x)";
+    let read = Expr::parse_printed(printed).unwrap();
+    assert_eq!(read.to_string(), "1/2*exp(x^2)-exp(cos(x))*exp(1)+log(x)");
+    let x = 0.7_f64;
+    let by_hand = 0.5 * (x * x).exp() - x.cos().exp() * std::f64::consts::E + x.ln();
+    let value = read.eval(&|s| (s == "x").then_some(x)).unwrap();
+    assert!((value - by_hand).abs() < 1e-15 * by_hand.abs().max(1.0));
+    assert!(Expr::parse("𝑒^x").is_err(), "a model file names exp()");
+}

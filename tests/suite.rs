@@ -29,6 +29,7 @@ mod integrators;
 mod massless;
 mod mechanism;
 mod model_errors;
+mod morse_pendulum;
 mod rattleback;
 mod report;
 mod runtime;

@@ -23,16 +23,11 @@ fn field_by_hand(y: [f64; 4], p: &Params) -> [f64; 4] {
 #[test]
 fn a_spring_written_in_the_fixed_frame_gives_the_hand_written_field() {
     let params = Params::default();
-    let mut worst: f64 = 0.0;
-    for i in 0..200 {
-        let s = |k: usize| ((i * 7919 + k * 104_729) % 1000) as f64 / 1000.0 - 0.5;
-        let y = [6.0 * s(1), 0.6 + 0.8 * s(2), 2.0 * s(3), 3.0 * s(4)];
-        let derived = exact_rhs(0.0, &y, &params);
-        let expected = field_by_hand(y, &params);
-        for (d, e) in derived.iter().zip(expected) {
-            worst = worst.max((d - e).abs() / (1.0 + e.abs()));
-        }
-    }
+    let worst = crate::common::worst_field_difference(
+        |s| [6.0 * s(1), 0.6 + 0.8 * s(2), 2.0 * s(3), 3.0 * s(4)],
+        |y| exact_rhs(0.0, y, &params),
+        |y| field_by_hand(*y, &params),
+    );
     assert!(
         worst < 1e-12,
         "derived field off the hand-written one by {worst:e}"

@@ -257,7 +257,7 @@ pub(crate) fn reduce_pythagorean(e: &Atom, angle: &str) -> Result<Atom, DeriveEr
 /// Symbolica's printed form of `e` read back as a model-file expression.
 fn read_back(e: &Atom) -> Result<Expr, DeriveError> {
     let text = e.to_string();
-    Expr::parse(&text).map_err(|err| DeriveError::Model {
+    Expr::parse_printed(&text).map_err(|err| DeriveError::Model {
         key: "lagrangian".into(),
         reason: format!("cannot read back '{text}': {err}"),
     })
@@ -352,7 +352,7 @@ fn reduce_polynomial(e: &Atom, angle: &str) -> Result<Atom, DeriveError> {
 /// Drops the terms of an expanded sum that depend on none of `symbols`.
 pub(crate) fn drop_terms_without(e: &Atom, symbols: &[String]) -> Result<Atom, DeriveError> {
     let text = e.expand().to_string();
-    let parsed = Expr::parse(&text).map_err(|err| DeriveError::Model {
+    let parsed = Expr::parse_printed(&text).map_err(|err| DeriveError::Model {
         key: "lagrangian".into(),
         reason: format!("cannot read back '{text}': {err}"),
     })?;

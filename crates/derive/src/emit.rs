@@ -421,7 +421,7 @@ impl Emitter {
     pub fn stage(&mut self, outputs: &[(String, String)]) -> Result<(), EmitError> {
         let mut stage = Vec::new();
         for (name, text) in outputs {
-            let e = Expr::parse(text).map_err(|err| EmitError::read(text, err))?;
+            let e = Expr::parse_printed(text).map_err(|err| EmitError::read(text, err))?;
             stage.push((name.clone(), self.build(&e)?));
         }
         self.stage_nodes(stage);
@@ -467,7 +467,7 @@ impl Emitter {
 
     /// The node of an expression over earlier outputs and variables.
     pub fn node(&mut self, text: &str) -> Result<usize, EmitError> {
-        let e = Expr::parse(text).map_err(|err| EmitError::read(text, err))?;
+        let e = Expr::parse_printed(text).map_err(|err| EmitError::read(text, err))?;
         self.build(&e)
     }
 

@@ -301,6 +301,40 @@ impl Expr {
         Ok(expr)
     }
 
+    /// Parses Symbolica's printed form: the model-file language, except
+    /// that Symbolica writes exp(x) as 𝑒^x (Euler's number to a power),
+    /// read back here as `exp(x)`.
+    pub fn parse_printed(text: &str) -> Result<Expr, ParseError> {
+        const EULER: &str = "euler__e";
+        if !text.contains('𝑒') {
+            return Expr::parse(text);
+        }
+        let parsed = Expr::parse(&text.replace('𝑒', EULER))?;
+        Ok(parsed.euler_powers_as_exp(EULER))
+    }
+
+    /// `e^x` as `exp(x)` and a bare `e` as `exp(1)`, for the symbol `e`.
+    fn euler_powers_as_exp(&self, e: &str) -> Expr {
+        let exp = |x: Expr| Expr::Call("exp".into(), vec![x]);
+        match self {
+            Expr::Sym(s) if s == e => exp(Expr::num(1)),
+            Expr::Num(_) | Expr::Sym(_) => self.clone(),
+            Expr::Bin(BinOp::Pow, base, power) if matches!(&**base, Expr::Sym(s) if s == e) => {
+                exp(power.euler_powers_as_exp(e))
+            }
+            Expr::Neg(a) => Expr::Neg(Box::new(a.euler_powers_as_exp(e))),
+            Expr::Bin(op, a, b) => Expr::Bin(
+                *op,
+                Box::new(a.euler_powers_as_exp(e)),
+                Box::new(b.euler_powers_as_exp(e)),
+            ),
+            Expr::Call(name, args) => Expr::Call(
+                name.clone(),
+                args.iter().map(|a| a.euler_powers_as_exp(e)).collect(),
+            ),
+        }
+    }
+
     pub fn num(value: i64) -> Expr {
         Expr::Num(value.to_string())
     }

@@ -1015,7 +1015,7 @@ pub struct Vocabulary {
 /// over the degrees in the key variables of reduced fractions, each in its
 /// shortest form.
 pub fn simplify(text: &str, vocabulary: &Vocabulary) -> Result<Expr, SimplifyError> {
-    let e = Expr::parse(text).map_err(|source| SimplifyError::Read {
+    let e = Expr::parse_printed(text).map_err(|source| SimplifyError::Read {
         text: text.to_string(),
         source,
     })?;
@@ -1095,7 +1095,7 @@ pub fn verify(
     seed: u64,
     start: &Start,
 ) -> Result<(), SimplifyError> {
-    let original = Expr::parse(original).map_err(|source| SimplifyError::Read {
+    let original = Expr::parse_printed(original).map_err(|source| SimplifyError::Read {
         text: original.to_string(),
         source,
     })?;
