@@ -897,3 +897,34 @@ fn a_sliding_contact_is_checked_against_its_body() {
     let off = SLIDING_BALL.replace("y - a*sin(theta)*cos(phi)", "y + a*sin(theta)*cos(phi)");
     assert_error(&off, "sliding[0].contact", "moves off the plane");
 }
+
+/// tan(u) reaches the derivation as sin(u)/cos(u), whose derivatives stay
+/// in sines and cosines (the computer algebra's own tan differentiates to
+/// sec, which the readable forms cannot evaluate); `pi` is not built in
+/// and its error says what to write.
+#[test]
+fn tan_is_read_as_a_quotient_and_pi_is_named_with_its_remedy() {
+    let with_tan = GOOD.replace("k*cos(q)", "k*tan(q/2)^2");
+    let model = Model::parse("models/toy.toml", &with_tan).unwrap();
+    let lagrangian = model.lagrangian.to_string();
+    assert!(
+        lagrangian.contains("sin(q/2)/cos(q/2)") && !lagrangian.contains("tan"),
+        "{lagrangian}"
+    );
+    let x = 0.4_f64;
+    let value = model
+        .lagrangian
+        .eval(&|s| match s {
+            "q" => Some(x),
+            "qd" => Some(0.0),
+            "k" => Some(1.0),
+            _ => None,
+        })
+        .unwrap();
+    assert!((value - (x / 2.0).tan().powi(2)).abs() < 1e-15);
+    assert_error(
+        &GOOD.replace("k*cos(q)", "k*cos(2*pi*q)"),
+        "lagrangian",
+        "declare a parameter such as `Pi`",
+    );
+}

@@ -905,6 +905,7 @@ impl<'f> Reader<'f> {
         })?;
         expr.check_calls()
             .map_err(|reason| self.error(key, reason.to_string()))?;
+        let expr = with_builtins(expr);
         if let Some(symbol) = expr
             .symbols()
             .into_iter()
@@ -914,6 +915,7 @@ impl<'f> Reader<'f> {
                 Some(phase) if symbol == self.time_name => {
                     format!(" (time enters only through the fast phase '{phase}')")
                 }
+                _ if symbol == "pi" => " (π is not built in: declare a parameter such as `Pi` with default 3.141592653589793)".to_string(),
                 _ => String::new(),
             };
             return Err(self.error(key, format!("unknown symbol '{symbol}'{hint}")));
@@ -946,6 +948,17 @@ impl<'f> Reader<'f> {
         });
         problem
     }
+}
+
+/// tan(u) as sin(u)/cos(u), so that the computer algebra's derivatives
+/// stay in the sines and cosines the rest of the pipeline reads.
+fn with_builtins(expr: Expr) -> Expr {
+    expr.rewrite_calls(&mut |name, args| {
+        (name == "tan").then(|| {
+            let call = |f: &str| Expr::Call(f.into(), args.to_vec());
+            Expr::Bin(BinOp::Div, Box::new(call("sin")), Box::new(call("cos")))
+        })
+    })
 }
 
 /// Parses one expression of the file: (key, text, allowed symbol sets, dot() allowed).
