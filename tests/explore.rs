@@ -509,3 +509,22 @@ fn a_vibration_at_amplitude_zero_is_not_said_to_do_work() {
     );
     assert!(vibrated.energy_label.contains("the vibration does work"));
 }
+
+/// Newton's method on a gradient of differences accepts a root, not an
+/// iterate walking off to where the potential flattens: for
+/// V = 1/(1 + x²) the gradient −2x/(1 + x²)² is below any tolerance far
+/// out, where Newton's steps grow with x.
+#[test]
+fn newton_on_a_noisy_gradient_does_not_take_a_flattening_tail_for_a_root() {
+    use mechlab::analysis::equilibria::{newton, Convergence};
+    use nalgebra::DMatrix;
+    let gradient = |q: &[f64]| vec![-2.0 * q[0] / (1.0 + q[0] * q[0]).powi(2)];
+    let hessian = |q: &[f64]| {
+        let x2 = q[0] * q[0];
+        DMatrix::from_element(1, 1, 2.0 * (3.0 * x2 - 1.0) / (1.0 + x2).powi(3))
+    };
+    let noisy = Convergence::Noisy { gradient: 1e-7 };
+    let root = newton(gradient, hessian, vec![0.3], noisy).expect("the maximum at 0");
+    assert!(root[0].abs() < 1e-12, "{root:?}");
+    assert_eq!(newton(gradient, hessian, vec![2.0], noisy), None);
+}

@@ -168,7 +168,9 @@ pub enum Convergence {
     Exact,
     /// A gradient with a noise floor (differences): the iterate after at
     /// most 50 steps (fewer once a step is below 10⁻¹², or where the
-    /// Hessian is singular) whose gradient's norm is at most `gradient`.
+    /// Hessian is singular) whose gradient's norm is at most `gradient`,
+    /// its last step below 10⁻⁶ of q's size (not one walking off to where
+    /// the potential flattens, as k/(1 + x²) at x ~ 10⁶).
     Noisy { gradient: f64 },
 }
 
@@ -187,6 +189,7 @@ pub fn newton(
         Convergence::Exact => 60,
         Convergence::Noisy { .. } => 50,
     };
+    let mut settled = false;
     for _ in 0..iterations {
         let g = gradient(&q);
         // At an equilibrium already (a start on a degenerate one, whose
@@ -202,7 +205,10 @@ pub fn newton(
             (None, Convergence::Exact) => h.svd(true, true).solve(&g, 1e-12).ok()?,
             // Where the Hessian of differences is singular, the iterate
             // stands and is judged by its gradient.
-            (None, Convergence::Noisy { .. }) => break,
+            (None, Convergence::Noisy { .. }) => {
+                settled = true;
+                break;
+            }
         };
         for (x, s) in q.iter_mut().zip(step.iter()) {
             *x -= s;
@@ -220,15 +226,20 @@ pub fn newton(
                     return (largest < 1e-9 * scale).then_some(q);
                 }
             }
-            Convergence::Noisy { .. } if step.norm() < 1e-12 => break,
-            Convergence::Noisy { .. } => {}
+            Convergence::Noisy { .. } => {
+                let size = 1.0 + q.iter().map(|x| x.abs()).fold(0.0, f64::max);
+                settled = step.norm() < 1e-6 * size;
+                if step.norm() < 1e-12 {
+                    break;
+                }
+            }
         }
     }
     match convergence {
         Convergence::Exact => None,
         Convergence::Noisy {
             gradient: tolerance,
-        } => (norm(&gradient(&q)) <= tolerance).then_some(q),
+        } => (settled && norm(&gradient(&q)) <= tolerance).then_some(q),
     }
 }
 
