@@ -528,3 +528,42 @@ fn newton_on_a_noisy_gradient_does_not_take_a_flattening_tail_for_a_root() {
     assert!(root[0].abs() < 1e-12, "{root:?}");
     assert_eq!(newton(gradient, hessian, vec![2.0], noisy), None);
 }
+
+/// A flat effective potential (here Kapitza's pendulum with V̄ made
+/// constant) is said to be flat, not listed as a grid of "inconclusive"
+/// equilibria; the real one is searched.
+#[test]
+fn a_flat_effective_potential_is_named_not_listed() {
+    use mechlab::analysis::equilibria::{effective_equilibria, NotSearched};
+    use mechlab::registry::{DynamicModel, ModelInfo};
+    struct Flat(&'static dyn DynamicModel);
+    impl DynamicModel for Flat {
+        fn info(&self) -> &'static ModelInfo {
+            self.0.info()
+        }
+        fn kind(&self) -> Kind {
+            self.0.kind()
+        }
+        fn defaults(&self) -> Vec<f64> {
+            self.0.defaults()
+        }
+        fn periodic(&self) -> Vec<bool> {
+            self.0.periodic()
+        }
+        fn energy(&self, params: &[f64], t: f64, y: &[f64]) -> f64 {
+            self.0.energy(params, t, y)
+        }
+        fn effective_potential(&self, _params: &[f64], _q: &[f64]) -> Option<f64> {
+            Some(0.25)
+        }
+        fn effective_potential_hessian(&self, _params: &[f64], q: &[f64]) -> Option<Vec<f64>> {
+            Some(vec![0.0; q.len() * q.len()])
+        }
+    }
+    let kapitza = models::by_name("kapitza").unwrap().dynamic;
+    let params = kapitza.defaults();
+    let flat = effective_equilibria(&Flat(kapitza), &params).map(|(found, _)| found.len());
+    assert_eq!(flat, Err(NotSearched::Flat));
+    let (found, _) = effective_equilibria(kapitza, &params).unwrap();
+    assert!(!found.is_empty());
+}

@@ -318,6 +318,27 @@ impl std::fmt::Display for Verdict {
     }
 }
 
+/// Whether V has one value, no slope and no curvature at every point (to
+/// 10⁻¹² of its size): then every configuration is an equilibrium, and a
+/// search would list its starts.
+fn is_flat(
+    points: &[Vec<f64>],
+    v: &dyn Fn(&[f64]) -> f64,
+    gradient: &dyn Fn(&[f64]) -> Vec<f64>,
+    hessian: &dyn Fn(&[f64]) -> nalgebra::DMatrix<f64>,
+) -> bool {
+    let Some(first) = points.first() else {
+        return false;
+    };
+    let v0 = v(first);
+    let small = 1e-12 * (1.0 + v0.abs());
+    points.iter().all(|q| {
+        (v(q) - v0).abs() <= small
+            && gradient(q).iter().all(|g| g.abs() <= small)
+            && hessian(q).amax() <= small
+    })
+}
+
 /// Why no equilibria were searched for.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, thiserror::Error)]
 pub enum NotSearched {
@@ -326,6 +347,11 @@ pub enum NotSearched {
     /// A constrained model: its equilibria lie on the constraints.
     #[error("the model is constrained: its equilibria lie on the constraints, where no effective potential is searched yet")]
     OnConstraints,
+    /// The effective potential is the same, with no slope and no
+    /// curvature, at every start (a free body; a vibration whose force is
+    /// O(1) at frequency 1/ε, whose effect is below first-order averaging).
+    #[error("the effective potential is flat (the same value, no slope and no curvature at every start): every configuration is an equilibrium, neutral at this order")]
+    Flat,
 }
 
 /// Equilibria of the effective potential: this finder (the starts and
@@ -367,8 +393,11 @@ pub fn effective_equilibria(
             .unwrap_or_else(|| vec![f64::NAN; n * n]);
         nalgebra::DMatrix::from_row_slice(n, n, &h)
     };
-    let mut found: Vec<Equilibrium> = Vec::new();
     let starts = starts(&periodic);
+    if is_flat(&starts.points, &v, &gradient, &hessian) {
+        return Err(NotSearched::Flat);
+    }
+    let mut found: Vec<Equilibrium> = Vec::new();
     for start in starts.points {
         // The differences' noise floor: a root is where the gradient is
         // below 10⁻⁷.
