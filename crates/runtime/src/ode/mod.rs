@@ -417,6 +417,10 @@ pub enum OdeError {
     /// model's domain) in a step from `y`, its last finite state, at `t`.
     #[error("the solution became non-finite (it diverged or left the model's domain) in a step from t = {t}, y = {y:?}")]
     NonFinite { t: f64, y: Vec<f64> },
+    /// Taylor's series are not finite at `y` though the field is: the field
+    /// is not analytic there (as |v| at v = 0), and another method is needed.
+    #[error("Taylor's series are not finite at t = {t}, y = {y:?}, where the field is: it is not analytic there (as |v| at v = 0); use another method")]
+    NotAnalytic { t: f64, y: Vec<f64> },
     /// The step collapsed at state `y` (a singular point, or a blow-up).
     #[error("step size underflow at t = {t} (h = {h:e}), y = {y:?}")]
     StepSizeUnderflow { t: f64, h: f64, y: Box<[f64]> },

@@ -229,6 +229,9 @@ impl<S: System<N>, const N: usize> Stepper<S, N> for Taylor<'_> {
             // Vanishing top coefficients: the series is exact.
             None => Ok(f64::INFINITY),
             Some(h) if h.is_finite() => Ok(h),
+            Some(_) if c[1].iter().all(|x| x.is_finite()) => {
+                Err(OdeError::NotAnalytic { t, y: y.to_vec() })
+            }
             Some(_) => Err(OdeError::NonFinite { t, y: y.to_vec() }),
         }
     }
